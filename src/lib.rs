@@ -1,0 +1,12 @@
+//! FMI 2.0 Co-Simulation FMUs of novel actuators: McKibben and knitted-sleeve pneumatic muscles and
+//! a multiferroic nano-motor, after the dissertation in `shared/seed/`.
+//!
+//! Data flows one way: `modelDescription/*.xml` (variables) -> [`variables`] (generated tables) ->
+//! [`models`] (variables to physics, effect switches) -> [`physics`] (pure equations).
+//! [`fmi2`] is the C ABI around any [`models::Model`], and the only place with `unsafe` code.
+
+pub mod fmi2;
+pub mod models;
+pub mod package;
+pub mod physics;
+pub mod variables;

@@ -1,0 +1,3 @@
+//! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no `unsafe`.
+
+pub mod gaylord;
