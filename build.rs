@@ -362,6 +362,12 @@ fn check_variable<'a>(
             ))
         }
     };
+    if variability == "tunable" && causality == "parameter" {
+        // Changing one mid-run would rebuild the model and lose its history; not supported yet.
+        return Err(
+            "tunable parameters are not supported by the export layer yet; use fixed".into(),
+        );
+    }
     if variability == "continuous" && type_index != 0 {
         return Err("only Real variables can be continuous".into());
     }

@@ -1,1 +1,10 @@
+//! The FMI 2.0 Co-Simulation export layer: the only `unsafe` code of the crate.
+//!
+//! `exports` holds the C functions; `instance` the call-sequence state machine and the variable
+//! rules; `runtime` the bridge to any [`crate::models::Model`]. A model needs no code here.
+
+mod exports;
+pub mod instance;
+mod logger;
 pub mod runtime;
+pub mod types;
