@@ -723,7 +723,58 @@ pub unsafe extern "C" fn fmi2GetStringStatus(
 
 #[cfg(test)]
 mod tests {
-    use super::resource_path;
+    use super::*;
+    use std::sync::Mutex;
+
+    unsafe extern "C" fn record(
+        env: *mut std::ffi::c_void,
+        _: fmi2String,
+        status: c_int,
+        _: fmi2String,
+        msg: fmi2String,
+    ) {
+        let log = &*(env as *const Mutex<Vec<(c_int, String)>>);
+        log.lock()
+            .unwrap()
+            .push((status, CStr::from_ptr(msg).to_string_lossy().into_owned()));
+    }
+
+    #[test]
+    fn a_panic_is_logged_and_becomes_fatal() {
+        let log: Mutex<Vec<(c_int, String)>> = Mutex::new(Vec::new());
+        // SAFETY (test only): the FMU calls the logger with exactly these five arguments.
+        let callback = unsafe {
+            std::mem::transmute::<
+                unsafe extern "C" fn(
+                    *mut std::ffi::c_void,
+                    fmi2String,
+                    c_int,
+                    fmi2String,
+                    fmi2String,
+                ),
+                fmi2CallbackLogger,
+            >(record)
+        };
+        let env = &log as *const _ as *mut std::ffi::c_void;
+        let instance = Instance::new(REGISTRY[0], Logger::new(Some(callback), env, "t"), None);
+        let c = Box::into_raw(Box::new(instance)) as fmi2Component;
+        assert_eq!(
+            guarded(c, "fmi2Test", |_| panic!("boom")),
+            fmi2Status::Fatal
+        );
+        assert_eq!(
+            log.lock().unwrap()[0],
+            (4, "fmi2Test: internal error: boom".to_string())
+        );
+        // Only freeing is left to do, and it works.
+        unsafe {
+            assert_eq!(fmi2EnterInitializationMode(c), fmi2Status::Error);
+            assert!(log.lock().unwrap()[1]
+                .1
+                .contains("illegal call in state Fatal"));
+            fmi2FreeInstance(c);
+        }
+    }
 
     #[test]
     fn resource_locations() {

@@ -1,0 +1,54 @@
+# Two commands for a new user: `make demo` and `make test`. Everything they need is installed here.
+SHELL := /bin/bash
+PYTHON ?= python3
+VENV := .venv
+PY := $(VENV)/bin/python
+LIB := target/release/libactuator_fmus.so
+SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
+
+.PHONY: all fmus demo test test-rust test-fmpy bench clean deps
+
+all: fmus
+
+## The Python tools, pinned (FMPy is the importer the tests and the demo drive).
+$(VENV)/.installed: tests/fmpy/requirements.txt
+	$(PYTHON) -m venv $(VENV)
+	$(VENV)/bin/pip install --quiet --upgrade pip
+	$(VENV)/bin/pip install --quiet -r tests/fmpy/requirements.txt
+	touch $@
+
+## libclang for the `fmi` crate's bindgen (a dev-dependency: the Rust tests import our FMUs with it).
+deps:
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libclang\(-[0-9.]*\)\?\.so'; then \
+	  echo "installing libclang-dev (needed by the fmi crate's bindgen)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libclang-dev; \
+	fi
+
+$(LIB) target/release/package_fmus: $(SOURCES)
+	cargo build --release --lib --bin package_fmus
+
+## target/fmu/<Model>.fmu for every model in modelDescription/.
+fmus: $(LIB) target/release/package_fmus
+	target/release/package_fmus $(LIB) target/fmu
+
+## Builds the FMUs and runs the default scene under FMPy: out/force_length.{csv,png}.
+demo: fmus $(VENV)/.installed
+	$(PY) examples/force_length.py --out out
+
+test-rust: deps fmus
+	cargo test --release
+
+test-fmpy: fmus $(VENV)/.installed
+	$(PY) -m pytest tests/fmpy -q
+
+## All Rust tests and the FMPy suite.
+test: test-rust test-fmpy
+
+## Native cost per FMI step (criterion), through the packaged FMU's C ABI.
+bench: deps fmus
+	cargo bench --bench fmi_step
+
+clean:
+	cargo clean
+	rm -rf out $(VENV)
