@@ -264,21 +264,19 @@ pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
     guarded(c, "fmi2Reset", |inst| inst.reset())
 }
 
-/// The shared body of fmi2SetReal/Integer/Boolean: checks the arrays, converts, sets.
-unsafe fn set_values<C: Copy, T: super::instance::Value>(
+/// The shared body of fmi2SetReal/Integer/Boolean: checks the arrays and sets, without copying.
+unsafe fn set_values<T: super::instance::Value>(
     c: fmi2Component,
     function: &'static str,
     vr: *const fmi2ValueReference,
     nvr: usize,
-    value: *const C,
-    convert: impl Fn(C) -> T,
+    value: *const T,
 ) -> fmi2Status {
     guarded(c, function, |inst| {
         let (Some(vrs), Some(values)) = (slice(vr, nvr), slice(value, nvr)) else {
             return null_argument(inst, function, "vr and value");
         };
-        let values: Vec<T> = values.iter().map(|&v| convert(v)).collect();
-        inst.set(function, vrs, &values)
+        inst.set(function, vrs, values)
     })
 }
 
@@ -289,7 +287,7 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    set_values(c, "fmi2SetReal", vr, nvr, value, |v| v)
+    set_values(c, "fmi2SetReal", vr, nvr, value)
 }
 
 #[no_mangle]
@@ -299,7 +297,7 @@ pub unsafe extern "C" fn fmi2SetInteger(
     nvr: usize,
     value: *const fmi2Integer,
 ) -> fmi2Status {
-    set_values(c, "fmi2SetInteger", vr, nvr, value, |v| v)
+    set_values(c, "fmi2SetInteger", vr, nvr, value)
 }
 
 #[no_mangle]
@@ -309,7 +307,14 @@ pub unsafe extern "C" fn fmi2SetBoolean(
     nvr: usize,
     value: *const fmi2Boolean,
 ) -> fmi2Status {
-    set_values(c, "fmi2SetBoolean", vr, nvr, value, |v| v != FMI2_FALSE)
+    // CBoolean is a transparent wrapper of the C int.
+    set_values(
+        c,
+        "fmi2SetBoolean",
+        vr,
+        nvr,
+        value as *const super::instance::CBoolean,
+    )
 }
 
 #[no_mangle]

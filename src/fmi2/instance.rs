@@ -150,33 +150,44 @@ impl Value for i32 {
     }
 }
 
-impl Value for bool {
+/// An `fmi2Boolean` as the importer passed it: any non-zero int is true.
+#[derive(Clone, Copy)]
+#[repr(transparent)]
+pub struct CBoolean(pub std::ffi::c_int);
+
+impl std::fmt::Display for CBoolean {
+    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+        write!(f, "{}", self.0 != 0)
+    }
+}
+
+impl Value for CBoolean {
     const KIND: VarType = VarType::Boolean;
     fn invalid_for(self, _: &Variable) -> Option<String> {
         None
     }
     fn store(self, vars: &mut crate::models::Vars, index: usize) {
-        vars.boolean[index] = self;
+        vars.boolean[index] = self.0 != 0;
     }
 }
 
 fn range_check(x: f64, var: &Variable) -> Option<String> {
+    let below = var
+        .min
+        .filter(|&min| x < min)
+        .map(|min| ("below its minimum", min));
+    let (what, bound) = below.or_else(|| {
+        var.max
+            .filter(|&max| x > max)
+            .map(|max| ("above its maximum", max))
+    })?;
+    // Formatting only on refusal: this runs for every value an importer sets.
     let unit = if var.unit.is_empty() || var.unit == "1" {
         String::new()
     } else {
         format!(" {}", var.unit)
     };
-    match (var.min, var.max) {
-        (Some(min), _) if x < min => Some(format!(
-            "{} = {x}{unit} is below its minimum {min}{unit}",
-            var.name
-        )),
-        (_, Some(max)) if x > max => Some(format!(
-            "{} = {x}{unit} is above its maximum {max}{unit}",
-            var.name
-        )),
-        _ => None,
-    }
+    Some(format!("{} = {x}{unit} is {what} {bound}{unit}", var.name))
 }
 
 fn to_fmi(status: Status) -> fmi2Status {
