@@ -169,7 +169,8 @@ fn torque_proportional_to_small_stress() {
     for stress in [1e4, 1e5, 1e6] {
         assert_relative_eq!(per_pa(stress), base, max_relative = 2e-3);
     }
-    // Linear theory: tau = k_bar k_me'/(k_bar) ... at beta ~ 0, tau ~ -E sin(2(0 - gamma)) = -E.
+    // Linear limit: the onion barely moves, so the bar's torque balances the magnetoelastic
+    // torque at beta ~ 0: tau = -E sin(2 (0 - gamma)) = -E at gamma = -45 degrees (eq. 3.4).
     let e = m.magnetoelastic_per_stress;
     assert_relative_eq!(base, -e, max_relative = 1e-3);
     // Roughly proportional up to 50 MPa; by 150 MPa (near the peak torque) clearly sublinear.
