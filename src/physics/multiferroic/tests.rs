@@ -600,3 +600,39 @@ proptest! {
         if locked_rotor { prop_assert_eq!(o.rotor_angle, angle); }
     }
 }
+
+#[test]
+fn extreme_inputs_stay_finite() {
+    for viscosity in [0.0, 1e-3] {
+        for gilbert in [false, true] {
+            let m = motor_with(|p| {
+                p.fluid_viscosity = viscosity;
+                p.max_substeps = 500;
+                if gilbert {
+                    p.onion_model = OnionModel::Gilbert;
+                }
+            });
+            for (stress, load, h) in [
+                (MAX_STRESS, MAX_LOAD_TORQUE, MAX_STEP),
+                (-MAX_STRESS, -MAX_LOAD_TORQUE, 1e-12),
+            ] {
+                let mut s = MotorState::aligned(1.0);
+                let inputs = MotorInputs {
+                    load_torque: load,
+                    ..MotorInputs::fixed(0.3, stress)
+                };
+                let r = m.step(&mut s, &inputs, h).unwrap();
+                let o = r.outputs;
+                for x in [
+                    o.torque,
+                    o.rotor_angle,
+                    o.rotor_speed,
+                    o.onion_angle,
+                    o.magnetoelastic_energy,
+                ] {
+                    assert!(x.is_finite(), "{o:?}");
+                }
+            }
+        }
+    }
+}
