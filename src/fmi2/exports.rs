@@ -176,22 +176,23 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 known.join(", ")
             ));
         };
-        let resources = match text(fmu_resource_location) {
-            None => None,
-            Some(uri) => match resource_path(&uri) {
-                Ok(p) => Some(p),
-                Err(why) => {
-                    logger.log(
-                        fmi2Status::Warning,
-                        &format!("fmi2Instantiate: {why}; resources are unavailable"),
-                    );
-                    None
-                }
-            },
-        };
         let mut logger = logger;
         logger.debug = logging_on != FMI2_FALSE;
-        Some(Box::into_raw(Box::new(Instance::new(*factory, logger, resources))) as fmi2Component)
+        // No model reads resources yet; a location that is not a file URI is still worth a word.
+        if let Some(uri) = text(fmu_resource_location) {
+            match resource_path(&uri) {
+                Ok(path) if logger.debug => logger.log(
+                    fmi2Status::OK,
+                    &format!("fmi2Instantiate: resources at {}", path.display()),
+                ),
+                Ok(_) => {}
+                Err(why) => logger.log(
+                    fmi2Status::Warning,
+                    &format!("fmi2Instantiate: {why}; resources are unavailable"),
+                ),
+            }
+        }
+        Some(Box::into_raw(Box::new(Instance::new(*factory, logger))) as fmi2Component)
     });
     result.ok().flatten().unwrap_or(std::ptr::null_mut())
 }
@@ -761,7 +762,7 @@ mod tests {
             >(record)
         };
         let env = &log as *const _ as *mut std::ffi::c_void;
-        let instance = Instance::new(REGISTRY[0], Logger::new(Some(callback), env, "t"), None);
+        let instance = Instance::new(REGISTRY[0], Logger::new(Some(callback), env, "t"));
         let c = Box::into_raw(Box::new(instance)) as fmi2Component;
         assert_eq!(
             guarded(c, "fmi2Test", |_| panic!("boom")),

@@ -10,7 +10,6 @@ use crate::variables::{Causality, Initial, ModelInfo, VarType, Variability, Vari
 use serde::{Deserialize, Serialize};
 use std::collections::HashSet;
 use std::ffi::CString;
-use std::path::PathBuf;
 
 /// Marks a live instance, so that a stale or foreign pointer is refused rather than used.
 pub const MAGIC: u64 = 0x6163_7475_6174_6f72;
@@ -107,7 +106,6 @@ pub struct Instance {
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
     fmu_states: HashSet<usize>,
-    pub resources: Option<PathBuf>,
 }
 
 fn type_index(kind: VarType) -> usize {
@@ -200,18 +198,17 @@ fn to_fmi(status: Status) -> fmi2Status {
 }
 
 impl Instance {
-    pub fn new(factory: &'static dyn Factory, logger: Logger, resources: Option<PathBuf>) -> Self {
+    pub fn new(factory: &'static dyn Factory, logger: Logger) -> Self {
         let info = factory.info();
-        let mut by_type: [Vec<&'static Variable>; 4] = Default::default();
-        for t in 0..4 {
-            by_type[t] = (0..info.counts[t])
+        let by_type = std::array::from_fn(|t| {
+            (0..info.counts[t])
                 .filter_map(|vr| {
                     info.variables
                         .iter()
                         .find(|v| type_index(v.kind) == t && v.vr as usize == vr)
                 })
-                .collect();
-        }
+                .collect()
+        });
         Self {
             magic: MAGIC,
             logger,
@@ -224,7 +221,6 @@ impl Instance {
             runtime: factory.create(),
             string_values: Vec::new(),
             fmu_states: HashSet::new(),
-            resources,
         }
     }
 
@@ -289,7 +285,7 @@ impl Instance {
         }
         if !start.is_finite()
             || stop.is_some_and(|s| !s.is_finite())
-            || tolerance.is_some_and(|t| !(t > 0.0))
+            || tolerance.is_some_and(|t| t.is_nan() || t <= 0.0)
         {
             return self.error(&format!(
                 "fmi2SetupExperiment: startTime {start}, stopTime {stop:?} and tolerance {tolerance:?} must be finite (tolerance positive)"
@@ -700,7 +696,10 @@ impl Instance {
         if !body.time.is_finite() {
             return Err(refuse("corrupt state: time is not finite".into()));
         }
-        let runtime = self.runtime.from_bytes(&body.runtime).map_err(&refuse)?;
+        let runtime = self
+            .runtime
+            .snapshot_from_bytes(&body.runtime)
+            .map_err(&refuse)?;
         let state = FmuState {
             time: body.time,
             start_time: body.start_time,

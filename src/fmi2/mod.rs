@@ -4,7 +4,7 @@
 //! rules; `runtime` the bridge to any [`crate::models::Model`]. A model needs no code here.
 
 mod exports;
-pub mod instance;
+mod instance;
 mod logger;
 pub mod runtime;
 pub mod types;

@@ -56,7 +56,7 @@ pub trait Runtime: Send {
     /// Copies `other` (a snapshot of the same model) into `self`.
     fn restore(&mut self, other: &dyn Runtime) -> Result<(), String>;
     fn to_bytes(&self) -> Result<Vec<u8>, String>;
-    fn from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String>;
+    fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String>;
     fn as_any(&self) -> &dyn Any;
 }
 
@@ -120,7 +120,7 @@ impl<M: Model> Runtime for RuntimeOf<M> {
     fn to_bytes(&self) -> Result<Vec<u8>, String> {
         postcard::to_stdvec(self).map_err(|e| e.to_string())
     }
-    fn from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
+    fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
         let r: Self =
             postcard::from_bytes(bytes).map_err(|e| format!("corrupt model state: {e}"))?;
         let [nr, ni, nb, ns] = M::INFO.counts;

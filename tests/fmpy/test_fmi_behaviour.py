@@ -140,3 +140,24 @@ def test_four_instances_in_four_threads_match_serial_runs():
         t.join()
     for k in range(4):
         assert np.array_equal(serial[k], threaded[k])
+
+
+def test_threads_that_outlive_the_unloaded_library_exit_cleanly():
+    # rust-lang/rust#91979: a thread that ran the FMU's code and exits after dlclose must not
+    # jump into unmapped thread-local destructors (the binary is linked with -z nodelete).
+    def worker(k):
+        fmu = slave(name=f"thread{k}")
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        trajectory(fmu, steps=20)
+        fmu.terminate()
+        fmu.freeInstance()  # dlclose while this thread is still alive
+
+    for round_ in range(25):
+        threads = [threading.Thread(target=worker, args=(4 * round_ + k,)) for k in range(4)]
+        for t in threads:
+            t.start()
+        for t in threads:
+            t.join()
