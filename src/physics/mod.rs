@@ -1,3 +1,4 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no `unsafe`.
 
+pub mod bladder;
 pub mod gaylord;
