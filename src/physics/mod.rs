@@ -3,3 +3,4 @@
 pub mod bladder;
 pub mod friction;
 pub mod gaylord;
+pub mod mckibben;
