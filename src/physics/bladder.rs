@@ -509,6 +509,7 @@ impl Bladder {
             return Ok(lo);
         }
         let mut hi = hi;
+        // From the unstrained side Newton approaches monotonically (r is convex here): ~6 steps.
         let mut x = lo;
         for _ in 0..ROOT_ITERATIONS {
             let Some((r, dr)) = residual(x) else {
@@ -525,16 +526,16 @@ impl Bladder {
                 hi = x;
             }
             let newton = x - r / dr;
-            let next = if newton.is_finite() && newton > lo && newton < hi {
+            let newton_ok = newton.is_finite() && newton >= lo && newton <= hi;
+            // Converged when the Newton correction is at rounding level (or the bracket is).
+            if (newton_ok && (newton - x).abs() <= 1e-14 * x) || hi - lo <= 1e-15 * hi {
+                return Ok(if newton_ok { newton } else { x });
+            }
+            x = if newton_ok && newton > lo && newton < hi {
                 newton
             } else {
                 0.5 * (lo + hi)
             };
-            let converged = (next - x).abs() <= 1e-14 * x || hi - lo <= 1e-15 * hi;
-            x = next;
-            if converged {
-                return Ok(x);
-            }
         }
         Ok(0.5 * (lo + hi))
     }

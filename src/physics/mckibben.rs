@@ -466,20 +466,21 @@ impl McKibben {
             }
             let slope = 1.0 + c * core.newton_slope;
             let newton = x - h / slope;
-            let next = if newton.is_finite() && slope > 0.0 && newton > lo && newton < hi {
+            let newton_ok = newton.is_finite() && slope > 0.0 && newton >= lo && newton <= hi;
+            let tol = 1e-14 * x.abs().max(1e-3);
+            if newton_ok && (newton - x).abs() <= tol {
+                // Converged: the length moves by less than rounding; F changes by K * tol.
+                return Ok(core);
+            }
+            best = Some(core);
+            if hi - lo <= tol {
+                break;
+            }
+            x = if newton_ok && newton > lo && newton < hi {
                 newton
             } else {
                 0.5 * (lo + hi)
             };
-            best = Some(core);
-            if (next - x).abs() <= 1e-14 * x.abs().max(1e-3) || hi - lo <= 1e-15 * hi.abs() {
-                if (next - x).abs() > 0.0 {
-                    // One last evaluation at the converged length.
-                    return eval(next).map(|(_, core)| core);
-                }
-                break;
-            }
-            x = next;
         }
         best.ok_or_else(|| "connector solve did not run".to_string())
     }
