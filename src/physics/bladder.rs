@@ -509,7 +509,8 @@ impl Bladder {
             return Ok(lo);
         }
         let mut hi = hi;
-        // From the unstrained side Newton approaches monotonically (r is convex here): ~6 steps.
+        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); any step
+        // leaving the bracket is replaced by bisection.
         let mut x = lo;
         for _ in 0..ROOT_ITERATIONS {
             let Some((r, dr)) = residual(x) else {

@@ -274,9 +274,11 @@ impl McKibben {
     /// `friction_state` of the result when the step is accepted.
     ///
     /// With a connector of stiffness `k` the input is the reported (measured) length and the
-    /// muscle's own length `L` solves `length = L + F(L)/k` (the connector stretches by `F/k`
-    /// under tension; section 2.4's correction "subtract F/k from the length"), bracketed and
-    /// solved by Newton-bisection.
+    /// muscle's own length `L` solves `length = L + F(L)/k`, i.e. `L = length - F/k` (section
+    /// 2.4: "subtracting a correction term F/k" from the measured length; the connector stretches
+    /// by `F/k` under tension). This sign makes the reported length grow monotonically with `L`
+    /// (unique root) and lets a muscle report lengths beyond its `max_length`, as Table 2.1's A
+    /// and B do. Bracketed, then solved by Newton-bisection.
     ///
     /// `Err` (with the reason) for non-finite inputs, a muscle length outside
     /// `(min_length, max_length)` (no solution: the rubber does not fit the sleeve), a reported
