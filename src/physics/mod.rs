@@ -1,4 +1,7 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no `unsafe`.
 
+pub mod bladder;
+pub mod friction;
 pub mod gaylord;
+pub mod mckibben;
 pub mod multiferroic;
