@@ -30,7 +30,7 @@ def main():
     out.mkdir(parents=True, exist_ok=True)
 
     md = read_model_description(str(FMU))
-    start = {v.name: float(v.start) for v in md.modelVariables if v.start is not None}
+    start = {v.name: float(v.start) for v in md.modelVariables if v.type == "Real" and v.start is not None}
     b, n = start["strand_length"], start["turns"]
 
     rows = []
