@@ -8,7 +8,9 @@ use super::{Model, Report, Status, Vars};
 use crate::physics::bladder::BladderTube;
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
-use crate::physics::mckibben::{BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry};
+use crate::physics::mckibben::{
+    BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
+};
 use crate::variables::mckibben_muscle::{boolean, integer, real, INFO};
 use crate::variables::ModelInfo;
 use serde::{Deserialize, Serialize};
@@ -31,7 +33,11 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
     let preset = match vars.integer[integer::PRESET] {
         0 => None,
         k @ 1..=4 => MuscleGeometry::preset((b'A' + k as u8 - 1) as char),
-        k => return Err(format!("preset must be 0 (none) or 1-4 (Table 2.1 A-D), got {k}")),
+        k => {
+            return Err(format!(
+                "preset must be 0 (none) or 1-4 (Table 2.1 A-D), got {k}"
+            ))
+        }
     };
     let tube = |length, inner_diameter, thickness| BladderTube {
         inner_diameter,
@@ -43,7 +49,11 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
     Ok(match preset {
         Some(g) => (
             g.sleeve()?,
-            tube(g.bladder_length, g.bladder_inner_diameter, g.bladder_thickness),
+            tube(
+                g.bladder_length,
+                g.bladder_inner_diameter,
+                g.bladder_thickness,
+            ),
         ),
         None => (
             Sleeve::new(r[real::STRAND_LENGTH], r[real::TURNS])?,
@@ -68,11 +78,20 @@ impl McKibbenMuscle {
             Err(reason) => reason,
         };
         let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() { LIMIT_MARGIN * (hi - lo) } else { 0.0 };
+        let margin = if self.muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
         let clamped = length.clamp(lo + margin, hi - margin);
         let fallback = [(pressure, clamped), (pressure.max(0.0), clamped)]
             .into_iter()
-            .find_map(|(p, l)| self.muscle.evaluate(p, l, &self.friction).ok().map(|o| (p, l, o)));
+            .find_map(|(p, l)| {
+                self.muscle
+                    .evaluate(p, l, &self.friction)
+                    .ok()
+                    .map(|o| (p, l, o))
+            });
         if !self.out_of_range {
             let what = match &fallback {
                 Some((p, l, _)) => format!("evaluating at pressure {p} Pa and length {l} m"),
@@ -119,12 +138,22 @@ impl Model for McKibbenMuscle {
             coefficient: vars.real[real::FRICTION_COEFFICIENT],
             presliding_length: vars.real[real::PRESLIDING_LENGTH],
         });
-        let muscle = McKibben::new(sleeve, tube, model, friction, vars.real[real::CONNECTOR_STIFFNESS])?;
+        let muscle = McKibben::new(
+            sleeve,
+            tube,
+            model,
+            friction,
+            vars.real[real::CONNECTOR_STIFFNESS],
+        )?;
         vars.real[real::MAX_LENGTH] = muscle.max_length();
         vars.real[real::MIN_LENGTH] = muscle.min_length();
         // Friction starts relaxed (z = 0) at the initial length.
         let friction = HysteresisState::at_rest(vars.real[real::LENGTH]);
-        Ok(Self { muscle, friction, out_of_range: false })
+        Ok(Self {
+            muscle,
+            friction,
+            out_of_range: false,
+        })
     }
 
     fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {

@@ -1,0 +1,168 @@
+"""McKibbenMuscle with its bladder, friction and connector effects under FMPy (dissertation ch. 2).
+Each test names the equation, table or figure it checks."""
+
+import math
+
+import numpy as np
+import pytest
+
+from conftest import Slave
+
+MODEL = "McKibbenMuscle"
+LISTED = {1: 0.10325, 2: 0.1088, 3: 0.0989, 4: 0.1358}  # Table 2.1 muscle lengths, A-D
+THIN, THICK = 1, 2
+
+
+def muscle(log=None, **parameters):
+    return Slave(MODEL, log=log, **parameters)
+
+
+def forces(m, pressure, lengths):
+    return np.array([m.at("force", pressure=pressure, length=L) for L in lengths])
+
+
+def test_a_vanishing_bladder_converges_to_eq_2_3():
+    # Thickness and rubber moduli scaled by eps -> the ideal sleeve (eq. 2.16 reduces to eq. 2.3).
+    eps = 1e-7 / 1.6e-3
+    m = muscle(preset=0, bladder_model=THIN, bladder_thickness=1e-7, mooney_c1=161e3 * eps, mooney_c2=39e3 * eps,
+               bladder_length=0.1113, length=0.08)
+    b, n = 0.1113, 3.74
+    full_scale = 6e5 * 2 * b * b / (4 * math.pi * n * n)
+    for p in (1e5, 3e5, 6e5):
+        for L in (0.07, 0.085, 0.1, 0.105):
+            ideal = p * (3 * L * L - b * b) / (4 * math.pi * n * n)
+            assert abs(m.at("force", pressure=p, length=L) - ideal) < 1e-3 * full_scale
+    m.close()
+
+
+@pytest.mark.parametrize("preset, fraction", [(1, 0.9424), (2, 0.9827), (3, 0.9993)])
+def test_max_length_is_where_the_bladder_fills_the_sleeve(preset, fraction):
+    # Eq. 2.7's inner diameter reaches zero: A stops near 0.94 of its listed length, B near 0.98.
+    m = muscle(preset=preset, bladder_model=THIN, length=0.08)
+    assert m.get("max_length") / LISTED[preset] == pytest.approx(fraction, abs=2e-4)
+    m.close()
+
+
+def test_force_rises_steeply_towards_the_limit_and_beyond_is_logged(recording_log):
+    m = muscle(log=recording_log, preset=1, bladder_model=THICK, length=0.08)
+    top = m.get("max_length")
+    f = forces(m, 4e5, top * np.array([0.9, 0.95, 0.99, 0.999]))
+    assert np.all(np.diff(f) > 0) and f[-1] > 20 * f[0]
+    beyond = m.at("force", "volume", "stiffness", pressure=4e5, length=1.2 * top)
+    assert all(math.isfinite(x) for x in beyond)
+    assert recording_log.contains("until the inputs return")
+    m.close()
+
+
+def test_thick_and_thin_walls_agree_for_thin_muscle_d_not_for_thick_muscle_a():
+    # Section 2.4: for muscle D (0.25 mm wall, 3.8 mm bore) the thick-walled model is unnecessary.
+    deviation = {}
+    for preset in (4, 1):
+        top = min(0.95 * LISTED[preset], 0.99 * muscle(preset=preset, bladder_model=THIN, length=0.08).get("max_length"))
+        lengths = np.linspace(0.6 * LISTED[preset], top, 30)
+        thin = forces(muscle(preset=preset, bladder_model=THIN, length=lengths[0]), 3.45e5, lengths)
+        thick = forces(muscle(preset=preset, bladder_model=THICK, bladder_layers=16, length=lengths[0]), 3.45e5, lengths)
+        deviation[preset] = np.max(np.abs(thick - thin)) / np.max(np.abs(thick))
+    print(f"max |thick - thin| / peak at 345 kPa: D {deviation[4]:.4f}, A {deviation[1]:.4f}")
+    assert deviation[4] < 0.03
+    assert deviation[1] > 0.2
+
+
+def test_thick_wall_converges_as_layers_grow():
+    # Eq. 2.19-2.20: successive layer doublings change the force less and less.
+    values = []
+    for layers in (1, 2, 4, 8, 16, 32, 64):
+        m = muscle(preset=1, bladder_model=THICK, bladder_layers=layers, length=0.09)
+        values.append(m.at("force", pressure=6.9e5, length=0.9 * LISTED[1]))
+        m.close()
+    changes = np.abs(np.diff(values))
+    print("muscle A, 690 kPa, 0.9 of its length, F by layers 1..64:", np.round(values, 3))
+    assert np.all(np.diff(changes) < 0)
+    assert changes[-1] < 0.01 * abs(values[-1])
+    one_layer = muscle(preset=1, bladder_model=THICK, bladder_layers=1, length=0.09)
+    thin = muscle(preset=1, bladder_model=THIN, length=0.09)
+    assert one_layer.at("force", pressure=4e5, length=0.09) == thin.at("force", pressure=4e5, length=0.09)
+
+
+def test_prestrained_muscles_pull_without_pressure():
+    # Fig. 2.10 b, c: pre-strained B and C pull at zero pressure, more than A at the same fraction.
+    for fraction in (0.75, 0.85):
+        f = {p: muscle(preset=p, bladder_model=THICK, length=0.08).at("force", pressure=0.0, length=fraction * LISTED[p])
+             for p in (1, 2, 3)}
+        assert f[2] > 0 and f[3] > 0
+        assert f[3] > f[2] > f[1]
+
+
+@pytest.mark.parametrize("model", [THIN, THICK])
+def test_force_is_continuous_across_the_contact_threshold(model):
+    # Eq. 2.18: below the threshold the bladder leaves the sleeve; the force must not jump.
+    m = muscle(preset=1, bladder_model=model, length=0.08)
+    full_scale = 6.9e5 * 2 * 0.1113**2 / (4 * math.pi * 3.74**2)
+    for L in (0.06, 0.075, 0.09):
+        threshold = m.at("threshold_pressure", pressure=0.0, length=L)
+        assert threshold > 0
+        below = m.at("force", "bladder_contact", pressure=threshold * (1 - 1e-9), length=L)
+        above = m.at("force", "bladder_contact", pressure=threshold * (1 + 1e-9), length=L)
+        assert below[1] is False or below[1] == 0
+        assert above[1] is True or above[1] == 1
+        assert abs(above[0] - below[0]) < 1e-6 * full_scale
+    m.close()
+
+
+def test_friction_loop_is_twice_the_friction_force_and_holding_still_changes_nothing():
+    # Eq. 2.4: +-Cf P_eff; extension above contraction by 2 Cf P_eff once the presliding is passed.
+    m = muscle(preset=4, bladder_model=THIN, friction=True, friction_coefficient=2e-5, presliding_length=1e-4,
+               length=0.09)
+    lengths = np.linspace(0.09, 0.125, 71)
+    up, down = [], []
+    for L in lengths:
+        m.step(pressure=3.45e5, length=L)
+        up.append(m.get("force", "friction_force", "effective_pressure"))
+    for L in lengths[::-1]:
+        m.step(pressure=3.45e5, length=L)
+        down.append(m.get("force", "friction_force", "effective_pressure"))
+    up, down = np.array(up), np.array(down)[::-1]
+    inner = slice(5, -5)  # away from the reversal's presliding zone
+    width = up[inner, 0] - down[inner, 0]
+    assert np.allclose(width, 2 * 2e-5 * up[inner, 2], rtol=1e-6)
+    assert np.allclose(up[inner, 1], 2e-5 * up[inner, 2], rtol=1e-9)
+    # Holding still leaves the force exactly as it is; jitter of 1e-12 m never flips the friction
+    # (a flip would move the force by 2 Cf P_eff, about 14 N here).
+    held = m.get("force")
+    for _ in range(100):
+        m.step(pressure=3.45e5, length=lengths[0])
+        assert m.get("force") == held
+    for k in range(200):
+        m.step(pressure=3.45e5, length=lengths[0] + (1e-12 if k % 2 else 0.0))
+        assert abs(m.get("force") - held) < 1e-6
+    m.close()
+
+
+def test_friction_state_is_part_of_the_fmu_state():
+    m = muscle(preset=4, bladder_model=THIN, friction=True, length=0.1)
+    for L in np.linspace(0.1, 0.12, 20):
+        m.step(pressure=3e5, length=L)
+    state, time = m.fmu.getFMUstate(), m.time
+    path = np.linspace(0.12, 0.1, 20)
+    first = [m.step(pressure=3e5, length=L) or m.get("force") for L in path]
+    m.fmu.setFMUstate(state)
+    m.time = time
+    again = [m.step(pressure=3e5, length=L) or m.get("force") for L in path]
+    assert first == again
+    m.close()
+
+
+@pytest.mark.parametrize("model, friction, connector", [(0, False, 0.0), (1, True, 0.0), (2, True, 2000.0)])
+def test_dense_grid_never_gives_nan(model, friction, connector, recording_log):
+    # Pressures from -100 kPa to 1 MPa, lengths from 0 to far beyond the limit.
+    m = muscle(log=recording_log, preset=1, bladder_model=model, bladder_layers=8, friction=friction,
+               connector_stiffness=connector, length=0.08)
+    names = ["force", "volume", "effective_pressure", "threshold_pressure", "stretch_axial", "stretch_hoop",
+             "stretch_radial", "stress_axial", "stress_hoop", "stress_radial", "friction_force", "stiffness"]
+    for p in np.linspace(-1e5, 1e6, 12):
+        for L in np.linspace(0.0, 0.2, 21):
+            values = m.at(*names, pressure=p, length=L)
+            assert all(math.isfinite(v) for v in values), (p, L, values)
+    if model and not connector:  # through a connector every measured length is reachable
+        assert recording_log.contains("until the inputs return"), "out-of-range points are logged"
+    m.close()
