@@ -1,3 +1,5 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no `unsafe`.
 
 pub mod gaylord;
+pub mod knitted;
+pub mod knitted_shape;
