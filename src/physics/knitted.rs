@@ -676,6 +676,80 @@ mod tests {
     }
 
     #[test]
+    fn non_cylindrical_prototype_against_cylinder_fig_1_14() {
+        let params = KnittedParams::prototype();
+        let nc = KnittedSleeve::new(params, ShapeKind::NonCylindrical { segments: 49 }).unwrap();
+        let cyl = ideal(params);
+        let p = 14e3;
+        assert_relative_eq!(nc.max_length(), cyl.max_length(), max_relative = 1e-12);
+        // Same start (all rows at r_min), then a faster rise, a lower peak and a shorter stroke.
+        assert_relative_eq!(nc.force(p, 0.514), cyl.force(p, 0.514), max_relative = 1e-9);
+        assert!(nc.force(p, 0.49) > 1.3 * cyl.force(p, 0.49));
+        let peak = |k: &KnittedSleeve| {
+            (0..=500)
+                .map(|i| {
+                    k.force(
+                        p,
+                        k.min_length() + (k.max_length() - k.min_length()) * i as f64 / 500.0,
+                    )
+                })
+                .fold(0.0f64, f64::max)
+        };
+        let (pn, pc) = (peak(&nc), peak(&cyl));
+        assert!(pn < 0.85 * pc, "{pn} {pc}");
+        // Measured at 14 kPa: 68.8 N against 85.8 N.
+        assert_relative_eq!(pn, 68.8, max_relative = 2e-3);
+        assert_relative_eq!(pc, 85.8, max_relative = 2e-3);
+        let (fn_, fc) = (nc.free_contraction_length(), cyl.free_contraction_length());
+        assert!(fn_ > fc + 0.005);
+        assert!(nc.force(p, fn_).abs() < 1e-6 * pn);
+        // Pocket: largest radius above the cylinder's early in the stroke.
+        assert!(nc.max_radius(0.49) > cyl.max_radius(0.49));
+        for l in [-1.0, 0.0, 0.1, 0.3, 0.6, f64::NAN, f64::INFINITY] {
+            assert!(nc.force(p, l).is_finite() && nc.stiffness(p, l).is_finite());
+            assert!(nc.volume(l).is_finite() && nc.max_radius(l).is_finite());
+        }
+    }
+
+    #[test]
+    fn friction_fig_1_18_contraction_and_extension() {
+        // Cf = 0.25 on the non-cylindrical prototype: contraction (z = -1) stops where its force
+        // reaches zero, short of the frictionless free contraction; extension starts there with
+        // positive force.
+        let nc = KnittedSleeve::new(
+            KnittedParams::prototype(),
+            ShapeKind::NonCylindrical { segments: 49 },
+        )
+        .unwrap();
+        let fr = StrandFriction::new(0.25).unwrap();
+        let p = 14e3;
+        let with = |l: f64, z: f64| fr.total_force(nc.force(p, l), p, nc.mean_area(l), z).0;
+        let (mut lo, mut hi) = (nc.free_contraction_length(), nc.max_length());
+        assert!(with(lo, -1.0) < 0.0 && with(hi, -1.0) > 0.0);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if with(mid, -1.0) > 0.0 {
+                hi = mid;
+            } else {
+                lo = mid;
+            }
+        }
+        let stop = 0.5 * (lo + hi);
+        let stroke = 1.0 - stop / nc.max_length();
+        // Measured: contraction stops at 54.4% stroke (frictionless: 63.5%).
+        assert!(
+            stroke < 1.0 - nc.free_contraction_length() / nc.max_length() - 0.05,
+            "{stroke}"
+        );
+        assert_relative_eq!(stroke, 0.544, max_relative = 1e-2);
+        assert!(with(stop, 1.0) > 0.0);
+        for i in 0..20 {
+            let l = stop + (nc.max_length() - stop) * i as f64 / 20.0;
+            assert!(with(l, 1.0) > nc.force(p, l) && nc.force(p, l) > with(l, -1.0));
+        }
+    }
+
+    #[test]
     fn rejects_bad_parameters() {
         let good = KnittedParams::prototype();
         for bad in [
