@@ -256,3 +256,27 @@ fn a_bar_that_does_not_fit_fails_initialization_with_a_reason() {
     assert_eq!(set_integer(&j, integer::ONION_MODEL, 2), ERROR);
     assert_eq!(set_integer(&j, integer::MAX_SUBSTEPS, 0), ERROR);
 }
+
+#[test]
+fn a_diverged_long_step_is_never_returned_as_a_result() {
+    // A 1 s step spans 10 000 switches of the 100 us schedule with a budget of 20 000 substeps.
+    // Whatever the integrator does, a returned rotor angle must respect the drag's speed limit,
+    // (largest torque) / drag ~ 6.7e4 rad/s for Table 3.1; otherwise the step is discarded.
+    let i = stepping();
+    let limit = 2.2e-18 / get(&i, real::DRAG);
+    let status = i.do_step(0.0, 1.0);
+    let angle = get(&i, real::ROTOR_ANGLE);
+    assert!(angle.is_finite());
+    match status {
+        OK | WARNING => assert!(angle.abs() <= 1.5 * limit, "{angle}"),
+        DISCARD => {
+            assert!(
+                i.log.contains("integration diverged"),
+                "{:?}",
+                i.log.lines()
+            );
+            assert_eq!(angle, 0.0, "the state before the step is kept");
+        }
+        other => panic!("status {other}: {:?}", i.log.lines()),
+    }
+}

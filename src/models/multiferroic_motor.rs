@@ -20,6 +20,8 @@ pub struct MultiferroicMotor {
     schedule: Option<SteppingSchedule>,
     rotor_locked: bool,
     state: MotorState,
+    /// Largest magnitude of the ring's torque on the bar (N m), for [`Self::implausible`].
+    max_torque: f64,
     /// Whether the accuracy warning was logged: it is logged once per run, later limited steps
     /// only return `fmi2Warning` (a 1 s step over thousands of switches is limited every time).
     accuracy_warned: bool,
@@ -34,6 +36,40 @@ impl MultiferroicMotor {
             rotor_locked: self.rotor_locked,
             schedule: self.schedule,
         }
+    }
+}
+
+impl MultiferroicMotor {
+    /// Why a step's result is physically impossible, if it is. With drag `c`, `I w' = F - c w`
+    /// and `|F| <= tau_max + |load|` keep `|w|` below `max(|w0|, (tau_max + |load|) / c)` at all
+    /// times, so the rotor cannot turn further than that speed times the step. A result beyond
+    /// (with a factor 1.5 of slack for the integrator's error) means the integration diverged:
+    /// budget-limited substeps far longer than the relaxation time can do that.
+    fn implausible(
+        &self,
+        before: &MotorState,
+        after: &MotorState,
+        inputs: &MotorInputs,
+        step: f64,
+    ) -> Option<String> {
+        let drag = self.motor.drag;
+        if inputs.rotor_locked || drag <= 0.0 {
+            return None;
+        }
+        let speed = before
+            .rotor_speed
+            .abs()
+            .max((self.max_torque + inputs.load_torque.abs()) / drag);
+        let turn = after.rotor_angle - before.rotor_angle;
+        let (turn_limit, speed_limit) = (1.5 * speed * step + 1e-12, 1.5 * speed);
+        (turn.abs() > turn_limit || after.rotor_speed.abs() > speed_limit).then(|| {
+            format!(
+                "the integration diverged (rotor turned {turn:e} rad at up to {:e} rad/s where \
+                 drag allows at most {turn_limit:e} rad and {speed_limit:e} rad/s): the step is too \
+                 long for max_substeps = {}; shorten the step or raise max_substeps",
+                after.rotor_speed, self.motor.params.max_substeps
+            )
+        })
     }
 }
 
@@ -115,11 +151,12 @@ impl Model for MultiferroicMotor {
             2.0 * std::f64::consts::PI * motor.undamped_frequency();
         vars.real[real::RELAXATION_TIME] = motor.rotor_relaxation_time();
         Ok(Self {
-            motor,
             schedule,
             rotor_locked: vars.boolean[boolean::ROTOR_LOCKED],
             // The rotor starts at rest with the onion state aligned with it, at angle 0.
             state: MotorState::aligned(0.0),
+            max_torque: motor.ring_bar.max_torque().1.abs(),
+            motor,
             accuracy_warned: false,
         })
     }
@@ -136,7 +173,13 @@ impl Model for MultiferroicMotor {
         let inputs = self.inputs(vars);
         // The importer's clock is the schedule's clock (they differ by rounding at most).
         let mut next = MotorState { time, ..self.state };
-        match self.motor.step(&mut next, &inputs, step) {
+        let result = self.motor.step(&mut next, &inputs, step).and_then(|r| {
+            match self.implausible(&self.state, &next, &inputs, step) {
+                Some(why) => Err(why),
+                None => Ok(r),
+            }
+        });
+        match result {
             Ok(r) => {
                 self.state = next;
                 write_outputs(vars, &r.outputs);
