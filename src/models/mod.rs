@@ -8,6 +8,7 @@ use crate::variables::{ModelInfo, Start, VarType};
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
 pub mod mckibben_muscle;
+pub mod multiferroic_motor;
 
 /// Outcome of a model call, in FMI's order of severity.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
