@@ -74,9 +74,44 @@ fn mckibben(c: &mut Criterion) {
     });
 }
 
+/// The motor under its stepping schedule, one 1 us communication step per iteration.
+fn motor(c: &mut Criterion) {
+    use actuator_fmus::variables::multiferroic_motor::{integer, real};
+    let api = common::Api::load(&common::extract_binary("MultiferroicMotor"));
+    let inst = api
+        .instantiate("bench", &common::guid_of("MultiferroicMotor"))
+        .unwrap_or_else(|_| panic!("instantiate"));
+    unsafe {
+        assert_eq!(
+            (api.fmi2SetInteger)(inst.c, [integer::SCHEDULE as u32].as_ptr(), 1, [1].as_ptr()),
+            common::OK
+        );
+    }
+    inst.initialize();
+    let mut t = 0.0;
+    let mut angle = [0.0];
+    c.bench_function(
+        "MultiferroicMotor step/stepping schedule: doStep(1 us) + get(rotor_angle)",
+        |bench| {
+            bench.iter(|| unsafe {
+                let s1 = (api.fmi2DoStep)(inst.c, t, 1e-6, 1);
+                t += 1e-6;
+                let s2 = (api.fmi2GetReal)(
+                    inst.c,
+                    [real::ROTOR_ANGLE as u32].as_ptr(),
+                    1,
+                    angle.as_mut_ptr(),
+                );
+                debug_assert!(s1 <= 1 && s2 <= 1);
+                black_box(angle[0])
+            })
+        },
+    );
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().measurement_time(Duration::from_secs(3)).warm_up_time(Duration::from_secs(1));
-    targets = mckibben
+    targets = mckibben, motor
 }
 criterion_main!(benches);

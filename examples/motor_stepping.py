@@ -48,7 +48,8 @@ def locked(signals, **start):
 
 
 def ramp(name, start, stop, points):
-    s = np.zeros(points + 1, dtype=[("time", float), (name, float)])
+    """A ramp of one input; the motor's other inputs are given explicitly (no load)."""
+    s = np.zeros(points + 1, dtype=[("time", float), (name, float), ("load_torque", float)])
     s["time"] = np.linspace(0.0, 1.0, points + 1)
     s[name] = np.linspace(start, stop, points + 1)
     return s
