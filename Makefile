@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo test test-rust test-fmpy bench clean deps
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench clean deps
 
 all: fmus
 
@@ -32,9 +32,19 @@ $(LIB) target/release/package_fmus: $(SOURCES)
 fmus: $(LIB) target/release/package_fmus
 	target/release/package_fmus $(LIB) target/fmu
 
-## Builds the FMUs and runs the default scene under FMPy: out/force_length.{csv,png}.
+DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
+
+## Builds the FMUs and runs the default scene under FMPy: out/fig2_3_ideal_mckibben.{csv,png}.
 demo: fmus $(VENV)/.installed
-	$(PY) examples/force_length.py --out out
+	$(PY) scenes/run.py $(DEFAULT_SCENE) --out out
+
+## Any scene: make scene SCENE=scenes/<name>.json
+scene: fmus $(VENV)/.installed
+	$(PY) scenes/run.py $(SCENE) --out out
+
+## Every scene at full length, and docs/figures.md with the plots beside the seed's statements.
+figures: fmus $(VENV)/.installed
+	$(PY) scenes/catalogue.py
 
 test-rust: deps fmus
 	cargo test --release

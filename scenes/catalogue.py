@@ -1,0 +1,44 @@
+"""Runs every scene in scenes/ (full length) and writes docs/figures.md with each plot beside what
+the seed says, and the seed's numbers beside ours. `make figures`."""
+
+import pathlib
+import re
+import shutil
+
+import run as scenes
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+
+
+def main():
+    out = ROOT / "out"
+    figures = ROOT / "docs" / "figures"
+    figures.mkdir(parents=True, exist_ok=True)
+    lines = [
+        "# Figure catalogue",
+        "",
+        "Each scene in `scenes/` reproduces the model side of one of the seed's figures. Regenerate this",
+        "page with `make figures`; run one scene with `.venv/bin/python scenes/run.py scenes/<scene>.json`.",
+        "",
+    ]
+    def figure_order(path):
+        return [int(x) if x.isdigit() else x for x in re.split(r"(\d+)", path.stem)]
+
+    for path in sorted((ROOT / "scenes").glob("*.json"), key=figure_order):
+        scene = scenes.load_scene(path)
+        runs = scenes.run_scene(scene)
+        scenes.write_outputs(scene, runs, out)
+        title, _, said = scene["description"].partition(": ")
+        lines += [f"## {title} (`scenes/{path.name}`)", "", said[:1].upper() + said[1:], ""]
+        if scene.get("plot"):
+            shutil.copy(out / f"{path.stem}.png", figures / f"{path.stem}.png")
+            lines += [f"![{title}](figures/{path.stem}.png)", ""]
+        for ok, text in scenes.evaluate_checks(scene, runs):
+            lines.append(f"- {'holds' if ok else 'FAILS'}: {text}")
+        lines.append("")
+    (ROOT / "docs" / "figures.md").write_text("\n".join(lines))
+    print(f"wrote docs/figures.md and {len(list(figures.glob('*.png')))} plots")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,217 @@
+"""Runs a scene file (scenes/*.json, format in src/scene.rs) under FMPy: writes <out>/<scene>.csv and
+<out>/<scene>.png, prints the seed's numbers beside ours, exits 1 if a check fails.
+
+    python scenes/run.py scenes/fig2_3_ideal_mckibben.json [--fast] [--out out]
+"""
+
+import argparse
+import json
+import math
+import pathlib
+import re
+import sys
+import time as clock
+
+import numpy as np
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+FMU_DIR = ROOT / "target" / "fmu"
+LONG_RUN_STEPS = 1000  # runs with more communication steps than this show a progress bar
+
+
+def load_scene(path, fast=False):
+    path = pathlib.Path(path)
+    scene = json.loads(path.read_text())
+    scene["_name"] = path.stem
+    scene["_dir"] = path.parent
+    if fast and scene.get("fast"):
+        f = scene["fast"]
+        scene["step"] = f.get("step", scene["step"])
+        scene["stop_time"] = f.get("stop_time", scene["stop_time"])
+        if scene.get("sweep") and "sweep_values" in f:
+            scene["sweep"] = dict(scene["sweep"], values=f["sweep_values"])
+    return scene
+
+
+def signal_values(signal, t, stop_time, directory):
+    kind = signal["type"]
+    if kind == "constant":
+        return np.full_like(t, signal["value"])
+    if kind == "ramp":
+        return signal["from"] + (signal["to"] - signal["from"]) * np.clip(t / stop_time, 0.0, 1.0)
+    if kind == "cycle":
+        phase = np.mod(t / signal["period"], 1.0)
+        up = np.where(phase < 0.5, 2 * phase, 2 - 2 * phase)
+        return signal["min"] + (signal["max"] - signal["min"]) * up
+    if kind == "steps":
+        idx = np.clip(np.searchsorted(signal["times"], t, side="right") - 1, 0, None)
+        return np.asarray(signal["values"], dtype=float)[idx]
+    if kind == "csv":
+        data = np.genfromtxt(directory / signal["file"], delimiter=",", names=True)
+        return np.interp(t, data["time"], data[signal["column"]])
+    raise ValueError(f"unknown signal type {kind}")
+
+
+class Progress:
+    """A progress bar on stderr for long runs: redrawn in place on a terminal, in quarters in a log."""
+
+    def __init__(self, label, total):
+        self.label, self.total, self.shown, self.start = label, total, -1, clock.time()
+        self.tty = sys.stderr.isatty()
+
+    def update(self, done):
+        percent = int(100 * done / self.total) if self.total else 100
+        quantum = 1 if self.tty else 25
+        if percent // quantum != self.shown:
+            self.shown = percent // quantum
+            bar = "#" * (percent // 4)
+            end = "" if self.tty else "\n"
+            print(f"\r{self.label} [{bar:<25}] {percent:3d}%", end=end, file=sys.stderr, flush=True)
+
+    def close(self):
+        print(f"{'' if self.tty else self.label} done in {clock.time() - self.start:.1f} s", file=sys.stderr, flush=True)
+
+
+def run_scene(scene, progress=True):
+    """Returns a list of (sweep value or None, structured result array)."""
+    from fmpy import simulate_fmu
+
+    fmu = str(FMU_DIR / f"{scene['fmu']}.fmu")
+    sweep = scene.get("sweep")
+    values = sweep["values"] if sweep else [None]
+    step, stop = scene["step"], scene["stop_time"]
+    n = int(round(stop / step))
+    t = np.linspace(0.0, n * step, n + 1)
+    runs = []
+    for k, value in enumerate(values):
+        parameters = dict(scene.get("parameters", {}))
+        inputs = dict(scene.get("inputs", {}))
+        if sweep:
+            if sweep["variable"] in inputs:
+                inputs[sweep["variable"]] = {"type": "constant", "value": value}
+            else:
+                parameters[sweep["variable"]] = value
+        signals = None
+        if inputs:
+            signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in inputs])
+            signals["time"] = t
+            for name, signal in inputs.items():
+                signals[name] = signal_values(signal, t, stop, scene["_dir"])
+        label = f"{scene['_name']} {k + 1}/{len(values)}"
+        bar = Progress(label, n) if progress and n >= LONG_RUN_STEPS else None
+
+        def step_finished(time, _recorder):
+            if bar:
+                bar.update(round(time / step))
+            return True
+
+        result = simulate_fmu(
+            fmu,
+            start_values=parameters,
+            input=signals,
+            output=scene["outputs"],
+            stop_time=n * step,
+            output_interval=step,
+            step_finished=step_finished,
+        )
+        if bar:
+            bar.close()
+        runs.append((value, result))
+    return runs
+
+
+def zero_crossing(x, y):
+    sign = np.sign(y)
+    idx = np.nonzero(sign[:-1] * sign[1:] <= 0)[0]
+    if idx.size == 0:
+        return math.nan
+    i = idx[0]
+    if y[i + 1] == y[i]:
+        return float(x[i])
+    return float(x[i] - y[i] * (x[i + 1] - x[i]) / (y[i + 1] - y[i]))
+
+
+def evaluate_checks(scene, runs):
+    """Returns a list of (passed, text) for the scene's checks."""
+    results = []
+    for check in scene.get("checks", []):
+        kind, out = check["kind"], check["output"]
+        if kind == "max":
+            got = max(float(np.max(r[out])) for _, r in runs)
+            ok = abs(got - check["expect"]) <= check["rel_tol"] * abs(check["expect"])
+            results.append((ok, f"max {out} = {got:.6g}, seed {check['expect']:.6g} ({check['source']})"))
+        elif kind == "zero_crossing":
+            for value, r in runs:
+                got = zero_crossing(r[check["x"]], r[out])
+                ok = abs(got - check["expect"]) <= check["rel_tol"] * abs(check["expect"])
+                results.append((ok, f"{out} = 0 at {check['x']} = {got:.6g}, seed {check['expect']:.6g} "
+                                    f"(run {value}; {check['source']})"))
+        elif kind == "final":
+            for value, r in runs:
+                got = float(r[out][-1])
+                ok = abs(got - check["expect"]) <= check["abs_tol"]
+                results.append((ok, f"final {out} = {got:.6g}, seed {check['expect']:.6g} "
+                                    f"(run {value}; {check['source']})"))
+        else:
+            results.append((False, f"unknown check kind {kind}"))
+    return results
+
+
+def write_outputs(scene, runs, out):
+    out.mkdir(parents=True, exist_ok=True)
+    sweep = scene.get("sweep")
+    names = list(runs[0][1].dtype.names)
+    with open(out / f"{scene['_name']}.csv", "w") as f:
+        header = ([sweep["variable"]] if sweep else []) + names
+        f.write(",".join(header) + "\n")
+        for value, r in runs:
+            for row in r:
+                f.write(",".join(([f"{value:.9g}"] if sweep else []) + [f"{row[n]:.9g}" for n in names]) + "\n")
+    plot = scene.get("plot")
+    if not plot:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    for value, r in runs:
+        for y in plot["y"]:
+            label = " ".join(s for s in [f"{sweep['variable']} = {value:g}" if sweep else "", y if len(plot["y"]) > 1 else ""] if s)
+            ax.plot(r[plot["x"]] * plot.get("x_scale", 1.0), r[y] * plot.get("y_scale", 1.0), label=label or None)
+    ax.set_xlabel(plot["x_label"])
+    ax.set_ylabel(plot["y_label"])
+    if plot.get("y_limits"):
+        ax.set_ylim(*plot["y_limits"])
+    figure, _, said = scene["description"].partition(": ")
+    title = f"{figure}: {re.split(r'\.\s+(?=[A-Z])', said)[0]}"
+    ax.set_title(title if len(title) < 90 else title[:87] + "...", fontsize=9)
+    ax.grid(alpha=0.3)
+    if sweep or len(plot["y"]) > 1:
+        ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(out / f"{scene['_name']}.png", dpi=110)
+    plt.close(fig)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("scene", nargs="+", help="scene files")
+    parser.add_argument("--fast", action="store_true", help="the scene's short variant (as in make test)")
+    parser.add_argument("--out", default="out", help="output directory")
+    args = parser.parse_args()
+    failed = 0
+    for path in args.scene:
+        scene = load_scene(path, fast=args.fast)
+        runs = run_scene(scene)
+        write_outputs(scene, runs, pathlib.Path(args.out))
+        for ok, text in evaluate_checks(scene, runs):
+            print(f"  {'ok  ' if ok else 'FAIL'} {text}")
+            failed += not ok
+        print(f"wrote {args.out}/{scene['_name']}.csv" + (f" and .png" if scene.get("plot") else ""))
+    sys.exit(1 if failed else 0)
+
+
+if __name__ == "__main__":
+    main()
