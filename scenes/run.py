@@ -185,7 +185,8 @@ def write_outputs(scene, runs, out):
     if plot.get("y_limits"):
         ax.set_ylim(*plot["y_limits"])
     figure, _, said = scene["description"].partition(": ")
-    title = f"{figure}: {re.split(r'\.\s+(?=[A-Z])', said)[0]}"
+    first_sentence = re.split(r"\.\s+(?=[A-Z])", said)[0]
+    title = f"{figure}: {first_sentence}"
     ax.set_title(title if len(title) < 90 else title[:87] + "...", fontsize=9)
     ax.grid(alpha=0.3)
     if sweep or len(plot["y"]) > 1:
