@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench clean deps
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps
 
 all: fmus
 
@@ -58,6 +58,12 @@ test: test-rust test-fmpy
 ## Native cost per FMI step (criterion), through the packaged FMU's C ABI.
 bench: deps fmus
 	cargo bench --bench fmi_step
+
+## docs/accuracy-cost.md: error against a converged reference and native time per step for every
+## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
+report: deps fmus $(VENV)/.installed
+	cargo bench --bench accuracy_cost
+	$(PY) benches/report.py
 
 clean:
 	cargo clean

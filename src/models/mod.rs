@@ -9,6 +9,7 @@ use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
 pub mod mckibben_muscle;
 pub mod multiferroic_motor;
+pub mod pass_through;
 
 /// Outcome of a model call, in FMI's order of severity.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
