@@ -157,9 +157,8 @@ impl Scene {
     }
 
     fn validate(&self) -> Result<(), String> {
-        if !(self.step > 0.0 && self.step.is_finite())
-            || !(self.stop_time > 0.0 && self.stop_time.is_finite())
-        {
+        let positive = |x: f64| x > 0.0 && x.is_finite();
+        if !positive(self.step) || !positive(self.stop_time) {
             return Err(format!(
                 "scene: step {} and stop_time {} must be positive",
                 self.step, self.stop_time
@@ -180,7 +179,7 @@ impl Scene {
                 }
             }
             if let Signal::Cycle { period, .. } = signal {
-                if !(*period > 0.0) {
+                if !positive(*period) {
                     return Err(format!(
                         "scene: input {name}: cycle period must be positive"
                     ));
