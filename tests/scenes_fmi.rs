@@ -1,7 +1,6 @@
 //! Every catalogue scene, in its fast variant, through the `fmi` crate: it runs, its outputs are
 //! finite and the seed's numbers it names hold (the FMPy runner checks the same in pytest).
 
-#[allow(dead_code)]
 mod common;
 #[allow(dead_code)]
 #[path = "common/scene_runner.rs"]
