@@ -3,7 +3,7 @@
 //!
 //! Data flows one way: `modelDescription/*.xml` (variables) -> [`variables`] (generated tables) ->
 //! [`models`] (variables to physics, effect switches) -> [`physics`] (pure equations).
-//! [`fmi2`] is the C ABI around any [`models::Model`], and the only place with `unsafe` code.
+//! [`fmi2`] is the C ABI around any [`models::Model`], and the only module that handles raw pointers.
 
 pub mod fmi2;
 pub mod models;

@@ -118,33 +118,33 @@ fn type_index(kind: VarType) -> usize {
 }
 
 /// A value that fmi2SetXXX can write into [`crate::models::Vars`].
-pub trait Value: Copy + std::fmt::Display {
+pub trait Value {
     const KIND: VarType;
     /// A reason to refuse the value for this variable, if any.
-    fn invalid_for(self, var: &Variable) -> Option<String>;
-    fn store(self, vars: &mut crate::models::Vars, index: usize);
+    fn invalid_for(&self, var: &Variable) -> Option<String>;
+    fn store(&self, vars: &mut crate::models::Vars, index: usize);
 }
 
 impl Value for f64 {
     const KIND: VarType = VarType::Real;
-    fn invalid_for(self, var: &Variable) -> Option<String> {
+    fn invalid_for(&self, var: &Variable) -> Option<String> {
         if !self.is_finite() {
             return Some(format!("{} = {self} is not finite", var.name));
         }
-        range_check(self, var)
+        range_check(*self, var)
     }
-    fn store(self, vars: &mut crate::models::Vars, index: usize) {
-        vars.real[index] = self;
+    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+        vars.real[index] = *self;
     }
 }
 
 impl Value for i32 {
     const KIND: VarType = VarType::Integer;
-    fn invalid_for(self, var: &Variable) -> Option<String> {
-        range_check(self as f64, var)
+    fn invalid_for(&self, var: &Variable) -> Option<String> {
+        range_check(*self as f64, var)
     }
-    fn store(self, vars: &mut crate::models::Vars, index: usize) {
-        vars.integer[index] = self;
+    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+        vars.integer[index] = *self;
     }
 }
 
@@ -153,19 +153,23 @@ impl Value for i32 {
 #[repr(transparent)]
 pub struct CBoolean(pub std::ffi::c_int);
 
-impl std::fmt::Display for CBoolean {
-    fn fmt(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
-        write!(f, "{}", self.0 != 0)
+impl Value for CBoolean {
+    const KIND: VarType = VarType::Boolean;
+    fn invalid_for(&self, _: &Variable) -> Option<String> {
+        None
+    }
+    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+        vars.boolean[index] = self.0 != 0;
     }
 }
 
-impl Value for CBoolean {
-    const KIND: VarType = VarType::Boolean;
-    fn invalid_for(self, _: &Variable) -> Option<String> {
+impl Value for String {
+    const KIND: VarType = VarType::String;
+    fn invalid_for(&self, _: &Variable) -> Option<String> {
         None
     }
-    fn store(self, vars: &mut crate::models::Vars, index: usize) {
-        vars.boolean[index] = self.0 != 0;
+    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+        vars.string[index].clone_from(self);
     }
 }
 
@@ -403,7 +407,7 @@ impl Instance {
             return fmi2Status::Error;
         }
         let mut parameters_changed = false;
-        for (&vr, &value) in vrs.iter().zip(values) {
+        for (&vr, value) in vrs.iter().zip(values) {
             let var = match self.lookup(function, T::KIND, vr) {
                 Ok(v) => v,
                 Err(status) => return status,
@@ -420,35 +424,8 @@ impl Instance {
             parameters_changed |= var.causality == Causality::Parameter;
         }
         let vars = self.runtime.vars_mut();
-        for (&vr, &value) in vrs.iter().zip(values) {
-            value.store(vars, vr as usize);
-        }
-        self.runtime.changed(parameters_changed);
-        fmi2Status::OK
-    }
-
-    pub fn set_strings(&mut self, vrs: &[u32], values: &[String]) -> fmi2Status {
-        const F: &str = "fmi2SetString";
-        if !self.allowed(F, allowed::SET) {
-            return fmi2Status::Error;
-        }
-        let mut parameters_changed = false;
-        for &vr in vrs {
-            let var = match self.lookup(F, VarType::String, vr) {
-                Ok(v) => v,
-                Err(status) => return status,
-            };
-            if !self.settable(var) {
-                return self.error(&format!(
-                    "{F}: {} cannot be set in state {:?}",
-                    var.name, self.state
-                ));
-            }
-            parameters_changed |= var.causality == Causality::Parameter;
-        }
-        let vars = self.runtime.vars_mut();
         for (&vr, value) in vrs.iter().zip(values) {
-            vars.string[vr as usize] = value.clone();
+            value.store(vars, vr as usize);
         }
         self.runtime.changed(parameters_changed);
         fmi2Status::OK

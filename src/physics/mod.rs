@@ -1,4 +1,4 @@
-//! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no `unsafe`.
+//! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no pointers.
 
 pub mod bladder;
 pub mod friction;
