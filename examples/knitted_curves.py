@@ -1,7 +1,7 @@
 """The section 1.4 knitted prototype (dissertation ch. 1) through the KnittedMuscle FMU:
 - out/knitted_curves.png: force-length at 14 kPa for each shape model (ideal cylinder, tubular
   knit, non-cylindrical), and the non-cylindrical one with friction Cf = 0.25 (Fig. 1.18);
-- out/knitted_profile.png: the non-cylindrical radius profile at several lengths (Fig. 1.13).
+- out/knitted_profile.png: the non-cylindrical radius profile at several lengths (Fig. 1.12).
   The FMU cannot return a profile: it comes from `cargo run --release --example knitted_profile`,
   which prints it as CSV from the crate's physics."""
 

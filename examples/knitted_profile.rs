@@ -11,7 +11,10 @@ use std::io::Write;
 
 fn main() -> Result<(), String> {
     let args: Vec<String> = std::env::args().skip(1).collect();
-    let parse = |s: &String| s.parse::<f64>().map_err(|e| format!("bad number '{s}': {e}"));
+    let parse = |s: &String| {
+        s.parse::<f64>()
+            .map_err(|e| format!("bad number '{s}': {e}"))
+    };
     let segments = match args.first() {
         Some(s) => s
             .parse::<usize>()
@@ -22,10 +25,16 @@ fn main() -> Result<(), String> {
         KnittedParams::prototype(),
         ShapeKind::NonCylindrical { segments },
     )?;
-    let mut lengths = args.iter().skip(1).map(parse).collect::<Result<Vec<_>, _>>()?;
+    let mut lengths = args
+        .iter()
+        .skip(1)
+        .map(parse)
+        .collect::<Result<Vec<_>, _>>()?;
     if lengths.is_empty() {
         let (top, free) = (sleeve.max_length(), sleeve.free_contraction_length());
-        lengths = (0..8).map(|i| top - (top - free) * i as f64 / 7.0).collect();
+        lengths = (0..8)
+            .map(|i| top - (top - free) * i as f64 / 7.0)
+            .collect();
     }
     let stdout = std::io::stdout();
     let mut out = stdout.lock();

@@ -199,3 +199,73 @@ impl Model for KnittedMuscle {
         self.history = out.history;
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vars_with(shape: i32, friction: bool) -> Vars {
+        let mut vars = Vars::from_start(&INFO);
+        vars.integer[integer::SHAPE_MODEL] = shape;
+        vars.boolean[boolean::FRICTION] = friction;
+        vars
+    }
+
+    #[test]
+    fn only_step_commits_the_friction_history() {
+        let mut vars = vars_with(0, true);
+        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let start = m.history;
+        vars.real[real::PRESSURE] = 14e3;
+        vars.real[real::LENGTH] = 0.35;
+        let mut report = Report::default();
+        m.evaluate(&mut vars, &mut report);
+        assert_eq!(m.history, start);
+        // Shortening by far more than the presliding length: full friction against it (z = -1),
+        // of magnitude sqrt(2) Cf (F + P A) (eq. 1.21).
+        assert!(vars.real[real::FRICTION_FORCE] < 0.0);
+        m.step(&mut vars, 0.0, 1e-3, &mut report);
+        assert_eq!(m.history.z, -1.0);
+        assert_eq!(m.history.position, 0.35);
+        let (f, fr) = (vars.real[real::FORCE], vars.real[real::FRICTION_FORCE]);
+        let tension = f + 14e3 * m.sleeve.mean_area(0.35);
+        assert!((fr + SQRT_2 * 0.25 * tension).abs() < 1e-12 * f.abs());
+        assert_eq!(report.status, Status::Ok);
+    }
+
+    #[test]
+    fn out_of_range_is_the_nearest_limit_warned_once_per_excursion() {
+        let mut vars = vars_with(2, false);
+        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let (lo, hi) = (vars.real[real::MIN_LENGTH], vars.real[real::MAX_LENGTH]);
+        vars.real[real::PRESSURE] = 14e3;
+        vars.real[real::LENGTH] = hi;
+        let mut report = Report::default();
+        m.evaluate(&mut vars, &mut report);
+        let at_limit = vars.real.clone();
+        let mut warned = 0;
+        for length in [hi + 1.0, 2.0 * hi, 0.4, 0.0, lo - 1e-9] {
+            let mut report = Report::default();
+            vars.real[real::LENGTH] = length;
+            m.evaluate(&mut vars, &mut report);
+            warned += report.messages.len();
+            assert_eq!(report.status > Status::Ok, !(lo..=hi).contains(&length));
+            if length > hi {
+                assert_eq!(vars.real[real::FORCE], at_limit[real::FORCE]);
+            }
+            assert!(vars.real.iter().all(|x| x.is_finite()));
+        }
+        assert_eq!(warned, 2);
+    }
+
+    #[test]
+    fn non_cylindrical_needs_a_thick_strand() {
+        let mut vars = vars_with(2, false);
+        vars.real[real::STRAND_THICKNESS] = 0.0;
+        let e = KnittedMuscle::new(&mut vars).unwrap_err();
+        assert!(e.contains("positive minimum radius"), "{e}");
+        vars.integer[integer::SHAPE_SEGMENTS] = -3;
+        vars.real[real::STRAND_THICKNESS] = 2e-4;
+        assert!(KnittedMuscle::new(&mut vars).is_err());
+    }
+}
