@@ -229,7 +229,7 @@ def test_knitted_against_mckibben_section_1_3_6():
     peak_mk = mk.at("force", pressure=p, length=b)
     print(f"110 mm, 14.6 mm, 550 kPa, ideal: stroke knitted {stroke_k:.4f} vs McKibben {stroke_mk:.4f}; "
           f"work {work_k:.3f} J vs {work_mk:.3f} J; peak {peak_k:.2f} N vs {peak_mk:.2f} N "
-          f"(ratio {peak_mk / peak_k:.3f}; the seed, with bladders: about 2, and 2.3 J vs 2.6 J)")
+          f"(ratio {peak_mk / peak_k:.3f}; the seed, with bladders: ratio about 2, work 2.6 J knitted vs 2.3 J McKibben)")
     assert stroke_k == pytest.approx(2 / 3, rel=1e-12)
     assert stroke_mk == pytest.approx(1 - 1 / math.sqrt(3), rel=1e-12)  # 42%
     # Ideal, the McKibben peak is P b^2 / (2 pi turns^2) and the knitted one P S^2 / (12 pi).
