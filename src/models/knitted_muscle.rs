@@ -1,0 +1,271 @@
+//! KnittedMuscle FMU: gauge pressure and length in, tension force out (dissertation chapter 1).
+//!
+//! The sleeve's shape model (`shape_model` 0 ideal cylinder, 1 tubular knit, 2 non-cylindrical)
+//! is built once from the parameters; the non-cylindrical volume-length table exists only when
+//! that shape is selected. Strand friction (eq. 1.21, `friction`) is the shared stop-operator
+//! hysteresis; its state is part of the FMU state and advances only in `step`.
+
+use super::{Model, Report, Status, Vars};
+use crate::physics::friction::{HysteresisState, StopOperator};
+use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
+use crate::variables::knitted_muscle::{boolean, integer, real, INFO};
+use crate::variables::ModelInfo;
+use serde::{Deserialize, Serialize};
+use std::f64::consts::SQRT_2;
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+struct Friction {
+    strand: StrandFriction,
+    operator: StopOperator,
+}
+
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct KnittedMuscle {
+    sleeve: KnittedSleeve,
+    /// `None` when `friction` is off.
+    friction: Option<Friction>,
+    /// Friction history (eq. 1.21), advanced only by accepted steps.
+    history: HysteresisState,
+    /// Whether the last evaluation was outside the valid lengths: its warning is logged once per
+    /// excursion.
+    out_of_range: bool,
+}
+
+/// Outputs at one input point, with the friction history after moving there.
+struct Output {
+    force: f64,
+    volume: f64,
+    effective_pressure: f64,
+    friction_force: f64,
+    max_radius: f64,
+    stiffness: f64,
+    history: HysteresisState,
+}
+
+fn sleeve_params(vars: &Vars) -> Result<KnittedParams, String> {
+    let r = &vars.real;
+    Ok(match vars.integer[integer::PRESET] {
+        0 => KnittedParams {
+            stitches_per_row: r[real::STITCHES_PER_ROW],
+            rows: r[real::ROWS],
+            row_strand_length: r[real::ROW_STRAND_LENGTH],
+            strand_thickness: r[real::STRAND_THICKNESS],
+            bladder_outer_radius: 0.0,
+        },
+        1 => KnittedParams::prototype(),
+        2 => KnittedParams::fig_1_16(r[real::STRAND_THICKNESS]),
+        k => {
+            return Err(format!(
+                "preset must be 0 (none), 1 (section 1.4 prototype) or 2 (Fig. 1.16), got {k}"
+            ))
+        }
+    })
+}
+
+fn shape_kind(vars: &Vars) -> Result<ShapeKind, String> {
+    Ok(match vars.integer[integer::SHAPE_MODEL] {
+        0 => ShapeKind::Ideal,
+        1 => ShapeKind::Tubular,
+        2 => {
+            let segments = vars.integer[integer::SHAPE_SEGMENTS];
+            // The range itself is checked by the shape solver; this only refuses negatives.
+            let segments = usize::try_from(segments)
+                .map_err(|_| format!("shape_segments must be at least 2, got {segments}"))?;
+            ShapeKind::NonCylindrical { segments }
+        }
+        k => {
+            return Err(format!(
+                "shape_model must be 0 (ideal cylinder), 1 (tubular knit) or 2 (non-cylindrical), \
+                 got {k}"
+            ))
+        }
+    })
+}
+
+impl KnittedMuscle {
+    /// The physics at the current inputs; a length outside `[min_length, max_length]` is
+    /// evaluated at the nearer limit, where the sleeve is rigid (logged once per excursion).
+    fn compute(&mut self, vars: &Vars, report: &mut Report) -> Output {
+        let (pressure, length) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+        let s = &self.sleeve;
+        let l = s.clamp_length(length);
+        if l == length {
+            self.out_of_range = false;
+        } else {
+            if !self.out_of_range {
+                report.warn(format!(
+                    "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
+                     evaluating at length {l} m until the inputs return",
+                    s.min_length(),
+                    s.max_length(),
+                    s.max_length()
+                ));
+            }
+            report.status = report.status.max(Status::Warning);
+            self.out_of_range = true;
+        }
+        // The thin bag inside the sleeve cannot pull it inwards: a vacuum acts as zero.
+        let p_eff = if pressure.is_finite() {
+            pressure.max(0.0)
+        } else {
+            0.0
+        };
+        let (volume, dv, _) = s.volume_derivatives(l);
+        let frictionless = s.force(p_eff, l);
+        let frictionless_stiffness = s.stiffness(p_eff, l);
+        let mut out = Output {
+            force: frictionless,
+            volume,
+            effective_pressure: p_eff,
+            friction_force: 0.0,
+            max_radius: s.max_radius(l),
+            stiffness: frictionless_stiffness,
+            history: self.history,
+        };
+        if let Some(f) = &self.friction {
+            let next = f.operator.advance(&self.history, l);
+            let area = s.mean_area(l);
+            let (force, friction_force) = f.strand.total_force(frictionless, p_eff, area, next.z);
+            out.force = force;
+            out.friction_force = friction_force;
+            out.history = next;
+            if friction_force != 0.0 {
+                // F = (F0 + k P A) / (1 - k), k = sqrt(2) Cf z held; A = V / L.
+                let k = SQRT_2 * f.strand.coefficient * next.z;
+                let area_slope = if l > 0.0 {
+                    (dv * l - volume) / (l * l)
+                } else {
+                    0.0
+                };
+                let stiffness = (frictionless_stiffness + k * p_eff * area_slope) / (1.0 - k);
+                out.stiffness = if stiffness.is_finite() {
+                    stiffness
+                } else {
+                    frictionless_stiffness
+                };
+            }
+        }
+        out
+    }
+
+    fn write(vars: &mut Vars, out: &Output) {
+        let r = &mut vars.real;
+        r[real::FORCE] = out.force;
+        r[real::VOLUME] = out.volume;
+        r[real::EFFECTIVE_PRESSURE] = out.effective_pressure;
+        r[real::FRICTION_FORCE] = out.friction_force;
+        r[real::MAX_RADIUS] = out.max_radius;
+        r[real::STIFFNESS] = out.stiffness;
+    }
+}
+
+impl Model for KnittedMuscle {
+    const INFO: &'static ModelInfo = &INFO;
+    const DOCUMENTATION: &'static str = include_str!("knitted_muscle.html");
+
+    fn new(vars: &mut Vars) -> Result<Self, String> {
+        let sleeve = KnittedSleeve::new(sleeve_params(vars)?, shape_kind(vars)?)?;
+        let friction = if vars.boolean[boolean::FRICTION] {
+            Some(Friction {
+                strand: StrandFriction::new(vars.real[real::FRICTION_COEFFICIENT])?,
+                operator: StopOperator::new(vars.real[real::PRESLIDING_LENGTH])?,
+            })
+        } else {
+            None
+        };
+        vars.real[real::MAX_LENGTH] = sleeve.max_length();
+        vars.real[real::MIN_LENGTH] = sleeve.min_length();
+        vars.real[real::FREE_CONTRACTION_LENGTH] = sleeve.free_contraction_length();
+        // Friction starts relaxed (z = 0) where the sleeve is at initialization.
+        let history = HysteresisState::at_rest(sleeve.clamp_length(vars.real[real::LENGTH]));
+        Ok(Self {
+            sleeve,
+            friction,
+            history,
+            out_of_range: false,
+        })
+    }
+
+    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
+        let out = self.compute(vars, report);
+        Self::write(vars, &out);
+    }
+
+    fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
+        // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
+        // history follows the length path sampled at the communication points.
+        let out = self.compute(vars, report);
+        Self::write(vars, &out);
+        self.history = out.history;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn vars_with(shape: i32, friction: bool) -> Vars {
+        let mut vars = Vars::from_start(&INFO);
+        vars.integer[integer::SHAPE_MODEL] = shape;
+        vars.boolean[boolean::FRICTION] = friction;
+        vars
+    }
+
+    #[test]
+    fn only_step_commits_the_friction_history() {
+        let mut vars = vars_with(0, true);
+        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let start = m.history;
+        vars.real[real::PRESSURE] = 14e3;
+        vars.real[real::LENGTH] = 0.35;
+        let mut report = Report::default();
+        m.evaluate(&mut vars, &mut report);
+        assert_eq!(m.history, start);
+        // Shortening by far more than the presliding length: full friction against it (z = -1),
+        // of magnitude sqrt(2) Cf (F + P A) (eq. 1.21).
+        assert!(vars.real[real::FRICTION_FORCE] < 0.0);
+        m.step(&mut vars, 0.0, 1e-3, &mut report);
+        assert_eq!(m.history.z, -1.0);
+        assert_eq!(m.history.position, 0.35);
+        let (f, fr) = (vars.real[real::FORCE], vars.real[real::FRICTION_FORCE]);
+        let tension = f + 14e3 * m.sleeve.mean_area(0.35);
+        assert!((fr + SQRT_2 * 0.25 * tension).abs() < 1e-12 * f.abs());
+        assert_eq!(report.status, Status::Ok);
+    }
+
+    #[test]
+    fn out_of_range_is_the_nearest_limit_warned_once_per_excursion() {
+        let mut vars = vars_with(2, false);
+        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let (lo, hi) = (vars.real[real::MIN_LENGTH], vars.real[real::MAX_LENGTH]);
+        vars.real[real::PRESSURE] = 14e3;
+        vars.real[real::LENGTH] = hi;
+        let mut report = Report::default();
+        m.evaluate(&mut vars, &mut report);
+        let at_limit = vars.real.clone();
+        let mut warned = 0;
+        for length in [hi + 1.0, 2.0 * hi, 0.4, 0.0, lo - 1e-9] {
+            let mut report = Report::default();
+            vars.real[real::LENGTH] = length;
+            m.evaluate(&mut vars, &mut report);
+            warned += report.messages.len();
+            assert_eq!(report.status > Status::Ok, !(lo..=hi).contains(&length));
+            if length > hi {
+                assert_eq!(vars.real[real::FORCE], at_limit[real::FORCE]);
+            }
+            assert!(vars.real.iter().all(|x| x.is_finite()));
+        }
+        assert_eq!(warned, 2);
+    }
+
+    #[test]
+    fn non_cylindrical_needs_a_thick_strand() {
+        let mut vars = vars_with(2, false);
+        vars.real[real::STRAND_THICKNESS] = 0.0;
+        let e = KnittedMuscle::new(&mut vars).unwrap_err();
+        assert!(e.contains("positive minimum radius"), "{e}");
+        vars.integer[integer::SHAPE_SEGMENTS] = -3;
+        vars.real[real::STRAND_THICKNESS] = 2e-4;
+        assert!(KnittedMuscle::new(&mut vars).is_err());
+    }
+}
