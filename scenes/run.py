@@ -29,7 +29,10 @@ def load_scene(path, fast=False):
         scene["step"] = f.get("step", scene["step"])
         scene["stop_time"] = f.get("stop_time", scene["stop_time"])
         if scene.get("sweep") and "sweep_values" in f:
-            scene["sweep"] = dict(scene["sweep"], values=f["sweep_values"])
+            sweep = scene["sweep"]
+            keep = [sweep["values"].index(v) for v in f["sweep_values"]]
+            also = {name: [column[i] for i in keep] for name, column in sweep.get("also", {}).items()}
+            scene["sweep"] = dict(sweep, values=f["sweep_values"], also=also)
     return scene
 
 
@@ -91,6 +94,8 @@ def run_scene(scene, progress=True):
                 inputs[sweep["variable"]] = {"type": "constant", "value": value}
             else:
                 parameters[sweep["variable"]] = value
+            for name, column in sweep.get("also", {}).items():
+                parameters[name] = column[k]
         signals = None
         if inputs:
             signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in inputs])

@@ -78,6 +78,9 @@ pub struct Sweep {
     /// A parameter or an input (which then becomes constant) by name.
     pub variable: String,
     pub values: Vec<f64>,
+    /// Parameters that change in step with `variable`, one value per run each.
+    #[serde(default)]
+    pub also: BTreeMap<String, Vec<f64>>,
 }
 
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -149,6 +152,14 @@ impl Scene {
             s.step = f.step.unwrap_or(s.step);
             s.stop_time = f.stop_time.unwrap_or(s.stop_time);
             if let (Some(sweep), Some(values)) = (&mut s.sweep, &f.sweep_values) {
+                // Keep the lockstep parameters of the sweep values that remain.
+                let keep: Vec<usize> = values
+                    .iter()
+                    .filter_map(|v| sweep.values.iter().position(|x| x == v))
+                    .collect();
+                for column in sweep.also.values_mut() {
+                    *column = keep.iter().map(|&i| column[i]).collect();
+                }
                 sweep.values = values.clone();
             }
         }
@@ -166,6 +177,17 @@ impl Scene {
         }
         if self.outputs.is_empty() {
             return Err("scene: no outputs to record".into());
+        }
+        if let Some(sweep) = &self.sweep {
+            if let Some((name, _)) = sweep
+                .also
+                .iter()
+                .find(|(_, v)| v.len() != sweep.values.len())
+            {
+                return Err(format!(
+                    "scene: sweep.also.{name} needs one value per sweep value"
+                ));
+            }
         }
         for (name, signal) in &self.inputs {
             if let Signal::Steps { times, values } = signal {

@@ -112,7 +112,7 @@ pub fn run(scene: &Scene, scene_dir: &Path, fmu_dir: &Path) -> Result<Vec<Run>, 
         None => vec![None],
     };
     let mut runs = Vec::new();
-    for value in sweep_values {
+    for (index, value) in sweep_values.into_iter().enumerate() {
         let mut parameters = scene.parameters.clone();
         let mut inputs = scene.inputs.clone();
         if let (Some(sweep), Some(v)) = (&scene.sweep, value) {
@@ -120,6 +120,9 @@ pub fn run(scene: &Scene, scene_dir: &Path, fmu_dir: &Path) -> Result<Vec<Run>, 
                 inputs.insert(sweep.variable.clone(), Signal::Constant { value: v });
             } else {
                 parameters.insert(sweep.variable.clone(), Value::Number(v));
+            }
+            for (name, column) in &sweep.also {
+                parameters.insert(name.clone(), Value::Number(column[index]));
             }
         }
         let mut cs = import
