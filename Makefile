@@ -58,6 +58,7 @@ test: test-rust test-fmpy
 ## Native cost per FMI step (criterion), through the packaged FMU's C ABI.
 bench: deps fmus
 	cargo bench --bench fmi_step
+	cargo bench --bench knitted_shape
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
