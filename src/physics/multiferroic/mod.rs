@@ -529,8 +529,17 @@ impl Motor {
         }
     }
 
-    /// Right-hand side and Jacobian of the ODE in `(phi, omega, psi, theta)`.
-    fn rhs_jacobian(&self, y: &Vector, d: &Drive) -> (Vector, [[f64; 4]; 4]) {
+    /// Right-hand side and Jacobian of the ODE in `(phi, omega, psi, theta)`, for a substep `dt`.
+    ///
+    /// Past the torque peak the rotor's linearized stiffness is negative and `exp(dt J)` grows
+    /// like `exp(lambda dt)` with the unstable rate `lambda`. That growth is real only while the
+    /// rotor stays near the linearization point; over a substep much longer than `1/lambda` (~ the
+    /// relaxation time `c/|k|`) the rotor has long left the region and the true motion is bounded by
+    /// the drag speed `|F|/c`. So when `lambda dt > 1` the negative stiffness is dropped (set to 0):
+    /// the substep then drifts at most at the terminal speed of its starting force and cannot
+    /// amplify. Such substeps are only ever taken when budget-forced (the error control rejects
+    /// them otherwise: their half steps keep the stiffness and disagree), and they are flagged.
+    fn rhs_jacobian(&self, y: &Vector, d: &Drive, dt: f64) -> (Vector, [[f64; 4]; 4]) {
         let mut f = [0.0; 4];
         let mut j = [[0.0; 4]; 4];
         let beta = y[2] - y[0];
@@ -552,10 +561,11 @@ impl Motor {
                 // Near a fold the sum vanishes; bound it so the linearization stays finite.
                 let sum = (k_bar + k_me).max(0.05 * (k_bar.abs() + k_me.abs()));
                 let k_eff = if sum > 0.0 { k_bar * k_me / sum } else { 0.0 };
-                j[1][0] = -k_eff / i;
+                j[1][0] = -self.bounded_stiffness(k_eff, dt) / i;
             } else {
-                j[1][0] = -k_bar / i;
-                j[1][2] = k_bar / i;
+                let k = self.bounded_stiffness(k_bar, dt);
+                j[1][0] = -k / i;
+                j[1][2] = k / i;
             }
         }
         if !quasi {
@@ -580,11 +590,27 @@ impl Motor {
         (f, j)
     }
 
+    /// The rotor stiffness `k` for the linearization over `dt`: unchanged unless it is negative
+    /// and the unstable rate `lambda = (sqrt(c^2 - 4 I k) - c) / (2 I)` of `I x'' + c x' + k x = 0`
+    /// times `dt` exceeds 1; then 0 (see [`Self::rhs_jacobian`]).
+    fn bounded_stiffness(&self, k: f64, dt: f64) -> f64 {
+        if k >= 0.0 {
+            return k;
+        }
+        let (i, c) = (self.inertia, self.drag);
+        let rate = ((c * c - 4.0 * i * k).sqrt() - c) / (2.0 * i);
+        if rate * dt > 1.0 {
+            0.0
+        } else {
+            k
+        }
+    }
+
     /// One exponential Rosenbrock-Euler substep: `y + dt phi1(dt J) f(y)`, computed as the last
     /// column of the exponential of the augmented matrix `dt [[J, f], [0, 0]]`. Exact for linear
     /// dynamics; the quasi-static onion is re-settled at the new rotor angle.
     fn exponential_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<Vector> {
-        let (f, j) = self.rhs_jacobian(y, d);
+        let (f, j) = self.rhs_jacobian(y, d, dt);
         let mut m = [[0.0; expm::N]; expm::N];
         for i in 0..4 {
             for k in 0..4 {
@@ -609,6 +635,149 @@ impl Motor {
         (out.iter().all(|x| x.is_finite()) && sane).then_some(out)
     }
 
+    /// Force on the rotor at `phi` with the onion settled at `psi`, `F = tau_bar + load`, and its
+    /// reduced stiffness `k = -dF/dphi` (the bar spring in series with the magnetoelastic one,
+    /// bounded near a fold as in [`Self::rhs_jacobian`]).
+    fn rotor_force(&self, phi: f64, psi: f64, d: &Drive) -> (f64, f64) {
+        let beta = psi - phi;
+        let k_bar = self.ring_bar.stiffness(beta);
+        let k_me =
+            2.0 * self.magnetoelastic_per_stress * d.stress * (2.0 * (psi - d.direction)).cos();
+        let sum = (k_bar + k_me).max(0.05 * (k_bar.abs() + k_me.abs()));
+        let k = if sum > 0.0 { k_bar * k_me / sum } else { 0.0 };
+        (self.ring_bar.torque(beta) + d.load, k)
+    }
+
+    /// The rotor after `available` seconds at constant drive, in the overdamped limit, when by
+    /// then it has come within [`MAX_SETTLE_RESIDUAL`] of its equilibrium; `None` when it has not
+    /// or that limit does not apply (locked rotor, Gilbert onion, no drag, a fast initial speed,
+    /// a rotor that slips without end, or a degenerate equilibrium).
+    ///
+    /// The rotor is strongly overdamped (`I/c` ~ 2 ns against `c/k` ~ 3 us), so after its speed's
+    /// initial layer (`omega I / c` of coasting, a few `I/c`) it moves as `c phi' = F(phi)`, a
+    /// gradient flow: it goes downhill from where it is and stops at the first zero of `F`, i.e.
+    /// the same memory rule as the onion's, with the onion re-settled (memory and folds included)
+    /// at every point of the path. The march follows `F` in strides that change `F` by at most a
+    /// quarter (and at most [`MAX_ROTOR_STRIDE`]) and adds up the travel time `int c / |F| dphi`
+    /// (trapezoid in `1/F`). Once the root is bracketed, the rest is the linear exponential
+    /// approach: the distance `d` left decays as `d exp(-k t / c)` with the stiffness `k` at the
+    /// root, which gives the end state and speed (an error of `delta` in the travel time moves the
+    /// end by `residual k delta / c`, below the tolerance for the residuals allowed). A fold that flips the force's sign (the onion jumps) turns the
+    /// rotor back and the march goes on from the jumped state. Hand-written for the hot path:
+    /// every loop is capped.
+    fn settle_rotor(&self, y: &Vector, d: &Drive, available: f64) -> Option<Vector> {
+        let (i, c) = (self.inertia, self.drag);
+        if d.locked || !self.quasi_static() || c <= 0.0 {
+            return None;
+        }
+        let coast = y[1] * i / c;
+        if coast.abs() > MAX_ROTOR_STRIDE {
+            return None;
+        }
+        let eps = 1e-2 * self.params.tolerance;
+        // Torque scale (N m): the alignment stiffness times one radian, plus the load.
+        let force_scale = self.alignment_stiffness.abs() + d.load.abs();
+        let continuous = 1e-6 * force_scale;
+        let mut phi = y[0] + coast;
+        let mut psi = self.landscape(phi, d.direction, d.stress).settle(y[2]);
+        // The initial layer: the speed has decayed by e^-20 after 20 I/c.
+        let mut time = 20.0 * i / c;
+        let mut travelled = 0.0;
+        let mut turnarounds = 0;
+        for _ in 0..MAX_ROTOR_MARCH {
+            let (force, k) = self.rotor_force(phi, psi, d);
+            if force == 0.0 && k > 0.0 {
+                return (time < available).then_some([phi, 0.0, psi, 0.0]);
+            }
+            let dir = force.signum();
+            let stride = if k > 0.0 && force.abs() <= k * MAX_ROTOR_STRIDE {
+                // Near the root: aim past it to bracket it.
+                (1.5 * force.abs() / k).max(eps)
+            } else if k != 0.0 {
+                (0.25 * force.abs() / k.abs()).clamp(eps, MAX_ROTOR_STRIDE)
+            } else {
+                MAX_ROTOR_STRIDE
+            };
+            let next_phi = phi + dir * stride;
+            let next_psi = self.landscape(next_phi, d.direction, d.stress).settle(psi);
+            let (next_force, _) = self.rotor_force(next_phi, next_psi, d);
+            if dir * next_force > 0.0 {
+                time += 0.5 * c * stride * (1.0 / force.abs() + 1.0 / next_force.abs());
+                travelled += stride;
+                if travelled > MAX_ROTOR_TRAVEL {
+                    return None; // slipping: no equilibrium ahead
+                }
+                phi = next_phi;
+                psi = next_psi;
+                continue;
+            }
+            // The force changed sign within the stride: refine by false position (Illinois),
+            // the onion settled from the near side each time.
+            let (mut lo, mut hi) = (phi, next_phi);
+            let (mut f_lo, mut f_hi) = (force, next_force);
+            let (mut psi_hi, mut psi_root, mut f_root) = (next_psi, psi, force);
+            let mut root = phi;
+            for _ in 0..MAX_ROOT_STEPS {
+                let mut x = hi - f_hi * (hi - lo) / (f_hi - f_lo);
+                let width = (hi - lo).abs();
+                if !(x - lo).is_finite()
+                    || (x - lo).abs() < 0.01 * width
+                    || (hi - x).abs() < 0.01 * width
+                {
+                    x = 0.5 * (lo + hi);
+                }
+                let x_psi = self.landscape(x, d.direction, d.stress).settle(psi);
+                let (fx, _) = self.rotor_force(x, x_psi, d);
+                root = x;
+                psi_root = x_psi;
+                f_root = fx;
+                if fx.abs() <= 1e-14 * force_scale {
+                    break;
+                }
+                if fx * f_lo > 0.0 {
+                    lo = x;
+                    f_lo = fx;
+                    f_hi *= 0.5;
+                } else {
+                    hi = x;
+                    f_hi = fx;
+                    psi_hi = x_psi;
+                    f_lo *= 0.5;
+                }
+                if (hi - lo).abs() <= 1e-15 * (1.0 + x.abs()) {
+                    break;
+                }
+            }
+            if f_root.abs() <= continuous {
+                let (_, k_root) = self.rotor_force(root, psi_root, d);
+                if k_root <= 0.0 {
+                    return None; // tangential equilibrium: no exponential approach
+                }
+                // The last stretch, from `phi` at `time`, is the linear exponential approach.
+                let rate = k_root / c;
+                let residual = (root - phi).abs() * (-(available - time) * rate).exp();
+                if !(time < available && residual <= MAX_SETTLE_RESIDUAL) {
+                    return None;
+                }
+                let end = root + (phi - root).signum() * residual;
+                let end_psi = self.landscape(end, d.direction, d.stress).settle(psi_root);
+                let speed = (root - end) * rate;
+                return Some([end, speed, end_psi, 0.0]);
+            }
+            // A jump of the onion flipped the force: the rotor turns back from the fold.
+            turnarounds += 1;
+            if turnarounds > MAX_TURNAROUNDS {
+                return None;
+            }
+            let reached = (hi - phi).abs();
+            time += c * reached / force.abs();
+            travelled += reached;
+            phi = hi;
+            psi = psi_hi;
+        }
+        None
+    }
+
     /// Step doubling: returns the two-half-step result and its error relative to the tolerance.
     fn doubled_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<(Vector, f64)> {
         let full = self.exponential_step(y, dt, d)?;
@@ -625,13 +794,28 @@ impl Motor {
     /// Advances `state` by `h` seconds with `inputs` held (the schedule, if any, switching inside
     /// the step) and returns the outputs at the end. On `Err` the state is untouched.
     ///
-    /// Substeps end exactly at the schedule's switches. The substep size follows the step-doubling
-    /// error estimate (growth at most 5x, shrink at most 5x per substep). The minimum substep is
-    /// `remaining time / remaining budget`, so at most about `max_substeps` attempts are made per
-    /// call whatever `h` is; a substep at that minimum is accepted even if its error exceeds the
-    /// tolerance (flagged). With the defaults (1e-6 rad, 20 000) a 1 s step of a steady rotor
-    /// takes a few dozen substeps; a 1 s step over 10 000 schedule switches is budget-limited to
-    /// about two substeps per switch, which keeps the rotor's steps but not their transients.
+    /// The step is cut at every switch of the schedule (no substep ever spans one), and each
+    /// piece of constant drive (a "segment") is advanced by one of:
+    /// - the overdamped settle ([`Self::settle_rotor`]) when the segment is longer than 10 rotor
+    ///   relaxation times and than 1.1 times the settle's computed travel time: the rotor then
+    ///   ends the segment at rest at its equilibrium within `tolerance / 100` rad, which is what
+    ///   the transient integration would give, at the cost of one substep;
+    /// - otherwise exponential substeps sized by the step-doubling error estimate (growth and
+    ///   shrink at most 5x per substep). The minimum substep is `remaining time / remaining
+    ///   budget`; a substep at that minimum is accepted even if its error exceeds the tolerance
+    ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]).
+    ///
+    /// With the stepping schedule, once two consecutive segments have ended settled at the same
+    /// place relative to the strain direction (within `tolerance / 1000` rad), every later whole
+    /// period repeats that period turned by `step_angle` (the equations are invariant under a
+    /// common rotation of rotor, onion and strain, and a settled end state does not depend on
+    /// the details of the start), so those periods are advanced at once. Hence what "accurate"
+    /// means for a long step: the state at its end, and at every switch inside it, is the
+    /// resolved trajectory's within the tolerance; the transients inside it are not reported.
+    ///
+    /// Costs: a 1 s step of a steady rotor takes one settle; a 1 s step over 10 000 schedule
+    /// switches that each let the rotor settle takes three. A step whose switches cannot be
+    /// settled nor repeated and outnumber the budget is refused with `Err`.
     pub fn step(
         &self,
         state: &mut MotorState,
@@ -662,8 +846,14 @@ impl Motor {
         } else {
             1e-10
         };
-        // Each pass either accepts a substep or counts a rejected attempt, and the minimum
-        // substep reaches the end once the budget is spent, so this bound is never the limit.
+        // The segment whose settle was tried, and where the last settled segment ended:
+        // (end time, rotor and onion angles relative to its strain direction).
+        let mut settle_tried_for = f64::NAN;
+        let mut last_settled: Option<(f64, f64, f64)> = None;
+        let long_segment = 10.0 * self.rotor_relaxation_time();
+        // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
+        // repeated periods; the minimum substep reaches the segment's end once the budget is
+        // spent, so the cap ends the loop early only when the switches outnumber the budget.
         for _ in 0..(2 * budget as u64 + 16) {
             if t >= t_end {
                 break;
@@ -679,15 +869,42 @@ impl Motor {
                 Some(s) => s.next_switch_after(t).min(t_end),
                 None => t_end,
             };
+            if settle_tried_for != segment_end && segment_end - t > long_segment {
+                settle_tried_for = segment_end;
+                if let Some(settled) = self.settle_rotor(&y, &d, segment_end - t) {
+                    {
+                        attempts = attempts.saturating_add(1);
+                        let starts_at_switch = last_settled.is_some_and(|(end, _, _)| end == t);
+                        y = settled;
+                        let relative = (y[0] - d.direction, y[2] - d.direction);
+                        let repeated = last_settled.is_some_and(|(_, r, o)| {
+                            let close = 1e-3 * self.params.tolerance;
+                            (r - relative.0).abs() <= close && (o - relative.1).abs() <= close
+                        });
+                        t = segment_end;
+                        last_settled = Some((t, relative.0, relative.1));
+                        if let (true, true, Some(s)) =
+                            (starts_at_switch, repeated, &inputs.schedule)
+                        {
+                            // Whole periods left before the one holding t_end, each one step on.
+                            let periods = s.step_index(t_end) - s.step_index(t);
+                            if periods >= 1.0 {
+                                y[0] += periods * s.step_angle;
+                                y[2] += periods * s.step_angle;
+                                t = (s.step_index(t_end) * s.step_period).min(t_end);
+                                last_settled = Some((t, relative.0, relative.1));
+                            }
+                        }
+                        continue;
+                    }
+                }
+            }
             let remaining = t_end - t;
             let left = budget.saturating_sub(attempts).max(1);
             let dt_min = remaining / left as f64;
-            let mut dt_try = dt.min(segment_end - t).max(dt_min).min(remaining);
+            let mut dt_try = dt.max(dt_min).min(segment_end - t);
             if dt_try < 1e-300 {
-                dt_try = remaining;
-            }
-            if t + dt_try > segment_end {
-                limited = true;
+                dt_try = segment_end - t;
             }
             attempts = attempts.saturating_add(1);
             if d.locked && self.quasi_static() {
@@ -722,7 +939,11 @@ impl Motor {
             }
         }
         if t < t_end {
-            limited = true;
+            return Err(format!(
+                "the step from t = {t_start} s by {h} s spans more schedule switches than \
+                 max_substeps = {budget} allows to resolve (the rotor cannot settle within a \
+                 period of the schedule); shorten the step or raise max_substeps"
+            ));
         }
         let d = self.drive_at(inputs, t_end);
         if d.locked {
@@ -746,6 +967,17 @@ impl Motor {
         })
     }
 }
+
+/// Largest stride of the rotor march in [`Motor::settle_rotor`] (rad), as the onion's.
+const MAX_ROTOR_STRIDE: f64 = 0.05;
+/// Rotor march caps: strides, travel (two turns: farther means it slips) and fold turnarounds.
+const MAX_ROTOR_MARCH: usize = 1000;
+const MAX_ROTOR_TRAVEL: f64 = 4.0 * PI;
+const MAX_TURNAROUNDS: usize = 8;
+const MAX_ROOT_STEPS: usize = 100;
+/// Largest distance from its equilibrium (rad) at which [`Motor::settle_rotor`] may leave the
+/// rotor at the end of an interval: close enough that the exponential tail is linear.
+const MAX_SETTLE_RESIDUAL: f64 = 1e-4;
 
 /// Next-substep factor for a second-order method (local error ~ dt^3), bounded to [0.2, 5].
 fn step_factor(err: f64) -> f64 {
