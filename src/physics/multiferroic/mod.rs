@@ -20,6 +20,14 @@
 //! comes out by itself), while the quasi-static onion is re-solved at the end of every substep.
 //! The method is second order; step doubling estimates the local error and sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see [`MotorParams::max_substeps`]).
+//!
+//! Long steps (issue 5): a substep far longer than the relaxation time is never integrated
+//! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
+//! a constant-drive interval long enough for the rotor to settle is advanced in the overdamped
+//! limit to its equilibrium (the same downhill memory rule as the onion's), whole periods of the
+//! schedule that repeat are advanced at once, and a slipping rotor advances by whole overdamped
+//! turns; what is left is integrated, and a forced substep drops the negative stiffness so it
+//! cannot amplify. See [`Motor::step`].
 
 pub mod expm;
 pub mod magnetics;
@@ -93,9 +101,11 @@ pub struct MotorParams {
     /// Local error tolerance per substep on angles (rad); speeds are scaled by the undamped
     /// natural frequency. Smaller is more accurate and costs more substeps.
     pub tolerance: f64,
-    /// Most attempted substeps per call of [`Motor::step`]. When a step needs more, the minimum
-    /// substep grows so that the budget still reaches the end of the step: accuracy degrades
-    /// (reported in [`StepReport::accuracy_limited`]) but the cost and stability do not.
+    /// Most attempted substeps per call of [`Motor::step`] (a settled interval counts as one).
+    /// When a step needs more, the minimum substep grows so that the budget still reaches the end
+    /// of the step: accuracy degrades (reported in [`StepReport::accuracy_limited`]) but the cost
+    /// and stability do not. Substeps never span a schedule switch, so a step whose switches
+    /// outnumber the budget and cannot be settled is refused.
     pub max_substeps: u32,
 }
 
@@ -263,7 +273,7 @@ pub struct StepReport {
     /// Attempted substeps (accepted and rejected).
     pub substeps: u32,
     /// True when the substep budget or a failed substep forced steps beyond the tolerance, or a
-    /// substep had to span a switch of the schedule.
+    /// slipping rotor was advanced by whole turns (their phase is not held to the tolerance).
     pub accuracy_limited: bool,
 }
 
@@ -778,6 +788,98 @@ impl Motor {
         None
     }
 
+    /// Time for one turn (2 pi) of a rotor that slips (its force never vanishes) from `phi`, in
+    /// the overdamped limit, and the onion angle after it; `None` if the force vanishes on the
+    /// way. `int c / |F| dphi` by Simpson's rule on strides that change `F` by at most a quarter;
+    /// a stride over which the onion jumps (a fold: `F` is discontinuous there) is halved down to
+    /// 1e-7 rad, so the jump costs no accuracy. The first inertial correction to the turn time is
+    /// `(I/c) [ln F]` over the turn, which vanishes on a periodic orbit; the next is of order
+    /// `(I k / c^2)^2` ~ 1e-6.
+    fn slip_turn(&self, phi0: f64, psi0: f64, d: &Drive) -> Option<(f64, f64)> {
+        let c = self.drag;
+        let (f0, _) = self.rotor_force(phi0, psi0, d);
+        if f0 == 0.0 {
+            return None;
+        }
+        let dir = f0.signum();
+        let target = phi0 + dir * 2.0 * PI;
+        let (mut phi, mut psi, mut force) = (phi0, psi0, f0);
+        let mut stride = MAX_ROTOR_STRIDE;
+        let mut time = 0.0;
+        let settle = |at: f64, from: f64| self.landscape(at, d.direction, d.stress).settle(from);
+        for _ in 0..MAX_SLIP_STRIDES {
+            let left = dir * (target - phi);
+            if left <= 0.0 {
+                return Some((time, psi));
+            }
+            let h = stride.min(left);
+            let mid = phi + 0.5 * dir * h;
+            let end = if h == left { target } else { phi + dir * h };
+            let psi_mid = settle(mid, psi);
+            let psi_end = settle(end, psi_mid);
+            let (f_mid, _) = self.rotor_force(mid, psi_mid, d);
+            let (f_end, k_end) = self.rotor_force(end, psi_end, d);
+            if dir * f_mid <= 0.0 || dir * f_end <= 0.0 {
+                return None;
+            }
+            // A jump moves the onion by tenths of a radian; the continuous branch moves by
+            // its slope times the stride, which grows without bound only right at a fold.
+            let jump = (5.0 * h).max(1e-3);
+            if ((psi_mid - psi).abs() > jump || (psi_end - psi_mid).abs() > jump) && h > 1e-7 {
+                stride = 0.5 * h;
+                continue;
+            }
+            time += c * h / 6.0 * (1.0 / force.abs() + 4.0 / f_mid.abs() + 1.0 / f_end.abs());
+            phi = end;
+            psi = psi_end;
+            force = f_end;
+            let smooth = if k_end != 0.0 {
+                0.25 * force.abs() / k_end.abs()
+            } else {
+                MAX_ROTOR_STRIDE
+            };
+            stride = (2.0 * h).min(smooth).clamp(1e-7, MAX_ROTOR_STRIDE);
+        }
+        None
+    }
+
+    /// A slipping rotor over `available` seconds at constant drive: one overdamped turn from the
+    /// present state (its start shifted by the speed's coast `omega I / c`), then, when a second
+    /// turn repeats it (onion back to the same place modulo 2 pi within `tolerance / 1000`), as
+    /// many more such turns as fit while leaving at least one turn of the interval to the error-
+    /// controlled integrator. Returns the time advanced and the state; `None` if the rotor does
+    /// not slip or too little time is left.
+    fn slip_turns(&self, y: &Vector, d: &Drive, available: f64) -> Option<(f64, Vector)> {
+        let (i, c) = (self.inertia, self.drag);
+        if d.locked || !self.quasi_static() || c <= 0.0 {
+            return None;
+        }
+        let coast = y[1] * i / c;
+        if coast.abs() > MAX_ROTOR_STRIDE {
+            return None;
+        }
+        let phi0 = y[0] + coast;
+        let psi0 = self.landscape(phi0, d.direction, d.stress).settle(y[2]);
+        let (first, psi1) = self.slip_turn(phi0, psi0, d)?;
+        let (f0, _) = self.rotor_force(phi0, psi0, d);
+        let turn = f0.signum() * 2.0 * PI;
+        let (period, psi2) = self.slip_turn(phi0 + turn, psi1, d)?;
+        let onion_turn = psi2 - psi1;
+        let winding = (onion_turn / (2.0 * PI)).round() * 2.0 * PI;
+        if (onion_turn - winding).abs() > 1e-3 * self.params.tolerance || period <= 0.0 {
+            return None;
+        }
+        // Turns after the first, leaving at least one period for the integrator.
+        let repeats = ((available - first) / period).floor() - 1.0;
+        if !(1.0..1e12).contains(&repeats) {
+            return None;
+        }
+        let phi = phi0 + turn * (1.0 + repeats);
+        let psi = psi1 + winding * repeats;
+        let (force, _) = self.rotor_force(phi, psi, d);
+        Some((first + repeats * period, [phi, force / c, psi, 0.0]))
+    }
+
     /// Step doubling: returns the two-half-step result and its error relative to the tolerance.
     fn doubled_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<(Vector, f64)> {
         let full = self.exponential_step(y, dt, d)?;
@@ -898,6 +1000,16 @@ impl Motor {
                         continue;
                     }
                 }
+                if let Some((advanced, slipped)) = self.slip_turns(&y, &d, segment_end - t) {
+                    // The turns' phase is only as good as their quadrature and the overdamped
+                    // limit (~1e-6 relative against resolved steps, see the tests): over
+                    // thousands of turns that is beyond the tolerance in angle, so flagged.
+                    attempts = attempts.saturating_add(1);
+                    limited = true;
+                    y = slipped;
+                    t = (t + advanced).min(segment_end);
+                    continue;
+                }
             }
             let remaining = t_end - t;
             let left = budget.saturating_sub(attempts).max(1);
@@ -975,6 +1087,9 @@ const MAX_ROTOR_MARCH: usize = 1000;
 const MAX_ROTOR_TRAVEL: f64 = 4.0 * PI;
 const MAX_TURNAROUNDS: usize = 8;
 const MAX_ROOT_STEPS: usize = 100;
+/// Strides of one slipping turn in [`Motor::slip_turn`]: 126 at the largest stride, plus the
+/// halvings at folds.
+const MAX_SLIP_STRIDES: usize = 20_000;
 /// Largest distance from its equilibrium (rad) at which [`Motor::settle_rotor`] may leave the
 /// rotor at the end of an interval: close enough that the exponential tail is linear.
 const MAX_SETTLE_RESIDUAL: f64 = 1e-4;

@@ -777,4 +777,31 @@ fn one_second_step_of_a_slipping_rotor_stays_within_the_drag_bounds() {
     );
     assert!(s.rotor_speed > 0.0 && s.rotor_speed < fast);
     assert!(r.outputs.torque.is_finite() && s.onion_angle.is_finite());
+    // Most of it is advanced as whole overdamped turns (flagged: their phase is not held to the
+    // tolerance over 1e4 turns), so it is cheap.
+    assert!(r.accuracy_limited && r.substeps < 2000, "{r:?}");
+}
+
+#[test]
+fn slipping_turns_agree_with_resolved_steps() {
+    // 2 ms of slipping (~21 turns of ~94 us): one step (whole overdamped turns by quadrature,
+    // then the integrator) against 2000 steps of 1 us (every substep error-controlled). Stated
+    // tolerance 1e-5 relative: the turn time's Simpson quadrature and the overdamped limit's
+    // second-order inertial error ((I k / c^2)^2 ~ 1e-6) are far below it; we measure 1e-6.
+    let m = motor();
+    let inputs = MotorInputs {
+        load_torque: 3e-18,
+        ..MotorInputs::fixed(PI / 2.0, 200e6)
+    };
+    let mut resolved = MotorState::aligned(0.0);
+    for _ in 0..2000 {
+        m.step(&mut resolved, &inputs, 1e-6).unwrap();
+    }
+    let mut one = MotorState::aligned(0.0);
+    let r = m.step(&mut one, &inputs, 2e-3).unwrap();
+    // It did take whole turns: resolving 21 turns costs ~5000 substeps.
+    assert!(r.accuracy_limited && r.substeps < 1000, "{r:?}");
+    assert!(resolved.rotor_angle > 100.0, "{}", resolved.rotor_angle);
+    assert_relative_eq!(one.rotor_angle, resolved.rotor_angle, max_relative = 1e-5);
+    assert_relative_eq!(one.time, resolved.time, max_relative = 1e-9);
 }
