@@ -899,25 +899,30 @@ impl Motor {
     /// The step is cut at every switch of the schedule (no substep ever spans one), and each
     /// piece of constant drive (a "segment") is advanced by one of:
     /// - the overdamped settle ([`Self::settle_rotor`]) when the segment is longer than 10 rotor
-    ///   relaxation times and than 1.1 times the settle's computed travel time: the rotor then
-    ///   ends the segment at rest at its equilibrium within `tolerance / 100` rad, which is what
-    ///   the transient integration would give, at the cost of one substep;
+    ///   relaxation times and the rotor ends it within [`MAX_SETTLE_RESIDUAL`] of its
+    ///   equilibrium, on the exponential tail (agrees with resolved integration within 3e-7 rad
+    ///   for the default schedule), at the cost of one substep;
     /// - otherwise exponential substeps sized by the step-doubling error estimate (growth and
     ///   shrink at most 5x per substep). The minimum substep is `remaining time / remaining
     ///   budget`; a substep at that minimum is accepted even if its error exceeds the tolerance
-    ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]).
+    ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]);
+    /// - a slipping rotor (no equilibrium ahead) advances by whole overdamped turns
+    ///   ([`Self::slip_turns`], flagged).
     ///
-    /// With the stepping schedule, once two consecutive segments have ended settled at the same
-    /// place relative to the strain direction (within `tolerance / 1000` rad), every later whole
-    /// period repeats that period turned by `step_angle` (the equations are invariant under a
-    /// common rotation of rotor, onion and strain, and a settled end state does not depend on
-    /// the details of the start), so those periods are advanced at once. Hence what "accurate"
-    /// means for a long step: the state at its end, and at every switch inside it, is the
-    /// resolved trajectory's within the tolerance; the transients inside it are not reported.
+    /// Each segment may use at most 1/16 of the substeps left. With the stepping schedule, once
+    /// three consecutive whole periods have ended in the same state relative to the strain
+    /// direction (within `tolerance / 100` and then `tolerance / 1000`), every later whole period
+    /// repeats the last one turned by `step_angle` (the equations are invariant under a common
+    /// rotation of rotor, onion and strain), so those periods are advanced at once. This covers
+    /// periods that let the rotor settle and faster ones where it turns continuously on a
+    /// periodic orbit. Hence what "accurate" means for a long step: the state at its end, and at
+    /// every switch inside it, is the resolved trajectory's within the tolerance; the transients
+    /// inside it are not reported.
     ///
-    /// Costs: a 1 s step of a steady rotor takes one settle; a 1 s step over 10 000 schedule
-    /// switches that each let the rotor settle takes three. A step whose switches cannot be
-    /// settled nor repeated and outnumber the budget is refused with `Err`.
+    /// Costs (release): a 1 s step of a steady rotor takes one settle; a 1 s step over the
+    /// 10 000 switches of the default schedule a few settles (~0.1 ms); with 25-60 us periods a
+    /// few hundred to two thousand substeps (~6 ms). A step whose switches outnumber the budget
+    /// and never repeat (a schedule too fast for the rotor, which loses steps) is refused.
     pub fn step(
         &self,
         state: &mut MotorState,
@@ -948,10 +953,16 @@ impl Motor {
         } else {
             1e-10
         };
-        // The segment whose settle was tried, and where the last settled segment ended:
-        // (end time, rotor and onion angles relative to its strain direction).
+        // The segment whose settle was tried.
         let mut settle_tried_for = f64::NAN;
-        let mut last_settled: Option<(f64, f64, f64)> = None;
+        // The segment in progress: its end, strain direction, and whether it began at a switch
+        // (a whole period of the schedule).
+        let (mut segment_end_prev, mut segment_direction, mut whole_period) =
+            (f64::NAN, 0.0, false);
+        // The state at the end of the last whole period relative to its strain direction
+        // (rotor, onion, speed) and how far it was from the one before (rad).
+        let mut period_end: Option<[f64; 3]> = None;
+        let mut period_mismatch = f64::INFINITY;
         let long_segment = 10.0 * self.rotor_relaxation_time();
         // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
         // repeated periods; the minimum substep reaches the segment's end once the budget is
@@ -959,6 +970,39 @@ impl Motor {
         for _ in 0..(2 * budget as u64 + 16) {
             if t >= t_end {
                 break;
+            }
+            if let (Some(s), true) = (&inputs.schedule, t == segment_end_prev) {
+                // A switch reached. The equations are invariant under a common rotation of rotor,
+                // onion and strain, so once whole periods end in the same relative state, every
+                // later period repeats the last one turned by step_angle. Required: three
+                // period ends within tolerance / 100 and then tolerance / 1000 of each other,
+                // i.e. the period map has converged onto its fixed point (a settled end state,
+                // or the rotor's periodic orbit) and contracts towards it.
+                let relative = [
+                    y[0] - segment_direction,
+                    y[2] - segment_direction,
+                    y[1] / self.speed_scale,
+                ];
+                let tol = self.params.tolerance;
+                if whole_period {
+                    let mismatch = period_end.map_or(f64::INFINITY, |p| {
+                        (0..3)
+                            .map(|i| (p[i] - relative[i]).abs())
+                            .fold(0.0, f64::max)
+                    });
+                    let periods = s.step_index(t_end) - s.step_index(t);
+                    if mismatch <= 1e-3 * tol && period_mismatch <= 1e-2 * tol && periods >= 1.0 {
+                        y[0] += periods * s.step_angle;
+                        y[2] += periods * s.step_angle;
+                        t = (s.step_index(t_end) * s.step_period).min(t_end);
+                        segment_end_prev = f64::NAN;
+                        period_end = None;
+                        period_mismatch = f64::INFINITY;
+                        continue;
+                    }
+                    period_mismatch = mismatch;
+                }
+                period_end = Some(relative);
             }
             let d = self.drive_at(inputs, t);
             if d.locked {
@@ -971,34 +1015,18 @@ impl Motor {
                 Some(s) => s.next_switch_after(t).min(t_end),
                 None => t_end,
             };
+            if segment_end != segment_end_prev {
+                whole_period = t == segment_end_prev;
+                segment_end_prev = segment_end;
+                segment_direction = d.direction;
+            }
             if settle_tried_for != segment_end && segment_end - t > long_segment {
                 settle_tried_for = segment_end;
                 if let Some(settled) = self.settle_rotor(&y, &d, segment_end - t) {
-                    {
-                        attempts = attempts.saturating_add(1);
-                        let starts_at_switch = last_settled.is_some_and(|(end, _, _)| end == t);
-                        y = settled;
-                        let relative = (y[0] - d.direction, y[2] - d.direction);
-                        let repeated = last_settled.is_some_and(|(_, r, o)| {
-                            let close = 1e-3 * self.params.tolerance;
-                            (r - relative.0).abs() <= close && (o - relative.1).abs() <= close
-                        });
-                        t = segment_end;
-                        last_settled = Some((t, relative.0, relative.1));
-                        if let (true, true, Some(s)) =
-                            (starts_at_switch, repeated, &inputs.schedule)
-                        {
-                            // Whole periods left before the one holding t_end, each one step on.
-                            let periods = s.step_index(t_end) - s.step_index(t);
-                            if periods >= 1.0 {
-                                y[0] += periods * s.step_angle;
-                                y[2] += periods * s.step_angle;
-                                t = (s.step_index(t_end) * s.step_period).min(t_end);
-                                last_settled = Some((t, relative.0, relative.1));
-                            }
-                        }
-                        continue;
-                    }
+                    attempts = attempts.saturating_add(1);
+                    y = settled;
+                    t = segment_end;
+                    continue;
                 }
                 if let Some((advanced, slipped)) = self.slip_turns(&y, &d, segment_end - t) {
                     // The turns' phase is only as good as their quadrature and the overdamped
@@ -1013,7 +1041,11 @@ impl Motor {
             }
             let remaining = t_end - t;
             let left = budget.saturating_sub(attempts).max(1);
-            let dt_min = remaining / left as f64;
+            // The budget is shared over the rest of the step, but each segment may use at most
+            // 1/16 of what is left, so that the first periods of a schedule are resolved well
+            // enough for their repetition to be detected (and then the rest costs nothing).
+            let per_segment = (left / SEGMENT_BUDGET_SHARE).max(1);
+            let dt_min = (remaining / left as f64).min((segment_end - t) / per_segment as f64);
             let mut dt_try = dt.max(dt_min).min(segment_end - t);
             if dt_try < 1e-300 {
                 dt_try = segment_end - t;
@@ -1080,6 +1112,8 @@ impl Motor {
     }
 }
 
+/// A segment of constant drive may use at most 1/this of the substeps left (see [`Motor::step`]).
+const SEGMENT_BUDGET_SHARE: u32 = 16;
 /// Largest stride of the rotor march in [`Motor::settle_rotor`] (rad), as the onion's.
 const MAX_ROTOR_STRIDE: f64 = 0.05;
 /// Rotor march caps: strides, travel (two turns: farther means it slips) and fold turnarounds.

@@ -805,3 +805,33 @@ fn slipping_turns_agree_with_resolved_steps() {
     assert_relative_eq!(one.rotor_angle, resolved.rotor_angle, max_relative = 1e-5);
     assert_relative_eq!(one.time, resolved.time, max_relative = 1e-9);
 }
+
+#[test]
+fn fast_schedule_long_steps_repeat_the_periodic_orbit() {
+    // 25 us periods (~3 relaxation times): the rotor turns continuously and never settles, so a
+    // long step resolves the first periods and, once whole periods end in the same state relative
+    // to the strain direction, repeats the last one. One 10 ms step against 10 000 steps of 1 us:
+    // within 2e-6 rad (the 1e-6 rad local tolerance; we measure 9e-7), and a 1 s step (40 000
+    // periods) follows at 60 degrees per period less the same small lag, cheaply.
+    let m = motor();
+    let inputs = schedule(25e-6);
+    let mut resolved = MotorState::aligned(0.0);
+    for _ in 0..10_000 {
+        m.step(&mut resolved, &inputs, 1e-6).unwrap();
+    }
+    let mut one = MotorState::aligned(0.0);
+    let r = m.step(&mut one, &inputs, 10e-3).unwrap();
+    assert!(!r.accuracy_limited && r.substeps < 5000, "{r:?}");
+    assert!(
+        (one.rotor_angle - resolved.rotor_angle).abs() < 2e-6,
+        "{} {}",
+        one.rotor_angle,
+        resolved.rotor_angle
+    );
+    let lag = 400.0 * PI / 3.0 - resolved.rotor_angle;
+    assert!(lag > 0.0 && lag < 0.2, "{lag}");
+    let mut long = MotorState::aligned(0.0);
+    let r = m.step(&mut long, &inputs, 1.0).unwrap();
+    assert!(!r.accuracy_limited && r.substeps < 5000, "{r:?}");
+    assert!((40_000.0 * PI / 3.0 - long.rotor_angle - lag).abs() < 2e-6);
+}
