@@ -188,11 +188,12 @@ impl Model for MultiferroicMotor {
                         report.status = report.status.max(Status::Warning);
                     } else {
                         report.warn(format!(
-                            "the step from t = {time} s by {step} s needed more than max_substeps \
-                             = {} substeps (or spanned a schedule switch) and was completed beyond \
-                             tolerance = {} rad; raise max_substeps or shorten the step for the \
-                             transients (logged once per run)",
-                            self.motor.params.max_substeps, self.motor.params.tolerance
+                            "the step from t = {time} s by {step} s was completed beyond tolerance \
+                             = {} rad (its substep budget max_substeps = {} ran out, or a slipping \
+                             rotor or the Gilbert onion model was advanced over many periods at \
+                             once); shorten the step or raise max_substeps where this matters \
+                             (logged once per run)",
+                            self.motor.params.tolerance, self.motor.params.max_substeps
                         ));
                         self.accuracy_warned = true;
                     }
