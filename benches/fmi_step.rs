@@ -5,6 +5,7 @@
 mod common;
 
 use actuator_fmus::physics::gaylord::Sleeve;
+use actuator_fmus::variables::REGISTRY;
 use common::mckibben::*;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::time::Duration;
@@ -109,9 +110,51 @@ fn motor(c: &mut Criterion) {
     );
 }
 
+/// Issue 6: the ideal McKibben step against eq. 2.3 hand-inlined behind the same FMI calls. Both
+/// FMUs get one fmi2SetReal of one value, one fmi2DoStep and one fmi2GetReal of one value; the
+/// PassThrough FMU's step is the FMI layer alone, and eq. 2.3 itself costs about 1 ns on top.
+fn ideal_against_inlined(c: &mut Criterion) {
+    let mut group = c.benchmark_group("same FMI calls: set one input, step, get one output");
+    for (model, input, output, value) in [
+        ("PassThrough", "u", "y", 0.5),
+        ("McKibbenMuscle", "length", "force", 0.09),
+    ] {
+        let info = REGISTRY
+            .iter()
+            .find(|f| f.info().name == model)
+            .expect("model")
+            .info();
+        let api = common::Api::load(&common::extract_binary(model));
+        let inst = api
+            .instantiate("bench", info.guid)
+            .unwrap_or_else(|_| panic!("instantiate"));
+        inst.initialize();
+        if model == "McKibbenMuscle" {
+            assert_eq!(inst.set_real(&[PRESSURE], &[4e5]), common::OK);
+        }
+        let (vin, vout) = (
+            info.by_name(input).expect("input").vr,
+            info.by_name(output).expect("output").vr,
+        );
+        let (mut t, mut k, mut out) = (0.0, 0u32, [0.0]);
+        group.bench_function(model, |bench| {
+            bench.iter(|| unsafe {
+                k = k.wrapping_add(1);
+                let x = value + 1e-6 * (k % 1000) as f64;
+                (api.fmi2SetReal)(inst.c, &vin, 1, &x);
+                (api.fmi2DoStep)(inst.c, t, 1e-3, 1);
+                t += 1e-3;
+                (api.fmi2GetReal)(inst.c, &vout, 1, out.as_mut_ptr());
+                black_box(out[0])
+            })
+        });
+    }
+    group.finish();
+}
+
 criterion_group! {
     name = benches;
     config = Criterion::default().measurement_time(Duration::from_secs(3)).warm_up_time(Duration::from_secs(1));
-    targets = mckibben, motor
+    targets = mckibben, motor, ideal_against_inlined
 }
 criterion_main!(benches);

@@ -19,9 +19,18 @@ use serde::{Deserialize, Serialize};
 /// is evaluated this fraction of the range inside the limit (finite, steep force).
 const LIMIT_MARGIN: f64 = 1e-3;
 
+/// The effects the parameters switch on, built once at initialization. The bare sleeve needs
+/// none of the bladder, friction and connector machinery, and none of their outputs change.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+enum Pipeline {
+    /// Eq. 2.3 alone: no bladder, no friction, rigid connector.
+    Sleeve(Sleeve),
+    Full(McKibben),
+}
+
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct McKibbenMuscle {
-    muscle: McKibben,
+    pipeline: Pipeline,
     /// Friction history (eq. 2.4), advanced only by accepted steps.
     friction: HysteresisState,
     /// Whether the last evaluation needed the fallback: its warning is logged once per excursion.
@@ -66,19 +75,69 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
     })
 }
 
+/// The warning for an input without a solution: once per excursion, then only the status.
+fn out_of_range(
+    logged: &mut bool,
+    report: &mut Report,
+    reason: &str,
+    (lo, hi): (f64, f64),
+    fallback: Option<(f64, f64)>,
+) {
+    if !*logged {
+        let what = match fallback {
+            Some((p, l)) => format!("evaluating at pressure {p} Pa and length {l} m"),
+            None => "holding the previous outputs".into(),
+        };
+        report.warn(format!(
+            "{reason} (valid lengths {lo} .. {hi} m, max_length {hi} m); {what} until the inputs return"
+        ));
+    }
+    report.status = report.status.max(Status::Warning);
+    *logged = true;
+}
+
+/// Eq. 2.3 for the bare sleeve; only the outputs that change are written.
+fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &mut Report) {
+    let (pressure, requested) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+    let b = sleeve.max_length();
+    let length = if requested > b {
+        let reason =
+            format!("length {requested} m is outside [0, b = {b}] m, the ideal sleeve's range");
+        out_of_range(logged, report, &reason, (0.0, b), Some((pressure, b)));
+        b
+    } else {
+        *logged = false;
+        requested
+    };
+    // The sleeve is only ever pushed outwards: under vacuum the bladder leaves it.
+    let p_eff = pressure.max(0.0);
+    let r = &mut vars.real;
+    r[real::FORCE] = sleeve.force(p_eff, length);
+    r[real::VOLUME] = sleeve.volume(length);
+    r[real::EFFECTIVE_PRESSURE] = p_eff;
+    r[real::STIFFNESS] = sleeve.stiffness(p_eff, length);
+    vars.boolean[boolean::BLADDER_CONTACT] = pressure > 0.0;
+}
+
 impl McKibbenMuscle {
-    /// The physics at the current inputs; out of range, the nearest point inside it (logged).
-    fn compute(&mut self, vars: &Vars, report: &mut Report) -> Option<McKibbenOutput> {
+    /// The full model at the current inputs; out of range, the nearest point inside it (logged).
+    fn compute(
+        muscle: &McKibben,
+        friction: &HysteresisState,
+        logged: &mut bool,
+        vars: &Vars,
+        report: &mut Report,
+    ) -> Option<McKibbenOutput> {
         let (pressure, length) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
-        let reason = match self.muscle.evaluate(pressure, length, &self.friction) {
+        let reason = match muscle.evaluate(pressure, length, friction) {
             Ok(out) => {
-                self.out_of_range = false;
+                *logged = false;
                 return Some(out);
             }
             Err(reason) => reason,
         };
-        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() {
+        let (lo, hi) = (muscle.min_length(), muscle.max_length());
+        let margin = if muscle.bladder().is_some() {
             LIMIT_MARGIN * (hi - lo)
         } else {
             0.0
@@ -86,23 +145,9 @@ impl McKibbenMuscle {
         let clamped = length.clamp(lo + margin, hi - margin);
         let fallback = [(pressure, clamped), (pressure.max(0.0), clamped)]
             .into_iter()
-            .find_map(|(p, l)| {
-                self.muscle
-                    .evaluate(p, l, &self.friction)
-                    .ok()
-                    .map(|o| (p, l, o))
-            });
-        if !self.out_of_range {
-            let what = match &fallback {
-                Some((p, l, _)) => format!("evaluating at pressure {p} Pa and length {l} m"),
-                None => "holding the previous outputs".into(),
-            };
-            report.warn(format!(
-                "{reason} (valid lengths {lo} .. {hi} m, max_length {hi} m); {what} until the inputs return"
-            ));
-        }
-        report.status = report.status.max(Status::Warning);
-        self.out_of_range = true;
+            .find_map(|(p, l)| muscle.evaluate(p, l, friction).ok().map(|o| (p, l, o)));
+        let point = fallback.as_ref().map(|(p, l, _)| (*p, *l));
+        out_of_range(logged, report, &reason, (lo, hi), point);
         fallback.map(|(_, _, out)| out)
     }
 
@@ -149,25 +194,63 @@ impl Model for McKibbenMuscle {
         vars.real[real::MIN_LENGTH] = muscle.min_length();
         // Friction starts relaxed (z = 0) at the initial length.
         let friction = HysteresisState::at_rest(vars.real[real::LENGTH]);
+        let pipeline =
+            if muscle.bladder().is_none() && !muscle.has_friction() && !muscle.has_connector() {
+                // The outputs of the absent effects keep these values for the whole run.
+                let r = &mut vars.real;
+                for (index, value) in [
+                    (real::THRESHOLD_PRESSURE, 0.0),
+                    (real::STRETCH_AXIAL, 1.0),
+                    (real::STRETCH_HOOP, 1.0),
+                    (real::STRETCH_RADIAL, 1.0),
+                    (real::STRESS_AXIAL, 0.0),
+                    (real::STRESS_HOOP, 0.0),
+                    (real::STRESS_RADIAL, 0.0),
+                    (real::FRICTION_FORCE, 0.0),
+                ] {
+                    r[index] = value;
+                }
+                Pipeline::Sleeve(*muscle.sleeve())
+            } else {
+                Pipeline::Full(muscle)
+            };
         Ok(Self {
-            muscle,
+            pipeline,
             friction,
             out_of_range: false,
         })
     }
 
     fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        if let Some(out) = self.compute(vars, report) {
-            Self::write(vars, &out);
+        match &self.pipeline {
+            Pipeline::Sleeve(sleeve) => {
+                sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
+            }
+            Pipeline::Full(muscle) => {
+                if let Some(out) =
+                    Self::compute(muscle, &self.friction, &mut self.out_of_range, vars, report)
+                {
+                    Self::write(vars, &out);
+                }
+            }
         }
     }
 
     fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
-        if let Some(out) = self.compute(vars, report) {
-            Self::write(vars, &out);
-            self.friction = out.friction_state;
+        match &self.pipeline {
+            Pipeline::Sleeve(sleeve) => {
+                sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
+            }
+            Pipeline::Full(muscle) => {
+                if let Some(out) =
+                    Self::compute(muscle, &self.friction, &mut self.out_of_range, vars, report)
+                {
+                    Self::write(vars, &out);
+                    self.friction = out.friction_state;
+                }
+            }
         }
     }
 }

@@ -253,6 +253,14 @@ impl McKibben {
         self.bladder.as_ref()
     }
 
+    pub fn has_friction(&self) -> bool {
+        self.friction.is_some()
+    }
+
+    pub fn has_connector(&self) -> bool {
+        self.connector_compliance.is_some()
+    }
+
     /// Longest actual muscle length, m (where the bladder fills the sleeve; `b` without bladder).
     pub fn max_length(&self) -> f64 {
         match &self.bladder {
