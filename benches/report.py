@@ -170,7 +170,7 @@ NATIVE_DEFAULT = {
 
 # Why a target is missed, where it is (measured causes, kept beside the numbers they explain).
 EXPLANATIONS = {
-    "McKibbenMuscle/bladder_model/none": "the full muscle computes and writes 13 outputs (stretches, stresses, stiffness, ...) every step, and the step checks the communication point and the input ranges; eq. 2.3 alone takes about 1 ns",
+    "McKibbenMuscle/bladder_model/none": "the FMI calls themselves cost about as much: behind the same calls the PassThrough FMU's step is as slow (`make bench`, group 'same FMI calls'), and eq. 2.3 adds about 1 ns",
     "McKibbenMuscle/bladder_model/thin": "the thin wall's Mooney-Rivlin stresses, the contact switch and the analytic stiffness: about 4 divisions and 2 square roots more than eq. 2.3, plus the free-bladder root below the threshold",
     "MultiferroicMotor/tolerance/1e-6": "the stepping transient needs about 100 error-controlled substeps per 60-degree step, each with a 5x5 matrix exponential and an onion-state solve",
 }

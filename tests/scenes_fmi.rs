@@ -43,3 +43,24 @@ fn catalogue_scenes_run_and_match_the_seed() {
         scenes.len()
     );
 }
+
+#[test]
+fn csv_input_signal_through_the_fmi_crate() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let dir = std::env::temp_dir().join(format!("scene-csv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    std::fs::write(dir.join("u.csv"), "time,u\n0,0\n0.5,1\n1,0\n").unwrap();
+    let scene = Scene::from_json(
+        r#"{"fmu": "PassThrough", "description": "echo", "step": 0.125, "stop_time": 1.0,
+            "inputs": {"u": {"type": "csv", "file": "u.csv", "column": "u"}}, "outputs": ["y"]}"#,
+    )
+    .unwrap();
+    let runs = scene_runner::run(&scene, &dir, &root.join("target/fmu")).unwrap();
+    let y = runs[0].column("y");
+    // The row at t + h holds the input applied at t: 0, 0, 0.25, 0.5, 0.75, 1, 0.75, 0.5, 0.25.
+    let expected = [0.0, 0.0, 0.25, 0.5, 0.75, 1.0, 0.75, 0.5, 0.25];
+    assert_eq!(y.len(), expected.len());
+    for (got, want) in y.iter().zip(expected) {
+        assert!((got - want).abs() < 1e-12, "{y:?}");
+    }
+}
