@@ -68,3 +68,9 @@ report: deps fmus $(VENV)/.installed
 clean:
 	cargo clean
 	rm -rf out $(VENV)
+
+## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
+## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
+robot-joint: deps fmus $(VENV)/.installed
+	$(PY) examples/robot_joint.py --out out
+	cargo run --release --example robot_joint
