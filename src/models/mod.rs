@@ -7,6 +7,7 @@
 use crate::variables::{ModelInfo, Start, VarType};
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
+pub mod mckibben_joint;
 pub mod mckibben_muscle;
 pub mod multiferroic_motor;
 pub mod pass_through;
