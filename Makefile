@@ -74,3 +74,9 @@ clean:
 robot-joint: deps fmus $(VENV)/.installed
 	$(PY) examples/robot_joint.py --out out
 	cargo run --release --example robot_joint
+
+## FMI cross-check files crosscheck/<Model>/<Model>_{in,ref}.csv, _ref.opt and the plots
+## docs/fmu/<Model>.png, then the FMUs again so that each documentation/ carries its plot.
+crosscheck: fmus $(VENV)/.installed
+	$(PY) crosscheck/generate.py
+	target/release/package_fmus $(LIB) target/fmu

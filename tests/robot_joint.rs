@@ -4,6 +4,7 @@
 
 #[allow(dead_code)]
 mod common;
+#[allow(dead_code)]
 #[path = "common/robot_joint.rs"]
 mod robot_joint;
 
