@@ -80,3 +80,9 @@ robot-joint: deps fmus $(VENV)/.installed
 crosscheck: fmus $(VENV)/.installed
 	$(PY) crosscheck/generate.py
 	target/release/package_fmus $(LIB) target/fmu
+
+## The robot joint as a system: out/systems/RobotJoint.ssp (fmpy simulate_ssp) and the container
+## FMU out/systems/RobotJoint.fmu (fmu-manipulation-toolbox), both run and plotted against the
+## two-FMU co-simulation: out/systems/robot_joint_systems.png.
+systems: fmus $(VENV)/.installed
+	$(PY) systems/build.py --run

@@ -45,6 +45,12 @@ def _motor(t):
     return {"strain_direction": 4 * np.pi * t / 1.2e-3, "stress": np.full_like(t, 2e8), "load_torque": np.zeros_like(t)}
 
 
+def _pulley(t):
+    # Muscle forces of a few newtons either way around 24 N: the joint swings against gravity.
+    swing = 5 * np.sin(2 * np.pi * 0.5 * t)
+    return {"flexor_force": 24 + swing, "extensor_force": 24 - swing}
+
+
 def _pass_through(t):
     return {"u": np.sin(2 * np.pi * t)}
 
@@ -54,6 +60,7 @@ SPEC = {
     "McKibbenJoint": (_joint, ["jointTorque", "flexor_force", "extensor_force", "flexor_pressure", "extensor_pressure"]),
     "MultiferroicMotor": (_motor, ["torque", "rotor_angle", "rotor_speed", "onion_angle", "offset_angle"]),
     "PassThrough": (_pass_through, ["y"]),
+    "PulleyJoint": (_pulley, ["joint_angle", "joint_velocity", "joint_torque", "flexor_pressure", "extensor_pressure"]),
 }
 
 

@@ -88,7 +88,9 @@ class Muscle:
 
 
 def simulate(p, stop_time=None):
-    """The co-simulation; returns the recorded rows (every `record_every` steps, and the last)."""
+    """The co-simulation; returns the recorded rows (every `record_every` steps, and the last).
+    A row holds the time t_k+1 and the state (q, dq) there, then what acted during the step from
+    t_k: the reference angle at t_k, the pressures, the forces and the torque."""
     h, r, L0 = p["step"], p["moment_arm"], p["rest_length"]
     n = int(round((p["stop_time"] if stop_time is None else stop_time) / h))
     mgl = p["mass"] * p["gravity"] * p["com_distance"]
