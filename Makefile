@@ -86,3 +86,9 @@ crosscheck: fmus $(VENV)/.installed
 ## two-FMU co-simulation: out/systems/robot_joint_systems.png.
 systems: fmus $(VENV)/.installed
 	$(PY) systems/build.py --run
+
+## Design sweep on Dask (not part of `make test`): bladder pre-strain x wall thickness -> net work per
+## stroke of the McKibbenMuscle FMU, out/sweep.{csv,png}. Local cluster by default; any running
+## scheduler with `make sweep SCHEDULER=tcp://host:8786`.
+sweep: fmus $(VENV)/.installed
+	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
