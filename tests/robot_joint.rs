@@ -45,6 +45,28 @@ fn fmi_crate_matches_fmpy_trajectory() {
 }
 
 #[test]
+fn joint_actuator_fmu_gives_the_same_trajectory() {
+    // McKibbenJoint computes r (F_f - F_e) from the same muscle physics with the same pressures
+    // and lengths, so stepped like gazebo-fmi steps it, it reproduces the two-muscle run.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    common::fmu_path("McKibbenJoint");
+    let p = robot_joint::Parameters::load(&root.join("examples/robot_joint.json")).unwrap();
+    let rows = robot_joint::simulate_joint_fmu(&p, &root.join("target/fmu"), None).unwrap();
+    let reference = reference();
+    assert_eq!(rows.len(), reference.len());
+    for (row, want) in rows.iter().zip(&reference) {
+        for (i, (a, b)) in row.iter().zip(want).enumerate() {
+            assert!(
+                (a - b).abs() <= 1e-9 * b.abs().max(1.0),
+                "t = {}: {} is {a}, the two-muscle run gave {b}",
+                row[0],
+                robot_joint::COLUMNS[i]
+            );
+        }
+    }
+}
+
+#[test]
 fn joint_tracks_the_reference_and_holds_the_gravity_load() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let p = robot_joint::Parameters::load(&root.join("examples/robot_joint.json")).unwrap();

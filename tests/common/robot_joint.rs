@@ -175,6 +175,87 @@ pub fn simulate(
     Ok(rows)
 }
 
+/// The same co-simulation with the McKibbenJoint FMU in place of the two muscles, stepped the way
+/// gazebo-fmi steps an actuator FMU: set `actuatorInput` (here the PD pressure difference),
+/// `jointPosition` and `jointVelocity`, do the step, read `jointTorque`.
+pub fn simulate_joint_fmu(
+    p: &Parameters,
+    fmu_dir: &Path,
+    stop_time: Option<f64>,
+) -> Result<Vec<[f64; 9]>, String> {
+    let import: Fmi2Import =
+        fmi::import::from_path(fmu_dir.join("McKibbenJoint.fmu")).map_err(|e| format!("{e}"))?;
+    let vars: BTreeMap<String, u32> = import
+        .model_description()
+        .model_variables
+        .variables
+        .iter()
+        .map(|v| (v.name.clone(), v.value_reference))
+        .collect();
+    let vr = |n: &str| {
+        vars.get(n)
+            .copied()
+            .ok_or_else(|| format!("McKibbenJoint has no variable {n}"))
+    };
+    let mut cs = import
+        .instantiate_cs("joint", false, false)
+        .map_err(|e| format!("{e}"))?;
+    let fail = |what: &str| format!("McKibbenJoint: {what} failed");
+    cs.setup_experiment(None, 0.0, None)
+        .map_err(|_| fail("setup"))?;
+    cs.enter_initialization_mode()
+        .map_err(|_| fail("enter initialization"))?;
+    let parameters = [
+        ("moment_arm", p.moment_arm),
+        ("flexor_rest_length", p.rest_length),
+        ("extensor_rest_length", p.rest_length),
+        ("common_mode_pressure", p.common_mode_pressure),
+        ("max_pressure", p.max_pressure),
+    ];
+    for (name, value) in parameters {
+        cs.set_real(&[vr(name)?], &[value])
+            .map_err(|_| fail(&format!("setting {name}")))?;
+    }
+    cs.exit_initialization_mode()
+        .map_err(|_| fail("exit initialization"))?;
+    let inputs = [
+        vr("actuatorInput")?,
+        vr("jointPosition")?,
+        vr("jointVelocity")?,
+    ];
+    let outputs = [
+        vr("jointTorque")?,
+        vr("flexor_pressure")?,
+        vr("extensor_pressure")?,
+        vr("flexor_force")?,
+        vr("extensor_force")?,
+    ];
+    let h = p.step;
+    let n = (stop_time.unwrap_or(p.stop_time) / h).round() as usize;
+    let mgl = p.mass * p.gravity * p.com_distance;
+    let (mut q, mut dq) = (0.0f64, 0.0f64);
+    let mut rows = Vec::new();
+    for k in 0..n {
+        let t = k as f64 * h;
+        let (q_ref, dq_ref) = p.reference(t);
+        let u = p.feedforward_gain * q_ref.sin() + p.kp * (q_ref - q) + p.kd * (dq_ref - dq);
+        cs.set_real(&inputs, &[u, q, dq])
+            .map_err(|_| fail(&format!("set inputs at t = {t}")))?;
+        cs.do_step(t, h, true)
+            .map_err(|_| fail(&format!("do_step at t = {t}")))?;
+        let mut out = [0.0; 5];
+        cs.get_real(&outputs, &mut out)
+            .map_err(|_| fail(&format!("get outputs at t = {t}")))?;
+        let [torque, p1, p2, f1, f2] = out;
+        dq += h * (torque - p.damping * dq - mgl * q.sin()) / p.inertia;
+        q += h * dq;
+        if (k + 1) % p.record_every.max(1) == 0 || k + 1 == n {
+            rows.push([(k + 1) as f64 * h, q, dq, q_ref, p1, p2, f1, f2, torque]);
+        }
+    }
+    Ok(rows)
+}
+
 /// CSV with a header; `{:?}` prints the shortest representation that reads back exactly.
 pub fn to_csv(rows: &[[f64; 9]]) -> String {
     let mut s = COLUMNS.join(",") + "\n";
