@@ -69,3 +69,27 @@ report: deps fmus $(VENV)/.installed
 clean:
 	cargo clean
 	rm -rf out $(VENV)
+
+## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
+## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
+robot-joint: deps fmus $(VENV)/.installed
+	$(PY) examples/robot_joint.py --out out
+	cargo run --release --example robot_joint
+
+## FMI cross-check files crosscheck/<Model>/<Model>_{in,ref}.csv, _ref.opt and the plots
+## docs/fmu/<Model>.png, then the FMUs again so that each documentation/ carries its plot.
+crosscheck: fmus $(VENV)/.installed
+	$(PY) crosscheck/generate.py
+	target/release/package_fmus $(LIB) target/fmu
+
+## The robot joint as a system: out/systems/RobotJoint.ssp (fmpy simulate_ssp) and the container
+## FMU out/systems/RobotJoint.fmu (fmu-manipulation-toolbox), both run and plotted against the
+## two-FMU co-simulation: out/systems/robot_joint_systems.png.
+systems: fmus $(VENV)/.installed
+	$(PY) systems/build.py --run
+
+## Design sweep on Dask (not part of `make test`): bladder pre-strain x wall thickness -> net work per
+## stroke of the McKibbenMuscle FMU, out/sweep.{csv,png}. Local cluster by default; any running
+## scheduler with `make sweep SCHEDULER=tcp://host:8786`.
+sweep: fmus $(VENV)/.installed
+	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))

@@ -25,8 +25,22 @@ fn package(factory: &dyn Factory, so: &[u8], out_dir: &Path) -> Result<PathBuf, 
         .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    let doc = documentation(info, factory.documentation());
-    let entries: [(String, &[u8]); 3] = [
+    // A plot of the model's cross-check run (crosscheck/generate.py), shipped when present.
+    let plot_path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("docs/fmu")
+        .join(format!("{}.png", info.name));
+    let plot = std::fs::read(&plot_path).ok();
+    let mut equations = factory.documentation().to_string();
+    if plot.is_some() {
+        equations.push_str(&format!(
+            "\n<h2>Plot</h2>\n<p>The cross-check run (default experiment, inputs from \
+             <code>{name}_in.csv</code>):</p>\n<p><img src=\"plot.png\" alt=\"{name} cross-check run\" \
+             style=\"max-width:100%\"></p>\n",
+            name = info.name
+        ));
+    }
+    let doc = documentation(info, &equations);
+    let mut entries: Vec<(String, &[u8])> = vec![
         (
             "modelDescription.xml".into(),
             info.model_description_xml.as_bytes(),
@@ -34,6 +48,9 @@ fn package(factory: &dyn Factory, so: &[u8], out_dir: &Path) -> Result<PathBuf, 
         (format!("binaries/linux64/{}.so", info.name), so),
         ("documentation/index.html".into(), doc.as_bytes()),
     ];
+    if let Some(png) = &plot {
+        entries.push(("documentation/plot.png".into(), png));
+    }
     for (name, data) in entries {
         zip.start_file(name.as_str(), options)
             .map_err(|e| e.to_string())?;

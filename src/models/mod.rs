@@ -8,9 +8,11 @@ use crate::variables::{ModelInfo, Start, VarType};
 use serde::{de::DeserializeOwned, Deserialize, Serialize};
 
 pub mod knitted_muscle;
+pub mod mckibben_joint;
 pub mod mckibben_muscle;
 pub mod multiferroic_motor;
 pub mod pass_through;
+pub mod pulley_joint;
 
 /// Outcome of a model call, in FMI's order of severity.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]

@@ -1,0 +1,142 @@
+"""Writes the FMI cross-check files of every packaged FMU (modelica/fmi-cross-check rules):
+
+    crosscheck/<Model>/<Model>_in.csv   inputs (time first), linearly interpolated by the importer
+    crosscheck/<Model>/<Model>_ref.csv  reference outputs at every communication point
+    crosscheck/<Model>/<Model>_ref.opt  StartTime, StopTime, StepSize, RelTol
+
+and docs/fmu/<Model>.png, the plot the packager puts into the FMU's documentation/.
+
+The run is each model's default experiment with its default parameters (the rules allow no other
+settings), StepSize = the default experiment's step as the communication step, and the inputs
+below. An FMU not listed here gets no _in.csv (its inputs keep their start values) and its first
+eight Real outputs. Usage: python crosscheck/generate.py [Model ...]"""
+
+import math
+import pathlib
+import sys
+
+import numpy as np
+from fmpy import read_model_description, simulate_fmu
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+FMU_DIR = ROOT / "target" / "fmu"
+OUT = ROOT / "crosscheck"
+PLOTS = ROOT / "docs" / "fmu"
+REL_TOL = 1e-6
+
+
+def _mckibben(t):
+    # Pressure ramps 0 -> 600 kPa; length swings between 0.07 and 0.10 m (ideal muscle, b = 0.1113 m).
+    return {"pressure": 6e5 * t, "length": 0.085 + 0.015 * np.sin(2 * np.pi * 2 * t)}
+
+
+def _joint(t):
+    # Like a robot simulator: a pressure-difference command and a swinging joint.
+    w = 2 * np.pi * 1.5
+    return {
+        "actuatorInput": 4e5 * np.sin(2 * np.pi * 0.7 * t),
+        "jointPosition": 0.3 * np.sin(w * t),
+        "jointVelocity": 0.3 * w * np.cos(w * t),
+    }
+
+
+def _motor(t):
+    # 200 MPa with the strain direction turning two full turns in 1.2 ms (continuous rotation).
+    return {"strain_direction": 4 * np.pi * t / 1.2e-3, "stress": np.full_like(t, 2e8), "load_torque": np.zeros_like(t)}
+
+
+def _pulley(t):
+    # Muscle forces of a few newtons either way around 24 N: the joint swings against gravity.
+    swing = 5 * np.sin(2 * np.pi * 0.5 * t)
+    return {"flexor_force": 24 + swing, "extensor_force": 24 - swing}
+
+
+def _pass_through(t):
+    return {"u": np.sin(2 * np.pi * t)}
+
+
+SPEC = {
+    "McKibbenMuscle": (_mckibben, ["force", "volume", "effective_pressure", "stiffness"]),
+    "McKibbenJoint": (_joint, ["jointTorque", "flexor_force", "extensor_force", "flexor_pressure", "extensor_pressure"]),
+    "MultiferroicMotor": (_motor, ["torque", "rotor_angle", "rotor_speed", "onion_angle", "offset_angle"]),
+    "PassThrough": (_pass_through, ["y"]),
+    "PulleyJoint": (_pulley, ["joint_angle", "joint_velocity", "joint_torque", "flexor_pressure", "extensor_pressure"]),
+}
+
+
+def experiment(md):
+    de = md.defaultExperiment
+    start = float(de.startTime or 0.0) if de else 0.0
+    stop = float(de.stopTime or 1.0) if de else 1.0
+    step = float(de.stepSize) if de and de.stepSize else (stop - start) / 1000
+    return start, stop, step
+
+
+def write_csv(path, names, columns):
+    with open(path, "w") as f:
+        f.write(",".join(names) + "\n")
+        for row in zip(*columns):
+            f.write(",".join(repr(float(x)) for x in row) + "\n")
+
+
+def generate(model):
+    fmu = str(FMU_DIR / f"{model}.fmu")
+    md = read_model_description(fmu)
+    start, stop, step = experiment(md)
+    inputs_of, outputs = SPEC.get(model, (None, None))
+    if outputs is None:
+        outputs = [v.name for v in md.modelVariables if v.causality == "output" and v.type == "Real"][:8]
+    d = OUT / model
+    d.mkdir(parents=True, exist_ok=True)
+    signals = None
+    if inputs_of is not None:
+        # Inputs at 201 points: the importer interpolates linearly between them.
+        t = np.linspace(start, stop, 201)
+        values = inputs_of(t)
+        names = ["time"] + list(values)
+        write_csv(d / f"{model}_in.csv", names, [t] + [values[n] for n in values])
+        signals = np.array(list(zip(t, *values.values())), dtype=[(n, np.float64) for n in names])
+    with open(d / f"{model}_ref.opt", "w") as f:
+        f.write(f"StartTime, {start!r}\nStopTime, {stop!r}\nStepSize, {step!r}\nRelTol, {REL_TOL!r}\n")
+    result = simulate_fmu(fmu, start_time=start, stop_time=stop, output_interval=step, input=signals, output=outputs)
+    write_csv(d / f"{model}_ref.csv", ["time"] + outputs, [result[n] for n in ["time"] + outputs])
+    plot(model, md, signals, result, outputs)
+    print(f"{model}: {len(result)} rows, {start} .. {stop} s every {step} s -> {d}", file=sys.stderr)
+
+
+def plot(model, md, signals, result, outputs):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    units = {v.name: v.unit or "" for v in md.modelVariables}
+    panels = ([signals.dtype.names[1:]] if signals is not None else []) + [outputs]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 2.6 * len(panels) + 0.6), sharex=True, squeeze=False)
+    for ax, names in zip(axes[:, 0], panels):
+        source = signals if names is not outputs else result
+        for n in names:
+            y = source[n]
+            scale = np.max(np.abs(y)) or 1.0
+            ax.plot(source["time"], y / scale, label=f"{n} / {scale:.3g} {units.get(n, '')}")
+        ax.set_ylabel("inputs" if names is not outputs else "outputs")
+        ax.legend(fontsize=7, loc="upper right")
+        ax.grid(alpha=0.3)
+    axes[-1, 0].set_xlabel("time (s)")
+    fig.suptitle(f"{model}: cross-check run (default experiment, {model}_in.csv)", fontsize=10)
+    fig.tight_layout()
+    PLOTS.mkdir(parents=True, exist_ok=True)
+    fig.savefig(PLOTS / f"{model}.png", dpi=80)
+    plt.close(fig)
+
+
+def main():
+    models = sys.argv[1:] or sorted(p.stem for p in FMU_DIR.glob("*.fmu"))
+    if not models:
+        sys.exit("no FMU in target/fmu: run `make fmus` first")
+    for model in models:
+        generate(model)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,96 @@
+"""The robot joint as a system, from the packaged FMUs in target/fmu:
+
+- out/systems/RobotJoint.ssp: systems/RobotJoint.ssd with the McKibbenMuscle and PulleyJoint FMUs
+  under resources/, for fmpy.ssp.simulation.simulate_ssp;
+- out/systems/RobotJoint.fmu: a container FMU built by fmu-manipulation-toolbox from
+  systems/RobotJoint.container.json (two McKibbenMuscle instances and PulleyJoint, 1 ms step).
+
+With --run both are simulated for 4 s and out/systems/robot_joint_systems.png compares them with
+the two-FMU co-simulation of examples/robot_joint.py. Usage: python systems/build.py [--run]"""
+
+import argparse
+import pathlib
+import shutil
+import sys
+import zipfile
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+FMU_DIR = ROOT / "target" / "fmu"
+OUT = ROOT / "out" / "systems"
+HERE = ROOT / "systems"
+STEP = 1e-3
+
+
+def build_ssp(out=OUT):
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / "RobotJoint.ssp"
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
+        z.write(HERE / "RobotJoint.ssd", "SystemStructure.ssd")
+        for model in ("McKibbenMuscle", "PulleyJoint"):
+            z.write(FMU_DIR / f"{model}.fmu", f"resources/{model}.fmu")
+    return path
+
+
+def build_container(out=OUT):
+    """fmu-manipulation-toolbox's Assembly, as its `fmucontainer -container <json>` CLI runs it."""
+    from fmu_manipulation_toolbox.assembly import Assembly
+
+    out.mkdir(parents=True, exist_ok=True)
+    for model in ("McKibbenMuscle", "PulleyJoint"):
+        shutil.copy(FMU_DIR / f"{model}.fmu", out / f"{model}.fmu")
+    shutil.copy(HERE / "RobotJoint.container.json", out / "RobotJoint.json")
+    assembly = Assembly("RobotJoint.json", fmu_directory=out, default_step_size=STEP)
+    assembly.make_fmu()
+    return out / "RobotJoint.fmu"
+
+
+def run_ssp(path, stop_time=4.0):
+    from fmpy.ssp.simulation import simulate_ssp
+
+    return simulate_ssp(str(path), stop_time=stop_time, step_size=STEP)
+
+
+def run_container(path, stop_time=4.0):
+    from fmpy import simulate_fmu
+
+    return simulate_fmu(str(path), stop_time=stop_time, output_interval=STEP,
+                        output=["joint_angle", "reference_angle", "joint_torque"])
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--run", action="store_true")
+    args = parser.parse_args()
+    ssp = build_ssp()
+    container = build_container()
+    print(f"wrote {ssp} and {container}")
+    if not args.run:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    import numpy as np
+
+    sys.path.insert(0, str(ROOT / "examples"))
+    import robot_joint
+
+    reference = np.array(robot_joint.read_csv(ROOT / "tests" / "data" / "robot_joint_ref.csv")[1])
+    s = run_ssp(ssp)
+    c = run_container(container)
+    fig, ax = plt.subplots(figsize=(8, 4))
+    ax.plot(reference[:, 0], np.degrees(reference[:, 3]), "k--", label="reference angle")
+    ax.plot(reference[:, 0], np.degrees(reference[:, 1]), label="two FMUs, FMPy FMU2Slave (Gauss-Seidel)")
+    ax.plot(s["time"] + STEP, np.degrees(s["joint.joint_angle"]), ":", label="SSP, fmpy simulate_ssp (Jacobi)")
+    ax.plot(c["time"], np.degrees(c["joint_angle"]), "-.", label="container FMU (fmu-manipulation-toolbox)")
+    ax.set_xlabel("time (s)")
+    ax.set_ylabel("joint angle (deg)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(OUT / "robot_joint_systems.png", dpi=100)
+    print(f"wrote {OUT}/robot_joint_systems.png")
+
+
+if __name__ == "__main__":
+    main()
