@@ -51,12 +51,18 @@ def _pulley(t):
     return {"flexor_force": 24 + swing, "extensor_force": 24 - swing}
 
 
+def _knitted(t):
+    # The section 1.4 prototype at 14 kPa, its length sweeping 0.25-0.50 m and back (ideal sleeve).
+    return {"pressure": np.full_like(t, 1.4e4), "length": 0.375 - 0.125 * np.cos(2 * np.pi * t)}
+
+
 def _pass_through(t):
     return {"u": np.sin(2 * np.pi * t)}
 
 
 SPEC = {
     "McKibbenMuscle": (_mckibben, ["force", "volume", "effective_pressure", "stiffness"]),
+    "KnittedMuscle": (_knitted, ["force", "volume", "max_radius", "stiffness"]),
     "McKibbenJoint": (_joint, ["jointTorque", "flexor_force", "extensor_force", "flexor_pressure", "extensor_pressure"]),
     "MultiferroicMotor": (_motor, ["torque", "rotor_angle", "rotor_speed", "onion_angle", "offset_angle"]),
     "PassThrough": (_pass_through, ["y"]),
