@@ -449,3 +449,25 @@ def test_knitted_against_mckibben_with_bladder_section_1_3_6():
         assert bladder["knitted"][3] < wk < wm
         kb.close()
         mkb.close()
+
+
+@pytest.mark.parametrize("shape", [IDEAL, TUBULAR])
+@pytest.mark.parametrize("friction", [False, True])
+@pytest.mark.parametrize("model", [1, 2])
+def test_bladder_dense_grid_never_gives_nan(shape, friction, model, recording_log):
+    m = knitted(log=recording_log, preset=2, strand_thickness=0.2e-3, shape_model=shape, friction=friction,
+                length=0.08, **dict(BLADDER, bladder_model=model))
+    names = ["force", "volume", "effective_pressure", "friction_force", "max_radius", "stiffness"]
+    for p in np.linspace(-101325, 1e6, 12):
+        for L in np.linspace(0.0, 0.15, 31):
+            m.step(pressure=p, length=L)
+            values = m.get(*names)
+            assert all(math.isfinite(v) for v in values), (p, L, values)
+            assert values[2] >= 0
+    assert recording_log.contains("until the inputs return"), "out-of-range points are logged"
+    m.close()
+
+
+def test_bladder_with_the_non_cylindrical_shape_fails_initialization():
+    with pytest.raises(Exception):
+        knitted(shape_model=NON_CYLINDRICAL, bladder_model=1)
