@@ -3,15 +3,29 @@
 //! The sleeve's shape model (`shape_model` 0 ideal cylinder, 1 tubular knit, 2 non-cylindrical)
 //! is built once from the parameters; the non-cylindrical volume-length table exists only when
 //! that shape is selected. Strand friction (eq. 1.21, `friction`) is the shared stop-operator
-//! hysteresis; its state is part of the FMU state and advances only in `step`.
+//! hysteresis; its state is part of the FMU state and advances only in `step`. The Mooney-Rivlin
+//! bladder of the McKibben muscle (`bladder_model` 1 thin wall, 2 thick wall; section 1.3.6) is the
+//! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
+//! non-cylindrical shape, which has no single bladder diameter.
 
 use super::{Model, Report, Status, Vars};
+use crate::physics::bladder::{
+    Bladder, BladderState, BladderTube, KnittedCylinder, SleeveGeometry,
+};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
+use crate::physics::mckibben::BladderModel;
 use crate::variables::knitted_muscle::{boolean, integer, real, INFO};
 use crate::variables::ModelInfo;
 use serde::{Deserialize, Serialize};
 use std::f64::consts::SQRT_2;
+
+/// With a bladder the force grows without bound where the rubber fills the sleeve; a length beyond
+/// such a limit is evaluated this fraction of the range inside it (finite, steep force), as in
+/// the McKibbenMuscle FMU. Where the sleeve's own limit (strand thickness) comes first the
+/// bladder is regular and only a rounding-level margin keeps the open interval.
+const FILL_MARGIN: f64 = 1e-3;
+const SLEEVE_MARGIN: f64 = 1e-12;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 struct Friction {
@@ -22,6 +36,10 @@ struct Friction {
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct KnittedMuscle {
     sleeve: KnittedSleeve,
+    /// `None` when `bladder_model` is 0.
+    bladder: Option<Bladder<KnittedCylinder>>,
+    /// Lengths evaluated: the sleeve's range, or inside the bladder's open range.
+    valid: (f64, f64),
     /// `None` when `friction` is off.
     friction: Option<Friction>,
     /// Friction history (eq. 1.21), advanced only by accepted steps.
@@ -29,6 +47,9 @@ pub struct KnittedMuscle {
     /// Whether the last evaluation was outside the valid lengths: its warning is logged once per
     /// excursion.
     out_of_range: bool,
+    /// Whether the last evaluation needed the zero-pressure fallback of a collapsing bladder:
+    /// logged once per excursion.
+    collapsed: bool,
 }
 
 /// Outputs at one input point, with the friction history after moving there.
@@ -62,6 +83,48 @@ fn sleeve_params(vars: &Vars) -> Result<KnittedParams, String> {
     })
 }
 
+fn bladder(
+    vars: &Vars,
+    sleeve: &KnittedSleeve,
+) -> Result<Option<Bladder<KnittedCylinder>>, String> {
+    let layers = match BladderModel::from_switch(
+        vars.integer[integer::BLADDER_MODEL],
+        vars.integer[integer::BLADDER_LAYERS],
+    )? {
+        BladderModel::None => return Ok(None),
+        BladderModel::ThinWall => 1,
+        BladderModel::ThickWall { layers } => layers,
+    };
+    let r = &vars.real;
+    let tube = BladderTube {
+        inner_diameter: r[real::BLADDER_INNER_DIAMETER],
+        thickness: r[real::BLADDER_THICKNESS],
+        unstretched_length: r[real::BLADDER_LENGTH],
+        mooney_c1: r[real::MOONEY_C1],
+        mooney_c2: r[real::MOONEY_C2],
+    };
+    Bladder::knitted(sleeve, tube, layers).map(Some)
+}
+
+/// The lengths evaluated: the sleeve's closed range, or the bladder's open range pulled in by a
+/// margin at each end (larger where the rubber fills the sleeve and the force is singular).
+fn valid_lengths(sleeve: &KnittedSleeve, bladder: Option<&Bladder<KnittedCylinder>>) -> (f64, f64) {
+    let (s_lo, s_hi) = (sleeve.min_length(), sleeve.max_length());
+    let Some(b) = bladder else {
+        return (s_lo, s_hi);
+    };
+    let (lo, hi) = (b.min_length(), b.max_length());
+    let margin = |sleeve_limited: bool| {
+        (hi - lo)
+            * if sleeve_limited {
+                SLEEVE_MARGIN
+            } else {
+                FILL_MARGIN
+            }
+    };
+    (lo + margin(lo <= s_lo), hi - margin(hi >= s_hi))
+}
+
 fn shape_kind(vars: &Vars) -> Result<ShapeKind, String> {
     Ok(match vars.integer[integer::SHAPE_MODEL] {
         0 => ShapeKind::Ideal,
@@ -88,7 +151,12 @@ impl KnittedMuscle {
     fn compute(&mut self, vars: &Vars, report: &mut Report) -> Output {
         let (pressure, length) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
         let s = &self.sleeve;
-        let l = s.clamp_length(length);
+        let (lo, hi) = self.valid;
+        let l = if length.is_nan() {
+            hi
+        } else {
+            length.clamp(lo, hi)
+        };
         if l == length {
             self.out_of_range = false;
         } else {
@@ -96,13 +164,26 @@ impl KnittedMuscle {
                 report.warn(format!(
                     "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
                      evaluating at length {l} m until the inputs return",
-                    s.min_length(),
-                    s.max_length(),
-                    s.max_length()
+                    lo,
+                    hi,
+                    vars.real[real::MAX_LENGTH]
                 ));
             }
             report.status = report.status.max(Status::Warning);
             self.out_of_range = true;
+        }
+        if let Some(b) = &self.bladder {
+            let (out, fallback) = self.compute_with_bladder(b, pressure, l);
+            if let Some(reason) = &fallback {
+                if !self.collapsed {
+                    report.warn(format!(
+                        "{reason}; evaluating at zero gauge pressure until the inputs return"
+                    ));
+                }
+                report.status = report.status.max(Status::Warning);
+            }
+            self.collapsed = fallback.is_some();
+            return out;
         }
         // The thin bag inside the sleeve cannot pull it inwards: a vacuum acts as zero.
         let p_eff = if pressure.is_finite() {
@@ -148,6 +229,82 @@ impl KnittedMuscle {
         out
     }
 
+    /// Section 1.3.6: the bladder's force (eq. 2.16-2.17 with the knitted cylinder) and, with
+    /// friction, eq. 1.21 fed by the sleeve's strand tension `P_eff (A - dV/dL)` (which is
+    /// `F + P A` without a bladder). A vacuum so deep that the free bladder would collapse is
+    /// evaluated at zero gauge pressure; the reason is returned for the log.
+    fn compute_with_bladder(
+        &self,
+        b: &Bladder<KnittedCylinder>,
+        pressure: f64,
+        l: f64,
+    ) -> (Output, Option<String>) {
+        let p = if pressure.is_finite() { pressure } else { 0.0 };
+        let mut fallback = None;
+        let state = match b.evaluate(p, l) {
+            Ok(state) => state,
+            Err(reason) => {
+                fallback = Some(reason);
+                match b.evaluate(0.0, l) {
+                    Ok(state) => state,
+                    // Cannot happen inside the valid range; keep the outputs finite regardless.
+                    Err(_) => BladderState {
+                        force: 0.0,
+                        strand_force: 0.0,
+                        strand_stiffness: 0.0,
+                        pressure_force: 0.0,
+                        elastic_force: 0.0,
+                        effective_pressure: 0.0,
+                        effective_pressure_slope: 0.0,
+                        contact: false,
+                        threshold_pressure: 0.0,
+                        fluid_volume: 0.0,
+                        inner_diameter: 0.0,
+                        outer_diameter: 0.0,
+                        stretch_axial: 1.0,
+                        stretch_hoop: 1.0,
+                        stretch_radial: 1.0,
+                        stress_axial: 0.0,
+                        stress_hoop: 0.0,
+                        stress_radial: 0.0,
+                        stiffness: 0.0,
+                    },
+                }
+            }
+        };
+        let mut out = Output {
+            force: state.force,
+            volume: state.fluid_volume,
+            effective_pressure: state.effective_pressure,
+            friction_force: 0.0,
+            max_radius: 0.5 * b.sleeve().diameter_and_slope(l).0,
+            stiffness: state.stiffness,
+            history: self.history,
+        };
+        if let Some(f) = &self.friction {
+            let next = f.operator.advance(&self.history, l);
+            // F = F_0 + k T with the strand tension T = F - (F_pressure + F_elastic): eq. 1.21's
+            // `total_force` with its `P A` term set to -(F_pressure + F_elastic).
+            let offset = state.pressure_force + state.elastic_force;
+            let (force, friction_force) = f.strand.total_force(state.force, 1.0, -offset, next.z);
+            out.force = force;
+            out.friction_force = friction_force;
+            out.history = next;
+            if friction_force != 0.0 {
+                // dF/dL = (F_0' - k offset') / (1 - k) with offset' = F_0' - T_0'.
+                let k = SQRT_2 * f.strand.coefficient * next.z;
+                let offset_slope = state.stiffness - state.strand_stiffness;
+                let stiffness = (state.stiffness - k * offset_slope) / (1.0 - k);
+                out.stiffness = if stiffness.is_finite() {
+                    stiffness
+                } else {
+                    state.stiffness
+                };
+            }
+        }
+        (out, fallback)
+    }
+
     fn write(vars: &mut Vars, out: &Output) {
         let r = &mut vars.real;
         r[real::FORCE] = out.force;
@@ -165,6 +322,8 @@ impl Model for KnittedMuscle {
 
     fn new(vars: &mut Vars) -> Result<Self, String> {
         let sleeve = KnittedSleeve::new(sleeve_params(vars)?, shape_kind(vars)?)?;
+        let bladder = bladder(vars, &sleeve)?;
+        let valid = valid_lengths(&sleeve, bladder.as_ref());
         let friction = if vars.boolean[boolean::FRICTION] {
             Some(Friction {
                 strand: StrandFriction::new(vars.real[real::FRICTION_COEFFICIENT])?,
@@ -173,16 +332,28 @@ impl Model for KnittedMuscle {
         } else {
             None
         };
-        vars.real[real::MAX_LENGTH] = sleeve.max_length();
-        vars.real[real::MIN_LENGTH] = sleeve.min_length();
+        let (min_length, max_length) = match &bladder {
+            Some(b) => (b.min_length(), b.max_length()),
+            None => (sleeve.min_length(), sleeve.max_length()),
+        };
+        vars.real[real::MAX_LENGTH] = max_length;
+        vars.real[real::MIN_LENGTH] = min_length;
         vars.real[real::FREE_CONTRACTION_LENGTH] = sleeve.free_contraction_length();
         // Friction starts relaxed (z = 0) where the sleeve is at initialization.
-        let history = HysteresisState::at_rest(sleeve.clamp_length(vars.real[real::LENGTH]));
+        let start = vars.real[real::LENGTH];
+        let history = HysteresisState::at_rest(if start.is_nan() {
+            valid.1
+        } else {
+            start.clamp(valid.0, valid.1)
+        });
         Ok(Self {
             sleeve,
+            bladder,
+            valid,
             friction,
             history,
             out_of_range: false,
+            collapsed: false,
         })
     }
 
@@ -256,6 +427,48 @@ mod tests {
             assert!(vars.real.iter().all(|x| x.is_finite()));
         }
         assert_eq!(warned, 2);
+    }
+
+    #[test]
+    fn bladder_is_refused_for_the_non_cylindrical_shape() {
+        let mut vars = vars_with(2, false);
+        vars.integer[integer::BLADDER_MODEL] = 2;
+        let e = KnittedMuscle::new(&mut vars).unwrap_err();
+        assert!(e.contains("cylindrical sleeve"), "{e}");
+        for shape in [0, 1] {
+            let mut vars = vars_with(shape, false);
+            vars.integer[integer::PRESET] = 2;
+            vars.integer[integer::BLADDER_MODEL] = 1;
+            assert!(KnittedMuscle::new(&mut vars).is_ok());
+        }
+    }
+
+    #[test]
+    fn bladder_friction_stiffness_is_the_slope_with_z_held() {
+        // Eq. 1.21 fed by the strand tension P_eff (A - dV/dL): dF/dL by central differences with
+        // the hysteresis state held (step commits z = -1 first).
+        let mut vars = vars_with(0, true);
+        vars.integer[integer::PRESET] = 2;
+        vars.integer[integer::BLADDER_MODEL] = 2;
+        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let mut report = Report::default();
+        vars.real[real::PRESSURE] = 550e3;
+        vars.real[real::LENGTH] = 0.07;
+        m.step(&mut vars, 0.0, 1e-3, &mut report);
+        assert_eq!(m.history.z, -1.0);
+        let at = |m: &mut KnittedMuscle, vars: &mut Vars, l: f64| {
+            vars.real[real::LENGTH] = l;
+            m.evaluate(vars, &mut Report::default());
+            (vars.real[real::FORCE], vars.real[real::STIFFNESS])
+        };
+        // Stay within the presliding length below 0.07 so that z stays -1.
+        let h = 1e-6;
+        let (fp, _) = at(&mut m, &mut vars, 0.07 - 1e-5 + h);
+        let (fm, _) = at(&mut m, &mut vars, 0.07 - 1e-5 - h);
+        let (f, k) = at(&mut m, &mut vars, 0.07 - 1e-5);
+        assert!(vars.real[real::FRICTION_FORCE] < 0.0);
+        let fd = (fp - fm) / (2.0 * h);
+        assert!((k - fd).abs() < 1e-4 * fd.abs(), "{k} {fd} (F {f})");
     }
 
     #[test]

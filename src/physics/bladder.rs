@@ -9,8 +9,16 @@
 //! multiplications per layer and one reciprocal; the partial derivatives with respect to the muscle
 //! length and the bladder's outer diameter are carried along in forward mode (a small dual number),
 //! which gives an analytic stiffness and the Newton slope of the free-bladder equation (eq. 2.18).
+//!
+//! The sleeve enters only through its diameter `D(L)` ([`SleeveGeometry`]). The strand force of
+//! eq. 2.16 is written as `P_eff (A - dV/dL)` with `A = pi D^2 / 4` (for a closed cylindrical sleeve
+//! `F + P A` is its strand tension, eq. 1.1 / 2.1), which is `P_eff L^2 / (2 pi n^2)` for the
+//! helical sleeve of chapter 2 and applies unchanged to the cylindrical knitted sleeves of chapter 1
+//! (section 1.3.6: "the same results apply to a knitted muscle"). The bladder is generic over the
+//! geometry, so the helical path is monomorphised and costs what it did before the generalisation.
 
 use crate::physics::gaylord::Sleeve;
+use crate::physics::knitted::{KnittedSleeve, ShapeModel};
 use std::f64::consts::PI;
 use std::ops::{Add, Mul, Sub};
 
@@ -41,6 +49,184 @@ pub struct BladderTube {
     pub mooney_c2: f64,
 }
 
+/// Iteration cap of the bisection for the knitted sleeve's fill lengths (at initialization only;
+/// 200 halvings reach any f64 bracket).
+const FILL_BISECTIONS: usize = 200;
+
+/// A cylindrical sleeve as the bladder sees it: diameter `D(L)`, the strand factor `A - dV/dL`
+/// of eq. 2.16, and where the rubber fits (eq. 2.7). Implemented by the helical McKibben sleeve
+/// ([`Sleeve`]) and the knitted cylinders ([`KnittedCylinder`]).
+pub trait SleeveGeometry {
+    /// `(D, dD/dL)` at `length` inside the bladder's range, m and m/m.
+    fn diameter_and_slope(&self, length: f64) -> (f64, f64);
+    /// `D(L)^2`, m^2 (may be negative outside the sleeve's geometry).
+    fn diameter_sq(&self, length: f64) -> f64;
+    /// `(A - dV/dL, d/dL of it)` with `A = pi D^2/4`, m^2 and m: the strand force per unit
+    /// effective pressure (eq. 2.16 generalised).
+    fn strand_area(&self, length: f64) -> (f64, f64);
+    /// `(min, max)` lengths, m, between which the rubber of volume `V_R` fits the sleeve (eq. 2.7's
+    /// inner diameter is positive) and the sleeve itself is valid; `None` if nowhere.
+    fn fill_lengths(&self, rubber_volume: f64) -> Option<(f64, f64)>;
+    /// The largest volume the sleeve encloses, m^3 (for error messages).
+    fn largest_volume(&self) -> f64;
+}
+
+impl SleeveGeometry for Sleeve {
+    #[inline]
+    fn diameter_and_slope(&self, length: f64) -> (f64, f64) {
+        let npi = self.turns * PI;
+        let d = self.diameter(length);
+        // D = sqrt(b^2 - L^2)/(n pi)  =>  dD/dL = -L / ((n pi)^2 D); d > 0 inside the range.
+        (d, -length / (npi * npi * d))
+    }
+    #[inline]
+    fn diameter_sq(&self, length: f64) -> f64 {
+        let (b, n) = (self.strand_length, self.turns);
+        (b * b - length * length) / (n * n * PI * PI)
+    }
+    #[inline]
+    fn strand_area(&self, length: f64) -> (f64, f64) {
+        // pi/4 (b^2 - L^2)/(n pi)^2 - (b^2 - 3 L^2)/(4 pi n^2) = L^2 / (2 pi n^2) (eq. 2.16).
+        let k = 1.0 / (2.0 * PI * self.turns * self.turns);
+        (length * length * k, 2.0 * length * k)
+    }
+    fn fill_lengths(&self, rubber_volume: f64) -> Option<(f64, f64)> {
+        fill_lengths(self, rubber_volume)
+    }
+    fn largest_volume(&self) -> f64 {
+        self.volume(self.free_contraction_length())
+    }
+}
+
+/// A cylindrical knitted sleeve (chapter 1, `shape_model` 0 ideal, eq. 1.5-1.8, or 1 tubular knit,
+/// eq. 1.11-1.14) as the bladder sees it. For both, `D^2` is a quadratic in `L`:
+/// ideal `pi^2 D^2 = (S - 2 m L/n)^2` (eq. 1.5), tubular `pi^2 D^2 = S^2 - 4 m S L/n +
+/// (4 m^2 - 1) L^2/n^2` (eq. 1.12), and the volume is exactly `pi D^2 L / 4` (eq. 1.6, 1.13), so
+/// `A - dV/dL = -L dA/dL`. The sleeve's own length range (strand thickness, eq. 1.16) is kept.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct KnittedCylinder {
+    /// `D^2 = d_sq[0] + d_sq[1] L + d_sq[2] L^2`, m^2.
+    d_sq: [f64; 3],
+    /// The sleeve's shortest valid length (`2 n t`), m.
+    sleeve_min_length: f64,
+    /// The sleeve's full extension (radius `r_min`, eq. 1.16), m.
+    sleeve_max_length: f64,
+}
+
+impl KnittedCylinder {
+    /// The cylinder of a built knitted sleeve. `Err` for the non-cylindrical shape (eq. 1.17-1.20):
+    /// its rows have different radii (clamped ends, a pocket), so there is no single bladder
+    /// diameter for eq. 2.7 / 2.20 and no single `P_eff`; a mean-area stand-in would be a number
+    /// with no derivation behind it, so it is refused rather than approximated.
+    pub fn new(sleeve: &KnittedSleeve) -> Result<Self, String> {
+        let p = sleeve.params();
+        let (m, n, s) = (p.stitches_per_row, p.rows, p.row_strand_length);
+        let pi_sq = PI * PI;
+        let quadratic = match sleeve.shape() {
+            ShapeModel::Ideal => 4.0 * m * m,
+            ShapeModel::Tubular => 4.0 * m * m - 1.0,
+            ShapeModel::NonCylindrical(_) => {
+                return Err("the hyperelastic bladder (section 1.3.6 with eq. 2.6-2.20) needs a                             cylindrical sleeve: use shape_model 0 (ideal) or 1 (tubular knit);                             the non-cylindrical shape has no single bladder diameter"
+                    .into())
+            }
+        };
+        let d_sq = [
+            s * s / pi_sq,
+            -4.0 * m * s / (n * pi_sq),
+            quadratic / (n * n * pi_sq),
+        ];
+        Ok(Self {
+            d_sq,
+            sleeve_min_length: sleeve.min_length(),
+            sleeve_max_length: sleeve.max_length(),
+        })
+    }
+
+    /// `pi/4 L D^2 - V_R`: sleeve volume minus rubber volume, m^3.
+    #[inline]
+    fn spare_volume(&self, length: f64, rubber_volume: f64) -> f64 {
+        PI / 4.0 * length * self.diameter_sq(length) - rubber_volume
+    }
+
+    /// Length of largest sleeve volume: the smaller root of `d(L D^2)/dL = 0`, in the sleeve's range.
+    fn largest_volume_length(&self) -> f64 {
+        let [c0, c1, c2] = self.d_sq;
+        let disc = c1 * c1 - 3.0 * c2 * c0;
+        let l = if c2 > 0.0 && disc >= 0.0 {
+            (-c1 - disc.sqrt()) / (3.0 * c2)
+        } else {
+            self.sleeve_max_length
+        };
+        if l.is_finite() {
+            l.clamp(self.sleeve_min_length, self.sleeve_max_length)
+        } else {
+            self.sleeve_max_length
+        }
+    }
+}
+
+impl SleeveGeometry for KnittedCylinder {
+    #[inline]
+    fn diameter_and_slope(&self, length: f64) -> (f64, f64) {
+        let [_, c1, c2] = self.d_sq;
+        let d = self.diameter_sq(length).max(0.0).sqrt();
+        (d, (c1 + 2.0 * c2 * length) / (2.0 * d))
+    }
+    #[inline]
+    fn diameter_sq(&self, length: f64) -> f64 {
+        let [c0, c1, c2] = self.d_sq;
+        c0 + (c1 + c2 * length) * length
+    }
+    #[inline]
+    fn strand_area(&self, length: f64) -> (f64, f64) {
+        // A - dV/dL = -L dA/dL with dA/dL = pi/4 (c1 + 2 c2 L).
+        let [_, c1, c2] = self.d_sq;
+        (
+            -PI / 4.0 * length * (c1 + 2.0 * c2 * length),
+            -PI / 4.0 * (c1 + 4.0 * c2 * length),
+        )
+    }
+    /// Bracketed bisection on the spare volume on each side of its maximum (it rises, then falls,
+    /// over the sleeve's range); at initialization only. A side where the sleeve's own limit comes
+    /// first keeps that limit.
+    fn fill_lengths(&self, rubber_volume: f64) -> Option<(f64, f64)> {
+        let peak = self.largest_volume_length();
+        let f = |l: f64| self.spare_volume(l, rubber_volume);
+        let spare_at_peak = f(peak);
+        if spare_at_peak.is_nan() || spare_at_peak <= 0.0 {
+            return None;
+        }
+        // Root of f between `bad` (f <= 0) and `good` (f > 0).
+        let root = |mut bad: f64, mut good: f64| {
+            for _ in 0..FILL_BISECTIONS {
+                let mid = 0.5 * (bad + good);
+                if mid == bad || mid == good {
+                    break;
+                }
+                if f(mid) > 0.0 {
+                    good = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            good
+        };
+        let lo = self.sleeve_min_length;
+        let hi = self.sleeve_max_length;
+        let min = if f(lo) > 0.0 && lo > 0.0 {
+            lo
+        } else {
+            root(lo, peak)
+        };
+        let max = if f(hi) > 0.0 { hi } else { root(hi, peak) };
+        (min > 0.0 && max > min).then_some((min, max))
+    }
+    fn largest_volume(&self) -> f64 {
+        let l = self.largest_volume_length();
+        PI / 4.0 * l * self.diameter_sq(l)
+    }
+}
+
 /// Parameter-only constants of one nested layer (eq. 2.19-2.20), precomputed once.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 struct Layer {
@@ -54,11 +240,12 @@ struct Layer {
     rubber_volume: f64,
 }
 
-/// A Mooney-Rivlin bladder inside a given sleeve, with everything that depends only on parameters
-/// precomputed (layer constants, rubber volume, length limits).
+/// A Mooney-Rivlin bladder inside a given sleeve (the helical McKibben [`Sleeve`] by default, or a
+/// [`KnittedCylinder`]), with everything that depends only on parameters precomputed (layer
+/// constants, rubber volume, length limits).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Bladder {
-    sleeve: Sleeve,
+pub struct Bladder<S = Sleeve> {
+    sleeve: S,
     tube: BladderTube,
     layers: Vec<Layer>,
     outer_diameter: f64,
@@ -73,8 +260,11 @@ pub struct BladderState {
     /// Muscle tension, N: strands + pressure end force + bladder elastic force (eq. 2.4 without
     /// friction, eq. 2.16 + 2.17).
     pub force: f64,
-    /// `F_strands = P_eff L^2 / (2 pi n^2)`, N (eq. 2.16).
+    /// `F_strands = P_eff (A - dV/dL)`, N (eq. 2.16; `P_eff L^2 / (2 pi n^2)` for the helical
+    /// sleeve): the sleeve's strand tension.
     pub strand_force: f64,
+    /// `dF_strands/dL` along the current branch, N/m (zero when free).
+    pub strand_stiffness: f64,
     /// `F_pressure = -P A_fluid`, N (eq. 2.5).
     pub pressure_force: f64,
     /// `F_elastic`, the axial force carried by the rubber, summed over layers, N (eq. 2.17).
@@ -110,10 +300,23 @@ pub struct BladderState {
     pub stiffness: f64,
 }
 
-impl Bladder {
+impl Bladder<KnittedCylinder> {
+    /// The bladder inside a cylindrical knitted sleeve (section 1.3.6); `Err` for the
+    /// non-cylindrical shape (see [`KnittedCylinder::new`]) or a tube that does not fit. The
+    /// length range is the sleeve's own (strand thickness) intersected with where the rubber fits.
+    pub fn knitted(
+        sleeve: &KnittedSleeve,
+        tube: BladderTube,
+        layers: usize,
+    ) -> Result<Self, String> {
+        Self::new(KnittedCylinder::new(sleeve)?, tube, layers)
+    }
+}
+
+impl<S: SleeveGeometry> Bladder<S> {
     /// Builds a bladder of `layers` nested thin layers (1 = thin-walled model, eq. 2.6-2.17;
     /// more = thick-walled model, eq. 2.19-2.20) inside `sleeve`.
-    pub fn new(sleeve: Sleeve, tube: BladderTube, layers: usize) -> Result<Self, String> {
+    pub fn new(sleeve: S, tube: BladderTube, layers: usize) -> Result<Self, String> {
         let positive = |name: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
@@ -151,11 +354,11 @@ impl Bladder {
             .collect();
         // Eq. 2.6.
         let rubber_volume = PI / 4.0 * (d_ro * d_ro - d_ri * d_ri) * tube.unstretched_length;
-        let (min_length, max_length) = fill_lengths(&sleeve, rubber_volume).ok_or_else(|| {
+        let (min_length, max_length) = sleeve.fill_lengths(rubber_volume).ok_or_else(|| {
             format!(
                 "the bladder's rubber volume {rubber_volume:e} m^3 does not fit in the sleeve \
                  (largest sleeve volume {:e} m^3): inner diameter of eq. 2.7 is never positive",
-                sleeve.volume(sleeve.free_contraction_length())
+                sleeve.largest_volume()
             )
         })?;
         if !(rubber_volume.is_finite() && min_length.is_finite() && max_length.is_finite()) {
@@ -172,7 +375,7 @@ impl Bladder {
         })
     }
 
-    pub fn sleeve(&self) -> &Sleeve {
+    pub fn sleeve(&self) -> &S {
         &self.sleeve
     }
 
@@ -190,8 +393,9 @@ impl Bladder {
     }
 
     /// Longest muscle length, m: the rubber fills the sleeve and eq. 2.7's inner diameter reaches
-    /// zero, i.e. the largest root of `L (b^2 - L^2) = 4 pi n^2 V_R`. The force rises without bound
-    /// towards it; at and beyond it [`Bladder::evaluate`] returns `Err`.
+    /// zero, i.e. the largest root of `L (b^2 - L^2) = 4 pi n^2 V_R` for the helical sleeve. The
+    /// force rises without bound towards it; at and beyond it [`Bladder::evaluate`] returns `Err`.
+    /// (A knitted sleeve whose strand thickness stops it first ends at its own full extension.)
     pub fn max_length(&self) -> f64 {
         self.max_length
     }
@@ -205,11 +409,7 @@ impl Bladder {
     /// Inner diameter of the bladder in contact with the sleeve at `length` (eq. 2.7), m, or `None`
     /// outside `(min_length, max_length)`.
     pub fn contact_inner_diameter(&self, length: f64) -> Option<f64> {
-        let s = &self.sleeve;
-        let n = s.turns;
-        let b = s.strand_length;
-        let d_in_sq = (b * b - length * length) / (n * n * PI * PI)
-            - 4.0 * self.rubber_volume / (PI * length);
+        let d_in_sq = self.sleeve.diameter_sq(length) - 4.0 * self.rubber_volume / (PI * length);
         (length > 0.0 && d_in_sq > 0.0 && d_in_sq.is_finite()).then(|| d_in_sq.sqrt())
     }
 
@@ -301,11 +501,7 @@ impl Bladder {
     /// Length seeded with d/dL = 1, and the sleeve diameter `D(L)` seeded with its total slope
     /// along the contact branch in `dl` and 1 in `dx`.
     fn contact_seed(&self, length: f64) -> (Dual, Dual) {
-        let s = &self.sleeve;
-        let npi = s.turns * PI;
-        let d = s.diameter(length);
-        // D = sqrt(b^2 - L^2)/(n pi)  =>  dD/dL = -L / ((n pi)^2 D); d > 0 inside the range.
-        let slope = -length / (npi * npi * d);
+        let (d, slope) = self.sleeve.diameter_and_slope(length);
         (
             Dual::var_l(length),
             Dual {
@@ -382,10 +578,14 @@ impl Bladder {
     }
 
     fn contact_state(&self, pressure: f64, length: f64, k: &Kernel) -> BladderState {
-        let n = self.sleeve.turns;
-        let l = Dual::var_l(length);
-        // Eq. 2.16: P_eff L^2/(2 pi n^2) - P A_fluid, plus eq. 2.17.
-        let strands = k.p_eff * (l * l) * (1.0 / (2.0 * PI * n * n));
+        let (g, g_slope) = self.sleeve.strand_area(length);
+        let strand_area = Dual {
+            v: g,
+            dl: g_slope,
+            dx: 0.0,
+        };
+        // Eq. 2.16: P_eff (A - dV/dL) - P A_fluid, plus eq. 2.17.
+        let strands = k.p_eff * strand_area;
         let area = self.fluid_area(k.inner.l2_sq);
         let pressure_force = area * (-pressure);
         let force = strands + pressure_force + k.elastic;
@@ -397,6 +597,7 @@ impl Bladder {
             Parts {
                 force: force.v,
                 strand: strands.v,
+                strand_slope: strands.dl,
                 pressure_force: pressure_force.v,
                 p_eff: k.p_eff.v,
                 p_eff_slope: k.p_eff.dl,
@@ -425,6 +626,7 @@ impl Bladder {
             Parts {
                 force: force.v,
                 strand: 0.0,
+                strand_slope: 0.0,
                 pressure_force: pressure_force.v,
                 p_eff: 0.0,
                 p_eff_slope: 0.0,
@@ -444,6 +646,7 @@ impl Bladder {
         BladderState {
             force: p.force,
             strand_force: p.strand,
+            strand_stiffness: p.strand_slope,
             pressure_force: p.pressure_force,
             elastic_force: k.elastic.v,
             effective_pressure: p.p_eff,
@@ -585,6 +788,7 @@ fn check_state(s: BladderState, length: f64) -> Result<BladderState, String> {
     let all = [
         s.force,
         s.strand_force,
+        s.strand_stiffness,
         s.pressure_force,
         s.elastic_force,
         s.effective_pressure,
@@ -613,6 +817,7 @@ fn check_state(s: BladderState, length: f64) -> Result<BladderState, String> {
 struct Parts {
     force: f64,
     strand: f64,
+    strand_slope: f64,
     pressure_force: f64,
     p_eff: f64,
     p_eff_slope: f64,
@@ -1188,6 +1393,217 @@ mod tests {
         }
     }
 
+    use crate::physics::knitted::{KnittedParams, ShapeKind};
+
+    /// Fig. 1.16 knitted sleeve (110 mm stretched, 14.6 mm at free contraction).
+    fn knitted_sleeve(kind: ShapeKind, strand_thickness: f64) -> KnittedSleeve {
+        KnittedSleeve::new(KnittedParams::fig_1_16(strand_thickness), kind).unwrap()
+    }
+
+    /// 1/4" latex tube (6.4 mm bore, 0.8 mm wall), unstretched at the 110 mm muscle length.
+    fn latex_tube() -> BladderTube {
+        BladderTube {
+            inner_diameter: 6.4e-3,
+            thickness: 0.8e-3,
+            unstretched_length: 0.110,
+            mooney_c1: MOONEY_C1,
+            mooney_c2: MOONEY_C2,
+        }
+    }
+
+    #[test]
+    fn knitted_cylinder_geometry_matches_the_knitted_sleeve() {
+        // D(L) is eq. 1.5 / 1.12 (2 r), and A - dV/dL with the sleeve's own V (eq. 1.6, 1.13).
+        for kind in [ShapeKind::Ideal, ShapeKind::Tubular] {
+            for t in [0.0, 0.2e-3] {
+                let ks = knitted_sleeve(kind, t);
+                let c = KnittedCylinder::new(&ks).unwrap();
+                for i in 1..40 {
+                    let l = ks.min_length() + (ks.max_length() - ks.min_length()) * i as f64 / 40.0;
+                    let (d, slope) = c.diameter_and_slope(l);
+                    assert_relative_eq!(d, 2.0 * ks.max_radius(l), max_relative = 1e-12);
+                    let (v, dv, ddv) = ks.volume_derivatives(l);
+                    assert_relative_eq!(PI / 4.0 * d * d * l, v, max_relative = 1e-12);
+                    let (g, g_slope) = c.strand_area(l);
+                    let scale = PI / 4.0 * d * d + dv.abs();
+                    assert_relative_eq!(g, PI / 4.0 * d * d - dv, epsilon = 1e-12 * scale);
+                    let da = PI / 2.0 * d * slope;
+                    assert_relative_eq!(g_slope, da - ddv, epsilon = 1e-9 * (da.abs() + ddv.abs()));
+                }
+            }
+        }
+        // The helical sleeve's factor is eq. 2.16's L^2 / (2 pi n^2) = A - dV/dL of eq. 2.2.
+        let s = Sleeve::new(0.1113, 3.74).unwrap();
+        for l in [0.03, 0.06, 0.1] {
+            let h = 1e-7;
+            let dv = (s.volume(l + h) - s.volume(l - h)) / (2.0 * h);
+            let a = PI / 4.0 * s.diameter(l).powi(2);
+            assert_relative_eq!(s.strand_area(l).0, a - dv, max_relative = 1e-7);
+        }
+    }
+
+    #[test]
+    fn vanishing_knitted_bladder_is_eq_1_8_and_eq_1_14() {
+        // V_R -> 0 (10 nm wall) with zero moduli: P_eff -> P and the force is -P dV/dL, eq. 1.8
+        // (ideal) and eq. 1.14 (tubular), to the wall's relative size.
+        let tube = BladderTube {
+            inner_diameter: 1e-3,
+            thickness: 1e-8,
+            unstretched_length: 0.1,
+            mooney_c1: 0.0,
+            mooney_c2: 0.0,
+        };
+        let p = 550e3;
+        for kind in [ShapeKind::Ideal, ShapeKind::Tubular] {
+            let ks = knitted_sleeve(kind, 0.0);
+            let bl = Bladder::knitted(&ks, tube, 4).unwrap();
+            let peak = p * ks.mean_area(ks.free_contraction_length());
+            for i in 1..50 {
+                let l = bl.min_length() + (bl.max_length() - bl.min_length()) * i as f64 / 50.0;
+                let s = bl.evaluate(p, l).unwrap();
+                assert!(s.contact);
+                assert_relative_eq!(s.effective_pressure, p, max_relative = 1e-4);
+                assert_relative_eq!(s.force, ks.force(p, l), epsilon = 1e-5 * peak);
+                assert_relative_eq!(
+                    s.stiffness,
+                    ks.stiffness(p, l),
+                    max_relative = 1e-4,
+                    epsilon = 1e-4 * peak / ks.max_length()
+                );
+                assert_relative_eq!(s.fluid_volume, ks.volume(l), epsilon = 1e-5 * peak / p * l);
+            }
+        }
+    }
+
+    #[test]
+    fn knitted_fill_lengths_leave_no_room_for_the_fluid() {
+        // Eq. 2.7 for the knitted cylinder: D_in = 0 where the sleeve volume equals V_R, unless the
+        // strand thickness (eq. 1.16) stops the sleeve first.
+        for kind in [ShapeKind::Ideal, ShapeKind::Tubular] {
+            let ks = knitted_sleeve(kind, 0.0);
+            let bl = Bladder::knitted(&ks, latex_tube(), 8).unwrap();
+            for edge in [bl.min_length(), bl.max_length()] {
+                let spare = ks.volume(edge) - bl.rubber_volume();
+                assert!(spare.abs() < 1e-12 * bl.rubber_volume(), "{spare}");
+            }
+            println!(
+                "{kind:?}: latex 6.4/8.0 mm tube fits {:.3} .. {:.3} mm of {:.1} mm",
+                bl.min_length() * 1e3,
+                bl.max_length() * 1e3,
+                ks.max_length() * 1e3
+            );
+            assert!(bl
+                .contact_inner_diameter(bl.max_length() * (1.0 - 1e-6))
+                .is_some());
+            assert!(bl
+                .contact_inner_diameter(bl.max_length() * (1.0 + 1e-6))
+                .is_none());
+            assert!(bl.evaluate(5e5, bl.max_length()).is_err());
+            // The force rises without bound towards the fill limit.
+            let f1 = bl
+                .evaluate(5e5, bl.max_length() * (1.0 - 1e-3))
+                .unwrap()
+                .force;
+            let f2 = bl
+                .evaluate(5e5, bl.max_length() * (1.0 - 1e-5))
+                .unwrap()
+                .force;
+            assert!(f2 > 10.0 * f1 && f1 > 0.0, "{f1} {f2}");
+        }
+        // A thick strand whose minimum radius (eq. 1.16) exceeds the filled diameter ends the
+        // range at the sleeve's own full extension.
+        let ks = knitted_sleeve(ShapeKind::Ideal, 0.5e-3);
+        let thin = BladderTube {
+            thickness: 0.05e-3,
+            inner_diameter: 2e-3,
+            ..latex_tube()
+        };
+        let bl = Bladder::knitted(&ks, thin, 1).unwrap();
+        assert_eq!(bl.max_length(), ks.max_length());
+        // Non-cylindrical: refused with a clear reason.
+        let nc = KnittedSleeve::new(
+            KnittedParams::fig_1_16(0.2e-3),
+            ShapeKind::NonCylindrical { segments: 40 },
+        )
+        .unwrap();
+        let e = Bladder::knitted(&nc, latex_tube(), 1).unwrap_err();
+        assert!(e.contains("cylindrical sleeve"), "{e}");
+    }
+
+    #[test]
+    fn knitted_force_is_continuous_at_contact_and_stiffness_is_its_slope() {
+        for kind in [ShapeKind::Ideal, ShapeKind::Tubular] {
+            for layers in [1, 16] {
+                let ks = knitted_sleeve(kind, 0.0);
+                let bl = Bladder::knitted(&ks, latex_tube(), layers).unwrap();
+                let scale = 550e3 * ks.mean_area(ks.free_contraction_length());
+                let (lo, hi) = (bl.min_length(), bl.max_length());
+                for i in 1..20 {
+                    let l = lo + (hi - lo) * i as f64 / 20.0;
+                    // In pressure, at the threshold (eq. 2.18 meets eq. 2.7).
+                    let th = bl.threshold_pressure(l).unwrap();
+                    // Thresholds below -1 atm are unreachable gauge pressures; there the finite
+                    // step dp alone moves the force by more than the tolerance.
+                    if th < -101325.0 {
+                        continue;
+                    }
+                    let dp = 1e-7 * th.abs().max(1e3);
+                    let (above, below) = (
+                        bl.evaluate(th + dp, l).unwrap(),
+                        bl.evaluate(th - dp, l).unwrap(),
+                    );
+                    assert!(above.contact && !below.contact);
+                    let jump = (above.force - below.force).abs();
+                    assert!(
+                        jump < 1e-6 * scale,
+                        "{kind:?} {layers} L={l} th={th}: {jump} {above:?} {below:?}"
+                    );
+                    // Stiffness is dF/dL on either branch.
+                    for p in [0.0, 1e5, 550e3] {
+                        let h = 1e-8;
+                        let (fp, fm) = (bl.evaluate(p, l + h), bl.evaluate(p, l - h));
+                        let (Ok(fp), Ok(fm)) = (fp, fm) else { continue };
+                        if fp.contact != fm.contact {
+                            continue;
+                        }
+                        let s = bl.evaluate(p, l).unwrap();
+                        let fd = (fp.force - fm.force) / (2.0 * h);
+                        assert_relative_eq!(s.stiffness, fd, max_relative = 1e-4, epsilon = 1e-2);
+                        let fd_strand = (fp.strand_force - fm.strand_force) / (2.0 * h);
+                        assert_relative_eq!(
+                            s.strand_stiffness,
+                            fd_strand,
+                            max_relative = 1e-4,
+                            epsilon = 1e-2
+                        );
+                    }
+                }
+                // In length at 550 kPa: scan for the contact onset and compare both sides.
+                let mut prev = bl.evaluate(550e3, lo + 1e-4 * (hi - lo)).unwrap();
+                for i in 1..=2000 {
+                    let l = lo + (hi - lo) * (1e-4 + 0.998 * i as f64 / 2000.0);
+                    let s = bl.evaluate(550e3, l).unwrap();
+                    if s.contact != prev.contact {
+                        let (mut a, mut b) =
+                            (lo + (hi - lo) * (1e-4 + 0.998 * (i - 1) as f64 / 2000.0), l);
+                        for _ in 0..60 {
+                            let mid = 0.5 * (a + b);
+                            if bl.evaluate(550e3, mid).unwrap().contact == prev.contact {
+                                a = mid
+                            } else {
+                                b = mid
+                            }
+                        }
+                        let jump = bl.evaluate(550e3, b).unwrap().force
+                            - bl.evaluate(550e3, a).unwrap().force;
+                        assert!(jump.abs() < 1e-6 * scale, "{kind:?} {layers}: jump {jump}");
+                    }
+                    prev = s;
+                }
+            }
+        }
+    }
+
     proptest! {
         #![proptest_config(ProptestConfig::with_cases(300))]
         /// Issue 3: any pressure in [-100 kPa, 1 MPa] and length up to beyond the limit gives
@@ -1205,6 +1621,28 @@ mod tests {
                 let l = bl.min_length() + frac * (bl.max_length() - bl.min_length());
                 if let Ok(stable) = bl.free_contact_is_stable(l) {
                     prop_assert!(stable, "{:?} layers {} at {}", tube, layers, l);
+                }
+            }
+        }
+
+        #[test]
+        fn knitted_finite_or_err(tubular in any::<bool>(), d_ri in 1e-3f64..12e-3, wall in 0.05e-3f64..2e-3,
+                                 lr0 in 0.03f64..0.15, layers in 1usize..20, t in 0.0f64..0.5e-3,
+                                 p in -1e5f64..1e6, frac in -0.1f64..1.2) {
+            let kind = if tubular { ShapeKind::Tubular } else { ShapeKind::Ideal };
+            let ks = knitted_sleeve(kind, t);
+            let tube = BladderTube { inner_diameter: d_ri, thickness: wall, unstretched_length: lr0,
+                mooney_c1: MOONEY_C1, mooney_c2: MOONEY_C2 };
+            if let Ok(bl) = Bladder::knitted(&ks, tube, layers) {
+                prop_assert!(bl.min_length() >= ks.min_length() && bl.max_length() <= ks.max_length());
+                let l = frac * ks.max_length();
+                match bl.evaluate(p, l) {
+                    Ok(s) => {
+                        prop_assert!(s.force.is_finite() && s.stiffness.is_finite() && s.fluid_volume > 0.0);
+                        prop_assert!(s.effective_pressure >= 0.0 && s.strand_force >= 0.0);
+                        prop_assert_eq!(s.contact, p >= s.threshold_pressure);
+                    }
+                    Err(e) => prop_assert!(!e.is_empty()),
                 }
             }
         }
