@@ -1498,6 +1498,18 @@ fn steps(fmu: &Fmu, t: &mut Tally, i: &Instance) {
             || (i.do_step(time, H), None),
         );
     }
+    // A long step must not widen the rounding allowance on the communication point.
+    for (time, h) in [(H, 1e10), (1.0, 1e17)] {
+        fmu.drive(i, State::StepComplete);
+        t.refused(
+            fmu,
+            i,
+            &format!("fmi2DoStep at t = {time} by {h}"),
+            ERROR,
+            "fmi2DoStep: expected currentCommunicationPoint",
+            || (i.do_step(time, h), None),
+        );
+    }
     // After a step: the old point again, a point in the future.
     for time in [0.0, 3.0 * H] {
         fmu.drive(i, State::StepComplete);

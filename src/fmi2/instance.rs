@@ -512,8 +512,10 @@ impl Instance {
                 "{F}: communicationStepSize = {step} must be positive and finite"
             ));
         }
-        // The importer's clock and ours may differ by rounding only; adopt the importer's.
-        let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs()).max(step);
+        // The importer's clock and ours may differ by rounding only; adopt the importer's. The
+        // allowance scales with the clocks, not the step: a long step must not excuse a wrong
+        // communication point.
+        let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs());
         if !time.is_finite() || (time - self.time).abs() > tolerance {
             return self.error(&format!(
                 "{F}: expected currentCommunicationPoint = {:.16e} but was {time:.16e}",
@@ -521,6 +523,8 @@ impl Instance {
             ));
         }
         if let Some(stop) = self.stop_time {
+            // A step computed as stop - time may overshoot by rounding of either.
+            let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
             if time + step > stop + tolerance {
                 return self.error(&format!(
                     "{F}: a step to {:.16e} would pass the stop time {stop:.16e}",
