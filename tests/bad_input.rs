@@ -1184,6 +1184,51 @@ unsafe fn serialize(api: &Api, c: Component, s: *mut c_void) -> Vec<c_char> {
     bytes
 }
 
+/// Serialized states whose clock fields are corrupt (FMI leaves the byte format to the FMU; ours
+/// is magic, format version, then postcard: GUID string, time, start time, optional stop time).
+fn corrupt_clocks(fmu: &Fmu, t: &mut Tally, i: &Instance) {
+    let api = &fmu.api;
+    let time_at = 10 + 1 + fmu.guid.len();
+    assert!(fmu.guid.len() < 128, "one-byte length prefix");
+    for (what, offset, value) in [
+        ("time NaN", time_at, f64::NAN),
+        ("startTime NaN", time_at + 8, f64::NAN),
+        ("startTime inf", time_at + 8, f64::INFINITY),
+        ("stopTime NaN", time_at + 17, f64::NAN),
+        ("stopTime -inf", time_at + 17, f64::NEG_INFINITY),
+        ("stopTime before startTime", time_at + 17, -1.0),
+    ] {
+        fmu.drive(i, State::Instantiated);
+        assert_eq!(
+            unsafe { (api.fmi2SetupExperiment)(i.c, 0, 0.0, 0.0, 1, 1.0) },
+            OK
+        );
+        let mut data = unsafe {
+            let mut s = null_mut();
+            (api.fmi2GetFMUstate)(i.c, &mut s);
+            let data = serialize(api, i.c, s);
+            (api.fmi2FreeFMUstate)(i.c, &mut s);
+            data
+        };
+        assert_eq!(data[time_at + 16], 1, "stop time present");
+        for (k, b) in value.to_le_bytes().iter().enumerate() {
+            data[offset + k] = *b as c_char;
+        }
+        t.refused(
+            fmu,
+            i,
+            &format!("fmi2DeSerializeFMUstate with {what}"),
+            ERROR,
+            "fmi2DeSerializeFMUstate: corrupt state",
+            || unsafe {
+                let mut s = null_mut();
+                let status = (api.fmi2DeSerializeFMUstate)(i.c, data.as_ptr(), data.len(), &mut s);
+                (status, (!s.is_null()).then(|| "a state was created".into()))
+            },
+        );
+    }
+}
+
 /// A state of every other FMU is refused by this one.
 fn foreign_states(fmus: &[Fmu], t: &mut Tally) {
     for fmu in fmus {
@@ -1638,6 +1683,7 @@ fn every_bad_input_is_refused_with_a_reason_and_reset_recovers() {
         null_pointers(fmu, &mut t, &i);
         call_order(fmu, &mut t, &i);
         steps(fmu, &mut t, &i);
+        corrupt_clocks(fmu, &mut t, &i);
         instantiation(fmu, &mut t);
     }
     foreign_states(&fmus, &mut t);

@@ -697,8 +697,15 @@ impl Instance {
                 body.guid, self.info.guid
             )));
         }
-        if !body.time.is_finite() {
-            return Err(refuse("corrupt state: time is not finite".into()));
+        // The clocks decide which steps are legal: non-finite ones would disable those checks.
+        let stop_ok = body
+            .stop_time
+            .is_none_or(|stop| stop.is_finite() && stop >= body.start_time);
+        if !body.time.is_finite() || !body.start_time.is_finite() || !stop_ok {
+            return Err(refuse(format!(
+                "corrupt state: time {}, startTime {} and stopTime {:?} must be finite, stopTime not before startTime",
+                body.time, body.start_time, body.stop_time
+            )));
         }
         let runtime = self
             .runtime
