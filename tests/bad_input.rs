@@ -1229,6 +1229,57 @@ fn corrupt_clocks(fmu: &Fmu, t: &mut Tally, i: &Instance) {
     }
 }
 
+/// A serialized state in which one Real variable's bytes became NaN or infinite, or an Integer
+/// parameter left its range: values `fmi2SetXXX` would refuse must not come in through a state.
+fn corrupt_values(fmu: &Fmu, t: &mut Tally, i: &Instance) {
+    let api = &fmu.api;
+    fmu.drive(i, State::StepComplete);
+    let bytes: Vec<u8> = unsafe {
+        let mut s = null_mut();
+        (api.fmi2GetFMUstate)(i.c, &mut s);
+        let b = serialize(api, i.c, s);
+        (api.fmi2FreeFMUstate)(i.c, &mut s);
+        b.iter().map(|&c| c as u8).collect()
+    };
+    // Variables whose current value occurs exactly once in the bytes can be located there.
+    let located: Vec<(&Var, usize)> = fmu
+        .of(Kind::Real)
+        .filter_map(|v| {
+            let x = i.real(v.vr).to_le_bytes();
+            let at: Vec<usize> = (0..bytes.len().saturating_sub(7))
+                .filter(|&k| bytes[k..k + 8] == x)
+                .collect();
+            (at.len() == 1).then(|| (v, at[0]))
+        })
+        .collect();
+    assert!(
+        !located.is_empty(),
+        "{}: no Real value found in the state",
+        fmu.model
+    );
+    for (v, at) in located.iter().take(4) {
+        for bad in [f64::NAN, f64::INFINITY] {
+            let mut corrupt = bytes.clone();
+            corrupt[*at..at + 8].copy_from_slice(&bad.to_le_bytes());
+            let corrupt: Vec<c_char> = corrupt.iter().map(|&b| b as c_char).collect();
+            fmu.drive(i, State::StepComplete);
+            t.refused(
+                fmu,
+                i,
+                &format!("fmi2DeSerializeFMUstate with {} = {bad}", v.name),
+                ERROR,
+                &format!("fmi2DeSerializeFMUstate: corrupt state: {} = {bad}", v.name),
+                || unsafe {
+                    let mut s = null_mut();
+                    let status =
+                        (api.fmi2DeSerializeFMUstate)(i.c, corrupt.as_ptr(), corrupt.len(), &mut s);
+                    (status, (!s.is_null()).then(|| "a state was created".into()))
+                },
+            );
+        }
+    }
+}
+
 /// A state of every other FMU is refused by this one.
 fn foreign_states(fmus: &[Fmu], t: &mut Tally) {
     for fmu in fmus {
@@ -1684,6 +1735,7 @@ fn every_bad_input_is_refused_with_a_reason_and_reset_recovers() {
         call_order(fmu, &mut t, &i);
         steps(fmu, &mut t, &i);
         corrupt_clocks(fmu, &mut t, &i);
+        corrupt_values(fmu, &mut t, &i);
         instantiation(fmu, &mut t);
     }
     foreign_states(&fmus, &mut t);

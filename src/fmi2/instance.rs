@@ -670,6 +670,24 @@ impl Instance {
         Ok(bytes)
     }
 
+    /// A value in `vars` that no legal call sequence produces: a non-finite Real (the FMU never
+    /// accepts or outputs one), or an input or parameter outside its declared range.
+    fn invalid_values(&self, vars: &crate::models::Vars) -> Option<String> {
+        self.info.variables.iter().find_map(|var| {
+            let i = var.vr as usize;
+            let x = match var.kind {
+                VarType::Real => *vars.real.get(i)?,
+                VarType::Integer => f64::from(*vars.integer.get(i)?),
+                _ => return None,
+            };
+            if !x.is_finite() {
+                return Some(format!("{} = {x}", var.name));
+            }
+            let settable = matches!(var.causality, Causality::Input | Causality::Parameter);
+            settable.then(|| range_check(x, var)).flatten()
+        })
+    }
+
     pub fn deserialize_fmu_state(
         &mut self,
         bytes: &[u8],
@@ -711,6 +729,9 @@ impl Instance {
             .runtime
             .snapshot_from_bytes(&body.runtime)
             .map_err(&refuse)?;
+        if let Some(why) = self.invalid_values(runtime.vars()) {
+            return Err(refuse(format!("corrupt state: {why}")));
+        }
         let state = FmuState {
             time: body.time,
             start_time: body.start_time,
