@@ -642,11 +642,34 @@ impl Driver {
                         if st != fmi2Status::OK {
                             return Ok(());
                         }
-                        // Corrupt some bytes, or cut them short, then read them back anywhere.
+                        // Corrupt some bytes, or write a special double anywhere (random bytes
+                        // rarely spell a NaN), or cut them short; then read them back anywhere.
                         for _ in 0..u.int_in_range(0..=3)? {
                             if size > 0 {
                                 let at = u.choose_index(size)?;
                                 bytes[at] = u.arbitrary::<u8>()? as c_char;
+                            }
+                        }
+                        if size >= 8 && u.ratio(1, 4)? {
+                            // Structure-aware: where a variable's current value is, if it can be
+                            // read and found; anywhere otherwise.
+                            let info = self.slots[k].as_ref().map(|s| s.info);
+                            let nr = info.map_or(0, |i| i.counts[0]);
+                            let mut at = u.choose_index(size - 7)?;
+                            if nr > 0 {
+                                let vr = u.int_in_range(0..=nr - 1)? as u32;
+                                let mut x = 0.0;
+                                if fmi2GetReal(c, &vr, 1, &mut x) <= fmi2Status::Warning {
+                                    let pattern = x.to_le_bytes().map(|b| b as c_char);
+                                    if let Some(found) = bytes.windows(8).position(|w| w == pattern)
+                                    {
+                                        at = found;
+                                    }
+                                }
+                            }
+                            let x = real(u, None)?;
+                            for (k, b) in x.to_le_bytes().iter().enumerate() {
+                                bytes[at + k] = *b as c_char;
                             }
                         }
                         let len = if u.ratio(1, 8)? {
@@ -662,6 +685,25 @@ impl Driver {
                         self.check(target, tbefore, st, "fmi2DeSerializeFMUstate");
                         if st == fmi2Status::OK {
                             self.slots[target].as_mut().unwrap().states.push(out);
+                            // Often go on at once: restore it and read every Real.
+                            if u.arbitrary()? {
+                                let before = self.logged(target);
+                                let st = fmi2SetFMUstate(tc, out);
+                                self.check(target, before, st, "fmi2SetFMUstate");
+                                let nr = self.slots[target].as_ref().unwrap().info.counts[0] as u32;
+                                let vrs: Vec<u32> = (0..nr).collect();
+                                let mut values = vec![0.0; vrs.len()];
+                                let before = self.logged(target);
+                                let st =
+                                    fmi2GetReal(tc, vrs.as_ptr(), vrs.len(), values.as_mut_ptr());
+                                self.check(target, before, st, "fmi2GetReal");
+                                if st <= fmi2Status::Warning {
+                                    assert!(
+                                        values.iter().all(|x| x.is_finite()),
+                                        "fmi2GetReal after a deserialized state gave {values:?} with {st:?}"
+                                    );
+                                }
+                            }
                         }
                         return Ok(());
                     }
