@@ -1403,6 +1403,7 @@ fn instantiation(fmu: &Fmu, t: &mut Tally) {
     let name = CString::new("n").unwrap();
     let guid = CString::new(fmu.guid.clone()).unwrap();
     let bad_guid = CString::new("{bad}").unwrap();
+    // fmi2CallbackFunctions with every member NULL: no logger, no environment.
     let silent = [0usize; 5];
     let cases: [(
         &str,
