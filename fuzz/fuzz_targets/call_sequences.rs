@@ -579,7 +579,7 @@ impl Driver {
         };
         let own = self.slots[k]
             .as_ref()
-            .map_or(false, |s| s.states.contains(&any_state));
+            .is_some_and(|s| s.states.contains(&any_state));
         let which = u.int_in_range(0..=4)?;
         let status = unsafe {
             match which {
