@@ -419,12 +419,41 @@ impl Instance {
             }
             parameters_changed |= var.causality == Causality::Parameter;
         }
+        let before = self.before_retune(parameters_changed);
         let vars = self.runtime.vars_mut();
         for (&vr, &value) in vrs.iter().zip(values) {
             value.store(vars, vr as usize);
         }
         self.runtime.changed(parameters_changed);
-        fmi2Status::OK
+        self.rebuild_or_undo(function, before)
+    }
+
+    /// A snapshot to undo a tunable parameter change with, if this set changes one between steps.
+    fn before_retune(&self, parameters_changed: bool) -> Option<Box<dyn Runtime>> {
+        (parameters_changed && self.state == MachineState::StepComplete)
+            .then(|| self.runtime.snapshot())
+    }
+
+    /// After a tunable parameter changed between steps: [`Model`](crate::models::Model) has no
+    /// update hook, so the model is rebuilt from its parameters at once (its history restarts).
+    /// Parameters it cannot be built from are refused and every value set by the call is undone.
+    fn rebuild_or_undo(&mut self, function: &str, before: Option<Box<dyn Runtime>>) -> fmi2Status {
+        let Some(before) = before else {
+            return fmi2Status::OK;
+        };
+        match self.runtime.build() {
+            Ok(()) => fmi2Status::OK,
+            Err(reason) => {
+                let undone = self.runtime.restore(before.as_ref());
+                self.error(&format!(
+                    "{function}: parameters rejected: {reason}; {}",
+                    match undone {
+                        Ok(()) => "the old values are kept".to_string(),
+                        Err(e) => format!("the old values could not be restored: {e}"),
+                    }
+                ))
+            }
+        }
     }
 
     pub fn set_strings(&mut self, vrs: &[u32], values: &[String]) -> fmi2Status {
@@ -446,12 +475,13 @@ impl Instance {
             }
             parameters_changed |= var.causality == Causality::Parameter;
         }
+        let before = self.before_retune(parameters_changed);
         let vars = self.runtime.vars_mut();
         for (&vr, value) in vrs.iter().zip(values) {
             vars.string[vr as usize] = value.clone();
         }
         self.runtime.changed(parameters_changed);
-        fmi2Status::OK
+        self.rebuild_or_undo(F, before)
     }
 
     /// Refreshes stale outputs, then copies `pick(vars, vr)` for each value reference.
@@ -760,5 +790,138 @@ impl Drop for Instance {
             // SAFETY: every pointer in the set came from Box::into_raw and was not freed.
             drop(unsafe { Box::from_raw(ptr as *mut FmuState) });
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The state machine with a minimal model that has what no shipped model has yet: a tunable
+    //! parameter (FMI 2.0.4 section 2.2.7 lets it change between steps).
+    use super::*;
+    use crate::fmi2::runtime::ModelFactory;
+    use crate::models::{Model, Vars};
+    use crate::variables::Start;
+
+    /// y = gain * u, with a tunable gain.
+    #[derive(Clone, Serialize, Deserialize)]
+    struct Gain {
+        gain: f64,
+    }
+
+    const fn var(
+        name: &'static str,
+        vr: u32,
+        causality: Causality,
+        variability: Variability,
+        initial: Initial,
+        start: Start,
+    ) -> Variable {
+        Variable {
+            name,
+            kind: VarType::Real,
+            vr,
+            causality,
+            variability,
+            initial,
+            start,
+            min: None,
+            max: None,
+            unit: "",
+            description: "",
+        }
+    }
+
+    static VARIABLES: [Variable; 3] = [
+        var(
+            "gain",
+            0,
+            Causality::Parameter,
+            Variability::Tunable,
+            Initial::Exact,
+            Start::Real(1.0),
+        ),
+        var(
+            "u",
+            1,
+            Causality::Input,
+            Variability::Continuous,
+            Initial::None,
+            Start::Real(0.0),
+        ),
+        var(
+            "y",
+            2,
+            Causality::Output,
+            Variability::Continuous,
+            Initial::Calculated,
+            Start::None,
+        ),
+    ];
+
+    static INFO: ModelInfo = ModelInfo {
+        name: "Gain",
+        guid: "{gain}",
+        description: "",
+        model_description_xml: "",
+        variables: &VARIABLES,
+        counts: [3, 0, 0, 0],
+        log_categories: &[],
+    };
+
+    impl Model for Gain {
+        const INFO: &'static ModelInfo = &INFO;
+        const DOCUMENTATION: &'static str = "";
+        fn new(vars: &mut Vars) -> Result<Self, String> {
+            match vars.real[0] {
+                0.0 => Err("gain must not be zero".into()),
+                gain => Ok(Self { gain }),
+            }
+        }
+        fn evaluate(&mut self, vars: &mut Vars, _: &mut Report) {
+            vars.real[2] = self.gain * vars.real[1];
+        }
+        fn step(&mut self, vars: &mut Vars, _: f64, _: f64, report: &mut Report) {
+            self.evaluate(vars, report);
+        }
+    }
+
+    static FACTORY: ModelFactory<Gain> = ModelFactory::NEW;
+
+    fn y(inst: &mut Instance) -> (fmi2Status, f64) {
+        let mut out = [f64::NAN];
+        let s = inst.get("fmi2GetReal", VarType::Real, &[2], &mut out, |v, i| {
+            v.real[i]
+        });
+        (s, out[0])
+    }
+
+    #[test]
+    fn a_tunable_parameter_set_between_steps_takes_effect() {
+        let mut inst = Instance::new(&FACTORY, Logger::new(None, std::ptr::null_mut(), "t"));
+        assert_eq!(inst.setup_experiment(None, 0.0, None), fmi2Status::OK);
+        assert_eq!(inst.enter_initialization_mode(), fmi2Status::OK);
+        assert_eq!(inst.exit_initialization_mode(), fmi2Status::OK);
+        assert_eq!(inst.set("fmi2SetReal", &[1], &[2.0]), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, 2.0));
+        assert_eq!(inst.set("fmi2SetReal", &[0], &[3.0]), fmi2Status::OK);
+        assert_eq!(
+            y(&mut inst),
+            (fmi2Status::OK, 6.0),
+            "outputs follow the new gain"
+        );
+        assert_eq!(inst.do_step(0.0, 0.1), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, 6.0), "and so does the step");
+        assert_eq!(inst.set("fmi2SetReal", &[0], &[-1.0]), fmi2Status::OK);
+        assert_eq!(inst.do_step(0.1, 0.1), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
+        // A gain the model refuses: the whole call is undone, the model keeps running.
+        assert_eq!(
+            inst.set("fmi2SetReal", &[1, 0], &[5.0, 0.0]),
+            fmi2Status::Error
+        );
+        assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
+        assert_eq!(inst.runtime.vars().real[..2], [-1.0, 2.0]);
+        assert_eq!(inst.do_step(0.2, 0.1), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
     }
 }
