@@ -1214,6 +1214,7 @@ fn corrupt_clocks(fmu: &Fmu, t: &mut Tally, i: &Instance) {
         for (k, b) in value.to_le_bytes().iter().enumerate() {
             data[offset + k] = *b as c_char;
         }
+        reseal(&mut data);
         t.refused(
             fmu,
             i,
@@ -1223,6 +1224,54 @@ fn corrupt_clocks(fmu: &Fmu, t: &mut Tally, i: &Instance) {
             || unsafe {
                 let mut s = null_mut();
                 let status = (api.fmi2DeSerializeFMUstate)(i.c, data.as_ptr(), data.len(), &mut s);
+                (status, (!s.is_null()).then(|| "a state was created".into()))
+            },
+        );
+    }
+}
+
+/// Recomputes the trailing FNV-1a checksum of a serialized state after an edit, so that the
+/// checks behind it (a state crafted with a valid checksum) are reached.
+fn reseal(data: &mut [c_char]) {
+    let n = data.len() - 8;
+    let sum = data[..n].iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b as u8)).wrapping_mul(0x100_0000_01b3)
+    });
+    for (k, b) in sum.to_le_bytes().iter().enumerate() {
+        data[n + k] = *b as c_char;
+    }
+}
+
+/// Any byte changed without resealing: refused by the checksum.
+fn unsealed_edits(fmu: &Fmu, t: &mut Tally, i: &Instance) {
+    let api = &fmu.api;
+    fmu.drive(i, State::StepComplete);
+    let data = unsafe {
+        let mut s = null_mut();
+        (api.fmi2GetFMUstate)(i.c, &mut s);
+        let b = serialize(api, i.c, s);
+        (api.fmi2FreeFMUstate)(i.c, &mut s);
+        b
+    };
+    // Past the header: every 16th byte, each checksum byte, and the last payload byte.
+    let positions: Vec<usize> = (10..data.len())
+        .step_by(16)
+        .chain(data.len() - 9..data.len())
+        .collect();
+    for at in positions {
+        let mut corrupt = data.clone();
+        corrupt[at] ^= 0x20;
+        fmu.drive(i, State::StepComplete);
+        t.refused(
+            fmu,
+            i,
+            &format!("fmi2DeSerializeFMUstate with byte {at} changed"),
+            ERROR,
+            "fmi2DeSerializeFMUstate: corrupt state: checksum mismatch",
+            || unsafe {
+                let mut s = null_mut();
+                let status =
+                    (api.fmi2DeSerializeFMUstate)(i.c, corrupt.as_ptr(), corrupt.len(), &mut s);
                 (status, (!s.is_null()).then(|| "a state was created".into()))
             },
         );
@@ -1261,7 +1310,8 @@ fn corrupt_values(fmu: &Fmu, t: &mut Tally, i: &Instance) {
         for bad in [f64::NAN, f64::INFINITY] {
             let mut corrupt = bytes.clone();
             corrupt[*at..at + 8].copy_from_slice(&bad.to_le_bytes());
-            let corrupt: Vec<c_char> = corrupt.iter().map(|&b| b as c_char).collect();
+            let mut corrupt: Vec<c_char> = corrupt.iter().map(|&b| b as c_char).collect();
+            reseal(&mut corrupt);
             fmu.drive(i, State::StepComplete);
             t.refused(
                 fmu,
@@ -1737,6 +1787,7 @@ fn every_bad_input_is_refused_with_a_reason_and_reset_recovers() {
         steps(fmu, &mut t, &i);
         corrupt_clocks(fmu, &mut t, &i);
         corrupt_values(fmu, &mut t, &i);
+        unsealed_edits(fmu, &mut t, &i);
         instantiation(fmu, &mut t);
     }
     foreign_states(&fmus, &mut t);

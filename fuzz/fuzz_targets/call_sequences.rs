@@ -581,6 +581,9 @@ impl Driver {
             .as_ref()
             .is_some_and(|s| s.states.contains(&any_state));
         let which = u.int_in_range(0..=4)?;
+        if std::env::var_os("CALL_SEQUENCES_TRACE").is_some() {
+            eprintln!("  fmu state call {which} on slot {k}");
+        }
         let status = unsafe {
             match which {
                 0 => {
@@ -671,6 +674,15 @@ impl Driver {
                             for (k, b) in x.to_le_bytes().iter().enumerate() {
                                 bytes[at + k] = *b as c_char;
                             }
+                            // A crafted state: a valid checksum, so that the value checks behind
+                            // it are what must refuse it. (Random flips stay unsealed: model
+                            // history crafted into garbage is beyond what the FMU can vet.)
+                            if at + 8 <= size - 8 {
+                                reseal(&mut bytes);
+                            }
+                        }
+                        if std::env::var_os("CALL_SEQUENCES_TRACE").is_some() {
+                            eprintln!("  serialized {size} bytes, now {:?}", bytes);
                         }
                         let len = if u.ratio(1, 8)? {
                             u.int_in_range(0..=size)?
@@ -783,7 +795,29 @@ impl Driver {
     }
 
     fn one(&mut self, u: &mut Unstructured) -> Result<()> {
-        match u.int_in_range(0..=15)? {
+        let op = u.int_in_range(0..=15)?;
+        if std::env::var_os("CALL_SEQUENCES_TRACE").is_some() {
+            const OPS: [&str; 16] = [
+                "instantiate",
+                "ready",
+                "free",
+                "simple",
+                "simple",
+                "setReal",
+                "setInteger",
+                "setBoolean/String",
+                "getReal",
+                "getReal",
+                "get",
+                "doStep",
+                "doStep",
+                "status",
+                "fmuState",
+                "fmuState",
+            ];
+            eprintln!("op {}", OPS[op as usize]);
+        }
+        match op {
             0 => self.instantiate(u),
             1 => self.ready(u),
             2 => self.free(u),
@@ -804,6 +838,17 @@ impl Driver {
             13 => self.status(u),
             _ => self.fmu_state(u),
         }
+    }
+}
+
+/// Recomputes the trailing FNV-1a checksum of a serialized state (format 2).
+fn reseal(data: &mut [c_char]) {
+    let n = data.len() - 8;
+    let sum = data[..n].iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b as u8)).wrapping_mul(0x100_0000_01b3)
+    });
+    for (k, b) in sum.to_le_bytes().iter().enumerate() {
+        data[n + k] = *b as c_char;
     }
 }
 

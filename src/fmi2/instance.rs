@@ -77,9 +77,18 @@ pub struct FmuState {
     runtime: Box<dyn Runtime>,
 }
 
-/// Versioned byte format of a serialized FMU state: magic, format version, then postcard.
+/// Versioned byte format of a serialized FMU state: magic, format version, postcard, then a
+/// 64-bit FNV-1a checksum of everything before it (format 2; format 1 had no checksum).
 const STATE_MAGIC: &[u8; 8] = b"AFMUSTAT";
-const STATE_FORMAT: u16 = 1;
+const STATE_FORMAT: u16 = 2;
+
+/// FNV-1a, 64 bit: catches accidental corruption of a stored state (a flipped byte in the model's
+/// history would otherwise reach the physics as garbage), not tampering.
+fn checksum(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
 
 #[derive(Serialize, Deserialize)]
 struct SerializedState {
@@ -697,6 +706,8 @@ impl Instance {
         let payload =
             postcard::to_stdvec(&body).map_err(|e| self.error(&format!("{function}: {e}")))?;
         bytes.extend_from_slice(&payload);
+        let sum = checksum(&bytes);
+        bytes.extend_from_slice(&sum.to_le_bytes());
         Ok(bytes)
     }
 
@@ -737,7 +748,17 @@ impl Instance {
                 "state format {format} is not supported (this binary reads {STATE_FORMAT})"
             )));
         }
-        let body: SerializedState = postcard::from_bytes(&bytes[10..])
+        let Some((sealed, sum)) = bytes.split_last_chunk::<8>().filter(|(s, _)| s.len() >= 10)
+        else {
+            return Err(refuse("corrupt state: too short".into()));
+        };
+        if checksum(sealed) != u64::from_le_bytes(*sum) {
+            return Err(refuse(
+                "corrupt state: checksum mismatch (the bytes changed since fmi2SerializeFMUstate)"
+                    .into(),
+            ));
+        }
+        let body: SerializedState = postcard::from_bytes(&sealed[10..])
             .map_err(|e| refuse(format!("corrupt state: {e}")))?;
         if body.guid != self.info.guid {
             return Err(refuse(format!(
