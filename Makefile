@@ -93,3 +93,30 @@ systems: fmus $(VENV)/.installed
 ## scheduler with `make sweep SCHEDULER=tcp://host:8786`.
 sweep: fmus $(VENV)/.installed
 	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
+
+## ---- Reliability jobs (issue 8): longer runs, not part of `make test`. ----
+.PHONY: fuzz memcheck
+
+FUZZ_SECONDS ?= 120
+## Fuzzes random FMI call sequences on both models for FUZZ_SECONDS (cargo-fuzz, nightly Rust).
+## The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go to the ignored
+## fuzz/corpus-run/, crashes to fuzz/artifacts/. Nothing is committed.
+fuzz:
+	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz
+	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
+	mkdir -p fuzz/corpus-run/call_sequences
+	cargo +nightly fuzz run call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
+	  $(CURDIR)/fuzz/corpus/call_sequences -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
+	  -rss_limit_mb=2048 -print_final_stats=1
+
+## The FMPy suite under valgrind memcheck: any memory error, or a leak allocated outside CPython
+## and NumPy, fails. PYTHONMALLOC=malloc lets valgrind see every Python allocation.
+MEMCHECK_TESTS ?= tests/fmpy
+memcheck: fmus $(VENV)/.installed
+	@command -v valgrind >/dev/null || { \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq valgrind; }
+	PYTHONMALLOC=malloc valgrind --tool=memcheck --error-exitcode=1 \
+	  --suppressions=tests/valgrind-python.supp --leak-check=full \
+	  --errors-for-leak-kinds=definite --show-leak-kinds=definite --num-callers=30 \
+	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS)

@@ -77,9 +77,18 @@ pub struct FmuState {
     runtime: Box<dyn Runtime>,
 }
 
-/// Versioned byte format of a serialized FMU state: magic, format version, then postcard.
+/// Versioned byte format of a serialized FMU state: magic, format version, postcard, then a
+/// 64-bit FNV-1a checksum of everything before it (format 2; format 1 had no checksum).
 const STATE_MAGIC: &[u8; 8] = b"AFMUSTAT";
-const STATE_FORMAT: u16 = 1;
+const STATE_FORMAT: u16 = 2;
+
+/// FNV-1a, 64 bit: catches accidental corruption of a stored state (a flipped byte in the model's
+/// history would otherwise reach the physics as garbage), not tampering.
+fn checksum(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
 
 #[derive(Serialize, Deserialize)]
 struct SerializedState {
@@ -423,12 +432,41 @@ impl Instance {
             }
             parameters_changed |= var.causality == Causality::Parameter;
         }
+        let before = self.before_retune(parameters_changed);
         let vars = self.runtime.vars_mut();
         for (&vr, value) in vrs.iter().zip(values) {
             value.store(vars, vr as usize);
         }
         self.runtime.changed(parameters_changed);
-        fmi2Status::OK
+        self.rebuild_or_undo(function, before)
+    }
+
+    /// A snapshot to undo a tunable parameter change with, if this set changes one between steps.
+    fn before_retune(&self, parameters_changed: bool) -> Option<Box<dyn Runtime>> {
+        (parameters_changed && self.state == MachineState::StepComplete)
+            .then(|| self.runtime.snapshot())
+    }
+
+    /// After a tunable parameter changed between steps: [`Model`](crate::models::Model) has no
+    /// update hook, so the model is rebuilt from its parameters at once (its history restarts).
+    /// Parameters it cannot be built from are refused and every value set by the call is undone.
+    fn rebuild_or_undo(&mut self, function: &str, before: Option<Box<dyn Runtime>>) -> fmi2Status {
+        let Some(before) = before else {
+            return fmi2Status::OK;
+        };
+        match self.runtime.build() {
+            Ok(()) => fmi2Status::OK,
+            Err(reason) => {
+                let undone = self.runtime.restore(before.as_ref());
+                self.error(&format!(
+                    "{function}: parameters rejected: {reason}; {}",
+                    match undone {
+                        Ok(()) => "the old values are kept".to_string(),
+                        Err(e) => format!("the old values could not be restored: {e}"),
+                    }
+                ))
+            }
+        }
     }
 
     /// Refreshes stale outputs, then copies `pick(vars, vr)` for each value reference.
@@ -489,8 +527,10 @@ impl Instance {
                 "{F}: communicationStepSize = {step} must be positive and finite"
             ));
         }
-        // The importer's clock and ours may differ by rounding only; adopt the importer's.
-        let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs()).max(step);
+        // The importer's clock and ours may differ by rounding only; adopt the importer's. The
+        // allowance scales with the clocks, not the step: a long step must not excuse a wrong
+        // communication point.
+        let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs());
         if !time.is_finite() || (time - self.time).abs() > tolerance {
             return self.error(&format!(
                 "{F}: expected currentCommunicationPoint = {:.16e} but was {time:.16e}",
@@ -498,6 +538,8 @@ impl Instance {
             ));
         }
         if let Some(stop) = self.stop_time {
+            // A step computed as stop - time may overshoot by rounding of either.
+            let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
             if time + step > stop + tolerance {
                 return self.error(&format!(
                     "{F}: a step to {:.16e} would pass the stop time {stop:.16e}",
@@ -640,7 +682,27 @@ impl Instance {
         let payload =
             postcard::to_stdvec(&body).map_err(|e| self.error(&format!("{function}: {e}")))?;
         bytes.extend_from_slice(&payload);
+        let sum = checksum(&bytes);
+        bytes.extend_from_slice(&sum.to_le_bytes());
         Ok(bytes)
+    }
+
+    /// A value in `vars` that no legal call sequence produces: a non-finite Real (the FMU never
+    /// accepts or outputs one), or an input or parameter outside its declared range.
+    fn invalid_values(&self, vars: &crate::models::Vars) -> Option<String> {
+        self.info.variables.iter().find_map(|var| {
+            let i = var.vr as usize;
+            let x = match var.kind {
+                VarType::Real => *vars.real.get(i)?,
+                VarType::Integer => f64::from(*vars.integer.get(i)?),
+                _ => return None,
+            };
+            if !x.is_finite() {
+                return Some(format!("{} = {x}", var.name));
+            }
+            let settable = matches!(var.causality, Causality::Input | Causality::Parameter);
+            settable.then(|| range_check(x, var)).flatten()
+        })
     }
 
     pub fn deserialize_fmu_state(
@@ -662,7 +724,17 @@ impl Instance {
                 "state format {format} is not supported (this binary reads {STATE_FORMAT})"
             )));
         }
-        let body: SerializedState = postcard::from_bytes(&bytes[10..])
+        let Some((sealed, sum)) = bytes.split_last_chunk::<8>().filter(|(s, _)| s.len() >= 10)
+        else {
+            return Err(refuse("corrupt state: too short".into()));
+        };
+        if checksum(sealed) != u64::from_le_bytes(*sum) {
+            return Err(refuse(
+                "corrupt state: checksum mismatch (the bytes changed since fmi2SerializeFMUstate)"
+                    .into(),
+            ));
+        }
+        let body: SerializedState = postcard::from_bytes(&sealed[10..])
             .map_err(|e| refuse(format!("corrupt state: {e}")))?;
         if body.guid != self.info.guid {
             return Err(refuse(format!(
@@ -670,13 +742,23 @@ impl Instance {
                 body.guid, self.info.guid
             )));
         }
-        if !body.time.is_finite() {
-            return Err(refuse("corrupt state: time is not finite".into()));
+        // The clocks decide which steps are legal: non-finite ones would disable those checks.
+        let stop_ok = body
+            .stop_time
+            .is_none_or(|stop| stop.is_finite() && stop >= body.start_time);
+        if !body.time.is_finite() || !body.start_time.is_finite() || !stop_ok {
+            return Err(refuse(format!(
+                "corrupt state: time {}, startTime {} and stopTime {:?} must be finite, stopTime not before startTime",
+                body.time, body.start_time, body.stop_time
+            )));
         }
         let runtime = self
             .runtime
             .snapshot_from_bytes(&body.runtime)
             .map_err(&refuse)?;
+        if let Some(why) = self.invalid_values(runtime.vars()) {
+            return Err(refuse(format!("corrupt state: {why}")));
+        }
         let state = FmuState {
             time: body.time,
             start_time: body.start_time,
@@ -705,5 +787,138 @@ impl Drop for Instance {
             // SAFETY: every pointer in the set came from Box::into_raw and was not freed.
             drop(unsafe { Box::from_raw(ptr as *mut FmuState) });
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    //! The state machine with a minimal model that has what no shipped model has yet: a tunable
+    //! parameter (FMI 2.0.4 section 2.2.7 lets it change between steps).
+    use super::*;
+    use crate::fmi2::runtime::ModelFactory;
+    use crate::models::{Model, Vars};
+    use crate::variables::Start;
+
+    /// y = gain * u, with a tunable gain.
+    #[derive(Clone, Serialize, Deserialize)]
+    struct Gain {
+        gain: f64,
+    }
+
+    const fn var(
+        name: &'static str,
+        vr: u32,
+        causality: Causality,
+        variability: Variability,
+        initial: Initial,
+        start: Start,
+    ) -> Variable {
+        Variable {
+            name,
+            kind: VarType::Real,
+            vr,
+            causality,
+            variability,
+            initial,
+            start,
+            min: None,
+            max: None,
+            unit: "",
+            description: "",
+        }
+    }
+
+    static VARIABLES: [Variable; 3] = [
+        var(
+            "gain",
+            0,
+            Causality::Parameter,
+            Variability::Tunable,
+            Initial::Exact,
+            Start::Real(1.0),
+        ),
+        var(
+            "u",
+            1,
+            Causality::Input,
+            Variability::Continuous,
+            Initial::None,
+            Start::Real(0.0),
+        ),
+        var(
+            "y",
+            2,
+            Causality::Output,
+            Variability::Continuous,
+            Initial::Calculated,
+            Start::None,
+        ),
+    ];
+
+    static INFO: ModelInfo = ModelInfo {
+        name: "Gain",
+        guid: "{gain}",
+        description: "",
+        model_description_xml: "",
+        variables: &VARIABLES,
+        counts: [3, 0, 0, 0],
+        log_categories: &[],
+    };
+
+    impl Model for Gain {
+        const INFO: &'static ModelInfo = &INFO;
+        const DOCUMENTATION: &'static str = "";
+        fn new(vars: &mut Vars) -> Result<Self, String> {
+            match vars.real[0] {
+                0.0 => Err("gain must not be zero".into()),
+                gain => Ok(Self { gain }),
+            }
+        }
+        fn evaluate(&mut self, vars: &mut Vars, _: &mut Report) {
+            vars.real[2] = self.gain * vars.real[1];
+        }
+        fn step(&mut self, vars: &mut Vars, _: f64, _: f64, report: &mut Report) {
+            self.evaluate(vars, report);
+        }
+    }
+
+    static FACTORY: ModelFactory<Gain> = ModelFactory::NEW;
+
+    fn y(inst: &mut Instance) -> (fmi2Status, f64) {
+        let mut out = [f64::NAN];
+        let s = inst.get("fmi2GetReal", VarType::Real, &[2], &mut out, |v, i| {
+            v.real[i]
+        });
+        (s, out[0])
+    }
+
+    #[test]
+    fn a_tunable_parameter_set_between_steps_takes_effect() {
+        let mut inst = Instance::new(&FACTORY, Logger::new(None, std::ptr::null_mut(), "t"));
+        assert_eq!(inst.setup_experiment(None, 0.0, None), fmi2Status::OK);
+        assert_eq!(inst.enter_initialization_mode(), fmi2Status::OK);
+        assert_eq!(inst.exit_initialization_mode(), fmi2Status::OK);
+        assert_eq!(inst.set("fmi2SetReal", &[1], &[2.0]), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, 2.0));
+        assert_eq!(inst.set("fmi2SetReal", &[0], &[3.0]), fmi2Status::OK);
+        assert_eq!(
+            y(&mut inst),
+            (fmi2Status::OK, 6.0),
+            "outputs follow the new gain"
+        );
+        assert_eq!(inst.do_step(0.0, 0.1), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, 6.0), "and so does the step");
+        assert_eq!(inst.set("fmi2SetReal", &[0], &[-1.0]), fmi2Status::OK);
+        assert_eq!(inst.do_step(0.1, 0.1), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
+        // A gain the model refuses: the whole call is undone, the model keeps running.
+        assert_eq!(
+            inst.set("fmi2SetReal", &[1, 0], &[5.0, 0.0]),
+            fmi2Status::Error
+        );
+        assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
+        assert_eq!(inst.runtime.vars().real[..2], [-1.0, 2.0]);
+        assert_eq!(inst.do_step(0.2, 0.1), fmi2Status::OK);
+        assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
     }
 }

@@ -155,7 +155,7 @@ impl KnittedMuscle {
         let l = if length.is_nan() {
             hi
         } else {
-            length.clamp(lo, hi)
+            length.max(lo).min(hi)
         };
         if l == length {
             self.out_of_range = false;
@@ -344,7 +344,7 @@ impl Model for KnittedMuscle {
         let history = HysteresisState::at_rest(if start.is_nan() {
             valid.1
         } else {
-            start.clamp(valid.0, valid.1)
+            start.max(valid.0).min(valid.1)
         });
         Ok(Self {
             sleeve,

@@ -108,7 +108,7 @@ impl McKibbenJoint {
         } else {
             0.0
         };
-        let inside = length.clamp(lo + margin, hi - margin);
+        let inside = length.max(lo + margin).min(hi - margin); // max/min: no panic on odd limits
         clamped.get_or_insert(format!(
             "{reason} (valid muscle lengths {lo} .. {hi} m); evaluating at {inside} m until the inputs return"
         ));

@@ -142,7 +142,8 @@ impl McKibbenMuscle {
         } else {
             0.0
         };
-        let clamped = length.clamp(lo + margin, hi - margin);
+        // max/min rather than clamp: never panics, even on limits from a crafted FMU state.
+        let clamped = length.max(lo + margin).min(hi - margin);
         let fallback = [(pressure, clamped), (pressure.max(0.0), clamped)]
             .into_iter()
             .find_map(|(p, l)| muscle.evaluate(p, l, friction).ok().map(|o| (p, l, o)));
