@@ -166,3 +166,26 @@ def test_dense_grid_never_gives_nan(model, friction, connector, recording_log):
     if model and not connector:  # through a connector every measured length is reachable
         assert recording_log.contains("until the inputs return"), "out-of-range points are logged"
     m.close()
+
+
+@pytest.mark.parametrize("model", [0, 1, 2])
+def test_length_reversals_at_every_point_of_the_stroke(model):
+    # Issue 8's hard case: reverse the length at 25 points along the stroke with friction on. At each
+    # reversal the force may change by at most the full friction swing 2 Cf P_eff plus the elastic
+    # change over the step; it never jumps beyond that, and nothing is NaN.
+    m = muscle(preset=4, bladder_model=model, bladder_layers=8, friction=True, friction_coefficient=2e-5,
+               presliding_length=1e-4, length=0.09)
+    top = 0.98 * m.get("max_length")
+    dl = 2e-4
+    for turn in np.linspace(0.095, top, 25):
+        path = list(np.arange(0.09, turn, dl)) + [turn] + list(np.arange(turn - dl, turn - 50 * dl, -dl))
+        previous = None
+        for L in path:
+            m.step(pressure=3.45e5, length=L)
+            force, stiffness, p_eff = m.get("force", "stiffness", "effective_pressure")
+            assert math.isfinite(force) and math.isfinite(stiffness)
+            if previous is not None:
+                bound = 2 * 2e-5 * max(p_eff, previous[2]) + 2 * max(abs(stiffness), abs(previous[1])) * dl + 1e-9
+                assert abs(force - previous[0]) <= bound, (turn, L, force, previous)
+            previous = (force, stiffness, p_eff)
+    m.close()
