@@ -1303,7 +1303,10 @@ fn corrupt_values(fmu: &Fmu, t: &mut Tally, i: &Instance) {
         .collect();
     if located.is_empty() {
         // PassThrough's y always equals u: no Real occurs once, so none can be located.
-        println!("{}: no Real value occurs once in the state; value corruption untested", fmu.model);
+        println!(
+            "{}: no Real value occurs once in the state; value corruption untested",
+            fmu.model
+        );
         return;
     }
     for (v, at) in located.iter().take(4) {

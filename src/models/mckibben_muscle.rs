@@ -120,6 +120,25 @@ fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &
 }
 
 impl McKibbenMuscle {
+    /// Writes the outputs of the selected pipeline; `commit` advances the friction history.
+    fn outputs(&mut self, vars: &mut Vars, report: &mut Report, commit: bool) {
+        match &self.pipeline {
+            Pipeline::Sleeve(sleeve) => {
+                sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
+            }
+            Pipeline::Full(muscle) => {
+                if let Some(out) =
+                    Self::compute(muscle, &self.friction, &mut self.out_of_range, vars, report)
+                {
+                    Self::write(vars, &out);
+                    if commit {
+                        self.friction = out.friction_state;
+                    }
+                }
+            }
+        }
+    }
+
     /// The full model at the current inputs; out of range, the nearest point inside it (logged).
     fn compute(
         muscle: &McKibben,
@@ -223,35 +242,12 @@ impl Model for McKibbenMuscle {
     }
 
     fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        match &self.pipeline {
-            Pipeline::Sleeve(sleeve) => {
-                sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
-            }
-            Pipeline::Full(muscle) => {
-                if let Some(out) =
-                    Self::compute(muscle, &self.friction, &mut self.out_of_range, vars, report)
-                {
-                    Self::write(vars, &out);
-                }
-            }
-        }
+        self.outputs(vars, report, false)
     }
 
     fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
-        match &self.pipeline {
-            Pipeline::Sleeve(sleeve) => {
-                sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
-            }
-            Pipeline::Full(muscle) => {
-                if let Some(out) =
-                    Self::compute(muscle, &self.friction, &mut self.out_of_range, vars, report)
-                {
-                    Self::write(vars, &out);
-                    self.friction = out.friction_state;
-                }
-            }
-        }
+        self.outputs(vars, report, true)
     }
 }
