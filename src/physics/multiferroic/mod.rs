@@ -621,17 +621,33 @@ impl Motor {
     /// dynamics; the quasi-static onion is re-settled at the new rotor angle.
     fn exponential_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<Vector> {
         let (f, j) = self.rhs_jacobian(y, d, dt);
-        let mut m = [[0.0; expm::N]; expm::N];
-        for i in 0..4 {
-            for k in 0..4 {
-                m[i][k] = dt * j[i][k];
-            }
-            m[i][4] = dt * f[i];
-        }
-        let e = expm::expm(&m)?;
         let mut out = *y;
-        for (i, x) in out.iter_mut().enumerate() {
-            *x += e[i][4];
+        if self.quasi_static() {
+            // The onion rows are zero here (it is re-settled below), so the onion does not move
+            // within the substep and the rotor block evolves alone: a 3x3 exponential of
+            // (angle, speed, forcing) gives the same increments as the 5x5 one at a fifth of
+            // the cost (the matrix products were 60% of a motor step).
+            let mut m = [[0.0; 3]; 3];
+            for i in 0..2 {
+                m[i][0] = dt * j[i][0];
+                m[i][1] = dt * j[i][1];
+                m[i][2] = dt * f[i];
+            }
+            let e = expm::expm(&m)?;
+            out[0] += e[0][2];
+            out[1] += e[1][2];
+        } else {
+            let mut m = [[0.0; expm::N]; expm::N];
+            for i in 0..4 {
+                for k in 0..4 {
+                    m[i][k] = dt * j[i][k];
+                }
+                m[i][4] = dt * f[i];
+            }
+            let e = expm::expm(&m)?;
+            for (i, x) in out.iter_mut().enumerate() {
+                *x += e[i][4];
+            }
         }
         if d.locked {
             out[0] = y[0];
