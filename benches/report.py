@@ -183,7 +183,7 @@ NATIVE_DEFAULT = {
 EXPLANATIONS = {
     "McKibbenMuscle/bladder_model/none": "the FMI calls themselves cost about as much: behind the same calls the PassThrough FMU's step is as slow (`make bench`, group 'same FMI calls'), and eq. 2.3 adds about 1 ns",
     "McKibbenMuscle/bladder_model/thin": "the thin wall's Mooney-Rivlin stresses, the contact switch and the analytic stiffness: about 4 divisions and 2 square roots more than eq. 2.3, plus the free-bladder root below the threshold",
-    "MultiferroicMotor/tolerance/1e-6": "every communication step takes at least one error-controlled substep, and step doubling makes each substep three exponential Rosenbrock solves (a 5x5 matrix exponential and an onion-state re-solve each); a looser tolerance or longer communication steps cost less per simulated second (through FMPy a 1 ms step, ten schedule periods, costs 41 us and a 1 s step 41 us: settled periods are advanced at once)",
+    "MultiferroicMotor/tolerance/1e-6": "every communication step takes at least one error-controlled substep, and step doubling makes each substep three exponential Rosenbrock solves (a 3x3 matrix exponential of the rotor by scaling and squaring, about 22 small matrix products, then an onion-state re-solve each; the products are half the time); a looser tolerance or longer communication steps cost less per simulated second (through FMPy a 1 ms step, ten schedule periods, costs 41 us and a 1 s step 41 us: settled periods are advanced at once)",
 }
 
 
