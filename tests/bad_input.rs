@@ -520,6 +520,24 @@ impl Tally {
     }
 }
 
+/// A getter's value array: NULL when the case asks for one, else the buffer.
+fn out_ptr<T>(buf: &mut [T], null: bool) -> *mut T {
+    if null {
+        null_mut()
+    } else {
+        buf.as_mut_ptr()
+    }
+}
+
+/// A setter's value array: NULL when the case asks for one, else the buffer.
+fn in_ptr<T>(buf: &[T], null: bool) -> *const T {
+    if null {
+        std::ptr::null()
+    } else {
+        buf.as_ptr()
+    }
+}
+
 fn values_beyond(v: &Var) -> Vec<(f64, &'static str)> {
     let mut out = Vec::new();
     let int = v.kind == Kind::Integer;
@@ -596,21 +614,21 @@ fn raw_array_calls<'a>(fmu: &'a Fmu, i: &'a Instance) -> Vec<RawCall<'a>> {
         "fmi2SetReal".into(),
         Box::new(move |vr, n, value_null| unsafe {
             let buf = [0.0f64; 4];
-            (api.fmi2SetReal)(c, vr, n, if value_null { null() } else { buf.as_ptr() })
+            (api.fmi2SetReal)(c, vr, n, in_ptr(&buf, value_null))
         }),
     ));
     calls.push((
         "fmi2SetInteger".into(),
         Box::new(move |vr, n, value_null| unsafe {
             let buf = [0 as c_int; 4];
-            (api.fmi2SetInteger)(c, vr, n, if value_null { null() } else { buf.as_ptr() })
+            (api.fmi2SetInteger)(c, vr, n, in_ptr(&buf, value_null))
         }),
     ));
     calls.push((
         "fmi2SetBoolean".into(),
         Box::new(move |vr, n, value_null| unsafe {
             let buf = [0 as c_int; 4];
-            (api.fmi2SetBoolean)(c, vr, n, if value_null { null() } else { buf.as_ptr() })
+            (api.fmi2SetBoolean)(c, vr, n, in_ptr(&buf, value_null))
         }),
     ));
     calls.push((
@@ -618,55 +636,35 @@ fn raw_array_calls<'a>(fmu: &'a Fmu, i: &'a Instance) -> Vec<RawCall<'a>> {
         Box::new(move |vr, n, value_null| unsafe {
             let s = CString::new("x").unwrap();
             let buf = [s.as_ptr(); 4];
-            (api.fmi2SetString)(c, vr, n, if value_null { null() } else { buf.as_ptr() })
+            (api.fmi2SetString)(c, vr, n, in_ptr(&buf, value_null))
         }),
     ));
     calls.push((
         "fmi2GetReal".into(),
         Box::new(move |vr, n, value_null| unsafe {
             let mut buf = [0.0f64; 4];
-            let p = if value_null {
-                null_mut()
-            } else {
-                buf.as_mut_ptr()
-            };
-            (api.fmi2GetReal)(c, vr, n, p)
+            (api.fmi2GetReal)(c, vr, n, out_ptr(&mut buf, value_null))
         }),
     ));
     calls.push((
         "fmi2GetInteger".into(),
         Box::new(move |vr, n, value_null| unsafe {
             let mut buf = [0 as c_int; 4];
-            let p = if value_null {
-                null_mut()
-            } else {
-                buf.as_mut_ptr()
-            };
-            (api.fmi2GetInteger)(c, vr, n, p)
+            (api.fmi2GetInteger)(c, vr, n, out_ptr(&mut buf, value_null))
         }),
     ));
     calls.push((
         "fmi2GetBoolean".into(),
         Box::new(move |vr, n, value_null| unsafe {
             let mut buf = [0 as c_int; 4];
-            let p = if value_null {
-                null_mut()
-            } else {
-                buf.as_mut_ptr()
-            };
-            (api.fmi2GetBoolean)(c, vr, n, p)
+            (api.fmi2GetBoolean)(c, vr, n, out_ptr(&mut buf, value_null))
         }),
     ));
     calls.push((
         "fmi2GetString".into(),
         Box::new(move |vr, n, value_null| unsafe {
             let mut buf = [null::<c_char>(); 4];
-            let p = if value_null {
-                null_mut()
-            } else {
-                buf.as_mut_ptr()
-            };
-            (api.fmi2GetString)(c, vr, n, p)
+            (api.fmi2GetString)(c, vr, n, out_ptr(&mut buf, value_null))
         }),
     ));
     calls
