@@ -953,6 +953,19 @@ mod tests {
     use approx::assert_relative_eq;
     use proptest::prelude::*;
 
+    /// At `max_length` eq. 2.7's inner diameter vanishes, for any sleeve: a contact diameter just
+    /// inside, none just outside, no solution at the limit, and the force at `pressure` rising
+    /// without bound towards it.
+    fn assert_fill_limit<S: SleeveGeometry>(bl: &Bladder<S>, pressure: f64) {
+        let top = bl.max_length();
+        assert!(bl.contact_inner_diameter(top * (1.0 - 1e-6)).is_some());
+        assert!(bl.contact_inner_diameter(top * (1.0 + 1e-6)).is_none());
+        assert!(bl.evaluate(pressure, top).is_err());
+        let force = |below: f64| bl.evaluate(pressure, top * (1.0 - below)).unwrap().force;
+        let (f1, f2) = (force(1e-3), force(1e-5));
+        assert!(f2 > 10.0 * f1 && f1 > 0.0, "{f1} {f2}");
+    }
+
     /// Table 2.1: (muscle length, bladder length, inner diameter, thickness, b, n), SI units.
     const TABLE_2_1: [(f64, f64, f64, f64, f64, f64); 4] = [
         (0.10325, 0.1005, 1.6e-3, 1.6e-3, 0.1113, 3.74),
@@ -1118,25 +1131,9 @@ mod tests {
                     - 4.0 * bl.rubber_volume() / (PI * edge);
                 assert!(d_sq.abs() < 1e-15, "{d_sq}");
             }
-            assert!(bl
-                .contact_inner_diameter(bl.max_length() * (1.0 - 1e-6))
-                .is_some());
-            assert!(bl
-                .contact_inner_diameter(bl.max_length() * (1.0 + 1e-6))
-                .is_none());
-            assert!(bl.evaluate(3e5, bl.max_length()).is_err());
+            assert_fill_limit(&bl, 3e5);
             assert!(bl.evaluate(3e5, bl.max_length() * 1.01).is_err());
             assert!(bl.evaluate(3e5, bl.min_length()).is_err());
-            // The force rises without bound towards the limit.
-            let f1 = bl
-                .evaluate(3e5, bl.max_length() * (1.0 - 1e-3))
-                .unwrap()
-                .force;
-            let f2 = bl
-                .evaluate(3e5, bl.max_length() * (1.0 - 1e-5))
-                .unwrap()
-                .force;
-            assert!(f2 > 10.0 * f1 && f1 > 0.0, "{f1} {f2}");
         }
         // Thicker or stiffer-to-fit rubber (more volume) shortens the reach (section 2.2.1).
         assert!(muscle(A, 1).max_length() / 0.1113 < muscle(B, 1).max_length() / 0.1160);
@@ -1492,23 +1489,7 @@ mod tests {
                 bl.max_length() * 1e3,
                 ks.max_length() * 1e3
             );
-            assert!(bl
-                .contact_inner_diameter(bl.max_length() * (1.0 - 1e-6))
-                .is_some());
-            assert!(bl
-                .contact_inner_diameter(bl.max_length() * (1.0 + 1e-6))
-                .is_none());
-            assert!(bl.evaluate(5e5, bl.max_length()).is_err());
-            // The force rises without bound towards the fill limit.
-            let f1 = bl
-                .evaluate(5e5, bl.max_length() * (1.0 - 1e-3))
-                .unwrap()
-                .force;
-            let f2 = bl
-                .evaluate(5e5, bl.max_length() * (1.0 - 1e-5))
-                .unwrap()
-                .force;
-            assert!(f2 > 10.0 * f1 && f1 > 0.0, "{f1} {f2}");
+            assert_fill_limit(&bl, 5e5);
         }
         // A thick strand whose minimum radius (eq. 1.16) exceeds the filled diameter ends the
         // range at the sleeve's own full extension.
