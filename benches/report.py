@@ -50,32 +50,47 @@ def progress(text):
 
 # ---- accuracy: the scenarios of benches/accuracy_cost.rs ----
 
-def mckibben_forces(parameters, lengths):
-    m = Slave("McKibbenMuscle", preset=1, length=lengths[0], **parameters)
-    f = np.array([m.at("force", pressure=6.9e5, length=L) for L in lengths])
+def forces(model, pressure, lengths, **parameters):
+    """The force along `lengths` at constant `pressure`, inputs set without stepping."""
+    m = Slave(model, length=lengths[0], **parameters)
+    f = np.array([m.at("force", pressure=pressure, length=L) for L in lengths])
     m.close()
     return f
+
+
+def friction_effect(model, pressure, lengths, scale, **parameters):
+    """Friction is an effect, not an approximation: its "error" is how much leaving it off
+    changes the force, the largest friction force along the stepped path relative to `scale`."""
+    m = Slave(model, friction=True, length=lengths[0], **parameters)
+    friction = []
+    for L in lengths:
+        m.step(pressure=pressure, length=L)
+        friction.append(m.get("friction_force"))
+    m.close()
+    return np.max(np.abs(friction)) / scale
+
+
+def error_rows(model, pressure, lengths, reference, configurations):
+    """(knob, value, largest deviation from the reference force relative to its largest value)."""
+    ref = forces(model, pressure, lengths, **reference)
+    scale = np.max(np.abs(ref))
+    rows = [(knob, value, np.max(np.abs(forces(model, pressure, lengths, **params) - ref)) / scale)
+            for knob, value, params in configurations]
+    return rows, scale
 
 
 def mckibben_rows():
     lengths = 0.10325 * np.linspace(0.75, 0.93, 40)
     progress("McKibbenMuscle: reference, thick wall with 1024 layers")
-    ref = mckibben_forces({"bladder_model": 2, "bladder_layers": 1024}, lengths)
-    scale = np.max(np.abs(ref))
-    rows = []
-    for value, params in [("none", {"bladder_model": 0}), ("thin", {"bladder_model": 1})]:
-        rows.append(("bladder_model", value, np.max(np.abs(mckibben_forces(params, lengths) - ref)) / scale))
-    for layers in (1, 2, 4, 8, 16, 32, 64):
-        f = mckibben_forces({"bladder_model": 2, "bladder_layers": layers}, lengths)
-        rows.append(("bladder_layers", str(layers), np.max(np.abs(f - ref)) / scale))
-    # Friction is an effect, not an approximation: its "error" is how much leaving it off changes the force.
-    m = Slave("McKibbenMuscle", preset=1, bladder_model=1, friction=True, length=lengths[0])
-    friction = []
-    for L in lengths:
-        m.step(pressure=6.9e5, length=L)
-        friction.append(m.get("friction_force"))
-    m.close()
-    rows.append(("friction", "on (thin)", np.max(np.abs(friction)) / scale))
+    a = {"preset": 1}
+    configurations = [("bladder_model", "none", {**a, "bladder_model": 0}),
+                      ("bladder_model", "thin", {**a, "bladder_model": 1})]
+    configurations += [("bladder_layers", str(n), {**a, "bladder_model": 2, "bladder_layers": n})
+                       for n in (1, 2, 4, 8, 16, 32, 64)]
+    rows, scale = error_rows("McKibbenMuscle", 6.9e5, lengths, {**a, "bladder_model": 2, "bladder_layers": 1024},
+                             configurations)
+    rows.append(("friction", "on (thin)",
+                 friction_effect("McKibbenMuscle", 6.9e5, lengths, scale, preset=1, bladder_model=1)))
     return "McKibbenMuscle", "muscle A, 690 kPa, 0.75-0.93 of its length; reference: thick wall, 1024 layers", rows
 
 
@@ -83,28 +98,13 @@ def knitted_rows():
     if not (FMU_DIR / "KnittedMuscle.fmu").exists():
         return None
     lengths = 0.514 * np.linspace(0.40, 0.95, 40)
-
-    def forces(params):
-        m = Slave("KnittedMuscle", length=lengths[0], **params)
-        f = np.array([m.at("force", pressure=1.4e4, length=L) for L in lengths])
-        m.close()
-        return f
-
     progress("KnittedMuscle: reference, non-cylindrical with 392 segments")
-    ref = forces({"shape_model": 2, "shape_segments": 392})
-    scale = np.max(np.abs(ref))
-    rows = [("shape_model", v, np.max(np.abs(forces({"shape_model": s}) - ref)) / scale)
-            for v, s in (("ideal", 0), ("tubular", 1))]
-    for segments in (12, 24, 49, 98, 196):
-        f = forces({"shape_model": 2, "shape_segments": segments})
-        rows.append(("shape_segments", str(segments), np.max(np.abs(f - ref)) / scale))
-    m = Slave("KnittedMuscle", shape_model=0, friction=True, length=lengths[0])
-    friction = []
-    for L in lengths:
-        m.step(pressure=1.4e4, length=L)
-        friction.append(m.get("friction_force"))
-    m.close()
-    rows.append(("friction", "on (ideal)", np.max(np.abs(friction)) / scale))
+    configurations = [("shape_model", "ideal", {"shape_model": 0}), ("shape_model", "tubular", {"shape_model": 1})]
+    configurations += [("shape_segments", str(n), {"shape_model": 2, "shape_segments": n})
+                       for n in (12, 24, 49, 98, 196)]
+    rows, scale = error_rows("KnittedMuscle", 1.4e4, lengths, {"shape_model": 2, "shape_segments": 392},
+                             configurations)
+    rows.append(("friction", "on (ideal)", friction_effect("KnittedMuscle", 1.4e4, lengths, scale, shape_model=0)))
     return "KnittedMuscle", "section 1.4 prototype, 14 kPa, 40-95% of 514 mm; reference: non-cylindrical, 392 segments", rows
 
 
