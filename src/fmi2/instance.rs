@@ -3,6 +3,7 @@
 //! over slices; `exports.rs` turns C pointers into those slices.
 
 use super::logger::{c_string, Logger};
+use super::out_of_range::OutOfRange;
 use super::runtime::{Factory, Runtime};
 use super::types::fmi2Status;
 use crate::models::{Report, Status};
@@ -115,6 +116,7 @@ pub struct Instance {
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
     fmu_states: HashSet<usize>,
+    out_of_range: OutOfRange,
 }
 
 fn type_index(kind: VarType) -> usize {
@@ -234,6 +236,7 @@ impl Instance {
             runtime: factory.create(),
             string_values: Vec::new(),
             fmu_states: HashSet::new(),
+            out_of_range: OutOfRange::new(info),
         }
     }
 
@@ -260,8 +263,15 @@ impl Instance {
         true
     }
 
-    /// Passes a model's messages to the logger and turns its status into an FMI status.
-    fn forward(&self, function: &str, report: Report) -> fmi2Status {
+    /// Applies the out-of-range policy, passes a model's messages to the logger and turns its
+    /// status into an FMI status.
+    fn forward(&mut self, function: &str, mut report: Report, in_step: bool) -> fmi2Status {
+        let notes = self
+            .out_of_range
+            .apply(self.runtime.vars_mut(), &mut report, in_step);
+        for note in notes {
+            self.logger.notice(&format!("{function}: {note}"));
+        }
         for (status, message) in &report.messages {
             self.logger
                 .log(to_fmi(*status), &format!("{function}: {message}"));
@@ -370,7 +380,7 @@ impl Instance {
         }
         let mut report = Report::default();
         self.runtime.refresh_outputs(&mut report);
-        self.forward(function, report)
+        self.forward(function, report, false)
     }
 
     fn lookup(
@@ -549,7 +559,7 @@ impl Instance {
         }
         let mut report = Report::default();
         self.runtime.step(time, step, &mut report);
-        let status = self.forward(F, report);
+        let status = self.forward(F, report, true);
         match status {
             fmi2Status::OK | fmi2Status::Warning => self.time = time + step,
             fmi2Status::Discard => self.state = MachineState::StepFailed,

@@ -6,5 +6,6 @@
 mod exports;
 mod instance;
 mod logger;
+mod out_of_range;
 pub mod runtime;
 pub mod types;

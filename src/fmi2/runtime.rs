@@ -92,12 +92,14 @@ impl<M: Model> Runtime for RuntimeOf<M> {
     fn refresh_outputs(&mut self, report: &mut Report) {
         if let (true, Some(model)) = (self.outputs_stale, self.model.as_mut()) {
             model.evaluate(&mut self.vars, report);
+            report.evaluated = true;
             self.outputs_stale = false;
         }
     }
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
         if let Some(model) = self.model.as_mut() {
             model.step(&mut self.vars, time, step, report);
+            report.evaluated = true;
             self.outputs_stale = false;
         }
     }

@@ -8,7 +8,7 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Report, Vars};
 use crate::physics::bladder::{
     Bladder, BladderState, BladderTube, KnittedCylinder, SleeveGeometry,
 };
@@ -160,27 +160,23 @@ impl KnittedMuscle {
         if l == length {
             self.out_of_range = false;
         } else {
-            if !self.out_of_range {
-                report.warn(format!(
+            report.clamp(!self.out_of_range, || {
+                format!(
                     "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
                      evaluating at length {l} m until the inputs return",
                     lo,
                     hi,
                     vars.real[real::MAX_LENGTH]
-                ));
-            }
-            report.status = report.status.max(Status::Warning);
+                )
+            });
             self.out_of_range = true;
         }
         if let Some(b) = &self.bladder {
             let (out, fallback) = self.compute_with_bladder(b, pressure, l);
             if let Some(reason) = &fallback {
-                if !self.collapsed {
-                    report.warn(format!(
-                        "{reason}; evaluating at zero gauge pressure until the inputs return"
-                    ));
-                }
-                report.status = report.status.max(Status::Warning);
+                report.clamp(!self.collapsed, || {
+                    format!("{reason}; evaluating at zero gauge pressure until the inputs return")
+                });
             }
             self.collapsed = fallback.is_some();
             return out;
@@ -374,6 +370,7 @@ impl Model for KnittedMuscle {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::Status;
 
     fn vars_with(shape: i32, friction: bool) -> Vars {
         let mut vars = Vars::from_start(&INFO);
@@ -419,8 +416,9 @@ mod tests {
             let mut report = Report::default();
             vars.real[real::LENGTH] = length;
             m.evaluate(&mut vars, &mut report);
-            warned += report.messages.len();
-            assert_eq!(report.status > Status::Ok, !(lo..=hi).contains(&length));
+            warned += report.clamp_messages.len();
+            assert_eq!(report.status, Status::Ok);
+            assert_eq!(report.clamped, !(lo..=hi).contains(&length));
             if length > hi {
                 assert_eq!(vars.real[real::FORCE], at_limit[real::FORCE]);
             }

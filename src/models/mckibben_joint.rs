@@ -7,7 +7,7 @@
 //! torque `r (F_flexor - F_extensor)` turns the joint towards the flexor. `actuatorInput` is the
 //! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Report, Vars};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
@@ -143,10 +143,9 @@ impl McKibbenJoint {
         );
         match clamped {
             Some(reason) => {
-                if !self.out_of_range {
-                    report.warn(format!("jointPosition {q} rad: {reason}"));
-                }
-                report.status = report.status.max(Status::Warning);
+                report.clamp(!self.out_of_range, || {
+                    format!("jointPosition {q} rad: {reason}")
+                });
                 self.out_of_range = true;
             }
             None => self.out_of_range = false,

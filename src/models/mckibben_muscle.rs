@@ -4,7 +4,7 @@
 //! wall, 2 thick wall of `bladder_layers` layers), friction hysteresis (`friction`) and a series
 //! connector (`connector_stiffness` > 0). With all of them off a step is eq. 2.3 alone.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Report, Vars};
 use crate::physics::bladder::BladderTube;
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
@@ -75,7 +75,7 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
     })
 }
 
-/// The warning for an input without a solution: once per excursion, then only the status.
+/// An input without a solution: explained once per excursion, then only flagged.
 fn out_of_range(
     logged: &mut bool,
     report: &mut Report,
@@ -83,16 +83,15 @@ fn out_of_range(
     (lo, hi): (f64, f64),
     fallback: Option<(f64, f64)>,
 ) {
-    if !*logged {
+    report.clamp(!*logged, || {
         let what = match fallback {
             Some((p, l)) => format!("evaluating at pressure {p} Pa and length {l} m"),
             None => "holding the previous outputs".into(),
         };
-        report.warn(format!(
+        format!(
             "{reason} (valid lengths {lo} .. {hi} m, max_length {hi} m); {what} until the inputs return"
-        ));
-    }
-    report.status = report.status.max(Status::Warning);
+        )
+    });
     *logged = true;
 }
 
