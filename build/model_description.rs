@@ -7,6 +7,9 @@ use std::collections::BTreeSet;
 use std::fmt::Write as _;
 use std::path::Path;
 
+#[path = "rules.rs"]
+pub mod rules;
+
 const GUID_PLACEHOLDER: &str = "@GUID@";
 
 #[derive(Deserialize)]
@@ -147,6 +150,7 @@ fn with_checked<R>(
     stem: &str,
     then: impl FnOnce(&ModelDescription, &[Checked], [usize; 4]) -> Result<R, String>,
 ) -> Result<R, String> {
+    rules::check(text)?;
     let md: ModelDescription =
         quick_xml::de::from_str(text).map_err(|e| format!("cannot parse: {e}"))?;
     if md.fmi_version != "2.0" {

@@ -162,3 +162,201 @@ fn the_guid_changes_with_any_variable() {
         guid_of(&edited(r#"name="volume""#, r#"name="volume_m3""#))
     );
 }
+
+/// The rules of `build/rules.rs` (FMI 2.0 chapter 2, after the INTO-CPS VDMCheck inventory):
+/// each one refuses a description that breaks it.
+mod rules {
+    use super::{edited, refused};
+
+    #[test]
+    fn duplicate_unit_type_and_category_names_are_refused() {
+        refused(
+            &edited(
+                r#"<Unit name="m"><BaseUnit m="1"/></Unit>"#,
+                r#"<Unit name="m"><BaseUnit m="1"/></Unit><Unit name="m"><BaseUnit m="1"/></Unit>"#,
+            ),
+            "unit 'm' is defined twice",
+        );
+        refused(
+            &edited(
+                "  <LogCategories>",
+                "  <TypeDefinitions><SimpleType name=\"T\"><Real/></SimpleType>\
+                 <SimpleType name=\"T\"><Real/></SimpleType></TypeDefinitions>\n  <LogCategories>",
+            ),
+            "type 'T' is defined twice",
+        );
+        refused(
+            &edited(
+                r#"<Category name="logStatusFatal""#,
+                r#"<Category name="logCalls"/><Category name="logStatusFatal""#,
+            ),
+            "log category 'logCalls' is declared twice",
+        );
+    }
+
+    #[test]
+    fn base_units_need_integer_exponents_and_a_factor() {
+        refused(
+            &edited(
+                r#"<BaseUnit m="1"/></Unit>"#,
+                r#"<BaseUnit m="1.5"/></Unit>"#,
+            ),
+            "must be an integer",
+        );
+        refused(
+            &edited(
+                r#"<BaseUnit m="1"/></Unit>"#,
+                r#"<BaseUnit m="1" factor="0"/></Unit>"#,
+            ),
+            "factor must not be zero",
+        );
+    }
+
+    #[test]
+    fn default_experiment_must_be_runnable() {
+        let experiment = r#"<DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>"#;
+        refused(
+            &edited(
+                experiment,
+                r#"<DefaultExperiment startTime="2" stopTime="1" stepSize="0.001"/>"#,
+            ),
+            "must be after startTime",
+        );
+        refused(
+            &edited(
+                experiment,
+                r#"<DefaultExperiment startTime="0" stopTime="1" stepSize="0"/>"#,
+            ),
+            "stepSize 0 must be positive",
+        );
+        refused(
+            &edited(
+                experiment,
+                r#"<DefaultExperiment startTime="0" stopTime="1" tolerance="-1"/>"#,
+            ),
+            "tolerance -1 must be positive",
+        );
+    }
+
+    #[test]
+    fn start_must_lie_within_min_and_max() {
+        refused(
+            &edited(
+                r#"min="1e-3" max="1e4" start="3.74""#,
+                r#"min="1e-3" max="1" start="3.74""#,
+            ),
+            "start 3.74 is outside",
+        );
+        refused(
+            &edited(
+                r#"min="1e-3" max="1e4" start="3.74""#,
+                r#"min="10" max="1" start="3.74""#,
+            ),
+            "min 10 is above max 1",
+        );
+        refused(
+            &edited(
+                r#"<Integer min="0" max="2" start="0"/>"#,
+                r#"<Integer min="1" max="2" start="0"/>"#,
+            ),
+            "start 0 is outside",
+        );
+        refused(
+            &edited(
+                r#"min="1e-3" max="1e4" start="3.74""#,
+                r#"min="1e-3" max="1e4" nominal="0" start="3.74""#,
+            ),
+            "nominal 0 must be positive",
+        );
+    }
+
+    #[test]
+    fn booleans_carry_no_numeric_attributes() {
+        refused(
+            &edited(
+                r#"<Boolean start="false"/>"#,
+                r#"<Boolean min="0" start="false"/>"#,
+            ),
+            "a Boolean has no attribute min",
+        );
+    }
+
+    #[test]
+    fn boolean_attributes_are_true_or_false() {
+        refused(
+            &edited(
+                r#"canHandleVariableCommunicationStepSize="true""#,
+                r#"canHandleVariableCommunicationStepSize="yes""#,
+            ),
+            "must be 'true' or 'false'",
+        );
+    }
+
+    #[test]
+    fn structured_names_follow_the_grammar() {
+        refused(
+            &edited(r#"name="force""#, r#"name="force (N)""#),
+            "structured naming convention",
+        );
+        refused(
+            &edited(r#"name="force""#, r#"name="1force""#),
+            "structured naming convention",
+        );
+        // Legal structured names pass this rule (and fail nothing else).
+        crate::model_description::check(
+            &edited(r#"name="force""#, r#"name="muscle.force[1]""#),
+            "McKibbenMuscle",
+        )
+        .unwrap();
+    }
+
+    #[test]
+    fn unknowns_refer_to_variables_once() {
+        refused(
+            &edited(r#"<Unknown index="3"/>"#, r#"<Unknown index="99"/>"#),
+            "Unknown index 99 is not a variable",
+        );
+        refused(
+            &edited(r#"<Unknown index="4"/>"#, r#"<Unknown index="3"/>"#),
+            "Unknown index 3 is listed twice",
+        );
+    }
+
+    #[test]
+    fn dependencies_are_sorted_inputs_with_one_kind_each() {
+        let force = r#"<Unknown index="3"/>"#;
+        refused(
+            &edited(force, r#"<Unknown index="3" dependencies="2 1"/>"#),
+            "must be ascending and unique",
+        );
+        refused(
+            &edited(force, r#"<Unknown index="3" dependencies="1 4"/>"#),
+            "may not depend on 'volume'",
+        );
+        refused(
+            &edited(
+                force,
+                r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent"/>"#,
+            ),
+            "1 dependenciesKind for 2 dependencies",
+        );
+        refused(
+            &edited(
+                force,
+                r#"<Unknown index="3" dependencies="1" dependenciesKind="linear"/>"#,
+            ),
+            "dependenciesKind 'linear' is not one of",
+        );
+        refused(
+            &edited(
+                force,
+                r#"<Unknown index="3" dependenciesKind="dependent"/>"#,
+            ),
+            "dependenciesKind without dependencies",
+        );
+        refused(
+            &edited(force, r#"<Unknown index="3" dependencies="1 x"/>"#),
+            "dependencies must be indices",
+        );
+    }
+}
