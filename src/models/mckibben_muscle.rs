@@ -35,9 +35,12 @@ pub struct McKibbenMuscle {
     friction: HysteresisState,
     /// Whether the last evaluation needed the fallback: its warning is logged once per excursion.
     out_of_range: bool,
+    /// `L_N` of `contraction = 1 - L / L_N`, m (the parameter, or the preset's listed length).
+    nominal_length: f64,
 }
 
-fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
+/// The muscle the parameters (or the preset) describe: sleeve, bladder tube and nominal length.
+fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube, f64), String> {
     let r = &vars.real;
     let preset = match vars.integer[integer::PRESET] {
         0 => None,
@@ -63,6 +66,7 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
                 g.bladder_inner_diameter,
                 g.bladder_thickness,
             ),
+            g.length,
         ),
         None => (
             Sleeve::new(r[real::STRAND_LENGTH], r[real::TURNS])?,
@@ -71,6 +75,7 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
                 r[real::BLADDER_INNER_DIAMETER],
                 r[real::BLADDER_THICKNESS],
             ),
+            r[real::NOMINAL_LENGTH],
         ),
     })
 }
@@ -122,6 +127,7 @@ fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &
 impl McKibbenMuscle {
     /// Writes the outputs of the selected pipeline; `commit` advances the friction history.
     fn outputs(&mut self, vars: &mut Vars, report: &mut Report, commit: bool) {
+        vars.real[real::CONTRACTION] = 1.0 - vars.real[real::LENGTH] / self.nominal_length;
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
                 sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
@@ -194,7 +200,13 @@ impl Model for McKibbenMuscle {
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
     fn new(vars: &mut Vars) -> Result<Self, String> {
-        let (sleeve, tube) = geometry(vars)?;
+        let (sleeve, tube, nominal_length) = geometry(vars)?;
+        if !(nominal_length.is_finite() && nominal_length > 0.0) {
+            return Err(format!(
+                "nominal_length must be positive and finite, got {nominal_length} m"
+            ));
+        }
+        vars.real[real::NOMINAL_LENGTH] = nominal_length;
         let model = BladderModel::from_switch(
             vars.integer[integer::BLADDER_MODEL],
             vars.integer[integer::BLADDER_LAYERS],
@@ -238,6 +250,7 @@ impl Model for McKibbenMuscle {
             pipeline,
             friction,
             out_of_range: false,
+            nominal_length,
         })
     }
 
