@@ -6,6 +6,8 @@
 
 use super::{Model, Report, Status, Vars};
 use crate::physics::bladder::BladderTube;
+use crate::physics::calibration::MuscleParams;
+use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::mckibben::{
@@ -37,46 +39,115 @@ pub struct McKibbenMuscle {
     out_of_range: bool,
     /// `L_N` of `contraction = 1 - L / L_N`, m (the parameter, or the preset's listed length).
     nominal_length: f64,
+    /// Which user-set parameters the preset replaced: a warning with the first outputs.
+    notice: Option<String>,
 }
 
-/// The muscle the parameters (or the preset) describe: sleeve, bladder tube and nominal length.
-fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube, f64), String> {
-    let r = &vars.real;
-    let preset = match vars.integer[integer::PRESET] {
-        0 => None,
-        k @ 1..=4 => MuscleGeometry::preset((b'A' + k as u8 - 1) as char),
+/// The muscle the parameters (or the preset) describe.
+struct Resolved {
+    sleeve: Sleeve,
+    tube: BladderTube,
+    nominal_length: f64,
+    model: BladderModel,
+    /// Parameters the user set that the preset replaced (logged once).
+    overridden: Vec<&'static str>,
+}
+
+/// Applies `preset`: 1-4 Table 2.1's geometry (the user's rubber and bladder model), 5-6 a Festo
+/// muscle fitted to its datasheet (geometry, rubber and thin wall; scaled to `nominal_length` if
+/// the user set it). Names the parameters the user set (away from their start values) that the
+/// preset replaces.
+fn geometry(vars: &Vars) -> Result<Resolved, String> {
+    let (r, i) = (&vars.real, &vars.integer);
+    let start = Vars::from_start(&INFO);
+    let user_set = |index: usize| r[index] != start.real[index];
+    let own_model =
+        BladderModel::from_switch(i[integer::BLADDER_MODEL], i[integer::BLADDER_LAYERS])?;
+    let params = match i[integer::PRESET] {
+        0 => MuscleParams {
+            nominal_length: r[real::NOMINAL_LENGTH],
+            strand_length: r[real::STRAND_LENGTH],
+            turns: r[real::TURNS],
+            bladder_model: i[integer::BLADDER_MODEL],
+            bladder_layers: i[integer::BLADDER_LAYERS],
+            bladder_length: r[real::BLADDER_LENGTH],
+            bladder_inner_diameter: r[real::BLADDER_INNER_DIAMETER],
+            bladder_thickness: r[real::BLADDER_THICKNESS],
+            mooney_c1: r[real::MOONEY_C1],
+            mooney_c2: r[real::MOONEY_C2],
+        },
+        k @ 1..=4 => {
+            let g = MuscleGeometry::preset((b'A' + k as u8 - 1) as char)
+                .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
+            MuscleParams {
+                nominal_length: g.length,
+                strand_length: g.strand_length,
+                turns: g.turns,
+                bladder_model: i[integer::BLADDER_MODEL],
+                bladder_layers: i[integer::BLADDER_LAYERS],
+                bladder_length: g.bladder_length,
+                bladder_inner_diameter: g.bladder_inner_diameter,
+                bladder_thickness: g.bladder_thickness,
+                mooney_c1: r[real::MOONEY_C1],
+                mooney_c2: r[real::MOONEY_C2],
+            }
+        }
+        k @ 5..=6 => {
+            let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
+            if user_set(real::NOMINAL_LENGTH) {
+                festo.scaled_to(r[real::NOMINAL_LENGTH])
+            } else {
+                festo
+            }
+        }
         k => {
             return Err(format!(
-                "preset must be 0 (none) or 1-4 (Table 2.1 A-D), got {k}"
+                "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10) or 6 (Festo DMSP-40), got {k}"
             ))
         }
     };
-    let tube = |length, inner_diameter, thickness| BladderTube {
-        inner_diameter,
-        thickness,
-        unstretched_length: length,
-        mooney_c1: r[real::MOONEY_C1],
-        mooney_c2: r[real::MOONEY_C2],
-    };
-    Ok(match preset {
-        Some(g) => (
-            g.sleeve()?,
-            tube(
-                g.bladder_length,
-                g.bladder_inner_diameter,
-                g.bladder_thickness,
-            ),
-            g.length,
-        ),
-        None => (
-            Sleeve::new(r[real::STRAND_LENGTH], r[real::TURNS])?,
-            tube(
-                r[real::BLADDER_LENGTH],
-                r[real::BLADDER_INNER_DIAMETER],
-                r[real::BLADDER_THICKNESS],
-            ),
-            r[real::NOMINAL_LENGTH],
-        ),
+    let mut overridden = Vec::new();
+    if i[integer::PRESET] != 0 {
+        let mut reals = vec![
+            ("strand_length", real::STRAND_LENGTH),
+            ("turns", real::TURNS),
+            ("bladder_length", real::BLADDER_LENGTH),
+            ("bladder_inner_diameter", real::BLADDER_INNER_DIAMETER),
+            ("bladder_thickness", real::BLADDER_THICKNESS),
+        ];
+        if i[integer::PRESET] <= 4 {
+            reals.push(("nominal_length", real::NOMINAL_LENGTH));
+        } else {
+            reals.push(("mooney_c1", real::MOONEY_C1));
+            reals.push(("mooney_c2", real::MOONEY_C2));
+            let festo_model = BladderModel::from_switch(params.bladder_model, 1)?;
+            if i[integer::BLADDER_MODEL] != start.integer[integer::BLADDER_MODEL]
+                && own_model != festo_model
+            {
+                overridden.push("bladder_model");
+            }
+        }
+        overridden.extend(reals.iter().filter(|(_, k)| user_set(*k)).map(|(n, _)| *n));
+    }
+    let model = BladderModel::from_switch(params.bladder_model, params.bladder_layers)?;
+    if !(params.nominal_length.is_finite() && params.nominal_length > 0.0) {
+        return Err(format!(
+            "nominal_length must be positive and finite, got {} m",
+            params.nominal_length
+        ));
+    }
+    Ok(Resolved {
+        sleeve: Sleeve::new(params.strand_length, params.turns)?,
+        tube: BladderTube {
+            inner_diameter: params.bladder_inner_diameter,
+            thickness: params.bladder_thickness,
+            unstretched_length: params.bladder_length,
+            mooney_c1: params.mooney_c1,
+            mooney_c2: params.mooney_c2,
+        },
+        nominal_length: params.nominal_length,
+        model,
+        overridden,
     })
 }
 
@@ -127,6 +198,10 @@ fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &
 impl McKibbenMuscle {
     /// Writes the outputs of the selected pipeline; `commit` advances the friction history.
     fn outputs(&mut self, vars: &mut Vars, report: &mut Report, commit: bool) {
+        if let Some(notice) = self.notice.take() {
+            // A warning: OK-status messages reach the log only with debug logging on.
+            report.warn(notice);
+        }
         vars.real[real::CONTRACTION] = 1.0 - vars.real[real::LENGTH] / self.nominal_length;
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
@@ -200,17 +275,42 @@ impl Model for McKibbenMuscle {
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
     fn new(vars: &mut Vars) -> Result<Self, String> {
-        let (sleeve, tube, nominal_length) = geometry(vars)?;
-        if !(nominal_length.is_finite() && nominal_length > 0.0) {
-            return Err(format!(
-                "nominal_length must be positive and finite, got {nominal_length} m"
-            ));
+        let Resolved {
+            sleeve,
+            tube,
+            nominal_length,
+            model,
+            overridden,
+        } = geometry(vars)?;
+        let r = &mut vars.real;
+        for (index, value) in [
+            (real::EFFECTIVE_NOMINAL_LENGTH, nominal_length),
+            (real::EFFECTIVE_STRAND_LENGTH, sleeve.strand_length),
+            (real::EFFECTIVE_TURNS, sleeve.turns),
+            (real::EFFECTIVE_BLADDER_LENGTH, tube.unstretched_length),
+            (real::EFFECTIVE_BLADDER_INNER_DIAMETER, tube.inner_diameter),
+            (real::EFFECTIVE_BLADDER_THICKNESS, tube.thickness),
+            (real::EFFECTIVE_MOONEY_C1, tube.mooney_c1),
+            (real::EFFECTIVE_MOONEY_C2, tube.mooney_c2),
+            (
+                real::EFFECTIVE_BRAID_ANGLE,
+                (nominal_length / sleeve.strand_length).min(1.0).acos(),
+            ),
+        ] {
+            r[index] = value;
         }
-        vars.real[real::NOMINAL_LENGTH] = nominal_length;
-        let model = BladderModel::from_switch(
-            vars.integer[integer::BLADDER_MODEL],
-            vars.integer[integer::BLADDER_LAYERS],
-        )?;
+        vars.integer[integer::EFFECTIVE_BLADDER_MODEL] = match model {
+            BladderModel::None => 0,
+            BladderModel::ThinWall => 1,
+            BladderModel::ThickWall { .. } => 2,
+        };
+        let notice = (!overridden.is_empty()).then(|| {
+            format!(
+                "preset {} replaces the value you set for {} (the effective_* calculated parameters show the values in use)",
+                vars.integer[integer::PRESET],
+                overridden.join(", ")
+            )
+        });
         let friction = vars.boolean[boolean::FRICTION].then(|| FrictionParams {
             coefficient: vars.real[real::FRICTION_COEFFICIENT],
             presliding_length: vars.real[real::PRESLIDING_LENGTH],
@@ -251,6 +351,7 @@ impl Model for McKibbenMuscle {
             friction,
             out_of_range: false,
             nominal_length,
+            notice,
         })
     }
 

@@ -382,7 +382,7 @@ pub fn fit(
             log_logit(rng.between(1e4, 1e6), MOONEY),
         ]);
         let (x, c) = levenberg_marquardt(x0, cfg, fit);
-        if best.as_ref().map_or(true, |b| c < b.cost) {
+        if best.as_ref().is_none_or(|b| c < b.cost) {
             best = Some(Fit {
                 params: decode(&x, cfg),
                 cost: c,

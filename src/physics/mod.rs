@@ -2,6 +2,7 @@
 
 pub mod bladder;
 pub mod calibration;
+pub mod festo;
 pub mod friction;
 pub mod gaylord;
 pub mod knitted;
