@@ -5,12 +5,15 @@
 //! Both muscles are [`McKibben`] physics instances built from the same parameters as the
 //! McKibbenMuscle FMU; the flexor's length is `L0f - r q`, the extensor's `L0e + r q`, so the
 //! torque `r (F_flexor - F_extensor)` turns the joint towards the flexor. `actuatorInput` is the
-//! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`.
+//! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`;
+//! with `command_mode` 1 it is a joint torque, met by solving for that difference through the same
+//! muscle physics ([`crate::physics::inverse::difference_for_torque`]).
 
 use super::{Model, Report, Status, Vars};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
+use crate::physics::inverse::{difference_for_torque, pair_pressures};
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
 };
@@ -36,6 +39,8 @@ pub struct McKibbenJoint {
     extensor_friction: HysteresisState,
     /// Whether the last evaluation needed the length fallback (warned once per excursion).
     out_of_range: bool,
+    /// `actuatorInput` is a joint torque (N m) to meet, not a pressure difference (Pa).
+    torque_command: bool,
 }
 
 /// Both muscles' operating point at the current inputs.
@@ -44,6 +49,8 @@ struct Pair {
     extensor: McKibbenOutput,
     pressures: [f64; 2],
     lengths: [f64; 2],
+    /// Command mode 1: the commanded torque was out of reach.
+    saturated: bool,
 }
 
 fn muscle(vars: &Vars) -> Result<McKibben, String> {
@@ -115,19 +122,42 @@ impl McKibbenJoint {
         self.muscle.evaluate(pressure, inside, history).ok()
     }
 
+    /// Torque of the pair at the pressures from `difference`, at the given lengths and histories.
+    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<f64, String> {
+        let p = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
+        let mut ignored = None;
+        let flexor = self.evaluate_muscle(p[0], lengths[0], &self.flexor_friction, &mut ignored);
+        let extensor =
+            self.evaluate_muscle(p[1], lengths[1], &self.extensor_friction, &mut ignored);
+        match (flexor, extensor) {
+            (Some(f), Some(e)) => Ok(self.moment_arm * (f.force - e.force)),
+            _ => Err("a muscle cannot be evaluated at this jointPosition".into()),
+        }
+    }
+
     fn compute(&mut self, vars: &Vars, report: &mut Report) -> Option<Pair> {
         let r = &vars.real;
         let (u, q) = (r[real::ACTUATORINPUT], r[real::JOINTPOSITION]);
-        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
-        // f64::clamp would pass a NaN through; max/min map it to a bound (inputs are finite anyway).
-        let pressures = [
-            (pc + 0.5 * u).max(0.0).min(pmax),
-            (pc - 0.5 * u).max(0.0).min(pmax),
-        ];
         let lengths = [
             self.flexor_rest_length - self.moment_arm * q,
             self.extensor_rest_length + self.moment_arm * q,
         ];
+        let (difference, saturated) = if self.torque_command {
+            // The pressure difference that meets the torque, through the same muscle physics.
+            match difference_for_torque(|d| self.torque_at(d, lengths), u, self.max_pressure) {
+                Ok(solved) => (solved.argument, solved.saturated),
+                Err(reason) => {
+                    report.add(
+                        Status::Discard,
+                        format!("jointPosition {q} rad, torque command {u} N m: {reason}"),
+                    );
+                    return None;
+                }
+            }
+        } else {
+            (u, false)
+        };
+        let pressures = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
         let mut clamped = None;
         let flexor = self.evaluate_muscle(
             pressures[0],
@@ -156,6 +186,7 @@ impl McKibbenJoint {
             extensor: extensor?,
             pressures,
             lengths,
+            saturated,
         })
     }
 
@@ -168,6 +199,7 @@ impl McKibbenJoint {
         r[real::EXTENSOR_FORCE] = pair.extensor.force;
         r[real::FLEXOR_LENGTH] = pair.lengths[0];
         r[real::EXTENSOR_LENGTH] = pair.lengths[1];
+        vars.boolean[boolean::TORQUE_SATURATED] = pair.saturated;
     }
 }
 
@@ -205,6 +237,15 @@ impl Model for McKibbenJoint {
         vars.real[real::MIN_POSITION] = min_position;
         vars.real[real::MAX_POSITION] = max_position;
         let q = vars.real[real::JOINTPOSITION];
+        let torque_command = match vars.integer[integer::COMMAND_MODE] {
+            0 => false,
+            1 => true,
+            k => {
+                return Err(format!(
+                    "command_mode must be 0 (pressure difference, Pa) or 1 (joint torque, N m), got {k}"
+                ))
+            }
+        };
         Ok(Self {
             muscle,
             moment_arm,
@@ -216,6 +257,7 @@ impl Model for McKibbenJoint {
             flexor_friction: HysteresisState::at_rest(flexor_rest_length - moment_arm * q),
             extensor_friction: HysteresisState::at_rest(extensor_rest_length + moment_arm * q),
             out_of_range: false,
+            torque_command,
         })
     }
 

@@ -10,6 +10,7 @@ use crate::physics::calibration::MuscleParams;
 use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
+use crate::physics::inverse::pressure_for_force;
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
 };
@@ -41,6 +42,8 @@ pub struct McKibbenMuscle {
     nominal_length: f64,
     /// Which user-set parameters the preset replaced: a warning with the first outputs.
     notice: Option<String>,
+    /// `pressure_solver` on: the muscle to invert and `max_pressure`.
+    solver: Option<(McKibben, f64)>,
 }
 
 /// The muscle the parameters (or the preset) describe.
@@ -198,6 +201,7 @@ fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &
 impl McKibbenMuscle {
     /// Writes the outputs of the selected pipeline; `commit` advances the friction history.
     fn outputs(&mut self, vars: &mut Vars, report: &mut Report, commit: bool) {
+        let history = self.friction;
         if let Some(notice) = self.notice.take() {
             // A warning: OK-status messages reach the log only with debug logging on.
             report.warn(notice);
@@ -217,6 +221,34 @@ impl McKibbenMuscle {
                     }
                 }
             }
+        }
+        if let Some((muscle, max_pressure)) = &self.solver {
+            // Solved from the history the step started with, as the forward model is.
+            Self::solve_pressure(muscle, *max_pressure, &history, vars);
+        }
+    }
+
+    /// `target_pressure`: the pressure that gives `target_force` at the input length (clamped
+    /// into the valid range as the forward model is), by the joint's torque-mode solver.
+    fn solve_pressure(
+        muscle: &McKibben,
+        max_pressure: f64,
+        history: &HysteresisState,
+        vars: &mut Vars,
+    ) {
+        let (length, force) = (vars.real[real::LENGTH], vars.real[real::TARGET_FORCE]);
+        let (lo, hi) = (muscle.min_length(), muscle.max_length());
+        let margin = if muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        let solved = pressure_for_force(muscle, length, force, max_pressure, history)
+            .or_else(|_| pressure_for_force(muscle, inside, force, max_pressure, history));
+        if let Ok(s) = solved {
+            vars.real[real::TARGET_PRESSURE] = s.argument;
+            vars.boolean[boolean::TARGET_FORCE_SATURATED] = s.saturated;
         }
     }
 
@@ -322,6 +354,13 @@ impl Model for McKibbenMuscle {
             friction,
             vars.real[real::CONNECTOR_STIFFNESS],
         )?;
+        let max_pressure = vars.real[real::MAX_PRESSURE];
+        if !(max_pressure.is_finite() && max_pressure >= 0.0) {
+            return Err(format!(
+                "max_pressure must be finite and >= 0 Pa, got {max_pressure}"
+            ));
+        }
+        let solver = vars.boolean[boolean::PRESSURE_SOLVER].then(|| (muscle.clone(), max_pressure));
         vars.real[real::MAX_LENGTH] = muscle.max_length();
         vars.real[real::MIN_LENGTH] = muscle.min_length();
         // Friction starts relaxed (z = 0) at the initial length.
@@ -352,6 +391,7 @@ impl Model for McKibbenMuscle {
             out_of_range: false,
             nominal_length,
             notice,
+            solver,
         })
     }
 

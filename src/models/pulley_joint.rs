@@ -5,10 +5,11 @@
 //! `examples/robot_joint.py`); out come the muscle lengths `L0 -/+ r q` and the PD pressure
 //! commands for the next step, so that two McKibbenMuscle FMUs wired to it by plain connections
 //! (SSP, container FMU) close the loop. Rigid-body mechanics and a controller, no dissertation
-//! physics: it lives here rather than in `src/physics/`.
+//! physics: it lives here rather than in `src/physics/`. With `external_pressures` the controller is
+//! bypassed and the pressure outputs pass on the `*_pressure_command` inputs (saturated).
 
 use super::{Model, Report, Status, Vars};
-use crate::variables::pulley_joint::{real, INFO};
+use crate::variables::pulley_joint::{boolean, real, INFO};
 use crate::variables::ModelInfo;
 use serde::{Deserialize, Serialize};
 
@@ -38,6 +39,8 @@ struct Params {
     feedforward_gain: f64,
     segment_time: f64,
     waypoints: [f64; 5],
+    /// The pressures come from the `*_pressure_command` inputs instead of the PD controller.
+    external_pressures: bool,
     /// Largest stable Euler substep, from the stiffest linearized mode (s).
     max_substep: f64,
 }
@@ -76,6 +79,17 @@ fn positive(vars: &Vars, name: &str, i: usize) -> Result<f64, String> {
 }
 
 impl PulleyJoint {
+    /// `external_pressures`: the commanded pressures, saturated to `0 .. max_pressure` (max/min
+    /// map a NaN to a bound).
+    fn pass_commands(p: &Params, r: &mut [f64]) {
+        for (out, command) in [
+            (real::FLEXOR_PRESSURE, real::FLEXOR_PRESSURE_COMMAND),
+            (real::EXTENSOR_PRESSURE, real::EXTENSOR_PRESSURE_COMMAND),
+        ] {
+            r[out] = r[command].max(0.0).min(p.max_pressure);
+        }
+    }
+
     fn write(&self, vars: &mut Vars, t: f64) {
         let p = &self.p;
         let (q_ref, dq_ref) = p.reference(t);
@@ -83,8 +97,12 @@ impl PulleyJoint {
             p.feedforward_gain * q_ref.sin() + p.kp * (q_ref - self.q) + p.kd * (dq_ref - self.dq);
         let (pc, pmax) = (p.common_mode_pressure, p.max_pressure);
         let r = &mut vars.real;
-        r[real::FLEXOR_PRESSURE] = (pc + 0.5 * u).max(0.0).min(pmax);
-        r[real::EXTENSOR_PRESSURE] = (pc - 0.5 * u).max(0.0).min(pmax);
+        if p.external_pressures {
+            Self::pass_commands(p, r);
+        } else {
+            r[real::FLEXOR_PRESSURE] = (pc + 0.5 * u).max(0.0).min(pmax);
+            r[real::EXTENSOR_PRESSURE] = (pc - 0.5 * u).max(0.0).min(pmax);
+        }
         r[real::FLEXOR_LENGTH] = p.rest_length - p.moment_arm * self.q;
         r[real::EXTENSOR_LENGTH] = p.rest_length + p.moment_arm * self.q;
         r[real::JOINT_ANGLE] = self.q;
@@ -148,6 +166,7 @@ impl Model for PulleyJoint {
             feedforward_gain,
             segment_time: positive(vars, "segment_time", real::SEGMENT_TIME)?,
             waypoints,
+            external_pressures: vars.boolean[boolean::EXTERNAL_PRESSURES],
             max_substep,
         };
         let joint = Self { p, q: 0.0, dq: 0.0 };
@@ -156,10 +175,14 @@ impl Model for PulleyJoint {
     }
 
     fn evaluate(&mut self, vars: &mut Vars, _report: &mut Report) {
-        // Outputs at the current time: only the torque follows the inputs directly.
+        // Outputs at the current time: the torque follows the inputs directly, and so do the
+        // pressures when they come from outside.
         let p = &self.p;
         vars.real[real::JOINT_TORQUE] =
             p.moment_arm * (vars.real[real::FLEXOR_FORCE] - vars.real[real::EXTENSOR_FORCE]);
+        if p.external_pressures {
+            Self::pass_commands(p, &mut vars.real);
+        }
     }
 
     fn step(&mut self, vars: &mut Vars, time: f64, step: f64, report: &mut Report) {

@@ -5,6 +5,7 @@ pub mod calibration;
 pub mod festo;
 pub mod friction;
 pub mod gaylord;
+pub mod inverse;
 pub mod knitted;
 pub mod knitted_shape;
 pub mod mckibben;
