@@ -8,7 +8,7 @@ runs `target/release/calibrate` (the fit, with the FMU's own physics), then chec
 parameters through the packaged McKibbenMuscle.fmu under FMPy and writes `OUT/report.md` with the
 error table and `OUT/fit.png` (data against model at every pressure). Also a command line:
 
-    python calibration/calibrate.py DATA LENGTH DIAMETER FIT OUT   (FIT: kPa, comma-separated)
+    python calibration/calibrate.py DATA LENGTH DIAMETER FIT OUT [STARTS]   (FIT: kPa, comma-separated)
 """
 
 import csv
@@ -147,7 +147,8 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
 
 
 if __name__ == "__main__":
-    if len(sys.argv) != 6:
+    if len(sys.argv) not in (6, 7):
         sys.exit(__doc__)
-    d, length, diameter, fit, out = sys.argv[1:]
-    calibrate(d, float(length), float(diameter), [float(k) for k in fit.split(",")], out)
+    d, length, diameter, fit, out = sys.argv[1:6]
+    starts = int(sys.argv[6]) if len(sys.argv) == 7 else 24
+    calibrate(d, float(length), float(diameter), [float(k) for k in fit.split(",")], out, starts=starts)

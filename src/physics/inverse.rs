@@ -178,7 +178,7 @@ mod tests {
                 let r = pressure_for_force(&m, length, target, 6e5, &rest).unwrap();
                 let f = m.evaluate(r.argument, length, &rest).unwrap().force;
                 assert!(
-                    !r.saturated && (f - target).abs() <= 1e-9 * top,
+                    !r.saturated && (f - target).abs() <= 1e-9 * top.abs(),
                     "{model:?} {f} {target}"
                 );
                 let over = pressure_for_force(&m, length, 2.0 * top, 6e5, &rest).unwrap();

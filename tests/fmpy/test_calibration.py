@@ -3,7 +3,7 @@ presets, their read-back and the contraction output, all through McKibbenMuscle.
 
 import csv
 import json
-import pathlib
+import subprocess
 import sys
 
 import numpy as np
@@ -117,3 +117,16 @@ def test_make_calibrate_function_fits_and_the_fmu_reproduces_the_report(tmp_path
     assert r["force"][-1] == pytest.approx(473.3, rel=0.05)  # DMSP-10 datasheet, 600 kPa, 0%
     ssv = (tmp_path / "params.ssv").read_text()
     assert 'name="strand_length"' in ssv and "SystemStructureParameterValues" in ssv
+
+
+def test_make_calibrate_runs_on_the_dmsp40_datasheet(tmp_path):
+    # The command users type, with a short search (4 starts).
+    out = tmp_path / "dmsp40"
+    run = subprocess.run(["make", "--no-print-directory", "calibrate", f"OUT={out}", "STARTS=4"], cwd=ROOT,
+                         capture_output=True, text=True)
+    assert run.returncode == 0, run.stdout + run.stderr
+    assert "start   4/4" in run.stderr, "progress is shown"
+    summary = json.loads((out / "fit.json").read_text())
+    assert summary["seconds"] < 60 and all(e["rms"] < 0.05 for e in summary["errors"])
+    report = (out / "report.md").read_text()
+    assert "| 100 | predicted |" in report and "fit.png" in report
