@@ -115,17 +115,17 @@ fn value_references_are_dense_and_names_unique() {
 
 #[test]
 fn model_structure_must_match_the_variables() {
-    // Drop the last output, then the last initial unknown (the min_length calculated parameter).
+    // Drop the last output, then the last initial unknown (target_force_saturated both times).
     refused(
-        &edited("<Unknown index=\"15\"/>\n    </Outputs>", "</Outputs>"),
-        "ModelStructure/Outputs must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15]",
+        &edited("<Unknown index=\"48\"/>\n    </Outputs>", "</Outputs>"),
+        "ModelStructure/Outputs must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 33, 47, 48]",
     );
     refused(
         &edited(
-            "<Unknown index=\"31\"/>\n    </InitialUnknowns>",
+            "<Unknown index=\"48\"/>\n    </InitialUnknowns>",
             "</InitialUnknowns>",
         ),
-        "InitialUnknowns must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31]",
+        "InitialUnknowns must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31, 33, 34, 35, 36, 37, 38, 39, 40, 41, 42, 43, 47, 48]",
     );
 }
 

@@ -115,8 +115,11 @@ def test_make_calibrate_function_fits_and_the_fmu_reproduces_the_report(tmp_path
     r = simulate_fmu(fmu_path("McKibbenMuscle"), start_values={**params, "pressure": 6e5, "length": 0.25},
                      stop_time=0.002, output=["force"])
     assert r["force"][-1] == pytest.approx(473.3, rel=0.05)  # DMSP-10 datasheet, 600 kPa, 0%
-    ssv = (tmp_path / "params.ssv").read_text()
-    assert 'name="strand_length"' in ssv and "SystemStructureParameterValues" in ssv
+    # params.ssv is valid SSP 1.0 (FMPy checks it against the standard's schema) with the same values.
+    from fmpy.ssp.ssd import read_ssv
+
+    ssv = {p.name: float(p.value) for p in read_ssv(str(tmp_path / "params.ssv"), validate=True).parameters}
+    assert ssv == pytest.approx({k: float(v) for k, v in params.items()}, rel=1e-15)
 
 
 def test_make_calibrate_runs_on_the_dmsp40_datasheet(tmp_path):
