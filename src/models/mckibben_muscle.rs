@@ -4,7 +4,7 @@
 //! wall, 2 thick wall of `bladder_layers` layers), friction hysteresis (`friction`) and a series
 //! connector (`connector_stiffness` > 0). With all of them off a step is eq. 2.3 alone.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::calibration::MuscleParams;
 use crate::physics::festo::{DMSP_10, DMSP_40};
@@ -14,8 +14,9 @@ use crate::physics::inverse::pressure_for_force;
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
 };
-use crate::variables::mckibben_muscle::{boolean, integer, real, INFO};
-use crate::variables::ModelInfo;
+use crate::variables::mckibben_muscle::{
+    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+};
 use serde::{Deserialize, Serialize};
 
 /// With a bladder the force grows without bound at both length limits; an out-of-range length
@@ -38,20 +39,18 @@ pub struct McKibbenMuscle {
     friction: HysteresisState,
     /// Whether the last evaluation needed the fallback: its warning is logged once per excursion.
     out_of_range: bool,
-    /// `L_N` of `contraction = 1 - L / L_N`, m (the parameter, or the preset's listed length).
-    nominal_length: f64,
+    /// The parameters in use (the preset's or the user's), read back as `effective_*`.
+    effective: MuscleParams,
     /// Which user-set parameters the preset replaced: a warning with the first outputs.
     notice: Option<String>,
     /// `pressure_solver` on: the muscle to invert and `max_pressure`.
     solver: Option<(McKibben, f64)>,
 }
 
-/// The muscle the parameters (or the preset) describe.
+/// The muscle the parameters (or the preset) describe, with the parameters the user set that
+/// the preset replaced.
 struct Resolved {
-    sleeve: Sleeve,
-    tube: BladderTube,
-    nominal_length: f64,
-    model: BladderModel,
+    params: MuscleParams,
     /// Parameters the user set that the preset replaced (logged once).
     overridden: Vec<&'static str>,
 }
@@ -60,25 +59,22 @@ struct Resolved {
 /// muscle fitted to its datasheet (geometry, rubber and thin wall; scaled to `nominal_length` if
 /// the user set it). Names the parameters the user set (away from their start values) that the
 /// preset replaces.
-fn geometry(vars: &Vars) -> Result<Resolved, String> {
-    let (r, i) = (&vars.real, &vars.integer);
-    let start = Vars::from_start(&INFO);
-    let user_set = |index: usize| r[index] != start.real[index];
-    let own_model =
-        BladderModel::from_switch(i[integer::BLADDER_MODEL], i[integer::BLADDER_LAYERS])?;
-    let params = match i[integer::PRESET] {
-        0 => MuscleParams {
-            nominal_length: r[real::NOMINAL_LENGTH],
-            strand_length: r[real::STRAND_LENGTH],
-            turns: r[real::TURNS],
-            bladder_model: i[integer::BLADDER_MODEL],
-            bladder_layers: i[integer::BLADDER_LAYERS],
-            bladder_length: r[real::BLADDER_LENGTH],
-            bladder_inner_diameter: r[real::BLADDER_INNER_DIAMETER],
-            bladder_thickness: r[real::BLADDER_THICKNESS],
-            mooney_c1: r[real::MOONEY_C1],
-            mooney_c2: r[real::MOONEY_C2],
-        },
+fn geometry(p: &Parameters) -> Result<Resolved, String> {
+    let start = Parameters::default();
+    let own = MuscleParams {
+        nominal_length: p.nominal_length,
+        strand_length: p.strand_length,
+        turns: p.turns,
+        bladder_model: p.bladder_model,
+        bladder_layers: p.bladder_layers,
+        bladder_length: p.bladder_length,
+        bladder_inner_diameter: p.bladder_inner_diameter,
+        bladder_thickness: p.bladder_thickness,
+        mooney_c1: p.mooney_c1,
+        mooney_c2: p.mooney_c2,
+    };
+    let params = match p.preset {
+        0 => own,
         k @ 1..=4 => {
             let g = MuscleGeometry::preset((b'A' + k as u8 - 1) as char)
                 .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
@@ -86,19 +82,16 @@ fn geometry(vars: &Vars) -> Result<Resolved, String> {
                 nominal_length: g.length,
                 strand_length: g.strand_length,
                 turns: g.turns,
-                bladder_model: i[integer::BLADDER_MODEL],
-                bladder_layers: i[integer::BLADDER_LAYERS],
                 bladder_length: g.bladder_length,
                 bladder_inner_diameter: g.bladder_inner_diameter,
                 bladder_thickness: g.bladder_thickness,
-                mooney_c1: r[real::MOONEY_C1],
-                mooney_c2: r[real::MOONEY_C2],
+                ..own
             }
         }
         k @ 5..=6 => {
             let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
-            if user_set(real::NOMINAL_LENGTH) {
-                festo.scaled_to(r[real::NOMINAL_LENGTH])
+            if p.nominal_length != start.nominal_length {
+                festo.scaled_to(p.nominal_length)
             } else {
                 festo
             }
@@ -110,48 +103,41 @@ fn geometry(vars: &Vars) -> Result<Resolved, String> {
         }
     };
     let mut overridden = Vec::new();
-    if i[integer::PRESET] != 0 {
-        let mut reals = vec![
-            ("strand_length", real::STRAND_LENGTH),
-            ("turns", real::TURNS),
-            ("bladder_length", real::BLADDER_LENGTH),
-            ("bladder_inner_diameter", real::BLADDER_INNER_DIAMETER),
-            ("bladder_thickness", real::BLADDER_THICKNESS),
+    if p.preset != 0 {
+        let mut replaced = vec![
+            ("strand_length", p.strand_length != start.strand_length),
+            ("turns", p.turns != start.turns),
+            ("bladder_length", p.bladder_length != start.bladder_length),
+            (
+                "bladder_inner_diameter",
+                p.bladder_inner_diameter != start.bladder_inner_diameter,
+            ),
+            (
+                "bladder_thickness",
+                p.bladder_thickness != start.bladder_thickness,
+            ),
         ];
-        if i[integer::PRESET] <= 4 {
-            reals.push(("nominal_length", real::NOMINAL_LENGTH));
+        if p.preset <= 4 {
+            replaced.push(("nominal_length", p.nominal_length != start.nominal_length));
         } else {
-            reals.push(("mooney_c1", real::MOONEY_C1));
-            reals.push(("mooney_c2", real::MOONEY_C2));
+            replaced.push(("mooney_c1", p.mooney_c1 != start.mooney_c1));
+            replaced.push(("mooney_c2", p.mooney_c2 != start.mooney_c2));
             let festo_model = BladderModel::from_switch(params.bladder_model, 1)?;
-            if i[integer::BLADDER_MODEL] != start.integer[integer::BLADDER_MODEL]
-                && own_model != festo_model
-            {
-                overridden.push("bladder_model");
-            }
+            let own_model = BladderModel::from_switch(p.bladder_model, p.bladder_layers).ok();
+            replaced.push((
+                "bladder_model",
+                p.bladder_model != start.bladder_model && own_model != Some(festo_model),
+            ));
         }
-        overridden.extend(reals.iter().filter(|(_, k)| user_set(*k)).map(|(n, _)| *n));
+        overridden.extend(replaced.iter().filter(|(_, set)| *set).map(|(n, _)| *n));
     }
-    let model = BladderModel::from_switch(params.bladder_model, params.bladder_layers)?;
     if !(params.nominal_length.is_finite() && params.nominal_length > 0.0) {
         return Err(format!(
             "nominal_length must be positive and finite, got {} m",
             params.nominal_length
         ));
     }
-    Ok(Resolved {
-        sleeve: Sleeve::new(params.strand_length, params.turns)?,
-        tube: BladderTube {
-            inner_diameter: params.bladder_inner_diameter,
-            thickness: params.bladder_thickness,
-            unstretched_length: params.bladder_length,
-            mooney_c1: params.mooney_c1,
-            mooney_c2: params.mooney_c2,
-        },
-        nominal_length: params.nominal_length,
-        model,
-        overridden,
-    })
+    Ok(Resolved { params, overridden })
 }
 
 /// The warning for an input without a solution: once per excursion, then only the status.
@@ -175,9 +161,15 @@ fn out_of_range(
     *logged = true;
 }
 
-/// Eq. 2.3 for the bare sleeve; only the outputs that change are written.
-fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &mut Report) {
-    let (pressure, requested) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+/// Eq. 2.3 for the bare sleeve; the outputs of the absent effects keep their neutral values.
+fn sleeve_outputs(
+    sleeve: &Sleeve,
+    inputs: &Inputs,
+    out: &mut Outputs,
+    logged: &mut bool,
+    report: &mut Report,
+) {
+    let (pressure, requested) = (inputs.pressure, inputs.length);
     let b = sleeve.max_length();
     let length = if requested > b {
         let reason =
@@ -190,32 +182,49 @@ fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &
     };
     // The sleeve is only ever pushed outwards: under vacuum the bladder leaves it.
     let p_eff = pressure.max(0.0);
-    let r = &mut vars.real;
-    r[real::FORCE] = sleeve.force(p_eff, length);
-    r[real::VOLUME] = sleeve.volume(length);
-    r[real::EFFECTIVE_PRESSURE] = p_eff;
-    r[real::STIFFNESS] = sleeve.stiffness(p_eff, length);
-    vars.boolean[boolean::BLADDER_CONTACT] = pressure > 0.0;
+    out.force = sleeve.force(p_eff, length);
+    out.volume = sleeve.volume(length);
+    out.effective_pressure = p_eff;
+    out.stiffness = sleeve.stiffness(p_eff, length);
+    out.bladder_contact = pressure > 0.0;
+    out.threshold_pressure = 0.0;
+    out.stretch_axial = 1.0;
+    out.stretch_hoop = 1.0;
+    out.stretch_radial = 1.0;
+    out.stress_axial = 0.0;
+    out.stress_hoop = 0.0;
+    out.stress_radial = 0.0;
+    out.friction_force = 0.0;
 }
 
 impl McKibbenMuscle {
     /// Writes the outputs of the selected pipeline; `commit` advances the friction history.
-    fn outputs(&mut self, vars: &mut Vars, report: &mut Report, commit: bool) {
-        let history = self.friction;
+    fn outputs(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        report: &mut Report,
+        commit: bool,
+    ) {
         if let Some(notice) = self.notice.take() {
             // A warning: OK-status messages reach the log only with debug logging on.
             report.warn(notice);
         }
-        vars.real[real::CONTRACTION] = 1.0 - vars.real[real::LENGTH] / self.nominal_length;
+        let history = self.friction;
+        outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
-                sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
+                sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report)
             }
             Pipeline::Full(muscle) => {
-                if let Some(out) =
-                    Self::compute(muscle, &self.friction, &mut self.out_of_range, vars, report)
-                {
-                    Self::write(vars, &out);
+                if let Some(out) = Self::compute(
+                    muscle,
+                    &self.friction,
+                    &mut self.out_of_range,
+                    inputs,
+                    report,
+                ) {
+                    Self::write(outputs, &out);
                     if commit {
                         self.friction = out.friction_state;
                     }
@@ -224,7 +233,7 @@ impl McKibbenMuscle {
         }
         if let Some((muscle, max_pressure)) = &self.solver {
             // Solved from the history the step started with, as the forward model is.
-            Self::solve_pressure(muscle, *max_pressure, &history, vars);
+            Self::solve_pressure(muscle, *max_pressure, &history, inputs, outputs);
         }
     }
 
@@ -234,9 +243,10 @@ impl McKibbenMuscle {
         muscle: &McKibben,
         max_pressure: f64,
         history: &HysteresisState,
-        vars: &mut Vars,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
     ) {
-        let (length, force) = (vars.real[real::LENGTH], vars.real[real::TARGET_FORCE]);
+        let (length, force) = (inputs.length, inputs.target_force);
         let (lo, hi) = (muscle.min_length(), muscle.max_length());
         let margin = if muscle.bladder().is_some() {
             LIMIT_MARGIN * (hi - lo)
@@ -247,8 +257,8 @@ impl McKibbenMuscle {
         let solved = pressure_for_force(muscle, length, force, max_pressure, history)
             .or_else(|_| pressure_for_force(muscle, inside, force, max_pressure, history));
         if let Ok(s) = solved {
-            vars.real[real::TARGET_PRESSURE] = s.argument;
-            vars.boolean[boolean::TARGET_FORCE_SATURATED] = s.saturated;
+            outputs.target_pressure = s.argument;
+            outputs.target_force_saturated = s.saturated;
         }
     }
 
@@ -257,10 +267,10 @@ impl McKibbenMuscle {
         muscle: &McKibben,
         friction: &HysteresisState,
         logged: &mut bool,
-        vars: &Vars,
+        inputs: &Inputs,
         report: &mut Report,
     ) -> Option<McKibbenOutput> {
-        let (pressure, length) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+        let (pressure, length) = (inputs.pressure, inputs.length);
         let reason = match muscle.evaluate(pressure, length, friction) {
             Ok(out) => {
                 *logged = false;
@@ -284,103 +294,62 @@ impl McKibbenMuscle {
         fallback.map(|(_, _, out)| out)
     }
 
-    fn write(vars: &mut Vars, out: &McKibbenOutput) {
-        let r = &mut vars.real;
-        r[real::FORCE] = out.force;
-        r[real::VOLUME] = out.volume;
-        r[real::EFFECTIVE_PRESSURE] = out.effective_pressure;
-        r[real::THRESHOLD_PRESSURE] = out.threshold_pressure;
-        r[real::STRETCH_AXIAL] = out.stretch_axial;
-        r[real::STRETCH_HOOP] = out.stretch_hoop;
-        r[real::STRETCH_RADIAL] = out.stretch_radial;
-        r[real::STRESS_AXIAL] = out.stress_axial;
-        r[real::STRESS_HOOP] = out.stress_hoop;
-        r[real::STRESS_RADIAL] = out.stress_radial;
-        r[real::FRICTION_FORCE] = out.friction_force;
-        r[real::STIFFNESS] = out.stiffness;
-        vars.boolean[boolean::BLADDER_CONTACT] = out.bladder_contact;
+    fn write(o: &mut Outputs, out: &McKibbenOutput) {
+        o.force = out.force;
+        o.volume = out.volume;
+        o.effective_pressure = out.effective_pressure;
+        o.threshold_pressure = out.threshold_pressure;
+        o.stretch_axial = out.stretch_axial;
+        o.stretch_hoop = out.stretch_hoop;
+        o.stretch_radial = out.stretch_radial;
+        o.stress_axial = out.stress_axial;
+        o.stress_hoop = out.stress_hoop;
+        o.stress_radial = out.stress_radial;
+        o.friction_force = out.friction_force;
+        o.stiffness = out.stiffness;
+        o.bladder_contact = out.bladder_contact;
     }
 }
 
 impl Model for McKibbenMuscle {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
-    fn new(vars: &mut Vars) -> Result<Self, String> {
-        let Resolved {
-            sleeve,
-            tube,
-            nominal_length,
-            model,
-            overridden,
-        } = geometry(vars)?;
-        let r = &mut vars.real;
-        for (index, value) in [
-            (real::EFFECTIVE_NOMINAL_LENGTH, nominal_length),
-            (real::EFFECTIVE_STRAND_LENGTH, sleeve.strand_length),
-            (real::EFFECTIVE_TURNS, sleeve.turns),
-            (real::EFFECTIVE_BLADDER_LENGTH, tube.unstretched_length),
-            (real::EFFECTIVE_BLADDER_INNER_DIAMETER, tube.inner_diameter),
-            (real::EFFECTIVE_BLADDER_THICKNESS, tube.thickness),
-            (real::EFFECTIVE_MOONEY_C1, tube.mooney_c1),
-            (real::EFFECTIVE_MOONEY_C2, tube.mooney_c2),
-            (
-                real::EFFECTIVE_BRAID_ANGLE,
-                (nominal_length / sleeve.strand_length).min(1.0).acos(),
-            ),
-        ] {
-            r[index] = value;
-        }
-        vars.integer[integer::EFFECTIVE_BLADDER_MODEL] = match model {
-            BladderModel::None => 0,
-            BladderModel::ThinWall => 1,
-            BladderModel::ThickWall { .. } => 2,
+    fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
+        let Resolved { params, overridden } = geometry(p)?;
+        let sleeve = Sleeve::new(params.strand_length, params.turns)?;
+        let tube = BladderTube {
+            inner_diameter: params.bladder_inner_diameter,
+            thickness: params.bladder_thickness,
+            unstretched_length: params.bladder_length,
+            mooney_c1: params.mooney_c1,
+            mooney_c2: params.mooney_c2,
         };
+        let model = BladderModel::from_switch(params.bladder_model, params.bladder_layers)?;
         let notice = (!overridden.is_empty()).then(|| {
             format!(
                 "preset {} replaces the value you set for {} (the effective_* calculated parameters show the values in use)",
-                vars.integer[integer::PRESET],
+                p.preset,
                 overridden.join(", ")
             )
         });
-        let friction = vars.boolean[boolean::FRICTION].then(|| FrictionParams {
-            coefficient: vars.real[real::FRICTION_COEFFICIENT],
-            presliding_length: vars.real[real::PRESLIDING_LENGTH],
+        let friction = p.friction.then(|| FrictionParams {
+            coefficient: p.friction_coefficient,
+            presliding_length: p.presliding_length,
         });
-        let muscle = McKibben::new(
-            sleeve,
-            tube,
-            model,
-            friction,
-            vars.real[real::CONNECTOR_STIFFNESS],
-        )?;
-        let max_pressure = vars.real[real::MAX_PRESSURE];
-        if !(max_pressure.is_finite() && max_pressure >= 0.0) {
+        let muscle = McKibben::new(sleeve, tube, model, friction, p.connector_stiffness)?;
+        if !(p.max_pressure.is_finite() && p.max_pressure >= 0.0) {
             return Err(format!(
-                "max_pressure must be finite and >= 0 Pa, got {max_pressure}"
-            ));
+                "max_pressure must be finite and >= 0 Pa, got {}",
+                p.max_pressure
+            )
+            .into());
         }
-        let solver = vars.boolean[boolean::PRESSURE_SOLVER].then(|| (muscle.clone(), max_pressure));
-        vars.real[real::MAX_LENGTH] = muscle.max_length();
-        vars.real[real::MIN_LENGTH] = muscle.min_length();
+        let solver = p.pressure_solver.then(|| (muscle.clone(), p.max_pressure));
         // Friction starts relaxed (z = 0) at the initial length.
-        let friction = HysteresisState::at_rest(vars.real[real::LENGTH]);
+        let friction = HysteresisState::at_rest(start.length);
         let pipeline =
             if muscle.bladder().is_none() && !muscle.has_friction() && !muscle.has_connector() {
-                // The outputs of the absent effects keep these values for the whole run.
-                let r = &mut vars.real;
-                for (index, value) in [
-                    (real::THRESHOLD_PRESSURE, 0.0),
-                    (real::STRETCH_AXIAL, 1.0),
-                    (real::STRETCH_HOOP, 1.0),
-                    (real::STRETCH_RADIAL, 1.0),
-                    (real::STRESS_AXIAL, 0.0),
-                    (real::STRESS_HOOP, 0.0),
-                    (real::STRESS_RADIAL, 0.0),
-                    (real::FRICTION_FORCE, 0.0),
-                ] {
-                    r[index] = value;
-                }
                 Pipeline::Sleeve(*muscle.sleeve())
             } else {
                 Pipeline::Full(muscle)
@@ -389,19 +358,49 @@ impl Model for McKibbenMuscle {
             pipeline,
             friction,
             out_of_range: false,
-            nominal_length,
+            effective: params,
             notice,
             solver,
         })
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        self.outputs(vars, report, false)
+    fn calculated_parameters(&self) -> CalculatedParameters {
+        let (max_length, min_length) = match &self.pipeline {
+            // The bare sleeve spans 0 .. b (eq. 2.3).
+            Pipeline::Sleeve(sleeve) => (sleeve.max_length(), 0.0),
+            Pipeline::Full(muscle) => (muscle.max_length(), muscle.min_length()),
+        };
+        let e = &self.effective;
+        CalculatedParameters {
+            max_length,
+            min_length,
+            effective_nominal_length: e.nominal_length,
+            effective_strand_length: e.strand_length,
+            effective_turns: e.turns,
+            effective_bladder_length: e.bladder_length,
+            effective_bladder_inner_diameter: e.bladder_inner_diameter,
+            effective_bladder_thickness: e.bladder_thickness,
+            effective_mooney_c1: e.mooney_c1,
+            effective_mooney_c2: e.mooney_c2,
+            effective_braid_angle: e.braid_angle(),
+            effective_bladder_model: e.bladder_model,
+        }
     }
 
-    fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        self.outputs(inputs, outputs, report, false)
+    }
+
+    fn step(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        _time: f64,
+        _step: f64,
+        report: &mut Report,
+    ) {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
-        self.outputs(vars, report, true)
+        self.outputs(inputs, outputs, report, true)
     }
 }
