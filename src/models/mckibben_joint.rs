@@ -11,6 +11,7 @@
 
 use super::{Model, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
+use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::inverse::{difference_for_torque, pair_pressures};
@@ -81,8 +82,25 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
                 .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
             McKibben::from_geometry(&geometry, model, friction, 0.0)
         }
+        // The Festo muscles fitted to their datasheets carry their own rubber and thin wall.
+        k @ 5..=6 => {
+            let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
+            McKibben::new(
+                Sleeve::new(festo.strand_length, festo.turns)?,
+                BladderTube {
+                    inner_diameter: festo.bladder_inner_diameter,
+                    thickness: festo.bladder_thickness,
+                    unstretched_length: festo.bladder_length,
+                    mooney_c1: festo.mooney_c1,
+                    mooney_c2: festo.mooney_c2,
+                },
+                BladderModel::from_switch(festo.bladder_model, festo.bladder_layers)?,
+                friction,
+                0.0,
+            )
+        }
         k => Err(format!(
-            "preset must be 0 (none) or 1-4 (Table 2.1 A-D), got {k}"
+            "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10) or 6 (Festo DMSP-40), got {k}"
         )),
     }
 }

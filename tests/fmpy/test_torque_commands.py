@@ -115,3 +115,24 @@ def test_pulley_joint_takes_external_pressures_and_bypasses_its_controller():
     pf, pe = j.get("flexor_pressure", "extensor_pressure")
     assert pf + pe == pytest.approx(2 * j.get("common_mode_pressure"), rel=1e-12)
     j.close()
+
+
+def test_festo_preset_in_the_joint_meets_torque_commands_and_matches_the_muscle_fmu():
+    # A DMSP-40 pair (nominal length 0.4 m) on a 30 mm pulley, rest lengths at 5% contraction.
+    rest, r = 0.38, 0.03
+    joint = Slave("McKibbenJoint", preset=6, command_mode=1, moment_arm=r, flexor_rest_length=rest,
+                  extensor_rest_length=rest, max_pressure=6e5, common_mode_pressure=3e5)
+    lo = joint.at("jointTorque", actuatorInput=-1e9, jointPosition=0.2)
+    hi = joint.at("jointTorque", actuatorInput=1e9, jointPosition=0.2)
+    torque, saturated, pf, pe = joint.at("jointTorque", "torque_saturated", "flexor_pressure", "extensor_pressure",
+                                         actuatorInput=0.3 * hi + 0.7 * lo, jointPosition=0.2)
+    assert not saturated and torque == pytest.approx(0.3 * hi + 0.7 * lo, rel=1e-6)
+    joint.close()
+    # The same muscles as McKibbenMuscle's preset 6 at those pressures and lengths.
+    flexor = Slave("McKibbenMuscle", preset=6, length=rest - r * 0.2)
+    extensor = Slave("McKibbenMuscle", preset=6, length=rest + r * 0.2)
+    f = flexor.at("force", pressure=pf, length=rest - r * 0.2)
+    e = extensor.at("force", pressure=pe, length=rest + r * 0.2)
+    assert torque == pytest.approx(r * (f - e), rel=1e-9)
+    flexor.close()
+    extensor.close()
