@@ -131,7 +131,11 @@ mod tests {
         let mut worst: f64 = 0.0;
         for (name, e, c) in [
             ("force", exact.force, fd.force),
-            ("effective_pressure", exact.effective_pressure, fd.effective_pressure),
+            (
+                "effective_pressure",
+                exact.effective_pressure,
+                fd.effective_pressure,
+            ),
             ("friction_force", exact.friction_force, fd.friction_force),
             ("volume", exact.volume, fd.volume),
         ] {
@@ -187,7 +191,9 @@ mod tests {
                             // History behind the length: friction mid-presliding (z = 0.3).
                             let s = HysteresisState::at_rest(l - 3e-5);
                             for p in [5e4, 2e5, 4e5] {
-                                let Ok(o) = m.evaluate(p, l, &s) else { continue };
+                                let Ok(o) = m.evaluate(p, l, &s) else {
+                                    continue;
+                                };
                                 if model != BladderModel::None {
                                     let th = o.threshold_pressure;
                                     // Keep the central difference off the contact kink.
@@ -210,13 +216,20 @@ mod tests {
         // Both bladder branches were exercised (thin-walled A is free at low pressure).
         assert!(free_points > 0, "no free-bladder point was checked");
         assert!(points > 300, "only {points} points checked");
-        eprintln!("{points} points ({free_points} free bladder): worst relative difference {worst:e}");
+        eprintln!(
+            "{points} points ({free_points} free bladder): worst relative difference {worst:e}"
+        );
     }
 
     #[test]
     fn contact_kink_returns_the_contact_branch() {
         // At the threshold pressure P_eff = 0 but dP_eff/dP = a > 0: the contact branch.
-        let m = muscle(&MuscleGeometry::muscle_a(), BladderModel::ThinWall, false, 0.0);
+        let m = muscle(
+            &MuscleGeometry::muscle_a(),
+            BladderModel::ThinWall,
+            false,
+            0.0,
+        );
         let l = 0.09;
         let s = HysteresisState::at_rest(l);
         let th = m.evaluate(0.0, l, &s).unwrap().threshold_pressure;
@@ -234,10 +247,16 @@ mod tests {
         // Saturated at z = +1 after extension: growing further adds no friction, shrinking does.
         let m = muscle(&MuscleGeometry::muscle_c(), BladderModel::None, true, 0.0);
         let l = 0.1;
-        let s = HysteresisState { z: 1.0, position: l };
+        let s = HysteresisState {
+            z: 1.0,
+            position: l,
+        };
         let (_, d) = m.partials(3e5, l, &s).unwrap();
         assert_eq!(d.friction_force[1], 0.0);
-        let mid = HysteresisState { z: 0.0, position: l };
+        let mid = HysteresisState {
+            z: 0.0,
+            position: l,
+        };
         let (_, d) = m.partials(3e5, l, &mid).unwrap();
         assert!((d.friction_force[1] - 1e-5 * 3e5 / 1e-4).abs() < 1e-9);
     }
