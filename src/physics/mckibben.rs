@@ -9,6 +9,9 @@ use crate::physics::bladder::{Bladder, BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
 
+mod partials;
+pub use partials::McKibbenPartials;
+
 /// Iteration caps of the connector solve (bracket search doubles its step; root is Newton-bisection).
 const BRACKET_STEPS: usize = 64;
 const ROOT_ITERATIONS: usize = 100;
