@@ -7,3 +7,4 @@ pub mod knitted;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
+pub mod root;

@@ -34,6 +34,8 @@ pub mod magnetics;
 pub mod onion;
 pub mod schedule;
 #[cfg(test)]
+mod onion_tests;
+#[cfg(test)]
 mod tests;
 
 use magnetics::{RingBar, GYROMAGNETIC_RATIO, MU0};
@@ -183,6 +185,8 @@ pub struct Motor {
     llg_rate: f64,
     /// `mu0 Ms^2 V_wall` (J): out-of-plane shape-anisotropy stiffness of the macrospin.
     tilt_stiffness: f64,
+    /// Bound on the third derivative of eq. 3.3 (J/rad^3), for the onion's safe march.
+    ring_bar_slope_bound: f64,
 }
 
 /// Inputs held over a communication step.
@@ -389,6 +393,7 @@ impl Motor {
             speed_scale: (alignment_stiffness / inertia).sqrt(),
             llg_rate,
             tilt_stiffness,
+            ring_bar_slope_bound: onion::curvature_slope_bound(&ring_bar),
             ring_bar,
             params,
         })
@@ -448,6 +453,7 @@ impl Motor {
             bar_angle,
             strain_direction,
             magnetoelastic: self.magnetoelastic_per_stress * stress,
+            ring_bar_slope_bound: self.ring_bar_slope_bound,
         }
     }
 
