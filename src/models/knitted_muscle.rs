@@ -18,7 +18,6 @@ use crate::physics::mckibben::BladderModel;
 use crate::variables::knitted_muscle::{boolean, integer, real, INFO};
 use crate::variables::ModelInfo;
 use serde::{Deserialize, Serialize};
-use std::f64::consts::SQRT_2;
 
 /// With a bladder the force grows without bound where the rubber fills the sleeve; a length beyond
 /// such a limit is evaluated this fraction of the range inside it (finite, steep force), as in
@@ -191,42 +190,43 @@ impl KnittedMuscle {
         } else {
             0.0
         };
-        let (volume, dv, _) = s.volume_derivatives(l);
-        let frictionless = s.force(p_eff, l);
-        let frictionless_stiffness = s.stiffness(p_eff, l);
-        let mut out = Output {
-            force: frictionless,
-            volume,
-            effective_pressure: p_eff,
-            friction_force: 0.0,
-            max_radius: s.max_radius(l),
-            stiffness: frictionless_stiffness,
-            history: self.history,
-        };
-        if let Some(f) = &self.friction {
-            let next = f.operator.advance(&self.history, l);
-            let area = s.mean_area(l);
-            let (force, friction_force) = f.strand.total_force(frictionless, p_eff, area, next.z);
-            out.force = force;
-            out.friction_force = friction_force;
-            out.history = next;
-            if friction_force != 0.0 {
-                // F = (F0 + k P A) / (1 - k), k = sqrt(2) Cf z held; A = V / L.
-                let k = SQRT_2 * f.strand.coefficient * next.z;
-                let area_slope = if l > 0.0 {
-                    (dv * l - volume) / (l * l)
-                } else {
-                    0.0
-                };
-                let stiffness = (frictionless_stiffness + k * p_eff * area_slope) / (1.0 - k);
-                out.stiffness = if stiffness.is_finite() {
-                    stiffness
-                } else {
-                    frictionless_stiffness
-                };
+        let next = self
+            .friction
+            .as_ref()
+            .map(|f| f.operator.advance(&self.history, l));
+        let friction = self
+            .friction
+            .as_ref()
+            .zip(next)
+            .map(|(f, n)| (&f.strand, n.z));
+        match s.evaluate(p_eff, l, friction) {
+            Ok(state) => Output {
+                force: state.force,
+                volume: state.volume,
+                effective_pressure: p_eff,
+                friction_force: state.friction_force,
+                max_radius: state.max_radius,
+                stiffness: state.stiffness,
+                history: next.unwrap_or(self.history),
+            },
+            Err(reason) => {
+                // Unreachable with finite inputs in range; the outputs keep their values.
+                report.add(
+                    Status::Error,
+                    format!("cannot evaluate the sleeve: {reason}"),
+                );
+                let r = &vars.real;
+                Output {
+                    force: r[real::FORCE],
+                    volume: r[real::VOLUME],
+                    effective_pressure: r[real::EFFECTIVE_PRESSURE],
+                    friction_force: r[real::FRICTION_FORCE],
+                    max_radius: r[real::MAX_RADIUS],
+                    stiffness: r[real::STIFFNESS],
+                    history: self.history,
+                }
             }
         }
-        out
     }
 
     /// Section 1.3.6: the bladder's force (eq. 2.16-2.17 with the knitted cylinder) and, with
@@ -283,23 +283,22 @@ impl KnittedMuscle {
         };
         if let Some(f) = &self.friction {
             let next = f.operator.advance(&self.history, l);
-            // F = F_0 + k T with the strand tension T = F - (F_pressure + F_elastic): eq. 1.21's
-            // `total_force` with its `P A` term set to -(F_pressure + F_elastic).
+            // Eq. 1.21 fed by the strand tension T = F - (F_pressure + F_elastic), with
+            // d(offset)/dL = F_0' - T_0'.
             let offset = state.pressure_force + state.elastic_force;
-            let (force, friction_force) = f.strand.total_force(state.force, 1.0, -offset, next.z);
-            out.force = force;
-            out.friction_force = friction_force;
-            out.history = next;
-            if friction_force != 0.0 {
-                // dF/dL = (F_0' - k offset') / (1 - k) with offset' = F_0' - T_0'.
-                let k = SQRT_2 * f.strand.coefficient * next.z;
-                let offset_slope = state.stiffness - state.strand_stiffness;
-                let stiffness = (state.stiffness - k * offset_slope) / (1.0 - k);
-                out.stiffness = if stiffness.is_finite() {
-                    stiffness
-                } else {
-                    state.stiffness
-                };
+            let offset_slope = state.stiffness - state.strand_stiffness;
+            match f
+                .strand
+                .apply(state.force, state.stiffness, -offset, -offset_slope, next.z)
+            {
+                Ok(with) => {
+                    out.force = with.force;
+                    out.friction_force = with.friction_force;
+                    out.stiffness = with.stiffness;
+                    out.history = next;
+                }
+                // Unreachable for a finite bladder state; the frictionless force stands.
+                Err(reason) => fallback = Some(format!("eq. 1.21 friction skipped: {reason}")),
             }
         }
         (out, fallback)
@@ -374,6 +373,7 @@ impl Model for KnittedMuscle {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::SQRT_2;
 
     fn vars_with(shape: i32, friction: bool) -> Vars {
         let mut vars = Vars::from_start(&INFO);

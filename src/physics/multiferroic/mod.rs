@@ -32,9 +32,9 @@
 pub mod expm;
 pub mod magnetics;
 pub mod onion;
-pub mod schedule;
 #[cfg(test)]
 mod onion_tests;
+pub mod schedule;
 #[cfg(test)]
 mod tests;
 

@@ -25,8 +25,17 @@ fn jump_near_a_fold_keeps_the_narrow_basin_of_issue_16() {
     let at_146 = ramp(&m, direction, (0.0, 0.0), 146e6, 14_600);
     let jumped = m.landscape(0.0, direction, 148e6).settle(at_146);
     let slow = ramp(&m, direction, (146e6, at_146), 148e6, 2000);
-    assert!((slow.to_degrees() - 16.69).abs() < 0.01, "{}", slow.to_degrees());
-    assert!((jumped - slow).abs() < 1e-9, "{} {}", jumped.to_degrees(), slow.to_degrees());
+    assert!(
+        (slow.to_degrees() - 16.69).abs() < 0.01,
+        "{}",
+        slow.to_degrees()
+    );
+    assert!(
+        (jumped - slow).abs() < 1e-9,
+        "{} {}",
+        jumped.to_degrees(),
+        slow.to_degrees()
+    );
     // The same through the motor's step (the FMU's path).
     let mut s = MotorState::aligned(0.0);
     for i in 1..=1460 {
