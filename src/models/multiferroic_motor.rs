@@ -7,7 +7,7 @@
 
 use super::{Model, Report, Status, Vars};
 use crate::physics::multiferroic::{
-    Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, SteppingSchedule,
+    drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, SteppingSchedule,
 };
 use crate::variables::multiferroic_motor::{boolean, integer, real, INFO};
 use crate::variables::ModelInfo;
@@ -19,6 +19,8 @@ pub struct MultiferroicMotor {
     /// The built-in stepping schedule when `schedule = 1`.
     schedule: Option<SteppingSchedule>,
     rotor_locked: bool,
+    /// Young's modulus (Pa) when `strain_drive`: the `strain` input times it is the stress.
+    strain_drive: Option<f64>,
     state: MotorState,
     /// Largest magnitude of the ring's torque on the bar (N m), for [`Self::implausible`].
     max_torque: f64,
@@ -29,9 +31,16 @@ pub struct MultiferroicMotor {
 
 impl MultiferroicMotor {
     fn inputs(&self, vars: &Vars) -> MotorInputs {
+        // An unrepresentable strain gives a NaN stress, which the physics refuses with a reason.
+        let stress = match self.strain_drive {
+            Some(modulus) => {
+                drive::uniaxial_stress(vars.real[real::STRAIN], modulus).unwrap_or(f64::NAN)
+            }
+            None => vars.real[real::STRESS],
+        };
         MotorInputs {
             strain_direction: vars.real[real::STRAIN_DIRECTION],
-            stress: vars.real[real::STRESS],
+            stress,
             load_torque: vars.real[real::LOAD_TORQUE],
             rotor_locked: self.rotor_locked,
             schedule: self.schedule,
@@ -143,6 +152,19 @@ impl Model for MultiferroicMotor {
             r[real::STRESS_AMPLITUDE],
         )?;
         let schedule = switch(vars, integer::SCHEDULE, "schedule")?.then_some(stepping);
+        let strain_drive = if vars.boolean[boolean::STRAIN_DRIVE] {
+            let modulus = vars.real[real::YOUNGS_MODULUS];
+            drive::uniaxial_stress(0.0, modulus)?;
+            Some(modulus)
+        } else {
+            None
+        };
+        let offset = r[real::INITIAL_ONION_OFFSET];
+        if !(offset.is_finite() && offset.abs() <= 1e3) {
+            return Err(format!(
+                "initial_onion_offset must be finite and within 1e3 rad, got {offset}"
+            ));
+        }
         let motor = Motor::new(params)?;
         vars.real[real::INERTIA] = motor.inertia;
         vars.real[real::DRAG] = motor.drag;
@@ -153,8 +175,13 @@ impl Model for MultiferroicMotor {
         Ok(Self {
             schedule,
             rotor_locked: vars.boolean[boolean::ROTOR_LOCKED],
-            // The rotor starts at rest with the onion state aligned with it, at angle 0.
-            state: MotorState::aligned(0.0),
+            strain_drive,
+            // The rotor starts at rest at angle 0, the onion state `initial_onion_offset` from
+            // alignment with it (the quasi-static one settles downhill at the first evaluation).
+            state: MotorState {
+                onion_angle: offset,
+                ..MotorState::aligned(0.0)
+            },
             max_torque: motor.ring_bar.max_torque().1.abs(),
             motor,
             accuracy_warned: false,

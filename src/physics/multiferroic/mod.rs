@@ -29,6 +29,7 @@
 //! turns; what is left is integrated, and a forced substep drops the negative stiffness so it
 //! cannot amplify. See [`Motor::step`].
 
+pub mod drive;
 pub mod expm;
 pub mod magnetics;
 pub mod onion;
