@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps motor-docs
 
 all: fmus
 
@@ -69,6 +69,11 @@ report: deps fmus $(VENV)/.installed
 clean:
 	cargo clean
 	rm -rf out $(VENV)
+
+## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
+## densities, strain drive and onion reorientation of the MultiferroicMotor FMU (issue 16).
+motor-docs: fmus $(VENV)/.installed
+	$(PY) examples/motor_characteristics.py
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
