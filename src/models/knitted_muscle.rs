@@ -13,7 +13,10 @@ use crate::physics::bladder::{
     Bladder, BladderState, BladderTube, KnittedCylinder, SleeveGeometry,
 };
 use crate::physics::friction::{HysteresisState, StopOperator};
-use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
+use crate::physics::knitted::{
+    KnittedParams, KnittedSleeve, ShapeKind, ShapeModel, StrandFriction,
+};
+use crate::physics::knitted_bag::Bag;
 use crate::physics::mckibben::BladderModel;
 use crate::variables::knitted_muscle::{boolean, integer, real, INFO};
 use crate::variables::ModelInfo;
@@ -41,6 +44,8 @@ pub struct KnittedMuscle {
     valid: (f64, f64),
     /// `None` when `friction` is off.
     friction: Option<Friction>,
+    /// Section 1.4's bag, `None` when `bag_diameter` is 0.
+    bag: Option<Bag>,
     /// Friction history (eq. 1.21), advanced only by accepted steps.
     history: HysteresisState,
     /// Whether the last evaluation was outside the valid lengths: its warning is logged once per
@@ -199,7 +204,7 @@ impl KnittedMuscle {
             .as_ref()
             .zip(next)
             .map(|(f, n)| (&f.strand, n.z));
-        match s.evaluate(p_eff, l, friction) {
+        match s.evaluate_in_bag(p_eff, l, friction, self.bag.as_ref()) {
             Ok(state) => Output {
                 force: state.force,
                 volume: state.volume,
@@ -323,6 +328,19 @@ impl Model for KnittedMuscle {
         let sleeve = KnittedSleeve::new(sleeve_params(vars)?, shape_kind(vars)?)?;
         let bladder = bladder(vars, &sleeve)?;
         let valid = valid_lengths(&sleeve, bladder.as_ref());
+        let bag = match vars.real[real::BAG_DIAMETER] {
+            0.0 => None,
+            diameter => {
+                if bladder.is_some() || matches!(sleeve.shape(), ShapeModel::NonCylindrical(_)) {
+                    return Err(
+                        "bag_diameter needs a cylindrical sleeve (shape_model 0 or 1) \
+                                and no rubber bladder (bladder_model 0)"
+                            .into(),
+                    );
+                }
+                Some(Bag::new(diameter, vars.real[real::BAG_MEMBRANE_STIFFNESS])?)
+            }
+        };
         let friction = if vars.boolean[boolean::FRICTION] {
             Some(Friction {
                 strand: StrandFriction::new(vars.real[real::FRICTION_COEFFICIENT])?,
@@ -350,6 +368,7 @@ impl Model for KnittedMuscle {
             bladder,
             valid,
             friction,
+            bag,
             history,
             out_of_range: false,
             collapsed: false,

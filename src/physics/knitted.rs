@@ -10,6 +10,7 @@
 // `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 use super::knitted_shape::{ShapeGeometry, ShapeTable, DEFAULT_TABLE_NODES};
+use crate::physics::knitted_bag::Bag;
 use std::f64::consts::{PI, SQRT_2};
 
 /// Sleeve parameters, SI units.
@@ -299,25 +300,53 @@ impl KnittedSleeve {
         length: f64,
         friction: Option<(&StrandFriction, f64)>,
     ) -> Result<SleeveState, String> {
+        self.evaluate_in_bag(pressure, length, friction, None)
+    }
+
+    /// [`Self::evaluate`] with the fluid held inside `bag` (section 1.4's polyethylene bag; see
+    /// [`crate::physics::knitted_bag`]): `F = -P dV/dL` of the capped volume.
+    pub fn evaluate_in_bag(
+        &self,
+        pressure: f64,
+        length: f64,
+        friction: Option<(&StrandFriction, f64)>,
+        bag: Option<&Bag>,
+    ) -> Result<SleeveState, String> {
         if !pressure.is_finite() || !length.is_finite() {
             return Err(format!(
                 "pressure and length must be finite, got {pressure} Pa and {length} m"
             ));
         }
         let l = self.clamp_length(length);
-        let (volume, dv, _) = self.volume_derivatives(l);
-        let frictionless = self.force(pressure, l);
-        let frictionless_stiffness = self.stiffness(pressure, l);
+        let sleeve_volume = self.volume_derivatives(l);
+        let (volume, dv, ddv) = match bag {
+            Some(b) => b.volume_derivatives(self, pressure, l),
+            None => sleeve_volume,
+        };
+        let bag_binds = (volume, dv, ddv) != sleeve_volume;
+        let (frictionless, frictionless_stiffness) = if bag_binds {
+            (-pressure * dv, -pressure * ddv)
+        } else {
+            (self.force(pressure, l), self.stiffness(pressure, l))
+        };
+        let max_radius = match bag {
+            Some(b) => self.max_radius(l).min(b.radius_at(pressure)),
+            None => self.max_radius(l),
+        };
         let mut state = SleeveState {
             force: frictionless,
             volume,
             friction_force: 0.0,
-            max_radius: self.max_radius(l),
+            max_radius,
             stiffness: frictionless_stiffness,
         };
         if let Some((strand, z)) = friction {
             // A = V / L, so d(P A)/dL = P (dV/dL L - V) / L^2.
-            let area = self.mean_area(l);
+            let area = if l > 0.0 {
+                (volume / l).max(0.0)
+            } else {
+                self.mean_area(l)
+            };
             let area_slope = if l > 0.0 {
                 (dv * l - volume) / (l * l)
             } else {

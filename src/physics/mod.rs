@@ -4,6 +4,7 @@ pub mod bladder;
 pub mod friction;
 pub mod gaylord;
 pub mod knitted;
+pub mod knitted_bag;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
