@@ -60,3 +60,19 @@ def test_a_ring_magnetised_parallel_to_the_bar_reorients_to_antiparallel():
         # Halfway round within 2 ns for a 1 degree start and sooner for larger ones.
         half = np.argmax(np.abs(np.degrees(r["offset_angle"])) < 90.0)
         assert 0 < r["time"][half] < (4e-9 if offset_deg == 180.0 else 2e-9)
+
+
+def test_a_jump_near_the_fold_keeps_the_narrow_basin():
+    # Issue 16: locked rotor, tension at -15 deg, stress ramped slowly to 146 MPa, then one step to
+    # 148 MPa. A minimum still exists at 16.69 deg, where a slow ramp ends; the old settle strode
+    # over its basin (< 1 deg wide) and left the onion at 58.97 deg.
+    n = 1460
+    t = np.arange(n + 3) * 1e-9
+    stress = np.concatenate([np.linspace(0.0, 146e6, n + 1), [148e6, 148e6]])
+    signal = np.array(list(zip(t, np.full(t.size, math.radians(-15.0)), stress)),
+                      dtype=[("time", float), ("strain_direction", float), ("stress", float)])
+    r = simulate_fmu(FMU, stop_time=t[-1], output_interval=1e-9, start_values={"rotor_locked": True},
+                     input=signal, output=["offset_angle", "applied_strain_direction"])
+    offset = np.degrees(r["offset_angle"])
+    assert offset[n] < 16.5  # before the jump, on the near branch
+    assert abs(offset[-1] - 16.69) < 0.01, offset[-3:]
