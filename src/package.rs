@@ -33,7 +33,7 @@ pub fn package_all_platforms(
         .collect::<Result<Vec<_>, String>>()?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-    crate::variables::REGISTRY
+    crate::fmi2::REGISTRY
         .iter()
         .map(|f| package(*f, &binaries, out_dir))
         .collect()

@@ -1,11 +1,12 @@
-//! The build script's checker refuses model descriptions that importers would reject; the GUID
-//! follows every change to the variables.
+//! The build script's checker refuses model descriptions that importers would reject; the shipped
+//! description gets the export layer's part and the ModelStructure indices; the GUID follows every
+//! change to the variables.
 
 #[allow(dead_code)]
 #[path = "../build/model_description.rs"]
 mod model_description;
 
-use model_description::{check, guid_of};
+use model_description::{check, guid_of, ResolvedUnknown};
 
 const SOURCE: &str = include_str!("../modelDescription/McKibbenMuscle.xml");
 
@@ -17,7 +18,7 @@ fn edited(from: &str, to: &str) -> String {
 
 fn refused(text: &str, reason: &str) {
     match check(text, "McKibbenMuscle") {
-        Ok(()) => panic!("accepted a description that should fail with '{reason}'"),
+        Ok(_) => panic!("accepted a description that should fail with '{reason}'"),
         Err(e) => assert!(e.contains(reason), "error '{e}' does not say '{reason}'"),
     }
 }
@@ -64,13 +65,15 @@ fn illegal_causality_variability_initial_combinations_fail() {
         ),
         "must not have a start value",
     );
-    refused(
+    // Tunable parameters are legal: the export layer rebuilds the model when one changes.
+    check(
         &edited(
             r#"causality="parameter" variability="fixed""#,
             r#"causality="parameter" variability="tunable""#,
         ),
-        "tunable parameters are not supported",
-    );
+        "McKibbenMuscle",
+    )
+    .unwrap();
 }
 
 #[test]
@@ -113,19 +116,138 @@ fn value_references_are_dense_and_names_unique() {
     );
 }
 
+/// The ModelStructure source part: dependencies by name, given for `force`.
+fn with_dependencies(attributes: &str) -> String {
+    edited(
+        "<ModelStructure/>",
+        &format!("<ModelStructure><Outputs><Unknown name=\"force\" {attributes}/></Outputs></ModelStructure>"),
+    )
+}
+
 #[test]
-fn model_structure_must_match_the_variables() {
-    // Drop the last output, then the last initial unknown (both input_clamped).
+fn model_structure_indices_are_generated() {
+    let m = check(SOURCE, "McKibbenMuscle").unwrap();
+    let indices = |u: &[ResolvedUnknown]| u.iter().map(|u| u.index).collect::<Vec<_>>();
+    // Every output in order (FMI 2.0 section 2.2.8)...
+    assert_eq!(
+        indices(&m.outputs),
+        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 33, 47, 48, 50]
+    );
+    // ...and the outputs with initial calculated plus the calculated parameters, ascending.
+    assert_eq!(
+        indices(&m.initial_unknowns),
+        [
+            3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31, 33, 34, 35, 36, 37, 38, 39, 40,
+            41, 42, 43, 47, 48, 50
+        ]
+    );
+    assert!(m.outputs.iter().all(|u| u.dependencies.is_none()));
+    let xml = &m.shipped_xml;
+    assert!(xml.contains(
+        r#"<CoSimulation
+    modelIdentifier="McKibbenMuscle""#
+    ));
+    assert!(xml.contains(r#"<Category name="logCalls""#));
+    assert!(xml.contains(r#"<Unknown index="31"/> <!-- min_length -->"#));
+    assert!(xml.contains(&format!(r#"guid="{}""#, m.guid)));
+}
+
+#[test]
+fn dependencies_by_name_become_sorted_indices() {
+    let m = check(
+        &with_dependencies(r#"dependencies="length pressure" dependenciesKind="dependent fixed""#),
+        "McKibbenMuscle",
+    )
+    .unwrap();
+    assert_eq!(
+        m.outputs[0],
+        ResolvedUnknown {
+            index: 3,
+            dependencies: Some(vec![1, 2]),
+            kinds: Some(vec!["fixed".into(), "dependent".into()]),
+        }
+    );
+    assert!(m.shipped_xml.contains(
+        r#"<Unknown index="3" dependencies="1 2" dependenciesKind="fixed dependent"/> <!-- force -->"#
+    ));
+    // An empty list says "depends on nothing".
+    let m = check(&with_dependencies(r#"dependencies="""#), "McKibbenMuscle").unwrap();
+    assert!(m
+        .shipped_xml
+        .contains(r#"<Unknown index="3" dependencies=""/>"#));
+}
+
+#[test]
+fn bad_model_structure_entries_fail() {
     refused(
-        &edited("<Unknown index=\"33\"/>\n    </Outputs>", "</Outputs>"),
-        "ModelStructure/Outputs must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 33]",
+        &with_dependencies(r#"dependencies="lenght""#),
+        "'lenght', not a variable",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="turns""#),
+        "may depend only on an input",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="length length""#),
+        "lists 'length' twice",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="length" dependenciesKind="dependent fixed""#),
+        "1 dependencies but 2 dependenciesKind",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="length" dependenciesKind="sometimes""#),
+        "dependenciesKind 'sometimes'",
+    );
+    refused(
+        &with_dependencies(r#"dependenciesKind="dependent""#),
+        "dependenciesKind without dependencies",
     );
     refused(
         &edited(
-            "<Unknown index=\"33\"/>\n    </InitialUnknowns>",
-            "</InitialUnknowns>",
+            "<ModelStructure/>",
+            r#"<ModelStructure><Outputs><Unknown index="3"/></Outputs></ModelStructure>"#,
         ),
-        "InitialUnknowns must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31, 33]",
+        "give the unknown by name",
+    );
+    refused(
+        &edited(
+            "<ModelStructure/>",
+            r#"<ModelStructure><Outputs><Unknown name="turns"/></Outputs></ModelStructure>"#,
+        ),
+        "'turns' does not belong in this list",
+    );
+    refused(
+        &edited(
+            "<ModelStructure/>",
+            r#"<ModelStructure><Outputs><Unknown name="force"/><Unknown name="force"/></Outputs></ModelStructure>"#,
+        ),
+        "'force' is listed twice",
+    );
+}
+
+#[test]
+fn the_export_layer_part_stays_out_of_the_source() {
+    refused(
+        &edited(
+            "<UnitDefinitions>",
+            "<CoSimulation modelIdentifier=\"McKibbenMuscle\"/>\n  <UnitDefinitions>",
+        ),
+        "<CoSimulation> belongs to the export layer",
+    );
+    refused(
+        &edited(
+            "<DefaultExperiment",
+            "<LogCategories><Category name=\"logCalls\"/></LogCategories>\n  <DefaultExperiment",
+        ),
+        "<LogCategories> belongs to the export layer",
+    );
+    refused(
+        &edited(
+            r#"<Unit name="m"><BaseUnit m="1"/></Unit>"#,
+            r#"<Unit name="m"><BaseUnit m="1"/></Unit><Unit name="m"/>"#,
+        ),
+        "a unit is defined twice",
     );
 }
 
@@ -136,11 +258,8 @@ fn identity_is_checked() {
         "guid must be the placeholder",
     );
     refused(
-        &edited(
-            r#"modelIdentifier="McKibbenMuscle""#,
-            r#"modelIdentifier="Other""#,
-        ),
-        "must both equal the file name",
+        &edited(r#"modelName="McKibbenMuscle""#, r#"modelName="Other""#),
+        "modelName must equal the file name",
     );
     refused(
         &edited(r#"fmiVersion="2.0""#, r#"fmiVersion="3.0""#),
@@ -161,53 +280,70 @@ fn the_guid_changes_with_any_variable() {
         original,
         guid_of(&edited(r#"name="volume""#, r#"name="volume_m3""#))
     );
+    // The GUID build.rs ships is that of the whole shipped description.
+    let shipped = check(SOURCE, "McKibbenMuscle").unwrap();
+    let renamed = check(
+        &edited(r#"name="volume""#, r#"name="volume_m3""#),
+        "McKibbenMuscle",
+    )
+    .unwrap();
+    assert_ne!(shipped.guid, renamed.guid);
 }
 
-/// The rules of `build/rules.rs` (FMI 2.0 chapter 2, after the INTO-CPS VDMCheck inventory):
-/// each one refuses a description that breaks it.
+/// The rules of `build/rules.rs` (FMI 2.0 chapter 2, after the INTO-CPS VDMCheck inventory),
+/// which build.rs runs on the source and again on the shipped description: each one refuses a
+/// shipped description that breaks it.
 mod rules {
-    use super::{edited, refused};
+    use super::{check, SOURCE};
+    use crate::model_description::rules;
+
+    fn shipped() -> String {
+        check(SOURCE, "McKibbenMuscle").unwrap().shipped_xml
+    }
+
+    /// The shipped McKibbenMuscle description with `from` replaced by `to` must fail with `reason`.
+    fn broken(from: &str, to: &str, reason: &str) {
+        let xml = shipped();
+        assert!(xml.contains(from), "test edit does not apply: {from}");
+        match rules::check(&xml.replacen(from, to, 1)) {
+            Ok(()) => panic!("accepted a description that should fail with '{reason}'"),
+            Err(e) => assert!(e.contains(reason), "error '{e}' does not say '{reason}'"),
+        }
+    }
+
+    #[test]
+    fn the_shipped_descriptions_pass_every_rule() {
+        rules::check(&shipped()).unwrap();
+        assert_eq!(rules::RULES.len(), 12);
+    }
 
     #[test]
     fn duplicate_unit_type_and_category_names_are_refused() {
-        refused(
-            &edited(
-                r#"<Unit name="m"><BaseUnit m="1"/></Unit>"#,
-                r#"<Unit name="m"><BaseUnit m="1"/></Unit><Unit name="m"><BaseUnit m="1"/></Unit>"#,
-            ),
-            "unit 'm' is defined twice",
-        );
-        refused(
-            &edited(
-                "  <LogCategories>",
-                "  <TypeDefinitions><SimpleType name=\"T\"><Real/></SimpleType>\
-                 <SimpleType name=\"T\"><Real/></SimpleType></TypeDefinitions>\n  <LogCategories>",
-            ),
+        let unit = r#"<Unit name="m"><BaseUnit m="1"/></Unit>"#;
+        broken(unit, &format!("{unit}{unit}"), "unit 'm' is defined twice");
+        broken(
+            "<LogCategories>",
+            "<TypeDefinitions><SimpleType name=\"T\"><Real/></SimpleType>\
+             <SimpleType name=\"T\"><Real/></SimpleType></TypeDefinitions>\n  <LogCategories>",
             "type 'T' is defined twice",
         );
-        refused(
-            &edited(
-                r#"<Category name="logStatusFatal""#,
-                r#"<Category name="logCalls"/><Category name="logStatusFatal""#,
-            ),
+        broken(
+            "<LogCategories>",
+            "<LogCategories><Category name=\"logCalls\"/>",
             "log category 'logCalls' is declared twice",
         );
     }
 
     #[test]
     fn base_units_need_integer_exponents_and_a_factor() {
-        refused(
-            &edited(
-                r#"<BaseUnit m="1"/></Unit>"#,
-                r#"<BaseUnit m="1.5"/></Unit>"#,
-            ),
+        broken(
+            r#"<BaseUnit m="1"/></Unit>"#,
+            r#"<BaseUnit m="1.5"/></Unit>"#,
             "must be an integer",
         );
-        refused(
-            &edited(
-                r#"<BaseUnit m="1"/></Unit>"#,
-                r#"<BaseUnit m="1" factor="0"/></Unit>"#,
-            ),
+        broken(
+            r#"<BaseUnit m="1"/></Unit>"#,
+            r#"<BaseUnit m="1" factor="0"/></Unit>"#,
             "factor must not be zero",
         );
     }
@@ -215,109 +351,95 @@ mod rules {
     #[test]
     fn default_experiment_must_be_runnable() {
         let experiment = r#"<DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>"#;
-        refused(
-            &edited(
-                experiment,
-                r#"<DefaultExperiment startTime="2" stopTime="1" stepSize="0.001"/>"#,
-            ),
+        broken(
+            experiment,
+            r#"<DefaultExperiment startTime="2" stopTime="1" stepSize="0.001"/>"#,
             "must be after startTime",
         );
-        refused(
-            &edited(
-                experiment,
-                r#"<DefaultExperiment startTime="0" stopTime="1" stepSize="0"/>"#,
-            ),
+        broken(
+            experiment,
+            r#"<DefaultExperiment startTime="0" stopTime="1" stepSize="0"/>"#,
             "stepSize 0 must be positive",
         );
-        refused(
-            &edited(
-                experiment,
-                r#"<DefaultExperiment startTime="0" stopTime="1" tolerance="-1"/>"#,
-            ),
+        broken(
+            experiment,
+            r#"<DefaultExperiment startTime="0" stopTime="1" tolerance="-1"/>"#,
             "tolerance -1 must be positive",
         );
     }
 
     #[test]
     fn start_must_lie_within_min_and_max() {
-        refused(
-            &edited(
-                r#"min="1e-3" max="1e4" start="3.74""#,
-                r#"min="1e-3" max="1" start="3.74""#,
-            ),
+        let turns = r#"min="1e-3" max="1e4" start="3.74""#;
+        broken(
+            turns,
+            r#"min="1e-3" max="1" start="3.74""#,
             "start 3.74 is outside",
         );
-        refused(
-            &edited(
-                r#"min="1e-3" max="1e4" start="3.74""#,
-                r#"min="10" max="1" start="3.74""#,
-            ),
+        broken(
+            turns,
+            r#"min="10" max="1" start="3.74""#,
             "min 10 is above max 1",
         );
-        refused(
-            &edited(
-                r#"<Integer min="0" max="2" start="0"/>"#,
-                r#"<Integer min="1" max="2" start="0"/>"#,
-            ),
+        broken(
+            r#"<Integer min="0" max="2" start="0"/>"#,
+            r#"<Integer min="1" max="2" start="0"/>"#,
             "start 0 is outside",
         );
-        refused(
-            &edited(
-                r#"min="1e-3" max="1e4" start="3.74""#,
-                r#"min="1e-3" max="1e4" nominal="0" start="3.74""#,
-            ),
+        broken(
+            turns,
+            r#"min="1e-3" max="1e4" nominal="0" start="3.74""#,
             "nominal 0 must be positive",
         );
     }
 
     #[test]
     fn booleans_carry_no_numeric_attributes() {
-        refused(
-            &edited(
-                r#"<Boolean start="false"/>"#,
-                r#"<Boolean min="0" start="false"/>"#,
-            ),
+        broken(
+            r#"<Boolean start="false"/>"#,
+            r#"<Boolean min="0" start="false"/>"#,
             "a Boolean has no attribute min",
         );
     }
 
     #[test]
     fn boolean_attributes_are_true_or_false() {
-        refused(
-            &edited(
-                r#"canHandleVariableCommunicationStepSize="true""#,
-                r#"canHandleVariableCommunicationStepSize="yes""#,
-            ),
+        broken(
+            r#"canHandleVariableCommunicationStepSize="true""#,
+            r#"canHandleVariableCommunicationStepSize="yes""#,
             "must be 'true' or 'false'",
         );
     }
 
     #[test]
     fn structured_names_follow_the_grammar() {
-        refused(
-            &edited(r#"name="force""#, r#"name="force (N)""#),
+        broken(
+            r#"name="force""#,
+            r#"name="force (N)""#,
             "structured naming convention",
         );
-        refused(
-            &edited(r#"name="force""#, r#"name="1force""#),
+        broken(
+            r#"name="force""#,
+            r#"name="1force""#,
             "structured naming convention",
         );
-        // Legal structured names pass this rule (and fail nothing else).
-        crate::model_description::check(
-            &edited(r#"name="force""#, r#"name="muscle.force[1]""#),
-            "McKibbenMuscle",
-        )
-        .unwrap();
+        // Legal structured names pass.
+        rules::check(&shipped().replacen(r#"name="force""#, r#"name="muscle.force[1]""#, 1))
+            .unwrap();
+        rules::check(&shipped().replacen(r#"name="force""#, r#"name="der(muscle.'x y', 2)""#, 1))
+            .unwrap();
     }
 
     #[test]
     fn unknowns_refer_to_variables_once() {
-        refused(
-            &edited(r#"<Unknown index="3"/>"#, r#"<Unknown index="99"/>"#),
+        broken(
+            r#"<Unknown index="3"/>"#,
+            r#"<Unknown index="99"/>"#,
             "Unknown index 99 is not a variable",
         );
-        refused(
-            &edited(r#"<Unknown index="4"/>"#, r#"<Unknown index="3"/>"#),
+        broken(
+            r#"<Unknown index="4"/>"#,
+            r#"<Unknown index="3"/>"#,
             "Unknown index 3 is listed twice",
         );
     }
@@ -325,37 +447,34 @@ mod rules {
     #[test]
     fn dependencies_are_sorted_inputs_with_one_kind_each() {
         let force = r#"<Unknown index="3"/>"#;
-        refused(
-            &edited(force, r#"<Unknown index="3" dependencies="2 1"/>"#),
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="2 1"/>"#,
             "must be ascending and unique",
         );
-        refused(
-            &edited(force, r#"<Unknown index="3" dependencies="1 4"/>"#),
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1 4"/>"#,
             "may not depend on 'volume'",
         );
-        refused(
-            &edited(
-                force,
-                r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent"/>"#,
-            ),
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent"/>"#,
             "1 dependenciesKind for 2 dependencies",
         );
-        refused(
-            &edited(
-                force,
-                r#"<Unknown index="3" dependencies="1" dependenciesKind="linear"/>"#,
-            ),
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1" dependenciesKind="linear"/>"#,
             "dependenciesKind 'linear' is not one of",
         );
-        refused(
-            &edited(
-                force,
-                r#"<Unknown index="3" dependenciesKind="dependent"/>"#,
-            ),
+        broken(
+            force,
+            r#"<Unknown index="3" dependenciesKind="dependent"/>"#,
             "dependenciesKind without dependencies",
         );
-        refused(
-            &edited(force, r#"<Unknown index="3" dependencies="1 x"/>"#),
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1 x"/>"#,
             "dependencies must be indices",
         );
     }

@@ -6,7 +6,8 @@
 //! Integer parameter `out_of_range_policy` asks for fmi2Warning (1) or, from fmi2DoStep,
 //! fmi2Discard (2) instead.
 
-use crate::models::{Report, Status, Vars};
+use super::runtime::Vars;
+use crate::models::{Report, Status};
 use crate::variables::{ModelInfo, VarType};
 
 /// Name of the Integer parameter that selects the policy.

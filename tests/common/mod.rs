@@ -286,6 +286,7 @@ pub mod mckibben {
     pub const STRAND_LENGTH: u32 = real::STRAND_LENGTH as u32;
     pub const TURNS: u32 = real::TURNS as u32;
     pub const MAX_LENGTH: u32 = real::MAX_LENGTH as u32;
+    pub const STIFFNESS: u32 = real::STIFFNESS as u32;
     pub const INPUT_CLAMPED: u32 =
         actuator_fmus::variables::mckibben_muscle::boolean::INPUT_CLAMPED as u32;
     pub const OUT_OF_RANGE_POLICY: u32 =
