@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps linearized
 
 all: fmus
 
@@ -65,6 +65,11 @@ bench: deps fmus
 report: deps fmus $(VENV)/.installed
 	cargo bench --bench accuracy_cost
 	$(PY) benches/report.py
+
+## docs/linearized-muscle.md: stiffness dF/dL and pressure gain dF/dP over the stroke of Table 2.1's
+## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
+linearized: fmus $(VENV)/.installed
+	$(PY) docs/linearized/generate.py > /dev/null
 
 clean:
 	cargo clean
