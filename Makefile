@@ -59,6 +59,7 @@ test: test-rust test-fmpy
 bench: deps fmus
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
+	cargo bench --bench directional_derivative
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
