@@ -11,6 +11,7 @@ mod derivatives;
 mod exports;
 mod instance;
 mod logger;
+mod model_exchange;
 mod out_of_range;
 pub mod registry;
 pub mod runtime;
