@@ -26,7 +26,7 @@ FMUS = sorted(p.stem for p in FMU_DIR.glob("*.fmu"))
 RTOL = 1e-12
 # Under wine the DLL calls wine's msvcrt libm, whose sin/cos/exp may differ from glibc's in the last
 # bit. The motor's adaptive substepping (tolerance 1e-6 rad) turns such a bit into a different
-# substep sequence, measured at 1.8e-9 relative; it is held to its own tolerance there. Every
+# substep sequence, measured at 1.1e-10 relative; it is held to its own tolerance there. Every
 # other FMU is bit-identical under wine, and all six are under qemu (same glibc code).
 RTOL_UNDER_WINE = {"MultiferroicMotor": 1e-6}
 CROSS_STEPS = 200
