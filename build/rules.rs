@@ -3,6 +3,9 @@
 //! events, so they hold whatever shape the generator's own structs take. Each rule has a test in
 //! `tests/model_description.rs` that feeds it a bad description.
 
+// `!(x > y)` is deliberate: it also refuses NaN.
+#![allow(clippy::neg_cmp_op_on_partial_ord)]
+
 use quick_xml::events::{BytesStart, Event};
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -149,10 +152,8 @@ pub fn check(text: &str) -> Result<(), String> {
                 structured_names =
                     attrs.get("variableNamingConvention").map(String::as_str) == Some("structured")
             }
-            ("UnitDefinitions", "Unit") => {
-                if !units.insert(name.clone()) {
-                    return Err(format!("unit '{name}' is defined twice in UnitDefinitions"));
-                }
+            ("UnitDefinitions", "Unit") if !units.insert(name.clone()) => {
+                return Err(format!("unit '{name}' is defined twice in UnitDefinitions"));
             }
             ("Unit", "BaseUnit") => {
                 for (key, value) in &attrs {
@@ -167,15 +168,11 @@ pub fn check(text: &str) -> Result<(), String> {
                     }
                 }
             }
-            ("TypeDefinitions", "SimpleType") => {
-                if !types.insert(name.clone()) {
-                    return Err(format!("type '{name}' is defined twice in TypeDefinitions"));
-                }
+            ("TypeDefinitions", "SimpleType") if !types.insert(name.clone()) => {
+                return Err(format!("type '{name}' is defined twice in TypeDefinitions"));
             }
-            ("LogCategories", "Category") => {
-                if !categories.insert(name.clone()) {
-                    return Err(format!("log category '{name}' is declared twice"));
-                }
+            ("LogCategories", "Category") if !categories.insert(name.clone()) => {
+                return Err(format!("log category '{name}' is declared twice"));
             }
             (_, "DefaultExperiment") => {
                 let at = "DefaultExperiment";
