@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo motor-docs knitted-bag-docs
 
 all: fmus
 
@@ -86,6 +86,16 @@ report: deps fmus $(VENV)/.installed
 clean:
 	cargo clean
 	rm -rf out $(VENV)
+
+## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
+## densities, strain drive and onion reorientation of the MultiferroicMotor FMU (issue 16).
+motor-docs: fmus $(VENV)/.installed
+	$(PY) examples/motor_characteristics.py
+
+## docs/knitted-bag.md and docs/img/knitted_bag.png: the section 1.4 prototype's polyethylene bag
+## and its stroke against the measured 42% and 51% (issue 16).
+knitted-bag-docs: fmus $(VENV)/.installed
+	$(PY) examples/knitted_bag.py
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).

@@ -4,7 +4,7 @@
 //! wall, 2 thick wall of `bladder_layers` layers), friction hysteresis (`friction`) and a series
 //! connector (`connector_stiffness` > 0). With all of them off a step is eq. 2.3 alone.
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::calibration::MuscleParams;
 use crate::physics::festo::{DMSP_10, DMSP_40};
@@ -12,7 +12,7 @@ use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::inverse::pressure_for_force;
 use crate::physics::mckibben::{
-    BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
+    BladderModel, FrictionParams, McKibben, McKibbenOutput, McKibbenPartials, MuscleGeometry,
 };
 use crate::variables::mckibben_muscle::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
@@ -311,6 +311,75 @@ impl McKibbenMuscle {
     }
 }
 
+/// The partials as the FMU's rows, by variable name.
+fn partial_rows(d: &McKibbenPartials) -> Partials {
+    let mut p = Partials::default();
+    for (name, [dp, dl]) in [
+        ("force", d.force),
+        ("volume", d.volume),
+        ("effective_pressure", d.effective_pressure),
+        ("friction_force", d.friction_force),
+    ] {
+        p.row(name, &[("pressure", dp), ("length", dl)]);
+    }
+    p
+}
+
+impl McKibbenMuscle {
+    /// Partials on the branch [`Model::evaluate`] takes: out of range it evaluates at a clamped
+    /// length (and, under a vacuum it cannot hold, at zero pressure), which the input no longer
+    /// moves, so those columns are zero.
+    fn partials_at(&self, inputs: &Inputs) -> Result<McKibbenPartials, String> {
+        let (pressure, length) = (inputs.pressure, inputs.length);
+        match &self.pipeline {
+            Pipeline::Sleeve(s) => {
+                let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+                let inside = length <= s.max_length();
+                let l = length.min(s.max_length());
+                let per_pa = s.force(1.0, l);
+                let dl = if inside { 1.0 } else { 0.0 };
+                Ok(McKibbenPartials {
+                    force: [on * per_pa, dl * s.stiffness(pressure.max(0.0), l)],
+                    effective_pressure: [on, 0.0],
+                    friction_force: [0.0, 0.0],
+                    volume: [0.0, -dl * per_pa],
+                })
+            }
+            Pipeline::Full(m) => {
+                if let Ok((_, d)) = m.partials(pressure, length, &self.friction) {
+                    return Ok(d);
+                }
+                let (lo, hi) = (m.min_length(), m.max_length());
+                let margin = if m.bladder().is_some() {
+                    LIMIT_MARGIN * (hi - lo)
+                } else {
+                    0.0
+                };
+                let clamped = length.max(lo + margin).min(hi - margin);
+                let zero_l = |mut d: McKibbenPartials, zero_p: bool| {
+                    for y in [
+                        &mut d.force,
+                        &mut d.volume,
+                        &mut d.effective_pressure,
+                        &mut d.friction_force,
+                    ] {
+                        y[1] = 0.0;
+                        if zero_p {
+                            y[0] = 0.0;
+                        }
+                    }
+                    d
+                };
+                if let Ok((_, d)) = m.partials(pressure, clamped, &self.friction) {
+                    return Ok(zero_l(d, false));
+                }
+                m.partials(pressure.max(0.0), clamped, &self.friction)
+                    .map(|(_, d)| zero_l(d, true))
+            }
+        }
+    }
+}
+
 impl Model for McKibbenMuscle {
     type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
@@ -402,5 +471,9 @@ impl Model for McKibbenMuscle {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
         self.outputs(inputs, outputs, report, true)
+    }
+
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        self.partials_at(inputs).map(|d| partial_rows(&d))
     }
 }

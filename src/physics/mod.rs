@@ -9,6 +9,8 @@ pub mod friction;
 pub mod gaylord;
 pub mod inverse;
 pub mod knitted;
+pub mod knitted_bag;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
+pub mod root;
