@@ -402,7 +402,7 @@ impl Model for McKibbenMuscle {
                 overridden.join(", ")
             )
         });
-        let friction = p.friction.then(|| FrictionParams {
+        let friction = p.friction.then_some(FrictionParams {
             coefficient: p.friction_coefficient,
             presliding_length: p.presliding_length,
         });
