@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps motor-docs knitted-bag-docs
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo motor-docs knitted-bag-docs
 
 all: fmus
 
@@ -25,8 +25,8 @@ deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libclang-dev; \
 	fi
 
-$(LIB) target/release/package_fmus: $(SOURCES)
-	cargo build --release --lib --bin package_fmus
+$(LIB) target/release/package_fmus target/release/calibrate: $(SOURCES)
+	cargo build --release --lib --bin package_fmus --bin calibrate
 
 ## target/fmu/<Model>.fmu for every model in modelDescription/.
 fmus: $(LIB) target/release/package_fmus
@@ -45,6 +45,23 @@ scene: fmus $(VENV)/.installed
 ## Every scene at full length, and docs/figures.md with the plots beside the seed's statements.
 figures: fmus $(VENV)/.installed
 	$(PY) scenes/catalogue.py
+
+## Fits McKibbenMuscle to a datasheet (CSV pressure_kpa,contraction,force_n) with the FMU's own
+## physics, checks the result through the FMU: OUT/{params.json,params.ssv,report.md,fit.png}.
+## STARTS: starting points of the search (fewer is faster, e.g. 4 in the tests).
+DATA ?= data/festo/festo_dmsp40.csv
+LENGTH ?= 0.4
+DIAMETER ?= 0.04
+FIT ?= 0,600
+OUT ?= out/calibrate
+STARTS ?= 24
+calibrate: fmus target/release/calibrate $(VENV)/.installed
+	$(PY) calibration/calibrate.py $(DATA) $(LENGTH) $(DIAMETER) $(FIT) $(OUT) $(STARTS)
+
+## The Festo presets' fits (src/physics/festo.rs) and their reports: docs/calibration/dmsp{40,10}/.
+calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
+	$(PY) calibration/calibrate.py data/festo/festo_dmsp40.csv 0.4 0.04 0,600 docs/calibration/dmsp40
+	$(PY) calibration/calibrate.py data/festo/festo_dmsp10.csv 0.25 0.01 0,600 docs/calibration/dmsp10
 
 test-rust: deps fmus
 	cargo test --release

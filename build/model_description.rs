@@ -38,8 +38,12 @@ const CO_SIMULATION_CAPABILITIES: &str = r#"needsExecutionTool="false"
     canBeInstantiatedOnlyOncePerProcess="false"
     canNotUseMemoryManagementFunctions="true"
     canGetAndSetFMUstate="true"
-    canSerializeFMUstate="true"
-    providesDirectionalDerivative="false""#;
+    canSerializeFMUstate="true""#;
+
+/// The models whose `Model::partials` gives exact partial derivatives (`src/models`), so that
+/// the export layer serves `fmi2GetDirectionalDerivative` for them; a Rust test checks that the
+/// shipped flag and the models agree.
+const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &["McKibbenMuscle", "PassThrough"];
 
 #[derive(Deserialize)]
 struct ModelDescription {
@@ -580,7 +584,8 @@ fn shipped(
         s.after_root,
         s.after_root,
         format!(
-            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}/>"
+            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}\n    providesDirectionalDerivative=\"{}\"/>",
+            PROVIDE_DIRECTIONAL_DERIVATIVE.contains(&stem)
         ),
     ));
     let mut log = String::from("<LogCategories>\n");

@@ -1116,7 +1116,7 @@ fn null_pointers(fmu: &Fmu, t: &mut Tally, i: &Instance) {
         ),
         (
             "fmi2GetDirectionalDerivative: all NULL",
-            "fmi2GetDirectionalDerivative: not supported",
+            "fmi2GetDirectionalDerivative: vUnknown_ref, vKnown_ref, dvKnown or dvUnknown must not be NULL",
             Box::new(|| unsafe {
                 (api.fmi2GetDirectionalDerivative)(c, null(), 1, null(), 1, null(), null_mut())
             }),

@@ -544,18 +544,27 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
-    _unknown: *const fmi2ValueReference,
-    _n_unknown: usize,
-    _known: *const fmi2ValueReference,
-    _n_known: usize,
-    _dv_known: *const fmi2Real,
-    _dv_unknown: *mut fmi2Real,
+    unknown: *const fmi2ValueReference,
+    n_unknown: usize,
+    known: *const fmi2ValueReference,
+    n_known: usize,
+    dv_known: *const fmi2Real,
+    dv_unknown: *mut fmi2Real,
 ) -> fmi2Status {
-    guarded(c, "fmi2GetDirectionalDerivative", |inst| {
-        inst.unsupported(
-            "fmi2GetDirectionalDerivative",
-            "providesDirectionalDerivative is false",
-        )
+    const F: &str = "fmi2GetDirectionalDerivative";
+    guarded(c, F, |inst| {
+        // SAFETY: the importer passes arrays of the stated lengths (or NULL, refused here).
+        let (Some(unknown), Some(known), Some(dv_known), Some(dv_unknown)) = (unsafe {
+            (
+                slice(unknown, n_unknown),
+                slice(known, n_known),
+                slice(dv_known, n_known),
+                slice_mut(dv_unknown, n_unknown),
+            )
+        }) else {
+            return null_argument(inst, F, "vUnknown_ref, vKnown_ref, dvKnown or dvUnknown");
+        };
+        inst.get_directional_derivative(unknown, known, dv_known, dv_unknown)
     })
 }
 

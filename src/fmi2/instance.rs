@@ -111,7 +111,7 @@ pub struct Instance {
     time: f64,
     start_time: f64,
     stop_time: Option<f64>,
-    runtime: Box<dyn Runtime>,
+    pub(super) runtime: Box<dyn Runtime>,
     /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
@@ -360,7 +360,7 @@ impl Instance {
     }
 
     /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.
-    fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
+    pub(super) fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
         if !self.runtime.is_built() {
             if self.state != MachineState::InitializationMode {
                 return fmi2Status::OK;

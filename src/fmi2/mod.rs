@@ -7,6 +7,7 @@
 
 // #![deny(unsafe_op_in_unsafe_fn)] (step 5)
 
+mod derivatives;
 mod exports;
 mod instance;
 mod logger;

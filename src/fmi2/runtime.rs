@@ -89,6 +89,15 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
+    /// ([`super::derivatives`]).
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String>;
     /// Start values, no model.
     fn reset(&mut self);
     fn snapshot(&self) -> Box<dyn Runtime>;
@@ -152,6 +161,22 @@ where
             M::Variables::write_outputs(&outputs, &mut self.vars);
             self.outputs_stale = false;
         }
+    }
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        super::derivatives::directional_derivative(
+            self.model.as_mut(),
+            &self.vars,
+            unknown,
+            known,
+            dv_known,
+            dv_unknown,
+        )
     }
     fn reset(&mut self) {
         self.vars = Vars::from_start(M::Variables::INFO);

@@ -10,6 +10,9 @@ use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
 use crate::physics::root::{newton_bisection, RootOptions, Sample};
 
+mod partials;
+pub use partials::McKibbenPartials;
+
 /// Iteration caps of the connector solve (bracket search doubles its step; root is Newton-bisection).
 const BRACKET_STEPS: usize = 64;
 const ROOT_ITERATIONS: usize = 100;

@@ -20,6 +20,7 @@
 mod dual;
 mod geometry;
 mod knitted_cylinder;
+mod partials;
 #[cfg(test)]
 mod tests;
 
@@ -29,6 +30,7 @@ use crate::physics::root::{newton_bisection, RootOptions, Sample};
 use dual::Dual;
 pub use geometry::SleeveGeometry;
 pub use knitted_cylinder::KnittedCylinder;
+pub use partials::BladderPartials;
 use std::f64::consts::PI;
 
 /// Mooney-Rivlin `C1` of natural latex used throughout chapter 2 (Fig. 2.9), Pa.
@@ -360,6 +362,8 @@ impl<S: SleeveGeometry> Bladder<S> {
         let mut a = Dual::constant(1.0);
         let mut c = Dual::constant(0.0);
         let mut elastic = Dual::constant(0.0);
+        // d(elastic)/dP at fixed (L, x): elastic is affine in P through each layer's p_in.
+        let mut elastic_dp = 0.0;
         let mut inner: Option<InnerLayer> = None;
         for layer in &self.layers {
             // Eq. 2.20 in squared form: lambda_2i^2 = (x^2 - (D_RO^2 - D_0i^2)/lambda_1) / D_0i^2.
@@ -378,6 +382,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             let p_in = a * pressure - c;
             // sigma_33 = -p_in; sigma_11 = sigma_33 + axial (eq. 2.17 for the layer).
             elastic = elastic + (axial - p_in) * inv_l * layer.rubber_volume;
+            elastic_dp -= a.v * inv_l.v * layer.rubber_volume;
             if inner.is_none() {
                 inner = Some(InnerLayer {
                     l2_sq,
@@ -399,6 +404,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             p_eff,
             threshold,
             elastic,
+            elastic_dp,
             inner,
         })
     }
@@ -625,5 +631,6 @@ struct Kernel {
     p_eff: Dual,
     threshold: f64,
     elastic: Dual,
+    elastic_dp: f64,
     inner: InnerLayer,
 }
