@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo motor-docs knitted-bag-docs
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized
 
 all: fmus
 
@@ -76,12 +76,18 @@ test: test-rust test-fmpy
 bench: deps fmus
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
+	cargo bench --bench directional_derivative
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
 report: deps fmus $(VENV)/.installed
 	cargo bench --bench accuracy_cost
 	$(PY) benches/report.py
+
+## docs/linearized-muscle.md: stiffness dF/dL and pressure gain dF/dP over the stroke of Table 2.1's
+## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
+linearized: fmus $(VENV)/.installed
+	$(PY) docs/linearized/generate.py > /dev/null
 
 clean:
 	cargo clean

@@ -95,13 +95,14 @@ fn bad_instantiate_arguments_return_null() {
 }
 
 #[test]
-fn model_exchange_is_refused() {
+fn model_exchange_is_accepted_and_other_types_refused() {
+    assert!(api().instantiate_as("m", &guid_of(MODEL), 0).is_ok());
     let log = api()
-        .instantiate_as("m", &guid_of(MODEL), 0)
+        .instantiate_as("m", &guid_of(MODEL), 2)
         .err()
-        .expect("Co-Simulation only");
+        .expect("not an fmi2Type");
     assert!(
-        log.contains("fmuType 0 is not supported: this FMU is Co-Simulation only"),
+        log.contains("fmuType 2 is not supported: not an fmi2Type"),
         "{:?}",
         log.lines()
     );

@@ -101,7 +101,7 @@ mod tests {
     use super::super::REGISTRY;
 
     #[test]
-    fn the_shipped_flag_says_which_models_have_partials() {
+    fn the_shipped_capabilities_match_the_models() {
         for factory in REGISTRY {
             let info = factory.info();
             let mut runtime = factory.create();
@@ -111,6 +111,8 @@ mod tests {
                 .model_description_xml
                 .contains(r#"providesDirectionalDerivative="true""#);
             assert_eq!(provided.is_ok(), flag, "{}: {provided:?}", info.name);
+            let model_exchange = info.model_description_xml.contains("<ModelExchange");
+            assert_eq!(factory.model_exchange(), model_exchange, "{}", info.name);
         }
     }
 }

@@ -11,6 +11,7 @@ mod derivatives;
 mod exports;
 mod instance;
 mod logger;
+mod model_exchange;
 pub mod registry;
 pub mod runtime;
 pub mod types;

@@ -49,6 +49,8 @@ pub trait Factory: Sync {
     /// HTML fragment describing the model's equations.
     fn documentation(&self) -> &'static str;
     fn create(&self) -> Box<dyn Runtime>;
+    /// Whether the model serves Model Exchange ([`Model::ALGEBRAIC_MODEL_EXCHANGE`]).
+    fn model_exchange(&self) -> bool;
 }
 
 pub struct ModelFactory<M>(PhantomData<fn() -> M>);
@@ -66,6 +68,9 @@ where
     }
     fn documentation(&self) -> &'static str {
         M::DOCUMENTATION
+    }
+    fn model_exchange(&self) -> bool {
+        M::ALGEBRAIC_MODEL_EXCHANGE
     }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
@@ -89,6 +94,9 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// Model Exchange: commits the history at the current inputs (completed integrator step or
+    /// event) and writes the outputs.
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report);
     /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
     /// ([`super::derivatives`]).
     fn directional_derivative(
@@ -158,6 +166,15 @@ where
             let inputs = M::Variables::inputs(&self.vars);
             let mut outputs = M::Variables::outputs(&self.vars);
             model.step(&inputs, &mut outputs, time, step, report);
+            M::Variables::write_outputs(&outputs, &mut self.vars);
+            self.outputs_stale = false;
+        }
+    }
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report) {
+        if let Some(model) = self.model.as_mut() {
+            let inputs = M::Variables::inputs(&self.vars);
+            let mut outputs = M::Variables::outputs(&self.vars);
+            model.update_discrete_states(&inputs, &mut outputs, time, report);
             M::Variables::write_outputs(&outputs, &mut self.vars);
             self.outputs_stale = false;
         }

@@ -309,6 +309,7 @@ impl KnittedMuscle {
 
 impl Model for KnittedMuscle {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("knitted_muscle.html");
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {

@@ -248,6 +248,7 @@ impl McKibbenJoint {
 
 impl Model for McKibbenJoint {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("mckibben_joint.html");
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {

@@ -382,6 +382,7 @@ impl McKibbenMuscle {
 
 impl Model for McKibbenMuscle {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {

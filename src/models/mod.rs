@@ -143,6 +143,23 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
         report: &mut Report,
     );
 
+    /// Whether the model serves FMI Model Exchange without continuous states: its outputs are
+    /// algebraic in the inputs and its history (friction) is a discrete state, committed by
+    /// [`Model::update_discrete_states`] at each completed integrator step and event.
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = false;
+
+    /// Model Exchange: commits the history at `inputs` and time `time` and writes the outputs
+    /// there. For a quasi-static model that is a step of zero length.
+    fn update_discrete_states(
+        &mut self,
+        inputs: &Inputs<Self>,
+        outputs: &mut Outputs<Self>,
+        time: f64,
+        report: &mut Report,
+    ) {
+        self.step(inputs, outputs, time, 0.0, report)
+    }
+
     /// Exact partial derivatives of the outputs with respect to the inputs at `inputs` and the
     /// current history, on the branch [`Model::evaluate`] takes there (analytic or forward-mode,
     /// never finite differences). `Err` says why there are none: by default this model does not

@@ -10,6 +10,7 @@ pub struct PassThrough;
 
 impl Model for PassThrough {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = "<h2>Equations</h2><p><code>y</code> = <code>u</code>. \
         A baseline for timing importers: the cost of a step of this FMU is the importer's and the \
         FMI layer's own.</p>";
