@@ -59,7 +59,7 @@ struct Pair {
 
 fn muscle(p: &Parameters) -> Result<McKibben, String> {
     let model = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?;
-    let friction = p.friction.then(|| FrictionParams {
+    let friction = p.friction.then_some(FrictionParams {
         coefficient: p.friction_coefficient,
         presliding_length: p.presliding_length,
     });
@@ -139,15 +139,42 @@ impl McKibbenJoint {
         self.muscle.evaluate(pressure, inside, history).ok()
     }
 
-    /// Torque of the pair at the pressures from `difference`, at the given lengths and histories.
-    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<f64, String> {
-        let p = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
-        let mut ignored = None;
-        let flexor = self.evaluate_muscle(p[0], lengths[0], &self.flexor_friction, &mut ignored);
-        let extensor =
-            self.evaluate_muscle(p[1], lengths[1], &self.extensor_friction, &mut ignored);
+    /// Force and dF/dP of one muscle, at the nearest valid length as [`Self::evaluate_muscle`].
+    fn force_and_slope(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Option<(f64, f64)> {
+        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
+        let margin = if self.muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        [length, inside]
+            .into_iter()
+            .find_map(|l| self.muscle.partials(pressure, l, history).ok())
+            .map(|(out, d)| (out.force, d.force[0]))
+    }
+
+    /// Torque of the pair at the pressures from `difference`, and its slope in the difference,
+    /// at the given lengths and histories.
+    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<(f64, f64), String> {
+        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
+        let p = pair_pressures(pc, difference, pmax);
+        // dP/d(difference) is +-1/2 where a pressure is not clipped.
+        let unclipped = |x: f64| if x > 0.0 && x < pmax { 0.5 } else { 0.0 };
+        let flexor = self.force_and_slope(p[0], lengths[0], &self.flexor_friction);
+        let extensor = self.force_and_slope(p[1], lengths[1], &self.extensor_friction);
         match (flexor, extensor) {
-            (Some(f), Some(e)) => Ok(self.moment_arm * (f.force - e.force)),
+            (Some((f, df)), Some((e, de))) => Ok((
+                self.moment_arm * (f - e),
+                self.moment_arm
+                    * (df * unclipped(pc + 0.5 * difference)
+                        + de * unclipped(pc - 0.5 * difference)),
+            )),
             _ => Err("a muscle cannot be evaluated at this jointPosition".into()),
         }
     }
