@@ -191,6 +191,7 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
             );
         }
         let _ = writeln!(code, "    }}");
+        let _ = writeln!(code, "    #[allow(clippy::derivable_impls)]");
         let _ = writeln!(code, "    impl Default for {name} {{");
         let _ = writeln!(code, "        fn default() -> Self {{");
         let _ = writeln!(code, "            Self {{");

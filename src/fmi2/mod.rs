@@ -5,7 +5,7 @@
 //! models and the bindings between value references and each model's typed variables. A model
 //! needs no code here.
 
-// #![deny(unsafe_op_in_unsafe_fn)] (step 5)
+#![deny(unsafe_op_in_unsafe_fn)]
 
 mod exports;
 mod instance;

@@ -51,7 +51,7 @@ struct Pair {
 
 fn muscle(p: &Parameters) -> Result<McKibben, String> {
     let model = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?;
-    let friction = p.friction.then(|| FrictionParams {
+    let friction = p.friction.then_some(FrictionParams {
         coefficient: p.friction_coefficient,
         presliding_length: p.presliding_length,
     });

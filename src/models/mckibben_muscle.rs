@@ -218,7 +218,7 @@ impl Model for McKibbenMuscle {
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
         let (sleeve, tube) = geometry(p)?;
         let model = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?;
-        let friction = p.friction.then(|| FrictionParams {
+        let friction = p.friction.then_some(FrictionParams {
             coefficient: p.friction_coefficient,
             presliding_length: p.presliding_length,
         });
