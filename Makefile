@@ -4,7 +4,7 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
-SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
+SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs
 
 .PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps
 
@@ -26,7 +26,8 @@ deps:
 	fi
 
 $(LIB) target/release/package_fmus: $(SOURCES)
-	cargo build --release --lib --bin package_fmus
+	cargo build --release --lib -p actuator-fmus
+	cargo build --release -p actuator-fmus-tools --bin package_fmus
 
 ## target/fmu/<Model>.fmu for every model in modelDescription/.
 fmus: $(LIB) target/release/package_fmus
@@ -47,7 +48,7 @@ figures: fmus $(VENV)/.installed
 	$(PY) scenes/catalogue.py
 
 test-rust: deps fmus
-	cargo test --release
+	cargo test --release --workspace
 
 test-fmpy: fmus $(VENV)/.installed
 	$(PY) -m pytest tests/fmpy -q
