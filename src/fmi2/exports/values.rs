@@ -2,7 +2,7 @@
 
 use super::{guarded, null_argument, slice, slice_mut, text};
 use crate::fmi2::instance::{CBoolean, Value};
-use crate::fmi2::runtime::Vars;
+use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::*;
 use crate::variables::VarType;
 
@@ -86,7 +86,7 @@ unsafe fn get_values<C: Copy + Default>(
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut C,
-    pick: impl Fn(&Vars, usize) -> C,
+    pick: impl Fn(&dyn Runtime, usize) -> C,
 ) -> fmi2Status {
     unsafe {
         guarded(c, function, |inst| {
@@ -107,7 +107,7 @@ pub unsafe extern "C" fn fmi2GetReal(
 ) -> fmi2Status {
     unsafe {
         get_values(c, "fmi2GetReal", VarType::Real, vr, nvr, value, |v, i| {
-            v.real[i]
+            v.real(i)
         })
     }
 }
@@ -127,7 +127,7 @@ pub unsafe extern "C" fn fmi2GetInteger(
             vr,
             nvr,
             value,
-            |v, i| v.integer[i],
+            |v, i| v.integer(i),
         )
     }
 }
@@ -147,7 +147,7 @@ pub unsafe extern "C" fn fmi2GetBoolean(
             vr,
             nvr,
             value,
-            |v, i| v.boolean[i] as fmi2Boolean,
+            |v, i| v.boolean(i) as fmi2Boolean,
         )
     }
 }

@@ -1,7 +1,7 @@
 //! FMU states (`fmi2GetFMUstate` and friends) and their versioned, checksummed serialization.
 
 use super::{allowed, values::range_check, Instance, MachineState};
-use crate::fmi2::runtime::{Runtime, Vars};
+use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::fmi2Status;
 use crate::variables::{Causality, VarType};
 use serde::{Deserialize, Serialize};
@@ -16,8 +16,8 @@ pub struct FmuState {
 }
 
 /// Versioned byte format of a serialized FMU state: magic, format version, postcard, then a
-/// 64-bit FNV-1a checksum of everything before it (format 3: the models hold their typed ranges
-/// and, for PulleyJoint, its time; format 2 had the same envelope; format 1 had no checksum).
+/// 64-bit FNV-1a checksum of everything before it (format 3: the variables are the models' typed
+/// structs; format 2 held them as arrays by value reference; format 1 had no checksum).
 const STATE_MAGIC: &[u8; 8] = b"AFMUSTAT";
 const STATE_FORMAT: u16 = 3;
 
@@ -152,14 +152,14 @@ impl Instance {
         Ok(bytes)
     }
 
-    /// A value in `vars` that no legal call sequence produces: a non-finite Real (the FMU never
+    /// A value in `runtime` that no legal call sequence produces: a non-finite Real (the FMU never
     /// accepts or outputs one), or an input or parameter outside its declared range.
-    fn invalid_values(&self, vars: &Vars) -> Option<String> {
+    fn invalid_values(&self, runtime: &dyn Runtime) -> Option<String> {
         self.info.variables.iter().find_map(|var| {
             let i = var.vr as usize;
             let x = match var.kind {
-                VarType::Real => *vars.real.get(i)?,
-                VarType::Integer => f64::from(*vars.integer.get(i)?),
+                VarType::Real => runtime.real(i),
+                VarType::Integer => f64::from(runtime.integer(i)),
                 _ => return None,
             };
             if !x.is_finite() {
@@ -221,7 +221,7 @@ impl Instance {
             .runtime
             .snapshot_from_bytes(&body.runtime)
             .map_err(&refuse)?;
-        if let Some(why) = self.invalid_values(runtime.vars()) {
+        if let Some(why) = self.invalid_values(runtime.as_ref()) {
             return Err(refuse(format!("corrupt state: {why}")));
         }
         let state = FmuState {

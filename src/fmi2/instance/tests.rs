@@ -3,7 +3,7 @@
 use super::*;
 use crate::fmi2::logger::Logger;
 use crate::fmi2::registry::Bindings;
-use crate::fmi2::runtime::{ModelFactory, Vars};
+use crate::fmi2::runtime::{ModelFactory, Values};
 use crate::models::{Model, Refusal};
 use crate::variables::{Causality, Initial, Interface, Start, Variability};
 use serde::{Deserialize, Serialize};
@@ -76,41 +76,60 @@ static INFO: ModelInfo = ModelInfo {
 
 /// What build.rs would generate for the three variables above.
 struct GainVariables;
+
+/// The gain, starting at 1 as the description says.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+struct GainParameters {
+    gain: f64,
+}
+
+impl Default for GainParameters {
+    fn default() -> Self {
+        Self { gain: 1.0 }
+    }
+}
+
 impl Interface for GainVariables {
-    type Parameters = f64;
+    type Parameters = GainParameters;
     type Inputs = f64;
     type Outputs = f64;
     type CalculatedParameters = ();
     const INFO: &'static ModelInfo = &INFO;
 }
 impl Bindings for GainVariables {
-    fn parameters(vars: &Vars) -> f64 {
-        vars.real[0]
+    fn real(v: &Values<Self>, vr: usize) -> f64 {
+        [v.parameters.gain, v.inputs, v.outputs]
+            .get(vr)
+            .copied()
+            .unwrap_or_default()
     }
-    fn write_parameters(values: &f64, vars: &mut Vars) {
-        vars.real[0] = *values;
+    fn set_real(v: &mut Values<Self>, vr: usize, x: f64) {
+        match vr {
+            0 => v.parameters.gain = x,
+            1 => v.inputs = x,
+            2 => v.outputs = x,
+            _ => {}
+        }
     }
-    fn inputs(vars: &Vars) -> f64 {
-        vars.real[1]
+    fn integer(_: &Values<Self>, _: usize) -> i32 {
+        0
     }
-    fn write_inputs(values: &f64, vars: &mut Vars) {
-        vars.real[1] = *values;
+    fn set_integer(_: &mut Values<Self>, _: usize, _: i32) {}
+    fn boolean(_: &Values<Self>, _: usize) -> bool {
+        false
     }
-    fn outputs(vars: &Vars) -> f64 {
-        vars.real[2]
+    fn set_boolean(_: &mut Values<Self>, _: usize, _: bool) {}
+    fn string(_: &Values<Self>, _: usize) -> &str {
+        ""
     }
-    fn write_outputs(values: &f64, vars: &mut Vars) {
-        vars.real[2] = *values;
-    }
-    fn calculated_parameters(_: &Vars) {}
-    fn write_calculated_parameters(_: &(), _: &mut Vars) {}
+    fn set_string(_: &mut Values<Self>, _: usize, _: &str) {}
 }
 
 impl Model for Gain {
     type Variables = GainVariables;
     const DOCUMENTATION: &'static str = "";
-    fn new(gain: &f64, _: &f64) -> Result<Self, Refusal> {
-        match *gain {
+    fn new(p: &GainParameters, _: &f64) -> Result<Self, Refusal> {
+        match p.gain {
             0.0 => Err("gain must not be zero".into()),
             gain => Ok(Self { gain }),
         }
@@ -128,7 +147,7 @@ static FACTORY: ModelFactory<Gain> = ModelFactory::NEW;
 fn y(inst: &mut Instance) -> (fmi2Status, f64) {
     let mut out = [f64::NAN];
     let s = inst.get("fmi2GetReal", VarType::Real, &[2], &mut out, |v, i| {
-        v.real[i]
+        v.real(i)
     });
     (s, out[0])
 }
@@ -158,7 +177,7 @@ fn a_tunable_parameter_set_between_steps_takes_effect() {
         fmi2Status::Error
     );
     assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
-    assert_eq!(inst.runtime.vars().real[..2], [-1.0, 2.0]);
+    assert_eq!([inst.runtime.real(0), inst.runtime.real(1)], [-1.0, 2.0]);
     assert_eq!(inst.do_step(0.2, 0.1), fmi2Status::OK);
     assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
 }

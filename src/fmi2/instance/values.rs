@@ -3,16 +3,16 @@
 
 use super::{allowed, type_index, Instance, MachineState};
 use crate::fmi2::logger::c_string;
-use crate::fmi2::runtime::{Runtime, Vars};
+use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::fmi2Status;
 use crate::variables::{Causality, Initial, VarType, Variability, Variable};
 
-/// A value that fmi2SetXXX can write into [`Vars`].
+/// A value that fmi2SetXXX can write into a [`Runtime`].
 pub trait Value {
     const KIND: VarType;
     /// A reason to refuse the value for this variable, if any.
     fn invalid_for(&self, var: &Variable) -> Option<String>;
-    fn store(&self, vars: &mut Vars, index: usize);
+    fn store(&self, runtime: &mut dyn Runtime, vr: usize);
 }
 
 impl Value for f64 {
@@ -23,8 +23,8 @@ impl Value for f64 {
         }
         range_check(*self, var)
     }
-    fn store(&self, vars: &mut Vars, index: usize) {
-        vars.real[index] = *self;
+    fn store(&self, runtime: &mut dyn Runtime, vr: usize) {
+        runtime.set_real(vr, *self);
     }
 }
 
@@ -33,8 +33,8 @@ impl Value for i32 {
     fn invalid_for(&self, var: &Variable) -> Option<String> {
         range_check(*self as f64, var)
     }
-    fn store(&self, vars: &mut Vars, index: usize) {
-        vars.integer[index] = *self;
+    fn store(&self, runtime: &mut dyn Runtime, vr: usize) {
+        runtime.set_integer(vr, *self);
     }
 }
 
@@ -48,8 +48,8 @@ impl Value for CBoolean {
     fn invalid_for(&self, _: &Variable) -> Option<String> {
         None
     }
-    fn store(&self, vars: &mut Vars, index: usize) {
-        vars.boolean[index] = self.0 != 0;
+    fn store(&self, runtime: &mut dyn Runtime, vr: usize) {
+        runtime.set_boolean(vr, self.0 != 0);
     }
 }
 
@@ -58,8 +58,8 @@ impl Value for String {
     fn invalid_for(&self, _: &Variable) -> Option<String> {
         None
     }
-    fn store(&self, vars: &mut Vars, index: usize) {
-        vars.string[index].clone_from(self);
+    fn store(&self, runtime: &mut dyn Runtime, vr: usize) {
+        runtime.set_string(vr, self);
     }
 }
 
@@ -143,9 +143,8 @@ impl Instance {
             parameters_changed |= var.causality == Causality::Parameter;
         }
         let before = self.before_retune(parameters_changed);
-        let vars = self.runtime.vars_mut();
         for (&vr, value) in vrs.iter().zip(values) {
-            value.store(vars, vr as usize);
+            value.store(self.runtime.as_mut(), vr as usize);
         }
         self.runtime.changed(parameters_changed);
         self.rebuild_or_undo(function, before)
@@ -186,7 +185,7 @@ impl Instance {
         kind: VarType,
         vrs: &[u32],
         out: &mut [T],
-        pick: impl Fn(&Vars, usize) -> T,
+        pick: impl Fn(&dyn Runtime, usize) -> T,
     ) -> fmi2Status {
         if !self.allowed(function, allowed::GET) {
             return fmi2Status::Error;
@@ -205,7 +204,7 @@ impl Instance {
             if let Err(s) = self.lookup(function, kind, vr) {
                 return s;
             }
-            *slot = pick(self.runtime.vars(), vr as usize);
+            *slot = pick(self.runtime.as_ref(), vr as usize);
         }
         status
     }
@@ -219,10 +218,10 @@ impl Instance {
         if status >= fmi2Status::Error {
             return Err(status);
         }
-        let vars = self.runtime.vars();
+        let runtime = self.runtime.as_ref();
         self.string_values = refs
             .iter()
-            .map(|&vr| c_string(&vars.string[vr as usize]))
+            .map(|&vr| c_string(runtime.string(vr as usize)))
             .collect();
         Ok(self.string_values.iter().map(|s| s.as_ptr()).collect())
     }
