@@ -50,6 +50,8 @@ pub trait Factory: Sync {
     /// HTML fragment describing the model's equations.
     fn documentation(&self) -> &'static str;
     fn create(&self) -> Box<dyn Runtime>;
+    /// Whether the model serves Model Exchange ([`Model::ALGEBRAIC_MODEL_EXCHANGE`]).
+    fn model_exchange(&self) -> bool;
 }
 
 pub struct ModelFactory<M>(PhantomData<fn() -> M>);
@@ -67,6 +69,9 @@ where
     }
     fn documentation(&self) -> &'static str {
         M::DOCUMENTATION
+    }
+    fn model_exchange(&self) -> bool {
+        M::ALGEBRAIC_MODEL_EXCHANGE
     }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
@@ -97,6 +102,18 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// Model Exchange: commits the history at the current inputs (completed integrator step or
+    /// event) and writes the outputs.
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report);
+    /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
+    /// ([`super::derivatives`]).
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String>;
     /// Start values, no model.
     fn reset(&mut self);
     fn snapshot(&self) -> Box<dyn Runtime>;
@@ -183,6 +200,29 @@ where
             model.step(&v.inputs, &mut v.outputs, time, step, report);
             self.outputs_stale = false;
         }
+    }
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report) {
+        if let Some(model) = self.model.as_mut() {
+            let v = &mut self.values;
+            model.update_discrete_states(&v.inputs, &mut v.outputs, time, report);
+            self.outputs_stale = false;
+        }
+    }
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        super::derivatives::directional_derivative(
+            self.model.as_mut(),
+            &self.values.inputs,
+            unknown,
+            known,
+            dv_known,
+            dv_unknown,
+        )
     }
     fn reset(&mut self) {
         self.values = Values::default();

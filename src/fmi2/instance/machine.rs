@@ -15,6 +15,10 @@ pub enum MachineState {
     Terminated,
     Error,
     Fatal,
+    /// Model Exchange (`src/fmi2/model_exchange.rs`); after the others so that saved states keep
+    /// their encoding.
+    EventMode,
+    ContinuousTimeMode,
 }
 
 impl MachineState {
@@ -43,19 +47,40 @@ pub mod allowed {
         StepFailed,
         Terminated,
         Error,
+        EventMode,
+        ContinuousTimeMode,
     ]);
     pub const SETUP_EXPERIMENT: u32 = mask(&[Instantiated]);
     pub const ENTER_INITIALIZATION: u32 = mask(&[Instantiated]);
     pub const EXIT_INITIALIZATION: u32 = mask(&[InitializationMode]);
-    pub const TERMINATE: u32 = mask(&[StepComplete, StepFailed]);
+    pub const TERMINATE: u32 = mask(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
     pub const GET: u32 = mask(&[
         InitializationMode,
         StepComplete,
         StepFailed,
         Terminated,
         Error,
+        EventMode,
+        ContinuousTimeMode,
     ]);
-    pub const SET: u32 = mask(&[Instantiated, InitializationMode, StepComplete]);
+    pub const SET: u32 = mask(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const EVENT_MODE: u32 = mask(&[EventMode]);
+    pub const CONTINUOUS_TIME_MODE: u32 = mask(&[ContinuousTimeMode]);
+    pub const EVENT_OR_CONTINUOUS_TIME_MODE: u32 = mask(&[EventMode, ContinuousTimeMode]);
+    /// The continuous-state getters (FMI 2.0.4 section 3.2.3).
+    pub const GET_STATES: u32 = mask(&[
+        InitializationMode,
+        EventMode,
+        ContinuousTimeMode,
+        Terminated,
+        Error,
+    ]);
     pub const DO_STEP: u32 = mask(&[StepComplete]);
     pub const STATUS: u32 = mask(&[StepComplete, StepFailed, Terminated]);
 }
@@ -125,7 +150,11 @@ impl Instance {
             self.state = MachineState::Error;
             return status;
         }
-        self.state = MachineState::StepComplete;
+        self.state = if self.model_exchange {
+            MachineState::EventMode
+        } else {
+            MachineState::StepComplete
+        };
         status
     }
 

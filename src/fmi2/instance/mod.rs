@@ -32,10 +32,12 @@ pub struct Instance {
     /// Variables by type and value reference (value references are dense per type).
     by_type: [Vec<&'static Variable>; 4],
     pub state: MachineState,
-    time: f64,
+    /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
+    pub(super) model_exchange: bool,
+    pub(super) time: f64,
     start_time: f64,
     stop_time: Option<f64>,
-    runtime: Box<dyn Runtime>,
+    pub(super) runtime: Box<dyn Runtime>,
     /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
@@ -78,6 +80,7 @@ impl Instance {
             info,
             by_type,
             state: MachineState::Instantiated,
+            model_exchange: false,
             time: 0.0,
             start_time: 0.0,
             stop_time: None,
@@ -111,7 +114,7 @@ impl Instance {
     }
 
     /// Passes a model's messages to the logger and turns its status into an FMI status.
-    fn forward(&self, function: &str, report: Report) -> fmi2Status {
+    pub(super) fn forward(&self, function: &str, report: Report) -> fmi2Status {
         for (status, message) in &report.messages {
             self.logger
                 .log(to_fmi(*status), &format!("{function}: {message}"));
@@ -120,7 +123,7 @@ impl Instance {
     }
 
     /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.
-    fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
+    pub(super) fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
         if !self.runtime.is_built() {
             if self.state != MachineState::InitializationMode {
                 return fmi2Status::OK;

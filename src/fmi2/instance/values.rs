@@ -111,11 +111,12 @@ impl Instance {
                 input || matches!(var.initial, Initial::Exact | Initial::Approx)
             }
             MachineState::InitializationMode => input || var.initial == Initial::Exact,
-            MachineState::StepComplete => {
+            MachineState::StepComplete | MachineState::EventMode => {
                 input
                     || (var.causality == Causality::Parameter
                         && var.variability == Variability::Tunable)
             }
+            MachineState::ContinuousTimeMode => input,
             _ => false,
         }
     }
@@ -152,8 +153,12 @@ impl Instance {
 
     /// A snapshot to undo a tunable parameter change with, if this set changes one between steps.
     fn before_retune(&self, parameters_changed: bool) -> Option<Box<dyn Runtime>> {
-        (parameters_changed && self.state == MachineState::StepComplete)
-            .then(|| self.runtime.snapshot())
+        (parameters_changed
+            && matches!(
+                self.state,
+                MachineState::StepComplete | MachineState::EventMode
+            ))
+        .then(|| self.runtime.snapshot())
     }
 
     /// After a tunable parameter changed between steps: [`Model`](crate::models::Model) has no
@@ -193,7 +198,10 @@ impl Instance {
         let mut status = fmi2Status::OK;
         if matches!(
             self.state,
-            MachineState::InitializationMode | MachineState::StepComplete
+            MachineState::InitializationMode
+                | MachineState::StepComplete
+                | MachineState::EventMode
+                | MachineState::ContinuousTimeMode
         ) {
             status = self.refresh_outputs(function);
             if status >= fmi2Status::Error {
