@@ -4,15 +4,14 @@
 
 use super::instance::{allowed, Instance};
 use super::registry::Bindings;
-use super::runtime::Vars;
 use super::types::fmi2Status;
-use crate::models::Model;
+use crate::models::{Inputs, Model};
 use crate::variables::{Causality, Interface, VarType};
 
 /// `dv_unknown[i] = sum_j d(unknown_i)/d(known_j) dv_known[j]` for model `M` at the current inputs.
 pub(super) fn directional_derivative<M: Model>(
     model: Option<&mut M>,
-    vars: &Vars,
+    inputs: &Inputs<M>,
     unknown: &[u32],
     known: &[u32],
     dv_known: &[f64],
@@ -47,7 +46,7 @@ where
         return Err(format!("dvKnown must be finite, got {bad}"));
     }
     let model = model.ok_or("no model yet: call it in initialization mode or later")?;
-    let partials = model.partials(&M::Variables::inputs(vars))?;
+    let partials = model.partials(inputs)?;
     for (slot, output) in dv_unknown.iter_mut().zip(&unknowns) {
         let row = partials
             .get(output)
