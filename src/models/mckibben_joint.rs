@@ -7,7 +7,7 @@
 //! torque `r (F_flexor - F_extensor)` turns the joint towards the flexor. `actuatorInput` is the
 //! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`.
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
@@ -157,6 +157,24 @@ impl McKibbenJoint {
         })
     }
 
+    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: at a clamped length
+    /// the length no longer moves the force.
+    fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
+        if let Ok((_, d)) = self.muscle.partials(pressure, length, history) {
+            return d.force;
+        }
+        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
+        let margin = if self.muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        self.muscle
+            .partials(pressure, inside, history)
+            .map_or([0.0, 0.0], |(_, d)| [d.force[0], 0.0])
+    }
+
     fn write(&self, out: &mut Outputs, pair: &Pair) {
         out.joint_torque = self.moment_arm * (pair.flexor.force - pair.extensor.force);
         out.flexor_pressure = pair.pressures[0];
@@ -220,6 +238,43 @@ impl Model for McKibbenJoint {
             min_position: self.position_range.0,
             max_position: self.position_range.1,
         }
+    }
+
+    /// The chain rule through the pressure split `P = pc +- u/2` (saturated: slope 0 at and past
+    /// the bounds 0 and max_pressure) and the lengths `L0 -+ r q`; jointVelocity moves nothing.
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let (u, q) = (inputs.actuator_input, inputs.joint_position);
+        let (pc, pmax, r) = (
+            self.common_mode_pressure,
+            self.max_pressure,
+            self.moment_arm,
+        );
+        let split = |sign: f64| {
+            let p = pc + sign * 0.5 * u;
+            let slope = if p > 0.0 && p < pmax { sign * 0.5 } else { 0.0 };
+            (p.max(0.0).min(pmax), slope)
+        };
+        let (pf, dpf) = split(1.0);
+        let (pe, dpe) = split(-1.0);
+        let lf = self.flexor_rest_length - r * q;
+        let le = self.extensor_rest_length + r * q;
+        let ff = self.muscle_partials(pf, lf, &self.flexor_friction);
+        let fe = self.muscle_partials(pe, le, &self.extensor_friction);
+        let flexor = [ff[0] * dpf, -r * ff[1]];
+        let extensor = [fe[0] * dpe, r * fe[1]];
+        let mut p = Partials::default();
+        let row = |d: [f64; 2]| [("actuatorInput", d[0]), ("jointPosition", d[1])];
+        p.row(
+            "jointTorque",
+            &row([r * (flexor[0] - extensor[0]), r * (flexor[1] - extensor[1])]),
+        )
+        .row("flexor_force", &row(flexor))
+        .row("extensor_force", &row(extensor))
+        .row("flexor_pressure", &row([dpf, 0.0]))
+        .row("extensor_pressure", &row([dpe, 0.0]))
+        .row("flexor_length", &row([0.0, -r]))
+        .row("extensor_length", &row([0.0, r]));
+        Ok(p)
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
