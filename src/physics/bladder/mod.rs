@@ -26,6 +26,7 @@ mod tests;
 
 use crate::physics::gaylord::Sleeve;
 use crate::physics::knitted::KnittedSleeve;
+use crate::physics::root::{newton_bisection, RootOptions, Sample};
 use dual::Dual;
 pub use geometry::SleeveGeometry;
 pub use knitted_cylinder::KnittedCylinder;
@@ -547,37 +548,21 @@ impl<S: SleeveGeometry> Bladder<S> {
         if r_lo == 0.0 {
             return Ok(lo);
         }
-        let mut hi = hi;
-        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); any step
-        // leaving the bracket is replaced by bisection.
-        let mut x = lo;
-        for _ in 0..ROOT_ITERATIONS {
-            let Some((r, dr)) = residual(x) else {
-                // Cannot happen inside (x_min, x_contact]; bisect to stay safe.
-                x = 0.5 * (lo + hi);
-                continue;
-            };
-            if r == 0.0 {
-                return Ok(x);
-            }
-            if r > 0.0 {
-                lo = x;
-            } else {
-                hi = x;
-            }
-            let newton = x - r / dr;
-            let newton_ok = newton.is_finite() && newton >= lo && newton <= hi;
-            // Converged when the Newton correction is at rounding level (or the bracket is).
-            if (newton_ok && (newton - x).abs() <= 1e-14 * x) || hi - lo <= 1e-15 * hi {
-                return Ok(if newton_ok { newton } else { x });
-            }
-            x = if newton_ok && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-        }
-        Ok(0.5 * (lo + hi))
+        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); P_eff falls
+        // from positive at `lo` to negative at `hi`.
+        let options = RootOptions {
+            absolute: 0.0,
+            relative: 1e-14,
+            max_iterations: ROOT_ITERATIONS,
+        };
+        let root = newton_bisection(lo, hi, lo, false, options, |x| {
+            Ok::<_, ()>(residual(x).map(|(value, slope)| Sample {
+                value,
+                slope,
+                payload: (),
+            }))
+        });
+        Ok(root.map_or(0.5 * (lo + hi), |r| r.x))
     }
 }
 
