@@ -302,28 +302,42 @@ impl Model for McKibbenJoint {
         }
     }
 
-    /// The chain rule through the pressure split `P = pc +- u/2` (saturated: slope 0 at and past
-    /// the bounds 0 and max_pressure) and the lengths `L0 -+ r q`; jointVelocity moves nothing.
+    /// The chain rule through the pressure difference `d`, the split `P = pc +- d/2` (slope 0
+    /// where a pressure is clipped to 0 or max_pressure) and the lengths `L0 -+ r q`. With
+    /// `command_mode` 1, `d` solves `torque(d, q) = u`: `dd/du = 1/torque_d` and
+    /// `dd/dq = -torque_q/torque_d` (implicit function theorem), both 0 when saturated.
+    /// jointVelocity moves nothing.
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
-        let (u, q) = (inputs.actuator_input, inputs.joint_position);
-        let (pc, pmax, r) = (
-            self.common_mode_pressure,
-            self.max_pressure,
-            self.moment_arm,
-        );
-        let split = |sign: f64| {
-            let p = pc + sign * 0.5 * u;
-            let slope = if p > 0.0 && p < pmax { sign * 0.5 } else { 0.0 };
-            (p.max(0.0).min(pmax), slope)
-        };
-        let (pf, dpf) = split(1.0);
-        let (pe, dpe) = split(-1.0);
+        let q = inputs.joint_position;
+        let (pmax, r) = (self.max_pressure, self.moment_arm);
+        // The operating point as `evaluate` finds it (a copy: the warning state stays put).
+        let pair = self
+            .clone()
+            .compute(inputs, &mut Report::default())
+            .ok_or("a muscle cannot be evaluated at this jointPosition")?;
+        let [pf, pe] = pair.pressures;
+        let interior = |p: f64| p > 0.0 && p < pmax;
+        let dpf = if interior(pf) { 0.5 } else { 0.0 };
+        let dpe = if interior(pe) { -0.5 } else { 0.0 };
         let lf = self.flexor_rest_length - r * q;
         let le = self.extensor_rest_length + r * q;
         let ff = self.muscle_partials(pf, lf, &self.flexor_friction);
         let fe = self.muscle_partials(pe, le, &self.extensor_friction);
-        let flexor = [ff[0] * dpf, -r * ff[1]];
-        let extensor = [fe[0] * dpe, r * fe[1]];
+        // Forces per unit d and per unit q at fixed d.
+        let (ff_d, fe_d) = (ff[0] * dpf, fe[0] * dpe);
+        let (ff_q, fe_q) = (-r * ff[1], r * fe[1]);
+        let (dd_du, dd_dq) = if !self.torque_command {
+            (1.0, 0.0)
+        } else {
+            let torque_d = r * (ff_d - fe_d);
+            if pair.saturated || torque_d == 0.0 {
+                (0.0, 0.0)
+            } else {
+                (1.0 / torque_d, -r * (ff_q - fe_q) / torque_d)
+            }
+        };
+        let flexor = [ff_d * dd_du, ff_d * dd_dq + ff_q];
+        let extensor = [fe_d * dd_du, fe_d * dd_dq + fe_q];
         let mut p = Partials::default();
         let row = |d: [f64; 2]| [("actuatorInput", d[0]), ("jointPosition", d[1])];
         p.row(
@@ -332,8 +346,8 @@ impl Model for McKibbenJoint {
         )
         .row("flexor_force", &row(flexor))
         .row("extensor_force", &row(extensor))
-        .row("flexor_pressure", &row([dpf, 0.0]))
-        .row("extensor_pressure", &row([dpe, 0.0]))
+        .row("flexor_pressure", &row([dpf * dd_du, dpf * dd_dq]))
+        .row("extensor_pressure", &row([dpe * dd_du, dpe * dd_dq]))
         .row("flexor_length", &row([0.0, -r]))
         .row("extensor_length", &row([0.0, r]));
         Ok(p)
