@@ -6,7 +6,7 @@
 //! Integer parameter `out_of_range_policy` asks for fmi2Warning (1) or, from fmi2DoStep,
 //! fmi2Discard (2) instead.
 
-use super::runtime::Vars;
+use super::runtime::Runtime;
 use crate::models::{Report, Status};
 use crate::variables::{ModelInfo, VarType};
 
@@ -38,8 +38,8 @@ impl OutOfRange {
 
     /// The status a clamped input earns under the policy; `in_step` is true for fmi2DoStep,
     /// the only call for which fmi2Discard means something (elsewhere it is a warning).
-    pub fn status(&self, vars: &Vars, in_step: bool) -> Status {
-        match self.policy.map_or(0, |i| vars.integer[i]) {
+    pub fn status(&self, runtime: &dyn Runtime, in_step: bool) -> Status {
+        match self.policy.map_or(0, |i| runtime.integer(i)) {
             0 => Status::Ok,
             2 if in_step => Status::Discard,
             _ => Status::Warning,
@@ -48,14 +48,19 @@ impl OutOfRange {
 
     /// Writes the flag, turns the clamp into the policy's status and its explanations into
     /// messages of that status (logged even at fmi2OK: one line per excursion).
-    pub fn apply(&self, vars: &mut Vars, report: &mut Report, in_step: bool) -> Vec<String> {
+    pub fn apply(
+        &self,
+        runtime: &mut dyn Runtime,
+        report: &mut Report,
+        in_step: bool,
+    ) -> Vec<String> {
         if let (true, Some(i)) = (report.evaluated, self.flag) {
-            vars.boolean[i] = report.clamped;
+            runtime.set_boolean(i, report.clamped);
         }
         if !report.clamped {
             return Vec::new();
         }
-        let status = self.status(vars, in_step);
+        let status = self.status(runtime, in_step);
         report.status = report.status.max(status);
         let messages = std::mem::take(&mut report.clamp_messages);
         if status > Status::Ok {

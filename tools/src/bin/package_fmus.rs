@@ -18,7 +18,7 @@ fn main() {
         };
         binaries.push((platform.to_string(), path.into()));
     }
-    match actuator_fmus::package::package_all_platforms(&binaries, out_dir.as_ref()) {
+    match actuator_fmus_tools::package::package_all_platforms(&binaries, out_dir.as_ref()) {
         Ok(paths) => paths.iter().for_each(|p| println!("wrote {}", p.display())),
         Err(e) => {
             eprintln!("package_fmus: {e}");
