@@ -35,6 +35,7 @@ mod long_steps;
 pub mod magnetics;
 pub mod onion;
 mod params;
+pub mod phi;
 pub mod schedule;
 #[cfg(test)]
 mod tests;
