@@ -1,4 +1,5 @@
-//! Exponential Rosenbrock-Euler substeps with step doubling (see [`Motor::step`]).
+//! Exponential Rosenbrock substeps with an embedded error estimate (quasi-static onion) or step
+//! doubling (Gilbert onion); see [`Motor::step`].
 
 use super::{expm, phi, Drive, Motor, StepRun, Vector, MAX_ANGLE};
 
