@@ -202,6 +202,14 @@ KNOB_LABELS = {
 }
 
 
+def is_number(text):
+    try:
+        float(text)
+        return True
+    except ValueError:
+        return False
+
+
 def plot_work_precision(fmu, scenario, points, rows, times):
     """Log-log error against native time, one labelled series per knob, values beside points."""
     import textwrap
@@ -211,17 +219,21 @@ def plot_work_precision(fmu, scenario, points, rows, times):
     for _, _, knob, _ in points:
         if knob not in knobs:
             knobs.append(knob)
-    for knob in knobs:
-        series = sorted((t, e, v) for t, e, k, v in points if k == knob)
+    offsets = [(-14, 7), (5, -11), (6, 4), (6, 6), (-14, -12)]
+    for n, knob in enumerate(knobs):
+        series = [(t, e, v) for t, e, k, v in points if k == knob]
+        numeric = all(is_number(v) for _, _, v in series)
+        if numeric:
+            series.sort(key=lambda p: float(p[2]))
         ts = [t * 1e9 for t, _, _ in series]
         es = [e for _, e, _ in series]
-        style = ":" if knob == "friction" else "-"
-        ax.loglog(ts, es, style, marker=next(markers), label=KNOB_LABELS.get(knob, knob))
-        for i, (t, e, v) in enumerate(series):
-            # Alternate above/below so that neighbouring values do not overlap.
-            ax.annotate(v, (t * 1e9, e), fontsize=7, xytext=(5, 5 if i % 2 == 0 else -10),
-                        textcoords="offset points")
-    unit = "rad" if fmu == "MultiferroicMotor" else "share of the reference's peak force (1)"
+        # A line joins the values of one numeric knob; categorical ones are points alone.
+        ax.loglog(ts, es, linestyle="-" if numeric and len(series) > 1 else "none",
+                  marker=next(markers), label=KNOB_LABELS.get(knob, knob))
+        dx, dy = offsets[n % len(offsets)]
+        for t, e, v in series:
+            ax.annotate(v, (t * 1e9, e), fontsize=7, xytext=(dx, dy), textcoords="offset points")
+    unit = "rad" if fmu == "MultiferroicMotor" else "share of peak force, 1"
     ax.set_xlabel("native time per step (ns)")
     ax.set_ylabel(f"largest error against the reference ({unit})")
     title = f"{fmu}: error against native cost per step. Scenario: {scenario}."
@@ -369,8 +381,10 @@ def continuum_wall_table():
 
 
 def cost_per_step_table(times):
-    rows = ["| FMU and effects | time per step |", "|---|---|"]
-    rows += [f"| {label} | {fmt_time(times[key])} |" for key, label in README_ROWS if key in times]
+    base = times.get("PassThrough/baseline/y = u")
+    rows = ["| FMU and effects | time per step | against PassThrough in the same run |", "|---|---|---|"]
+    rows += [f"| {label} | {fmt_time(times[key])} | {times[key] / base:.2f}x |" if base else
+             f"| {label} | {fmt_time(times[key])} | |" for key, label in README_ROWS if key in times]
     return rows
 
 
