@@ -38,8 +38,31 @@ const CO_SIMULATION_CAPABILITIES: &str = r#"needsExecutionTool="false"
     canBeInstantiatedOnlyOncePerProcess="false"
     canNotUseMemoryManagementFunctions="true"
     canGetAndSetFMUstate="true"
-    canSerializeFMUstate="true"
-    providesDirectionalDerivative="false""#;
+    canSerializeFMUstate="true""#;
+
+/// The Model Exchange capabilities of the export layer (`src/fmi2/model_exchange.rs`): the friction
+/// history is committed at completed integrator steps, so the importer must call them.
+const MODEL_EXCHANGE_CAPABILITIES: &str = r#"needsExecutionTool="false"
+    completedIntegratorStepNotNeeded="false"
+    canBeInstantiatedOnlyOncePerProcess="false"
+    canNotUseMemoryManagementFunctions="true"
+    canGetAndSetFMUstate="true"
+    canSerializeFMUstate="true""#;
+
+/// The models whose `Model::partials` gives exact partial derivatives (`src/models`), so that
+/// the export layer serves `fmi2GetDirectionalDerivative` for them; a Rust test checks that the
+/// shipped flag and the models agree.
+const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &["McKibbenMuscle", "PassThrough"];
+
+/// The models that also serve Model Exchange, without continuous states
+/// (`Model::ALGEBRAIC_MODEL_EXCHANGE`, `src/fmi2/model_exchange.rs`); a Rust test checks that the
+/// shipped block and the models agree.
+const MODEL_EXCHANGE: &[&str] = &[
+    "KnittedMuscle",
+    "McKibbenJoint",
+    "McKibbenMuscle",
+    "PassThrough",
+];
 
 #[derive(Deserialize)]
 struct ModelDescription {
@@ -575,12 +598,20 @@ fn shipped(
     initial_unknowns: &[ResolvedUnknown],
 ) -> Result<String, String> {
     let s = find_splices(text)?;
+    let derivatives = PROVIDE_DIRECTIONAL_DERIVATIVE.contains(&stem);
     let mut inserts: Vec<(usize, usize, String)> = Vec::new();
     inserts.push((
         s.after_root,
         s.after_root,
         format!(
-            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}/>"
+            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->{}\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}\n    providesDirectionalDerivative=\"{derivatives}\"/>",
+            if MODEL_EXCHANGE.contains(&stem) {
+                format!(
+                    "\n  <ModelExchange\n    modelIdentifier=\"{stem}\"\n    {MODEL_EXCHANGE_CAPABILITIES}\n    providesDirectionalDerivative=\"{derivatives}\"/>"
+                )
+            } else {
+                String::new()
+            }
         ),
     ));
     let mut log = String::from("<LogCategories>\n");

@@ -23,6 +23,10 @@ pub enum MachineState {
     Terminated,
     Error,
     Fatal,
+    /// Model Exchange (`src/fmi2/model_exchange.rs`); after the others so that saved states keep
+    /// their encoding.
+    EventMode,
+    ContinuousTimeMode,
 }
 
 impl MachineState {
@@ -51,19 +55,40 @@ pub mod allowed {
         StepFailed,
         Terminated,
         Error,
+        EventMode,
+        ContinuousTimeMode,
     ]);
     pub const SETUP_EXPERIMENT: u32 = mask(&[Instantiated]);
     pub const ENTER_INITIALIZATION: u32 = mask(&[Instantiated]);
     pub const EXIT_INITIALIZATION: u32 = mask(&[InitializationMode]);
-    pub const TERMINATE: u32 = mask(&[StepComplete, StepFailed]);
+    pub const TERMINATE: u32 = mask(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
     pub const GET: u32 = mask(&[
         InitializationMode,
         StepComplete,
         StepFailed,
         Terminated,
         Error,
+        EventMode,
+        ContinuousTimeMode,
     ]);
-    pub const SET: u32 = mask(&[Instantiated, InitializationMode, StepComplete]);
+    pub const SET: u32 = mask(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const EVENT_MODE: u32 = mask(&[EventMode]);
+    pub const CONTINUOUS_TIME_MODE: u32 = mask(&[ContinuousTimeMode]);
+    pub const EVENT_OR_CONTINUOUS_TIME_MODE: u32 = mask(&[EventMode, ContinuousTimeMode]);
+    /// The continuous-state getters (FMI 2.0.4 section 3.2.3).
+    pub const GET_STATES: u32 = mask(&[
+        InitializationMode,
+        EventMode,
+        ContinuousTimeMode,
+        Terminated,
+        Error,
+    ]);
     pub const DO_STEP: u32 = mask(&[StepComplete]);
     pub const STATUS: u32 = mask(&[StepComplete, StepFailed, Terminated]);
 }
@@ -108,10 +133,12 @@ pub struct Instance {
     /// Variables by type and value reference (value references are dense per type).
     by_type: [Vec<&'static Variable>; 4],
     pub state: MachineState,
-    time: f64,
+    /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
+    pub(super) model_exchange: bool,
+    pub(super) time: f64,
     start_time: f64,
     stop_time: Option<f64>,
-    runtime: Box<dyn Runtime>,
+    pub(super) runtime: Box<dyn Runtime>,
     /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
@@ -229,6 +256,7 @@ impl Instance {
             info,
             by_type,
             state: MachineState::Instantiated,
+            model_exchange: false,
             time: 0.0,
             start_time: 0.0,
             stop_time: None,
@@ -262,7 +290,7 @@ impl Instance {
     }
 
     /// Passes a model's messages to the logger and turns its status into an FMI status.
-    fn forward(&self, function: &str, report: Report) -> fmi2Status {
+    pub(super) fn forward(&self, function: &str, report: Report) -> fmi2Status {
         for (status, message) in &report.messages {
             self.logger
                 .log(to_fmi(*status), &format!("{function}: {message}"));
@@ -334,7 +362,11 @@ impl Instance {
             self.state = MachineState::Error;
             return status;
         }
-        self.state = MachineState::StepComplete;
+        self.state = if self.model_exchange {
+            MachineState::EventMode
+        } else {
+            MachineState::StepComplete
+        };
         status
     }
 
@@ -360,7 +392,7 @@ impl Instance {
     }
 
     /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.
-    fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
+    pub(super) fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
         if !self.runtime.is_built() {
             if self.state != MachineState::InitializationMode {
                 return fmi2Status::OK;
@@ -402,11 +434,12 @@ impl Instance {
                 input || matches!(var.initial, Initial::Exact | Initial::Approx)
             }
             MachineState::InitializationMode => input || var.initial == Initial::Exact,
-            MachineState::StepComplete => {
+            MachineState::StepComplete | MachineState::EventMode => {
                 input
                     || (var.causality == Causality::Parameter
                         && var.variability == Variability::Tunable)
             }
+            MachineState::ContinuousTimeMode => input,
             _ => false,
         }
     }
@@ -444,8 +477,12 @@ impl Instance {
 
     /// A snapshot to undo a tunable parameter change with, if this set changes one between steps.
     fn before_retune(&self, parameters_changed: bool) -> Option<Box<dyn Runtime>> {
-        (parameters_changed && self.state == MachineState::StepComplete)
-            .then(|| self.runtime.snapshot())
+        (parameters_changed
+            && matches!(
+                self.state,
+                MachineState::StepComplete | MachineState::EventMode
+            ))
+        .then(|| self.runtime.snapshot())
     }
 
     /// After a tunable parameter changed between steps: [`Model`](crate::models::Model) has no
@@ -485,7 +522,10 @@ impl Instance {
         let mut status = fmi2Status::OK;
         if matches!(
             self.state,
-            MachineState::InitializationMode | MachineState::StepComplete
+            MachineState::InitializationMode
+                | MachineState::StepComplete
+                | MachineState::EventMode
+                | MachineState::ContinuousTimeMode
         ) {
             status = self.refresh_outputs(function);
             if status >= fmi2Status::Error {

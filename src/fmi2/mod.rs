@@ -7,9 +7,11 @@
 
 // #![deny(unsafe_op_in_unsafe_fn)] (step 5)
 
+mod derivatives;
 mod exports;
 mod instance;
 mod logger;
+mod model_exchange;
 pub mod registry;
 pub mod runtime;
 pub mod types;

@@ -49,6 +49,8 @@ pub trait Factory: Sync {
     /// HTML fragment describing the model's equations.
     fn documentation(&self) -> &'static str;
     fn create(&self) -> Box<dyn Runtime>;
+    /// Whether the model serves Model Exchange ([`Model::ALGEBRAIC_MODEL_EXCHANGE`]).
+    fn model_exchange(&self) -> bool;
 }
 
 pub struct ModelFactory<M>(PhantomData<fn() -> M>);
@@ -66,6 +68,9 @@ where
     }
     fn documentation(&self) -> &'static str {
         M::DOCUMENTATION
+    }
+    fn model_exchange(&self) -> bool {
+        M::ALGEBRAIC_MODEL_EXCHANGE
     }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
@@ -89,6 +94,18 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// Model Exchange: commits the history at the current inputs (completed integrator step or
+    /// event) and writes the outputs.
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report);
+    /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
+    /// ([`super::derivatives`]).
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String>;
     /// Start values, no model.
     fn reset(&mut self);
     fn snapshot(&self) -> Box<dyn Runtime>;
@@ -152,6 +169,31 @@ where
             M::Variables::write_outputs(&outputs, &mut self.vars);
             self.outputs_stale = false;
         }
+    }
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report) {
+        if let Some(model) = self.model.as_mut() {
+            let inputs = M::Variables::inputs(&self.vars);
+            let mut outputs = M::Variables::outputs(&self.vars);
+            model.update_discrete_states(&inputs, &mut outputs, time, report);
+            M::Variables::write_outputs(&outputs, &mut self.vars);
+            self.outputs_stale = false;
+        }
+    }
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        super::derivatives::directional_derivative(
+            self.model.as_mut(),
+            &self.vars,
+            unknown,
+            known,
+            dv_known,
+            dv_unknown,
+        )
     }
     fn reset(&mut self) {
         self.vars = Vars::from_start(M::Variables::INFO);

@@ -5,12 +5,16 @@
 //! Both muscles are [`McKibben`] physics instances built from the same parameters as the
 //! McKibbenMuscle FMU; the flexor's length is `L0f - r q`, the extensor's `L0e + r q`, so the
 //! torque `r (F_flexor - F_extensor)` turns the joint towards the flexor. `actuatorInput` is the
-//! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`.
+//! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`;
+//! with `command_mode` 1 it is a joint torque, met by solving for that difference through the same
+//! muscle physics ([`crate::physics::inverse::difference_for_torque`]).
 
 use super::{Model, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
+use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
+use crate::physics::inverse::{difference_for_torque, pair_pressures};
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
 };
@@ -39,6 +43,8 @@ pub struct McKibbenJoint {
     out_of_range: bool,
     /// Joint angles that keep both muscles inside their length range (rad).
     position_range: (f64, f64),
+    /// `actuatorInput` is a joint torque (N m) to meet, not a pressure difference (Pa).
+    torque_command: bool,
 }
 
 /// Both muscles' operating point at the current inputs.
@@ -47,6 +53,8 @@ struct Pair {
     extensor: McKibbenOutput,
     pressures: [f64; 2],
     lengths: [f64; 2],
+    /// Command mode 1: the commanded torque was out of reach.
+    saturated: bool,
 }
 
 fn muscle(p: &Parameters) -> Result<McKibben, String> {
@@ -74,8 +82,25 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
                 .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
             McKibben::from_geometry(&geometry, model, friction, 0.0)
         }
+        // The Festo muscles fitted to their datasheets carry their own rubber and thin wall.
+        k @ 5..=6 => {
+            let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
+            McKibben::new(
+                Sleeve::new(festo.strand_length, festo.turns)?,
+                BladderTube {
+                    inner_diameter: festo.bladder_inner_diameter,
+                    thickness: festo.bladder_thickness,
+                    unstretched_length: festo.bladder_length,
+                    mooney_c1: festo.mooney_c1,
+                    mooney_c2: festo.mooney_c2,
+                },
+                BladderModel::from_switch(festo.bladder_model, festo.bladder_layers)?,
+                friction,
+                0.0,
+            )
+        }
         k => Err(format!(
-            "preset must be 0 (none) or 1-4 (Table 2.1 A-D), got {k}"
+            "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10) or 6 (Festo DMSP-40), got {k}"
         )),
     }
 }
@@ -114,18 +139,42 @@ impl McKibbenJoint {
         self.muscle.evaluate(pressure, inside, history).ok()
     }
 
+    /// Torque of the pair at the pressures from `difference`, at the given lengths and histories.
+    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<f64, String> {
+        let p = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
+        let mut ignored = None;
+        let flexor = self.evaluate_muscle(p[0], lengths[0], &self.flexor_friction, &mut ignored);
+        let extensor =
+            self.evaluate_muscle(p[1], lengths[1], &self.extensor_friction, &mut ignored);
+        match (flexor, extensor) {
+            (Some(f), Some(e)) => Ok(self.moment_arm * (f.force - e.force)),
+            _ => Err("a muscle cannot be evaluated at this jointPosition".into()),
+        }
+    }
+
     fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Option<Pair> {
         let (u, q) = (inputs.actuator_input, inputs.joint_position);
-        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
-        // f64::clamp would pass a NaN through; max/min map it to a bound (inputs are finite anyway).
-        let pressures = [
-            (pc + 0.5 * u).max(0.0).min(pmax),
-            (pc - 0.5 * u).max(0.0).min(pmax),
-        ];
         let lengths = [
             self.flexor_rest_length - self.moment_arm * q,
             self.extensor_rest_length + self.moment_arm * q,
         ];
+        let (difference, saturated) = if self.torque_command {
+            // The pressure difference that meets the torque, through the same muscle physics.
+            match difference_for_torque(|d| self.torque_at(d, lengths), u, self.max_pressure) {
+                Ok(solved) => (solved.argument, solved.saturated),
+                Err(reason) => {
+                    report.add(
+                        Status::Discard,
+                        format!("jointPosition {q} rad, torque command {u} N m: {reason}"),
+                    );
+                    return None;
+                }
+            }
+        } else {
+            (u, false)
+        };
+        // Each pressure clipped to 0 .. max_pressure (a NaN maps to a bound).
+        let pressures = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
         let mut clamped = None;
         let flexor = self.evaluate_muscle(
             pressures[0],
@@ -154,6 +203,7 @@ impl McKibbenJoint {
             extensor: extensor?,
             pressures,
             lengths,
+            saturated,
         })
     }
 
@@ -165,11 +215,13 @@ impl McKibbenJoint {
         out.extensor_force = pair.extensor.force;
         out.flexor_length = pair.lengths[0];
         out.extensor_length = pair.lengths[1];
+        out.torque_saturated = pair.saturated;
     }
 }
 
 impl Model for McKibbenJoint {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("mckibben_joint.html");
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
@@ -199,6 +251,16 @@ impl Model for McKibbenJoint {
             ).into());
         }
         let q = start.joint_position;
+        let torque_command = match p.command_mode {
+            0 => false,
+            1 => true,
+            k => {
+                return Err(format!(
+                    "command_mode must be 0 (pressure difference, Pa) or 1 (joint torque, N m), got {k}"
+                )
+                .into())
+            }
+        };
         Ok(Self {
             muscle,
             moment_arm,
@@ -211,6 +273,7 @@ impl Model for McKibbenJoint {
             extensor_friction: HysteresisState::at_rest(extensor_rest_length + moment_arm * q),
             out_of_range: false,
             position_range: (min_position, max_position),
+            torque_command,
         })
     }
 

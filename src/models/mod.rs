@@ -69,6 +69,35 @@ impl From<&str> for Refusal {
     }
 }
 
+/// Exact partial derivatives of some outputs with respect to the inputs, by variable name, at one
+/// point: what `fmi2GetDirectionalDerivative` combines with the importer's seed. An output without
+/// a row is not provided; an input missing from a row does not affect that output.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Partials {
+    rows: Vec<(&'static str, Vec<(&'static str, f64)>)>,
+}
+
+impl Partials {
+    /// Adds the row of `output`: its partial with respect to each listed input.
+    pub fn row(&mut self, output: &'static str, by_input: &[(&'static str, f64)]) -> &mut Self {
+        self.rows.push((output, by_input.to_vec()));
+        self
+    }
+
+    /// The row of `output`, if provided.
+    pub fn get(&self, output: &str) -> Option<&[(&'static str, f64)]> {
+        self.rows
+            .iter()
+            .find(|(name, _)| *name == output)
+            .map(|(_, row)| row.as_slice())
+    }
+
+    /// The outputs that have a row.
+    pub fn outputs(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.rows.iter().map(|(name, _)| *name)
+    }
+}
+
 /// The typed variable groups of model `M`, generated from its model description.
 pub type Parameters<M> = <<M as Model>::Variables as Interface>::Parameters;
 pub type Inputs<M> = <<M as Model>::Variables as Interface>::Inputs;
@@ -113,4 +142,29 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
         step: f64,
         report: &mut Report,
     );
+
+    /// Whether the model serves FMI Model Exchange without continuous states: its outputs are
+    /// algebraic in the inputs and its history (friction) is a discrete state, committed by
+    /// [`Model::update_discrete_states`] at each completed integrator step and event.
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = false;
+
+    /// Model Exchange: commits the history at `inputs` and time `time` and writes the outputs
+    /// there. For a quasi-static model that is a step of zero length.
+    fn update_discrete_states(
+        &mut self,
+        inputs: &Inputs<Self>,
+        outputs: &mut Outputs<Self>,
+        time: f64,
+        report: &mut Report,
+    ) {
+        self.step(inputs, outputs, time, 0.0, report)
+    }
+
+    /// Exact partial derivatives of the outputs with respect to the inputs at `inputs` and the
+    /// current history, on the branch [`Model::evaluate`] takes there (analytic or forward-mode,
+    /// never finite differences). `Err` says why there are none: by default this model does not
+    /// provide them, and its model description says `providesDirectionalDerivative="false"`.
+    fn partials(&mut self, _inputs: &Inputs<Self>) -> Result<Partials, String> {
+        Err("this model does not provide partial derivatives".into())
+    }
 }

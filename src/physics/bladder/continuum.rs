@@ -148,6 +148,8 @@ impl<S: SleeveGeometry> Bladder<S> {
             p_eff,
             threshold: c.v / a.v,
             elastic,
+            // Only the last term of `elastic` depends on P (at fixed L and x).
+            elastic_dp: -phi_in.v * inv_d_in.v,
             inner: InnerLayer {
                 l2_sq: l2_in,
                 stress_axial: axial_in.v - pressure,

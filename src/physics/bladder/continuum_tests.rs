@@ -176,3 +176,27 @@ proptest! {
         }
     }
 }
+
+#[test]
+fn continuum_pressure_partial_is_the_slope_in_pressure() {
+    // The directional derivatives (Model Exchange) use d(elastic)/dP of the wall: check the
+    // continuum's against central differences in pressure, in contact and free.
+    let bl = bladder(MUSCLE_C, Wall::Continuum(8));
+    for &p in &[20e3, 100e3, 450e3] {
+        for &l in &stroke(&bl, 9)[1..8] {
+            let dp = 1.0;
+            let (Ok(hi), Ok(lo)) = (bl.evaluate(p + dp, l), bl.evaluate(p - dp, l)) else {
+                continue;
+            };
+            if hi.contact != lo.contact {
+                continue;
+            }
+            let fd = (hi.force - lo.force) / (2.0 * dp);
+            let partial = bl.partials(p, l).unwrap().force[0];
+            assert!(
+                (partial - fd).abs() <= 1e-5 * fd.abs().max(1e-6),
+                "p {p} l {l}: {partial} vs {fd}"
+            );
+        }
+    }
+}

@@ -23,15 +23,18 @@ mod continuum_tests;
 mod dual;
 mod geometry;
 mod knitted_cylinder;
+mod partials;
 #[cfg(test)]
 mod tests;
 
 use crate::physics::gaylord::Sleeve;
 use crate::physics::knitted::KnittedSleeve;
+use crate::physics::root::{newton_bisection, RootOptions, Sample};
 use continuum::WallNode;
 use dual::Dual;
 pub use geometry::SleeveGeometry;
 pub use knitted_cylinder::KnittedCylinder;
+pub use partials::BladderPartials;
 use std::f64::consts::PI;
 
 /// Mooney-Rivlin `C1` of natural latex used throughout chapter 2 (Fig. 2.9), Pa.
@@ -413,6 +416,8 @@ impl<S: SleeveGeometry> Bladder<S> {
         let mut a = Dual::constant(1.0);
         let mut c = Dual::constant(0.0);
         let mut elastic = Dual::constant(0.0);
+        // d(elastic)/dP at fixed (L, x): elastic is affine in P through each layer's p_in.
+        let mut elastic_dp = 0.0;
         let mut inner: Option<InnerLayer> = None;
         for layer in &self.layers {
             // Eq. 2.20 in squared form: lambda_2i^2 = (x^2 - (D_RO^2 - D_0i^2)/lambda_1) / D_0i^2.
@@ -431,6 +436,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             let p_in = a * pressure - c;
             // sigma_33 = -p_in; sigma_11 = sigma_33 + axial (eq. 2.17 for the layer).
             elastic = elastic + (axial - p_in) * inv_l * layer.rubber_volume;
+            elastic_dp -= a.v * inv_l.v * layer.rubber_volume;
             if inner.is_none() {
                 inner = Some(InnerLayer {
                     l2_sq,
@@ -452,6 +458,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             p_eff,
             threshold,
             elastic,
+            elastic_dp,
             inner,
         })
     }
@@ -595,37 +602,21 @@ impl<S: SleeveGeometry> Bladder<S> {
         if r_lo == 0.0 {
             return Ok(lo);
         }
-        let mut hi = hi;
-        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); any step
-        // leaving the bracket is replaced by bisection.
-        let mut x = lo;
-        for _ in 0..ROOT_ITERATIONS {
-            let Some((r, dr)) = residual(x) else {
-                // Cannot happen inside (x_min, x_contact]; bisect to stay safe.
-                x = 0.5 * (lo + hi);
-                continue;
-            };
-            if r == 0.0 {
-                return Ok(x);
-            }
-            if r > 0.0 {
-                lo = x;
-            } else {
-                hi = x;
-            }
-            let newton = x - r / dr;
-            let newton_ok = newton.is_finite() && newton >= lo && newton <= hi;
-            // Converged when the Newton correction is at rounding level (or the bracket is).
-            if (newton_ok && (newton - x).abs() <= 1e-14 * x) || hi - lo <= 1e-15 * hi {
-                return Ok(if newton_ok { newton } else { x });
-            }
-            x = if newton_ok && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-        }
-        Ok(0.5 * (lo + hi))
+        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); P_eff falls
+        // from positive at `lo` to negative at `hi`.
+        let options = RootOptions {
+            absolute: 0.0,
+            relative: 1e-14,
+            max_iterations: ROOT_ITERATIONS,
+        };
+        let root = newton_bisection(lo, hi, lo, false, options, |x| {
+            Ok::<_, ()>(residual(x).map(|(value, slope)| Sample {
+                value,
+                slope,
+                payload: (),
+            }))
+        });
+        Ok(root.map_or(0.5 * (lo + hi), |r| r.x))
     }
 }
 
@@ -694,5 +685,6 @@ struct Kernel {
     p_eff: Dual,
     threshold: f64,
     elastic: Dual,
+    elastic_dp: f64,
     inner: InnerLayer,
 }

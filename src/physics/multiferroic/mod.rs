@@ -32,11 +32,14 @@
 //! turns; what is left is integrated, and a forced substep drops the negative stiffness so it
 //! cannot amplify. See [`Motor::step`].
 
+pub mod drive;
 pub mod expm;
 mod integrator;
 mod long_steps;
 pub mod magnetics;
 pub mod onion;
+#[cfg(test)]
+mod onion_tests;
 mod params;
 pub mod phi;
 pub mod schedule;
@@ -70,6 +73,8 @@ pub struct Motor {
     llg_rate: f64,
     /// `mu0 Ms^2 V_wall` (J): out-of-plane shape-anisotropy stiffness of the macrospin.
     tilt_stiffness: f64,
+    /// Bound on the third derivative of eq. 3.3 (J/rad^3), for the onion's safe march.
+    ring_bar_slope_bound: f64,
 }
 
 /// Inputs held over a communication step.
@@ -336,6 +341,7 @@ impl Motor {
             speed_scale: (alignment_stiffness / inertia).sqrt(),
             llg_rate,
             tilt_stiffness,
+            ring_bar_slope_bound: onion::curvature_slope_bound(&ring_bar),
             ring_bar,
             params,
         })
@@ -395,6 +401,7 @@ impl Motor {
             bar_angle,
             strain_direction,
             magnetoelastic: self.magnetoelastic_per_stress * stress,
+            ring_bar_slope_bound: self.ring_bar_slope_bound,
         }
     }
 
