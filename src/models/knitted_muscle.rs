@@ -4,7 +4,7 @@
 //! is built once from the parameters; the non-cylindrical volume-length table exists only when
 //! that shape is selected. Strand friction (eq. 1.21, `friction`) is the shared stop-operator
 //! hysteresis; its state is part of the FMU state and advances only in `step`. The Mooney-Rivlin
-//! bladder of the McKibben muscle (`bladder_model` 1 thin wall, 2 thick wall; section 1.3.6) is the
+//! bladder of the McKibben muscle (`bladder_model` 1 thin, 2 thick, 3 continuum wall; section 1.3.6) is the
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
@@ -93,10 +93,8 @@ fn bladder(
     r: &Parameters,
     sleeve: &KnittedSleeve,
 ) -> Result<Option<Bladder<KnittedCylinder>>, String> {
-    let layers = match BladderModel::from_switch(r.bladder_model, r.bladder_layers)? {
-        BladderModel::None => return Ok(None),
-        BladderModel::ThinWall => 1,
-        BladderModel::ThickWall { layers } => layers,
+    let Some(wall) = BladderModel::from_switch(r.bladder_model, r.bladder_layers)?.wall() else {
+        return Ok(None);
     };
     let tube = BladderTube {
         inner_diameter: r.bladder_inner_diameter,
@@ -105,7 +103,7 @@ fn bladder(
         mooney_c1: r.mooney_c1,
         mooney_c2: r.mooney_c2,
     };
-    Bladder::knitted(sleeve, tube, layers).map(Some)
+    Bladder::knitted_wall(sleeve, tube, wall).map(Some)
 }
 
 /// The lengths evaluated: the sleeve's closed range, or the bladder's open range pulled in by a

@@ -1,8 +1,9 @@
 //! McKibbenMuscle FMU: gauge pressure and length in, tension force out.
 //!
 //! Effects, each built only when switched on: the Mooney-Rivlin bladder (`bladder_model` 1 thin
-//! wall, 2 thick wall of `bladder_layers` layers), friction hysteresis (`friction`) and a series
-//! connector (`connector_stiffness` > 0). With all of them off a step is eq. 2.3 alone.
+//! wall, 2 thick wall of `bladder_layers` layers, 3 continuum wall of `bladder_layers` quadrature
+//! nodes), friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
+//! With all of them off a step is eq. 2.3 alone.
 
 use super::{Model, Partials, Refusal, Report};
 use crate::physics::bladder::BladderTube;

@@ -160,3 +160,34 @@ def test_model_exchange_calls_are_checked(recording_log):
     assert recording_log.contains("instantiated for Co-Simulation")
     cs.terminate()
     cs.freeInstance()
+
+
+def test_a_co_simulation_state_is_not_restored_into_model_exchange(recording_log):
+    from fmpy import extract
+    from fmpy.fmi2 import FMU2Model, FMU2Slave
+
+    path = fmu_path("McKibbenMuscle")
+    md = read_model_description(path)
+    where = extract(path)
+
+    def ready(cls, name):
+        fmu = cls(guid=md.guid, unzipDirectory=where, modelIdentifier="McKibbenMuscle", instanceName=name)
+        fmu.instantiate(callbacks=recording_log.callbacks)
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        return fmu
+
+    cs, me = ready(FMU2Slave, "cs"), ready(FMU2Model, "me")
+    cs.doStep(0.0, 1e-3)
+    serialized = cs.serializeFMUstate(cs.getFMUstate())
+    state = me.deSerializeFMUstate(serialized)
+    with pytest.raises(Exception):
+        me.setFMUstate(state)
+    assert recording_log.contains("saved in state StepComplete, which this Model Exchange instance has not")
+    # Its own state round-trips.
+    own = me.getFMUstate()
+    me.setFMUstate(own)
+    for fmu in (cs, me):
+        fmu.terminate()
+        fmu.freeInstance()

@@ -93,6 +93,24 @@ impl Instance {
     }
 
     fn restore(&mut self, function: &str, saved: &FmuState) -> fmi2Status {
+        use MachineState::*;
+        // A state saved mid-run by one interface cannot continue in the other's state machine.
+        let interface_of = |m| match m {
+            StepComplete | StepFailed => Some(false),
+            EventMode | ContinuousTimeMode => Some(true),
+            _ => None,
+        };
+        if interface_of(saved.machine).is_some_and(|me| me != self.model_exchange) {
+            return self.error(&format!(
+                "{function}: the FMU state was saved in state {:?}, which this {} instance has not",
+                saved.machine,
+                if self.model_exchange {
+                    "Model Exchange"
+                } else {
+                    "Co-Simulation"
+                }
+            ));
+        }
         if let Err(reason) = self.runtime.restore(saved.runtime.as_ref()) {
             return self.error(&format!("{function}: {reason}"));
         }

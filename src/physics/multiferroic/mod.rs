@@ -18,7 +18,10 @@
 //! linear system exactly with a matrix exponential, so the 2 ns inertial mode and the GHz onion
 //! precession never limit the substep (no stiffness instability; the overdamped first-order limit
 //! comes out by itself), while the quasi-static onion is re-solved at the end of every substep.
-//! The method is second order; step doubling estimates the local error and sizes the next substep.
+//! The method is second order. With the quasi-static onion the rotor block is 2x2, its `phi`
+//! functions come in closed form and the third-order member of an embedded exponential Rosenbrock
+//! pair (exprb32) estimates the local error; the Gilbert onion keeps step doubling. The estimate
+//! sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see [`MotorParams::max_substeps`]).
 //!
 //! Long steps (issue 5): a substep far longer than the relaxation time is never integrated
@@ -38,6 +41,7 @@ pub mod onion;
 #[cfg(test)]
 mod onion_tests;
 mod params;
+pub mod phi;
 pub mod schedule;
 #[cfg(test)]
 mod tests;
@@ -498,8 +502,8 @@ impl Motor {
     ///   relaxation times and the rotor ends it within [`MAX_SETTLE_RESIDUAL`] of its
     ///   equilibrium, on the exponential tail (agrees with resolved integration within 3e-7 rad
     ///   for the default schedule), at the cost of one substep;
-    /// - otherwise exponential substeps sized by the step-doubling error estimate (growth and
-    ///   shrink at most 5x per substep). The minimum substep is `remaining time / remaining
+    /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
+    ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
     ///   budget`; a substep at that minimum is accepted even if its error exceeds the tolerance
     ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]);
     /// - a slipping rotor (no equilibrium ahead) advances by whole overdamped turns
