@@ -4,7 +4,7 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
-SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
+SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs
 
 .PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized
 
@@ -26,7 +26,8 @@ deps:
 	fi
 
 $(LIB) target/release/package_fmus target/release/calibrate: $(SOURCES)
-	cargo build --release --lib --bin package_fmus --bin calibrate
+	cargo build --release --lib -p actuator-fmus
+	cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
 
 ## target/fmu/<Model>.fmu for every model in modelDescription/.
 fmus: $(LIB) target/release/package_fmus
@@ -64,7 +65,7 @@ calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
 	$(PY) calibration/calibrate.py data/festo/festo_dmsp10.csv 0.25 0.01 0,600 docs/calibration/dmsp10
 
 test-rust: deps fmus
-	cargo test --release
+	cargo test --release --workspace
 
 test-fmpy: fmus $(VENV)/.installed
 	$(PY) -m pytest tests/fmpy -q

@@ -4,7 +4,7 @@
 //!   `<LogCategories>`, ModelStructure indices and GUID added (`build/model_description.rs`);
 //! - `model_tables.rs`: value references, metadata and the typed `Parameters`, `Inputs`,
 //!   `Outputs` and `CalculatedParameters` of each model (included by `src/variables.rs`);
-//! - `model_bindings.rs`: the export layer's copies between its value arrays and those structs,
+//! - `model_bindings.rs`: the export layer's access to those structs' fields by value reference,
 //!   and the registry of models (included by `src/fmi2/registry.rs`).
 //!
 //! The XML is the single source of truth: a renamed or removed variable breaks the model code at
@@ -55,7 +55,7 @@ fn main() {
             .unwrap_or_else(|e| fail(path, &e.to_string()));
         codegen::tables(&model, &xml_path.display().to_string(), &mut tables)
             .unwrap_or_else(|e| fail(path, &e));
-        codegen::bindings(&model, &mut bindings);
+        codegen::bindings(&model, &mut bindings).unwrap_or_else(|e| fail(path, &e));
         models.push(model);
     }
     codegen::registry(&models, &mut bindings);

@@ -1,5 +1,5 @@
 """Calibrate McKibbenMuscle to a Festo DMSP-40 datasheet and use the result.  Run after `make fmus`
-(and `cargo build --release --bin calibrate`, which `make fmus` also builds):
+(and `cargo build --release -p actuator-fmus-tools --bin calibrate`, which `make fmus` also builds):
     .venv/bin/python recipes/calibrate_datasheet.py
 
 Fits at 0 and 600 kPa only, predicts the other pressures, checks the fitted parameters through the

@@ -4,15 +4,14 @@
 
 use super::instance::{allowed, Instance};
 use super::registry::Bindings;
-use super::runtime::Vars;
 use super::types::fmi2Status;
-use crate::models::Model;
+use crate::models::{Inputs, Model};
 use crate::variables::{Causality, Interface, VarType};
 
 /// `dv_unknown[i] = sum_j d(unknown_i)/d(known_j) dv_known[j]` for model `M` at the current inputs.
 pub(super) fn directional_derivative<M: Model>(
     model: Option<&mut M>,
-    vars: &Vars,
+    inputs: &Inputs<M>,
     unknown: &[u32],
     known: &[u32],
     dv_known: &[f64],
@@ -47,7 +46,7 @@ where
         return Err(format!("dvKnown must be finite, got {bad}"));
     }
     let model = model.ok_or("no model yet: call it in initialization mode or later")?;
-    let partials = model.partials(&M::Variables::inputs(vars))?;
+    let partials = model.partials(inputs)?;
     for (slot, output) in dv_unknown.iter_mut().zip(&unknowns) {
         let row = partials
             .get(output)
@@ -81,8 +80,13 @@ impl Instance {
         if !self.allowed(F, allowed::GET) {
             return fmi2Status::Error;
         }
-        // Builds the model in initialization mode (as fmi2GetReal does).
-        let status = self.refresh_outputs(F);
+        // Builds the model in initialization mode (as fmi2GetReal does); the partials need no
+        // fresh outputs, so a built model skips that evaluation.
+        let status = if self.runtime.is_built() {
+            fmi2Status::OK
+        } else {
+            self.refresh_outputs(F)
+        };
         if status >= fmi2Status::Error {
             return status;
         }

@@ -125,7 +125,7 @@ impl Instance {
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-    guarded(c, "fmi2EnterEventMode", |inst| inst.enter_event_mode())
+    unsafe { guarded(c, "fmi2EnterEventMode", |inst| inst.enter_event_mode()) }
 }
 
 #[no_mangle]
@@ -134,20 +134,24 @@ pub unsafe extern "C" fn fmi2NewDiscreteStates(
     event_info: *mut fmi2EventInfo,
 ) -> fmi2Status {
     const F: &str = "fmi2NewDiscreteStates";
-    guarded(c, F, |inst| {
-        // SAFETY: a non-null pointer from the importer points to an fmi2EventInfo.
-        match unsafe { event_info.as_mut() } {
-            Some(info) => inst.new_discrete_states(info),
-            None => null_argument(inst, F, "fmi2eventInfo"),
-        }
-    })
+    unsafe {
+        guarded(c, F, |inst| {
+            // SAFETY: a non-null pointer from the importer points to an fmi2EventInfo.
+            match event_info.as_mut() {
+                Some(info) => inst.new_discrete_states(info),
+                None => null_argument(inst, F, "fmi2eventInfo"),
+            }
+        })
+    }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-    guarded(c, "fmi2EnterContinuousTimeMode", |inst| {
-        inst.enter_continuous_time_mode()
-    })
+    unsafe {
+        guarded(c, "fmi2EnterContinuousTimeMode", |inst| {
+            inst.enter_continuous_time_mode()
+        })
+    }
 }
 
 #[no_mangle]
@@ -158,23 +162,25 @@ pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
     terminate_simulation: *mut fmi2Boolean,
 ) -> fmi2Status {
     const F: &str = "fmi2CompletedIntegratorStep";
-    guarded(c, F, |inst| {
-        // SAFETY: non-null pointers from the importer point to fmi2Booleans.
-        let (Some(enter), Some(terminate)) =
-            (unsafe { (enter_event_mode.as_mut(), terminate_simulation.as_mut()) })
-        else {
-            return null_argument(inst, F, "enterEventMode or terminateSimulation");
-        };
-        let (status, event) = inst.completed_integrator_step();
-        *enter = if event { FMI2_TRUE } else { FMI2_FALSE };
-        *terminate = FMI2_FALSE;
-        status
-    })
+    unsafe {
+        guarded(c, F, |inst| {
+            // SAFETY: non-null pointers from the importer point to fmi2Booleans.
+            let (Some(enter), Some(terminate)) =
+                (enter_event_mode.as_mut(), terminate_simulation.as_mut())
+            else {
+                return null_argument(inst, F, "enterEventMode or terminateSimulation");
+            };
+            let (status, event) = inst.completed_integrator_step();
+            *enter = if event { FMI2_TRUE } else { FMI2_FALSE };
+            *terminate = FMI2_FALSE;
+            status
+        })
+    }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
-    guarded(c, "fmi2SetTime", |inst| inst.set_time(time))
+    unsafe { guarded(c, "fmi2SetTime", |inst| inst.set_time(time)) }
 }
 
 #[no_mangle]
@@ -184,13 +190,15 @@ pub unsafe extern "C" fn fmi2SetContinuousStates(
     nx: usize,
 ) -> fmi2Status {
     const F: &str = "fmi2SetContinuousStates";
-    guarded(c, F, |inst| {
-        // SAFETY: the importer passes nx readable values (or NULL, refused here).
-        if unsafe { slice(x, nx) }.is_none() {
-            return null_argument(inst, F, "x");
-        }
-        inst.states(F, allowed::CONTINUOUS_TIME_MODE, nx, "states")
-    })
+    unsafe {
+        guarded(c, F, |inst| {
+            // SAFETY: the importer passes nx readable values (or NULL, refused here).
+            if slice(x, nx).is_none() {
+                return null_argument(inst, F, "x");
+            }
+            inst.states(F, allowed::CONTINUOUS_TIME_MODE, nx, "states")
+        })
+    }
 }
 
 /// The getters of state-sized vectors: none to write.
@@ -202,13 +210,15 @@ unsafe fn get_vector(
     n: usize,
     what: &'static str,
 ) -> fmi2Status {
-    guarded(c, function, |inst| {
-        // SAFETY: the importer passes n writable values (or NULL, refused here).
-        if unsafe { slice_mut(values, n) }.is_none() {
-            return null_argument(inst, function, what);
-        }
-        inst.states(function, mask, n, what)
-    })
+    unsafe {
+        guarded(c, function, |inst| {
+            // SAFETY: the importer passes n writable values (or NULL, refused here).
+            if slice_mut(values, n).is_none() {
+                return null_argument(inst, function, what);
+            }
+            inst.states(function, mask, n, what)
+        })
+    }
 }
 
 #[no_mangle]
@@ -217,14 +227,16 @@ pub unsafe extern "C" fn fmi2GetDerivatives(
     derivatives: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    get_vector(
-        c,
-        "fmi2GetDerivatives",
-        allowed::GET_STATES,
-        derivatives,
-        nx,
-        "derivatives",
-    )
+    unsafe {
+        get_vector(
+            c,
+            "fmi2GetDerivatives",
+            allowed::GET_STATES,
+            derivatives,
+            nx,
+            "derivatives",
+        )
+    }
 }
 
 #[no_mangle]
@@ -233,14 +245,16 @@ pub unsafe extern "C" fn fmi2GetEventIndicators(
     indicators: *mut fmi2Real,
     ni: usize,
 ) -> fmi2Status {
-    get_vector(
-        c,
-        "fmi2GetEventIndicators",
-        allowed::GET_STATES,
-        indicators,
-        ni,
-        "event indicators",
-    )
+    unsafe {
+        get_vector(
+            c,
+            "fmi2GetEventIndicators",
+            allowed::GET_STATES,
+            indicators,
+            ni,
+            "event indicators",
+        )
+    }
 }
 
 #[no_mangle]
@@ -249,14 +263,16 @@ pub unsafe extern "C" fn fmi2GetContinuousStates(
     x: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    get_vector(
-        c,
-        "fmi2GetContinuousStates",
-        allowed::GET_STATES,
-        x,
-        nx,
-        "states",
-    )
+    unsafe {
+        get_vector(
+            c,
+            "fmi2GetContinuousStates",
+            allowed::GET_STATES,
+            x,
+            nx,
+            "states",
+        )
+    }
 }
 
 #[no_mangle]
@@ -265,12 +281,14 @@ pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
     nominals: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    get_vector(
-        c,
-        "fmi2GetNominalsOfContinuousStates",
-        allowed::GET_STATES,
-        nominals,
-        nx,
-        "nominals",
-    )
+    unsafe {
+        get_vector(
+            c,
+            "fmi2GetNominalsOfContinuousStates",
+            allowed::GET_STATES,
+            nominals,
+            nx,
+            "nominals",
+        )
+    }
 }

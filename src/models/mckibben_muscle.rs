@@ -404,7 +404,7 @@ impl Model for McKibbenMuscle {
                 overridden.join(", ")
             )
         });
-        let friction = p.friction.then(|| FrictionParams {
+        let friction = p.friction.then_some(FrictionParams {
             coefficient: p.friction_coefficient,
             presliding_length: p.presliding_length,
         });
@@ -476,6 +476,10 @@ impl Model for McKibbenMuscle {
     }
 
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
-        self.partials_at(inputs).map(|d| partial_rows(&d))
+        let mut rows = self.partials_at(inputs).map(|d| partial_rows(&d))?;
+        // contraction = 1 - length / nominal_length.
+        let per_length = -1.0 / self.effective.nominal_length;
+        rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
+        Ok(rows)
     }
 }

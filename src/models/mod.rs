@@ -109,9 +109,9 @@ pub type CalculatedParameters<M> = <<M as Model>::Variables as Interface>::Calcu
 /// owns its physics and its history (friction state, onion state, rotor state), which is part of
 /// the FMU state.
 ///
-/// Model Exchange can extend this without touching the co-simulation models: a subtrait
-/// `ModelExchange: Model` with the continuous states, derivatives, event updates and directional
-/// derivatives, and further associated types on [`Interface`].
+/// Model Exchange extends it through defaults that co-simulation-only models never write
+/// (`ALGEBRAIC_MODEL_EXCHANGE`, `update_discrete_states`, `partials`); continuous states would come
+/// as further associated types on [`Interface`].
 pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// The generated interface, `crate::variables::<model>::Variables`.
     type Variables: Interface;

@@ -6,7 +6,7 @@ fn main() {
         eprintln!("usage: package_fmus <path to libactuator_fmus.so> <output directory>");
         std::process::exit(2);
     };
-    match actuator_fmus::package::package_all(binary.as_ref(), out_dir.as_ref()) {
+    match actuator_fmus_tools::package::package_all(binary.as_ref(), out_dir.as_ref()) {
         Ok(paths) => paths.iter().for_each(|p| println!("wrote {}", p.display())),
         Err(e) => {
             eprintln!("package_fmus: {e}");

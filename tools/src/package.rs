@@ -1,7 +1,7 @@
 //! Writes `<Model>.fmu` archives: model description, binary, and generated documentation.
 
-use crate::fmi2::runtime::Factory;
-use crate::variables::{ModelInfo, Start, Variable};
+use actuator_fmus::fmi2::runtime::Factory;
+use actuator_fmus::variables::{ModelInfo, Start, Variable};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
@@ -12,7 +12,7 @@ pub fn package_all(binary: &Path, out_dir: &Path) -> Result<Vec<PathBuf>, String
     let so = std::fs::read(binary).map_err(|e| format!("cannot read {}: {e}", binary.display()))?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-    crate::fmi2::REGISTRY
+    actuator_fmus::fmi2::REGISTRY
         .iter()
         .map(|f| package(*f, &so, out_dir))
         .collect()
@@ -26,7 +26,7 @@ fn package(factory: &dyn Factory, so: &[u8], out_dir: &Path) -> Result<PathBuf, 
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     // A plot of the model's cross-check run (crosscheck/generate.py), shipped when present.
-    let plot_path = Path::new(env!("CARGO_MANIFEST_DIR"))
+    let plot_path = crate::repository_root()
         .join("docs/fmu")
         .join(format!("{}.png", info.name));
     let plot = std::fs::read(&plot_path).ok();

@@ -1,17 +1,17 @@
 //! Runs scene files through the `fmi` crate (the Rust-side importer) and writes
-//! `<out>/<scene>_fmi.csv`: `cargo run --release --example run_scene -- scenes/<scene>.json [--fast]`.
+//! `<out>/<scene>_fmi.csv`: `cargo run --release -p actuator-fmus-tools --example run_scene -- scenes/<scene>.json [--fast]`.
 
 #[allow(dead_code)]
 #[path = "../tests/common/scene_runner.rs"]
 mod scene_runner;
 
-use actuator_fmus::scene::Scene;
+use actuator_fmus_tools::scene::Scene;
 use std::path::{Path, PathBuf};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let fast = args.iter().any(|a| a == "--fast");
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = &actuator_fmus_tools::repository_root();
     let mut failed = 0;
     for path in args
         .iter()

@@ -243,7 +243,7 @@ mod tests {
 
     #[test]
     fn every_catalogue_scene_parses() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let dir = crate::repository_root().join("scenes");
         let mut n = 0;
         for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();
