@@ -66,7 +66,7 @@ def _errors(rows, force_key):
     return out
 
 
-def _plot(rows, summary, path, title):
+def _plot(rows, summary, path, title, dense=None):
     import matplotlib
 
     matplotlib.use("Agg")
@@ -82,8 +82,12 @@ def _plot(rows, summary, path, title):
         role = "fitted" if kpa in fitted else "predicted"
         ax.plot(c, [r["force_n"] for r in curve], "o", color=color, ms=4,
                 label=f"datasheet, {kpa:g} kPa")
-        ax.plot(c, [r["model_force_n"] for r in curve], "-", color=color,
-                label=f"model, {kpa:g} kPa ({role})")
+        if dense:  # the FMU sampled finely over the curve's range
+            c, f = dense[kpa]
+            c = [100 * x for x in c]
+        else:
+            f = [r["model_force_n"] for r in curve]
+        ax.plot(c, f, "-", color=color, label=f"model, {kpa:g} kPa ({role})")
     ax.set_xlabel("contraction 1 - L / L_N (%)")
     ax.set_ylabel("force (N)")
     ax.set_title("\n".join(textwrap.wrap(title, 70)))
@@ -116,11 +120,23 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
         through_fmu = _errors(rows, "fmu_force_n")
         summary["fmu_max_force_difference_n"] = max(abs(r["fmu_force_n"] - r["model_force_n"]) for r in rows)
         summary["fmu_errors"] = {f"{k:g}": {"rms": v[0], "max": v[1]} for k, v in through_fmu.items()}
+    dense = None
+    if verify:
+        # Smooth model curves for the plot: 60 contractions per pressure, through the FMU.
+        dense, grid = {}, []
+        for kpa in sorted({r["pressure_kpa"] for r in rows}):
+            cs = [r["contraction"] for r in rows if r["pressure_kpa"] == kpa]
+            c = [min(cs) + (max(cs) - min(cs)) * i / 59 for i in range(60)]
+            dense[kpa] = (c, None)
+            grid += [(1e3 * kpa, length * (1 - x)) for x in c]
+        forces = fmu_forces(params, grid)
+        for i, kpa in enumerate(dense):
+            dense[kpa] = (dense[kpa][0], forces[60 * i: 60 * (i + 1)])
     name = pathlib.Path(data).stem
     title = (f"{name}: datasheet force against McKibbenMuscle fitted at "
              f"{' + '.join(f'{k:g}' for k in fit_kpa)} kPa (nominal length {length:g} m, "
              f"{'thin' if layers == 1 else f'{layers}-layer thick'}-walled bladder)")
-    _plot(rows, summary, out / "fit.png", title)
+    _plot(rows, summary, out / "fit.png", title, dense)
     lines = [f"# Calibration of McKibbenMuscle to `{name}`", "",
              f"Fitted at {', '.join(f'{k:g}' for k in fit_kpa)} kPa in {summary['seconds']:.2f} s "
              f"({starts} starts); nominal length {length:g} m, nominal inner diameter {diameter:g} m; "

@@ -3,9 +3,10 @@ measured through FMPy, and section 3.2.3's density figures. Run after `make fmus
 
     .venv/bin/python examples/motor_characteristics.py   (or `make motor-docs`)
 
-writes docs/motor.md with docs/img/motor_static_torque.png, docs/img/motor_pull_torque.png and
-docs/img/motor_onion_reorientation.png. tests/fmpy/test_motor_characteristics.py imports the
-measuring functions and checks the figures the document states."""
+writes docs/motor.md with docs/img/motor_static_torque.png, docs/img/motor_pull_torque.png,
+docs/img/motor_fold_jump.png and docs/img/motor_onion_reorientation.png.
+tests/fmpy/test_motor_characteristics.py imports the measuring functions and checks the figures
+the document states."""
 
 import math
 import pathlib
@@ -139,6 +140,19 @@ class Motor:
         self.stop()
         return np.array(rows)
 
+    def locked_ramp(self, direction_deg, stresses):
+        """Locked rotor, tension at `direction_deg`: the offset (rad) after each stress in turn,
+        each applied as one jump from the last."""
+        self.start(rotor_locked=True)
+        self.set(strain_direction=math.radians(direction_deg))
+        offsets = []
+        for i, stress in enumerate(stresses):
+            self.set(stress=stress)
+            self.fmu.doStep(currentCommunicationPoint=i * 1e-9, communicationStepSize=1e-9)
+            offsets.append(self.get("offset_angle"))
+        self.stop()
+        return np.array(offsets)
+
     def locked_torque(self, direction_deg, stress):
         self.start(rotor_locked=True)
         self.set(strain_direction=math.radians(direction_deg), stress=stress)
@@ -185,6 +199,11 @@ def main():
                    (("200 micro-strain x 200 GPa = 40 MPa", 40e6), ("200 MPa (Fig. 3.3b) = 1000 micro-strain", 200e6))]
     curves = {(deg, model): m.reorientation(math.radians(deg), model)
               for deg in (180.0, 179.0, 150.0, 90.0) for model in (0, 1)}
+    slow = np.linspace(0.0, 160e6, 3201)
+    slow_offsets = m.locked_ramp(-15.0, slow)
+    to_146 = np.linspace(0.0, 146e6, 2921)
+    jump_ends = np.array([146.5e6, 147e6, 147.5e6, 148e6, 148.3e6, 148.6e6, 150e6, 155e6])
+    jumps = [m.locked_ramp(-15.0, np.append(to_146, end))[-1] for end in jump_ends]
     m.close()
     d = densities(torque_peak=holding)
 
@@ -234,6 +253,21 @@ def main():
     fig.tight_layout()
     fig.savefig(img / "motor_onion_reorientation.png", dpi=110)
     plt.close(fig)
+
+    fig, ax = plt.subplots(figsize=(7, 4.2))
+    ax.plot(slow / 1e6, np.degrees(slow_offsets), label="slow ramp (50 kPa per step)")
+    ax.plot(jump_ends / 1e6, np.degrees(jumps), "o", label="slow ramp to 146 MPa, then one jump to the marked stress")
+    ax.set_xlim(120, 160)
+    ax.set_xlabel("stress sigma11 - sigma22 (MPa)")
+    ax.set_ylabel("onion offset from the locked rotor (deg)")
+    ax.set_title("Onion state near the fold, tension at -15 degrees (issue 16): jumps end where a\n"
+                 "slow ramp ends, in the narrow basin, until the fold", wrap=True, fontsize=10)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    fig.tight_layout()
+    fig.savefig(img / "motor_fold_jump.png", dpi=110)
+    plt.close(fig)
+    fold = slow[np.argmax(np.diff(np.degrees(slow_offsets)) > 5.0) + 1]
 
     rows = "\n".join(f"| {p * 1e6:g} | {i:.3g} | {o:.3g} |" for p, i, o in zip(PERIODS, pull_in, pull_out))
     gilbert_half = {deg: curves[(deg, 1)][np.argmax(np.abs(np.degrees(curves[(deg, 1)][:, 1] - curves[(deg, 1)][:, 2])) < 90.0), 0]
@@ -307,6 +341,17 @@ Tension at -45 degrees on the locked rotor:
 Section 3.3 applies "200 micro-strain" and reports 2e-18 N m; in nickel that strain is only 40 MPa,
 which the calibrated model turns into about a third of that torque. Fig. 3.3b's 200 MPa gives the
 reported torque, so the FMU's default drive is stress, and the strain reading is available.
+
+## The onion state after a jump near a fold
+
+Section 3.2.2: the onion state settles at the minimum closest to its orientation. Tension at
+-15 degrees on the locked rotor: a slow ramp keeps the onion state on the near branch until its
+minimum disappears at a fold ({fold / 1e6:.2f} MPa in this ramp), then it jumps to the far minimum. A
+single jump from 146 MPa ends where the slow ramp ends for every size up to the fold: 148 MPa gives
+{np.degrees(jumps[3]):.2f} degrees (the settle once strode over this basin, less than a degree
+wide, and ended at 58.97 degrees).
+
+![fold jump](img/motor_fold_jump.png)
 
 ## A ring magnetised parallel to the bar
 

@@ -80,8 +80,13 @@ impl Instance {
         if !self.allowed(F, allowed::GET) {
             return fmi2Status::Error;
         }
-        // Builds the model in initialization mode (as fmi2GetReal does).
-        let status = self.refresh_outputs(F);
+        // Builds the model in initialization mode (as fmi2GetReal does); the partials need no
+        // fresh outputs, so a built model skips that evaluation.
+        let status = if self.runtime.is_built() {
+            fmi2Status::OK
+        } else {
+            self.refresh_outputs(F)
+        };
         if status >= fmi2Status::Error {
             return status;
         }

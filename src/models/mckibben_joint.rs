@@ -9,7 +9,7 @@
 //! with `command_mode` 1 it is a joint torque, met by solving for that difference through the same
 //! muscle physics ([`crate::physics::inverse::difference_for_torque`]).
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
@@ -139,15 +139,42 @@ impl McKibbenJoint {
         self.muscle.evaluate(pressure, inside, history).ok()
     }
 
-    /// Torque of the pair at the pressures from `difference`, at the given lengths and histories.
-    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<f64, String> {
-        let p = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
-        let mut ignored = None;
-        let flexor = self.evaluate_muscle(p[0], lengths[0], &self.flexor_friction, &mut ignored);
-        let extensor =
-            self.evaluate_muscle(p[1], lengths[1], &self.extensor_friction, &mut ignored);
+    /// Force and dF/dP of one muscle, at the nearest valid length as [`Self::evaluate_muscle`].
+    fn force_and_slope(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Option<(f64, f64)> {
+        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
+        let margin = if self.muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        [length, inside]
+            .into_iter()
+            .find_map(|l| self.muscle.partials(pressure, l, history).ok())
+            .map(|(out, d)| (out.force, d.force[0]))
+    }
+
+    /// Torque of the pair at the pressures from `difference`, and its slope in the difference,
+    /// at the given lengths and histories.
+    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<(f64, f64), String> {
+        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
+        let p = pair_pressures(pc, difference, pmax);
+        // dP/d(difference) is +-1/2 where a pressure is not clipped.
+        let unclipped = |x: f64| if x > 0.0 && x < pmax { 0.5 } else { 0.0 };
+        let flexor = self.force_and_slope(p[0], lengths[0], &self.flexor_friction);
+        let extensor = self.force_and_slope(p[1], lengths[1], &self.extensor_friction);
         match (flexor, extensor) {
-            (Some(f), Some(e)) => Ok(self.moment_arm * (f.force - e.force)),
+            (Some((f, df)), Some((e, de))) => Ok((
+                self.moment_arm * (f - e),
+                self.moment_arm
+                    * (df * unclipped(pc + 0.5 * difference)
+                        + de * unclipped(pc - 0.5 * difference)),
+            )),
             _ => Err("a muscle cannot be evaluated at this jointPosition".into()),
         }
     }
@@ -205,6 +232,24 @@ impl McKibbenJoint {
             lengths,
             saturated,
         })
+    }
+
+    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: at a clamped length
+    /// the length no longer moves the force.
+    fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
+        if let Ok((_, d)) = self.muscle.partials(pressure, length, history) {
+            return d.force;
+        }
+        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
+        let margin = if self.muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        self.muscle
+            .partials(pressure, inside, history)
+            .map_or([0.0, 0.0], |(_, d)| [d.force[0], 0.0])
     }
 
     fn write(&self, out: &mut Outputs, pair: &Pair) {
@@ -282,6 +327,57 @@ impl Model for McKibbenJoint {
             min_position: self.position_range.0,
             max_position: self.position_range.1,
         }
+    }
+
+    /// The chain rule through the pressure difference `d`, the split `P = pc +- d/2` (slope 0
+    /// where a pressure is clipped to 0 or max_pressure) and the lengths `L0 -+ r q`. With
+    /// `command_mode` 1, `d` solves `torque(d, q) = u`: `dd/du = 1/torque_d` and
+    /// `dd/dq = -torque_q/torque_d` (implicit function theorem), both 0 when saturated.
+    /// jointVelocity moves nothing.
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let q = inputs.joint_position;
+        let (pmax, r) = (self.max_pressure, self.moment_arm);
+        // The operating point as `evaluate` finds it (a copy: the warning state stays put).
+        let pair = self
+            .clone()
+            .compute(inputs, &mut Report::default())
+            .ok_or("a muscle cannot be evaluated at this jointPosition")?;
+        let [pf, pe] = pair.pressures;
+        let interior = |p: f64| p > 0.0 && p < pmax;
+        let dpf = if interior(pf) { 0.5 } else { 0.0 };
+        let dpe = if interior(pe) { -0.5 } else { 0.0 };
+        let lf = self.flexor_rest_length - r * q;
+        let le = self.extensor_rest_length + r * q;
+        let ff = self.muscle_partials(pf, lf, &self.flexor_friction);
+        let fe = self.muscle_partials(pe, le, &self.extensor_friction);
+        // Forces per unit d and per unit q at fixed d.
+        let (ff_d, fe_d) = (ff[0] * dpf, fe[0] * dpe);
+        let (ff_q, fe_q) = (-r * ff[1], r * fe[1]);
+        let (dd_du, dd_dq) = if !self.torque_command {
+            (1.0, 0.0)
+        } else {
+            let torque_d = r * (ff_d - fe_d);
+            if pair.saturated || torque_d == 0.0 {
+                (0.0, 0.0)
+            } else {
+                (1.0 / torque_d, -r * (ff_q - fe_q) / torque_d)
+            }
+        };
+        let flexor = [ff_d * dd_du, ff_d * dd_dq + ff_q];
+        let extensor = [fe_d * dd_du, fe_d * dd_dq + fe_q];
+        let mut p = Partials::default();
+        let row = |d: [f64; 2]| [("actuatorInput", d[0]), ("jointPosition", d[1])];
+        p.row(
+            "jointTorque",
+            &row([r * (flexor[0] - extensor[0]), r * (flexor[1] - extensor[1])]),
+        )
+        .row("flexor_force", &row(flexor))
+        .row("extensor_force", &row(extensor))
+        .row("flexor_pressure", &row([dpf * dd_du, dpf * dd_dq]))
+        .row("extensor_pressure", &row([dpe * dd_du, dpe * dd_dq]))
+        .row("flexor_length", &row([0.0, -r]))
+        .row("extensor_length", &row([0.0, r]));
+        Ok(p)
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {

@@ -475,6 +475,10 @@ impl Model for McKibbenMuscle {
     }
 
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
-        self.partials_at(inputs).map(|d| partial_rows(&d))
+        let mut rows = self.partials_at(inputs).map(|d| partial_rows(&d))?;
+        // contraction = 1 - length / nominal_length.
+        let per_length = -1.0 / self.effective.nominal_length;
+        rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
+        Ok(rows)
     }
 }

@@ -6,9 +6,15 @@
 
 use crate::physics::friction::HysteresisState;
 use crate::physics::mckibben::McKibben;
+use crate::physics::root::{newton_bisection, RootOptions, Sample};
 
-/// Iteration cap of [`invert_monotonic`]: bisection alone halves a bracket 200 times.
-const ITERATIONS: usize = 200;
+/// Stopping rule of the inversions: the Newton correction of the argument (Pa) below 1e-13 of
+/// it plus 1e-9 Pa, or 200 evaluations (bisection alone would halve any bracket that often).
+const OPTIONS: RootOptions = RootOptions {
+    absolute: 1e-9,
+    relative: 1e-13,
+    max_iterations: 200,
+};
 
 /// The result of an inversion.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,83 +28,50 @@ pub struct Inversion {
 }
 
 /// Solves `f(x) = target` for `x` in `[lo, hi]` when `f` is monotonic there (either direction;
-/// flat stretches allowed). Out of reach, returns the end whose value is nearer, flagged
-/// `saturated`. A safeguarded regula falsi (Illinois variant): every step stays in the bracket and
-/// falls back to bisection when the secant stalls, so it converges to `|f - target| <= tol *
-/// |f(hi) - f(lo)|` or a bracket at the resolution of f64. `Err` if `f` fails.
+/// flat stretches allowed); `f` returns its value and slope. Out of reach, returns the end whose
+/// value is nearer, flagged `saturated`. Inside, the shared safeguarded Newton-bisection
+/// ([`newton_bisection`]): every step stays in the shrinking bracket, so it cannot diverge. `Err`
+/// if `f` fails.
 pub fn invert_monotonic(
-    mut f: impl FnMut(f64) -> Result<f64, String>,
+    mut f: impl FnMut(f64) -> Result<(f64, f64), String>,
     target: f64,
     lo: f64,
     hi: f64,
-    tol: f64,
 ) -> Result<Inversion, String> {
     if !(target.is_finite() && lo.is_finite() && hi.is_finite() && lo <= hi) {
         return Err(format!(
             "cannot invert for target {target} on [{lo}, {hi}]: not finite or empty"
         ));
     }
-    let (f_lo, f_hi) = (f(lo)?, f(hi)?);
+    let (f_lo, f_hi) = (f(lo)?.0, f(hi)?.0);
     let rising = f_hi >= f_lo;
     let (min, max) = if rising { (f_lo, f_hi) } else { (f_hi, f_lo) };
+    let (x_min, x_max) = if rising { (lo, hi) } else { (hi, lo) };
     let end = |x: f64, y: f64, saturated| Inversion {
         argument: x,
         achieved: y,
         saturated,
     };
-    let (x_min, x_max) = if rising { (lo, hi) } else { (hi, lo) };
     if target <= min {
         return Ok(end(x_min, min, target < min));
     }
     if target >= max {
         return Ok(end(x_max, max, target > max));
     }
-    // g = f - target changes sign on the bracket: a < 0 < b in g.
-    let (mut a, mut b) = (x_min, x_max);
-    let (mut ga, mut gb) = (min - target, max - target);
-    let tolerance = tol * (max - min);
-    let mut best = if -ga < gb { (a, ga) } else { (b, gb) };
-    let mut side = 0i8;
-    for _ in 0..ITERATIONS {
-        let secant = a - ga * (b - a) / (gb - ga);
-        let mid = 0.5 * (a + b);
-        // Stay strictly inside; otherwise bisect.
-        let x = if secant.is_finite() && (secant - a) * (secant - b) < 0.0 {
-            secant
-        } else {
-            mid
-        };
-        if x == a || x == b {
-            break;
-        }
-        let g = f(x)? - target;
-        if g.abs() < best.1.abs() {
-            best = (x, g);
-        }
-        if g.abs() <= tolerance {
-            break;
-        }
-        if g < 0.0 {
-            a = x;
-            ga = g;
-            if side == -1 {
-                gb *= 0.5; // Illinois: halve the stale end so the secant moves past it
-            }
-            side = -1;
-        } else {
-            b = x;
-            gb = g;
-            if side == 1 {
-                ga *= 0.5;
-            }
-            side = 1;
-        }
-    }
-    Ok(end(best.0, best.1 + target, false))
+    // Start from the secant through the ends (exact for eq. 2.3, linear in P).
+    let start = x_min + (target - min) / (max - min) * (x_max - x_min);
+    let root = newton_bisection(lo, hi, start, rising, OPTIONS, |x| {
+        f(x).map(|(value, slope)| {
+            Some(Sample {
+                value: value - target,
+                slope,
+                payload: value,
+            })
+        })
+    })?;
+    let achieved = root.payload.ok_or("no evaluation inside the bracket")?;
+    Ok(end(root.x, achieved, false))
 }
-
-/// Relative tolerance of the inversions below (of the reachable force or torque range).
-pub const TOLERANCE: f64 = 1e-12;
 
 /// The gauge pressure in `0 ..= max_pressure` at which `muscle` at input length `length` (from
 /// friction history `history`) pulls with `force`. Out of reach: the pressure of the nearest
@@ -111,11 +84,14 @@ pub fn pressure_for_force(
     history: &HysteresisState,
 ) -> Result<Inversion, String> {
     invert_monotonic(
-        |p| muscle.evaluate(p, length, history).map(|o| o.force),
+        |p| {
+            muscle
+                .partials(p, length, history)
+                .map(|(o, d)| (o.force, d.force[0]))
+        },
         force,
         0.0,
         max_pressure,
-        TOLERANCE,
     )
 }
 
@@ -129,17 +105,17 @@ pub fn pair_pressures(common_mode: f64, difference: f64, max_pressure: f64) -> [
 }
 
 /// The pressure difference whose clipped pair ([`pair_pressures`]) gives `torque`, where
-/// `torque_of(difference)` is the pair's torque; out of reach, the nearest torque (`saturated`).
+/// `torque_of(difference)` is the pair's torque and its slope; out of reach, the nearest torque (`saturated`).
 /// The torque of an antagonistic pair is monotonic in the difference while each muscle's force
 /// is monotonic in its pressure; the search covers every difference that changes a clipped
 /// pressure, `-2 max_pressure ..= 2 max_pressure`.
 pub fn difference_for_torque(
-    torque_of: impl FnMut(f64) -> Result<f64, String>,
+    torque_of: impl FnMut(f64) -> Result<(f64, f64), String>,
     torque: f64,
     max_pressure: f64,
 ) -> Result<Inversion, String> {
     let span = 2.0 * max_pressure;
-    invert_monotonic(torque_of, torque, -span, span, TOLERANCE)
+    invert_monotonic(torque_of, torque, -span, span)
 }
 
 #[cfg(test)]
@@ -149,16 +125,16 @@ mod tests {
 
     #[test]
     fn inverts_rising_falling_and_flat_stretches_and_saturates() {
-        let cube = |x: f64| Ok(x * x * x);
-        let r = invert_monotonic(cube, 0.3, -1.0, 2.0, 1e-14).unwrap();
+        let cube = |x: f64| Ok((x * x * x, 3.0 * x * x));
+        let r = invert_monotonic(cube, 0.3, -1.0, 2.0).unwrap();
         assert!((r.achieved - 0.3).abs() < 1e-13 && !r.saturated);
         assert!((r.argument - 0.3f64.cbrt()).abs() < 1e-9);
-        let falling = |x: f64| Ok(-x.max(0.5));
-        let r = invert_monotonic(falling, -0.75, 0.0, 1.0, 1e-14).unwrap();
+        let falling = |x: f64| Ok((-x.max(0.5), if x > 0.5 { -1.0 } else { 0.0 }));
+        let r = invert_monotonic(falling, -0.75, 0.0, 1.0).unwrap();
         assert!((r.argument - 0.75).abs() < 1e-12, "{r:?}");
-        let r = invert_monotonic(cube, 9.0, -1.0, 2.0, 1e-14).unwrap();
+        let r = invert_monotonic(cube, 9.0, -1.0, 2.0).unwrap();
         assert!(r.saturated && r.argument == 2.0 && r.achieved == 8.0);
-        let r = invert_monotonic(cube, -3.0, -1.0, 2.0, 1e-14).unwrap();
+        let r = invert_monotonic(cube, -3.0, -1.0, 2.0).unwrap();
         assert!(r.saturated && r.argument == -1.0);
     }
 

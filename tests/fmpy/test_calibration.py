@@ -133,3 +133,13 @@ def test_make_calibrate_runs_on_the_dmsp40_datasheet(tmp_path):
     assert summary["seconds"] < 60 and all(e["rms"] < 0.05 for e in summary["errors"])
     report = (out / "report.md").read_text()
     assert "| 100 | predicted |" in report and "fit.png" in report
+
+
+def test_contraction_has_its_directional_derivative():
+    # d contraction / d length = -1 / nominal_length, with the preset's nominal length (DMSP-40: 0.4 m).
+    from test_directional_derivatives import directional
+
+    m = Slave("McKibbenMuscle", preset=DMSP_40, length=0.38)
+    m.set(pressure=3e5, length=0.38)
+    assert directional(m, ["contraction"], ["pressure", "length"], [1.0, 2.0]) == [pytest.approx(-2.0 / 0.4, rel=1e-15)]
+    m.close()

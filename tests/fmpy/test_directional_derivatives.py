@@ -85,6 +85,47 @@ def test_models_without_partials_declare_it():
 
     from conftest import fmu_path
 
-    for model in ["KnittedMuscle", "McKibbenJoint", "PulleyJoint", "MultiferroicMotor"]:
+    for model in ["KnittedMuscle", "PulleyJoint", "MultiferroicMotor"]:
         md = read_model_description(fmu_path(model))
         assert not md.coSimulation.providesDirectionalDerivative, model
+
+
+JOINT_OUTPUTS = ["jointTorque", "flexor_force", "extensor_force", "flexor_pressure", "extensor_pressure",
+                 "flexor_length", "extensor_length"]
+JOINT_INPUTS = ["actuatorInput", "jointPosition", "jointVelocity"]
+
+
+@pytest.mark.parametrize(
+    "parameters",
+    [
+        dict(),
+        dict(bladder_model=2, bladder_layers=8),
+        dict(bladder_model=1, friction=True),
+        dict(bladder_model=1, command_mode=1),
+    ],
+    ids=["ideal", "thick wall", "thin wall + friction", "thin wall, torque command"],
+)
+def test_joint_partials_match_central_differences(parameters):
+    s = Slave("McKibbenJoint", **parameters)
+    try:
+        # Inside the pressure range (no saturation) and with friction mid-presliding.
+        torque = parameters.get("command_mode") == 1
+        for u, q in [(0.3, 0.05), (-0.5, -0.1)] if torque else [(1e5, 0.05), (-2e5, -0.1)]:
+            s.step(actuatorInput=u, jointPosition=q + 1e-3)
+            base = dict(actuatorInput=u, jointPosition=q, jointVelocity=0.0)
+            s.set(**base)
+            for j, name in enumerate(JOINT_INPUTS):
+                h = (1e-6 if torque else 1.0) if name == "actuatorInput" else 1e-7
+                seed = [1.0 if k == j else 0.0 for k in range(3)]
+                s.set(**base)
+                exact = directional(s, JOINT_OUTPUTS, JOINT_INPUTS, seed)
+                up = s.at(*JOINT_OUTPUTS, **{**base, name: base[name] + h})
+                down = s.at(*JOINT_OUTPUTS, **{**base, name: base[name] - h})
+                for out, e, a, b in zip(JOINT_OUTPUTS, exact, up, down):
+                    central = (a - b) / (2 * h)
+                    # Absolute slack: the torque solver meets the command to rounding (1e-16 N m / h).
+                    assert abs(e - central) <= 1e-5 * max(abs(e), abs(central)) + 1e-8, (
+                        f"{parameters} u={u} q={q}: d{out}/d{name} exact {e} central {central}"
+                    )
+    finally:
+        s.close()

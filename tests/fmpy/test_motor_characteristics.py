@@ -54,3 +54,20 @@ def test_section_3_2_3_densities():
     assert abs(d["magnetic_nickel"] - 148_000) < 500
     assert abs(d["torque_density_llg"] - 260) < 1
     assert abs(mc.densities(torque_peak=2.16e-18)["torque_density_peak"] - 280) < 1
+
+
+def test_jumps_near_the_fold_end_where_the_slow_ramp_ends(motor):
+    # docs/motor.md: the fold at -15 deg lies near 148.15 MPa; a jump from 146 MPa to any stress
+    # below it ends on the slow ramp's near branch, one past it on the far branch.
+    import numpy as np
+
+    slow = np.linspace(0.0, 150e6, 3001)
+    ramp = np.degrees(motor.locked_ramp(-15.0, slow))
+    fold = slow[np.argmax(np.diff(ramp) > 5.0) + 1]
+    assert 148.0e6 < fold < 148.3e6, fold
+    to_146 = np.linspace(0.0, 146e6, 2921)
+    for end in (147e6, 148e6, 148.1e6):
+        jumped = math.degrees(motor.locked_ramp(-15.0, np.append(to_146, end))[-1])
+        assert abs(jumped - np.interp(end, slow, ramp)) < 0.05, (end, jumped)
+        assert jumped < 20.0
+    assert math.degrees(motor.locked_ramp(-15.0, np.append(to_146, 149e6))[-1]) > 55.0
