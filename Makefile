@@ -4,9 +4,9 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
-SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs
+SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized
 
 all: fmus
 
@@ -29,9 +29,38 @@ $(LIB) target/release/package_fmus target/release/calibrate: $(SOURCES)
 	cargo build --release --lib -p actuator-fmus
 	cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
 
-## target/fmu/<Model>.fmu for every model in modelDescription/.
-fmus: $(LIB) target/release/package_fmus
-	target/release/package_fmus $(LIB) target/fmu
+## Cross toolchains for the win64 and aarch64-linux binaries, and the emulators the tests run them
+## under (wine, qemu-user); each installed only when missing.
+CROSS_DEBS := gcc-mingw-w64-x86-64 gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user wine64
+CROSS_TARGETS := x86_64-pc-windows-gnu aarch64-unknown-linux-gnu
+cross-deps:
+	@missing=$$(for p in $(CROSS_DEBS); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  echo "installing $$missing (cross builds and their emulators)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+	@installed=$$(rustup target list --installed); for t in $(CROSS_TARGETS); do \
+	  echo "$$installed" | grep -qx $$t || rustup target add $$t; done
+
+WIN_DLL := target/x86_64-pc-windows-gnu/release/actuator_fmus.dll
+ARM_SO := target/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
+
+$(WIN_DLL): $(SOURCES) | cross-deps
+	cargo build --release --lib --target x86_64-pc-windows-gnu
+
+$(ARM_SO): $(SOURCES) | cross-deps
+	cargo build --release --lib --target aarch64-unknown-linux-gnu
+
+## target/fmu/<Model>.fmu for every model in modelDescription/, with binaries for linux64, win64 and
+## aarch64-linux (`make fmus CROSS=0`: linux64 only, no cross toolchains needed).
+CROSS ?= 1
+ifeq ($(CROSS),1)
+CROSS_BINARIES := $(WIN_DLL) $(ARM_SO)
+CROSS_ARGS := win64=$(WIN_DLL) aarch64-linux=$(ARM_SO)
+endif
+fmus: $(LIB) target/release/package_fmus $(CROSS_BINARIES)
+	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
 
 DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
 
@@ -67,7 +96,15 @@ calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
 test-rust: deps fmus
 	cargo test --release --workspace
 
-test-fmpy: fmus $(VENV)/.installed
+## ecos (ecospy, tests/fmpy/test_interop.py) needs Debian's libtbb12.
+interop-deps:
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12'; then \
+	  echo "installing libtbb12 (needed by ecospy)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libtbb12; \
+	fi
+
+test-fmpy: fmus $(VENV)/.installed interop-deps
 	$(PY) -m pytest tests/fmpy -q
 
 ## All Rust tests and the FMPy suite.
@@ -114,7 +151,7 @@ robot-joint: deps fmus $(VENV)/.installed
 ## docs/fmu/<Model>.png, then the FMUs again so that each documentation/ carries its plot.
 crosscheck: fmus $(VENV)/.installed
 	$(PY) crosscheck/generate.py
-	target/release/package_fmus $(LIB) target/fmu
+	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
 
 ## The robot joint as a system: out/systems/RobotJoint.ssp (fmpy simulate_ssp) and the container
 ## FMU out/systems/RobotJoint.fmu (fmu-manipulation-toolbox), both run and plotted against the

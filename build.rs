@@ -20,8 +20,12 @@ use std::path::Path;
 
 fn main() {
     // A cdylib whose thread-local destructors outlive dlclose crashes the host at thread exit
-    // (rust-lang/rust#91979): never unload the code.
-    println!("cargo:rustc-cdylib-link-arg=-Wl,-z,nodelete");
+    // (rust-lang/rust#91979): never unload the code. `-z` is an ELF linker option (mingw's ld
+    // refuses it; a Windows DLL has no such problem).
+    let target_os = std::env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
+    if target_os != "windows" && target_os != "macos" {
+        println!("cargo:rustc-cdylib-link-arg=-Wl,-z,nodelete");
+    }
     println!("cargo:rerun-if-changed=modelDescription");
     println!("cargo:rerun-if-changed=build");
 

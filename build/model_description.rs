@@ -12,6 +12,9 @@ use sha2::{Digest, Sha256};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
+#[path = "rules.rs"]
+pub mod rules;
+
 const GUID_PLACEHOLDER: &str = "@GUID@";
 
 // The export layer's part of every shipped description: log categories and capabilities.
@@ -250,7 +253,10 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
         }
     }
     let (outputs, initial_unknowns) = resolve_structure(&md.model_structure, &variables)?;
+    rules::check(text)?;
     let rendered = shipped(text, stem, &variables, &outputs, &initial_unknowns)?;
+    // The rules again on what ships: the export layer's part and the resolved indices included.
+    rules::check(&rendered).map_err(|e| format!("shipped description: {e}"))?;
     let guid = guid_of(&rendered);
     Ok(Model {
         name: stem.to_string(),

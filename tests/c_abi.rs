@@ -289,35 +289,49 @@ fn vacuum_leaves_the_sleeve_unloaded() {
 }
 
 #[test]
-fn length_beyond_the_sleeve_is_clamped_with_one_warning() {
+fn length_beyond_the_sleeve_is_clamped_flagged_and_logged_once_per_excursion() {
     let i = ready();
     assert_eq!(i.set_real(&[PRESSURE, LENGTH], &[4e5, 0.2]), OK);
     let mut t = 0.0;
     for _ in 0..5 {
-        assert_eq!(i.do_step(t, 0.01), WARNING);
+        // The default out-of-range policy: strict masters see fmi2OK.
+        assert_eq!(i.do_step(t, 0.01), OK);
         t += 0.01;
         assert_eq!(i.real(FORCE), gaylord_force(4e5, B, B, N));
         assert_eq!(i.real(VOLUME), 0.0);
+        assert!(i.boolean(INPUT_CLAMPED));
     }
-    let warnings = i
-        .log
-        .lines()
-        .iter()
-        .filter(|l| l.contains("until the inputs return"))
-        .count();
-    assert_eq!(warnings, 1, "{:?}", i.log.lines());
-    assert_eq!(i.set_real(&[LENGTH], &[0.1]), OK);
-    assert_eq!(i.do_step(t, 0.01), OK);
-    assert_eq!(i.set_real(&[LENGTH], &[0.3]), OK);
-    assert_eq!(i.do_step(t + 0.01, 0.01), WARNING, "a new excursion");
-    assert_eq!(
+    let explained = |i: &Instance| {
         i.log
             .lines()
             .iter()
             .filter(|l| l.contains("until the inputs return"))
-            .count(),
-        2
-    );
+            .count()
+    };
+    assert_eq!(explained(&i), 1, "{:?}", i.log.lines());
+    assert_eq!(i.set_real(&[LENGTH], &[0.1]), OK);
+    assert_eq!(i.do_step(t, 0.01), OK);
+    assert!(!i.boolean(INPUT_CLAMPED));
+    assert_eq!(i.set_real(&[LENGTH], &[0.3]), OK);
+    assert_eq!(i.do_step(t + 0.01, 0.01), OK, "a new excursion");
+    assert_eq!(explained(&i), 2);
+}
+
+#[test]
+fn out_of_range_policy_restores_the_warning_or_discards_the_step() {
+    for (policy, expected) in [(0, OK), (1, WARNING), (2, DISCARD)] {
+        let i = instance();
+        assert_eq!(i.setup(), OK);
+        assert_eq!(i.enter(), OK);
+        assert_eq!(i.set_integer(&[OUT_OF_RANGE_POLICY], &[policy]), OK);
+        assert_eq!(i.exit(), OK);
+        assert_eq!(i.set_real(&[PRESSURE, LENGTH], &[4e5, 0.2]), OK);
+        // Outside fmi2DoStep a discard means nothing: the getter warns instead.
+        let (status, _) = i.get_real(&[FORCE]);
+        assert_eq!(status, expected.min(WARNING), "policy {policy}");
+        assert!(i.boolean(INPUT_CLAMPED));
+        assert_eq!(i.do_step(0.0, 0.01), expected, "policy {policy}");
+    }
 }
 
 #[test]

@@ -13,6 +13,7 @@ mod exports;
 mod instance;
 mod logger;
 mod model_exchange;
+mod out_of_range;
 pub mod registry;
 pub mod runtime;
 pub mod types;

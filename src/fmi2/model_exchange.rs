@@ -48,7 +48,7 @@ impl Instance {
         }
         let mut report = Report::default();
         self.runtime.update_discrete_states(self.time, &mut report);
-        status.max(self.forward(function, report))
+        status.max(self.forward(function, report, false))
     }
 
     pub fn enter_event_mode(&mut self) -> fmi2Status {

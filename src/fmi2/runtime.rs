@@ -191,6 +191,7 @@ where
         if let (true, Some(model)) = (self.outputs_stale, self.model.as_mut()) {
             let v = &mut self.values;
             model.evaluate(&v.inputs, &mut v.outputs, report);
+            report.evaluated = true;
             self.outputs_stale = false;
         }
     }
@@ -198,6 +199,7 @@ where
         if let Some(model) = self.model.as_mut() {
             let v = &mut self.values;
             model.step(&v.inputs, &mut v.outputs, time, step, report);
+            report.evaluated = true;
             self.outputs_stale = false;
         }
     }

@@ -161,25 +161,21 @@ impl KnittedMuscle {
         if l == length {
             self.out_of_range = false;
         } else {
-            if !self.out_of_range {
-                report.warn(format!(
+            report.clamp(!self.out_of_range, || {
+                format!(
                     "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
                      evaluating at length {l} m until the inputs return",
                     lo, hi, self.length_range.1
-                ));
-            }
-            report.status = report.status.max(Status::Warning);
+                )
+            });
             self.out_of_range = true;
         }
         if let Some(b) = &self.bladder {
             let (out, fallback) = self.compute_with_bladder(b, pressure, l);
             if let Some(reason) = &fallback {
-                if !self.collapsed {
-                    report.warn(format!(
-                        "{reason}; evaluating at zero gauge pressure until the inputs return"
-                    ));
-                }
-                report.status = report.status.max(Status::Warning);
+                report.clamp(!self.collapsed, || {
+                    format!("{reason}; evaluating at zero gauge pressure until the inputs return")
+                });
             }
             self.collapsed = fallback.is_some();
             return Some(out);
@@ -393,6 +389,7 @@ impl Model for KnittedMuscle {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::Status;
     use std::f64::consts::SQRT_2;
 
     fn parameters_with(shape: i32, friction: bool) -> Parameters {
@@ -446,8 +443,9 @@ mod tests {
             let mut report = Report::default();
             inputs.length = length;
             m.evaluate(&inputs, &mut out, &mut report);
-            warned += report.messages.len();
-            assert_eq!(report.status > Status::Ok, !(lo..=hi).contains(&length));
+            warned += report.clamp_messages.len();
+            assert_eq!(report.status, Status::Ok);
+            assert_eq!(report.clamped, !(lo..=hi).contains(&length));
             if length > hi {
                 assert_eq!(out.force, at_limit.force);
             }

@@ -217,10 +217,9 @@ impl McKibbenJoint {
         );
         match clamped {
             Some(reason) => {
-                if !self.out_of_range {
-                    report.warn(format!("jointPosition {q} rad: {reason}"));
-                }
-                report.status = report.status.max(Status::Warning);
+                report.clamp(!self.out_of_range, || {
+                    format!("jointPosition {q} rad: {reason}")
+                });
                 self.out_of_range = true;
             }
             None => self.out_of_range = false,

@@ -5,7 +5,7 @@
 //! nodes), friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
-use super::{Model, Partials, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report};
 use crate::physics::bladder::BladderTube;
 use crate::physics::calibration::MuscleParams;
 use crate::physics::festo::{DMSP_10, DMSP_40};
@@ -141,7 +141,7 @@ fn geometry(p: &Parameters) -> Result<Resolved, String> {
     Ok(Resolved { params, overridden })
 }
 
-/// The warning for an input without a solution: once per excursion, then only the status.
+/// An input without a solution: explained once per excursion, then only flagged.
 fn out_of_range(
     logged: &mut bool,
     report: &mut Report,
@@ -149,16 +149,15 @@ fn out_of_range(
     (lo, hi): (f64, f64),
     fallback: Option<(f64, f64)>,
 ) {
-    if !*logged {
+    report.clamp(!*logged, || {
         let what = match fallback {
             Some((p, l)) => format!("evaluating at pressure {p} Pa and length {l} m"),
             None => "holding the previous outputs".into(),
         };
-        report.warn(format!(
+        format!(
             "{reason} (valid lengths {lo} .. {hi} m, max_length {hi} m); {what} until the inputs return"
-        ));
-    }
-    report.status = report.status.max(Status::Warning);
+        )
+    });
     *logged = true;
 }
 

@@ -34,6 +34,13 @@ pub enum Status {
 pub struct Report {
     pub status: Status,
     pub messages: Vec<(Status, String)>,
+    /// The model ran (evaluated or stepped): `clamped` describes the outputs it wrote.
+    pub evaluated: bool,
+    /// An input lay outside the model's solvable range and was evaluated at the nearest valid
+    /// point. The export layer turns this into a status by the `out_of_range_policy` parameter.
+    pub clamped: bool,
+    /// Why, logged once per excursion (the first call that leaves the range).
+    pub clamp_messages: Vec<String>,
 }
 
 impl Report {
@@ -43,6 +50,14 @@ impl Report {
     }
     pub fn warn(&mut self, message: impl Into<String>) {
         self.add(Status::Warning, message)
+    }
+    /// Records an input evaluated at the nearest valid point; `message` is built only on the
+    /// first call of an excursion (`first`), so that the log gets one line per excursion.
+    pub fn clamp(&mut self, first: bool, message: impl FnOnce() -> String) {
+        self.clamped = true;
+        if first {
+            self.clamp_messages.push(message());
+        }
     }
 }
 

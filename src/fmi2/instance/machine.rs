@@ -211,7 +211,7 @@ impl Instance {
         }
         let mut report = Report::default();
         self.runtime.step(time, step, &mut report);
-        let status = self.forward(F, report);
+        let status = self.forward(F, report, true);
         match status {
             fmi2Status::OK | fmi2Status::Warning => self.time = time + step,
             fmi2Status::Discard => self.state = MachineState::StepFailed,

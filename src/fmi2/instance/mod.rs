@@ -15,6 +15,7 @@ pub use machine::{allowed, MachineState};
 pub use values::{CBoolean, Value};
 
 use super::logger::Logger;
+use super::out_of_range::OutOfRange;
 use super::runtime::{Factory, Runtime};
 use super::types::fmi2Status;
 use crate::models::{Report, Status};
@@ -42,6 +43,7 @@ pub struct Instance {
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
     fmu_states: HashSet<usize>,
+    out_of_range: OutOfRange,
 }
 
 fn type_index(kind: VarType) -> usize {
@@ -87,6 +89,7 @@ impl Instance {
             runtime: factory.create(),
             string_values: Vec::new(),
             fmu_states: HashSet::new(),
+            out_of_range: OutOfRange::new(info),
         }
     }
 
@@ -113,8 +116,20 @@ impl Instance {
         true
     }
 
-    /// Passes a model's messages to the logger and turns its status into an FMI status.
-    pub(super) fn forward(&self, function: &str, report: Report) -> fmi2Status {
+    /// Applies the out-of-range policy, passes a model's messages to the logger and turns its
+    /// status into an FMI status; `in_step` for fmi2DoStep.
+    pub(super) fn forward(
+        &mut self,
+        function: &str,
+        mut report: Report,
+        in_step: bool,
+    ) -> fmi2Status {
+        let notes = self
+            .out_of_range
+            .apply(self.runtime.as_mut(), &mut report, in_step);
+        for note in notes {
+            self.logger.notice(&format!("{function}: {note}"));
+        }
         for (status, message) in &report.messages {
             self.logger
                 .log(to_fmi(*status), &format!("{function}: {message}"));
@@ -134,7 +149,7 @@ impl Instance {
         }
         let mut report = Report::default();
         self.runtime.refresh_outputs(&mut report);
-        self.forward(function, report)
+        self.forward(function, report, false)
     }
 }
 
