@@ -10,7 +10,8 @@
  *   S h                                    fmi2DoStep from the current time by h
  *   G vr ...                               print the Reals (one line)
  *   N                                      a fresh instance (the old one terminated and freed)
- * Exits 1 on any status other than fmi2OK, after printing the call and status. */
+ * Exits 1 on fmi2Discard or worse, after printing the call and status; a warning (logged on
+ * stderr) lets the run go on, since the transcripts compare numbers. */
 #include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -57,7 +58,7 @@ static void *symbol(const char *name) {
 }
 
 static void check(const char *call, int status) {
-    if (status != 0) {
+    if (status > 1) {
         printf("%s returned %d\n", call, status);
         exit(1);
     }
