@@ -125,16 +125,79 @@ impl Motor {
         self.sane(&out).then_some(out)
     }
 
-    /// One error-controlled substep: the new state and its error relative to the tolerance.
-    /// The quasi-static rotor uses the embedded pair ([`Self::embedded_step`]); the Gilbert onion
-    /// (a 4x4 system) keeps step doubling.
-    pub(super) fn controlled_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<(Vector, f64)> {
+    /// One error-controlled substep: the new state, its error relative to the tolerance and the
+    /// time it advances (`dt`, or less when the quasi-static onion snaps inside it, see
+    /// [`Self::step_to_onion_snap`]). The quasi-static rotor uses the embedded pair
+    /// ([`Self::embedded_step`]); the Gilbert onion (a 4x4 system) keeps step doubling.
+    pub(super) fn controlled_step(
+        &self,
+        y: &Vector,
+        dt: f64,
+        d: &Drive,
+    ) -> Option<(Vector, f64, f64)> {
         if self.quasi_static() && !d.locked {
-            if let Some(result) = self.embedded_step(y, dt, d) {
-                return result;
+            match self.embedded_step(y, dt, d) {
+                Some(Some((u, err))) if self.onion_snapped(y, &u) => {
+                    return self.step_to_onion_snap(y, dt, d).or(Some((u, err, dt)));
+                }
+                Some(result) => return result.map(|(u, err)| (u, err, dt)),
+                None => {}
             }
         }
-        self.doubled_step(y, dt, d)
+        self.doubled_step(y, dt, d).map(|(u, err)| (u, err, dt))
+    }
+
+    /// Whether the quasi-static onion left its branch between `y` and `u`: its minimum of eq. 3.3
+    /// plus eq. 3.4 vanished at a fold and it fell into the other one (the jump far out of
+    /// alignment of Figure 3.3a). Along a branch it turns with the rotor, by
+    /// `k_bar / (k_bar + k_me)` times the rotor's turn (a few times it except at the fold itself),
+    /// so a turn beyond that plus `ONION_SNAP` rad is a jump.
+    fn onion_snapped(&self, y: &Vector, u: &Vector) -> bool {
+        (u[2] - y[2]).abs() > ONION_SNAP + 4.0 * (u[0] - y[0]).abs()
+    }
+
+    /// A substep across an onion snap, cut at the snap. The torque jumps there, so the pair's
+    /// defect (and step doubling's difference) stays of the order of the jump however short the
+    /// substep: the error control alone can only shrink the substep to the budget's minimum and
+    /// accept it flagged, with the snap misplaced by up to that substep (4.8 ns against the
+    /// rotor's 2 ns inertial time `I/c`). Instead the snap is located by bisection on the substep
+    /// length, the rotor advanced on the old branch to just before it (error-controlled as
+    /// usual), and the onion put on its new branch; the substep after it starts from the new
+    /// torque. `None` if no snap-free prefix is found.
+    fn step_to_onion_snap(&self, y: &Vector, dt: f64, d: &Drive) -> Option<(Vector, f64, f64)> {
+        let (mut before, mut after) = (0.0, dt);
+        let mut last_before: Option<(Vector, f64)> = None;
+        let mut snapped = None;
+        // The snap is placed within SNAP_RESOLUTION of the rotor's inertial time: the rotor
+        // turns by less than that times its speed in the gap (~1e-8 rad at 5e4 rad/s).
+        let resolution = SNAP_RESOLUTION * self.inertia / self.drag;
+        for _ in 0..60 {
+            if after - before <= resolution {
+                break;
+            }
+            let mid = 0.5 * (before + after);
+            match self.embedded_step(y, mid, d) {
+                Some(Some((u, err))) if !self.onion_snapped(y, &u) => {
+                    before = mid;
+                    last_before = Some((u, err));
+                }
+                Some(Some((u, _))) => {
+                    after = mid;
+                    snapped = Some(u);
+                }
+                _ => return None,
+            }
+        }
+        let (mut u, err) = last_before?;
+        let snapped = match snapped {
+            Some(v) => v,
+            None => self.embedded_step(y, dt, d)??.0,
+        };
+        // The rotor state at the snap, the onion on the branch it fell into there.
+        u[2] = self
+            .landscape(u[0], d.direction, d.stress)
+            .settle(snapped[2]);
+        self.sane(&u).then_some((u, err, after))
     }
 
     /// The exponential Rosenbrock pair of order 2(3) of Hochbruck, Ostermann and Schweitzer
@@ -219,20 +282,20 @@ impl Motor {
         }
         let forced = dt_try <= dt_min * (1.0 + 1e-12);
         match self.controlled_step(&run.y, dt_try, d) {
-            Some((y_new, err)) if err <= 1.0 || forced => {
+            Some((y_new, err, taken)) if err <= 1.0 || forced => {
                 if err > 1.0 {
                     run.limited = true;
                 }
                 run.y = y_new;
-                let end = t + dt_try;
+                let end = t + taken;
                 run.t = if end >= segment_end || segment_end - end < 1e-15 * run.t_end {
                     segment_end.max(end).min(run.t_end)
                 } else {
                     end
                 };
-                run.dt = dt_try * step_factor(err);
+                run.dt = taken * step_factor(err);
             }
-            Some((_, err)) => run.dt = (dt_try * step_factor(err)).max(dt_min),
+            Some((_, err, _)) => run.dt = (dt_try * step_factor(err)).max(dt_min),
             None if forced => {
                 // The linearization overflowed even at the smallest allowed substep: hold the
                 // state over it rather than produce garbage.
@@ -254,6 +317,13 @@ pub(super) fn step_factor(err: f64) -> f64 {
         (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
     }
 }
+
+/// A turn of the quasi-static onion beyond its branch's (rad) that marks a snap to the other
+/// branch ([`Motor::onion_snapped`]); the snaps seen are about 1 rad.
+const ONION_SNAP: f64 = 0.05;
+
+/// The snap is located within this fraction of the rotor's inertial time `I/c`.
+const SNAP_RESOLUTION: f64 = 1e-4;
 
 /// A segment of constant drive may use at most 1/this of the substeps left (see [`Motor::step`]).
 const SEGMENT_BUDGET_SHARE: u32 = 16;

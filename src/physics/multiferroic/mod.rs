@@ -505,7 +505,9 @@ impl Motor {
     /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
     ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
     ///   budget`; a substep at that minimum is accepted even if its error exceeds the tolerance
-    ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]);
+    ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]). A substep across a snap of
+    ///   the quasi-static onion to its other branch is cut at the snap (located by bisection),
+    ///   since the torque jumps there and no error estimate shrinks with a substep across it;
     /// - a slipping rotor (no equilibrium ahead) advances by whole overdamped turns
     ///   ([`Self::slip_turns`], flagged).
     ///
