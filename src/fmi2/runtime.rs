@@ -2,7 +2,7 @@
 //! trait object so that the exported functions are written once for every model.
 
 use crate::models::{Model, Report, Vars};
-use crate::variables::ModelInfo;
+use crate::variables::{Causality, ModelInfo, VarType};
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::marker::PhantomData;
@@ -121,7 +121,7 @@ impl<M: Model> Runtime for RuntimeOf<M> {
         postcard::to_stdvec(self).map_err(|e| e.to_string())
     }
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
-        let r: Self =
+        let mut r: Self =
             postcard::from_bytes(bytes).map_err(|e| format!("corrupt model state: {e}"))?;
         let [nr, ni, nb, ns] = M::INFO.counts;
         let v = &r.vars;
@@ -134,9 +134,40 @@ impl<M: Model> Runtime for RuntimeOf<M> {
         {
             return Err("the variable counts do not match this model".into());
         }
+        if let Some(saved) = r.model.take() {
+            r.model = Some(rebuilt(&r.vars, &saved)?);
+        }
         Ok(Box::new(r))
     }
     fn as_any(&self) -> &dyn Any {
         self
     }
+}
+
+/// The model that `saved` (deserialized from an importer's bytes) stands for, rebuilt from the
+/// parameters in `vars` so that its derived data (limits, geometry, caches) never comes from the
+/// bytes, with `saved`'s history once the model has checked it. The checksum of a serialized state
+/// only catches accidents: bytes changed and resealed deliberately reach this point.
+fn rebuilt<M: Model>(vars: &Vars, saved: &M) -> Result<M, String> {
+    // `new` also writes the calculated parameters (and some models their initial outputs) into
+    // its copy: the restored variables keep their own values, which must agree on the former.
+    let mut fresh_vars = vars.clone();
+    let mut model = M::new(&mut fresh_vars)
+        .map_err(|e| format!("corrupt model state: its parameters do not build the model: {e}"))?;
+    for var in M::INFO.variables {
+        let i = var.vr as usize;
+        if var.causality == Causality::CalculatedParameter
+            && var.kind == VarType::Real
+            && vars.real[i].to_bits() != fresh_vars.real[i].to_bits()
+        {
+            return Err(format!(
+                "corrupt model state: calculated parameter {} = {} but its parameters give {}",
+                var.name, vars.real[i], fresh_vars.real[i]
+            ));
+        }
+    }
+    model
+        .adopt_history(saved)
+        .map_err(|e| format!("corrupt model state: {e}"))?;
+    Ok(model)
 }

@@ -320,6 +320,14 @@ impl Model for KnittedMuscle {
     const INFO: &'static ModelInfo = &INFO;
     const DOCUMENTATION: &'static str = include_str!("knitted_muscle.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        saved.history.check("friction history")?;
+        self.history = saved.history;
+        self.out_of_range = saved.out_of_range;
+        self.collapsed = saved.collapsed;
+        Ok(())
+    }
+
     fn new(vars: &mut Vars) -> Result<Self, String> {
         let sleeve = KnittedSleeve::new(sleeve_params(vars)?, shape_kind(vars)?)?;
         let bladder = bladder(vars, &sleeve)?;

@@ -175,6 +175,15 @@ impl Model for McKibbenJoint {
     const INFO: &'static ModelInfo = &INFO;
     const DOCUMENTATION: &'static str = include_str!("mckibben_joint.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        saved.flexor_friction.check("flexor friction history")?;
+        saved.extensor_friction.check("extensor friction history")?;
+        self.flexor_friction = saved.flexor_friction;
+        self.extensor_friction = saved.extensor_friction;
+        self.out_of_range = saved.out_of_range;
+        Ok(())
+    }
+
     fn new(vars: &mut Vars) -> Result<Self, String> {
         let r = &vars.real;
         let moment_arm = positive("moment_arm", r[real::MOMENT_ARM])?;

@@ -193,6 +193,13 @@ impl Model for McKibbenMuscle {
     const INFO: &'static ModelInfo = &INFO;
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        saved.friction.check("friction history")?;
+        self.friction = saved.friction;
+        self.out_of_range = saved.out_of_range;
+        Ok(())
+    }
+
     fn new(vars: &mut Vars) -> Result<Self, String> {
         let (sleeve, tube) = geometry(vars)?;
         let model = BladderModel::from_switch(

@@ -94,4 +94,13 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// Advances from `time` to `time + step` with the inputs held, commits the history and writes
     /// the outputs at the end of the step.
     fn step(&mut self, vars: &mut Vars, time: f64, step: f64, report: &mut Report);
+
+    /// Takes over the history of `saved`, a model deserialized from an importer's bytes, after
+    /// checking it against the model's invariants. `self` was rebuilt by [`Model::new`] from the
+    /// parameters that came with `saved`, so nothing derived from parameters (limits, geometry,
+    /// caches) is taken from the bytes. A history no legal call sequence produces is an `Err`
+    /// saying which. The default, for models without history, takes nothing.
+    fn adopt_history(&mut self, _saved: &Self) -> Result<(), String> {
+        Ok(())
+    }
 }

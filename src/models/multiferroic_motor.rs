@@ -7,7 +7,8 @@
 
 use super::{Model, Report, Status, Vars};
 use crate::physics::multiferroic::{
-    Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, SteppingSchedule,
+    Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, ScheduleSwitch,
+    SteppingSchedule,
 };
 use crate::variables::multiferroic_motor::{boolean, integer, real, INFO};
 use crate::variables::ModelInfo;
@@ -17,7 +18,7 @@ use serde::{Deserialize, Serialize};
 pub struct MultiferroicMotor {
     motor: Motor,
     /// The built-in stepping schedule when `schedule = 1`.
-    schedule: Option<SteppingSchedule>,
+    schedule: ScheduleSwitch,
     rotor_locked: bool,
     state: MotorState,
     /// Largest magnitude of the ring's torque on the bar (N m), for [`Self::implausible`].
@@ -106,6 +107,13 @@ impl Model for MultiferroicMotor {
     const INFO: &'static ModelInfo = &INFO;
     const DOCUMENTATION: &'static str = include_str!("multiferroic_motor.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        Motor::validate_state(&saved.state).map_err(|e| format!("motor state: {e}"))?;
+        self.state = saved.state;
+        self.accuracy_warned = saved.accuracy_warned;
+        Ok(())
+    }
+
     fn new(vars: &mut Vars) -> Result<Self, String> {
         let r = &vars.real;
         let max_substeps = u32::try_from(vars.integer[integer::MAX_SUBSTEPS]).map_err(|_| {
@@ -142,7 +150,7 @@ impl Model for MultiferroicMotor {
             r[real::STEP_PERIOD],
             r[real::STRESS_AMPLITUDE],
         )?;
-        let schedule = switch(vars, integer::SCHEDULE, "schedule")?.then_some(stepping);
+        let schedule = ScheduleSwitch::new(switch(vars, integer::SCHEDULE, "schedule")?, stepping);
         let motor = Motor::new(params)?;
         vars.real[real::INERTIA] = motor.inertia;
         vars.real[real::DRAG] = motor.drag;

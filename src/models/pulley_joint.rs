@@ -43,6 +43,14 @@ struct Params {
 }
 
 impl Params {
+    /// Whether angle `q` and velocity `dq` give finite outputs: huge (but legal) moment arms or
+    /// rest lengths can overflow the muscle lengths `L0 -/+ r q`.
+    fn representable(&self, q: f64, dq: f64) -> bool {
+        dq.is_finite()
+            && (self.rest_length - self.moment_arm * q).is_finite()
+            && (self.rest_length + self.moment_arm * q).is_finite()
+    }
+
     /// Quintic moves between the waypoints, as `reference` in examples/robot_joint.py.
     fn reference(&self, t: f64) -> (f64, f64) {
         let (w, period) = (&self.waypoints, self.segment_time);
@@ -97,6 +105,20 @@ impl PulleyJoint {
 impl Model for PulleyJoint {
     const INFO: &'static ModelInfo = &INFO;
     const DOCUMENTATION: &'static str = include_str!("pulley_joint.html");
+
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        // Any angle and velocity whose outputs are finite is a state the joint can be driven into.
+        if !self.p.representable(saved.q, saved.dq) {
+            return Err(format!(
+                "joint angle {} rad and velocity {} rad/s must be finite, and so the muscle \
+                 lengths they give",
+                saved.q, saved.dq
+            ));
+        }
+        self.q = saved.q;
+        self.dq = saved.dq;
+        Ok(())
+    }
 
     fn new(vars: &mut Vars) -> Result<Self, String> {
         let inertia = positive(vars, "inertia", real::INERTIA)?;
@@ -155,11 +177,22 @@ impl Model for PulleyJoint {
         Ok(joint)
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, _report: &mut Report) {
+    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
         // Outputs at the current time: only the torque follows the inputs directly.
         let p = &self.p;
-        vars.real[real::JOINT_TORQUE] =
+        let torque =
             p.moment_arm * (vars.real[real::FLEXOR_FORCE] - vars.real[real::EXTENSOR_FORCE]);
+        if torque.is_finite() {
+            vars.real[real::JOINT_TORQUE] = torque;
+        } else {
+            report.add(
+                Status::Error,
+                format!(
+                    "the joint torque overflows (moment arm {} m times the force difference)",
+                    p.moment_arm
+                ),
+            );
+        }
     }
 
     fn step(&mut self, vars: &mut Vars, time: f64, step: f64, report: &mut Report) {
@@ -175,7 +208,7 @@ impl Model for PulleyJoint {
             dq += h * (torque - p.damping * dq - p.gravity_torque * q.sin()) / p.inertia;
             q += h * dq;
         }
-        if !(q.is_finite() && dq.is_finite()) {
+        if !(p.representable(q, dq) && torque.is_finite()) {
             report.add(
                 Status::Discard,
                 format!("the joint diverged in the step from t = {time} s (torque {torque} N.m); state kept"),

@@ -38,7 +38,7 @@ mod tests;
 
 use magnetics::{RingBar, GYROMAGNETIC_RATIO, MU0};
 use onion::Landscape;
-pub use schedule::SteppingSchedule;
+pub use schedule::{ScheduleSwitch, SteppingSchedule};
 use std::f64::consts::PI;
 
 /// Largest accepted `|sigma11 - sigma22|` (Pa): far beyond any material's strength.
@@ -197,7 +197,7 @@ pub struct MotorInputs {
     /// Holds the rotor still (to measure static torque).
     pub rotor_locked: bool,
     /// Built-in stepping schedule; overrides `strain_direction` and `stress`.
-    pub schedule: Option<SteppingSchedule>,
+    pub schedule: ScheduleSwitch,
 }
 
 impl MotorInputs {
@@ -207,7 +207,7 @@ impl MotorInputs {
             stress,
             load_torque: 0.0,
             rotor_locked: false,
-            schedule: None,
+            schedule: ScheduleSwitch::OFF,
         }
     }
 }
@@ -460,7 +460,7 @@ impl Motor {
         )?;
         check_finite("stress", inputs.stress, MAX_STRESS, "Pa")?;
         check_finite("load_torque", inputs.load_torque, MAX_LOAD_TORQUE, "N m")?;
-        if let Some(s) = &inputs.schedule {
+        if let Some(s) = inputs.schedule.get() {
             SteppingSchedule::new(
                 s.initial_direction,
                 s.step_angle,
@@ -471,7 +471,8 @@ impl Motor {
         Ok(())
     }
 
-    fn validate_state(state: &MotorState) -> Result<(), String> {
+    /// Why `state` is not one [`Motor::step`] can start from (non-finite or beyond its bounds).
+    pub fn validate_state(state: &MotorState) -> Result<(), String> {
         check_finite("time", state.time, 1e12, "s")?;
         check_finite("rotor_angle", state.rotor_angle, MAX_ANGLE, "rad")?;
         check_finite("rotor_speed", state.rotor_speed, 1e30, "rad/s")?;
@@ -481,7 +482,7 @@ impl Motor {
     }
 
     fn drive_at(&self, inputs: &MotorInputs, time: f64) -> Drive {
-        let (direction, stress) = match &inputs.schedule {
+        let (direction, stress) = match inputs.schedule.get() {
             Some(s) => (s.direction(time), s.stress_amplitude),
             None => (inputs.strain_direction, inputs.stress),
         };
@@ -987,7 +988,7 @@ impl Motor {
             if t >= t_end {
                 break;
             }
-            if let (Some(s), true) = (&inputs.schedule, t == segment_end_prev) {
+            if let (Some(s), true) = (inputs.schedule.get(), t == segment_end_prev) {
                 // A switch reached. The equations are invariant under a common rotation of rotor,
                 // onion and strain, so once whole periods end in the same relative state, every
                 // later period repeats the last one turned by step_angle. Required: three
@@ -1027,7 +1028,7 @@ impl Motor {
             if self.quasi_static() {
                 y[2] = self.settle(&y, &d);
             }
-            let segment_end = match &inputs.schedule {
+            let segment_end = match inputs.schedule.get() {
                 Some(s) => s.next_switch_after(t).min(t_end),
                 None => t_end,
             };
