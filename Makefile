@@ -98,16 +98,25 @@ sweep: fmus $(VENV)/.installed
 .PHONY: fuzz memcheck
 
 FUZZ_SECONDS ?= 120
-## Fuzzes random FMI call sequences on both models for FUZZ_SECONDS (cargo-fuzz, nightly Rust).
-## The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go to the ignored
-## fuzz/corpus-run/, crashes to fuzz/artifacts/. Nothing is committed.
+## address (the default: AddressSanitizer, ~15x slower) or none (the plain build, for volume).
+SANITIZER ?= address
+## Fuzzes random FMI call sequences on all six models for FUZZ_SECONDS (cargo-fuzz, nightly Rust),
+## with the harness of tests/fuzz_driver/ (tests/fuzz_corpus.rs replays the committed corpus in
+## `make test`). The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go
+## to the ignored fuzz/corpus-run/, findings to the ignored fuzz/artifacts/. The summary line
+## counts the sequences run ("stat::number_of_executed_units"). The tracked fuzz/Cargo.lock must
+## come out unchanged (a dependency change shows here, to be committed).
 fuzz:
-	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz
+	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
-	mkdir -p fuzz/corpus-run/call_sequences
-	cargo +nightly fuzz run call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
+	mkdir -p fuzz/corpus-run/call_sequences fuzz/logs
+	cargo +nightly fuzz run -s $(SANITIZER) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
 	  $(CURDIR)/fuzz/corpus/call_sequences -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
-	  -rss_limit_mb=2048 -print_final_stats=1
+	  -rss_limit_mb=2048 -print_final_stats=1 \
+	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; test $${PIPESTATUS[0]} = 0
+	@grep -h 'stat::number_of_executed_units' fuzz/logs/$(SANITIZER).log \
+	  | awk '{n += $$2} END {print "make fuzz SANITIZER=$(SANITIZER): " n " sequences without a finding"}'
+	@git diff --exit-code --stat -- fuzz/Cargo.lock
 
 ## The FMPy suite under valgrind memcheck: any memory error, or a leak allocated outside CPython
 ## and NumPy, fails. PYTHONMALLOC=malloc lets valgrind see every Python allocation.

@@ -22,6 +22,7 @@
 
 // `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+use super::bounds::limit;
 use std::f64::consts::PI;
 
 /// Newton iterations per solve; the warm start usually converges in 3-5.
@@ -554,7 +555,7 @@ impl Solver {
                     self.radii[j] = if self.held[j] {
                         base[j]
                     } else {
-                        (base[j] + alpha * self.x[j]).clamp(r_min, r_ceiling)
+                        limit(base[j] + alpha * self.x[j], r_min, r_ceiling)
                     };
                 }
                 self.hold_touching(r_min);
@@ -627,7 +628,7 @@ impl Solver {
         } else {
             n
         };
-        let period = period.clamp(2.0 * geom.rows_per_segment(), n);
+        let period = limit(period, 2.0 * geom.rows_per_segment(), n);
         let amplitude = deficit * m / (PI * period);
         let k = geom.rows_per_segment();
         let rings = self.radii.len();
@@ -715,7 +716,7 @@ impl ShapeTable {
         if last == 0 || !(self.spacing > 0.0) {
             return (0, 0.0);
         }
-        let u = ((self.max_length - length) / self.spacing).clamp(0.0, last as f64);
+        let u = limit((self.max_length - length) / self.spacing, 0.0, last as f64);
         let i = (u.floor() as usize).min(last - 1);
         (i, u - i as f64)
     }
@@ -788,7 +789,7 @@ impl ShapeTable {
         if !length.is_finite() {
             return Err(format!("length must be finite, got {length}"));
         }
-        let length = length.clamp(self.min_length(), self.max_length);
+        let length = limit(length, self.min_length(), self.max_length);
         let mut solver = Solver::new(&self.geometry);
         let nodes = self.volume.len().saturating_sub(1).max(1);
         follow_path(&self.geometry, &mut solver, length, nodes, Some(length))?;
@@ -820,7 +821,7 @@ fn follow_path(
     let l_max = geom.max_length();
     let r = geom.min_radius;
     let s = geom.row_strand_length;
-    let end = end_length.clamp(0.0, l_max);
+    let end = limit(end_length, 0.0, l_max);
     let nodes = nodes.clamp(2, 100_000);
     let step = (l_max - end) / nodes as f64;
     let mut pts = Vec::with_capacity(nodes + 1);
@@ -979,7 +980,7 @@ pub fn seed_gradient_volume_curve(
     let l_max = geom.max_length();
     let r_min = geom.min_radius;
     let r_ceiling = geom.radius_ceiling();
-    let end = end_length.clamp(0.0, l_max);
+    let end = limit(end_length, 0.0, l_max);
     let steps = options.length_steps.clamp(1, 100_000);
     let rings = geom.segments + 1;
     let r_ref = geom.row_strand_length / (2.0 * PI);
@@ -1079,7 +1080,7 @@ pub fn seed_gradient_volume_curve(
                     .map(|(a, b)| a.lb + b.la);
                 match dlw {
                     Some(g) if g < 0.0 => {
-                        trial[worst] = (trial[worst] - err / g).clamp(r_min, r_ceiling)
+                        trial[worst] = limit(trial[worst] - err / g, r_min, r_ceiling)
                     }
                     _ => break,
                 }

@@ -1,6 +1,7 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no pointers.
 
 pub mod bladder;
+pub mod bounds;
 pub mod friction;
 pub mod gaylord;
 pub mod knitted;
