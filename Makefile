@@ -118,14 +118,33 @@ fuzz:
 	  | awk '{n += $$2} END {print "make fuzz SANITIZER=$(SANITIZER): " n " sequences without a finding"}'
 	@git diff --exit-code --stat -- fuzz/Cargo.lock
 
-## The FMPy suite under valgrind memcheck: any memory error, or a leak allocated outside CPython
-## and NumPy, fails. PYTHONMALLOC=malloc lets valgrind see every Python allocation.
+## Valgrind memcheck, two halves, each with its whole log kept in out/memcheck/ and its summary
+## printed; any error in either fails:
+## - native: examples/memcheck_native.rs loads every FMU through its C ABI (no Python), runs
+##   each with default parameters and with all effects on, and every scene; definite and
+##   indirect leaks count as errors and nothing is suppressed.
+## - fmpy: the FMPy suite (MEMCHECK_TESTS) with memory errors checked, not leaks (the Python
+##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so.
 MEMCHECK_TESTS ?= tests/fmpy
+MEMCHECK_DIR := out/memcheck
+VALGRIND := valgrind --tool=memcheck --error-exitcode=1 --num-callers=30
 memcheck: fmus $(VENV)/.installed
 	@command -v valgrind >/dev/null || { \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq valgrind; }
-	PYTHONMALLOC=malloc valgrind --tool=memcheck --error-exitcode=1 \
-	  --suppressions=tests/valgrind-python.supp --leak-check=full \
-	  --errors-for-leak-kinds=definite --show-leak-kinds=definite --num-callers=30 \
-	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS)
+	cargo build --release --example memcheck_native
+	mkdir -p $(MEMCHECK_DIR)
+	@start=$$(date +%s); \
+	$(VALGRIND) --leak-check=full --errors-for-leak-kinds=definite,indirect \
+	  --show-leak-kinds=definite,indirect --log-file=$(MEMCHECK_DIR)/native.log \
+	  target/release/examples/memcheck_native > $(MEMCHECK_DIR)/native.out 2>&1; native=$$?; \
+	tail -1 $(MEMCHECK_DIR)/native.out; \
+	echo "native: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/native.log)"; \
+	grep -h 'definitely lost\|indirectly lost\|All heap blocks were freed' $(MEMCHECK_DIR)/native.log; \
+	PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
+	  --log-file=$(MEMCHECK_DIR)/fmpy.log \
+	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS) > $(MEMCHECK_DIR)/fmpy.out 2>&1; fmpy=$$?; \
+	tail -1 $(MEMCHECK_DIR)/fmpy.out; \
+	echo "fmpy: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/fmpy.log)"; \
+	echo "make memcheck: $$(( $$(date +%s) - start )) s; logs in $(MEMCHECK_DIR)/"; \
+	test $$native = 0 -a $$fmpy = 0
