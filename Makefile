@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized
 
 all: fmus
 
@@ -25,8 +25,8 @@ deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libclang-dev; \
 	fi
 
-$(LIB) target/release/package_fmus: $(SOURCES)
-	cargo build --release --lib --bin package_fmus
+$(LIB) target/release/package_fmus target/release/calibrate: $(SOURCES)
+	cargo build --release --lib --bin package_fmus --bin calibrate
 
 ## target/fmu/<Model>.fmu for every model in modelDescription/.
 fmus: $(LIB) target/release/package_fmus
@@ -46,6 +46,23 @@ scene: fmus $(VENV)/.installed
 figures: fmus $(VENV)/.installed
 	$(PY) scenes/catalogue.py
 
+## Fits McKibbenMuscle to a datasheet (CSV pressure_kpa,contraction,force_n) with the FMU's own
+## physics, checks the result through the FMU: OUT/{params.json,params.ssv,report.md,fit.png}.
+## STARTS: starting points of the search (fewer is faster, e.g. 4 in the tests).
+DATA ?= data/festo/festo_dmsp40.csv
+LENGTH ?= 0.4
+DIAMETER ?= 0.04
+FIT ?= 0,600
+OUT ?= out/calibrate
+STARTS ?= 24
+calibrate: fmus target/release/calibrate $(VENV)/.installed
+	$(PY) calibration/calibrate.py $(DATA) $(LENGTH) $(DIAMETER) $(FIT) $(OUT) $(STARTS)
+
+## The Festo presets' fits (src/physics/festo.rs) and their reports: docs/calibration/dmsp{40,10}/.
+calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
+	$(PY) calibration/calibrate.py data/festo/festo_dmsp40.csv 0.4 0.04 0,600 docs/calibration/dmsp40
+	$(PY) calibration/calibrate.py data/festo/festo_dmsp10.csv 0.25 0.01 0,600 docs/calibration/dmsp10
+
 test-rust: deps fmus
 	cargo test --release
 
@@ -59,6 +76,7 @@ test: test-rust test-fmpy
 bench: deps fmus
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
+	cargo bench --bench directional_derivative
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
@@ -66,9 +84,24 @@ report: deps fmus $(VENV)/.installed
 	cargo bench --bench accuracy_cost
 	$(PY) benches/report.py
 
+## docs/linearized-muscle.md: stiffness dF/dL and pressure gain dF/dP over the stroke of Table 2.1's
+## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
+linearized: fmus $(VENV)/.installed
+	$(PY) docs/linearized/generate.py > /dev/null
+
 clean:
 	cargo clean
 	rm -rf out $(VENV)
+
+## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
+## densities, strain drive and onion reorientation of the MultiferroicMotor FMU (issue 16).
+motor-docs: fmus $(VENV)/.installed
+	$(PY) examples/motor_characteristics.py
+
+## docs/knitted-bag.md and docs/img/knitted_bag.png: the section 1.4 prototype's polyethylene bag
+## and its stroke against the measured 42% and 51% (issue 16).
+knitted-bag-docs: fmus $(VENV)/.installed
+	$(PY) examples/knitted_bag.py
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
@@ -100,6 +133,9 @@ sweep: fmus $(VENV)/.installed
 FUZZ_SECONDS ?= 120
 ## address (the default: AddressSanitizer, ~15x slower) or none (the plain build, for volume).
 SANITIZER ?= address
+## Per-sequence limit in wall-clock seconds: the longest sequences take ~0.3 s of CPU, but a
+## niced run on a loaded machine waits many times that for a core.
+FUZZ_TIMEOUT ?= 120
 ## Fuzzes random FMI call sequences on all six models for FUZZ_SECONDS (cargo-fuzz, nightly Rust),
 ## with the harness of tests/fuzz_driver/ (tests/fuzz_corpus.rs replays the committed corpus in
 ## `make test`). The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go
@@ -111,7 +147,7 @@ fuzz:
 	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
 	mkdir -p fuzz/corpus-run/call_sequences fuzz/logs
 	cargo +nightly fuzz run -s $(SANITIZER) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
-	  $(CURDIR)/fuzz/corpus/call_sequences -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
+	  $(CURDIR)/fuzz/corpus/call_sequences -- -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
 	  -rss_limit_mb=2048 -print_final_stats=1 \
 	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; test $${PIPESTATUS[0]} = 0
 	@grep -h 'stat::number_of_executed_units' fuzz/logs/$(SANITIZER).log \

@@ -100,7 +100,7 @@ fn knitted_min_length_above_max_length_resealed_is_refused() {
     assert_eq!(restore_and_step(&i, info, &crafted), ERROR);
     assert!(
         i.log
-            .contains("corrupt model state: calculated parameter min_length"),
+            .contains("corrupt model state: its calculated parameters"),
         "{:?}",
         i.log.lines()
     );

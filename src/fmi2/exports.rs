@@ -4,8 +4,8 @@
 
 use super::instance::{FmuState, Instance, MAGIC};
 use super::logger::Logger;
+use super::registry::REGISTRY;
 use super::types::*;
-use crate::variables::REGISTRY;
 use std::ffi::{c_char, c_int, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
@@ -32,7 +32,7 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 }
 
 /// Runs `body` on the instance `c`; a panic is logged, the instance becomes fatal.
-fn guarded(
+pub(super) fn guarded(
     c: fmi2Component,
     function: &str,
     body: impl FnOnce(&mut Instance) -> fmi2Status,
@@ -61,7 +61,7 @@ fn guarded(
 ///
 /// # Safety
 /// A non-null `ptr` must point to `n` readable elements.
-unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
+pub(super) unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
     match (ptr.is_null(), n) {
         (_, 0) => Some(&[]),
         (true, _) => None,
@@ -71,7 +71,7 @@ unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
 
 /// # Safety
 /// As [`slice`], for `n` writable elements.
-unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize) -> Option<&'a mut [T]> {
+pub(super) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize) -> Option<&'a mut [T]> {
     match (ptr.is_null(), n) {
         (_, 0) => Some(&mut []),
         (true, _) => None,
@@ -85,7 +85,7 @@ unsafe fn text(s: fmi2String) -> Option<String> {
     (!s.is_null()).then(|| CStr::from_ptr(s).to_string_lossy().into_owned())
 }
 
-fn null_argument(inst: &Instance, function: &str, argument: &str) -> fmi2Status {
+pub(super) fn null_argument(inst: &Instance, function: &str, argument: &str) -> fmi2Status {
     inst.error(&format!("{function}: {argument} must not be NULL"))
 }
 
@@ -158,9 +158,9 @@ pub unsafe extern "C" fn fmi2Instantiate(
         if name.as_deref().is_none_or(str::is_empty) {
             return refuse("instanceName must be a non-empty string".into());
         }
-        if fmu_type != FMI2_CO_SIMULATION {
+        if fmu_type != FMI2_CO_SIMULATION && fmu_type != FMI2_MODEL_EXCHANGE {
             return refuse(format!(
-                "fmuType {fmu_type} is not supported: this FMU is Co-Simulation only (fmuType 1)"
+                "fmuType {fmu_type} is not supported: not an fmi2Type (0 Model Exchange, 1 Co-Simulation)"
             ));
         }
         let Some(guid) = text(fmu_guid) else {
@@ -176,6 +176,13 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 known.join(", ")
             ));
         };
+        let model_exchange = fmu_type == FMI2_MODEL_EXCHANGE;
+        if model_exchange && !factory.model_exchange() {
+            return refuse(format!(
+                "fmuType 0 is not supported: {} is Co-Simulation only (fmuType 1)",
+                factory.info().name
+            ));
+        }
         let mut logger = logger;
         logger.debug = logging_on != FMI2_FALSE;
         // No model reads resources yet; a location that is not a file URI is still worth a word.
@@ -192,7 +199,9 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 ),
             }
         }
-        Some(Box::into_raw(Box::new(Instance::new(*factory, logger))) as fmi2Component)
+        let mut instance = Instance::new(*factory, logger);
+        instance.model_exchange = model_exchange;
+        Some(Box::into_raw(Box::new(instance)) as fmi2Component)
     });
     result.ok().flatten().unwrap_or(std::ptr::null_mut())
 }
@@ -347,7 +356,7 @@ unsafe fn get_values<C: Copy + Default>(
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut C,
-    pick: impl Fn(&crate::models::Vars, usize) -> C,
+    pick: impl Fn(&super::runtime::Vars, usize) -> C,
 ) -> fmi2Status {
     guarded(c, function, |inst| {
         let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
@@ -544,18 +553,27 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
     c: fmi2Component,
-    _unknown: *const fmi2ValueReference,
-    _n_unknown: usize,
-    _known: *const fmi2ValueReference,
-    _n_known: usize,
-    _dv_known: *const fmi2Real,
-    _dv_unknown: *mut fmi2Real,
+    unknown: *const fmi2ValueReference,
+    n_unknown: usize,
+    known: *const fmi2ValueReference,
+    n_known: usize,
+    dv_known: *const fmi2Real,
+    dv_unknown: *mut fmi2Real,
 ) -> fmi2Status {
-    guarded(c, "fmi2GetDirectionalDerivative", |inst| {
-        inst.unsupported(
-            "fmi2GetDirectionalDerivative",
-            "providesDirectionalDerivative is false",
-        )
+    const F: &str = "fmi2GetDirectionalDerivative";
+    guarded(c, F, |inst| {
+        // SAFETY: the importer passes arrays of the stated lengths (or NULL, refused here).
+        let (Some(unknown), Some(known), Some(dv_known), Some(dv_unknown)) = (unsafe {
+            (
+                slice(unknown, n_unknown),
+                slice(known, n_known),
+                slice(dv_known, n_known),
+                slice_mut(dv_unknown, n_unknown),
+            )
+        }) else {
+            return null_argument(inst, F, "vUnknown_ref, vKnown_ref, dvKnown or dvUnknown");
+        };
+        inst.get_directional_derivative(unknown, known, dv_known, dv_unknown)
     })
 }
 

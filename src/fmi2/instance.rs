@@ -23,6 +23,10 @@ pub enum MachineState {
     Terminated,
     Error,
     Fatal,
+    /// Model Exchange (`src/fmi2/model_exchange.rs`); after the others so that saved states keep
+    /// their encoding.
+    EventMode,
+    ContinuousTimeMode,
 }
 
 impl MachineState {
@@ -51,19 +55,40 @@ pub mod allowed {
         StepFailed,
         Terminated,
         Error,
+        EventMode,
+        ContinuousTimeMode,
     ]);
     pub const SETUP_EXPERIMENT: u32 = mask(&[Instantiated]);
     pub const ENTER_INITIALIZATION: u32 = mask(&[Instantiated]);
     pub const EXIT_INITIALIZATION: u32 = mask(&[InitializationMode]);
-    pub const TERMINATE: u32 = mask(&[StepComplete, StepFailed]);
+    pub const TERMINATE: u32 = mask(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
     pub const GET: u32 = mask(&[
         InitializationMode,
         StepComplete,
         StepFailed,
         Terminated,
         Error,
+        EventMode,
+        ContinuousTimeMode,
     ]);
-    pub const SET: u32 = mask(&[Instantiated, InitializationMode, StepComplete]);
+    pub const SET: u32 = mask(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const EVENT_MODE: u32 = mask(&[EventMode]);
+    pub const CONTINUOUS_TIME_MODE: u32 = mask(&[ContinuousTimeMode]);
+    pub const EVENT_OR_CONTINUOUS_TIME_MODE: u32 = mask(&[EventMode, ContinuousTimeMode]);
+    /// The continuous-state getters (FMI 2.0.4 section 3.2.3).
+    pub const GET_STATES: u32 = mask(&[
+        InitializationMode,
+        EventMode,
+        ContinuousTimeMode,
+        Terminated,
+        Error,
+    ]);
     pub const DO_STEP: u32 = mask(&[StepComplete]);
     pub const STATUS: u32 = mask(&[StepComplete, StepFailed, Terminated]);
 }
@@ -78,9 +103,10 @@ pub struct FmuState {
 }
 
 /// Versioned byte format of a serialized FMU state: magic, format version, postcard, then a
-/// 64-bit FNV-1a checksum of everything before it (format 2; format 1 had no checksum).
+/// 64-bit FNV-1a checksum of everything before it (format 3: the models hold their typed ranges
+/// and, for PulleyJoint, its time; format 2 had the same envelope; format 1 had no checksum).
 const STATE_MAGIC: &[u8; 8] = b"AFMUSTAT";
-const STATE_FORMAT: u16 = 2;
+const STATE_FORMAT: u16 = 3;
 
 /// FNV-1a, 64 bit: catches accidental corruption of a stored state (a flipped byte in the model's
 /// history would otherwise reach the physics as garbage), not tampering.
@@ -107,10 +133,12 @@ pub struct Instance {
     /// Variables by type and value reference (value references are dense per type).
     by_type: [Vec<&'static Variable>; 4],
     pub state: MachineState,
-    time: f64,
+    /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
+    pub(super) model_exchange: bool,
+    pub(super) time: f64,
     start_time: f64,
     stop_time: Option<f64>,
-    runtime: Box<dyn Runtime>,
+    pub(super) runtime: Box<dyn Runtime>,
     /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
@@ -126,12 +154,12 @@ fn type_index(kind: VarType) -> usize {
     }
 }
 
-/// A value that fmi2SetXXX can write into [`crate::models::Vars`].
+/// A value that fmi2SetXXX can write into [`super::runtime::Vars`].
 pub trait Value {
     const KIND: VarType;
     /// A reason to refuse the value for this variable, if any.
     fn invalid_for(&self, var: &Variable) -> Option<String>;
-    fn store(&self, vars: &mut crate::models::Vars, index: usize);
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize);
 }
 
 impl Value for f64 {
@@ -142,7 +170,7 @@ impl Value for f64 {
         }
         range_check(*self, var)
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.real[index] = *self;
     }
 }
@@ -152,7 +180,7 @@ impl Value for i32 {
     fn invalid_for(&self, var: &Variable) -> Option<String> {
         range_check(*self as f64, var)
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.integer[index] = *self;
     }
 }
@@ -167,7 +195,7 @@ impl Value for CBoolean {
     fn invalid_for(&self, _: &Variable) -> Option<String> {
         None
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.boolean[index] = self.0 != 0;
     }
 }
@@ -177,7 +205,7 @@ impl Value for String {
     fn invalid_for(&self, _: &Variable) -> Option<String> {
         None
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.string[index].clone_from(self);
     }
 }
@@ -228,6 +256,7 @@ impl Instance {
             info,
             by_type,
             state: MachineState::Instantiated,
+            model_exchange: false,
             time: 0.0,
             start_time: 0.0,
             stop_time: None,
@@ -261,7 +290,7 @@ impl Instance {
     }
 
     /// Passes a model's messages to the logger and turns its status into an FMI status.
-    fn forward(&self, function: &str, report: Report) -> fmi2Status {
+    pub(super) fn forward(&self, function: &str, report: Report) -> fmi2Status {
         for (status, message) in &report.messages {
             self.logger
                 .log(to_fmi(*status), &format!("{function}: {message}"));
@@ -333,7 +362,11 @@ impl Instance {
             self.state = MachineState::Error;
             return status;
         }
-        self.state = MachineState::StepComplete;
+        self.state = if self.model_exchange {
+            MachineState::EventMode
+        } else {
+            MachineState::StepComplete
+        };
         status
     }
 
@@ -359,7 +392,7 @@ impl Instance {
     }
 
     /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.
-    fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
+    pub(super) fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
         if !self.runtime.is_built() {
             if self.state != MachineState::InitializationMode {
                 return fmi2Status::OK;
@@ -401,11 +434,12 @@ impl Instance {
                 input || matches!(var.initial, Initial::Exact | Initial::Approx)
             }
             MachineState::InitializationMode => input || var.initial == Initial::Exact,
-            MachineState::StepComplete => {
+            MachineState::StepComplete | MachineState::EventMode => {
                 input
                     || (var.causality == Causality::Parameter
                         && var.variability == Variability::Tunable)
             }
+            MachineState::ContinuousTimeMode => input,
             _ => false,
         }
     }
@@ -443,8 +477,12 @@ impl Instance {
 
     /// A snapshot to undo a tunable parameter change with, if this set changes one between steps.
     fn before_retune(&self, parameters_changed: bool) -> Option<Box<dyn Runtime>> {
-        (parameters_changed && self.state == MachineState::StepComplete)
-            .then(|| self.runtime.snapshot())
+        (parameters_changed
+            && matches!(
+                self.state,
+                MachineState::StepComplete | MachineState::EventMode
+            ))
+        .then(|| self.runtime.snapshot())
     }
 
     /// After a tunable parameter changed between steps: [`Model`](crate::models::Model) has no
@@ -476,7 +514,7 @@ impl Instance {
         kind: VarType,
         vrs: &[u32],
         out: &mut [T],
-        pick: impl Fn(&crate::models::Vars, usize) -> T,
+        pick: impl Fn(&super::runtime::Vars, usize) -> T,
     ) -> fmi2Status {
         if !self.allowed(function, allowed::GET) {
             return fmi2Status::Error;
@@ -484,7 +522,10 @@ impl Instance {
         let mut status = fmi2Status::OK;
         if matches!(
             self.state,
-            MachineState::InitializationMode | MachineState::StepComplete
+            MachineState::InitializationMode
+                | MachineState::StepComplete
+                | MachineState::EventMode
+                | MachineState::ContinuousTimeMode
         ) {
             status = self.refresh_outputs(function);
             if status >= fmi2Status::Error {
@@ -689,7 +730,7 @@ impl Instance {
 
     /// A value in `vars` that no legal call sequence produces: a non-finite Real (the FMU never
     /// accepts or outputs one), or an input or parameter outside its declared range.
-    fn invalid_values(&self, vars: &crate::models::Vars) -> Option<String> {
+    fn invalid_values(&self, vars: &super::runtime::Vars) -> Option<String> {
         self.info.variables.iter().find_map(|var| {
             let i = var.vr as usize;
             let x = match var.kind {
@@ -795,9 +836,10 @@ mod tests {
     //! The state machine with a minimal model that has what no shipped model has yet: a tunable
     //! parameter (FMI 2.0.4 section 2.2.7 lets it change between steps).
     use super::*;
-    use crate::fmi2::runtime::ModelFactory;
-    use crate::models::{Model, Vars};
-    use crate::variables::Start;
+    use crate::fmi2::registry::Bindings;
+    use crate::fmi2::runtime::{ModelFactory, Vars};
+    use crate::models::{Model, Refusal};
+    use crate::variables::{Interface, Start};
 
     /// y = gain * u, with a tunable gain.
     #[derive(Clone, Serialize, Deserialize)]
@@ -865,20 +907,52 @@ mod tests {
         log_categories: &[],
     };
 
-    impl Model for Gain {
+    /// What build.rs would generate for the three variables above.
+    struct GainVariables;
+    impl Interface for GainVariables {
+        type Parameters = f64;
+        type Inputs = f64;
+        type Outputs = f64;
+        type CalculatedParameters = ();
         const INFO: &'static ModelInfo = &INFO;
+    }
+    impl Bindings for GainVariables {
+        fn parameters(vars: &Vars) -> f64 {
+            vars.real[0]
+        }
+        fn write_parameters(values: &f64, vars: &mut Vars) {
+            vars.real[0] = *values;
+        }
+        fn inputs(vars: &Vars) -> f64 {
+            vars.real[1]
+        }
+        fn write_inputs(values: &f64, vars: &mut Vars) {
+            vars.real[1] = *values;
+        }
+        fn outputs(vars: &Vars) -> f64 {
+            vars.real[2]
+        }
+        fn write_outputs(values: &f64, vars: &mut Vars) {
+            vars.real[2] = *values;
+        }
+        fn calculated_parameters(_: &Vars) {}
+        fn write_calculated_parameters(_: &(), _: &mut Vars) {}
+    }
+
+    impl Model for Gain {
+        type Variables = GainVariables;
         const DOCUMENTATION: &'static str = "";
-        fn new(vars: &mut Vars) -> Result<Self, String> {
-            match vars.real[0] {
+        fn new(gain: &f64, _: &f64) -> Result<Self, Refusal> {
+            match *gain {
                 0.0 => Err("gain must not be zero".into()),
                 gain => Ok(Self { gain }),
             }
         }
-        fn evaluate(&mut self, vars: &mut Vars, _: &mut Report) {
-            vars.real[2] = self.gain * vars.real[1];
+        fn evaluate(&mut self, u: &f64, y: &mut f64, _: &mut Report) {
+            *y = self.gain * u;
         }
-        fn step(&mut self, vars: &mut Vars, _: f64, _: f64, report: &mut Report) {
-            self.evaluate(vars, report);
+        fn step(&mut self, u: &f64, y: &mut f64, _: f64, _: f64, report: &mut Report) {
+            self.evaluate(u, y, report);
         }
     }
 

@@ -1,11 +1,47 @@
-//! The bridge between the C ABI and any [`Model`]: one instance's variables and model, behind a
-//! trait object so that the exported functions are written once for every model.
+//! The bridge between the C ABI and any [`Model`]: one instance's variable values and model,
+//! behind a trait object so that the exported functions are written once for every model.
 
-use crate::models::{Model, Report, Vars};
-use crate::variables::{Causality, ModelInfo, VarType};
+use super::registry::Bindings;
+use crate::models::{Model, Report};
+use crate::variables::{Interface, ModelInfo, Start, VarType};
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::marker::PhantomData;
+
+/// Current values of all variables, indexed by value reference within each type: what
+/// `fmi2GetXXX`/`fmi2SetXXX` read and write. Models never see it; [`Bindings`] copy between it
+/// and their typed groups.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Vars {
+    pub real: Vec<f64>,
+    pub integer: Vec<i32>,
+    pub boolean: Vec<bool>,
+    pub string: Vec<String>,
+}
+
+impl Vars {
+    /// Start values from the model description; variables without one start at zero.
+    pub fn from_start(info: &ModelInfo) -> Self {
+        let [nr, ni, nb, ns] = info.counts;
+        let mut v = Vars {
+            real: vec![0.0; nr],
+            integer: vec![0; ni],
+            boolean: vec![false; nb],
+            string: vec![String::new(); ns],
+        };
+        for var in info.variables {
+            let i = var.vr as usize;
+            match (var.kind, var.start) {
+                (VarType::Real, Start::Real(x)) => v.real[i] = x,
+                (VarType::Integer, Start::Integer(x)) => v.integer[i] = x,
+                (VarType::Boolean, Start::Boolean(x)) => v.boolean[i] = x,
+                (VarType::String, Start::String(x)) => v.string[i] = x.to_string(),
+                _ => {}
+            }
+        }
+        v
+    }
+}
 
 /// Creates instances of one model; the generated `REGISTRY` holds one per model description.
 pub trait Factory: Sync {
@@ -13,6 +49,8 @@ pub trait Factory: Sync {
     /// HTML fragment describing the model's equations.
     fn documentation(&self) -> &'static str;
     fn create(&self) -> Box<dyn Runtime>;
+    /// Whether the model serves Model Exchange ([`Model::ALGEBRAIC_MODEL_EXCHANGE`]).
+    fn model_exchange(&self) -> bool;
 }
 
 pub struct ModelFactory<M>(PhantomData<fn() -> M>);
@@ -21,16 +59,22 @@ impl<M> ModelFactory<M> {
     pub const NEW: Self = Self(PhantomData);
 }
 
-impl<M: Model> Factory for ModelFactory<M> {
+impl<M: Model> Factory for ModelFactory<M>
+where
+    M::Variables: Bindings,
+{
     fn info(&self) -> &'static ModelInfo {
-        M::INFO
+        M::Variables::INFO
     }
     fn documentation(&self) -> &'static str {
         M::DOCUMENTATION
     }
+    fn model_exchange(&self) -> bool {
+        M::ALGEBRAIC_MODEL_EXCHANGE
+    }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
-            vars: Vars::from_start(M::INFO),
+            vars: Vars::from_start(M::Variables::INFO),
             model: None,
             outputs_stale: true,
         })
@@ -50,6 +94,18 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// Model Exchange: commits the history at the current inputs (completed integrator step or
+    /// event) and writes the outputs.
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report);
+    /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
+    /// ([`super::derivatives`]).
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String>;
     /// Start values, no model.
     fn reset(&mut self);
     fn snapshot(&self) -> Box<dyn Runtime>;
@@ -68,7 +124,10 @@ struct RuntimeOf<M: Model> {
     outputs_stale: bool,
 }
 
-impl<M: Model> Runtime for RuntimeOf<M> {
+impl<M: Model> Runtime for RuntimeOf<M>
+where
+    M::Variables: Bindings,
+{
     fn vars(&self) -> &Vars {
         &self.vars
     }
@@ -85,24 +144,59 @@ impl<M: Model> Runtime for RuntimeOf<M> {
         self.model.is_some()
     }
     fn build(&mut self) -> Result<(), String> {
-        self.model = Some(M::new(&mut self.vars)?);
+        let parameters = M::Variables::parameters(&self.vars);
+        let start = M::Variables::inputs(&self.vars);
+        let model = M::new(&parameters, &start).map_err(|r| r.0)?;
+        M::Variables::write_calculated_parameters(&model.calculated_parameters(), &mut self.vars);
+        self.model = Some(model);
         self.outputs_stale = true;
         Ok(())
     }
     fn refresh_outputs(&mut self, report: &mut Report) {
         if let (true, Some(model)) = (self.outputs_stale, self.model.as_mut()) {
-            model.evaluate(&mut self.vars, report);
+            let inputs = M::Variables::inputs(&self.vars);
+            let mut outputs = M::Variables::outputs(&self.vars);
+            model.evaluate(&inputs, &mut outputs, report);
+            M::Variables::write_outputs(&outputs, &mut self.vars);
             self.outputs_stale = false;
         }
     }
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
         if let Some(model) = self.model.as_mut() {
-            model.step(&mut self.vars, time, step, report);
+            let inputs = M::Variables::inputs(&self.vars);
+            let mut outputs = M::Variables::outputs(&self.vars);
+            model.step(&inputs, &mut outputs, time, step, report);
+            M::Variables::write_outputs(&outputs, &mut self.vars);
             self.outputs_stale = false;
         }
     }
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report) {
+        if let Some(model) = self.model.as_mut() {
+            let inputs = M::Variables::inputs(&self.vars);
+            let mut outputs = M::Variables::outputs(&self.vars);
+            model.update_discrete_states(&inputs, &mut outputs, time, report);
+            M::Variables::write_outputs(&outputs, &mut self.vars);
+            self.outputs_stale = false;
+        }
+    }
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        super::derivatives::directional_derivative(
+            self.model.as_mut(),
+            &self.vars,
+            unknown,
+            known,
+            dv_known,
+            dv_unknown,
+        )
+    }
     fn reset(&mut self) {
-        self.vars = Vars::from_start(M::INFO);
+        self.vars = Vars::from_start(M::Variables::INFO);
         self.model = None;
         self.outputs_stale = true;
     }
@@ -123,7 +217,7 @@ impl<M: Model> Runtime for RuntimeOf<M> {
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
         let mut r: Self =
             postcard::from_bytes(bytes).map_err(|e| format!("corrupt model state: {e}"))?;
-        let [nr, ni, nb, ns] = M::INFO.counts;
+        let [nr, ni, nb, ns] = M::Variables::INFO.counts;
         let v = &r.vars;
         if (
             v.real.len(),
@@ -146,25 +240,28 @@ impl<M: Model> Runtime for RuntimeOf<M> {
 
 /// The model that `saved` (deserialized from an importer's bytes) stands for, rebuilt from the
 /// parameters in `vars` so that its derived data (limits, geometry, caches) never comes from the
-/// bytes, with `saved`'s history once the model has checked it. The checksum of a serialized state
-/// only catches accidents: bytes changed and resealed deliberately reach this point.
-fn rebuilt<M: Model>(vars: &Vars, saved: &M) -> Result<M, String> {
-    // `new` also writes the calculated parameters (and some models their initial outputs) into
-    // its copy: the restored variables keep their own values, which must agree on the former.
-    let mut fresh_vars = vars.clone();
-    let mut model = M::new(&mut fresh_vars)
-        .map_err(|e| format!("corrupt model state: its parameters do not build the model: {e}"))?;
-    for var in M::INFO.variables {
-        let i = var.vr as usize;
-        if var.causality == Causality::CalculatedParameter
-            && var.kind == VarType::Real
-            && vars.real[i].to_bits() != fresh_vars.real[i].to_bits()
-        {
-            return Err(format!(
-                "corrupt model state: calculated parameter {} = {} but its parameters give {}",
-                var.name, vars.real[i], fresh_vars.real[i]
-            ));
-        }
+/// bytes, with `saved`'s history once the model has checked it ([`Model::adopt_history`]). The
+/// checksum of a serialized state only catches accidents: bytes changed and resealed deliberately
+/// reach this point.
+fn rebuilt<M: Model>(vars: &Vars, saved: &M) -> Result<M, String>
+where
+    M::Variables: Bindings,
+{
+    let parameters = M::Variables::parameters(vars);
+    let inputs = M::Variables::inputs(vars);
+    let mut model = M::new(&parameters, &inputs).map_err(|r| {
+        format!(
+            "corrupt model state: its parameters do not build the model: {}",
+            r.0
+        )
+    })?;
+    // The restored variables keep their own values, which must agree with what the parameters give.
+    if model.calculated_parameters() != M::Variables::calculated_parameters(vars) {
+        return Err(format!(
+            "corrupt model state: its calculated parameters {:?} are not those its parameters give, {:?}",
+            M::Variables::calculated_parameters(vars),
+            model.calculated_parameters()
+        ));
     }
     model
         .adopt_history(saved)

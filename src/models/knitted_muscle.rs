@@ -8,17 +8,20 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Refusal, Report, Status};
 use crate::physics::bladder::{
     Bladder, BladderState, BladderTube, KnittedCylinder, SleeveGeometry,
 };
 use crate::physics::friction::{HysteresisState, StopOperator};
-use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
+use crate::physics::knitted::{
+    KnittedParams, KnittedSleeve, ShapeKind, ShapeModel, StrandFriction,
+};
+use crate::physics::knitted_bag::Bag;
 use crate::physics::mckibben::BladderModel;
-use crate::variables::knitted_muscle::{boolean, integer, real, INFO};
-use crate::variables::ModelInfo;
+use crate::variables::knitted_muscle::{
+    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+};
 use serde::{Deserialize, Serialize};
-use std::f64::consts::SQRT_2;
 
 /// With a bladder the force grows without bound where the rubber fills the sleeve; a length beyond
 /// such a limit is evaluated this fraction of the range inside it (finite, steep force), as in
@@ -42,6 +45,8 @@ pub struct KnittedMuscle {
     valid: (f64, f64),
     /// `None` when `friction` is off.
     friction: Option<Friction>,
+    /// Section 1.4's bag, `None` when `bag_diameter` is 0.
+    bag: Option<Bag>,
     /// Friction history (eq. 1.21), advanced only by accepted steps.
     history: HysteresisState,
     /// Whether the last evaluation was outside the valid lengths: its warning is logged once per
@@ -50,6 +55,8 @@ pub struct KnittedMuscle {
     /// Whether the last evaluation needed the zero-pressure fallback of a collapsing bladder:
     /// logged once per excursion.
     collapsed: bool,
+    /// The length range reported as `min_length`, `max_length` (m).
+    length_range: (f64, f64),
 }
 
 /// Outputs at one input point, with the friction history after moving there.
@@ -63,18 +70,17 @@ struct Output {
     history: HysteresisState,
 }
 
-fn sleeve_params(vars: &Vars) -> Result<KnittedParams, String> {
-    let r = &vars.real;
-    Ok(match vars.integer[integer::PRESET] {
+fn sleeve_params(r: &Parameters) -> Result<KnittedParams, String> {
+    Ok(match r.preset {
         0 => KnittedParams {
-            stitches_per_row: r[real::STITCHES_PER_ROW],
-            rows: r[real::ROWS],
-            row_strand_length: r[real::ROW_STRAND_LENGTH],
-            strand_thickness: r[real::STRAND_THICKNESS],
+            stitches_per_row: r.stitches_per_row,
+            rows: r.rows,
+            row_strand_length: r.row_strand_length,
+            strand_thickness: r.strand_thickness,
             bladder_outer_radius: 0.0,
         },
         1 => KnittedParams::prototype(),
-        2 => KnittedParams::fig_1_16(r[real::STRAND_THICKNESS]),
+        2 => KnittedParams::fig_1_16(r.strand_thickness),
         k => {
             return Err(format!(
                 "preset must be 0 (none), 1 (section 1.4 prototype) or 2 (Fig. 1.16), got {k}"
@@ -84,24 +90,20 @@ fn sleeve_params(vars: &Vars) -> Result<KnittedParams, String> {
 }
 
 fn bladder(
-    vars: &Vars,
+    r: &Parameters,
     sleeve: &KnittedSleeve,
 ) -> Result<Option<Bladder<KnittedCylinder>>, String> {
-    let layers = match BladderModel::from_switch(
-        vars.integer[integer::BLADDER_MODEL],
-        vars.integer[integer::BLADDER_LAYERS],
-    )? {
+    let layers = match BladderModel::from_switch(r.bladder_model, r.bladder_layers)? {
         BladderModel::None => return Ok(None),
         BladderModel::ThinWall => 1,
         BladderModel::ThickWall { layers } => layers,
     };
-    let r = &vars.real;
     let tube = BladderTube {
-        inner_diameter: r[real::BLADDER_INNER_DIAMETER],
-        thickness: r[real::BLADDER_THICKNESS],
-        unstretched_length: r[real::BLADDER_LENGTH],
-        mooney_c1: r[real::MOONEY_C1],
-        mooney_c2: r[real::MOONEY_C2],
+        inner_diameter: r.bladder_inner_diameter,
+        thickness: r.bladder_thickness,
+        unstretched_length: r.bladder_length,
+        mooney_c1: r.mooney_c1,
+        mooney_c2: r.mooney_c2,
     };
     Bladder::knitted(sleeve, tube, layers).map(Some)
 }
@@ -125,12 +127,12 @@ fn valid_lengths(sleeve: &KnittedSleeve, bladder: Option<&Bladder<KnittedCylinde
     (lo + margin(lo <= s_lo), hi - margin(hi >= s_hi))
 }
 
-fn shape_kind(vars: &Vars) -> Result<ShapeKind, String> {
-    Ok(match vars.integer[integer::SHAPE_MODEL] {
+fn shape_kind(p: &Parameters) -> Result<ShapeKind, String> {
+    Ok(match p.shape_model {
         0 => ShapeKind::Ideal,
         1 => ShapeKind::Tubular,
         2 => {
-            let segments = vars.integer[integer::SHAPE_SEGMENTS];
+            let segments = p.shape_segments;
             // The range itself is checked by the shape solver; this only refuses negatives.
             let segments = usize::try_from(segments)
                 .map_err(|_| format!("shape_segments must be at least 2, got {segments}"))?;
@@ -148,8 +150,9 @@ fn shape_kind(vars: &Vars) -> Result<ShapeKind, String> {
 impl KnittedMuscle {
     /// The physics at the current inputs; a length outside `[min_length, max_length]` is
     /// evaluated at the nearer limit, where the sleeve is rigid (logged once per excursion).
-    fn compute(&mut self, vars: &Vars, report: &mut Report) -> Output {
-        let (pressure, length) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+    /// `None` when the physics refuses (logged); the outputs then keep their values.
+    fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Option<Output> {
+        let (pressure, length) = (inputs.pressure, inputs.length);
         let s = &self.sleeve;
         let (lo, hi) = self.valid;
         let l = if length.is_nan() {
@@ -164,9 +167,7 @@ impl KnittedMuscle {
                 report.warn(format!(
                     "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
                      evaluating at length {l} m until the inputs return",
-                    lo,
-                    hi,
-                    vars.real[real::MAX_LENGTH]
+                    lo, hi, self.length_range.1
                 ));
             }
             report.status = report.status.max(Status::Warning);
@@ -183,7 +184,7 @@ impl KnittedMuscle {
                 report.status = report.status.max(Status::Warning);
             }
             self.collapsed = fallback.is_some();
-            return out;
+            return Some(out);
         }
         // The thin bag inside the sleeve cannot pull it inwards: a vacuum acts as zero.
         let p_eff = if pressure.is_finite() {
@@ -191,42 +192,34 @@ impl KnittedMuscle {
         } else {
             0.0
         };
-        let (volume, dv, _) = s.volume_derivatives(l);
-        let frictionless = s.force(p_eff, l);
-        let frictionless_stiffness = s.stiffness(p_eff, l);
-        let mut out = Output {
-            force: frictionless,
-            volume,
-            effective_pressure: p_eff,
-            friction_force: 0.0,
-            max_radius: s.max_radius(l),
-            stiffness: frictionless_stiffness,
-            history: self.history,
-        };
-        if let Some(f) = &self.friction {
-            let next = f.operator.advance(&self.history, l);
-            let area = s.mean_area(l);
-            let (force, friction_force) = f.strand.total_force(frictionless, p_eff, area, next.z);
-            out.force = force;
-            out.friction_force = friction_force;
-            out.history = next;
-            if friction_force != 0.0 {
-                // F = (F0 + k P A) / (1 - k), k = sqrt(2) Cf z held; A = V / L.
-                let k = SQRT_2 * f.strand.coefficient * next.z;
-                let area_slope = if l > 0.0 {
-                    (dv * l - volume) / (l * l)
-                } else {
-                    0.0
-                };
-                let stiffness = (frictionless_stiffness + k * p_eff * area_slope) / (1.0 - k);
-                out.stiffness = if stiffness.is_finite() {
-                    stiffness
-                } else {
-                    frictionless_stiffness
-                };
+        let next = self
+            .friction
+            .as_ref()
+            .map(|f| f.operator.advance(&self.history, l));
+        let friction = self
+            .friction
+            .as_ref()
+            .zip(next)
+            .map(|(f, n)| (&f.strand, n.z));
+        match s.evaluate_in_bag(p_eff, l, friction, self.bag.as_ref()) {
+            Ok(state) => Some(Output {
+                force: state.force,
+                volume: state.volume,
+                effective_pressure: p_eff,
+                friction_force: state.friction_force,
+                max_radius: state.max_radius,
+                stiffness: state.stiffness,
+                history: next.unwrap_or(self.history),
+            }),
+            Err(reason) => {
+                // Unreachable with finite inputs in range.
+                report.add(
+                    Status::Error,
+                    format!("cannot evaluate the sleeve: {reason}"),
+                );
+                None
             }
         }
-        out
     }
 
     /// Section 1.3.6: the bladder's force (eq. 2.16-2.17 with the knitted cylinder) and, with
@@ -283,41 +276,40 @@ impl KnittedMuscle {
         };
         if let Some(f) = &self.friction {
             let next = f.operator.advance(&self.history, l);
-            // F = F_0 + k T with the strand tension T = F - (F_pressure + F_elastic): eq. 1.21's
-            // `total_force` with its `P A` term set to -(F_pressure + F_elastic).
+            // Eq. 1.21 fed by the strand tension T = F - (F_pressure + F_elastic), with
+            // d(offset)/dL = F_0' - T_0'.
             let offset = state.pressure_force + state.elastic_force;
-            let (force, friction_force) = f.strand.total_force(state.force, 1.0, -offset, next.z);
-            out.force = force;
-            out.friction_force = friction_force;
-            out.history = next;
-            if friction_force != 0.0 {
-                // dF/dL = (F_0' - k offset') / (1 - k) with offset' = F_0' - T_0'.
-                let k = SQRT_2 * f.strand.coefficient * next.z;
-                let offset_slope = state.stiffness - state.strand_stiffness;
-                let stiffness = (state.stiffness - k * offset_slope) / (1.0 - k);
-                out.stiffness = if stiffness.is_finite() {
-                    stiffness
-                } else {
-                    state.stiffness
-                };
+            let offset_slope = state.stiffness - state.strand_stiffness;
+            match f
+                .strand
+                .apply(state.force, state.stiffness, -offset, -offset_slope, next.z)
+            {
+                Ok(with) => {
+                    out.force = with.force;
+                    out.friction_force = with.friction_force;
+                    out.stiffness = with.stiffness;
+                    out.history = next;
+                }
+                // Unreachable for a finite bladder state; the frictionless force stands.
+                Err(reason) => fallback = Some(format!("eq. 1.21 friction skipped: {reason}")),
             }
         }
         (out, fallback)
     }
 
-    fn write(vars: &mut Vars, out: &Output) {
-        let r = &mut vars.real;
-        r[real::FORCE] = out.force;
-        r[real::VOLUME] = out.volume;
-        r[real::EFFECTIVE_PRESSURE] = out.effective_pressure;
-        r[real::FRICTION_FORCE] = out.friction_force;
-        r[real::MAX_RADIUS] = out.max_radius;
-        r[real::STIFFNESS] = out.stiffness;
+    fn write(o: &mut Outputs, out: &Output) {
+        o.force = out.force;
+        o.volume = out.volume;
+        o.effective_pressure = out.effective_pressure;
+        o.friction_force = out.friction_force;
+        o.max_radius = out.max_radius;
+        o.stiffness = out.stiffness;
     }
 }
 
 impl Model for KnittedMuscle {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("knitted_muscle.html");
 
     fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
@@ -328,27 +320,37 @@ impl Model for KnittedMuscle {
         Ok(())
     }
 
-    fn new(vars: &mut Vars) -> Result<Self, String> {
-        let sleeve = KnittedSleeve::new(sleeve_params(vars)?, shape_kind(vars)?)?;
-        let bladder = bladder(vars, &sleeve)?;
+    fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
+        let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape_kind(p)?)?;
+        let bladder = bladder(p, &sleeve)?;
         let valid = valid_lengths(&sleeve, bladder.as_ref());
-        let friction = if vars.boolean[boolean::FRICTION] {
+        let bag = match p.bag_diameter {
+            0.0 => None,
+            diameter => {
+                if bladder.is_some() || matches!(sleeve.shape(), ShapeModel::NonCylindrical(_)) {
+                    return Err(
+                        "bag_diameter needs a cylindrical sleeve (shape_model 0 or 1) \
+                                and no rubber bladder (bladder_model 0)"
+                            .into(),
+                    );
+                }
+                Some(Bag::new(diameter, p.bag_membrane_stiffness)?)
+            }
+        };
+        let friction = if p.friction {
             Some(Friction {
-                strand: StrandFriction::new(vars.real[real::FRICTION_COEFFICIENT])?,
-                operator: StopOperator::new(vars.real[real::PRESLIDING_LENGTH])?,
+                strand: StrandFriction::new(p.friction_coefficient)?,
+                operator: StopOperator::new(p.presliding_length)?,
             })
         } else {
             None
         };
-        let (min_length, max_length) = match &bladder {
+        let length_range = match &bladder {
             Some(b) => (b.min_length(), b.max_length()),
             None => (sleeve.min_length(), sleeve.max_length()),
         };
-        vars.real[real::MAX_LENGTH] = max_length;
-        vars.real[real::MIN_LENGTH] = min_length;
-        vars.real[real::FREE_CONTRACTION_LENGTH] = sleeve.free_contraction_length();
         // Friction starts relaxed (z = 0) where the sleeve is at initialization.
-        let start = vars.real[real::LENGTH];
+        let start = start.length;
         let history = HysteresisState::at_rest(if start.is_nan() {
             valid.1
         } else {
@@ -359,54 +361,82 @@ impl Model for KnittedMuscle {
             bladder,
             valid,
             friction,
+            bag,
             history,
             out_of_range: false,
             collapsed: false,
+            length_range,
         })
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        let out = self.compute(vars, report);
-        Self::write(vars, &out);
+    fn calculated_parameters(&self) -> CalculatedParameters {
+        CalculatedParameters {
+            min_length: self.length_range.0,
+            max_length: self.length_range.1,
+            free_contraction_length: self.sleeve.free_contraction_length(),
+        }
     }
 
-    fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        if let Some(out) = self.compute(inputs, report) {
+            Self::write(outputs, &out);
+        }
+    }
+
+    fn step(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        _time: f64,
+        _step: f64,
+        report: &mut Report,
+    ) {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
-        let out = self.compute(vars, report);
-        Self::write(vars, &out);
-        self.history = out.history;
+        if let Some(out) = self.compute(inputs, report) {
+            Self::write(outputs, &out);
+            self.history = out.history;
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use std::f64::consts::SQRT_2;
 
-    fn vars_with(shape: i32, friction: bool) -> Vars {
-        let mut vars = Vars::from_start(&INFO);
-        vars.integer[integer::SHAPE_MODEL] = shape;
-        vars.boolean[boolean::FRICTION] = friction;
-        vars
+    fn parameters_with(shape: i32, friction: bool) -> Parameters {
+        Parameters {
+            shape_model: shape,
+            friction,
+            ..Parameters::default()
+        }
+    }
+
+    /// A model from `p` at the start inputs, with its calculated parameters.
+    fn built(p: &Parameters) -> (KnittedMuscle, Inputs, Outputs, CalculatedParameters) {
+        let inputs = Inputs::default();
+        let m = KnittedMuscle::new(p, &inputs).unwrap();
+        let calculated = m.calculated_parameters();
+        (m, inputs, Outputs::default(), calculated)
     }
 
     #[test]
     fn only_step_commits_the_friction_history() {
-        let mut vars = vars_with(0, true);
-        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let (mut m, mut inputs, mut out, _) = built(&parameters_with(0, true));
         let start = m.history;
-        vars.real[real::PRESSURE] = 14e3;
-        vars.real[real::LENGTH] = 0.35;
+        inputs.pressure = 14e3;
+        inputs.length = 0.35;
         let mut report = Report::default();
-        m.evaluate(&mut vars, &mut report);
+        m.evaluate(&inputs, &mut out, &mut report);
         assert_eq!(m.history, start);
         // Shortening by far more than the presliding length: full friction against it (z = -1),
         // of magnitude sqrt(2) Cf (F + P A) (eq. 1.21).
-        assert!(vars.real[real::FRICTION_FORCE] < 0.0);
-        m.step(&mut vars, 0.0, 1e-3, &mut report);
+        assert!(out.friction_force < 0.0);
+        m.step(&inputs, &mut out, 0.0, 1e-3, &mut report);
         assert_eq!(m.history.z, -1.0);
         assert_eq!(m.history.position, 0.35);
-        let (f, fr) = (vars.real[real::FORCE], vars.real[real::FRICTION_FORCE]);
+        let (f, fr) = (out.force, out.friction_force);
         let tension = f + 14e3 * m.sleeve.mean_area(0.35);
         assert!((fr + SQRT_2 * 0.25 * tension).abs() < 1e-12 * f.abs());
         assert_eq!(report.status, Status::Ok);
@@ -414,40 +444,47 @@ mod tests {
 
     #[test]
     fn out_of_range_is_the_nearest_limit_warned_once_per_excursion() {
-        let mut vars = vars_with(2, false);
-        let mut m = KnittedMuscle::new(&mut vars).unwrap();
-        let (lo, hi) = (vars.real[real::MIN_LENGTH], vars.real[real::MAX_LENGTH]);
-        vars.real[real::PRESSURE] = 14e3;
-        vars.real[real::LENGTH] = hi;
+        let (mut m, mut inputs, mut out, calculated) = built(&parameters_with(2, false));
+        let (lo, hi) = (calculated.min_length, calculated.max_length);
+        inputs.pressure = 14e3;
+        inputs.length = hi;
         let mut report = Report::default();
-        m.evaluate(&mut vars, &mut report);
-        let at_limit = vars.real.clone();
+        m.evaluate(&inputs, &mut out, &mut report);
+        let at_limit = out.clone();
         let mut warned = 0;
         for length in [hi + 1.0, 2.0 * hi, 0.4, 0.0, lo - 1e-9] {
             let mut report = Report::default();
-            vars.real[real::LENGTH] = length;
-            m.evaluate(&mut vars, &mut report);
+            inputs.length = length;
+            m.evaluate(&inputs, &mut out, &mut report);
             warned += report.messages.len();
             assert_eq!(report.status > Status::Ok, !(lo..=hi).contains(&length));
             if length > hi {
-                assert_eq!(vars.real[real::FORCE], at_limit[real::FORCE]);
+                assert_eq!(out.force, at_limit.force);
             }
-            assert!(vars.real.iter().all(|x| x.is_finite()));
+            let values = [
+                out.force,
+                out.volume,
+                out.effective_pressure,
+                out.friction_force,
+                out.max_radius,
+                out.stiffness,
+            ];
+            assert!(values.iter().all(|x| x.is_finite()));
         }
         assert_eq!(warned, 2);
     }
 
     #[test]
     fn bladder_is_refused_for_the_non_cylindrical_shape() {
-        let mut vars = vars_with(2, false);
-        vars.integer[integer::BLADDER_MODEL] = 2;
-        let e = KnittedMuscle::new(&mut vars).unwrap_err();
+        let mut p = parameters_with(2, false);
+        p.bladder_model = 2;
+        let e = KnittedMuscle::new(&p, &Inputs::default()).unwrap_err().0;
         assert!(e.contains("cylindrical sleeve"), "{e}");
         for shape in [0, 1] {
-            let mut vars = vars_with(shape, false);
-            vars.integer[integer::PRESET] = 2;
-            vars.integer[integer::BLADDER_MODEL] = 1;
-            assert!(KnittedMuscle::new(&mut vars).is_ok());
+            let mut p = parameters_with(shape, false);
+            p.preset = 2;
+            p.bladder_model = 1;
+            assert!(KnittedMuscle::new(&p, &Inputs::default()).is_ok());
         }
     }
 
@@ -455,38 +492,38 @@ mod tests {
     fn bladder_friction_stiffness_is_the_slope_with_z_held() {
         // Eq. 1.21 fed by the strand tension P_eff (A - dV/dL): dF/dL by central differences with
         // the hysteresis state held (step commits z = -1 first).
-        let mut vars = vars_with(0, true);
-        vars.integer[integer::PRESET] = 2;
-        vars.integer[integer::BLADDER_MODEL] = 2;
-        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let mut p = parameters_with(0, true);
+        p.preset = 2;
+        p.bladder_model = 2;
+        let (mut m, mut inputs, mut out, _) = built(&p);
         let mut report = Report::default();
-        vars.real[real::PRESSURE] = 550e3;
-        vars.real[real::LENGTH] = 0.07;
-        m.step(&mut vars, 0.0, 1e-3, &mut report);
+        inputs.pressure = 550e3;
+        inputs.length = 0.07;
+        m.step(&inputs, &mut out, 0.0, 1e-3, &mut report);
         assert_eq!(m.history.z, -1.0);
-        let at = |m: &mut KnittedMuscle, vars: &mut Vars, l: f64| {
-            vars.real[real::LENGTH] = l;
-            m.evaluate(vars, &mut Report::default());
-            (vars.real[real::FORCE], vars.real[real::STIFFNESS])
+        let mut at = |m: &mut KnittedMuscle, l: f64| {
+            inputs.length = l;
+            m.evaluate(&inputs, &mut out, &mut Report::default());
+            (out.force, out.stiffness, out.friction_force)
         };
         // Stay within the presliding length below 0.07 so that z stays -1.
         let h = 1e-6;
-        let (fp, _) = at(&mut m, &mut vars, 0.07 - 1e-5 + h);
-        let (fm, _) = at(&mut m, &mut vars, 0.07 - 1e-5 - h);
-        let (f, k) = at(&mut m, &mut vars, 0.07 - 1e-5);
-        assert!(vars.real[real::FRICTION_FORCE] < 0.0);
+        let (fp, _, _) = at(&mut m, 0.07 - 1e-5 + h);
+        let (fm, _, _) = at(&mut m, 0.07 - 1e-5 - h);
+        let (f, k, friction_force) = at(&mut m, 0.07 - 1e-5);
+        assert!(friction_force < 0.0);
         let fd = (fp - fm) / (2.0 * h);
         assert!((k - fd).abs() < 1e-4 * fd.abs(), "{k} {fd} (F {f})");
     }
 
     #[test]
     fn non_cylindrical_needs_a_thick_strand() {
-        let mut vars = vars_with(2, false);
-        vars.real[real::STRAND_THICKNESS] = 0.0;
-        let e = KnittedMuscle::new(&mut vars).unwrap_err();
+        let mut p = parameters_with(2, false);
+        p.strand_thickness = 0.0;
+        let e = KnittedMuscle::new(&p, &Inputs::default()).unwrap_err().0;
         assert!(e.contains("positive minimum radius"), "{e}");
-        vars.integer[integer::SHAPE_SEGMENTS] = -3;
-        vars.real[real::STRAND_THICKNESS] = 2e-4;
-        assert!(KnittedMuscle::new(&mut vars).is_err());
+        p.shape_segments = -3;
+        p.strand_thickness = 2e-4;
+        assert!(KnittedMuscle::new(&p, &Inputs::default()).is_err());
     }
 }

@@ -8,6 +8,10 @@
 use crate::physics::bladder::{Bladder, BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
+use crate::physics::root::{newton_bisection, RootOptions, Sample};
+
+mod partials;
+pub use partials::McKibbenPartials;
 
 /// Iteration caps of the connector solve (bracket search doubles its step; root is Newton-bisection).
 const BRACKET_STEPS: usize = 64;
@@ -457,42 +461,29 @@ impl McKibben {
                 self.max_length()
             ));
         };
-        let (mut lo, mut hi) = if upward {
+        let (lo, hi) = if upward {
             (inner, outer)
         } else {
             (outer, inner)
         };
-        let mut x = 0.5 * (lo + hi);
-        let mut best = None;
-        for _ in 0..ROOT_ITERATIONS {
-            let (h, core) = eval(x)?;
-            if h == 0.0 {
-                return Ok(core);
-            }
-            if h < 0.0 {
-                lo = x;
-            } else {
-                hi = x;
-            }
+        // h rises with L (slope 1 + c dF/dL > 0 on the stable branch). Converged when the length
+        // moves by less than rounding; F then changes by K times that.
+        let options = RootOptions {
+            absolute: 1e-17,
+            relative: 1e-14,
+            max_iterations: ROOT_ITERATIONS,
+        };
+        let root = newton_bisection(lo, hi, 0.5 * (lo + hi), true, options, |x| {
+            let (value, core) = eval(x)?;
             let slope = 1.0 + c * core.newton_slope;
-            let newton = x - h / slope;
-            let newton_ok = newton.is_finite() && slope > 0.0 && newton >= lo && newton <= hi;
-            let tol = 1e-14 * x.abs().max(1e-3);
-            if newton_ok && (newton - x).abs() <= tol {
-                // Converged: the length moves by less than rounding; F changes by K * tol.
-                return Ok(core);
-            }
-            best = Some(core);
-            if hi - lo <= tol {
-                break;
-            }
-            x = if newton_ok && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-        }
-        best.ok_or_else(|| "connector solve did not run".to_string())
+            Ok::<_, String>(Some(Sample {
+                value,
+                slope,
+                payload: core,
+            }))
+        })?;
+        root.payload
+            .ok_or_else(|| "connector solve did not run".to_string())
     }
 }
 

@@ -1,10 +1,17 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no pointers.
 
+#![forbid(unsafe_code)]
+
 pub mod bladder;
 pub mod bounds;
+pub mod calibration;
+pub mod festo;
 pub mod friction;
 pub mod gaylord;
+pub mod inverse;
 pub mod knitted;
+pub mod knitted_bag;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
+pub mod root;

@@ -3,7 +3,8 @@
 #![allow(dead_code)]
 
 use crate::common::*;
-use actuator_fmus::variables::{Causality, ModelInfo, Start, VarType, REGISTRY};
+use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::variables::{Causality, ModelInfo, Start, VarType};
 use std::ffi::{c_char, c_int};
 
 /// Every model in the binary (the generated registry): its name and variable tables.

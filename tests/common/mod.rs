@@ -284,6 +284,7 @@ pub mod mckibben {
     pub const STRAND_LENGTH: u32 = real::STRAND_LENGTH as u32;
     pub const TURNS: u32 = real::TURNS as u32;
     pub const MAX_LENGTH: u32 = real::MAX_LENGTH as u32;
+    pub const STIFFNESS: u32 = real::STIFFNESS as u32;
 }
 
 /// Eq. 2.3, written out independently of the crate.

@@ -12,7 +12,8 @@
 #![allow(dead_code)]
 
 use actuator_fmus::fmi2::types::*;
-use actuator_fmus::variables::{ModelInfo, Start, VarType, REGISTRY};
+use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::variables::{ModelInfo, Start, VarType};
 use arbitrary::{Result, Unstructured};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::ptr::{null, null_mut};

@@ -1,0 +1,196 @@
+//! Inverse McKibben problems: the pressure that gives a force at a length, and the antagonistic
+//! pressure pair that gives a joint torque. Both invert the forward model (eq. 2.3, or eq. 2.4
+//! with the bladder of eq. 2.6-2.20) at a fixed length, where the force is monotonic in pressure:
+//! linear for the ideal sleeve, and in contact the effective pressure rises with `P - threshold`
+//! (eq. 2.12, 2.19) while below the threshold the force does not depend on `P` at all.
+
+use crate::physics::friction::HysteresisState;
+use crate::physics::mckibben::McKibben;
+
+/// Iteration cap of [`invert_monotonic`]: bisection alone halves a bracket 200 times.
+const ITERATIONS: usize = 200;
+
+/// The result of an inversion.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Inversion {
+    /// The argument found (a pressure, or a pressure difference), inside the bracket.
+    pub argument: f64,
+    /// The value the forward model gives there (force, torque).
+    pub achieved: f64,
+    /// Whether the target lies outside the reachable range: `argument` is then the nearer end.
+    pub saturated: bool,
+}
+
+/// Solves `f(x) = target` for `x` in `[lo, hi]` when `f` is monotonic there (either direction;
+/// flat stretches allowed). Out of reach, returns the end whose value is nearer, flagged
+/// `saturated`. A safeguarded regula falsi (Illinois variant): every step stays in the bracket and
+/// falls back to bisection when the secant stalls, so it converges to `|f - target| <= tol *
+/// |f(hi) - f(lo)|` or a bracket at the resolution of f64. `Err` if `f` fails.
+pub fn invert_monotonic(
+    mut f: impl FnMut(f64) -> Result<f64, String>,
+    target: f64,
+    lo: f64,
+    hi: f64,
+    tol: f64,
+) -> Result<Inversion, String> {
+    if !(target.is_finite() && lo.is_finite() && hi.is_finite() && lo <= hi) {
+        return Err(format!(
+            "cannot invert for target {target} on [{lo}, {hi}]: not finite or empty"
+        ));
+    }
+    let (f_lo, f_hi) = (f(lo)?, f(hi)?);
+    let rising = f_hi >= f_lo;
+    let (min, max) = if rising { (f_lo, f_hi) } else { (f_hi, f_lo) };
+    let end = |x: f64, y: f64, saturated| Inversion {
+        argument: x,
+        achieved: y,
+        saturated,
+    };
+    let (x_min, x_max) = if rising { (lo, hi) } else { (hi, lo) };
+    if target <= min {
+        return Ok(end(x_min, min, target < min));
+    }
+    if target >= max {
+        return Ok(end(x_max, max, target > max));
+    }
+    // g = f - target changes sign on the bracket: a < 0 < b in g.
+    let (mut a, mut b) = (x_min, x_max);
+    let (mut ga, mut gb) = (min - target, max - target);
+    let tolerance = tol * (max - min);
+    let mut best = if -ga < gb { (a, ga) } else { (b, gb) };
+    let mut side = 0i8;
+    for _ in 0..ITERATIONS {
+        let secant = a - ga * (b - a) / (gb - ga);
+        let mid = 0.5 * (a + b);
+        // Stay strictly inside; otherwise bisect.
+        let x = if secant.is_finite() && (secant - a) * (secant - b) < 0.0 {
+            secant
+        } else {
+            mid
+        };
+        if x == a || x == b {
+            break;
+        }
+        let g = f(x)? - target;
+        if g.abs() < best.1.abs() {
+            best = (x, g);
+        }
+        if g.abs() <= tolerance {
+            break;
+        }
+        if g < 0.0 {
+            a = x;
+            ga = g;
+            if side == -1 {
+                gb *= 0.5; // Illinois: halve the stale end so the secant moves past it
+            }
+            side = -1;
+        } else {
+            b = x;
+            gb = g;
+            if side == 1 {
+                ga *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Ok(end(best.0, best.1 + target, false))
+}
+
+/// Relative tolerance of the inversions below (of the reachable force or torque range).
+pub const TOLERANCE: f64 = 1e-12;
+
+/// The gauge pressure in `0 ..= max_pressure` at which `muscle` at input length `length` (from
+/// friction history `history`) pulls with `force`. Out of reach: the pressure of the nearest
+/// force, `saturated`. `Err` if the muscle cannot be evaluated at `length`.
+pub fn pressure_for_force(
+    muscle: &McKibben,
+    length: f64,
+    force: f64,
+    max_pressure: f64,
+    history: &HysteresisState,
+) -> Result<Inversion, String> {
+    invert_monotonic(
+        |p| muscle.evaluate(p, length, history).map(|o| o.force),
+        force,
+        0.0,
+        max_pressure,
+        TOLERANCE,
+    )
+}
+
+/// The pressures `[flexor, extensor]` from a pressure difference around the common mode, each
+/// clipped to `0 ..= max_pressure` (max/min so that a NaN maps to a bound).
+pub fn pair_pressures(common_mode: f64, difference: f64, max_pressure: f64) -> [f64; 2] {
+    [
+        (common_mode + 0.5 * difference).max(0.0).min(max_pressure),
+        (common_mode - 0.5 * difference).max(0.0).min(max_pressure),
+    ]
+}
+
+/// The pressure difference whose clipped pair ([`pair_pressures`]) gives `torque`, where
+/// `torque_of(difference)` is the pair's torque; out of reach, the nearest torque (`saturated`).
+/// The torque of an antagonistic pair is monotonic in the difference while each muscle's force
+/// is monotonic in its pressure; the search covers every difference that changes a clipped
+/// pressure, `-2 max_pressure ..= 2 max_pressure`.
+pub fn difference_for_torque(
+    torque_of: impl FnMut(f64) -> Result<f64, String>,
+    torque: f64,
+    max_pressure: f64,
+) -> Result<Inversion, String> {
+    let span = 2.0 * max_pressure;
+    invert_monotonic(torque_of, torque, -span, span, TOLERANCE)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::mckibben::{BladderModel, MuscleGeometry};
+
+    #[test]
+    fn inverts_rising_falling_and_flat_stretches_and_saturates() {
+        let cube = |x: f64| Ok(x * x * x);
+        let r = invert_monotonic(cube, 0.3, -1.0, 2.0, 1e-14).unwrap();
+        assert!((r.achieved - 0.3).abs() < 1e-13 && !r.saturated);
+        assert!((r.argument - 0.3f64.cbrt()).abs() < 1e-9);
+        let falling = |x: f64| Ok(-x.max(0.5));
+        let r = invert_monotonic(falling, -0.75, 0.0, 1.0, 1e-14).unwrap();
+        assert!((r.argument - 0.75).abs() < 1e-12, "{r:?}");
+        let r = invert_monotonic(cube, 9.0, -1.0, 2.0, 1e-14).unwrap();
+        assert!(r.saturated && r.argument == 2.0 && r.achieved == 8.0);
+        let r = invert_monotonic(cube, -3.0, -1.0, 2.0, 1e-14).unwrap();
+        assert!(r.saturated && r.argument == -1.0);
+    }
+
+    #[test]
+    fn pressure_for_force_inverts_eq_2_3_and_every_bladder() {
+        let g = MuscleGeometry::muscle_a();
+        let rest = HysteresisState::at_rest(0.09);
+        for model in [
+            BladderModel::None,
+            BladderModel::ThinWall,
+            BladderModel::ThickWall { layers: 16 },
+        ] {
+            let m = McKibben::from_geometry(&g, model, None, 0.0).unwrap();
+            for length in [0.085, 0.09, 0.095] {
+                let top = m.evaluate(6e5, length, &rest).unwrap().force;
+                let target = 0.6 * top;
+                let r = pressure_for_force(&m, length, target, 6e5, &rest).unwrap();
+                let f = m.evaluate(r.argument, length, &rest).unwrap().force;
+                assert!(
+                    !r.saturated && (f - target).abs() <= 1e-9 * top.abs(),
+                    "{model:?} {f} {target}"
+                );
+                let over = pressure_for_force(&m, length, 2.0 * top, 6e5, &rest).unwrap();
+                assert!(over.saturated && over.argument == 6e5);
+            }
+        }
+        // Eq. 2.3 is linear in P: the exact answer is known.
+        let m = McKibben::from_geometry(&g, BladderModel::None, None, 0.0).unwrap();
+        let s = m.sleeve();
+        let p = pressure_for_force(&m, 0.1, 50.0, 1e6, &rest)
+            .unwrap()
+            .argument;
+        assert!((p - 50.0 / s.force(1.0, 0.1)).abs() < 1e-6 * p);
+    }
+}
