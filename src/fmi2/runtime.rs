@@ -113,6 +113,9 @@ pub trait Runtime: Send {
     fn restore(&mut self, other: &dyn Runtime) -> Result<(), String>;
     fn to_bytes(&self) -> Result<Vec<u8>, String>;
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String>;
+    /// For a snapshot from bytes whose values passed the declared checks: the model rebuilt from
+    /// its parameters, with only its checked history taken from the bytes ([`rebuilt`]).
+    fn rebuild_model(&mut self) -> Result<(), String>;
     fn as_any(&self) -> &dyn Any;
 }
 
@@ -214,8 +217,14 @@ where
     fn to_bytes(&self) -> Result<Vec<u8>, String> {
         postcard::to_stdvec(self).map_err(|e| e.to_string())
     }
+    fn rebuild_model(&mut self) -> Result<(), String> {
+        if let Some(saved) = self.model.take() {
+            self.model = Some(rebuilt(&self.vars, &saved)?);
+        }
+        Ok(())
+    }
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
-        let mut r: Self =
+        let r: Self =
             postcard::from_bytes(bytes).map_err(|e| format!("corrupt model state: {e}"))?;
         let [nr, ni, nb, ns] = M::Variables::INFO.counts;
         let v = &r.vars;
@@ -227,9 +236,6 @@ where
         ) != (nr, ni, nb, ns)
         {
             return Err("the variable counts do not match this model".into());
-        }
-        if let Some(saved) = r.model.take() {
-            r.model = Some(rebuilt(&r.vars, &saved)?);
         }
         Ok(Box::new(r))
     }
