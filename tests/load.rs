@@ -77,11 +77,11 @@ fn run(api: &Api, info: &ModelInfo, k: usize, steps: usize) -> Vec<u64> {
         .collect()
 }
 
-/// One cycle: instantiate (all effects on every tenth cycle, whose model build costs the most),
+/// One cycle: instantiate (all effects on every hundredth cycle: their builds and steps cost most),
 /// initialize, step, a serialized state restored
 /// and freed, a state left for fmi2FreeInstance, every Real read, free.
 fn cycle(api: &Api, info: &ModelInfo, k: usize) {
-    let i = ready(api, info, k % 10 == 0);
+    let i = ready(api, info, k % 100 == 0);
     step_and_read(&i, info, k, 0);
     let bytes = serialized_state(&i);
     unsafe {
