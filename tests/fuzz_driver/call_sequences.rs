@@ -12,6 +12,7 @@
 #![allow(dead_code)]
 
 use actuator_fmus::fmi2::types::*;
+use actuator_fmus::fmi2::runtime::Factory;
 use actuator_fmus::fmi2::REGISTRY;
 use actuator_fmus::variables::{ModelInfo, Start, VarType};
 use arbitrary::{Result, Unstructured};
@@ -249,7 +250,8 @@ impl Driver {
         if let Some(old) = self.slots[k].take() {
             unsafe { fmi2FreeInstance(old.c) };
         }
-        let info = REGISTRY[u.choose_index(REGISTRY.len())?].info();
+        let factory = REGISTRY[u.choose_index(REGISTRY.len())?];
+        let info = factory.info();
         let guid = match u.int_in_range(0..=7)? {
             0 => None,
             1 => Some(CString::new("{not-a-guid}").unwrap()),
@@ -296,7 +298,8 @@ impl Driver {
         self.calls += 1;
         let valid = name.as_ref().is_some_and(|n| !n.is_empty())
             && guid.as_ref().is_some_and(|g| g.to_str() == Ok(info.guid))
-            && kind == 1
+            // Co-Simulation always; Model Exchange for the models that serve it.
+            && (kind == 1 || (kind == 0 && factory.model_exchange()))
             && !no_callbacks;
         assert_eq!(
             !c.is_null(),
