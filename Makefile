@@ -128,7 +128,11 @@ sweep: fmus $(VENV)/.installed
 	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
 
 ## ---- Reliability jobs (issue 8): longer runs, not part of `make test`. ----
-.PHONY: fuzz memcheck
+.PHONY: fuzz memcheck load
+
+## tests/load.rs with its 10,000-cycle heap test of every FMU (ignored by `make test`: minutes of CPU).
+load: fmus
+	cargo test --release --test load -- --include-ignored --nocapture
 
 FUZZ_SECONDS ?= 120
 ## address (the default: AddressSanitizer, ~15x slower) or none (the plain build, for volume).
