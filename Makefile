@@ -166,28 +166,63 @@ sweep: fmus $(VENV)/.installed
 	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
 
 ## ---- Reliability jobs (issue 8): longer runs, not part of `make test`. ----
-.PHONY: fuzz memcheck
+.PHONY: fuzz memcheck load
+
+## tests/load.rs with its 10,000-cycle heap test of every FMU (ignored by `make test`: minutes of CPU).
+load: fmus
+	cargo test --release --test load -- --include-ignored --nocapture
 
 FUZZ_SECONDS ?= 120
-## Fuzzes random FMI call sequences on both models for FUZZ_SECONDS (cargo-fuzz, nightly Rust).
-## The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go to the ignored
-## fuzz/corpus-run/, crashes to fuzz/artifacts/. Nothing is committed.
+## address (the default: AddressSanitizer, ~15x slower) or none (the plain build, for volume).
+SANITIZER ?= address
+## Per-sequence limit in wall-clock seconds: the longest sequences take ~0.3 s of CPU, but a
+## niced run on a loaded machine waits many times that for a core.
+FUZZ_TIMEOUT ?= 120
+## Fuzzes random FMI call sequences on all six models for FUZZ_SECONDS (cargo-fuzz, nightly Rust),
+## with the harness of tests/fuzz_driver/ (tests/fuzz_corpus.rs replays the committed corpus in
+## `make test`). The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go
+## to the ignored fuzz/corpus-run/, findings to the ignored fuzz/artifacts/. The summary line
+## counts the sequences run ("stat::number_of_executed_units"). The tracked fuzz/Cargo.lock must
+## come out unchanged (a dependency change shows here, to be committed).
 fuzz:
-	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz
+	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
-	mkdir -p fuzz/corpus-run/call_sequences
-	cargo +nightly fuzz run call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
-	  $(CURDIR)/fuzz/corpus/call_sequences -- -max_total_time=$(FUZZ_SECONDS) -timeout=10 \
-	  -rss_limit_mb=2048 -print_final_stats=1
+	mkdir -p fuzz/corpus-run/call_sequences fuzz/logs
+	cargo +nightly fuzz run -s $(SANITIZER) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
+	  $(CURDIR)/fuzz/corpus/call_sequences -- -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
+	  -rss_limit_mb=2048 -print_final_stats=1 \
+	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; test $${PIPESTATUS[0]} = 0
+	@grep -h 'stat::number_of_executed_units' fuzz/logs/$(SANITIZER).log \
+	  | awk '{n += $$2} END {print "make fuzz SANITIZER=$(SANITIZER): " n " sequences without a finding"}'
+	@git diff --exit-code --stat -- fuzz/Cargo.lock
 
-## The FMPy suite under valgrind memcheck: any memory error, or a leak allocated outside CPython
-## and NumPy, fails. PYTHONMALLOC=malloc lets valgrind see every Python allocation.
+## Valgrind memcheck, two halves, each with its whole log kept in out/memcheck/ and its summary
+## printed; any error in either fails:
+## - native: tools/examples/memcheck_native.rs loads every FMU through its C ABI (no Python), runs
+##   each with default parameters and with all effects on, and every scene; definite and
+##   indirect leaks count as errors and nothing is suppressed.
+## - fmpy: the FMPy suite (MEMCHECK_TESTS) with memory errors checked, not leaks (the Python
+##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so.
 MEMCHECK_TESTS ?= tests/fmpy
+MEMCHECK_DIR := out/memcheck
+VALGRIND := valgrind --tool=memcheck --error-exitcode=1 --num-callers=30
 memcheck: fmus $(VENV)/.installed
 	@command -v valgrind >/dev/null || { \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq valgrind; }
-	PYTHONMALLOC=malloc valgrind --tool=memcheck --error-exitcode=1 \
-	  --suppressions=tests/valgrind-python.supp --leak-check=full \
-	  --errors-for-leak-kinds=definite --show-leak-kinds=definite --num-callers=30 \
-	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS)
+	cargo build --release -p actuator-fmus-tools --example memcheck_native
+	mkdir -p $(MEMCHECK_DIR)
+	@start=$$(date +%s); \
+	$(VALGRIND) --leak-check=full --errors-for-leak-kinds=definite,indirect \
+	  --show-leak-kinds=definite,indirect --log-file=$(MEMCHECK_DIR)/native.log \
+	  target/release/examples/memcheck_native > $(MEMCHECK_DIR)/native.out 2>&1; native=$$?; \
+	tail -1 $(MEMCHECK_DIR)/native.out; \
+	echo "native: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/native.log)"; \
+	grep -h 'definitely lost\|indirectly lost\|All heap blocks were freed' $(MEMCHECK_DIR)/native.log; \
+	PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
+	  --log-file=$(MEMCHECK_DIR)/fmpy.log \
+	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS) > $(MEMCHECK_DIR)/fmpy.out 2>&1; fmpy=$$?; \
+	tail -1 $(MEMCHECK_DIR)/fmpy.out; \
+	echo "fmpy: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/fmpy.log)"; \
+	echo "make memcheck: $$(( $$(date +%s) - start )) s; logs in $(MEMCHECK_DIR)/"; \
+	test $$native = 0 -a $$fmpy = 0

@@ -1728,6 +1728,15 @@ fn steps(fmu: &Fmu, t: &mut Tally, i: &Instance) {
             0.0,
             "tolerance positive",
         ),
+        (
+            "tolerance inf",
+            1,
+            f64::INFINITY,
+            0.0,
+            0,
+            0.0,
+            "tolerance positive",
+        ),
     ] {
         fmu.drive(i, State::Instantiated);
         t.refused(

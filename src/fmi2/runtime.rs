@@ -121,6 +121,9 @@ pub trait Runtime: Send {
     fn restore(&mut self, other: &dyn Runtime) -> Result<(), String>;
     fn to_bytes(&self) -> Result<Vec<u8>, String>;
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String>;
+    /// For a snapshot from bytes whose values passed the declared checks: the model rebuilt from
+    /// its parameters, with only its checked history taken from the bytes ([`rebuilt`]).
+    fn rebuild_model(&mut self) -> Result<(), String>;
     fn as_any(&self) -> &dyn Any;
 }
 
@@ -245,6 +248,12 @@ where
     fn to_bytes(&self) -> Result<Vec<u8>, String> {
         postcard::to_stdvec(self).map_err(|e| e.to_string())
     }
+    fn rebuild_model(&mut self) -> Result<(), String> {
+        if let Some(saved) = self.model.take() {
+            self.model = Some(rebuilt(&self.values, &saved)?);
+        }
+        Ok(())
+    }
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
         let r: Self =
             postcard::from_bytes(bytes).map_err(|e| format!("corrupt model state: {e}"))?;
@@ -253,4 +262,33 @@ where
     fn as_any(&self) -> &dyn Any {
         self
     }
+}
+
+/// The model that `saved` (deserialized from an importer's bytes) stands for, rebuilt from the
+/// parameters in `values` so that its derived data (limits, geometry, caches) never comes from the
+/// bytes, with `saved`'s history once the model has checked it ([`Model::adopt_history`]). The
+/// checksum of a serialized state only catches accidents: bytes changed and resealed deliberately
+/// reach this point.
+fn rebuilt<M: Model>(values: &Values<M::Variables>, saved: &M) -> Result<M, String>
+where
+    M::Variables: Bindings,
+{
+    let mut model = M::new(&values.parameters, &values.inputs).map_err(|r| {
+        format!(
+            "corrupt model state: its parameters do not build the model: {}",
+            r.0
+        )
+    })?;
+    // The restored variables keep their own values, which must agree with what the parameters give.
+    if model.calculated_parameters() != values.calculated {
+        return Err(format!(
+            "corrupt model state: its calculated parameters {:?} are not those its parameters give, {:?}",
+            values.calculated,
+            model.calculated_parameters()
+        ));
+    }
+    model
+        .adopt_history(saved)
+        .map_err(|e| format!("corrupt model state: {e}"))?;
+    Ok(model)
 }

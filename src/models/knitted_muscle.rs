@@ -306,6 +306,14 @@ impl Model for KnittedMuscle {
     const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("knitted_muscle.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        saved.history.check("friction history")?;
+        self.history = saved.history;
+        self.out_of_range = saved.out_of_range;
+        self.collapsed = saved.collapsed;
+        Ok(())
+    }
+
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
         let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape_kind(p)?)?;
         let bladder = bladder(p, &sleeve)?;

@@ -268,6 +268,15 @@ impl Model for McKibbenJoint {
     const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("mckibben_joint.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        saved.flexor_friction.check("flexor friction history")?;
+        saved.extensor_friction.check("extensor friction history")?;
+        self.flexor_friction = saved.flexor_friction;
+        self.extensor_friction = saved.extensor_friction;
+        self.out_of_range = saved.out_of_range;
+        Ok(())
+    }
+
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
         let moment_arm = positive("moment_arm", p.moment_arm)?;
         let flexor_rest_length = positive("flexor_rest_length", p.flexor_rest_length)?;

@@ -385,6 +385,17 @@ impl Model for McKibbenMuscle {
     const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        saved.friction.check("friction history")?;
+        self.friction = saved.friction;
+        self.out_of_range = saved.out_of_range;
+        // The parameter notice is logged once: not again if the saved model had logged it.
+        if saved.notice.is_none() {
+            self.notice = None;
+        }
+        Ok(())
+    }
+
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
         let Resolved { params, overridden } = geometry(p)?;
         let sleeve = Sleeve::new(params.strand_length, params.turns)?;

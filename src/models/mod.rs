@@ -182,4 +182,13 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     fn partials(&mut self, _inputs: &Inputs<Self>) -> Result<Partials, String> {
         Err("this model does not provide partial derivatives".into())
     }
+
+    /// Takes over the history of `saved`, a model deserialized from an importer's bytes, after
+    /// checking it against the model's invariants. `self` was rebuilt by [`Model::new`] from the
+    /// parameters that came with `saved`, so nothing derived from parameters (limits, geometry,
+    /// caches) is taken from the bytes. A history no legal call sequence produces is an `Err`
+    /// saying which. The default, for models without history, takes nothing.
+    fn adopt_history(&mut self, _saved: &Self) -> Result<(), String> {
+        Ok(())
+    }
 }

@@ -7,7 +7,8 @@
 
 use super::{Model, Refusal, Report, Status};
 use crate::physics::multiferroic::{
-    drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, SteppingSchedule,
+    drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, ScheduleSwitch,
+    SteppingSchedule,
 };
 use crate::variables::multiferroic_motor::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
@@ -18,7 +19,7 @@ use serde::{Deserialize, Serialize};
 pub struct MultiferroicMotor {
     motor: Motor,
     /// The built-in stepping schedule when `schedule = 1`.
-    schedule: Option<SteppingSchedule>,
+    schedule: ScheduleSwitch,
     rotor_locked: bool,
     /// Young's modulus (Pa) when `strain_drive`: the `strain` input times it is the stress.
     strain_drive: Option<f64>,
@@ -115,6 +116,13 @@ impl Model for MultiferroicMotor {
     type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("multiferroic_motor.html");
 
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        Motor::validate_state(&saved.state).map_err(|e| format!("motor state: {e}"))?;
+        self.state = saved.state;
+        self.accuracy_warned = saved.accuracy_warned;
+        Ok(())
+    }
+
     fn new(r: &Parameters, _: &Inputs) -> Result<Self, Refusal> {
         let max_substeps = u32::try_from(r.max_substeps)
             .map_err(|_| format!("max_substeps must be positive, got {}", r.max_substeps))?;
@@ -146,7 +154,7 @@ impl Model for MultiferroicMotor {
             r.step_period,
             r.stress_amplitude,
         )?;
-        let schedule = switch(r.schedule, "schedule")?.then_some(stepping);
+        let schedule = ScheduleSwitch::new(switch(r.schedule, "schedule")?, stepping);
         let strain_drive = if r.strain_drive {
             drive::uniaxial_stress(0.0, r.youngs_modulus)?;
             Some(r.youngs_modulus)

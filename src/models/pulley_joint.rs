@@ -47,6 +47,14 @@ struct Params {
 }
 
 impl Params {
+    /// Whether angle `q` and velocity `dq` give finite outputs: huge (but legal) moment arms or
+    /// rest lengths can overflow the muscle lengths `L0 -/+ r q`.
+    fn representable(&self, q: f64, dq: f64) -> bool {
+        dq.is_finite()
+            && (self.rest_length - self.moment_arm * q).is_finite()
+            && (self.rest_length + self.moment_arm * q).is_finite()
+    }
+
     /// Quintic moves between the waypoints, as `reference` in examples/robot_joint.py.
     fn reference(&self, t: f64) -> (f64, f64) {
         let (w, period) = (&self.waypoints, self.segment_time);
@@ -103,13 +111,33 @@ impl PulleyJoint {
         out.joint_angle = self.q;
         out.joint_velocity = self.dq;
         out.reference_angle = q_ref;
-        out.joint_torque = self.torque(inputs);
+        // A huge moment arm times huge forces overflows: the torque keeps its last value then
+        // (evaluate says so).
+        let torque = self.torque(inputs);
+        if torque.is_finite() {
+            out.joint_torque = torque;
+        }
     }
 }
 
 impl Model for PulleyJoint {
     type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("pulley_joint.html");
+
+    fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
+        // Any angle and velocity whose outputs are finite is a state the joint can be driven into.
+        if !(self.p.representable(saved.q, saved.dq) && saved.time.is_finite()) {
+            return Err(format!(
+                "joint angle {} rad, velocity {} rad/s and time {} s must be finite, and so the \
+                 muscle lengths they give",
+                saved.q, saved.dq, saved.time
+            ));
+        }
+        self.q = saved.q;
+        self.dq = saved.dq;
+        self.time = saved.time;
+        Ok(())
+    }
 
     fn new(v: &Parameters, _: &Inputs) -> Result<Self, Refusal> {
         let inertia = positive("inertia", v.inertia)?;
@@ -162,10 +190,19 @@ impl Model for PulleyJoint {
         })
     }
 
-    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, _report: &mut Report) {
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
         // Outputs at the current time: the torque follows the inputs directly, and so do the
         // pressures with external_pressures.
         self.write(inputs, outputs);
+        if !self.torque(inputs).is_finite() {
+            report.add(
+                Status::Error,
+                format!(
+                    "the joint torque overflows (moment arm {} m times the force difference)",
+                    self.p.moment_arm
+                ),
+            );
+        }
     }
 
     fn step(
@@ -187,7 +224,7 @@ impl Model for PulleyJoint {
             dq += h * (torque - p.damping * dq - p.gravity_torque * q.sin()) / p.inertia;
             q += h * dq;
         }
-        if !(q.is_finite() && dq.is_finite()) {
+        if !(p.representable(q, dq) && torque.is_finite()) {
             report.add(
                 Status::Discard,
                 format!("the joint diverged in the step from t = {time} s (torque {torque} N.m); state kept"),

@@ -33,6 +33,18 @@ impl HysteresisState {
             position: if position.is_finite() { position } else { 0.0 },
         }
     }
+
+    /// Why this history cannot come from [`StopOperator::advance`] (eq. 1.21, 2.4): `z` outside
+    /// [-1, 1] or a non-finite position. For histories restored from an importer's bytes.
+    pub fn check(&self, name: &str) -> Result<(), String> {
+        if !(self.z.abs() <= 1.0 && self.position.is_finite()) {
+            return Err(format!(
+                "{name}: z = {} must be in [-1, 1] and position = {} m finite",
+                self.z, self.position
+            ));
+        }
+        Ok(())
+    }
 }
 
 impl StopOperator {

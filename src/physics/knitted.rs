@@ -224,7 +224,7 @@ impl KnittedSleeve {
         if length.is_nan() {
             return self.max_length;
         }
-        length.clamp(self.min_length, self.max_length)
+        super::bounds::limit(length, self.min_length, self.max_length)
     }
 
     /// `(V, dV/dL, d2V/dL2)` at a (clamped) length.

@@ -440,7 +440,7 @@ impl McKibben {
             let core = self.at_actual_length(pressure, l, history)?;
             Ok((l + c * core.out.force - reported, core))
         };
-        let x0 = reported.clamp(lo_edge, hi_edge);
+        let x0 = super::bounds::limit(reported, lo_edge, hi_edge);
         let (h0, core0) = eval(x0)?;
         if h0 == 0.0 {
             return Ok(core0);

@@ -3,6 +3,7 @@
 #![forbid(unsafe_code)]
 
 pub mod bladder;
+pub mod bounds;
 pub mod calibration;
 pub mod festo;
 pub mod friction;

@@ -110,9 +110,9 @@ pub fn extract_binary(model: &str) -> PathBuf {
 
 macro_rules! api {
     ($($name:ident: fn($($arg:ty),*) $(-> $ret:ty)?;)*) => {
-        /// The FMI 2.0 functions of one loaded binary.
+        /// The FMI 2.0 functions of one loaded binary (or of the crate linked into the test).
         pub struct Api {
-            _lib: libloading::Library,
+            _lib: Option<libloading::Library>,
             $(pub $name: unsafe extern "C" fn($($arg),*) $(-> $ret)?,)*
         }
         impl Api {
@@ -121,8 +121,16 @@ macro_rules! api {
                     let lib = libloading::Library::new(path).unwrap();
                     $(let $name = *lib.get::<unsafe extern "C" fn($($arg),*) $(-> $ret)?>(concat!(stringify!($name), "\0").as_bytes())
                         .unwrap_or_else(|e| panic!("missing symbol {}: {e}", stringify!($name)));)*
-                    Api { _lib: lib, $($name,)* }
+                    Api { _lib: Some(lib), $($name,)* }
                 }
+            }
+            /// The functions of the crate linked into this test binary (all models in one):
+            /// its allocations go through the test's global allocator, which can count them.
+            pub fn linked() -> Api {
+                extern "C" {
+                    $(fn $name($(_: $arg),*) $(-> $ret)?;)*
+                }
+                Api { _lib: None, $($name,)* }
             }
         }
     };

@@ -235,13 +235,15 @@ impl Instance {
                 body.time, body.start_time, body.stop_time
             )));
         }
-        let runtime = self
+        let mut runtime = self
             .runtime
             .snapshot_from_bytes(&body.runtime)
             .map_err(&refuse)?;
         if let Some(why) = self.invalid_values(runtime.as_ref()) {
             return Err(refuse(format!("corrupt state: {why}")));
         }
+        // Derived data is rebuilt from the parameters, never trusted from the bytes.
+        runtime.rebuild_model().map_err(&refuse)?;
         let state = FmuState {
             time: body.time,
             start_time: body.start_time,

@@ -115,7 +115,7 @@ impl Instance {
         }
         if !start.is_finite()
             || stop.is_some_and(|s| !s.is_finite())
-            || tolerance.is_some_and(|t| t.is_nan() || t <= 0.0)
+            || tolerance.is_some_and(|t| !(t.is_finite() && t > 0.0))
         {
             return self.error(&format!(
                 "fmi2SetupExperiment: startTime {start}, stopTime {stop:?} and tolerance {tolerance:?} must be finite (tolerance positive)"

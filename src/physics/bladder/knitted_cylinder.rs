@@ -68,7 +68,7 @@ impl KnittedCylinder {
             self.sleeve_max_length
         };
         if l.is_finite() {
-            l.clamp(self.sleeve_min_length, self.sleeve_max_length)
+            crate::physics::bounds::limit(l, self.sleeve_min_length, self.sleeve_max_length)
         } else {
             self.sleeve_max_length
         }

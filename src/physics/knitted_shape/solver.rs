@@ -352,7 +352,7 @@ impl Solver {
                     self.radii[j] = if self.held[j] {
                         base[j]
                     } else {
-                        (base[j] + alpha * self.x[j]).clamp(r_min, r_ceiling)
+                        crate::physics::bounds::limit(base[j] + alpha * self.x[j], r_min, r_ceiling)
                     };
                 }
                 self.hold_touching(r_min);
@@ -425,7 +425,7 @@ impl Solver {
         } else {
             n
         };
-        let period = period.clamp(2.0 * geom.rows_per_segment(), n);
+        let period = crate::physics::bounds::limit(period, 2.0 * geom.rows_per_segment(), n);
         let amplitude = deficit * m / (PI * period);
         let k = geom.rows_per_segment();
         let rings = self.radii.len();

@@ -49,7 +49,7 @@ mod tests;
 use magnetics::{RingBar, GYROMAGNETIC_RATIO, MU0};
 use onion::Landscape;
 pub use params::*;
-pub use schedule::SteppingSchedule;
+pub use schedule::{ScheduleSwitch, SteppingSchedule};
 use std::f64::consts::PI;
 
 /// The motor built from its parameters, with everything that depends only on them precomputed.
@@ -89,7 +89,7 @@ pub struct MotorInputs {
     /// Holds the rotor still (to measure static torque).
     pub rotor_locked: bool,
     /// Built-in stepping schedule; overrides `strain_direction` and `stress`.
-    pub schedule: Option<SteppingSchedule>,
+    pub schedule: ScheduleSwitch,
 }
 
 impl MotorInputs {
@@ -99,7 +99,7 @@ impl MotorInputs {
             stress,
             load_torque: 0.0,
             rotor_locked: false,
-            schedule: None,
+            schedule: ScheduleSwitch::OFF,
         }
     }
 }
@@ -414,7 +414,7 @@ impl Motor {
         )?;
         check_finite("stress", inputs.stress, MAX_STRESS, "Pa")?;
         check_finite("load_torque", inputs.load_torque, MAX_LOAD_TORQUE, "N m")?;
-        if let Some(s) = &inputs.schedule {
+        if let Some(s) = inputs.schedule.get() {
             SteppingSchedule::new(
                 s.initial_direction,
                 s.step_angle,
@@ -425,7 +425,8 @@ impl Motor {
         Ok(())
     }
 
-    fn validate_state(state: &MotorState) -> Result<(), String> {
+    /// Why `state` is not one [`Motor::step`] can start from (non-finite or beyond its bounds).
+    pub fn validate_state(state: &MotorState) -> Result<(), String> {
         check_finite("time", state.time, 1e12, "s")?;
         check_finite("rotor_angle", state.rotor_angle, MAX_ANGLE, "rad")?;
         check_finite("rotor_speed", state.rotor_speed, 1e30, "rad/s")?;
@@ -435,7 +436,7 @@ impl Motor {
     }
 
     fn drive_at(&self, inputs: &MotorInputs, time: f64) -> Drive {
-        let (direction, stress) = match &inputs.schedule {
+        let (direction, stress) = match inputs.schedule.get() {
             Some(s) => (s.direction(time), s.stress_amplitude),
             None => (inputs.strain_direction, inputs.stress),
         };
@@ -548,14 +549,14 @@ impl Motor {
             if run.t >= run.t_end {
                 break;
             }
-            if let (Some(s), true) = (&inputs.schedule, run.t == run.segment_end) {
+            if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
                 if self.skip_repeated_periods(&mut run, s) {
                     continue;
                 }
             }
             let d = self.drive_at(inputs, run.t);
             self.constrain(&mut run.y, &d);
-            let segment_end = match &inputs.schedule {
+            let segment_end = match inputs.schedule.get() {
                 Some(s) => s.next_switch_after(run.t).min(run.t_end),
                 None => run.t_end,
             };

@@ -81,3 +81,40 @@ impl SteppingSchedule {
         }
     }
 }
+
+/// The built-in schedule, switched on or off. Deliberately not an `Option<SteppingSchedule>`: a
+/// `None` leaves the four payload floats uninitialised, and optimized code loaded `step_period`
+/// from it and branched on its `floor` before testing the tag (valgrind: "conditional jump
+/// depends on uninitialised value"). Here every field is always defined, whichever the switch.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ScheduleSwitch {
+    on: bool,
+    schedule: SteppingSchedule,
+}
+
+impl ScheduleSwitch {
+    /// No schedule: the fixed `strain_direction` and `stress` drive the ring.
+    pub const OFF: Self = Self {
+        on: false,
+        schedule: SteppingSchedule {
+            initial_direction: 0.0,
+            step_angle: 0.0,
+            step_period: 1.0,
+            stress_amplitude: 0.0,
+        },
+    };
+
+    /// `schedule`, used only when `on`.
+    pub fn new(on: bool, schedule: SteppingSchedule) -> Self {
+        Self { on, schedule }
+    }
+
+    pub fn on(schedule: SteppingSchedule) -> Self {
+        Self::new(true, schedule)
+    }
+
+    /// The schedule if it is switched on.
+    pub fn get(&self) -> Option<&SteppingSchedule> {
+        self.on.then_some(&self.schedule)
+    }
+}

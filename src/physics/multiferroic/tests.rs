@@ -22,7 +22,7 @@ fn schedule(period: f64) -> MotorInputs {
     )
     .unwrap();
     MotorInputs {
-        schedule: Some(s),
+        schedule: ScheduleSwitch::on(s),
         ..MotorInputs::fixed(0.0, 0.0)
     }
 }

@@ -1,0 +1,166 @@
+//! The native half of `make memcheck`: every packaged FMU loaded through its C ABI (no Python),
+//! run under valgrind with a leak check that counts definite and indirect leaks as errors.
+//!
+//! - every model twice, with default parameters and with all effects on, over 40 steps of inputs
+//!   inside their declared ranges, through an FMU state get / serialize / deserialize / set;
+//! - every catalogue scene (`scenes/*.json`, fast variant) with its parameters, inputs and every
+//!   sweep value;
+//! - every instance and FMU state freed, so anything left is a leak of ours.
+//!
+//! `cargo run --release --example memcheck_native` runs it without valgrind (a few seconds).
+
+#[allow(dead_code)]
+#[path = "../../tests/common/mod.rs"]
+mod common;
+#[allow(dead_code)]
+#[path = "../../tests/common/exercise.rs"]
+mod exercise;
+
+use actuator_fmus::variables::{ModelInfo, VarType};
+use actuator_fmus_tools::scene::{Scene, Value};
+use common::*;
+use exercise::*;
+use std::ffi::c_int;
+use std::path::Path;
+use std::ptr::null_mut;
+
+fn models_run(api: &Api, info: &ModelInfo, effects: bool) -> usize {
+    let i = ready(api, info, effects);
+    let mut steps = 0;
+    for n in 0..20 {
+        step_and_read(&i, info, 0, n);
+        steps += 1;
+    }
+    // Through a serialized state and back, then on.
+    let bytes = serialized_state(&i);
+    unsafe {
+        let mut s = null_mut();
+        let st = (api.fmi2DeSerializeFMUstate)(i.c, bytes.as_ptr(), bytes.len(), &mut s);
+        assert_eq!(st, OK, "{}: {:?}", info.name, i.log.lines());
+        assert_eq!((api.fmi2SetFMUstate)(i.c, s), OK);
+        // One state left for fmi2FreeInstance to free.
+        let mut kept = null_mut();
+        assert_eq!((api.fmi2GetFMUstate)(i.c, &mut kept), OK);
+        assert_eq!((api.fmi2FreeFMUstate)(i.c, &mut s), OK);
+    }
+    for n in 20..40 {
+        step_and_read(&i, info, 0, n);
+        steps += 1;
+    }
+    unsafe {
+        assert_eq!((api.fmi2Terminate)(i.c), OK);
+        assert_eq!((api.fmi2Reset)(i.c), OK);
+    }
+    steps
+}
+
+/// One run of `scene` (with the sweep value `sweep` if any): parameters, inputs at t, a step.
+fn scene_run(api: &Api, info: &ModelInfo, scene: &Scene, sweep: Option<usize>) -> usize {
+    let i = api
+        .instantiate("memcheck", info.guid)
+        .unwrap_or_else(|l| panic!("{:?}", l.lines()));
+    assert_eq!(i.setup(), OK);
+    assert_eq!(i.enter(), OK);
+    let var = |name: &str| {
+        info.variables
+            .iter()
+            .find(|v| v.name == name)
+            .unwrap_or_else(|| panic!("{}: no variable {name}", info.name))
+    };
+    let set = |name: &str, x: f64| {
+        let v = var(name);
+        let s = unsafe {
+            match v.kind {
+                VarType::Real => (api.fmi2SetReal)(i.c, &v.vr, 1, &x),
+                VarType::Integer => (api.fmi2SetInteger)(i.c, &v.vr, 1, &(x as c_int)),
+                VarType::Boolean => (api.fmi2SetBoolean)(i.c, &v.vr, 1, &c_int::from(x != 0.0)),
+                VarType::String => panic!("string parameter {name}"),
+            }
+        };
+        assert!(s <= WARNING, "{name} = {x}: {:?}", i.log.lines());
+    };
+    for (name, value) in &scene.parameters {
+        set(
+            name,
+            match value {
+                Value::Bool(b) => f64::from(u8::from(*b)),
+                Value::Number(x) => *x,
+            },
+        );
+    }
+    if let (Some(sw), Some(k)) = (&scene.sweep, sweep) {
+        set(&sw.variable, sw.values[k]);
+        for (name, values) in &sw.also {
+            set(name, values[k]);
+        }
+    }
+    for (name, signal) in &scene.inputs {
+        if let Some(x) = signal.at(0.0, scene.stop_time) {
+            set(name, x);
+        }
+    }
+    // A Warning (an input outside the valid range, logged) is a legal outcome of a scene.
+    assert!(i.exit() <= WARNING, "{}: {:?}", info.name, i.log.lines());
+    let outputs: Vec<u32> = scene.outputs.iter().map(|n| var(n).vr).collect();
+    let n = (scene.stop_time / scene.step).round() as usize;
+    for k in 0..n {
+        let t = k as f64 * scene.step;
+        for (name, signal) in &scene.inputs {
+            if let Some(x) = signal.at(t, scene.stop_time) {
+                set(name, x);
+            }
+        }
+        let s = i.do_step(t, scene.step);
+        assert!(s <= WARNING, "{} step {k}: {:?}", info.name, i.log.lines());
+        let (s, values) = i.get_real(&outputs);
+        assert!(s <= WARNING && values.iter().all(|x| x.is_finite()));
+    }
+    n
+}
+
+fn main() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let apis: Vec<(&ModelInfo, Api)> = models()
+        .into_iter()
+        .map(|info| (info, Api::load(&extract_binary(info.name))))
+        .collect();
+    let api_of = |name: &str| {
+        apis.iter()
+            .find(|(i, _)| i.name == name)
+            .unwrap_or_else(|| panic!("no FMU {name}"))
+    };
+    for (info, api) in &apis {
+        let steps = models_run(api, info, false) + models_run(api, info, true);
+        println!("{}: default and all effects on, {steps} steps", info.name);
+    }
+    let mut paths: Vec<_> = std::fs::read_dir(root.join("scenes"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "json"))
+        .collect();
+    paths.sort();
+    for path in &paths {
+        let scene = Scene::from_json(&std::fs::read_to_string(path).unwrap())
+            .unwrap()
+            .fast();
+        let (info, api) = api_of(&scene.fmu);
+        let sweeps: Vec<Option<usize>> = match &scene.sweep {
+            Some(s) => (0..s.values.len()).map(Some).collect(),
+            None => vec![None],
+        };
+        let steps: usize = sweeps
+            .iter()
+            .map(|&k| scene_run(api, info, &scene, k))
+            .sum();
+        println!(
+            "{}: {} runs, {steps} steps",
+            path.file_name().unwrap().to_string_lossy(),
+            sweeps.len()
+        );
+    }
+    println!(
+        "memcheck_native: {} FMUs and {} scenes done",
+        apis.len(),
+        paths.len()
+    );
+}
