@@ -42,7 +42,7 @@ demo: fmus $(VENV)/.installed
 scene: fmus $(VENV)/.installed
 	$(PY) scenes/run.py $(SCENE) --out out
 
-## Every scene at full length, and docs/figures.md with the plots beside the seed's statements.
+## Every scene at full length, and docs/figures.md with the plots beside the dissertation's statements.
 figures: fmus $(VENV)/.installed
 	$(PY) scenes/catalogue.py
 

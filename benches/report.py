@@ -233,7 +233,7 @@ def main():
 
     shape = shape_table_times()
     if shape:
-        lines += ["## Knitted shape table: ours against the seed's algorithm", "",
+        lines += ["## Knitted shape table: ours against the dissertation's algorithm", "",
                   "Building the non-cylindrical volume-length table of the section 1.4 prototype (49 rows) once, at",
                   "initialization (`make bench`, benches/knitted_shape.rs):", "",
                   "| method | time to build |", "|---|---|"]
@@ -242,7 +242,7 @@ def main():
             ours = next(t for n, t in shape.items() if n.startswith("ours"))
             seed = next(t for n, t in shape.items() if n.startswith("seed"))
             lines += ["", f"Ours is {seed / ours:.0f} times faster. The two agree to 7 digits in volume from the",
-                      "free contraction up to 0.356 m; nearer full extension the seed's exchange stalls on the",
+                      "free contraction up to 0.356 m; nearer full extension the dissertation's exchange stalls on the",
                       "unstable uniform bulge (its stopping rule is met there) and its volume falls up to 27% short.",
                       "So it is not the same accuracy at lower cost: it is lower accuracy at far higher cost.", ""]
     progress("cost under FMPy")

@@ -1,5 +1,5 @@
 """Runs every scene in scenes/ (full length) and writes docs/figures.md with each plot beside what
-the seed says, and the seed's numbers beside ours. `make figures`."""
+the dissertation says, and the dissertation's numbers beside ours. `make figures`."""
 
 import pathlib
 import re
@@ -17,7 +17,7 @@ def main():
     lines = [
         "# Figure catalogue",
         "",
-        "Each scene in `scenes/` reproduces the model side of one of the seed's figures. Regenerate this",
+        "Each scene in `scenes/` reproduces the model side of one of the dissertation's figures. Regenerate this",
         "page with `make figures`; run one scene with `.venv/bin/python scenes/run.py scenes/<scene>.json`.",
         "",
     ]

@@ -1,5 +1,5 @@
 """Runs a scene file (scenes/*.json, format in src/scene.rs) under FMPy: writes <out>/<scene>.csv and
-<out>/<scene>.png, prints the seed's numbers beside ours, exits 1 if a check fails.
+<out>/<scene>.png, prints the dissertation's numbers beside ours, exits 1 if a check fails.
 
     python scenes/run.py scenes/fig2_3_ideal_mckibben.json [--fast] [--out out]
 """
@@ -144,18 +144,18 @@ def evaluate_checks(scene, runs):
         if kind == "max":
             got = max(float(np.max(r[out])) for _, r in runs)
             ok = abs(got - check["expect"]) <= check["rel_tol"] * abs(check["expect"])
-            results.append((ok, f"max {out} = {got:.6g}, seed {check['expect']:.6g} ({check['source']})"))
+            results.append((ok, f"max {out} = {got:.6g}, dissertation {check['expect']:.6g} ({check['source']})"))
         elif kind == "zero_crossing":
             for value, r in runs:
                 got = zero_crossing(r[check["x"]], r[out])
                 ok = abs(got - check["expect"]) <= check["rel_tol"] * abs(check["expect"])
-                results.append((ok, f"{out} = 0 at {check['x']} = {got:.6g}, seed {check['expect']:.6g} "
+                results.append((ok, f"{out} = 0 at {check['x']} = {got:.6g}, dissertation {check['expect']:.6g} "
                                     f"(run {value}; {check['source']})"))
         elif kind == "final":
             for value, r in runs:
                 got = float(r[out][-1])
                 ok = abs(got - check["expect"]) <= check["abs_tol"]
-                results.append((ok, f"final {out} = {got:.6g}, seed {check['expect']:.6g} "
+                results.append((ok, f"final {out} = {got:.6g}, dissertation {check['expect']:.6g} "
                                     f"(run {value}; {check['source']})"))
         else:
             results.append((False, f"unknown check kind {kind}"))

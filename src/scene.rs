@@ -1,6 +1,6 @@
 //! Scene files (`scenes/*.json`): which FMU, which parameters and effects, the input signals, the
 //! communication step and stop time, the outputs to record, an optional sweep, the plot and the
-//! numbers to check against the seed. The FMPy runner (`scenes/run.py`) reads the same files;
+//! numbers to check against the dissertation. The FMPy runner (`scenes/run.py`) reads the same files;
 //! `examples/run_scene.rs` runs them through the `fmi` crate.
 
 use serde::{Deserialize, Serialize};
@@ -11,7 +11,7 @@ use std::collections::BTreeMap;
 pub struct Scene {
     /// Model identifier: `target/fmu/<fmu>.fmu`.
     pub fmu: String,
-    /// What the scene reproduces (figure number, what the seed says about it).
+    /// What the scene reproduces (figure number, what the dissertation says about it).
     pub description: String,
     /// Start values of parameters (effects, fidelity levels, presets) by variable name.
     #[serde(default)]
@@ -29,7 +29,7 @@ pub struct Scene {
     /// A shorter scene for `make test`: replaces these fields.
     pub fast: Option<Fast>,
     pub plot: Option<Plot>,
-    /// Numbers the seed gives, checked by the runners and in `make test`.
+    /// Numbers the dissertation gives, checked by the runners and in `make test`.
     #[serde(default)]
     pub checks: Vec<Check>,
 }
@@ -110,7 +110,7 @@ fn one() -> f64 {
     1.0
 }
 
-/// A number the seed gives, and how close the scene must come.
+/// A number the dissertation gives, and how close the scene must come.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Check {

@@ -1,5 +1,5 @@
 //! Every catalogue scene, in its fast variant, through the `fmi` crate: it runs, its outputs are
-//! finite and the seed's numbers it names hold (the FMPy runner checks the same in pytest).
+//! finite and the dissertation's numbers it names hold (the FMPy runner checks the same in pytest).
 
 mod common;
 #[allow(dead_code)]
@@ -10,7 +10,7 @@ use actuator_fmus::scene::Scene;
 use std::path::Path;
 
 #[test]
-fn catalogue_scenes_run_and_match_the_seed() {
+fn catalogue_scenes_run_and_match_the_dissertation() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
     let mut scenes: Vec<_> = std::fs::read_dir(root.join("scenes"))
         .unwrap()

@@ -1,5 +1,5 @@
 """Every catalogue scene (scenes/*.json), fast variant, under FMPy: it runs, writes its CSV and plot,
-gives finite outputs, and the seed's numbers it names hold."""
+gives finite outputs, and the dissertation's numbers it names hold."""
 
 import pathlib
 import sys
