@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps py-deps
 
 all: fmus
 
@@ -23,6 +23,14 @@ deps:
 	  echo "installing libclang-dev (needed by the fmi crate's bindgen)"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libclang-dev; \
+	fi
+
+## Debian's libtbb12 for ecospy's native library (recipes/importers_ssp_libcosim_ecos.py).
+py-deps:
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12'; then \
+	  echo "installing libtbb12 (needed by ecospy)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libtbb12; \
 	fi
 
 $(LIB) target/release/package_fmus: $(SOURCES)
@@ -49,7 +57,7 @@ figures: fmus $(VENV)/.installed
 test-rust: deps fmus
 	cargo test --release
 
-test-fmpy: fmus $(VENV)/.installed
+test-fmpy: fmus $(VENV)/.installed py-deps
 	$(PY) -m pytest tests/fmpy -q
 
 ## All Rust tests and the FMPy suite.
