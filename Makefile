@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps py-deps
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps py-deps scene-schema
 
 all: fmus
 
@@ -25,12 +25,17 @@ deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libclang-dev; \
 	fi
 
-## Debian's libtbb12 for ecospy's native library (recipes/importers_ssp_libcosim_ecos.py).
+## Debian packages the FMPy suite needs: libtbb12 for ecospy's native library
+## (recipes/importers_ssp_libcosim_ecos.py) and chromium for the FMU pages' screenshot test.
 py-deps:
-	@if ! ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12'; then \
-	  echo "installing libtbb12 (needed by ecospy)"; \
+	@missing=""; \
+	ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12' || missing="$$missing libtbb12"; \
+	command -v chromium >/dev/null || missing="$$missing chromium"; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing$$missing"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
-	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libtbb12; \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq \
+	    --no-install-recommends $$missing; \
 	fi
 
 $(LIB) target/release/package_fmus: $(SOURCES)
@@ -45,6 +50,10 @@ DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
 ## Builds the FMUs and runs the default scene under FMPy: out/fig2_3_ideal_mckibben.{csv,png}.
 demo: fmus $(VENV)/.installed
 	$(PY) scenes/run.py $(DEFAULT_SCENE) --out out
+
+## scenes/schema/scene.schema.json, the JSON Schema of scene files, from the Rust types in src/scene.rs.
+scene-schema:
+	cargo run --release --quiet --example run_scene -- --schema > scenes/schema/scene.schema.json
 
 ## Any scene: make scene SCENE=scenes/<name>.json
 scene: fmus $(VENV)/.installed
