@@ -260,7 +260,7 @@ def main():
         why = f": its own step costs {fmt_time(native)} natively" if native else ""
         verdict = "met" if ratio <= 1.2 else f"missed by {ratio / 1.2:.2f}x{why}"
         lines.append(f"| {model} | {fmt_time(t)} | {ratio:.2f} | {verdict} |")
-    lines += ["", "## Targets (issue 7)", "", "| target | measured | verdict |", "|---|---|---|"]
+    lines += ["", "## Targets: what the project set out to reach", "", "| target | measured | verdict |", "|---|---|---|"]
     for key, target, label in NATIVE_TARGETS:
         t = times.get(key)
         if t is None:

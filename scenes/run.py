@@ -206,15 +206,17 @@ def quantity(value, unit):
             if value == 0 or abs(value) * factor >= 1:
                 return f"{value * factor:.4g} {name}"
         return f"{value:.4g} s"
-    name, factor = DISPLAY.get(unit, (unit, 1.0))
-    return f"{value * factor:.4g} {name}".strip()
+    if unit in ("", "1"):
+        return f"{value:.4g}"
+    name, factor = DISPLAY.get(unit, (unit.replace(".", " "), 1.0))
+    return f"{value * factor:.4g} {name}"
 
 
 def run_label(scene, value, unit_of):
     if value is None:
         return ""
     variable = scene["sweep"]["variable"]
-    return f"{variable} {quantity(value, unit_of.get(variable, ''))}"
+    return f"{variable} = {quantity(value, unit_of.get(variable, ''))}"
 
 
 def evaluate_checks(scene, runs):
