@@ -101,7 +101,10 @@ pub fn number(x: f64) -> String {
             mantissa
         };
         let exponent: i32 = exponent.parse().unwrap_or(0);
-        format!("{mantissa}e{}{exponent}", if exponent > 0 { "+" } else { "" })
+        format!(
+            "{mantissa}e{}{exponent}",
+            if exponent > 0 { "+" } else { "" }
+        )
     }
 }
 

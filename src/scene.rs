@@ -388,7 +388,8 @@ mod tests {
 
     #[test]
     fn shipped_schema_is_the_generated_one() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/schema/scene.schema.json");
+        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("scenes/schema/scene.schema.json");
         let shipped = std::fs::read_to_string(&path).unwrap_or_default();
         assert!(
             shipped == json_schema(),
