@@ -8,7 +8,8 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use actuator_fmus::variables::{VarType, REGISTRY};
+use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::variables::VarType;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::time::Duration;
 

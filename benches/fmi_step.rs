@@ -4,8 +4,8 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
+use actuator_fmus::fmi2::REGISTRY;
 use actuator_fmus::physics::gaylord::Sleeve;
-use actuator_fmus::variables::REGISTRY;
 use common::mckibben::*;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::time::Duration;

@@ -1,13 +1,45 @@
-//! Parsing and checking of `modelDescription/<Model>.xml`, and generation of the Rust tables.
-//! Used by build.rs, and by `tests/model_description.rs` to prove that bad descriptions fail.
+//! Parsing and checking of `modelDescription/<Model>.xml`, and the shipped model description that
+//! build.rs writes from it. Used by build.rs (with `build/codegen.rs`, which writes the Rust
+//! code), and by `tests/model_description.rs` to prove that bad descriptions fail.
+//!
+//! A source description holds only the model's own: its variables, units, default experiment and
+//! output dependencies (by variable name). The export layer's part is written here: the
+//! `<CoSimulation>` block, the `<LogCategories>`, the 1-based ModelStructure indices and the GUID.
 
+use serde::de::IgnoredAny;
 use serde::Deserialize;
 use sha2::{Digest, Sha256};
-use std::collections::BTreeSet;
+use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
-use std::path::Path;
 
 const GUID_PLACEHOLDER: &str = "@GUID@";
+
+/// The export layer's log categories (`src/fmi2` checks `fmi2SetDebugLogging` against them).
+pub const LOG_CATEGORIES: [(&str, &str); 5] = [
+    (
+        "logStatusWarning",
+        "Warnings: inputs outside the model's range, clamped",
+    ),
+    ("logStatusDiscard", "Steps that could not be completed"),
+    (
+        "logStatusError",
+        "Errors: bad arguments, illegal call order, bad parameters",
+    ),
+    ("logStatusFatal", "Fatal errors: internal faults"),
+    ("logCalls", "Every FMI function call (debug logging)"),
+];
+
+/// The capabilities of the export layer in `src/fmi2`, the same for every model.
+const CO_SIMULATION_CAPABILITIES: &str = r#"needsExecutionTool="false"
+    canHandleVariableCommunicationStepSize="true"
+    canInterpolateInputs="false"
+    maxOutputDerivativeOrder="0"
+    canRunAsynchronuously="false"
+    canBeInstantiatedOnlyOncePerProcess="false"
+    canNotUseMemoryManagementFunctions="true"
+    canGetAndSetFMUstate="true"
+    canSerializeFMUstate="true"
+    providesDirectionalDerivative="false""#;
 
 #[derive(Deserialize)]
 struct ModelDescription {
@@ -20,33 +52,23 @@ struct ModelDescription {
     #[serde(rename = "@description", default)]
     description: String,
     #[serde(rename = "CoSimulation")]
-    co_simulation: CoSimulation,
+    co_simulation: Option<IgnoredAny>,
+    #[serde(rename = "ModelExchange")]
+    model_exchange: Option<IgnoredAny>,
+    #[serde(rename = "LogCategories")]
+    log_categories: Option<IgnoredAny>,
     #[serde(rename = "UnitDefinitions", default)]
     unit_definitions: UnitDefinitions,
-    #[serde(rename = "LogCategories", default)]
-    log_categories: LogCategories,
     #[serde(rename = "ModelVariables")]
     model_variables: ModelVariables,
-    #[serde(rename = "ModelStructure")]
+    #[serde(rename = "ModelStructure", default)]
     model_structure: ModelStructure,
-}
-
-#[derive(Deserialize)]
-struct CoSimulation {
-    #[serde(rename = "@modelIdentifier")]
-    model_identifier: String,
 }
 
 #[derive(Deserialize, Default)]
 struct UnitDefinitions {
     #[serde(rename = "Unit", default)]
     units: Vec<Named>,
-}
-
-#[derive(Deserialize, Default)]
-struct LogCategories {
-    #[serde(rename = "Category", default)]
-    categories: Vec<Named>,
 }
 
 #[derive(Deserialize)]
@@ -106,10 +128,12 @@ struct TypeAttributes {
     declared_type: Option<String>,
 }
 
-#[derive(Deserialize)]
+#[derive(Deserialize, Default)]
 struct ModelStructure {
     #[serde(rename = "Outputs", default)]
     outputs: Unknowns,
+    #[serde(rename = "Derivatives")]
+    derivatives: Option<IgnoredAny>,
     #[serde(rename = "InitialUnknowns", default)]
     initial_unknowns: Unknowns,
 }
@@ -120,47 +144,89 @@ struct Unknowns {
     unknowns: Vec<Unknown>,
 }
 
+/// `<Unknown name="force" dependencies="pressure length" dependenciesKind="dependent dependent"/>`
 #[derive(Deserialize)]
 struct Unknown {
+    #[serde(rename = "@name")]
+    name: Option<String>,
     #[serde(rename = "@index")]
-    index: usize,
+    index: Option<IgnoredAny>,
+    #[serde(rename = "@dependencies")]
+    dependencies: Option<String>,
+    #[serde(rename = "@dependenciesKind")]
+    dependencies_kind: Option<String>,
 }
 
-const TYPES: [&str; 4] = ["Real", "Integer", "Boolean", "String"];
+pub const TYPES: [&str; 4] = ["Real", "Integer", "Boolean", "String"];
 
-struct Checked<'a> {
-    var: &'a ScalarVariable,
-    type_index: usize,
-    attrs: &'a TypeAttributes,
-    initial: &'static str,
+/// One checked `ScalarVariable`, owned, for the code generator.
+pub struct Variable {
+    pub name: String,
+    pub description: String,
+    /// Index into [`TYPES`].
+    pub type_index: usize,
+    pub value_reference: u32,
+    pub causality: String,
+    pub variability: String,
+    /// The `initial` in effect ("none" for inputs and the independent variable).
+    pub initial: &'static str,
+    pub start: Option<String>,
+    pub min: Option<String>,
+    pub max: Option<String>,
+    pub unit: Option<String>,
+}
+
+/// One ModelStructure entry with 1-based indices.
+#[derive(Debug, PartialEq)]
+pub struct ResolvedUnknown {
+    pub index: usize,
+    /// Ascending indices; `None` when the source declares none (then the attribute is left out).
+    pub dependencies: Option<Vec<usize>>,
+    pub kinds: Option<Vec<String>>,
+}
+
+/// A checked model description: what the code generator and the shipped XML need.
+pub struct Model {
+    pub name: String,
+    pub description: String,
+    pub variables: Vec<Variable>,
+    /// Number of Real, Integer, Boolean and String variables.
+    pub counts: [usize; 4],
+    #[allow(dead_code)] // read by tests/model_description.rs
+    pub outputs: Vec<ResolvedUnknown>,
+    #[allow(dead_code)]
+    pub initial_unknowns: Vec<ResolvedUnknown>,
+    /// The model description as shipped in the FMU, GUID filled in.
+    pub shipped_xml: String,
+    pub guid: String,
 }
 
 /// Checks the model description `text` of file `<stem>.xml`; the error says what is wrong.
-#[allow(dead_code)]
-pub fn check(text: &str, stem: &str) -> Result<(), String> {
-    with_checked(text, stem, |_, _, _| Ok(()))
-}
-
-/// Parses and checks `text`, then hands the checked variables and per-type counts to `then`.
-fn with_checked<R>(
-    text: &str,
-    stem: &str,
-    then: impl FnOnce(&ModelDescription, &[Checked], [usize; 4]) -> Result<R, String>,
-) -> Result<R, String> {
+pub fn check(text: &str, stem: &str) -> Result<Model, String> {
     let md: ModelDescription =
         quick_xml::de::from_str(text).map_err(|e| format!("cannot parse: {e}"))?;
     if md.fmi_version != "2.0" {
         return Err(format!("fmiVersion must be 2.0, found {}", md.fmi_version));
     }
-    if md.model_name != stem || md.co_simulation.model_identifier != stem {
-        return Err(format!(
-            "modelName and modelIdentifier must both equal the file name '{stem}'"
-        ));
+    if md.model_name != stem {
+        return Err(format!("modelName must equal the file name '{stem}'"));
     }
     if md.guid != GUID_PLACEHOLDER {
         return Err(format!(
             "guid must be the placeholder \"{GUID_PLACEHOLDER}\"; build.rs fills it in"
         ));
+    }
+    for (present, element) in [
+        (md.co_simulation.is_some(), "CoSimulation"),
+        (md.model_exchange.is_some(), "ModelExchange"),
+        (md.log_categories.is_some(), "LogCategories"),
+        (md.model_structure.derivatives.is_some(), "Derivatives"),
+    ] {
+        if present {
+            return Err(format!(
+                "<{element}> belongs to the export layer: build.rs writes it, remove it from the source"
+            ));
+        }
     }
     let units: BTreeSet<&str> = md
         .unit_definitions
@@ -168,26 +234,37 @@ fn with_checked<R>(
         .iter()
         .map(|u| u.name.as_str())
         .collect();
+    if units.len() != md.unit_definitions.units.len() {
+        return Err("a unit is defined twice in UnitDefinitions".into());
+    }
 
-    let mut checked = Vec::new();
+    let mut variables = Vec::new();
     let mut names = BTreeSet::new();
+    let mut field_names = BTreeSet::new();
     for v in &md.model_variables.variables {
         let c = check_variable(v, &units).map_err(|e| format!("variable '{}': {e}", v.name))?;
         if !names.insert(v.name.as_str()) {
             return Err(format!("variable name '{}' is used twice", v.name));
         }
-        checked.push(c);
+        if !field_names.insert(field_name(&v.name)) {
+            return Err(format!(
+                "variable '{}' has the same Rust field name as another, '{}'",
+                v.name,
+                field_name(&v.name)
+            ));
+        }
+        variables.push(c);
     }
     // Value references are dense per type so that the export layer indexes arrays directly.
     let mut counts = [0usize; 4];
-    for t in 0..4 {
-        let mut vrs: Vec<u32> = checked
+    for (t, count) in counts.iter_mut().enumerate() {
+        let mut vrs: Vec<u32> = variables
             .iter()
             .filter(|c| c.type_index == t)
-            .map(|c| c.var.value_reference)
+            .map(|c| c.value_reference)
             .collect();
         vrs.sort_unstable();
-        counts[t] = vrs.len();
+        *count = vrs.len();
         if vrs.iter().enumerate().any(|(i, &vr)| vr as usize != i) {
             return Err(format!(
                 "{} value references must be 0..{} without gaps or repeats, found {vrs:?}",
@@ -196,136 +273,23 @@ fn with_checked<R>(
             ));
         }
     }
-    check_model_structure(&md, &checked)?;
-    then(&md, &checked, counts)
-}
-
-/// Validates one model description and appends its tables; returns (module, type name).
-pub fn generate(path: &Path, out_dir: &str, code: &mut String) -> Result<(String, String), String> {
-    let text = std::fs::read_to_string(path).map_err(|e| e.to_string())?;
-    let stem = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .unwrap_or_default();
-    with_checked(&text, stem, |md, checked, counts| {
-        emit(md, checked, counts, &text, stem, out_dir, code)
+    let (outputs, initial_unknowns) = resolve_structure(&md.model_structure, &variables)?;
+    let rendered = shipped(text, stem, &variables, &outputs, &initial_unknowns)?;
+    let guid = guid_of(&rendered);
+    Ok(Model {
+        name: stem.to_string(),
+        description: md.description,
+        variables,
+        counts,
+        outputs,
+        initial_unknowns,
+        shipped_xml: rendered.replacen(GUID_PLACEHOLDER, &guid, 1),
+        guid,
     })
 }
 
-fn emit(
-    md: &ModelDescription,
-    checked: &[Checked],
-    counts: [usize; 4],
-    text: &str,
-    stem: &str,
-    out_dir: &str,
-    code: &mut String,
-) -> Result<(String, String), String> {
-    let guid = guid_of(text);
-    let shipped = text.replacen(GUID_PLACEHOLDER, &guid, 1);
-    let xml_path = Path::new(out_dir).join(format!("{stem}.xml"));
-    std::fs::write(&xml_path, shipped).map_err(|e| e.to_string())?;
-
-    let module = snake_case(stem);
-    let _ = writeln!(
-        code,
-        "/// Tables of `{stem}`, from modelDescription/{stem}.xml."
-    );
-    let _ = writeln!(code, "pub mod {module} {{");
-    let _ = writeln!(code, "    use crate::variables::*;");
-    for (t, type_name) in TYPES.iter().enumerate() {
-        let _ = writeln!(
-            code,
-            "    /// Value references (array indices) of the {type_name} variables."
-        );
-        let _ = writeln!(code, "    #[allow(dead_code)]");
-        let _ = writeln!(code, "    pub mod {} {{", type_name.to_lowercase());
-        for c in checked.iter().filter(|c| c.type_index == t) {
-            let _ = writeln!(code, "        /// {}", c.var.description);
-            let _ = writeln!(
-                code,
-                "        pub const {}: usize = {};",
-                c.var.name.to_uppercase().replace('.', "_"),
-                c.var.value_reference
-            );
-        }
-        let _ = writeln!(code, "    }}");
-    }
-    let _ = writeln!(code, "    pub static VARIABLES: &[Variable] = &[");
-    for c in checked {
-        let a = c.attrs;
-        let start = match (c.type_index, &a.start) {
-            (_, None) => "Start::None".to_string(),
-            (0, Some(s)) => format!("Start::Real({})", real_literal(s)?),
-            (1, Some(s)) => format!(
-                "Start::Integer({})",
-                s.trim()
-                    .parse::<i32>()
-                    .map_err(|e| format!("bad start '{s}': {e}"))?
-            ),
-            (2, Some(s)) => format!("Start::Boolean({})", parse_bool(s)?),
-            (_, Some(s)) => format!("Start::String({s:?})"),
-        };
-        let bound = |b: &Option<String>| -> Result<String, String> {
-            Ok(match b {
-                None => "None".into(),
-                Some(s) if c.type_index == 0 => format!("Some({})", real_literal(s)?),
-                Some(s) => format!(
-                    "Some({}.0)",
-                    s.trim()
-                        .parse::<i64>()
-                        .map_err(|e| format!("bad bound '{s}': {e}"))?
-                ),
-            })
-        };
-        let _ = writeln!(
-            code,
-            "        Variable {{ name: {:?}, kind: VarType::{}, vr: {}, causality: Causality::{}, variability: Variability::{}, initial: Initial::{}, start: {start}, min: {}, max: {}, unit: {:?}, description: {:?} }},",
-            c.var.name,
-            TYPES[c.type_index],
-            c.var.value_reference,
-            capitalize(&c.var.causality),
-            capitalize(&c.var.variability),
-            capitalize(c.initial),
-            bound(&a.min)?,
-            bound(&a.max)?,
-            a.unit.clone().unwrap_or_default(),
-            c.var.description,
-        );
-    }
-    let _ = writeln!(code, "    ];");
-    let categories: Vec<String> = md
-        .log_categories
-        .categories
-        .iter()
-        .map(|c| format!("{:?}", c.name))
-        .collect();
-    let _ = writeln!(code, "    pub static INFO: ModelInfo = ModelInfo {{");
-    let _ = writeln!(code, "        name: {stem:?},");
-    let _ = writeln!(code, "        guid: {guid:?},");
-    let _ = writeln!(code, "        description: {:?},", md.description);
-    let _ = writeln!(
-        code,
-        "        model_description_xml: include_str!({:?}),",
-        xml_path.display().to_string()
-    );
-    let _ = writeln!(code, "        variables: VARIABLES,");
-    let _ = writeln!(code, "        counts: {counts:?},");
-    let _ = writeln!(
-        code,
-        "        log_categories: &[{}],",
-        categories.join(", ")
-    );
-    let _ = writeln!(code, "    }};");
-    let _ = writeln!(code, "}}\n");
-    Ok((module, stem.to_string()))
-}
-
 /// FMI 2.0 section 2.2.7: which causality/variability pairs exist and which `initial` each allows.
-fn check_variable<'a>(
-    v: &'a ScalarVariable,
-    units: &BTreeSet<&str>,
-) -> Result<Checked<'a>, String> {
+fn check_variable(v: &ScalarVariable, units: &BTreeSet<&str>) -> Result<Variable, String> {
     let typed = [&v.real, &v.integer, &v.boolean, &v.string];
     let present: Vec<usize> = (0..4).filter(|&t| typed[t].is_some()).collect();
     let [type_index] = present[..] else {
@@ -334,6 +298,8 @@ fn check_variable<'a>(
     let attrs = typed[type_index].as_ref().expect("checked present");
     let (causality, variability) = (v.causality.as_str(), v.variability.as_str());
     // Case letters of the spec's table: which initial values are legal, the first being the default.
+    // Tunable parameters are accepted: the export layer rebuilds the model when one changes
+    // between steps (src/fmi2/values.rs).
     let allowed: &[&'static str] = match (variability, causality) {
         ("constant", "output" | "local") => &["exact"],
         ("fixed" | "tunable", "parameter") => &["exact"],
@@ -347,12 +313,6 @@ fn check_variable<'a>(
             ))
         }
     };
-    if variability == "tunable" && causality == "parameter" {
-        // Changing one mid-run would rebuild the model and lose its history; not supported yet.
-        return Err(
-            "tunable parameters are not supported by the export layer yet; use fixed".into(),
-        );
-    }
     if variability == "continuous" && type_index != 0 {
         return Err("only Real variables can be continuous".into());
     }
@@ -386,55 +346,303 @@ fn check_variable<'a>(
             return Err(format!("unit '{unit}' is not defined in UnitDefinitions"));
         }
     }
-    Ok(Checked {
-        var: v,
+    if field_name(&v.name).is_empty() {
+        return Err("the name has no letter or digit for a Rust field".into());
+    }
+    Ok(Variable {
+        name: v.name.clone(),
+        description: v.description.clone(),
         type_index,
-        attrs,
+        value_reference: v.value_reference,
+        causality: v.causality.clone(),
+        variability: v.variability.clone(),
         initial,
+        start: attrs.start.clone(),
+        min: attrs.min.clone(),
+        max: attrs.max.clone(),
+        unit: attrs.unit.clone(),
     })
 }
 
-/// Outputs: every output in order. InitialUnknowns: outputs with initial calculated or approx and
-/// every calculated parameter, ascending (FMI 2.0 section 2.2.8).
-fn check_model_structure(md: &ModelDescription, checked: &[Checked]) -> Result<(), String> {
-    let expected_outputs: Vec<usize> = (0..checked.len())
-        .filter(|&i| checked[i].var.causality == "output")
-        .map(|i| i + 1)
+const DEPENDENCY_KINDS: [&str; 5] = ["dependent", "constant", "fixed", "tunable", "discrete"];
+
+/// FMI 2.0 section 2.2.8. Outputs: every output, in order. InitialUnknowns: outputs with initial
+/// calculated or approx and every calculated parameter, ascending. The source may list any of
+/// them by name to give their dependencies; the rest are written without a dependency list.
+fn resolve_structure(
+    md: &ModelStructure,
+    variables: &[Variable],
+) -> Result<(Vec<ResolvedUnknown>, Vec<ResolvedUnknown>), String> {
+    let expected_outputs: Vec<usize> = (0..variables.len())
+        .filter(|&i| variables[i].causality == "output")
         .collect();
-    let expected_initial: Vec<usize> = (0..checked.len())
+    let expected_initial: Vec<usize> = (0..variables.len())
         .filter(|&i| {
-            let c = &checked[i];
-            (c.var.causality == "output" && matches!(c.initial, "calculated" | "approx"))
-                || c.var.causality == "calculatedParameter"
+            let v = &variables[i];
+            (v.causality == "output" && matches!(v.initial, "calculated" | "approx"))
+                || v.causality == "calculatedParameter"
         })
-        .map(|i| i + 1)
         .collect();
-    let outputs: Vec<usize> = md
-        .model_structure
-        .outputs
-        .unknowns
-        .iter()
-        .map(|u| u.index)
-        .collect();
-    let initial: Vec<usize> = md
-        .model_structure
-        .initial_unknowns
-        .unknowns
-        .iter()
-        .map(|u| u.index)
-        .collect();
-    if outputs != expected_outputs {
-        return Err(format!(
-            "ModelStructure/Outputs must list indices {expected_outputs:?}, found {outputs:?}"
-        ));
-    }
-    if initial != expected_initial {
-        return Err(format!("ModelStructure/InitialUnknowns must list indices {expected_initial:?}, found {initial:?}"));
-    }
-    Ok(())
+    let outputs = resolve_list(
+        "Outputs",
+        &md.outputs,
+        &expected_outputs,
+        variables,
+        |v| v.causality == "input",
+        "an input",
+    )?;
+    let initial = resolve_list(
+        "InitialUnknowns",
+        &md.initial_unknowns,
+        &expected_initial,
+        variables,
+        |v| v.causality == "input" || v.initial == "exact",
+        "an input or a variable with initial 'exact'",
+    )?;
+    Ok((outputs, initial))
 }
 
-/// A GUID derived from the whole source file: any change to a variable changes it.
+fn resolve_list(
+    list: &str,
+    source: &Unknowns,
+    expected: &[usize],
+    variables: &[Variable],
+    may_depend_on: impl Fn(&Variable) -> bool,
+    allowed: &str,
+) -> Result<Vec<ResolvedUnknown>, String> {
+    let index_of: BTreeMap<&str, usize> = variables
+        .iter()
+        .enumerate()
+        .map(|(i, v)| (v.name.as_str(), i))
+        .collect();
+    let mut given: BTreeMap<usize, ResolvedUnknown> = BTreeMap::new();
+    for u in &source.unknowns {
+        let context = |e: String| format!("ModelStructure/{list}: {e}");
+        if u.index.is_some() {
+            return Err(context(
+                "give the unknown by name=\"...\"; build.rs writes the index".into(),
+            ));
+        }
+        let name = u
+            .name
+            .as_deref()
+            .ok_or_else(|| context("an Unknown needs a name".into()))?;
+        let &i = index_of
+            .get(name)
+            .ok_or_else(|| context(format!("'{name}' is not a variable")))?;
+        if !expected.contains(&i) {
+            return Err(context(format!(
+                "'{name}' does not belong in this list (FMI 2.0 section 2.2.8)"
+            )));
+        }
+        let names: Option<Vec<&str>> = u
+            .dependencies
+            .as_deref()
+            .map(|d| d.split_whitespace().collect());
+        let kinds: Option<Vec<&str>> = u
+            .dependencies_kind
+            .as_deref()
+            .map(|d| d.split_whitespace().collect());
+        let mut pairs: Vec<(usize, Option<&str>)> = Vec::new();
+        match (&names, &kinds) {
+            (None, Some(_)) => {
+                return Err(context(format!(
+                    "'{name}' has dependenciesKind without dependencies"
+                )))
+            }
+            (Some(n), Some(k)) if n.len() != k.len() => {
+                return Err(context(format!(
+                    "'{name}' has {} dependencies but {} dependenciesKind",
+                    n.len(),
+                    k.len()
+                )))
+            }
+            _ => {}
+        }
+        for (j, dep) in names.iter().flatten().enumerate() {
+            let &d = index_of
+                .get(dep)
+                .ok_or_else(|| context(format!("'{name}' depends on '{dep}', not a variable")))?;
+            if !may_depend_on(&variables[d]) {
+                return Err(context(format!(
+                    "'{name}' may depend only on {allowed}, not on '{dep}'"
+                )));
+            }
+            let kind = kinds.as_ref().map(|k| k[j]);
+            if let Some(k) = kind.filter(|k| !DEPENDENCY_KINDS.contains(k)) {
+                return Err(context(format!(
+                    "dependenciesKind '{k}' of '{name}' is not one of {DEPENDENCY_KINDS:?}"
+                )));
+            }
+            if pairs.iter().any(|(p, _)| *p == d + 1) {
+                return Err(context(format!("'{name}' lists '{dep}' twice")));
+            }
+            pairs.push((d + 1, kind));
+        }
+        // The spec orders the dependency indices by magnitude.
+        pairs.sort_unstable_by_key(|(d, _)| *d);
+        let resolved = ResolvedUnknown {
+            index: i + 1,
+            dependencies: names.as_ref().map(|_| pairs.iter().map(|p| p.0).collect()),
+            kinds: kinds.as_ref().map(|_| {
+                pairs
+                    .iter()
+                    .map(|p| p.1.unwrap_or_default().to_string())
+                    .collect()
+            }),
+        };
+        if given.insert(i, resolved).is_some() {
+            return Err(context(format!("'{name}' is listed twice")));
+        }
+    }
+    Ok(expected
+        .iter()
+        .map(|&i| {
+            given.remove(&i).unwrap_or(ResolvedUnknown {
+                index: i + 1,
+                dependencies: None,
+                kinds: None,
+            })
+        })
+        .collect())
+}
+
+/// Byte offsets in the source where the export layer's parts go.
+#[derive(Default)]
+struct Splices {
+    /// Right after the `<fmiModelDescription ...>` start tag.
+    after_root: usize,
+    /// Before the first of DefaultExperiment, VendorAnnotations, ModelVariables.
+    log_categories: Option<usize>,
+    /// Before each ScalarVariable.
+    variables: Vec<usize>,
+    /// The source's ModelStructure element, start and end.
+    model_structure: Option<(usize, usize)>,
+}
+
+fn find_splices(text: &str) -> Result<Splices, String> {
+    use quick_xml::events::Event;
+    let mut reader = quick_xml::Reader::from_str(text);
+    let mut splices = Splices::default();
+    let mut depth = 0usize;
+    let mut structure_start = None;
+    loop {
+        let before = reader.buffer_position() as usize;
+        let event = reader
+            .read_event()
+            .map_err(|e| format!("cannot parse: {e}"))?;
+        let after = reader.buffer_position() as usize;
+        let (name, empty) = match &event {
+            Event::Start(e) => (e.local_name().as_ref().to_vec(), false),
+            Event::Empty(e) => (e.local_name().as_ref().to_vec(), true),
+            Event::End(_) => {
+                depth -= 1;
+                if depth == 1 {
+                    if let Some(start) = structure_start.take() {
+                        splices.model_structure = Some((start, after));
+                    }
+                }
+                continue;
+            }
+            Event::Eof => break,
+            _ => continue,
+        };
+        match (depth, name.as_slice()) {
+            (0, b"fmiModelDescription") => splices.after_root = after,
+            (1, b"DefaultExperiment" | b"VendorAnnotations" | b"ModelVariables") => {
+                splices.log_categories.get_or_insert(before);
+            }
+            (1, b"ModelStructure") if empty => splices.model_structure = Some((before, after)),
+            (1, b"ModelStructure") => structure_start = Some(before),
+            (2, b"ScalarVariable") => splices.variables.push(before),
+            _ => {}
+        }
+        if !empty {
+            depth += 1;
+        }
+    }
+    Ok(splices)
+}
+
+/// The model description as shipped (GUID still the placeholder): the source with the export
+/// layer's `<CoSimulation>` and `<LogCategories>`, an index comment before each variable, and the
+/// ModelStructure with 1-based indices.
+fn shipped(
+    text: &str,
+    stem: &str,
+    variables: &[Variable],
+    outputs: &[ResolvedUnknown],
+    initial_unknowns: &[ResolvedUnknown],
+) -> Result<String, String> {
+    let s = find_splices(text)?;
+    let mut inserts: Vec<(usize, usize, String)> = Vec::new();
+    inserts.push((
+        s.after_root,
+        s.after_root,
+        format!(
+            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}/>"
+        ),
+    ));
+    let mut log = String::from("<LogCategories>\n");
+    for (name, description) in LOG_CATEGORIES {
+        let _ = writeln!(
+            log,
+            "    <Category name=\"{name}\" description=\"{description}\"/>"
+        );
+    }
+    log.push_str("  </LogCategories>\n\n  ");
+    let at = s.log_categories.ok_or("no ModelVariables element found")?;
+    inserts.push((at, at, log));
+    for (i, &at) in s.variables.iter().enumerate() {
+        inserts.push((at, at, format!("<!-- {} -->", i + 1)));
+    }
+    let mut structure = String::from("<ModelStructure>\n");
+    for (list, unknowns) in [("Outputs", outputs), ("InitialUnknowns", initial_unknowns)] {
+        if unknowns.is_empty() {
+            continue;
+        }
+        let _ = writeln!(structure, "    <{list}>");
+        for u in unknowns {
+            let mut attributes = format!("index=\"{}\"", u.index);
+            if let Some(d) = &u.dependencies {
+                let d: Vec<String> = d.iter().map(|i| i.to_string()).collect();
+                let _ = write!(attributes, " dependencies=\"{}\"", d.join(" "));
+            }
+            if let Some(k) = &u.kinds {
+                let _ = write!(attributes, " dependenciesKind=\"{}\"", k.join(" "));
+            }
+            let _ = writeln!(
+                structure,
+                "      <Unknown {attributes}/> <!-- {} -->",
+                variables[u.index - 1].name
+            );
+        }
+        let _ = writeln!(structure, "    </{list}>");
+    }
+    structure.push_str("  </ModelStructure>");
+    match s.model_structure {
+        Some((start, end)) => inserts.push((start, end, structure)),
+        None => {
+            // No ModelStructure in the source: it goes before the closing root tag.
+            let end = text
+                .rfind("</fmiModelDescription>")
+                .ok_or("no closing </fmiModelDescription>")?;
+            inserts.push((end, end, format!("\n  {structure}\n")));
+        }
+    }
+    inserts.sort_by_key(|(start, _, _)| *start);
+    let mut out = String::with_capacity(text.len() + 4096);
+    let mut cursor = 0;
+    for (start, end, insert) in inserts {
+        out.push_str(&text[cursor..start]);
+        out.push_str(&insert);
+        cursor = end;
+    }
+    out.push_str(&text[cursor..]);
+    Ok(out)
+}
+
+/// A GUID derived from the whole shipped description: any change to a variable changes it.
 pub fn guid_of(text: &str) -> String {
     let normalized = text.replace("\r\n", "\n");
     let h = Sha256::digest(normalized.as_bytes());
@@ -449,46 +657,27 @@ pub fn guid_of(text: &str) -> String {
     )
 }
 
-fn real_literal(s: &str) -> Result<String, String> {
-    let x: f64 = s
-        .trim()
-        .parse()
-        .map_err(|e| format!("bad number '{s}': {e}"))?;
-    if !x.is_finite() {
-        return Err(format!("'{s}' is not finite"));
-    }
-    Ok(format!("{x:?}"))
-}
-
-fn parse_bool(s: &str) -> Result<bool, String> {
-    match s.trim() {
-        "true" | "1" => Ok(true),
-        "false" | "0" => Ok(false),
-        _ => Err(format!("bad Boolean '{s}'")),
-    }
-}
-
-fn capitalize(s: &str) -> String {
-    let mut c = s.chars();
-    c.next()
-        .map(|f| f.to_uppercase().collect::<String>() + c.as_str())
-        .unwrap_or_default()
-}
-
-/// `McKibbenMuscle` -> `mckibben_muscle`: a word break comes before a capital that follows a
-/// lower-case letter, unless the word so far is a two-letter prefix such as "Mc".
-fn snake_case(s: &str) -> String {
+/// The Rust field name of a variable: `jointPosition` -> `joint_position`, `a.b` -> `a_b`.
+pub fn field_name(name: &str) -> String {
     let mut out = String::new();
-    let mut word_len = 0;
     let mut prev_lower = false;
-    for ch in s.chars() {
-        if ch.is_uppercase() && prev_lower && word_len > 2 {
-            out.push('_');
-            word_len = 0;
+    for ch in name.chars() {
+        if !ch.is_ascii_alphanumeric() {
+            if !out.is_empty() && !out.ends_with('_') {
+                out.push('_');
+            }
+            prev_lower = false;
+            continue;
         }
-        out.extend(ch.to_lowercase());
-        word_len += 1;
-        prev_lower = ch.is_lowercase();
+        if ch.is_ascii_uppercase() && prev_lower {
+            out.push('_');
+        }
+        out.push(ch.to_ascii_lowercase());
+        prev_lower = ch.is_ascii_lowercase() || ch.is_ascii_digit();
     }
-    out
+    let out = out.trim_end_matches('_').to_string();
+    match out.chars().next() {
+        Some(c) if c.is_ascii_digit() => format!("v_{out}"),
+        _ => out,
+    }
 }

@@ -1,10 +1,14 @@
 //! FMI 2.0 Co-Simulation FMUs of novel actuators: McKibben and knitted-sleeve pneumatic muscles and
-//! a multiferroic nano-motor, after E. Ball, *Novel Methods in Meso-Scale and Nano-Scale Actuation*,
-//! M.S. thesis, Cornell University, 2014 ("the dissertation"; Cornell's eCommons repository).
+//! a multiferroic nano-motor, after the dissertation (E. Ball, *Novel Methods in Meso-Scale and
+//! Nano-Scale Actuation*, M.S. thesis, Cornell University,
+//! 2014; Cornell's eCommons repository).
 //!
-//! Data flows one way: `modelDescription/*.xml` (variables) -> [`variables`] (generated tables) ->
-//! [`models`] (variables to physics, effect switches) -> [`physics`] (pure equations).
-//! [`fmi2`] is the C ABI around any [`models::Model`], and the only module that handles raw pointers.
+//! Data flows one way, every arrow pointing down:
+//! [`fmi2`] (C ABI, registry, value arrays) -> [`models`] (typed variables to physics, effect
+//! switches) -> [`physics`] (pure equations). Beside them, [`variables`] holds what build.rs
+//! generates from `modelDescription/*.xml`: value references, metadata and each model's typed
+//! `Parameters`, `Inputs`, `Outputs` and `CalculatedParameters`; it names nothing above it.
+//! [`fmi2`] is the only module with `unsafe` code; `physics` and `models` forbid it.
 
 pub mod fmi2;
 pub mod models;

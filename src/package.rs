@@ -12,7 +12,7 @@ pub fn package_all(binary: &Path, out_dir: &Path) -> Result<Vec<PathBuf>, String
     let so = std::fs::read(binary).map_err(|e| format!("cannot read {}: {e}", binary.display()))?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-    crate::variables::REGISTRY
+    crate::fmi2::REGISTRY
         .iter()
         .map(|f| package(*f, &so, out_dir))
         .collect()

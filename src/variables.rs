@@ -1,4 +1,6 @@
-//! Variable metadata generated from `modelDescription/*.xml` by build.rs, and the types it uses.
+//! Variable metadata and typed variable groups generated from `modelDescription/*.xml` by
+//! build.rs, and the types they use. Nothing here names the models or the export layer: the
+//! models read these types, the export layer (`crate::fmi2`) binds them to value references.
 
 /// FMI base type of a variable; its value reference indexes the array of that type.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -85,6 +87,25 @@ impl ModelInfo {
     pub fn by_name(&self, name: &str) -> Option<&'static Variable> {
         self.variables.iter().find(|v| v.name == name)
     }
+}
+
+/// One model's typed variable groups, generated per model description as
+/// `crate::variables::<model>::Variables`. Field names are the variable names in snake case, so a
+/// renamed variable is a compile error in the model that uses it.
+///
+/// Model Exchange (continuous states, derivatives, event indicators) would add its groups here as
+/// further associated types, generated from `<ModelStructure><Derivatives>`.
+pub trait Interface: 'static {
+    /// Parameters (fixed or tunable); `Default` gives the start values.
+    type Parameters: Clone + std::fmt::Debug + Default + PartialEq;
+    /// Inputs; `Default` gives the start values.
+    type Inputs: Clone + std::fmt::Debug + Default + PartialEq;
+    /// Outputs; `Default` gives zeros (or declared start values).
+    type Outputs: Clone + std::fmt::Debug + Default + PartialEq;
+    /// Calculated parameters, written once when the model is built.
+    type CalculatedParameters: Clone + std::fmt::Debug + Default + PartialEq;
+    /// Metadata of every variable.
+    const INFO: &'static ModelInfo;
 }
 
 include!(concat!(env!("OUT_DIR"), "/model_tables.rs"));

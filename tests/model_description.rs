@@ -1,11 +1,12 @@
-//! The build script's checker refuses model descriptions that importers would reject; the GUID
-//! follows every change to the variables.
+//! The build script's checker refuses model descriptions that importers would reject; the shipped
+//! description gets the export layer's part and the ModelStructure indices; the GUID follows every
+//! change to the variables.
 
 #[allow(dead_code)]
 #[path = "../build/model_description.rs"]
 mod model_description;
 
-use model_description::{check, guid_of};
+use model_description::{check, guid_of, ResolvedUnknown};
 
 const SOURCE: &str = include_str!("../modelDescription/McKibbenMuscle.xml");
 
@@ -17,7 +18,7 @@ fn edited(from: &str, to: &str) -> String {
 
 fn refused(text: &str, reason: &str) {
     match check(text, "McKibbenMuscle") {
-        Ok(()) => panic!("accepted a description that should fail with '{reason}'"),
+        Ok(_) => panic!("accepted a description that should fail with '{reason}'"),
         Err(e) => assert!(e.contains(reason), "error '{e}' does not say '{reason}'"),
     }
 }
@@ -64,13 +65,15 @@ fn illegal_causality_variability_initial_combinations_fail() {
         ),
         "must not have a start value",
     );
-    refused(
+    // Tunable parameters are legal: the export layer rebuilds the model when one changes.
+    check(
         &edited(
             r#"causality="parameter" variability="fixed""#,
             r#"causality="parameter" variability="tunable""#,
         ),
-        "tunable parameters are not supported",
-    );
+        "McKibbenMuscle",
+    )
+    .unwrap();
 }
 
 #[test]
@@ -113,19 +116,135 @@ fn value_references_are_dense_and_names_unique() {
     );
 }
 
+/// The ModelStructure source part: dependencies by name, given for `force`.
+fn with_dependencies(attributes: &str) -> String {
+    edited(
+        "<ModelStructure/>",
+        &format!("<ModelStructure><Outputs><Unknown name=\"force\" {attributes}/></Outputs></ModelStructure>"),
+    )
+}
+
 #[test]
-fn model_structure_must_match_the_variables() {
-    // Drop the last output, then the last initial unknown (the min_length calculated parameter).
+fn model_structure_indices_are_generated() {
+    let m = check(SOURCE, "McKibbenMuscle").unwrap();
+    let indices = |u: &[ResolvedUnknown]| u.iter().map(|u| u.index).collect::<Vec<_>>();
+    // Every output in order (FMI 2.0 section 2.2.8)...
+    assert_eq!(
+        indices(&m.outputs),
+        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15]
+    );
+    // ...and the outputs with initial calculated plus the calculated parameters, ascending.
+    assert_eq!(
+        indices(&m.initial_unknowns),
+        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31]
+    );
+    assert!(m.outputs.iter().all(|u| u.dependencies.is_none()));
+    let xml = &m.shipped_xml;
+    assert!(xml.contains(
+        r#"<CoSimulation
+    modelIdentifier="McKibbenMuscle""#
+    ));
+    assert!(xml.contains(r#"<Category name="logCalls""#));
+    assert!(xml.contains(r#"<Unknown index="31"/> <!-- min_length -->"#));
+    assert!(xml.contains(&format!(r#"guid="{}""#, m.guid)));
+}
+
+#[test]
+fn dependencies_by_name_become_sorted_indices() {
+    let m = check(
+        &with_dependencies(r#"dependencies="length pressure" dependenciesKind="dependent fixed""#),
+        "McKibbenMuscle",
+    )
+    .unwrap();
+    assert_eq!(
+        m.outputs[0],
+        ResolvedUnknown {
+            index: 3,
+            dependencies: Some(vec![1, 2]),
+            kinds: Some(vec!["fixed".into(), "dependent".into()]),
+        }
+    );
+    assert!(m.shipped_xml.contains(
+        r#"<Unknown index="3" dependencies="1 2" dependenciesKind="fixed dependent"/> <!-- force -->"#
+    ));
+    // An empty list says "depends on nothing".
+    let m = check(&with_dependencies(r#"dependencies="""#), "McKibbenMuscle").unwrap();
+    assert!(m
+        .shipped_xml
+        .contains(r#"<Unknown index="3" dependencies=""/>"#));
+}
+
+#[test]
+fn bad_model_structure_entries_fail() {
     refused(
-        &edited("<Unknown index=\"15\"/>\n    </Outputs>", "</Outputs>"),
-        "ModelStructure/Outputs must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15]",
+        &with_dependencies(r#"dependencies="lenght""#),
+        "'lenght', not a variable",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="turns""#),
+        "may depend only on an input",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="length length""#),
+        "lists 'length' twice",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="length" dependenciesKind="dependent fixed""#),
+        "1 dependencies but 2 dependenciesKind",
+    );
+    refused(
+        &with_dependencies(r#"dependencies="length" dependenciesKind="sometimes""#),
+        "dependenciesKind 'sometimes'",
+    );
+    refused(
+        &with_dependencies(r#"dependenciesKind="dependent""#),
+        "dependenciesKind without dependencies",
     );
     refused(
         &edited(
-            "<Unknown index=\"31\"/>\n    </InitialUnknowns>",
-            "</InitialUnknowns>",
+            "<ModelStructure/>",
+            r#"<ModelStructure><Outputs><Unknown index="3"/></Outputs></ModelStructure>"#,
         ),
-        "InitialUnknowns must list indices [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31]",
+        "give the unknown by name",
+    );
+    refused(
+        &edited(
+            "<ModelStructure/>",
+            r#"<ModelStructure><Outputs><Unknown name="turns"/></Outputs></ModelStructure>"#,
+        ),
+        "'turns' does not belong in this list",
+    );
+    refused(
+        &edited(
+            "<ModelStructure/>",
+            r#"<ModelStructure><Outputs><Unknown name="force"/><Unknown name="force"/></Outputs></ModelStructure>"#,
+        ),
+        "'force' is listed twice",
+    );
+}
+
+#[test]
+fn the_export_layer_part_stays_out_of_the_source() {
+    refused(
+        &edited(
+            "<UnitDefinitions>",
+            "<CoSimulation modelIdentifier=\"McKibbenMuscle\"/>\n  <UnitDefinitions>",
+        ),
+        "<CoSimulation> belongs to the export layer",
+    );
+    refused(
+        &edited(
+            "<DefaultExperiment",
+            "<LogCategories><Category name=\"logCalls\"/></LogCategories>\n  <DefaultExperiment",
+        ),
+        "<LogCategories> belongs to the export layer",
+    );
+    refused(
+        &edited(
+            r#"<Unit name="m"><BaseUnit m="1"/></Unit>"#,
+            r#"<Unit name="m"><BaseUnit m="1"/></Unit><Unit name="m"/>"#,
+        ),
+        "a unit is defined twice",
     );
 }
 
@@ -136,11 +255,8 @@ fn identity_is_checked() {
         "guid must be the placeholder",
     );
     refused(
-        &edited(
-            r#"modelIdentifier="McKibbenMuscle""#,
-            r#"modelIdentifier="Other""#,
-        ),
-        "must both equal the file name",
+        &edited(r#"modelName="McKibbenMuscle""#, r#"modelName="Other""#),
+        "modelName must equal the file name",
     );
     refused(
         &edited(r#"fmiVersion="2.0""#, r#"fmiVersion="3.0""#),
@@ -161,4 +277,12 @@ fn the_guid_changes_with_any_variable() {
         original,
         guid_of(&edited(r#"name="volume""#, r#"name="volume_m3""#))
     );
+    // The GUID build.rs ships is that of the whole shipped description.
+    let shipped = check(SOURCE, "McKibbenMuscle").unwrap();
+    let renamed = check(
+        &edited(r#"name="volume""#, r#"name="volume_m3""#),
+        "McKibbenMuscle",
+    )
+    .unwrap();
+    assert_ne!(shipped.guid, renamed.guid);
 }

@@ -9,7 +9,8 @@
 #![no_main]
 
 use actuator_fmus::fmi2::types::*;
-use actuator_fmus::variables::{ModelInfo, Start, VarType, REGISTRY};
+use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::variables::{ModelInfo, Start, VarType};
 use libfuzzer_sys::arbitrary::{Result, Unstructured};
 use libfuzzer_sys::fuzz_target;
 use std::ffi::{c_char, c_int, c_void, CStr, CString};

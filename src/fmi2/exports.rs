@@ -4,8 +4,8 @@
 
 use super::instance::{FmuState, Instance, MAGIC};
 use super::logger::Logger;
+use super::registry::REGISTRY;
 use super::types::*;
-use crate::variables::REGISTRY;
 use std::ffi::{c_char, c_int, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
@@ -347,7 +347,7 @@ unsafe fn get_values<C: Copy + Default>(
     vr: *const fmi2ValueReference,
     nvr: usize,
     value: *mut C,
-    pick: impl Fn(&crate::models::Vars, usize) -> C,
+    pick: impl Fn(&super::runtime::Vars, usize) -> C,
 ) -> fmi2Status {
     guarded(c, function, |inst| {
         let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {

@@ -78,9 +78,10 @@ pub struct FmuState {
 }
 
 /// Versioned byte format of a serialized FMU state: magic, format version, postcard, then a
-/// 64-bit FNV-1a checksum of everything before it (format 2; format 1 had no checksum).
+/// 64-bit FNV-1a checksum of everything before it (format 3: the models hold their typed ranges
+/// and, for PulleyJoint, its time; format 2 had the same envelope; format 1 had no checksum).
 const STATE_MAGIC: &[u8; 8] = b"AFMUSTAT";
-const STATE_FORMAT: u16 = 2;
+const STATE_FORMAT: u16 = 3;
 
 /// FNV-1a, 64 bit: catches accidental corruption of a stored state (a flipped byte in the model's
 /// history would otherwise reach the physics as garbage), not tampering.
@@ -126,12 +127,12 @@ fn type_index(kind: VarType) -> usize {
     }
 }
 
-/// A value that fmi2SetXXX can write into [`crate::models::Vars`].
+/// A value that fmi2SetXXX can write into [`super::runtime::Vars`].
 pub trait Value {
     const KIND: VarType;
     /// A reason to refuse the value for this variable, if any.
     fn invalid_for(&self, var: &Variable) -> Option<String>;
-    fn store(&self, vars: &mut crate::models::Vars, index: usize);
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize);
 }
 
 impl Value for f64 {
@@ -142,7 +143,7 @@ impl Value for f64 {
         }
         range_check(*self, var)
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.real[index] = *self;
     }
 }
@@ -152,7 +153,7 @@ impl Value for i32 {
     fn invalid_for(&self, var: &Variable) -> Option<String> {
         range_check(*self as f64, var)
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.integer[index] = *self;
     }
 }
@@ -167,7 +168,7 @@ impl Value for CBoolean {
     fn invalid_for(&self, _: &Variable) -> Option<String> {
         None
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.boolean[index] = self.0 != 0;
     }
 }
@@ -177,7 +178,7 @@ impl Value for String {
     fn invalid_for(&self, _: &Variable) -> Option<String> {
         None
     }
-    fn store(&self, vars: &mut crate::models::Vars, index: usize) {
+    fn store(&self, vars: &mut super::runtime::Vars, index: usize) {
         vars.string[index].clone_from(self);
     }
 }
@@ -476,7 +477,7 @@ impl Instance {
         kind: VarType,
         vrs: &[u32],
         out: &mut [T],
-        pick: impl Fn(&crate::models::Vars, usize) -> T,
+        pick: impl Fn(&super::runtime::Vars, usize) -> T,
     ) -> fmi2Status {
         if !self.allowed(function, allowed::GET) {
             return fmi2Status::Error;
@@ -689,7 +690,7 @@ impl Instance {
 
     /// A value in `vars` that no legal call sequence produces: a non-finite Real (the FMU never
     /// accepts or outputs one), or an input or parameter outside its declared range.
-    fn invalid_values(&self, vars: &crate::models::Vars) -> Option<String> {
+    fn invalid_values(&self, vars: &super::runtime::Vars) -> Option<String> {
         self.info.variables.iter().find_map(|var| {
             let i = var.vr as usize;
             let x = match var.kind {
@@ -795,9 +796,10 @@ mod tests {
     //! The state machine with a minimal model that has what no shipped model has yet: a tunable
     //! parameter (FMI 2.0.4 section 2.2.7 lets it change between steps).
     use super::*;
-    use crate::fmi2::runtime::ModelFactory;
-    use crate::models::{Model, Vars};
-    use crate::variables::Start;
+    use crate::fmi2::registry::Bindings;
+    use crate::fmi2::runtime::{ModelFactory, Vars};
+    use crate::models::{Model, Refusal};
+    use crate::variables::{Interface, Start};
 
     /// y = gain * u, with a tunable gain.
     #[derive(Clone, Serialize, Deserialize)]
@@ -865,20 +867,52 @@ mod tests {
         log_categories: &[],
     };
 
-    impl Model for Gain {
+    /// What build.rs would generate for the three variables above.
+    struct GainVariables;
+    impl Interface for GainVariables {
+        type Parameters = f64;
+        type Inputs = f64;
+        type Outputs = f64;
+        type CalculatedParameters = ();
         const INFO: &'static ModelInfo = &INFO;
+    }
+    impl Bindings for GainVariables {
+        fn parameters(vars: &Vars) -> f64 {
+            vars.real[0]
+        }
+        fn write_parameters(values: &f64, vars: &mut Vars) {
+            vars.real[0] = *values;
+        }
+        fn inputs(vars: &Vars) -> f64 {
+            vars.real[1]
+        }
+        fn write_inputs(values: &f64, vars: &mut Vars) {
+            vars.real[1] = *values;
+        }
+        fn outputs(vars: &Vars) -> f64 {
+            vars.real[2]
+        }
+        fn write_outputs(values: &f64, vars: &mut Vars) {
+            vars.real[2] = *values;
+        }
+        fn calculated_parameters(_: &Vars) {}
+        fn write_calculated_parameters(_: &(), _: &mut Vars) {}
+    }
+
+    impl Model for Gain {
+        type Variables = GainVariables;
         const DOCUMENTATION: &'static str = "";
-        fn new(vars: &mut Vars) -> Result<Self, String> {
-            match vars.real[0] {
+        fn new(gain: &f64, _: &f64) -> Result<Self, Refusal> {
+            match *gain {
                 0.0 => Err("gain must not be zero".into()),
                 gain => Ok(Self { gain }),
             }
         }
-        fn evaluate(&mut self, vars: &mut Vars, _: &mut Report) {
-            vars.real[2] = self.gain * vars.real[1];
+        fn evaluate(&mut self, u: &f64, y: &mut f64, _: &mut Report) {
+            *y = self.gain * u;
         }
-        fn step(&mut self, vars: &mut Vars, _: f64, _: f64, report: &mut Report) {
-            self.evaluate(vars, report);
+        fn step(&mut self, u: &f64, y: &mut f64, _: f64, _: f64, report: &mut Report) {
+            self.evaluate(u, y, report);
         }
     }
 

@@ -8,15 +8,16 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Refusal, Report, Status};
 use crate::physics::bladder::{
     Bladder, BladderState, BladderTube, KnittedCylinder, SleeveGeometry,
 };
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
 use crate::physics::mckibben::BladderModel;
-use crate::variables::knitted_muscle::{boolean, integer, real, INFO};
-use crate::variables::ModelInfo;
+use crate::variables::knitted_muscle::{
+    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::SQRT_2;
 
@@ -50,6 +51,8 @@ pub struct KnittedMuscle {
     /// Whether the last evaluation needed the zero-pressure fallback of a collapsing bladder:
     /// logged once per excursion.
     collapsed: bool,
+    /// The length range reported as `min_length`, `max_length` (m).
+    length_range: (f64, f64),
 }
 
 /// Outputs at one input point, with the friction history after moving there.
@@ -63,18 +66,17 @@ struct Output {
     history: HysteresisState,
 }
 
-fn sleeve_params(vars: &Vars) -> Result<KnittedParams, String> {
-    let r = &vars.real;
-    Ok(match vars.integer[integer::PRESET] {
+fn sleeve_params(r: &Parameters) -> Result<KnittedParams, String> {
+    Ok(match r.preset {
         0 => KnittedParams {
-            stitches_per_row: r[real::STITCHES_PER_ROW],
-            rows: r[real::ROWS],
-            row_strand_length: r[real::ROW_STRAND_LENGTH],
-            strand_thickness: r[real::STRAND_THICKNESS],
+            stitches_per_row: r.stitches_per_row,
+            rows: r.rows,
+            row_strand_length: r.row_strand_length,
+            strand_thickness: r.strand_thickness,
             bladder_outer_radius: 0.0,
         },
         1 => KnittedParams::prototype(),
-        2 => KnittedParams::fig_1_16(r[real::STRAND_THICKNESS]),
+        2 => KnittedParams::fig_1_16(r.strand_thickness),
         k => {
             return Err(format!(
                 "preset must be 0 (none), 1 (section 1.4 prototype) or 2 (Fig. 1.16), got {k}"
@@ -84,24 +86,20 @@ fn sleeve_params(vars: &Vars) -> Result<KnittedParams, String> {
 }
 
 fn bladder(
-    vars: &Vars,
+    r: &Parameters,
     sleeve: &KnittedSleeve,
 ) -> Result<Option<Bladder<KnittedCylinder>>, String> {
-    let layers = match BladderModel::from_switch(
-        vars.integer[integer::BLADDER_MODEL],
-        vars.integer[integer::BLADDER_LAYERS],
-    )? {
+    let layers = match BladderModel::from_switch(r.bladder_model, r.bladder_layers)? {
         BladderModel::None => return Ok(None),
         BladderModel::ThinWall => 1,
         BladderModel::ThickWall { layers } => layers,
     };
-    let r = &vars.real;
     let tube = BladderTube {
-        inner_diameter: r[real::BLADDER_INNER_DIAMETER],
-        thickness: r[real::BLADDER_THICKNESS],
-        unstretched_length: r[real::BLADDER_LENGTH],
-        mooney_c1: r[real::MOONEY_C1],
-        mooney_c2: r[real::MOONEY_C2],
+        inner_diameter: r.bladder_inner_diameter,
+        thickness: r.bladder_thickness,
+        unstretched_length: r.bladder_length,
+        mooney_c1: r.mooney_c1,
+        mooney_c2: r.mooney_c2,
     };
     Bladder::knitted(sleeve, tube, layers).map(Some)
 }
@@ -125,12 +123,12 @@ fn valid_lengths(sleeve: &KnittedSleeve, bladder: Option<&Bladder<KnittedCylinde
     (lo + margin(lo <= s_lo), hi - margin(hi >= s_hi))
 }
 
-fn shape_kind(vars: &Vars) -> Result<ShapeKind, String> {
-    Ok(match vars.integer[integer::SHAPE_MODEL] {
+fn shape_kind(p: &Parameters) -> Result<ShapeKind, String> {
+    Ok(match p.shape_model {
         0 => ShapeKind::Ideal,
         1 => ShapeKind::Tubular,
         2 => {
-            let segments = vars.integer[integer::SHAPE_SEGMENTS];
+            let segments = p.shape_segments;
             // The range itself is checked by the shape solver; this only refuses negatives.
             let segments = usize::try_from(segments)
                 .map_err(|_| format!("shape_segments must be at least 2, got {segments}"))?;
@@ -148,8 +146,8 @@ fn shape_kind(vars: &Vars) -> Result<ShapeKind, String> {
 impl KnittedMuscle {
     /// The physics at the current inputs; a length outside `[min_length, max_length]` is
     /// evaluated at the nearer limit, where the sleeve is rigid (logged once per excursion).
-    fn compute(&mut self, vars: &Vars, report: &mut Report) -> Output {
-        let (pressure, length) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+    fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Output {
+        let (pressure, length) = (inputs.pressure, inputs.length);
         let s = &self.sleeve;
         let (lo, hi) = self.valid;
         let l = if length.is_nan() {
@@ -164,9 +162,7 @@ impl KnittedMuscle {
                 report.warn(format!(
                     "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
                      evaluating at length {l} m until the inputs return",
-                    lo,
-                    hi,
-                    vars.real[real::MAX_LENGTH]
+                    lo, hi, self.length_range.1
                 ));
             }
             report.status = report.status.max(Status::Warning);
@@ -305,42 +301,38 @@ impl KnittedMuscle {
         (out, fallback)
     }
 
-    fn write(vars: &mut Vars, out: &Output) {
-        let r = &mut vars.real;
-        r[real::FORCE] = out.force;
-        r[real::VOLUME] = out.volume;
-        r[real::EFFECTIVE_PRESSURE] = out.effective_pressure;
-        r[real::FRICTION_FORCE] = out.friction_force;
-        r[real::MAX_RADIUS] = out.max_radius;
-        r[real::STIFFNESS] = out.stiffness;
+    fn write(o: &mut Outputs, out: &Output) {
+        o.force = out.force;
+        o.volume = out.volume;
+        o.effective_pressure = out.effective_pressure;
+        o.friction_force = out.friction_force;
+        o.max_radius = out.max_radius;
+        o.stiffness = out.stiffness;
     }
 }
 
 impl Model for KnittedMuscle {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("knitted_muscle.html");
 
-    fn new(vars: &mut Vars) -> Result<Self, String> {
-        let sleeve = KnittedSleeve::new(sleeve_params(vars)?, shape_kind(vars)?)?;
-        let bladder = bladder(vars, &sleeve)?;
+    fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
+        let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape_kind(p)?)?;
+        let bladder = bladder(p, &sleeve)?;
         let valid = valid_lengths(&sleeve, bladder.as_ref());
-        let friction = if vars.boolean[boolean::FRICTION] {
+        let friction = if p.friction {
             Some(Friction {
-                strand: StrandFriction::new(vars.real[real::FRICTION_COEFFICIENT])?,
-                operator: StopOperator::new(vars.real[real::PRESLIDING_LENGTH])?,
+                strand: StrandFriction::new(p.friction_coefficient)?,
+                operator: StopOperator::new(p.presliding_length)?,
             })
         } else {
             None
         };
-        let (min_length, max_length) = match &bladder {
+        let length_range = match &bladder {
             Some(b) => (b.min_length(), b.max_length()),
             None => (sleeve.min_length(), sleeve.max_length()),
         };
-        vars.real[real::MAX_LENGTH] = max_length;
-        vars.real[real::MIN_LENGTH] = min_length;
-        vars.real[real::FREE_CONTRACTION_LENGTH] = sleeve.free_contraction_length();
         // Friction starts relaxed (z = 0) where the sleeve is at initialization.
-        let start = vars.real[real::LENGTH];
+        let start = start.length;
         let history = HysteresisState::at_rest(if start.is_nan() {
             valid.1
         } else {
@@ -354,19 +346,35 @@ impl Model for KnittedMuscle {
             history,
             out_of_range: false,
             collapsed: false,
+            length_range,
         })
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        let out = self.compute(vars, report);
-        Self::write(vars, &out);
+    fn calculated_parameters(&self) -> CalculatedParameters {
+        CalculatedParameters {
+            min_length: self.length_range.0,
+            max_length: self.length_range.1,
+            free_contraction_length: self.sleeve.free_contraction_length(),
+        }
     }
 
-    fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        let out = self.compute(inputs, report);
+        Self::write(outputs, &out);
+    }
+
+    fn step(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        _time: f64,
+        _step: f64,
+        report: &mut Report,
+    ) {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
-        let out = self.compute(vars, report);
-        Self::write(vars, &out);
+        let out = self.compute(inputs, report);
+        Self::write(outputs, &out);
         self.history = out.history;
     }
 }
@@ -375,30 +383,38 @@ impl Model for KnittedMuscle {
 mod tests {
     use super::*;
 
-    fn vars_with(shape: i32, friction: bool) -> Vars {
-        let mut vars = Vars::from_start(&INFO);
-        vars.integer[integer::SHAPE_MODEL] = shape;
-        vars.boolean[boolean::FRICTION] = friction;
-        vars
+    fn parameters_with(shape: i32, friction: bool) -> Parameters {
+        Parameters {
+            shape_model: shape,
+            friction,
+            ..Parameters::default()
+        }
+    }
+
+    /// A model from `p` at the start inputs, with its calculated parameters.
+    fn built(p: &Parameters) -> (KnittedMuscle, Inputs, Outputs, CalculatedParameters) {
+        let inputs = Inputs::default();
+        let m = KnittedMuscle::new(p, &inputs).unwrap();
+        let calculated = m.calculated_parameters();
+        (m, inputs, Outputs::default(), calculated)
     }
 
     #[test]
     fn only_step_commits_the_friction_history() {
-        let mut vars = vars_with(0, true);
-        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let (mut m, mut inputs, mut out, _) = built(&parameters_with(0, true));
         let start = m.history;
-        vars.real[real::PRESSURE] = 14e3;
-        vars.real[real::LENGTH] = 0.35;
+        inputs.pressure = 14e3;
+        inputs.length = 0.35;
         let mut report = Report::default();
-        m.evaluate(&mut vars, &mut report);
+        m.evaluate(&inputs, &mut out, &mut report);
         assert_eq!(m.history, start);
         // Shortening by far more than the presliding length: full friction against it (z = -1),
         // of magnitude sqrt(2) Cf (F + P A) (eq. 1.21).
-        assert!(vars.real[real::FRICTION_FORCE] < 0.0);
-        m.step(&mut vars, 0.0, 1e-3, &mut report);
+        assert!(out.friction_force < 0.0);
+        m.step(&inputs, &mut out, 0.0, 1e-3, &mut report);
         assert_eq!(m.history.z, -1.0);
         assert_eq!(m.history.position, 0.35);
-        let (f, fr) = (vars.real[real::FORCE], vars.real[real::FRICTION_FORCE]);
+        let (f, fr) = (out.force, out.friction_force);
         let tension = f + 14e3 * m.sleeve.mean_area(0.35);
         assert!((fr + SQRT_2 * 0.25 * tension).abs() < 1e-12 * f.abs());
         assert_eq!(report.status, Status::Ok);
@@ -406,40 +422,47 @@ mod tests {
 
     #[test]
     fn out_of_range_is_the_nearest_limit_warned_once_per_excursion() {
-        let mut vars = vars_with(2, false);
-        let mut m = KnittedMuscle::new(&mut vars).unwrap();
-        let (lo, hi) = (vars.real[real::MIN_LENGTH], vars.real[real::MAX_LENGTH]);
-        vars.real[real::PRESSURE] = 14e3;
-        vars.real[real::LENGTH] = hi;
+        let (mut m, mut inputs, mut out, calculated) = built(&parameters_with(2, false));
+        let (lo, hi) = (calculated.min_length, calculated.max_length);
+        inputs.pressure = 14e3;
+        inputs.length = hi;
         let mut report = Report::default();
-        m.evaluate(&mut vars, &mut report);
-        let at_limit = vars.real.clone();
+        m.evaluate(&inputs, &mut out, &mut report);
+        let at_limit = out.clone();
         let mut warned = 0;
         for length in [hi + 1.0, 2.0 * hi, 0.4, 0.0, lo - 1e-9] {
             let mut report = Report::default();
-            vars.real[real::LENGTH] = length;
-            m.evaluate(&mut vars, &mut report);
+            inputs.length = length;
+            m.evaluate(&inputs, &mut out, &mut report);
             warned += report.messages.len();
             assert_eq!(report.status > Status::Ok, !(lo..=hi).contains(&length));
             if length > hi {
-                assert_eq!(vars.real[real::FORCE], at_limit[real::FORCE]);
+                assert_eq!(out.force, at_limit.force);
             }
-            assert!(vars.real.iter().all(|x| x.is_finite()));
+            let values = [
+                out.force,
+                out.volume,
+                out.effective_pressure,
+                out.friction_force,
+                out.max_radius,
+                out.stiffness,
+            ];
+            assert!(values.iter().all(|x| x.is_finite()));
         }
         assert_eq!(warned, 2);
     }
 
     #[test]
     fn bladder_is_refused_for_the_non_cylindrical_shape() {
-        let mut vars = vars_with(2, false);
-        vars.integer[integer::BLADDER_MODEL] = 2;
-        let e = KnittedMuscle::new(&mut vars).unwrap_err();
+        let mut p = parameters_with(2, false);
+        p.bladder_model = 2;
+        let e = KnittedMuscle::new(&p, &Inputs::default()).unwrap_err().0;
         assert!(e.contains("cylindrical sleeve"), "{e}");
         for shape in [0, 1] {
-            let mut vars = vars_with(shape, false);
-            vars.integer[integer::PRESET] = 2;
-            vars.integer[integer::BLADDER_MODEL] = 1;
-            assert!(KnittedMuscle::new(&mut vars).is_ok());
+            let mut p = parameters_with(shape, false);
+            p.preset = 2;
+            p.bladder_model = 1;
+            assert!(KnittedMuscle::new(&p, &Inputs::default()).is_ok());
         }
     }
 
@@ -447,38 +470,38 @@ mod tests {
     fn bladder_friction_stiffness_is_the_slope_with_z_held() {
         // Eq. 1.21 fed by the strand tension P_eff (A - dV/dL): dF/dL by central differences with
         // the hysteresis state held (step commits z = -1 first).
-        let mut vars = vars_with(0, true);
-        vars.integer[integer::PRESET] = 2;
-        vars.integer[integer::BLADDER_MODEL] = 2;
-        let mut m = KnittedMuscle::new(&mut vars).unwrap();
+        let mut p = parameters_with(0, true);
+        p.preset = 2;
+        p.bladder_model = 2;
+        let (mut m, mut inputs, mut out, _) = built(&p);
         let mut report = Report::default();
-        vars.real[real::PRESSURE] = 550e3;
-        vars.real[real::LENGTH] = 0.07;
-        m.step(&mut vars, 0.0, 1e-3, &mut report);
+        inputs.pressure = 550e3;
+        inputs.length = 0.07;
+        m.step(&inputs, &mut out, 0.0, 1e-3, &mut report);
         assert_eq!(m.history.z, -1.0);
-        let at = |m: &mut KnittedMuscle, vars: &mut Vars, l: f64| {
-            vars.real[real::LENGTH] = l;
-            m.evaluate(vars, &mut Report::default());
-            (vars.real[real::FORCE], vars.real[real::STIFFNESS])
+        let mut at = |m: &mut KnittedMuscle, l: f64| {
+            inputs.length = l;
+            m.evaluate(&inputs, &mut out, &mut Report::default());
+            (out.force, out.stiffness, out.friction_force)
         };
         // Stay within the presliding length below 0.07 so that z stays -1.
         let h = 1e-6;
-        let (fp, _) = at(&mut m, &mut vars, 0.07 - 1e-5 + h);
-        let (fm, _) = at(&mut m, &mut vars, 0.07 - 1e-5 - h);
-        let (f, k) = at(&mut m, &mut vars, 0.07 - 1e-5);
-        assert!(vars.real[real::FRICTION_FORCE] < 0.0);
+        let (fp, _, _) = at(&mut m, 0.07 - 1e-5 + h);
+        let (fm, _, _) = at(&mut m, 0.07 - 1e-5 - h);
+        let (f, k, friction_force) = at(&mut m, 0.07 - 1e-5);
+        assert!(friction_force < 0.0);
         let fd = (fp - fm) / (2.0 * h);
         assert!((k - fd).abs() < 1e-4 * fd.abs(), "{k} {fd} (F {f})");
     }
 
     #[test]
     fn non_cylindrical_needs_a_thick_strand() {
-        let mut vars = vars_with(2, false);
-        vars.real[real::STRAND_THICKNESS] = 0.0;
-        let e = KnittedMuscle::new(&mut vars).unwrap_err();
+        let mut p = parameters_with(2, false);
+        p.strand_thickness = 0.0;
+        let e = KnittedMuscle::new(&p, &Inputs::default()).unwrap_err().0;
         assert!(e.contains("positive minimum radius"), "{e}");
-        vars.integer[integer::SHAPE_SEGMENTS] = -3;
-        vars.real[real::STRAND_THICKNESS] = 2e-4;
-        assert!(KnittedMuscle::new(&mut vars).is_err());
+        p.shape_segments = -3;
+        p.strand_thickness = 2e-4;
+        assert!(KnittedMuscle::new(&p, &Inputs::default()).is_err());
     }
 }

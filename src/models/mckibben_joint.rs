@@ -7,15 +7,16 @@
 //! torque `r (F_flexor - F_extensor)` turns the joint towards the flexor. `actuatorInput` is the
 //! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
 };
-use crate::variables::mckibben_joint::{boolean, integer, real, INFO};
-use crate::variables::ModelInfo;
+use crate::variables::mckibben_joint::{
+    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+};
 use serde::{Deserialize, Serialize};
 
 /// As in McKibbenMuscle: with a bladder the force grows without bound at both length limits, so
@@ -36,6 +37,8 @@ pub struct McKibbenJoint {
     extensor_friction: HysteresisState,
     /// Whether the last evaluation needed the length fallback (warned once per excursion).
     out_of_range: bool,
+    /// Joint angles that keep both muscles inside their length range (rad).
+    position_range: (f64, f64),
 }
 
 /// Both muscles' operating point at the current inputs.
@@ -46,23 +49,19 @@ struct Pair {
     lengths: [f64; 2],
 }
 
-fn muscle(vars: &Vars) -> Result<McKibben, String> {
-    let r = &vars.real;
-    let model = BladderModel::from_switch(
-        vars.integer[integer::BLADDER_MODEL],
-        vars.integer[integer::BLADDER_LAYERS],
-    )?;
-    let friction = vars.boolean[boolean::FRICTION].then(|| FrictionParams {
-        coefficient: r[real::FRICTION_COEFFICIENT],
-        presliding_length: r[real::PRESLIDING_LENGTH],
+fn muscle(p: &Parameters) -> Result<McKibben, String> {
+    let model = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?;
+    let friction = p.friction.then(|| FrictionParams {
+        coefficient: p.friction_coefficient,
+        presliding_length: p.presliding_length,
     });
-    match vars.integer[integer::PRESET] {
+    match p.preset {
         0 => McKibben::new(
-            Sleeve::new(r[real::STRAND_LENGTH], r[real::TURNS])?,
+            Sleeve::new(p.strand_length, p.turns)?,
             BladderTube {
-                inner_diameter: r[real::BLADDER_INNER_DIAMETER],
-                thickness: r[real::BLADDER_THICKNESS],
-                unstretched_length: r[real::BLADDER_LENGTH],
+                inner_diameter: p.bladder_inner_diameter,
+                thickness: p.bladder_thickness,
+                unstretched_length: p.bladder_length,
                 mooney_c1: MOONEY_C1,
                 mooney_c2: MOONEY_C2,
             },
@@ -81,11 +80,11 @@ fn muscle(vars: &Vars) -> Result<McKibben, String> {
     }
 }
 
-fn positive(name: &str, x: f64) -> Result<f64, String> {
+fn positive(name: &str, x: f64) -> Result<f64, Refusal> {
     if x.is_finite() && x > 0.0 {
         Ok(x)
     } else {
-        Err(format!("{name} must be finite and > 0, got {x}"))
+        Err(format!("{name} must be finite and > 0, got {x}").into())
     }
 }
 
@@ -115,9 +114,8 @@ impl McKibbenJoint {
         self.muscle.evaluate(pressure, inside, history).ok()
     }
 
-    fn compute(&mut self, vars: &Vars, report: &mut Report) -> Option<Pair> {
-        let r = &vars.real;
-        let (u, q) = (r[real::ACTUATORINPUT], r[real::JOINTPOSITION]);
+    fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Option<Pair> {
+        let (u, q) = (inputs.actuator_input, inputs.joint_position);
         let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
         // f64::clamp would pass a NaN through; max/min map it to a bound (inputs are finite anyway).
         let pressures = [
@@ -159,37 +157,35 @@ impl McKibbenJoint {
         })
     }
 
-    fn write(&self, vars: &mut Vars, pair: &Pair) {
-        let r = &mut vars.real;
-        r[real::JOINTTORQUE] = self.moment_arm * (pair.flexor.force - pair.extensor.force);
-        r[real::FLEXOR_PRESSURE] = pair.pressures[0];
-        r[real::EXTENSOR_PRESSURE] = pair.pressures[1];
-        r[real::FLEXOR_FORCE] = pair.flexor.force;
-        r[real::EXTENSOR_FORCE] = pair.extensor.force;
-        r[real::FLEXOR_LENGTH] = pair.lengths[0];
-        r[real::EXTENSOR_LENGTH] = pair.lengths[1];
+    fn write(&self, out: &mut Outputs, pair: &Pair) {
+        out.joint_torque = self.moment_arm * (pair.flexor.force - pair.extensor.force);
+        out.flexor_pressure = pair.pressures[0];
+        out.extensor_pressure = pair.pressures[1];
+        out.flexor_force = pair.flexor.force;
+        out.extensor_force = pair.extensor.force;
+        out.flexor_length = pair.lengths[0];
+        out.extensor_length = pair.lengths[1];
     }
 }
 
 impl Model for McKibbenJoint {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("mckibben_joint.html");
 
-    fn new(vars: &mut Vars) -> Result<Self, String> {
-        let r = &vars.real;
-        let moment_arm = positive("moment_arm", r[real::MOMENT_ARM])?;
-        let flexor_rest_length = positive("flexor_rest_length", r[real::FLEXOR_REST_LENGTH])?;
-        let extensor_rest_length = positive("extensor_rest_length", r[real::EXTENSOR_REST_LENGTH])?;
-        let max_pressure = positive("max_pressure", r[real::MAX_PRESSURE])?;
-        let common_mode_pressure = r[real::COMMON_MODE_PRESSURE];
+    fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
+        let moment_arm = positive("moment_arm", p.moment_arm)?;
+        let flexor_rest_length = positive("flexor_rest_length", p.flexor_rest_length)?;
+        let extensor_rest_length = positive("extensor_rest_length", p.extensor_rest_length)?;
+        let max_pressure = positive("max_pressure", p.max_pressure)?;
+        let common_mode_pressure = p.common_mode_pressure;
         if !(common_mode_pressure.is_finite()
             && (0.0..=max_pressure).contains(&common_mode_pressure))
         {
             return Err(format!(
                 "common_mode_pressure must lie in 0 .. max_pressure = {max_pressure} Pa, got {common_mode_pressure}"
-            ));
+            ).into());
         }
-        let muscle = muscle(vars)?;
+        let muscle = muscle(p)?;
         let (lo, hi) = (muscle.min_length(), muscle.max_length());
         // Flexor L0f - r q and extensor L0e + r q both inside (lo, hi).
         let min_position =
@@ -200,11 +196,9 @@ impl Model for McKibbenJoint {
             return Err(format!(
                 "no joint angle keeps both muscles inside their length range {lo} .. {hi} m \
                  (flexor_rest_length {flexor_rest_length} m, extensor_rest_length {extensor_rest_length} m)"
-            ));
+            ).into());
         }
-        vars.real[real::MIN_POSITION] = min_position;
-        vars.real[real::MAX_POSITION] = max_position;
-        let q = vars.real[real::JOINTPOSITION];
+        let q = start.joint_position;
         Ok(Self {
             muscle,
             moment_arm,
@@ -216,20 +210,35 @@ impl Model for McKibbenJoint {
             flexor_friction: HysteresisState::at_rest(flexor_rest_length - moment_arm * q),
             extensor_friction: HysteresisState::at_rest(extensor_rest_length + moment_arm * q),
             out_of_range: false,
+            position_range: (min_position, max_position),
         })
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        if let Some(pair) = self.compute(vars, report) {
-            self.write(vars, &pair);
+    fn calculated_parameters(&self) -> CalculatedParameters {
+        CalculatedParameters {
+            min_position: self.position_range.0,
+            max_position: self.position_range.1,
         }
     }
 
-    fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        if let Some(pair) = self.compute(inputs, report) {
+            self.write(outputs, &pair);
+        }
+    }
+
+    fn step(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        _time: f64,
+        _step: f64,
+        report: &mut Report,
+    ) {
         // Quasi-static, as McKibbenMuscle: the held inputs fix the outputs at the end of the step
         // and each friction history follows its muscle's length at the communication points.
-        if let Some(pair) = self.compute(vars, report) {
-            self.write(vars, &pair);
+        if let Some(pair) = self.compute(inputs, report) {
+            self.write(outputs, &pair);
             self.flexor_friction = pair.flexor.friction_state;
             self.extensor_friction = pair.extensor.friction_state;
         }

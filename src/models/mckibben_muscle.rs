@@ -4,15 +4,16 @@
 //! wall, 2 thick wall of `bladder_layers` layers), friction hysteresis (`friction`) and a series
 //! connector (`connector_stiffness` > 0). With all of them off a step is eq. 2.3 alone.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
 };
-use crate::variables::mckibben_muscle::{boolean, integer, real, INFO};
-use crate::variables::ModelInfo;
+use crate::variables::mckibben_muscle::{
+    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+};
 use serde::{Deserialize, Serialize};
 
 /// With a bladder the force grows without bound at both length limits; an out-of-range length
@@ -37,9 +38,8 @@ pub struct McKibbenMuscle {
     out_of_range: bool,
 }
 
-fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
-    let r = &vars.real;
-    let preset = match vars.integer[integer::PRESET] {
+fn geometry(p: &Parameters) -> Result<(Sleeve, BladderTube), String> {
+    let preset = match p.preset {
         0 => None,
         k @ 1..=4 => MuscleGeometry::preset((b'A' + k as u8 - 1) as char),
         k => {
@@ -52,8 +52,8 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
         inner_diameter,
         thickness,
         unstretched_length: length,
-        mooney_c1: r[real::MOONEY_C1],
-        mooney_c2: r[real::MOONEY_C2],
+        mooney_c1: p.mooney_c1,
+        mooney_c2: p.mooney_c2,
     };
     Ok(match preset {
         Some(g) => (
@@ -65,11 +65,11 @@ fn geometry(vars: &Vars) -> Result<(Sleeve, BladderTube), String> {
             ),
         ),
         None => (
-            Sleeve::new(r[real::STRAND_LENGTH], r[real::TURNS])?,
+            Sleeve::new(p.strand_length, p.turns)?,
             tube(
-                r[real::BLADDER_LENGTH],
-                r[real::BLADDER_INNER_DIAMETER],
-                r[real::BLADDER_THICKNESS],
+                p.bladder_length,
+                p.bladder_inner_diameter,
+                p.bladder_thickness,
             ),
         ),
     })
@@ -96,9 +96,15 @@ fn out_of_range(
     *logged = true;
 }
 
-/// Eq. 2.3 for the bare sleeve; only the outputs that change are written.
-fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &mut Report) {
-    let (pressure, requested) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+/// Eq. 2.3 for the bare sleeve; the outputs of the absent effects keep their neutral values.
+fn sleeve_outputs(
+    sleeve: &Sleeve,
+    inputs: &Inputs,
+    out: &mut Outputs,
+    logged: &mut bool,
+    report: &mut Report,
+) {
+    let (pressure, requested) = (inputs.pressure, inputs.length);
     let b = sleeve.max_length();
     let length = if requested > b {
         let reason =
@@ -111,26 +117,43 @@ fn sleeve_outputs(sleeve: &Sleeve, vars: &mut Vars, logged: &mut bool, report: &
     };
     // The sleeve is only ever pushed outwards: under vacuum the bladder leaves it.
     let p_eff = pressure.max(0.0);
-    let r = &mut vars.real;
-    r[real::FORCE] = sleeve.force(p_eff, length);
-    r[real::VOLUME] = sleeve.volume(length);
-    r[real::EFFECTIVE_PRESSURE] = p_eff;
-    r[real::STIFFNESS] = sleeve.stiffness(p_eff, length);
-    vars.boolean[boolean::BLADDER_CONTACT] = pressure > 0.0;
+    out.force = sleeve.force(p_eff, length);
+    out.volume = sleeve.volume(length);
+    out.effective_pressure = p_eff;
+    out.stiffness = sleeve.stiffness(p_eff, length);
+    out.bladder_contact = pressure > 0.0;
+    out.threshold_pressure = 0.0;
+    out.stretch_axial = 1.0;
+    out.stretch_hoop = 1.0;
+    out.stretch_radial = 1.0;
+    out.stress_axial = 0.0;
+    out.stress_hoop = 0.0;
+    out.stress_radial = 0.0;
+    out.friction_force = 0.0;
 }
 
 impl McKibbenMuscle {
     /// Writes the outputs of the selected pipeline; `commit` advances the friction history.
-    fn outputs(&mut self, vars: &mut Vars, report: &mut Report, commit: bool) {
+    fn outputs(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        report: &mut Report,
+        commit: bool,
+    ) {
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
-                sleeve_outputs(sleeve, vars, &mut self.out_of_range, report)
+                sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report)
             }
             Pipeline::Full(muscle) => {
-                if let Some(out) =
-                    Self::compute(muscle, &self.friction, &mut self.out_of_range, vars, report)
-                {
-                    Self::write(vars, &out);
+                if let Some(out) = Self::compute(
+                    muscle,
+                    &self.friction,
+                    &mut self.out_of_range,
+                    inputs,
+                    report,
+                ) {
+                    Self::write(outputs, &out);
                     if commit {
                         self.friction = out.friction_state;
                     }
@@ -144,10 +167,10 @@ impl McKibbenMuscle {
         muscle: &McKibben,
         friction: &HysteresisState,
         logged: &mut bool,
-        vars: &Vars,
+        inputs: &Inputs,
         report: &mut Report,
     ) -> Option<McKibbenOutput> {
-        let (pressure, length) = (vars.real[real::PRESSURE], vars.real[real::LENGTH]);
+        let (pressure, length) = (inputs.pressure, inputs.length);
         let reason = match muscle.evaluate(pressure, length, friction) {
             Ok(out) => {
                 *logged = false;
@@ -171,65 +194,39 @@ impl McKibbenMuscle {
         fallback.map(|(_, _, out)| out)
     }
 
-    fn write(vars: &mut Vars, out: &McKibbenOutput) {
-        let r = &mut vars.real;
-        r[real::FORCE] = out.force;
-        r[real::VOLUME] = out.volume;
-        r[real::EFFECTIVE_PRESSURE] = out.effective_pressure;
-        r[real::THRESHOLD_PRESSURE] = out.threshold_pressure;
-        r[real::STRETCH_AXIAL] = out.stretch_axial;
-        r[real::STRETCH_HOOP] = out.stretch_hoop;
-        r[real::STRETCH_RADIAL] = out.stretch_radial;
-        r[real::STRESS_AXIAL] = out.stress_axial;
-        r[real::STRESS_HOOP] = out.stress_hoop;
-        r[real::STRESS_RADIAL] = out.stress_radial;
-        r[real::FRICTION_FORCE] = out.friction_force;
-        r[real::STIFFNESS] = out.stiffness;
-        vars.boolean[boolean::BLADDER_CONTACT] = out.bladder_contact;
+    fn write(o: &mut Outputs, out: &McKibbenOutput) {
+        o.force = out.force;
+        o.volume = out.volume;
+        o.effective_pressure = out.effective_pressure;
+        o.threshold_pressure = out.threshold_pressure;
+        o.stretch_axial = out.stretch_axial;
+        o.stretch_hoop = out.stretch_hoop;
+        o.stretch_radial = out.stretch_radial;
+        o.stress_axial = out.stress_axial;
+        o.stress_hoop = out.stress_hoop;
+        o.stress_radial = out.stress_radial;
+        o.friction_force = out.friction_force;
+        o.stiffness = out.stiffness;
+        o.bladder_contact = out.bladder_contact;
     }
 }
 
 impl Model for McKibbenMuscle {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
-    fn new(vars: &mut Vars) -> Result<Self, String> {
-        let (sleeve, tube) = geometry(vars)?;
-        let model = BladderModel::from_switch(
-            vars.integer[integer::BLADDER_MODEL],
-            vars.integer[integer::BLADDER_LAYERS],
-        )?;
-        let friction = vars.boolean[boolean::FRICTION].then(|| FrictionParams {
-            coefficient: vars.real[real::FRICTION_COEFFICIENT],
-            presliding_length: vars.real[real::PRESLIDING_LENGTH],
+    fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
+        let (sleeve, tube) = geometry(p)?;
+        let model = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?;
+        let friction = p.friction.then(|| FrictionParams {
+            coefficient: p.friction_coefficient,
+            presliding_length: p.presliding_length,
         });
-        let muscle = McKibben::new(
-            sleeve,
-            tube,
-            model,
-            friction,
-            vars.real[real::CONNECTOR_STIFFNESS],
-        )?;
-        vars.real[real::MAX_LENGTH] = muscle.max_length();
-        vars.real[real::MIN_LENGTH] = muscle.min_length();
+        let muscle = McKibben::new(sleeve, tube, model, friction, p.connector_stiffness)?;
         // Friction starts relaxed (z = 0) at the initial length.
-        let friction = HysteresisState::at_rest(vars.real[real::LENGTH]);
+        let friction = HysteresisState::at_rest(start.length);
         let pipeline =
             if muscle.bladder().is_none() && !muscle.has_friction() && !muscle.has_connector() {
-                // The outputs of the absent effects keep these values for the whole run.
-                let r = &mut vars.real;
-                for (index, value) in [
-                    (real::THRESHOLD_PRESSURE, 0.0),
-                    (real::STRETCH_AXIAL, 1.0),
-                    (real::STRETCH_HOOP, 1.0),
-                    (real::STRETCH_RADIAL, 1.0),
-                    (real::STRESS_AXIAL, 0.0),
-                    (real::STRESS_HOOP, 0.0),
-                    (real::STRESS_RADIAL, 0.0),
-                    (real::FRICTION_FORCE, 0.0),
-                ] {
-                    r[index] = value;
-                }
                 Pipeline::Sleeve(*muscle.sleeve())
             } else {
                 Pipeline::Full(muscle)
@@ -241,13 +238,34 @@ impl Model for McKibbenMuscle {
         })
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        self.outputs(vars, report, false)
+    fn calculated_parameters(&self) -> CalculatedParameters {
+        match &self.pipeline {
+            // The bare sleeve spans 0 .. b (eq. 2.3).
+            Pipeline::Sleeve(sleeve) => CalculatedParameters {
+                max_length: sleeve.max_length(),
+                min_length: 0.0,
+            },
+            Pipeline::Full(muscle) => CalculatedParameters {
+                max_length: muscle.max_length(),
+                min_length: muscle.min_length(),
+            },
+        }
     }
 
-    fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, report: &mut Report) {
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        self.outputs(inputs, outputs, report, false)
+    }
+
+    fn step(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        _time: f64,
+        _step: f64,
+        report: &mut Report,
+    ) {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
-        self.outputs(vars, report, true)
+        self.outputs(inputs, outputs, report, true)
     }
 }

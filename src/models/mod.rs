@@ -2,10 +2,13 @@
 //!
 //! A model is built from its parameters when initialization ends (only the effects switched on),
 //! then evaluated and stepped by the export layer through [`Model`]. Models know nothing of FMI
-//! calls, states or pointers.
+//! calls, states, pointers or value references: they read and write the typed structs generated
+//! from their model description.
 
-use crate::variables::{ModelInfo, Start, VarType};
-use serde::{de::DeserializeOwned, Deserialize, Serialize};
+#![forbid(unsafe_code)]
+
+use crate::variables::Interface;
+use serde::{de::DeserializeOwned, Serialize};
 
 pub mod knitted_muscle;
 pub mod mckibben_joint;
@@ -43,55 +46,71 @@ impl Report {
     }
 }
 
-/// Current values of all variables, indexed by value reference within each type.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Vars {
-    pub real: Vec<f64>,
-    pub integer: Vec<i32>,
-    pub boolean: Vec<bool>,
-    pub string: Vec<String>,
-}
+/// Why a model cannot be built from its parameters: the export layer logs it and refuses
+/// initialization (or the parameter change).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Refusal(pub String);
 
-impl Vars {
-    /// Start values from the model description; variables without one start at zero.
-    pub fn from_start(info: &ModelInfo) -> Self {
-        let [nr, ni, nb, ns] = info.counts;
-        let mut v = Vars {
-            real: vec![0.0; nr],
-            integer: vec![0; ni],
-            boolean: vec![false; nb],
-            string: vec![String::new(); ns],
-        };
-        for var in info.variables {
-            let i = var.vr as usize;
-            match (var.kind, var.start) {
-                (VarType::Real, Start::Real(x)) => v.real[i] = x,
-                (VarType::Integer, Start::Integer(x)) => v.integer[i] = x,
-                (VarType::Boolean, Start::Boolean(x)) => v.boolean[i] = x,
-                (VarType::String, Start::String(x)) => v.string[i] = x.to_string(),
-                _ => {}
-            }
-        }
-        v
+impl std::fmt::Display for Refusal {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(&self.0)
     }
 }
 
-/// A co-simulation model. The export layer owns the [`Vars`]; the model owns its physics and its
-/// history (friction state, onion state, rotor state), which is part of the FMU state.
+impl From<String> for Refusal {
+    fn from(reason: String) -> Self {
+        Self(reason)
+    }
+}
+
+impl From<&str> for Refusal {
+    fn from(reason: &str) -> Self {
+        Self(reason.to_string())
+    }
+}
+
+/// The typed variable groups of model `M`, generated from its model description.
+pub type Parameters<M> = <<M as Model>::Variables as Interface>::Parameters;
+pub type Inputs<M> = <<M as Model>::Variables as Interface>::Inputs;
+pub type Outputs<M> = <<M as Model>::Variables as Interface>::Outputs;
+pub type CalculatedParameters<M> = <<M as Model>::Variables as Interface>::CalculatedParameters;
+
+/// A co-simulation model. It sees its variables only as the typed structs generated from its
+/// model description (`crate::variables::<model>`); the export layer owns their values. The model
+/// owns its physics and its history (friction state, onion state, rotor state), which is part of
+/// the FMU state.
+///
+/// Model Exchange can extend this without touching the co-simulation models: a subtrait
+/// `ModelExchange: Model` with the continuous states, derivatives, event updates and directional
+/// derivatives, and further associated types on [`Interface`].
 pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
-    /// The generated tables of this model's variables.
-    const INFO: &'static ModelInfo;
+    /// The generated interface, `crate::variables::<model>::Variables`.
+    type Variables: Interface;
     /// HTML fragment for the FMU's `documentation/index.html`: the equations it implements.
     const DOCUMENTATION: &'static str;
 
-    /// Builds the model from its parameters, with only the effects they switch on, and writes the
-    /// calculated parameters. An unusable parameter set is an `Err` that says which and why.
-    fn new(vars: &mut Vars) -> Result<Self, String>;
+    /// Builds the model from its parameters, with only the effects they switch on; `start` are the
+    /// inputs when initialization ends (the history starts there). An unusable parameter set is a
+    /// [`Refusal`] that says which and why.
+    fn new(parameters: &Parameters<Self>, start: &Inputs<Self>) -> Result<Self, Refusal>;
 
-    /// Writes the outputs for the current inputs and history, without advancing the history.
-    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report);
+    /// The calculated parameters of the built model (none by default).
+    fn calculated_parameters(&self) -> CalculatedParameters<Self> {
+        Default::default()
+    }
 
-    /// Advances from `time` to `time + step` with the inputs held, commits the history and writes
+    /// Writes the outputs for `inputs` and the current history, without advancing the history.
+    /// Outputs it leaves alone keep their previous values.
+    fn evaluate(&mut self, inputs: &Inputs<Self>, outputs: &mut Outputs<Self>, report: &mut Report);
+
+    /// Advances from `time` to `time + step` with `inputs` held, commits the history and writes
     /// the outputs at the end of the step.
-    fn step(&mut self, vars: &mut Vars, time: f64, step: f64, report: &mut Report);
+    fn step(
+        &mut self,
+        inputs: &Inputs<Self>,
+        outputs: &mut Outputs<Self>,
+        time: f64,
+        step: f64,
+        report: &mut Report,
+    );
 }

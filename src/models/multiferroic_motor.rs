@@ -5,12 +5,13 @@
 //! maps the variables onto [`MotorParams`] and [`MotorInputs`] and keeps the [`MotorState`], which
 //! is serialized with the FMU state.
 
-use super::{Model, Report, Status, Vars};
+use super::{Model, Refusal, Report, Status};
 use crate::physics::multiferroic::{
     Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, SteppingSchedule,
 };
-use crate::variables::multiferroic_motor::{boolean, integer, real, INFO};
-use crate::variables::ModelInfo;
+use crate::variables::multiferroic_motor::{
+    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -28,11 +29,11 @@ pub struct MultiferroicMotor {
 }
 
 impl MultiferroicMotor {
-    fn inputs(&self, vars: &Vars) -> MotorInputs {
+    fn inputs(&self, inputs: &Inputs) -> MotorInputs {
         MotorInputs {
-            strain_direction: vars.real[real::STRAIN_DIRECTION],
-            stress: vars.real[real::STRESS],
-            load_torque: vars.real[real::LOAD_TORQUE],
+            strain_direction: inputs.strain_direction,
+            stress: inputs.stress,
+            load_torque: inputs.load_torque,
             rotor_locked: self.rotor_locked,
             schedule: self.schedule,
         }
@@ -73,29 +74,30 @@ impl MultiferroicMotor {
     }
 }
 
-fn write_outputs(vars: &mut Vars, o: &MotorOutputs) {
-    let values = [
-        (real::TORQUE, o.torque),
-        (real::ROTOR_ANGLE, o.rotor_angle),
-        (real::ROTOR_SPEED, o.rotor_speed),
-        (real::ONION_ANGLE, o.onion_angle),
-        (real::OFFSET_ANGLE, o.offset_angle),
-        (real::MAGNETOSTATIC_ENERGY, o.magnetostatic_energy),
-        (real::MAGNETOELASTIC_ENERGY, o.magnetoelastic_energy),
-        (real::APPLIED_STRAIN_DIRECTION, o.applied_strain_direction),
-    ];
+fn write_outputs(out: &mut Outputs, o: &MotorOutputs) {
     // The physics never returns non-finite outputs; this guard keeps that promise at the ABI
     // even if it ever did (the old value stays).
-    for (index, value) in values {
+    let set = |slot: &mut f64, value: f64| {
         if value.is_finite() {
-            vars.real[index] = value;
+            *slot = value;
         }
-    }
+    };
+    set(&mut out.torque, o.torque);
+    set(&mut out.rotor_angle, o.rotor_angle);
+    set(&mut out.rotor_speed, o.rotor_speed);
+    set(&mut out.onion_angle, o.onion_angle);
+    set(&mut out.offset_angle, o.offset_angle);
+    set(&mut out.magnetostatic_energy, o.magnetostatic_energy);
+    set(&mut out.magnetoelastic_energy, o.magnetoelastic_energy);
+    set(
+        &mut out.applied_strain_direction,
+        o.applied_strain_direction,
+    );
 }
 
 /// An Integer switch that must be 0 or 1 (the model description's bounds say so too).
-fn switch(vars: &Vars, index: usize, name: &str) -> Result<bool, String> {
-    match vars.integer[index] {
+fn switch(value: i32, name: &str) -> Result<bool, String> {
+    match value {
         0 => Ok(false),
         1 => Ok(true),
         other => Err(format!("{name} must be 0 or 1, got {other}")),
@@ -103,56 +105,45 @@ fn switch(vars: &Vars, index: usize, name: &str) -> Result<bool, String> {
 }
 
 impl Model for MultiferroicMotor {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("multiferroic_motor.html");
 
-    fn new(vars: &mut Vars) -> Result<Self, String> {
-        let r = &vars.real;
-        let max_substeps = u32::try_from(vars.integer[integer::MAX_SUBSTEPS]).map_err(|_| {
-            format!(
-                "max_substeps must be positive, got {}",
-                vars.integer[integer::MAX_SUBSTEPS]
-            )
-        })?;
+    fn new(r: &Parameters, _: &Inputs) -> Result<Self, Refusal> {
+        let max_substeps = u32::try_from(r.max_substeps)
+            .map_err(|_| format!("max_substeps must be positive, got {}", r.max_substeps))?;
         let params = MotorParams {
-            ring_outer_diameter: r[real::RING_OUTER_DIAMETER],
-            ring_inner_diameter: r[real::RING_INNER_DIAMETER],
-            bar_length: r[real::BAR_LENGTH],
-            bar_width: r[real::BAR_WIDTH],
-            thickness: r[real::THICKNESS],
-            saturation_magnetization: r[real::SATURATION_MAGNETIZATION],
-            magnetostriction: r[real::MAGNETOSTRICTION],
-            wall_volume: r[real::WALL_VOLUME],
-            density: r[real::DENSITY],
-            fluid_viscosity: r[real::FLUID_VISCOSITY],
-            gilbert_damping: r[real::GILBERT_DAMPING],
-            onion_model: if switch(vars, integer::ONION_MODEL, "onion_model")? {
+            ring_outer_diameter: r.ring_outer_diameter,
+            ring_inner_diameter: r.ring_inner_diameter,
+            bar_length: r.bar_length,
+            bar_width: r.bar_width,
+            thickness: r.thickness,
+            saturation_magnetization: r.saturation_magnetization,
+            magnetostriction: r.magnetostriction,
+            wall_volume: r.wall_volume,
+            density: r.density,
+            fluid_viscosity: r.fluid_viscosity,
+            gilbert_damping: r.gilbert_damping,
+            onion_model: if switch(r.onion_model, "onion_model")? {
                 OnionModel::Gilbert
             } else {
                 OnionModel::QuasiStatic
             },
-            tolerance: r[real::TOLERANCE],
+            tolerance: r.tolerance,
             max_substeps,
         };
         // The schedule is validated here even when unused, so that a bad one fails
         // initialization rather than a later step.
         let stepping = SteppingSchedule::new(
-            r[real::SCHEDULE_INITIAL_DIRECTION],
-            r[real::STEP_ANGLE],
-            r[real::STEP_PERIOD],
-            r[real::STRESS_AMPLITUDE],
+            r.schedule_initial_direction,
+            r.step_angle,
+            r.step_period,
+            r.stress_amplitude,
         )?;
-        let schedule = switch(vars, integer::SCHEDULE, "schedule")?.then_some(stepping);
+        let schedule = switch(r.schedule, "schedule")?.then_some(stepping);
         let motor = Motor::new(params)?;
-        vars.real[real::INERTIA] = motor.inertia;
-        vars.real[real::DRAG] = motor.drag;
-        vars.real[real::BAR_MASS] = motor.bar_mass;
-        vars.real[real::UNDAMPED_FREQUENCY] =
-            2.0 * std::f64::consts::PI * motor.undamped_frequency();
-        vars.real[real::RELAXATION_TIME] = motor.rotor_relaxation_time();
         Ok(Self {
             schedule,
-            rotor_locked: vars.boolean[boolean::ROTOR_LOCKED],
+            rotor_locked: r.rotor_locked,
             // The rotor starts at rest with the onion state aligned with it, at angle 0.
             state: MotorState::aligned(0.0),
             max_torque: motor.ring_bar.max_torque().1.abs(),
@@ -161,16 +152,34 @@ impl Model for MultiferroicMotor {
         })
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, report: &mut Report) {
-        match self.motor.outputs(&self.state, &self.inputs(vars)) {
-            Ok(o) => write_outputs(vars, &o),
+    fn calculated_parameters(&self) -> CalculatedParameters {
+        let motor = &self.motor;
+        CalculatedParameters {
+            inertia: motor.inertia,
+            drag: motor.drag,
+            bar_mass: motor.bar_mass,
+            undamped_frequency: 2.0 * std::f64::consts::PI * motor.undamped_frequency(),
+            relaxation_time: motor.rotor_relaxation_time(),
+        }
+    }
+
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        match self.motor.outputs(&self.state, &self.inputs(inputs)) {
+            Ok(o) => write_outputs(outputs, &o),
             // Unreachable with inputs inside their declared bounds; the outputs keep their values.
             Err(e) => report.add(Status::Error, format!("cannot evaluate the motor: {e}")),
         }
     }
 
-    fn step(&mut self, vars: &mut Vars, time: f64, step: f64, report: &mut Report) {
-        let inputs = self.inputs(vars);
+    fn step(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        time: f64,
+        step: f64,
+        report: &mut Report,
+    ) {
+        let inputs = self.inputs(inputs);
         // The importer's clock is the schedule's clock (they differ by rounding at most).
         let mut next = MotorState { time, ..self.state };
         let result = self.motor.step(&mut next, &inputs, step).and_then(|r| {
@@ -182,7 +191,7 @@ impl Model for MultiferroicMotor {
         match result {
             Ok(r) => {
                 self.state = next;
-                write_outputs(vars, &r.outputs);
+                write_outputs(outputs, &r.outputs);
                 if r.accuracy_limited {
                     if self.accuracy_warned {
                         report.status = report.status.max(Status::Warning);

@@ -1,29 +1,28 @@
 //! PassThrough FMU: `y = u`. A measurement baseline: an importer's cost per step measured on it
 //! is the share of any other FMU's step time that is not the model's (docs/accuracy-cost.md).
 
-use super::{Model, Report, Vars};
-use crate::variables::pass_through::{real, INFO};
-use crate::variables::ModelInfo;
+use super::{Model, Refusal, Report};
+use crate::variables::pass_through::{Inputs, Outputs, Parameters, Variables};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PassThrough;
 
 impl Model for PassThrough {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
     const DOCUMENTATION: &'static str = "<h2>Equations</h2><p><code>y</code> = <code>u</code>. \
         A baseline for timing importers: the cost of a step of this FMU is the importer's and the \
         FMI layer's own.</p>";
 
-    fn new(_vars: &mut Vars) -> Result<Self, String> {
+    fn new(_: &Parameters, _: &Inputs) -> Result<Self, Refusal> {
         Ok(Self)
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, _report: &mut Report) {
-        vars.real[real::Y] = vars.real[real::U];
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, _: &mut Report) {
+        outputs.y = inputs.u;
     }
 
-    fn step(&mut self, vars: &mut Vars, _time: f64, _step: f64, _report: &mut Report) {
-        vars.real[real::Y] = vars.real[real::U];
+    fn step(&mut self, inputs: &Inputs, outputs: &mut Outputs, _: f64, _: f64, _: &mut Report) {
+        outputs.y = inputs.u;
     }
 }

@@ -7,9 +7,8 @@
 //! (SSP, container FMU) close the loop. Rigid-body mechanics and a controller, no dissertation
 //! physics: it lives here rather than in `src/physics/`.
 
-use super::{Model, Report, Status, Vars};
-use crate::variables::pulley_joint::{real, INFO};
-use crate::variables::ModelInfo;
+use super::{Model, Refusal, Report, Status};
+use crate::variables::pulley_joint::{Inputs, Outputs, Parameters, Variables};
 use serde::{Deserialize, Serialize};
 
 /// Substep cap: a long communication step is split so that each Euler substep stays well
@@ -19,9 +18,11 @@ const MAX_SUBSTEPS: usize = 100_000;
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PulleyJoint {
     p: Params,
-    /// Joint angle and velocity, the model's history.
+    /// Joint angle and velocity at `time`, the model's history.
     q: f64,
     dq: f64,
+    /// End of the last accepted step (0 at initialization, as in the example).
+    time: f64,
 }
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -59,76 +60,69 @@ impl Params {
     }
 }
 
-fn non_negative(vars: &Vars, name: &str, i: usize) -> Result<f64, String> {
-    let x = vars.real[i];
+fn non_negative(name: &str, x: f64) -> Result<f64, Refusal> {
     if x.is_finite() && x >= 0.0 {
         Ok(x)
     } else {
-        Err(format!("{name} must be finite and >= 0, got {x}"))
+        Err(format!("{name} must be finite and >= 0, got {x}").into())
     }
 }
 
-fn positive(vars: &Vars, name: &str, i: usize) -> Result<f64, String> {
-    match non_negative(vars, name, i)? {
+fn positive(name: &str, x: f64) -> Result<f64, Refusal> {
+    match non_negative(name, x)? {
         x if x > 0.0 => Ok(x),
-        x => Err(format!("{name} must be > 0, got {x}")),
+        x => Err(format!("{name} must be > 0, got {x}").into()),
     }
 }
 
 impl PulleyJoint {
-    fn write(&self, vars: &mut Vars, t: f64) {
+    fn torque(&self, inputs: &Inputs) -> f64 {
+        self.p.moment_arm * (inputs.flexor_force - inputs.extensor_force)
+    }
+
+    /// Every output at the current state and time.
+    fn write(&self, inputs: &Inputs, out: &mut Outputs) {
         let p = &self.p;
-        let (q_ref, dq_ref) = p.reference(t);
+        let (q_ref, dq_ref) = p.reference(self.time);
         let u =
             p.feedforward_gain * q_ref.sin() + p.kp * (q_ref - self.q) + p.kd * (dq_ref - self.dq);
         let (pc, pmax) = (p.common_mode_pressure, p.max_pressure);
-        let r = &mut vars.real;
-        r[real::FLEXOR_PRESSURE] = (pc + 0.5 * u).max(0.0).min(pmax);
-        r[real::EXTENSOR_PRESSURE] = (pc - 0.5 * u).max(0.0).min(pmax);
-        r[real::FLEXOR_LENGTH] = p.rest_length - p.moment_arm * self.q;
-        r[real::EXTENSOR_LENGTH] = p.rest_length + p.moment_arm * self.q;
-        r[real::JOINT_ANGLE] = self.q;
-        r[real::JOINT_VELOCITY] = self.dq;
-        r[real::REFERENCE_ANGLE] = q_ref;
-        r[real::JOINT_TORQUE] = p.moment_arm * (r[real::FLEXOR_FORCE] - r[real::EXTENSOR_FORCE]);
+        out.flexor_pressure = (pc + 0.5 * u).max(0.0).min(pmax);
+        out.extensor_pressure = (pc - 0.5 * u).max(0.0).min(pmax);
+        out.flexor_length = p.rest_length - p.moment_arm * self.q;
+        out.extensor_length = p.rest_length + p.moment_arm * self.q;
+        out.joint_angle = self.q;
+        out.joint_velocity = self.dq;
+        out.reference_angle = q_ref;
+        out.joint_torque = self.torque(inputs);
     }
 }
 
 impl Model for PulleyJoint {
-    const INFO: &'static ModelInfo = &INFO;
+    type Variables = Variables;
     const DOCUMENTATION: &'static str = include_str!("pulley_joint.html");
 
-    fn new(vars: &mut Vars) -> Result<Self, String> {
-        let inertia = positive(vars, "inertia", real::INERTIA)?;
-        let max_pressure = positive(vars, "max_pressure", real::MAX_PRESSURE)?;
-        let common_mode_pressure =
-            non_negative(vars, "common_mode_pressure", real::COMMON_MODE_PRESSURE)?;
+    fn new(v: &Parameters, _: &Inputs) -> Result<Self, Refusal> {
+        let inertia = positive("inertia", v.inertia)?;
+        let max_pressure = positive("max_pressure", v.max_pressure)?;
+        let common_mode_pressure = non_negative("common_mode_pressure", v.common_mode_pressure)?;
         if common_mode_pressure > max_pressure {
             return Err(format!(
                 "common_mode_pressure must not exceed max_pressure = {max_pressure} Pa, got {common_mode_pressure}"
-            ));
+            ).into());
         }
-        let r = &vars.real;
-        let waypoints = [
-            0.0,
-            r[real::WAYPOINT_1],
-            r[real::WAYPOINT_2],
-            r[real::WAYPOINT_3],
-            r[real::WAYPOINT_4],
-        ];
+        let waypoints = [0.0, v.waypoint_1, v.waypoint_2, v.waypoint_3, v.waypoint_4];
         if let Some(w) = waypoints.iter().find(|w| !w.is_finite()) {
-            return Err(format!("waypoints must be finite, got {w}"));
+            return Err(format!("waypoints must be finite, got {w}").into());
         }
-        let feedforward_gain = r[real::FEEDFORWARD_GAIN];
+        let feedforward_gain = v.feedforward_gain;
         if !feedforward_gain.is_finite() {
-            return Err(format!(
-                "feedforward_gain must be finite, got {feedforward_gain}"
-            ));
+            return Err(format!("feedforward_gain must be finite, got {feedforward_gain}").into());
         }
-        let damping = non_negative(vars, "damping", real::DAMPING)?;
-        let gravity_torque = non_negative(vars, "mass", real::MASS)?
-            * non_negative(vars, "gravity", real::GRAVITY)?
-            * non_negative(vars, "com_distance", real::COM_DISTANCE)?;
+        let damping = non_negative("damping", v.damping)?;
+        let gravity_torque = non_negative("mass", v.mass)?
+            * non_negative("gravity", v.gravity)?
+            * non_negative("com_distance", v.com_distance)?;
         // Semi-implicit Euler on I q'' + c q' + k q = 0 is stable for h < 2/omega (and h < I/c
         // keeps the damping explicit part stable); the gravity torque bounds k from the side of
         // the joint alone. The muscles' stiffness is outside this FMU: the importer's step sets it.
@@ -136,36 +130,43 @@ impl Model for PulleyJoint {
         let max_substep = (0.5 * (inertia / stiffness).sqrt())
             .min(0.5 * inertia / damping.max(f64::MIN_POSITIVE));
         let p = Params {
-            moment_arm: positive(vars, "moment_arm", real::MOMENT_ARM)?,
-            rest_length: positive(vars, "rest_length", real::REST_LENGTH)?,
+            moment_arm: positive("moment_arm", v.moment_arm)?,
+            rest_length: positive("rest_length", v.rest_length)?,
             inertia,
             damping,
             gravity_torque,
             common_mode_pressure,
             max_pressure,
-            kp: non_negative(vars, "kp", real::KP)?,
-            kd: non_negative(vars, "kd", real::KD)?,
+            kp: non_negative("kp", v.kp)?,
+            kd: non_negative("kd", v.kd)?,
             feedforward_gain,
-            segment_time: positive(vars, "segment_time", real::SEGMENT_TIME)?,
+            segment_time: positive("segment_time", v.segment_time)?,
             waypoints,
             max_substep,
         };
-        let joint = Self { p, q: 0.0, dq: 0.0 };
-        joint.write(vars, 0.0);
-        Ok(joint)
+        Ok(Self {
+            p,
+            q: 0.0,
+            dq: 0.0,
+            time: 0.0,
+        })
     }
 
-    fn evaluate(&mut self, vars: &mut Vars, _report: &mut Report) {
+    fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, _report: &mut Report) {
         // Outputs at the current time: only the torque follows the inputs directly.
-        let p = &self.p;
-        vars.real[real::JOINT_TORQUE] =
-            p.moment_arm * (vars.real[real::FLEXOR_FORCE] - vars.real[real::EXTENSOR_FORCE]);
+        self.write(inputs, outputs);
     }
 
-    fn step(&mut self, vars: &mut Vars, time: f64, step: f64, report: &mut Report) {
+    fn step(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        time: f64,
+        step: f64,
+        report: &mut Report,
+    ) {
         let p = &self.p;
-        let torque =
-            p.moment_arm * (vars.real[real::FLEXOR_FORCE] - vars.real[real::EXTENSOR_FORCE]);
+        let torque = self.torque(inputs);
         // One Euler step per communication step, as the example does; a step longer than the
         // joint's own stability limit is split (bounded by MAX_SUBSTEPS).
         let n = ((step / p.max_substep).ceil() as usize).clamp(1, MAX_SUBSTEPS);
@@ -184,6 +185,7 @@ impl Model for PulleyJoint {
         }
         self.q = q;
         self.dq = dq;
-        self.write(vars, time + step);
+        self.time = time + step;
+        self.write(inputs, outputs);
     }
 }

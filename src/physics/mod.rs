@@ -1,5 +1,7 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no pointers.
 
+#![forbid(unsafe_code)]
+
 pub mod bladder;
 pub mod friction;
 pub mod gaylord;

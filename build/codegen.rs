@@ -1,0 +1,318 @@
+//! The Rust code build.rs generates from each checked model description:
+//! - `model_tables.rs`, included by `src/variables.rs`: per model, the value references, the
+//!   variable metadata and the typed `Parameters`, `Inputs`, `Outputs` and
+//!   `CalculatedParameters` structs. It names nothing above the variables module.
+//! - `model_bindings.rs`, included by `src/fmi2/registry.rs`: per model, the copies between the
+//!   export layer's value arrays and those structs, and the registry of every model.
+
+use crate::model_description::{field_name, Model, Variable, TYPES};
+use std::fmt::Write as _;
+
+/// `McKibbenMuscle` -> `mckibben_muscle`: a word break comes before a capital that follows a
+/// lower-case letter, unless the word so far is a two-letter prefix such as "Mc".
+pub fn module_name(s: &str) -> String {
+    let mut out = String::new();
+    let mut word_len = 0;
+    let mut prev_lower = false;
+    for ch in s.chars() {
+        if ch.is_uppercase() && prev_lower && word_len > 2 {
+            out.push('_');
+            word_len = 0;
+        }
+        out.extend(ch.to_lowercase());
+        word_len += 1;
+        prev_lower = ch.is_lowercase();
+    }
+    out
+}
+
+const KEYWORDS: &[&str] = &[
+    "as", "async", "await", "break", "const", "continue", "dyn", "else", "enum", "extern", "false",
+    "fn", "for", "gen", "if", "impl", "in", "let", "loop", "match", "mod", "move", "mut", "pub",
+    "ref", "return", "static", "struct", "trait", "true", "type", "unsafe", "use", "where",
+    "while", "abstract", "become", "box", "do", "final", "macro", "override", "priv", "try",
+    "typeof", "unsized", "virtual", "yield",
+];
+
+/// The field identifier of a variable (a raw identifier where the name is a keyword).
+fn ident(v: &Variable) -> String {
+    let f = field_name(&v.name);
+    match f.as_str() {
+        "self" | "super" | "crate" => format!("{f}_"),
+        _ if KEYWORDS.contains(&f.as_str()) => format!("r#{f}"),
+        _ => f,
+    }
+}
+
+fn const_name(v: &Variable) -> String {
+    v.name.to_uppercase().replace('.', "_")
+}
+
+const RUST_TYPES: [&str; 4] = ["f64", "i32", "bool", "String"];
+const ARRAYS: [&str; 4] = ["real", "integer", "boolean", "string"];
+
+/// The four typed groups of a model's variables: (struct name, doc, causality test).
+const GROUPS: [(&str, &str, &str); 4] = [
+    (
+        "Parameters",
+        "The parameters (fixed or tunable); `Default` gives the start values.",
+        "parameter",
+    ),
+    (
+        "Inputs",
+        "The inputs; `Default` gives the start values.",
+        "input",
+    ),
+    (
+        "Outputs",
+        "The outputs; `Default` gives zero (or the start value where one is declared).",
+        "output",
+    ),
+    (
+        "CalculatedParameters",
+        "The calculated parameters, which a model computes from its parameters when it is built.",
+        "calculatedParameter",
+    ),
+];
+
+fn literal(v: &Variable, value: Option<&str>) -> Result<String, String> {
+    Ok(match (v.type_index, value) {
+        (0, None) => "0.0".into(),
+        (1, None) => "0".into(),
+        (2, None) => "false".into(),
+        (_, None) => "String::new()".into(),
+        (0, Some(s)) => real_literal(s)?,
+        (1, Some(s)) => s
+            .trim()
+            .parse::<i32>()
+            .map_err(|e| format!("bad start '{s}': {e}"))?
+            .to_string(),
+        (2, Some(s)) => parse_bool(s)?.to_string(),
+        (_, Some(s)) => format!("String::from({s:?})"),
+    })
+}
+
+/// Appends the tables and typed structs of `model` to `code` (`model_tables.rs`).
+pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), String> {
+    let stem = &model.name;
+    let module = module_name(stem);
+    let _ = writeln!(
+        code,
+        "/// Variables of `{stem}`, from modelDescription/{stem}.xml."
+    );
+    let _ = writeln!(code, "pub mod {module} {{");
+    let _ = writeln!(code, "    use crate::variables::*;");
+    for (t, type_name) in TYPES.iter().enumerate() {
+        let _ = writeln!(
+            code,
+            "    /// Value references (array indices) of the {type_name} variables."
+        );
+        let _ = writeln!(code, "    #[allow(dead_code)]");
+        let _ = writeln!(code, "    pub mod {} {{", ARRAYS[t]);
+        for v in model.variables.iter().filter(|v| v.type_index == t) {
+            let _ = writeln!(code, "        /// {}", v.description);
+            let _ = writeln!(
+                code,
+                "        pub const {}: usize = {};",
+                const_name(v),
+                v.value_reference
+            );
+        }
+        let _ = writeln!(code, "    }}");
+    }
+    let _ = writeln!(code, "    pub static VARIABLES: &[Variable] = &[");
+    for v in &model.variables {
+        let start = match (v.type_index, &v.start) {
+            (_, None) => "Start::None".to_string(),
+            (3, Some(s)) => format!("Start::String({s:?})"),
+            (t, Some(s)) => format!("Start::{}({})", TYPES[t], literal(v, Some(s))?),
+        };
+        let bound = |b: &Option<String>| -> Result<String, String> {
+            Ok(match b {
+                None => "None".into(),
+                Some(s) if v.type_index == 0 => format!("Some({})", real_literal(s)?),
+                Some(s) => format!(
+                    "Some({}.0)",
+                    s.trim()
+                        .parse::<i64>()
+                        .map_err(|e| format!("bad bound '{s}': {e}"))?
+                ),
+            })
+        };
+        let _ = writeln!(
+            code,
+            "        Variable {{ name: {:?}, kind: VarType::{}, vr: {}, causality: Causality::{}, variability: Variability::{}, initial: Initial::{}, start: {start}, min: {}, max: {}, unit: {:?}, description: {:?} }},",
+            v.name,
+            TYPES[v.type_index],
+            v.value_reference,
+            capitalize(&v.causality),
+            capitalize(&v.variability),
+            capitalize(v.initial),
+            bound(&v.min)?,
+            bound(&v.max)?,
+            v.unit.clone().unwrap_or_default(),
+            v.description,
+        );
+    }
+    let _ = writeln!(code, "    ];");
+    let _ = writeln!(code, "    pub static INFO: ModelInfo = ModelInfo {{");
+    let _ = writeln!(code, "        name: {stem:?},");
+    let _ = writeln!(code, "        guid: {:?},", model.guid);
+    let _ = writeln!(code, "        description: {:?},", model.description);
+    let _ = writeln!(
+        code,
+        "        model_description_xml: include_str!({xml_path:?}),"
+    );
+    let _ = writeln!(code, "        variables: VARIABLES,");
+    let _ = writeln!(code, "        counts: {:?},", model.counts);
+    let _ = writeln!(code, "        log_categories: LOG_CATEGORIES,");
+    let _ = writeln!(code, "    }};");
+
+    for (name, doc, causality) in GROUPS {
+        let _ = writeln!(code, "    /// {doc}");
+        let _ = writeln!(code, "    #[derive(Clone, Debug, PartialEq)]");
+        let _ = writeln!(code, "    pub struct {name} {{");
+        let members: Vec<&Variable> = model
+            .variables
+            .iter()
+            .filter(|v| v.causality == causality)
+            .collect();
+        for v in &members {
+            let unit = match v.unit.as_deref() {
+                Some(u) if u != "1" => format!(" ({u})"),
+                _ => String::new(),
+            };
+            let _ = writeln!(code, "        /// {}{unit}", v.description);
+            let _ = writeln!(
+                code,
+                "        pub {}: {},",
+                ident(v),
+                RUST_TYPES[v.type_index]
+            );
+        }
+        let _ = writeln!(code, "    }}");
+        let _ = writeln!(code, "    impl Default for {name} {{");
+        let _ = writeln!(code, "        fn default() -> Self {{");
+        let _ = writeln!(code, "            Self {{");
+        for v in &members {
+            let _ = writeln!(
+                code,
+                "                {}: {},",
+                ident(v),
+                literal(v, v.start.as_deref())?
+            );
+        }
+        let _ = writeln!(code, "            }}");
+        let _ = writeln!(code, "        }}");
+        let _ = writeln!(code, "    }}");
+    }
+    let _ = writeln!(
+        code,
+        "    /// The interface of `{stem}`: its typed variable groups and metadata."
+    );
+    let _ = writeln!(code, "    pub struct Variables;");
+    let _ = writeln!(code, "    impl Interface for Variables {{");
+    for (name, _, _) in GROUPS {
+        let _ = writeln!(code, "        type {name} = {name};");
+    }
+    let _ = writeln!(code, "        const INFO: &'static ModelInfo = &INFO;");
+    let _ = writeln!(code, "    }}");
+    let _ = writeln!(code, "}}\n");
+    Ok(())
+}
+
+/// Appends the export layer's copies between value arrays and the typed structs of `model`
+/// (`model_bindings.rs`).
+pub fn bindings(model: &Model, code: &mut String) {
+    let module = module_name(&model.name);
+    let path = format!("crate::variables::{module}");
+    let _ = writeln!(code, "impl Bindings for {path}::Variables {{");
+    for (name, _, causality) in GROUPS {
+        let members: Vec<&Variable> = model
+            .variables
+            .iter()
+            .filter(|v| v.causality == causality)
+            .collect();
+        let snake = module_name(name);
+        let _ = writeln!(code, "    #[inline]");
+        let _ = writeln!(code, "    fn {snake}(_vars: &Vars) -> {path}::{name} {{");
+        let _ = writeln!(code, "        {path}::{name} {{");
+        for v in &members {
+            let array = ARRAYS[v.type_index];
+            let read = if v.type_index == 3 {
+                format!("_vars.{array}[{}].clone()", v.value_reference)
+            } else {
+                format!("_vars.{array}[{}]", v.value_reference)
+            };
+            let _ = writeln!(code, "            {}: {read},", ident(v));
+        }
+        let _ = writeln!(code, "        }}");
+        let _ = writeln!(code, "    }}");
+        let _ = writeln!(code, "    #[inline]");
+        let _ = writeln!(
+            code,
+            "    fn write_{snake}(_values: &{path}::{name}, _vars: &mut Vars) {{"
+        );
+        for v in &members {
+            let array = ARRAYS[v.type_index];
+            if v.type_index == 3 {
+                let _ = writeln!(
+                    code,
+                    "        _vars.{array}[{}].clone_from(&_values.{});",
+                    v.value_reference,
+                    ident(v)
+                );
+            } else {
+                let _ = writeln!(
+                    code,
+                    "        _vars.{array}[{}] = _values.{};",
+                    v.value_reference,
+                    ident(v)
+                );
+            }
+        }
+        let _ = writeln!(code, "    }}");
+    }
+    let _ = writeln!(code, "}}\n");
+}
+
+/// The registry: one factory per model, the model type named after the description.
+pub fn registry(models: &[Model], code: &mut String) {
+    code.push_str("/// Every model of the crate, as generated from modelDescription/.\n");
+    code.push_str("pub static REGISTRY: &[&dyn Factory] = &[\n");
+    for m in models {
+        let _ = writeln!(
+            code,
+            "    &ModelFactory::<crate::models::{}::{}>::NEW,",
+            module_name(&m.name),
+            m.name
+        );
+    }
+    code.push_str("];\n");
+}
+
+fn real_literal(s: &str) -> Result<String, String> {
+    let x: f64 = s
+        .trim()
+        .parse()
+        .map_err(|e| format!("bad number '{s}': {e}"))?;
+    if !x.is_finite() {
+        return Err(format!("'{s}' is not finite"));
+    }
+    Ok(format!("{x:?}"))
+}
+
+fn parse_bool(s: &str) -> Result<bool, String> {
+    match s.trim() {
+        "true" | "1" => Ok(true),
+        "false" | "0" => Ok(false),
+        _ => Err(format!("bad Boolean '{s}'")),
+    }
+}
+
+fn capitalize(s: &str) -> String {
+    let mut c = s.chars();
+    c.next()
+        .map(|f| f.to_uppercase().collect::<String>() + c.as_str())
+        .unwrap_or_default()
+}

@@ -1,0 +1,644 @@
+//! Hyperelastic McKibben bladder, dissertation section 2.2.2 (eq. 2.6-2.20).
+//!
+//! The bladder is an incompressible Mooney-Rivlin tube (eq. 2.8) clamped inside the ideal sleeve of
+//! [`crate::physics::gaylord`]. It is modelled as `gamma` nested thin-walled layers (eq. 2.19-2.20);
+//! one layer is exactly the thin-walled tube of eq. 2.6-2.17. Each layer follows eq. 2.9-2.12 with
+//! the radial stress taken as minus the pressure inside that layer (for one layer, `sigma_33 = -P`).
+//!
+//! Every layer is described by its stretch in squared form, so the per-call work is a handful of
+//! multiplications per layer and one reciprocal; the partial derivatives with respect to the muscle
+//! length and the bladder's outer diameter are carried along in forward mode (a small dual number),
+//! which gives an analytic stiffness and the Newton slope of the free-bladder equation (eq. 2.18).
+//!
+//! The sleeve enters only through its diameter `D(L)` ([`SleeveGeometry`]). The strand force of
+//! eq. 2.16 is written as `P_eff (A - dV/dL)` with `A = pi D^2 / 4` (for a closed cylindrical sleeve
+//! `F + P A` is its strand tension, eq. 1.1 / 2.1), which is `P_eff L^2 / (2 pi n^2)` for the
+//! helical sleeve of chapter 2 and applies unchanged to the cylindrical knitted sleeves of chapter 1
+//! (section 1.3.6: "the same results apply to a knitted muscle"). The bladder is generic over the
+//! geometry, so the helical path is monomorphised and costs what it did before the generalisation.
+
+mod dual;
+mod geometry;
+mod knitted_cylinder;
+#[cfg(test)]
+mod tests;
+
+use crate::physics::gaylord::Sleeve;
+use crate::physics::knitted::KnittedSleeve;
+use dual::Dual;
+pub use geometry::SleeveGeometry;
+pub use knitted_cylinder::KnittedCylinder;
+use std::f64::consts::PI;
+
+/// Mooney-Rivlin `C1` of natural latex used throughout chapter 2 (Fig. 2.9), Pa.
+pub const MOONEY_C1: f64 = 161e3;
+/// Mooney-Rivlin `C2` of natural latex used throughout chapter 2 (Fig. 2.9), Pa.
+pub const MOONEY_C2: f64 = 39e3;
+/// Largest accepted number of layers: far past convergence, and it bounds the per-call work.
+pub const MAX_LAYERS: usize = 4096;
+
+/// Iteration cap of the free-bladder root finder (safeguarded Newton-bisection converges in <10).
+const ROOT_ITERATIONS: usize = 100;
+/// Halvings allowed when looking for the collapsed side of the free-bladder bracket under vacuum.
+const BRACKET_HALVINGS: usize = 200;
+
+/// The relaxed bladder tube before it is clamped into the sleeve (Table 2.1 columns).
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BladderTube {
+    /// Unstretched inner diameter `D_RI`, m.
+    pub inner_diameter: f64,
+    /// Unstretched wall thickness, m; `D_RO = D_RI + 2 thickness`.
+    pub thickness: f64,
+    /// Unstretched length `L_R0`, m; shorter than the muscle means pre-strain (Table 2.1 B, C).
+    pub unstretched_length: f64,
+    /// Mooney-Rivlin `C1`, Pa (eq. 2.8).
+    pub mooney_c1: f64,
+    /// Mooney-Rivlin `C2`, Pa (eq. 2.8).
+    pub mooney_c2: f64,
+}
+
+/// Parameter-only constants of one nested layer (eq. 2.19-2.20), precomputed once.
+#[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
+struct Layer {
+    /// `1 / D_0i^2`.
+    inv_d0_sq: f64,
+    /// `D_RO^2 - D_0i^2`: with the axial stretch it fixes the layer's diameter (incompressibility).
+    excess_sq: f64,
+    /// `Delta D / D_0i`, the layer's relative wall in eq. 2.19.
+    wall_ratio: f64,
+    /// Rubber volume of the layer, m^3 (eq. 2.6 for the layer).
+    rubber_volume: f64,
+}
+
+/// A Mooney-Rivlin bladder inside a given sleeve (the helical McKibben [`Sleeve`] by default, or a
+/// [`KnittedCylinder`]), with everything that depends only on parameters precomputed (layer
+/// constants, rubber volume, length limits).
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct Bladder<S = Sleeve> {
+    sleeve: S,
+    tube: BladderTube,
+    layers: Vec<Layer>,
+    outer_diameter: f64,
+    rubber_volume: f64,
+    min_length: f64,
+    max_length: f64,
+}
+
+/// Everything the bladder model says at one pressure and muscle length.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct BladderState {
+    /// Muscle tension, N: strands + pressure end force + bladder elastic force (eq. 2.4 without
+    /// friction, eq. 2.16 + 2.17).
+    pub force: f64,
+    /// `F_strands = P_eff (A - dV/dL)`, N (eq. 2.16; `P_eff L^2 / (2 pi n^2)` for the helical
+    /// sleeve): the sleeve's strand tension.
+    pub strand_force: f64,
+    /// `dF_strands/dL` along the current branch, N/m (zero when free).
+    pub strand_stiffness: f64,
+    /// `F_pressure = -P A_fluid`, N (eq. 2.5).
+    pub pressure_force: f64,
+    /// `F_elastic`, the axial force carried by the rubber, summed over layers, N (eq. 2.17).
+    pub elastic_force: f64,
+    /// Contact pressure of bladder on sleeve, Pa, never negative (eq. 2.12, 2.19).
+    pub effective_pressure: f64,
+    /// `dP_eff/dL` along the current branch, Pa/m (zero when free).
+    pub effective_pressure_slope: f64,
+    /// Whether the bladder presses on the sleeve (`P >= threshold_pressure`).
+    pub contact: bool,
+    /// See [`Bladder::threshold_pressure`], Pa.
+    pub threshold_pressure: f64,
+    /// Gas volume inside the bladder, `pi/4 D_in^2 L`, m^3.
+    pub fluid_volume: f64,
+    /// Inner diameter of the bladder, m (eq. 2.7 in contact, eq. 2.18 when free).
+    pub inner_diameter: f64,
+    /// Outer diameter of the bladder, m (the sleeve's diameter in contact).
+    pub outer_diameter: f64,
+    /// `lambda_1 = L / L_R0` (eq. 2.8a).
+    pub stretch_axial: f64,
+    /// `lambda_2` of the inner wall, `D_in / D_RI` (eq. 2.8b).
+    pub stretch_hoop: f64,
+    /// `lambda_3 = 1 / (lambda_1 lambda_2)` of the inner wall (eq. 2.8c).
+    pub stretch_radial: f64,
+    /// True axial stress of the innermost layer, Pa (eq. 2.9a; the thin-wall value for one layer).
+    pub stress_axial: f64,
+    /// True hoop stress of the innermost layer, Pa (eq. 2.9b, 2.11).
+    pub stress_hoop: f64,
+    /// True radial stress of the innermost layer, `-P`, Pa.
+    pub stress_radial: f64,
+    /// `dF/dL`, N/m, analytic (forward-mode derivative through the layer recursion; when free,
+    /// through the root of eq. 2.18 by the implicit function theorem).
+    pub stiffness: f64,
+}
+
+impl Bladder<KnittedCylinder> {
+    /// The bladder inside a cylindrical knitted sleeve (section 1.3.6); `Err` for the
+    /// non-cylindrical shape (see [`KnittedCylinder::new`]) or a tube that does not fit. The
+    /// length range is the sleeve's own (strand thickness) intersected with where the rubber fits.
+    pub fn knitted(
+        sleeve: &KnittedSleeve,
+        tube: BladderTube,
+        layers: usize,
+    ) -> Result<Self, String> {
+        Self::new(KnittedCylinder::new(sleeve)?, tube, layers)
+    }
+}
+
+impl<S: SleeveGeometry> Bladder<S> {
+    /// Builds a bladder of `layers` nested thin layers (1 = thin-walled model, eq. 2.6-2.17;
+    /// more = thick-walled model, eq. 2.19-2.20) inside `sleeve`.
+    pub fn new(sleeve: S, tube: BladderTube, layers: usize) -> Result<Self, String> {
+        let positive = |name: &str, v: f64| {
+            if v.is_finite() && v > 0.0 {
+                Ok(())
+            } else {
+                Err(format!("{name} must be positive and finite, got {v}"))
+            }
+        };
+        positive("bladder inner_diameter (m)", tube.inner_diameter)?;
+        positive("bladder thickness (m)", tube.thickness)?;
+        positive("bladder unstretched_length (m)", tube.unstretched_length)?;
+        for (name, c) in [("mooney_c1", tube.mooney_c1), ("mooney_c2", tube.mooney_c2)] {
+            if !(c.is_finite() && c >= 0.0) {
+                return Err(format!("{name} must be finite and >= 0 Pa, got {c}"));
+            }
+        }
+        if !(1..=MAX_LAYERS).contains(&layers) {
+            return Err(format!(
+                "bladder layers must be 1..={MAX_LAYERS}, got {layers}"
+            ));
+        }
+        let d_ri = tube.inner_diameter;
+        let d_ro = d_ri + 2.0 * tube.thickness;
+        let step = (d_ro - d_ri) / layers as f64;
+        let layer_list: Vec<Layer> = (0..layers)
+            .map(|i| {
+                let d0 = d_ri + i as f64 * step;
+                let d1 = d0 + step;
+                Layer {
+                    inv_d0_sq: 1.0 / (d0 * d0),
+                    excess_sq: d_ro * d_ro - d0 * d0,
+                    wall_ratio: step / d0,
+                    rubber_volume: PI / 4.0 * (d1 * d1 - d0 * d0) * tube.unstretched_length,
+                }
+            })
+            .collect();
+        // Eq. 2.6.
+        let rubber_volume = PI / 4.0 * (d_ro * d_ro - d_ri * d_ri) * tube.unstretched_length;
+        let (min_length, max_length) = sleeve.fill_lengths(rubber_volume).ok_or_else(|| {
+            format!(
+                "the bladder's rubber volume {rubber_volume:e} m^3 does not fit in the sleeve \
+                 (largest sleeve volume {:e} m^3): inner diameter of eq. 2.7 is never positive",
+                sleeve.largest_volume()
+            )
+        })?;
+        if !(rubber_volume.is_finite() && min_length.is_finite() && max_length.is_finite()) {
+            return Err("bladder geometry gives non-finite rubber volume or lengths".into());
+        }
+        Ok(Self {
+            sleeve,
+            tube,
+            layers: layer_list,
+            outer_diameter: d_ro,
+            rubber_volume,
+            min_length,
+            max_length,
+        })
+    }
+
+    pub fn sleeve(&self) -> &S {
+        &self.sleeve
+    }
+
+    pub fn tube(&self) -> &BladderTube {
+        &self.tube
+    }
+
+    pub fn layer_count(&self) -> usize {
+        self.layers.len()
+    }
+
+    /// Rubber volume `V_R`, m^3 (eq. 2.6); constant because rubber is incompressible.
+    pub fn rubber_volume(&self) -> f64 {
+        self.rubber_volume
+    }
+
+    /// Longest muscle length, m: the rubber fills the sleeve and eq. 2.7's inner diameter reaches
+    /// zero, i.e. the largest root of `L (b^2 - L^2) = 4 pi n^2 V_R` for the helical sleeve. The
+    /// force rises without bound towards it; at and beyond it [`Bladder::evaluate`] returns `Err`.
+    /// (A knitted sleeve whose strand thickness stops it first ends at its own full extension.)
+    pub fn max_length(&self) -> f64 {
+        self.max_length
+    }
+
+    /// Shortest muscle length, m: the other positive root of the same cubic, where the short
+    /// sleeve's volume has shrunk to the rubber volume. At and below it `evaluate` returns `Err`.
+    pub fn min_length(&self) -> f64 {
+        self.min_length
+    }
+
+    /// Inner diameter of the bladder in contact with the sleeve at `length` (eq. 2.7), m, or `None`
+    /// outside `(min_length, max_length)`.
+    pub fn contact_inner_diameter(&self, length: f64) -> Option<f64> {
+        let d_in_sq = self.sleeve.diameter_sq(length) - 4.0 * self.rubber_volume / (PI * length);
+        (length > 0.0 && d_in_sq > 0.0 && d_in_sq.is_finite()).then(|| d_in_sq.sqrt())
+    }
+
+    /// Threshold pressure at `length`, Pa: the gauge pressure at which the bladder, stretched
+    /// axially to `length` and inflated to exactly the sleeve's inner diameter, is in equilibrium
+    /// with zero contact pressure, i.e. `P_eff = 0` in eq. 2.12 / 2.19 (eq. 2.18 solved for `P` at
+    /// the contact diameter). `P_eff` is proportional to `P - threshold` with a positive factor, so
+    /// the bladder is in contact exactly when `P >= threshold` (the switch used by `evaluate`).
+    /// It is negative near `max_length`, where the sleeve squeezes the bladder even under vacuum.
+    pub fn threshold_pressure(&self, length: f64) -> Result<f64, String> {
+        self.check_length(length)?;
+        let (l, x) = self.contact_seed(length);
+        let k = self
+            .kernel(0.0, l, x)
+            .ok_or_else(|| self.domain_error(length))?;
+        finite_or(k.threshold, "threshold pressure", length)
+    }
+
+    /// The bladder's state at gauge pressure `pressure` (Pa) and muscle length `length` (m).
+    ///
+    /// In contact (`P >= threshold`) the outer diameter is the sleeve's (eq. 2.7, 2.20); otherwise
+    /// the bladder is free and its diameter solves eq. 2.18 (generalised to the layers) by a
+    /// bracketed safeguarded Newton-bisection. At `P = threshold` both branches give the same
+    /// diameter with `P_eff = 0`, so the force is continuous in pressure (its slope kinks), because
+    /// the free equilibrium pressure rises monotonically with diameter (see
+    /// [`Bladder::free_contact_is_stable`]): the free root is unique and meets the sleeve there.
+    ///
+    /// `Err` for a non-finite input, for a length outside `(min_length, max_length)` (no solution:
+    /// the rubber does not fit), for a vacuum so deep that the free bladder would collapse, or if
+    /// the numbers overflow right at the limits.
+    pub fn evaluate(&self, pressure: f64, length: f64) -> Result<BladderState, String> {
+        if !pressure.is_finite() {
+            return Err(format!("pressure must be finite, got {pressure} Pa"));
+        }
+        self.check_length(length)?;
+        let (l, x) = self.contact_seed(length);
+        let contact = self
+            .kernel(pressure, l, x)
+            .ok_or_else(|| self.domain_error(length))?;
+        if contact.p_eff.v >= 0.0 {
+            let state = self.contact_state(pressure, length, &contact);
+            return check_state(state, length);
+        }
+        // Free bladder: solve P_eff(x) = 0 for the outer diameter x below the sleeve's.
+        let x_root = self.free_outer_diameter(pressure, length, x.v)?;
+        let free = self
+            .kernel(pressure, Dual::var_l(length), Dual::var_x(x_root))
+            .ok_or_else(|| self.domain_error(length))?;
+        let state = self.free_state(pressure, length, &free, contact.threshold);
+        check_state(state, length)
+    }
+
+    /// Whether the free bladder's equilibrium pressure rises with its diameter at the sleeve's
+    /// diameter (at `length`), i.e. whether losing contact is gradual rather than a snap.
+    ///
+    /// For one layer this always holds: eq. 2.18 gives the free equilibrium pressure
+    /// `P = 2 (C1/l1 + C2 l1) (u - a/u) / (c + r u)` with `u = l2^2`, `a = 1/l1^2`, `c = 1/l1`,
+    /// `r = D_RI/(D_RO - D_RI)`, whose `u`-derivative has the sign of `c + a c/u^2 + 2 r a/u > 0`.
+    /// (With the sleeve's clamps fixing `l1`, the tube has no balloon limit point.) For layered
+    /// walls it is checked by a property test over random tubes. `Err` outside the length range.
+    pub fn free_contact_is_stable(&self, length: f64) -> Result<bool, String> {
+        self.check_length(length)?;
+        let (_, x) = self.contact_seed(length);
+        // P_hold = c/a; its x-slope has the sign of (c' a - c a').
+        let k = self
+            .kernel(0.0, Dual::var_l(length), Dual::var_x(x.v))
+            .ok_or_else(|| self.domain_error(length))?;
+        Ok(k.c.dx * k.a.v - k.c.v * k.a.dx > 0.0)
+    }
+
+    fn check_length(&self, length: f64) -> Result<(), String> {
+        if !length.is_finite() {
+            return Err(format!("length must be finite, got {length} m"));
+        }
+        if length <= self.min_length || length >= self.max_length {
+            return Err(self.domain_error(length));
+        }
+        Ok(())
+    }
+
+    fn domain_error(&self, length: f64) -> String {
+        format!(
+            "length {length} m is outside ({}, {}) m, where the bladder fits the sleeve \
+             (eq. 2.7's inner diameter is positive only there): no solution",
+            self.min_length, self.max_length
+        )
+    }
+
+    /// Length seeded with d/dL = 1, and the sleeve diameter `D(L)` seeded with its total slope
+    /// along the contact branch in `dl` and 1 in `dx`.
+    fn contact_seed(&self, length: f64) -> (Dual, Dual) {
+        let (d, slope) = self.sleeve.diameter_and_slope(length);
+        (
+            Dual::var_l(length),
+            Dual {
+                v: d,
+                dl: slope,
+                dx: 1.0,
+            },
+        )
+    }
+
+    /// The layer recursion of eq. 2.19-2.20 at muscle length `l` and bladder outer diameter `x`.
+    /// `None` if a layer's squared hoop stretch is not positive (outside the geometry) or not finite.
+    #[inline]
+    fn kernel(&self, pressure: f64, l: Dual, x: Dual) -> Option<Kernel> {
+        let c1x2 = 2.0 * self.tube.mooney_c1;
+        let c2x2 = 2.0 * self.tube.mooney_c2;
+        let lambda1 = l * (1.0 / self.tube.unstretched_length);
+        let inv_lambda1 = lambda1.recip();
+        let lambda1_sq = lambda1 * lambda1;
+        let inv_lambda1_sq = inv_lambda1 * inv_lambda1;
+        let inv_l = l.recip();
+        let x_sq = x * x;
+        // Pressure inside the current layer is a P - c (linear in P, a > 0), so the threshold
+        // pressure c/a of the whole stack falls out of the same pass.
+        let mut a = Dual::constant(1.0);
+        let mut c = Dual::constant(0.0);
+        let mut elastic = Dual::constant(0.0);
+        let mut inner: Option<InnerLayer> = None;
+        for layer in &self.layers {
+            // Eq. 2.20 in squared form: lambda_2i^2 = (x^2 - (D_RO^2 - D_0i^2)/lambda_1) / D_0i^2.
+            let l2_sq = (x_sq - inv_lambda1 * layer.excess_sq) * layer.inv_d0_sq;
+            if !(l2_sq.v > 0.0 && l2_sq.v.is_finite()) {
+                return None;
+            }
+            let inv_l2_sq = l2_sq.recip();
+            let l3_sq = inv_lambda1_sq * inv_l2_sq;
+            let inv_l3_sq = lambda1_sq * l2_sq;
+            // Eq. 2.9b and 2.9a without the radial stress.
+            let hoop = (l2_sq - l3_sq) * c1x2 - (inv_l2_sq - inv_l3_sq) * c2x2;
+            let axial = (lambda1_sq - l3_sq) * c1x2 - (inv_lambda1_sq - inv_l3_sq) * c2x2;
+            // lambda_3 / lambda_2 * Delta D / D_0i of eq. 2.19.
+            let k = inv_lambda1 * inv_l2_sq * layer.wall_ratio;
+            let p_in = a * pressure - c;
+            // sigma_33 = -p_in; sigma_11 = sigma_33 + axial (eq. 2.17 for the layer).
+            elastic = elastic + (axial - p_in) * inv_l * layer.rubber_volume;
+            if inner.is_none() {
+                inner = Some(InnerLayer {
+                    l2_sq,
+                    stress_axial: axial.v - pressure,
+                    stress_hoop: hoop.v - pressure,
+                });
+            }
+            // Eq. 2.12 for the layer: p_out = p_in - sigma_22 k with sigma_22 = -p_in + hoop.
+            let one_k = k + 1.0;
+            c = c * one_k + hoop * k;
+            a = a * one_k;
+        }
+        let inner = inner?;
+        let p_eff = a * pressure - c;
+        let threshold = c.v / a.v;
+        Some(Kernel {
+            a,
+            c,
+            p_eff,
+            threshold,
+            elastic,
+            inner,
+        })
+    }
+
+    fn fluid_area(&self, inner_l2_sq: Dual) -> Dual {
+        let d_ri = self.tube.inner_diameter;
+        inner_l2_sq * (PI / 4.0 * d_ri * d_ri)
+    }
+
+    fn contact_state(&self, pressure: f64, length: f64, k: &Kernel) -> BladderState {
+        let (g, g_slope) = self.sleeve.strand_area(length);
+        let strand_area = Dual {
+            v: g,
+            dl: g_slope,
+            dx: 0.0,
+        };
+        // Eq. 2.16: P_eff (A - dV/dL) - P A_fluid, plus eq. 2.17.
+        let strands = k.p_eff * strand_area;
+        let area = self.fluid_area(k.inner.l2_sq);
+        let pressure_force = area * (-pressure);
+        let force = strands + pressure_force + k.elastic;
+        // The dual-number seed carried the contact branch's total d/dL in `dl`.
+        self.state(
+            pressure,
+            length,
+            k,
+            Parts {
+                force: force.v,
+                strand: strands.v,
+                strand_slope: strands.dl,
+                pressure_force: pressure_force.v,
+                p_eff: k.p_eff.v,
+                p_eff_slope: k.p_eff.dl,
+                contact: true,
+                threshold: k.threshold,
+                area: area.v,
+                stiffness: force.dl,
+            },
+        )
+    }
+
+    fn free_state(&self, pressure: f64, length: f64, k: &Kernel, threshold: f64) -> BladderState {
+        let area = self.fluid_area(k.inner.l2_sq);
+        let pressure_force = area * (-pressure);
+        let force = pressure_force + k.elastic;
+        // Implicit function theorem on P_eff(L, x) = 0: dx/dL = -dP_eff/dL / dP_eff/dx.
+        let dx_dl = if k.p_eff.dx != 0.0 {
+            -k.p_eff.dl / k.p_eff.dx
+        } else {
+            0.0
+        };
+        self.state(
+            pressure,
+            length,
+            k,
+            Parts {
+                force: force.v,
+                strand: 0.0,
+                strand_slope: 0.0,
+                pressure_force: pressure_force.v,
+                p_eff: 0.0,
+                p_eff_slope: 0.0,
+                contact: false,
+                threshold,
+                area: area.v,
+                stiffness: force.dl + force.dx * dx_dl,
+            },
+        )
+    }
+
+    fn state(&self, pressure: f64, length: f64, k: &Kernel, p: Parts) -> BladderState {
+        let lambda1 = length / self.tube.unstretched_length;
+        let lambda2 = k.inner.l2_sq.v.sqrt();
+        let d_in = lambda2 * self.tube.inner_diameter;
+        let d_out = (d_in * d_in + 4.0 * self.rubber_volume / (PI * length)).sqrt();
+        BladderState {
+            force: p.force,
+            strand_force: p.strand,
+            strand_stiffness: p.strand_slope,
+            pressure_force: p.pressure_force,
+            elastic_force: k.elastic.v,
+            effective_pressure: p.p_eff,
+            effective_pressure_slope: p.p_eff_slope,
+            contact: p.contact,
+            threshold_pressure: p.threshold,
+            fluid_volume: p.area * length,
+            inner_diameter: d_in,
+            outer_diameter: d_out,
+            stretch_axial: lambda1,
+            stretch_hoop: lambda2,
+            stretch_radial: 1.0 / (lambda1 * lambda2),
+            stress_axial: k.inner.stress_axial,
+            stress_hoop: k.inner.stress_hoop,
+            stress_radial: -pressure,
+            stiffness: p.stiffness,
+        }
+    }
+
+    /// Outer diameter of the free bladder (eq. 2.18 generalised to the layers): the root of
+    /// `P_eff(x) = 0` for `x` below the sleeve's diameter `x_contact`, where `P_eff < 0`.
+    /// Hand-written safeguarded Newton-bisection on the analytic slope, for speed on the per-step
+    /// path; every loop is capped.
+    fn free_outer_diameter(
+        &self,
+        pressure: f64,
+        length: f64,
+        x_contact: f64,
+    ) -> Result<f64, String> {
+        let lambda1 = length / self.tube.unstretched_length;
+        let d_ro = self.outer_diameter;
+        let d_ri = self.tube.inner_diameter;
+        // Inner wall collapses at x_min; all layers are unstrained at x_rest = D_RO/sqrt(lambda_1),
+        // where P_eff = P (a = 1... times P, c = 0), so for P > 0 the root lies above x_rest.
+        let x_min = ((d_ro * d_ro - d_ri * d_ri) / lambda1).sqrt();
+        let x_rest = d_ro / lambda1.sqrt();
+        let residual = |x: f64| {
+            self.kernel(pressure, Dual::var_l(length), Dual::var_x(x))
+                .map(|k| (k.p_eff.v, k.p_eff.dx))
+        };
+        let hi = x_contact;
+        let start = if x_rest < hi { x_rest } else { hi };
+        let mut lo = start;
+        let mut r_lo = None;
+        for j in 0..BRACKET_HALVINGS {
+            if j > 0 {
+                lo = x_min + (start - x_min) * 0.5f64.powi(j as i32);
+            }
+            if let Some((r, _)) = residual(lo) {
+                if r >= 0.0 {
+                    r_lo = Some(r);
+                    break;
+                }
+            }
+        }
+        let Some(r_lo) = r_lo else {
+            return Err(format!(
+                "pressure {pressure} Pa at length {length} m: the free bladder has no equilibrium \
+                 short of collapse (vacuum too deep; collapse is not modelled)"
+            ));
+        };
+        if r_lo == 0.0 {
+            return Ok(lo);
+        }
+        let mut hi = hi;
+        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); any step
+        // leaving the bracket is replaced by bisection.
+        let mut x = lo;
+        for _ in 0..ROOT_ITERATIONS {
+            let Some((r, dr)) = residual(x) else {
+                // Cannot happen inside (x_min, x_contact]; bisect to stay safe.
+                x = 0.5 * (lo + hi);
+                continue;
+            };
+            if r == 0.0 {
+                return Ok(x);
+            }
+            if r > 0.0 {
+                lo = x;
+            } else {
+                hi = x;
+            }
+            let newton = x - r / dr;
+            let newton_ok = newton.is_finite() && newton >= lo && newton <= hi;
+            // Converged when the Newton correction is at rounding level (or the bracket is).
+            if (newton_ok && (newton - x).abs() <= 1e-14 * x) || hi - lo <= 1e-15 * hi {
+                return Ok(if newton_ok { newton } else { x });
+            }
+            x = if newton_ok && newton > lo && newton < hi {
+                newton
+            } else {
+                0.5 * (lo + hi)
+            };
+        }
+        Ok(0.5 * (lo + hi))
+    }
+}
+
+fn finite_or(v: f64, what: &str, length: f64) -> Result<f64, String> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!(
+            "{what} overflows at length {length} m (too close to a length limit)"
+        ))
+    }
+}
+
+fn check_state(s: BladderState, length: f64) -> Result<BladderState, String> {
+    let all = [
+        s.force,
+        s.strand_force,
+        s.strand_stiffness,
+        s.pressure_force,
+        s.elastic_force,
+        s.effective_pressure,
+        s.effective_pressure_slope,
+        s.threshold_pressure,
+        s.fluid_volume,
+        s.inner_diameter,
+        s.outer_diameter,
+        s.stretch_axial,
+        s.stretch_hoop,
+        s.stretch_radial,
+        s.stress_axial,
+        s.stress_hoop,
+        s.stress_radial,
+        s.stiffness,
+    ];
+    if all.iter().all(|v| v.is_finite()) {
+        Ok(s)
+    } else {
+        Err(format!(
+            "bladder state overflows at length {length} m (too close to a length limit)"
+        ))
+    }
+}
+
+struct Parts {
+    force: f64,
+    strand: f64,
+    strand_slope: f64,
+    pressure_force: f64,
+    p_eff: f64,
+    p_eff_slope: f64,
+    contact: bool,
+    threshold: f64,
+    area: f64,
+    stiffness: f64,
+}
+
+struct InnerLayer {
+    l2_sq: Dual,
+    stress_axial: f64,
+    stress_hoop: f64,
+}
+
+struct Kernel {
+    a: Dual,
+    c: Dual,
+    p_eff: Dual,
+    threshold: f64,
+    elastic: Dual,
+    inner: InnerLayer,
+}

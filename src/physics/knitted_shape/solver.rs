@@ -1,0 +1,445 @@
+//! Newton steps on the KKT system of the volume maximum (tridiagonal Hessian, eq. 1.19-1.20).
+
+// `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+use super::geometry::ShapeGeometry;
+use std::f64::consts::PI;
+
+/// Newton iterations per solve; the warm start usually converges in 3-5.
+pub(super) const MAX_NEWTON: usize = 60;
+/// Active-set passes per solve (rings released from the minimum radius).
+pub(super) const MAX_ACTIVE_PASSES: usize = 40;
+/// Halvings of a length step before the path is declared ended.
+pub(super) const MAX_SUBSTEP_HALVINGS: usize = 12;
+
+/// Working state of the constrained maximization: radii, multiplier and active set.
+#[derive(Clone, Debug)]
+pub(super) struct Solver {
+    pub(super) radii: Vec<f64>,
+    /// `lambda = dV/dL` at the optimum (negative in the stroke: tension).
+    pub(super) lambda: f64,
+    /// `true` for rings held at the minimum radius (and the two clamped ends).
+    pub(super) held: Vec<bool>,
+    // Gradients and tridiagonal Hessians of V and L over the rings.
+    pub(super) gv: Vec<f64>,
+    pub(super) gl: Vec<f64>,
+    pub(super) dv: Vec<f64>,
+    pub(super) dl: Vec<f64>,
+    pub(super) ov: Vec<f64>,
+    pub(super) ol: Vec<f64>,
+    // Scratch of the bordered tridiagonal solve.
+    pub(super) x: Vec<f64>,
+    pub(super) y: Vec<f64>,
+    pub(super) c: Vec<f64>,
+}
+
+/// Converged point on the path.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct PathPoint {
+    pub(super) length: f64,
+    pub(super) volume: f64,
+    pub(super) slope: f64,
+    pub(super) curvature: f64,
+    pub(super) max_radius: f64,
+}
+
+impl Solver {
+    pub(super) fn new(geom: &ShapeGeometry) -> Self {
+        let rings = geom.segments + 1;
+        let mut held = vec![false; rings];
+        held[0] = true;
+        held[rings - 1] = true;
+        let z = vec![0.0; rings];
+        Self {
+            radii: vec![geom.min_radius; rings],
+            lambda: 0.0,
+            held,
+            gv: z.clone(),
+            gl: z.clone(),
+            dv: z.clone(),
+            dl: z.clone(),
+            ov: z.clone(),
+            ol: z.clone(),
+            x: z.clone(),
+            y: z.clone(),
+            c: z,
+        }
+    }
+
+    /// Gradients and tridiagonal Hessians of `V` and `L` (eq. 1.19-1.20 and their second
+    /// derivatives). Returns `(L, V)`, `None` if a segment cannot close.
+    pub(super) fn assemble(&mut self, geom: &ShapeGeometry) -> Option<(f64, f64)> {
+        let rings = self.radii.len();
+        for v in [
+            &mut self.gv,
+            &mut self.gl,
+            &mut self.dv,
+            &mut self.dl,
+            &mut self.ov,
+            &mut self.ol,
+        ] {
+            v.iter_mut().for_each(|x| *x = 0.0);
+        }
+        let (mut l, mut v) = (0.0, 0.0);
+        for i in 1..rings {
+            let seg = geom.segment(self.radii[i - 1], self.radii[i])?;
+            l += seg.l;
+            v += seg.v;
+            let (a, b) = (i - 1, i);
+            self.gv[a] += seg.va;
+            self.gl[a] += seg.la;
+            self.dv[a] += seg.vaa;
+            self.dl[a] += seg.laa;
+            self.gv[b] += seg.vb;
+            self.gl[b] += seg.lb;
+            self.dv[b] += seg.vbb;
+            self.dl[b] += seg.lbb;
+            self.ov[a] = seg.vab;
+            self.ol[a] = seg.lab;
+        }
+        Some((l, v))
+    }
+
+    /// Least-squares multiplier `lambda = (g_L . g_V) / (g_L . g_L)` over the free rings.
+    pub(super) fn multiplier(&self) -> Option<f64> {
+        let (mut num, mut den) = (0.0, 0.0);
+        for j in 0..self.radii.len() {
+            if !self.held[j] {
+                num += self.gl[j] * self.gv[j];
+                den += self.gl[j] * self.gl[j];
+            }
+        }
+        (den > 0.0).then(|| num / den)
+    }
+
+    /// Solves `(H - mu I) x = R` and `(H - mu I) y = g_L` on the free rings, with
+    /// `H = Hess V - lambda Hess L` and `R = grad V - lambda grad L`, by the Thomas algorithm
+    /// (hand-written: two right-hand sides per factorization, on the hot path of the table build).
+    /// Returns the number of positive pivots (Sylvester inertia of `H - mu I`), `None` on a
+    /// vanishing pivot.
+    pub(super) fn shifted_solve(&mut self, lambda: f64, mu: f64) -> Option<usize> {
+        let rings = self.radii.len();
+        let mut scale = 0.0f64;
+        for j in 0..rings {
+            scale = scale.max((self.dv[j] - lambda * self.dl[j]).abs());
+        }
+        let tiny = 1e-14 * scale.max(f64::MIN_POSITIVE) + mu * 1e-14;
+        let mut positive = 0;
+        let mut prev_off = 0.0;
+        for j in 0..rings {
+            let held = self.held[j];
+            let diag = if held {
+                1.0
+            } else {
+                self.dv[j] - lambda * self.dl[j] - mu
+            };
+            let off_here = if held || j + 1 >= rings || self.held[j + 1] {
+                0.0
+            } else {
+                self.ov[j] - lambda * self.ol[j]
+            };
+            let (rx, ry) = if held {
+                (0.0, 0.0)
+            } else {
+                (self.gv[j] - lambda * self.gl[j], self.gl[j])
+            };
+            let (cp, xp, yp) = if j > 0 {
+                (self.c[j - 1], self.x[j - 1], self.y[j - 1])
+            } else {
+                (0.0, 0.0, 0.0)
+            };
+            let denom = diag - prev_off * cp;
+            if !(denom.abs() > tiny) || !denom.is_finite() {
+                return None;
+            }
+            if !held && denom > 0.0 {
+                positive += 1;
+            }
+            self.c[j] = off_here / denom;
+            self.x[j] = (rx - prev_off * xp) / denom;
+            self.y[j] = (ry - prev_off * yp) / denom;
+            prev_off = off_here;
+        }
+        for j in (0..rings - 1).rev() {
+            self.x[j] -= self.c[j] * self.x[j + 1];
+            self.y[j] -= self.c[j] * self.y[j + 1];
+        }
+        Some(positive)
+    }
+
+    /// Moves the free rings along the length gradient until `L = target` (1-D Newton, capped),
+    /// holding any ring that reaches the minimum radius. Returns `(L, V)`.
+    pub(super) fn restore_length(
+        &mut self,
+        geom: &ShapeGeometry,
+        target: f64,
+    ) -> Option<(f64, f64)> {
+        let r_min = geom.min_radius;
+        let mut lv = geom.length_and_volume(&self.radii)?;
+        for _ in 0..30 {
+            if (lv.0 - target).abs() <= 1e-14 * geom.max_length() {
+                return Some(lv);
+            }
+            self.assemble(geom)?;
+            let gg: f64 = (0..self.radii.len())
+                .filter(|&j| !self.held[j])
+                .map(|j| self.gl[j] * self.gl[j])
+                .sum();
+            if !(gg > 0.0) {
+                return None;
+            }
+            let mut beta = (target - lv.0) / gg;
+            let base = self.radii.clone();
+            let mut ok = false;
+            for _ in 0..40 {
+                for j in 0..self.radii.len() {
+                    if !self.held[j] {
+                        self.radii[j] = (base[j] + beta * self.gl[j]).max(r_min);
+                    }
+                }
+                if let Some(x) = geom.length_and_volume(&self.radii) {
+                    lv = x;
+                    ok = true;
+                    break;
+                }
+                beta *= 0.5;
+            }
+            if !ok {
+                self.radii.copy_from_slice(&base);
+                return None;
+            }
+            self.hold_touching(r_min);
+        }
+        ((lv.0 - target).abs() <= 1e-10 * geom.max_length()).then_some(lv)
+    }
+
+    pub(super) fn hold_touching(&mut self, r_min: f64) {
+        let rings = self.radii.len();
+        for j in 1..rings - 1 {
+            if !self.held[j] && self.radii[j] <= r_min {
+                self.radii[j] = r_min;
+                self.held[j] = true;
+            }
+        }
+    }
+
+    /// Maximizes `V` at `L = target` from the current rings: a Newton step on the KKT system
+    /// whose Hessian is shifted until its reduced form is negative definite (so every step is
+    /// an ascent direction, never towards a saddle), a line search on `V` after restoring the
+    /// length, and release of held rings that want to grow. `Err` names the failure; the caller
+    /// then takes a shorter length step.
+    pub(super) fn solve(
+        &mut self,
+        geom: &ShapeGeometry,
+        target: f64,
+    ) -> Result<PathPoint, &'static str> {
+        let rings = self.radii.len();
+        let r_min = geom.min_radius;
+        let r_ceiling = geom.radius_ceiling();
+        let s_row = geom.row_strand_length;
+        let step_cap = 0.05 * s_row;
+        let (_, mut volume) = self.restore_length(geom, target).ok_or("restore")?;
+        let mut quiet = 0;
+        let mut stalled = false;
+        let mut releases = vec![0u8; rings];
+        let mut last_mu = 0.0;
+        for _it in 0..MAX_NEWTON * MAX_ACTIVE_PASSES {
+            self.assemble(geom).ok_or("assemble")?;
+            let lambda = self.multiplier().ok_or("multiplier")?;
+            self.lambda = lambda;
+            let mut res = 0.0f64;
+            for j in 0..rings {
+                if !self.held[j] {
+                    res = res.max((self.gv[j] - lambda * self.gl[j]).abs());
+                }
+            }
+            // Held rings that want to grow (KKT sign) are released one at a time, once the free
+            // rings are converged or the ascent has stalled.
+            let grad_tol = 1e-10 * s_row * s_row;
+            // Near a symmetric saddle of the pocket's lattice position the shifted steps crawl;
+            // a residual this small changes the volume by far less than roundoff of the table.
+            let saddle_ok = last_mu > 0.0 && res <= 1e3 * grad_tol;
+            if res <= grad_tol || stalled || saddle_ok {
+                if stalled && res > 1e-7 * s_row * s_row {
+                    return Err("line search");
+                }
+                stalled = false;
+                quiet = 0;
+                let mut release = None;
+                let mut worst = grad_tol;
+                for j in 1..rings - 1 {
+                    let grow = self.gv[j] - lambda * self.gl[j];
+                    // A ring that keeps falling back to the floor is left there (bounded work).
+                    if self.held[j] && grow > worst && releases[j] < 3 {
+                        worst = grow;
+                        release = Some(j);
+                    }
+                }
+                match release {
+                    Some(j) => {
+                        self.held[j] = false;
+                        releases[j] += 1;
+                        let twin = rings - 1 - j;
+                        if twin != 0 && twin != rings - 1 && twin != j {
+                            self.held[twin] = false;
+                            releases[twin] += 1;
+                        }
+                        continue;
+                    }
+                    None => {
+                        let curvature = self.sensitivity(geom).ok_or("sensitivity")?;
+                        let (length, _) = geom.length_and_volume(&self.radii).ok_or("segment")?;
+                        let max_radius = self.radii.iter().cloned().fold(r_min, f64::max);
+                        return Ok(PathPoint {
+                            length,
+                            volume,
+                            slope: lambda,
+                            curvature,
+                            max_radius,
+                        });
+                    }
+                }
+            }
+            // Inertia-corrected bordered Newton step (tangent to the length constraint).
+            let mut mu = 0.0;
+            let mut step_ok = false;
+            for _ in 0..80 {
+                if let Some(pos) = self.shifted_solve(lambda, mu) {
+                    let mut gx = 0.0;
+                    let mut gy = 0.0;
+                    for j in 0..rings {
+                        if !self.held[j] {
+                            gx += self.gl[j] * self.x[j];
+                            gy += self.gl[j] * self.y[j];
+                        }
+                    }
+                    // Positive eigenvalues of the bordered matrix: pos(H) + [g' H^-1 g < 0];
+                    // exactly one means the reduced Hessian is negative definite.
+                    let bordered_pos = pos + usize::from(gy < 0.0);
+                    if bordered_pos == 1 && gy != 0.0 {
+                        let dlam = gx / gy;
+                        for j in 0..rings {
+                            self.x[j] = -self.x[j] + dlam * self.y[j];
+                        }
+                        step_ok = true;
+                        break;
+                    }
+                }
+                mu = if mu == 0.0 {
+                    1e-8 * s_row.max(1e-300)
+                } else {
+                    mu * 4.0
+                };
+            }
+            if !step_ok {
+                return Err("inertia");
+            }
+            last_mu = mu;
+            let max_step = self.x.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if !max_step.is_finite() {
+                return Err("nonfinite");
+            }
+            let mut alpha = if max_step > step_cap {
+                step_cap / max_step
+            } else {
+                1.0
+            };
+            let base = self.radii.clone();
+            let base_held = self.held.clone();
+            let mut accepted = false;
+            for _ in 0..40 {
+                for j in 0..rings {
+                    self.radii[j] = if self.held[j] {
+                        base[j]
+                    } else {
+                        (base[j] + alpha * self.x[j]).clamp(r_min, r_ceiling)
+                    };
+                }
+                self.hold_touching(r_min);
+                if let Some((_, v)) = self.restore_length(geom, target) {
+                    if v >= volume - 1e-15 * volume.abs() {
+                        accepted = true;
+                        let gain = v - volume;
+                        volume = v;
+                        if gain <= 1e-15 * v.abs() {
+                            quiet += 1;
+                        } else {
+                            quiet = 0;
+                        }
+                        break;
+                    }
+                }
+                self.radii.copy_from_slice(&base);
+                self.held.copy_from_slice(&base_held);
+                alpha *= 0.5;
+            }
+            if !accepted || quiet > 5 {
+                // No further ascent at this residual: roundoff floor, go to the release check.
+                stalled = true;
+            }
+        }
+        Err("iteration cap")
+    }
+
+    /// `d lambda / dL = d2V/dL2` at a converged point (implicit function theorem on the KKT
+    /// system: `H dr = g dlambda`, `g . dr = 1`); leaves `dr/dL` in `y`.
+    pub(super) fn sensitivity(&mut self, geom: &ShapeGeometry) -> Option<f64> {
+        self.assemble(geom)?;
+        let lambda = self.multiplier()?;
+        self.shifted_solve(lambda, 0.0)?;
+        let gy: f64 = (0..self.radii.len())
+            .filter(|&j| !self.held[j])
+            .map(|j| self.gl[j] * self.y[j])
+            .sum();
+        if !(gy.abs() > 0.0) {
+            return None;
+        }
+        let dlam = 1.0 / gy;
+        for yj in self.y.iter_mut() {
+            *yj *= dlam;
+        }
+        dlam.is_finite().then_some(dlam)
+    }
+
+    /// Frees every interior ring just above the minimum radius (the dissertation's uniform raise).
+    pub(super) fn seed_uniform(&mut self, geom: &ShapeGeometry) {
+        let rings = self.radii.len();
+        for j in 1..rings - 1 {
+            self.radii[j] = geom.min_radius * (1.0 + 1e-9);
+            self.held[j] = false;
+        }
+        self.lambda = 0.0;
+    }
+
+    /// Seeds a small centred pocket of length deficit `deficit` (section 1.3.5: the instability
+    /// nucleates a pocket of finite width; near onset its profile is one period of a cosine).
+    pub(super) fn seed_pocket(&mut self, geom: &ShapeGeometry, deficit: f64) {
+        let m = geom.stitches_per_row;
+        let s = geom.row_strand_length;
+        let r = geom.min_radius;
+        let n = geom.rows;
+        // Small-amplitude period (rows) of the first integral of the continuum problem.
+        let denom = PI * (s - 6.0 * PI * r);
+        let period = if denom > 0.0 {
+            2.0 * PI * m * (2.0 * r / denom).sqrt()
+        } else {
+            n
+        };
+        let period = period.clamp(2.0 * geom.rows_per_segment(), n);
+        let amplitude = deficit * m / (PI * period);
+        let k = geom.rows_per_segment();
+        let rings = self.radii.len();
+        let centre = 0.5 * n;
+        for j in 0..rings {
+            let pos = j as f64 * k - centre;
+            let inside = pos.abs() < 0.5 * period && j > 0 && j < rings - 1;
+            self.radii[j] = if inside {
+                r + amplitude * (1.0 + (2.0 * PI * pos / period).cos())
+            } else {
+                r
+            };
+            self.held[j] = !inside;
+        }
+        self.lambda = 3.0 * PI * r * r - r * s;
+    }
+}

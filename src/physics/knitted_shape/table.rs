@@ -1,0 +1,300 @@
+//! The volume-length table read per step, and the path that builds it.
+
+// `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+use super::geometry::ShapeGeometry;
+use super::solver::{PathPoint, Solver, MAX_SUBSTEP_HALVINGS};
+use std::f64::consts::PI;
+
+/// Volume-length curve of the non-cylindrical sleeve, built once per parameter set and read per
+/// step. Nodes are uniform in length from `max_length` downward.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+pub struct ShapeTable {
+    pub(super) geometry: ShapeGeometry,
+    /// Node spacing (m); node `i` is at `max_length - i * spacing`.
+    pub(super) spacing: f64,
+    pub(super) max_length: f64,
+    /// Per node: volume (m^3), `dV/dL` (m^2), `d2V/dL2` (m), largest radius (m).
+    pub(super) volume: Vec<f64>,
+    pub(super) slope: Vec<f64>,
+    pub(super) curvature: Vec<f64>,
+    pub(super) max_radius: Vec<f64>,
+}
+
+/// Table nodes used by [`ShapeTable::build`] over the stroke.
+pub const DEFAULT_TABLE_NODES: usize = 160;
+
+impl ShapeTable {
+    /// Follows the volume maximum from full extension (all rings at `r_min`, the cylinder's
+    /// volume and slope) down to `end_length` (clamped to the reachable range) with `nodes`
+    /// uniform steps, sub-stepping when Newton struggles. The path ends early, with a shorter
+    /// table, if the maximum cannot be followed further; `Err` if not even one step succeeds.
+    pub fn build(geometry: ShapeGeometry, end_length: f64, nodes: usize) -> Result<Self, String> {
+        let mut solver = Solver::new(&geometry);
+        let pts = follow_path(&geometry, &mut solver, end_length, nodes, None)?;
+        let max_length = geometry.max_length();
+        let spacing = if pts.len() > 1 {
+            (max_length - pts[pts.len() - 1].length) / (pts.len() - 1) as f64
+        } else {
+            0.0
+        };
+        Ok(Self {
+            geometry,
+            spacing,
+            max_length,
+            volume: pts.iter().map(|p| p.volume).collect(),
+            slope: pts.iter().map(|p| p.slope).collect(),
+            curvature: pts.iter().map(|p| p.curvature).collect(),
+            max_radius: pts.iter().map(|p| p.max_radius).collect(),
+        })
+    }
+
+    pub fn geometry(&self) -> &ShapeGeometry {
+        &self.geometry
+    }
+
+    /// Full extension (m).
+    pub fn max_length(&self) -> f64 {
+        self.max_length
+    }
+
+    /// Shortest tabulated length (m).
+    pub fn min_length(&self) -> f64 {
+        self.max_length - self.spacing * (self.volume.len().saturating_sub(1)) as f64
+    }
+
+    /// Node lengths, longest first.
+    pub fn lengths(&self) -> impl Iterator<Item = f64> + '_ {
+        (0..self.volume.len()).map(|i| self.max_length - i as f64 * self.spacing)
+    }
+
+    /// Interval index and local coordinate for a length, clamped into the table.
+    #[inline]
+    fn locate(&self, length: f64) -> (usize, f64) {
+        let last = self.volume.len().saturating_sub(1);
+        if last == 0 || !(self.spacing > 0.0) {
+            return (0, 0.0);
+        }
+        let u = ((self.max_length - length) / self.spacing).clamp(0.0, last as f64);
+        let i = (u.floor() as usize).min(last - 1);
+        (i, u - i as f64)
+    }
+
+    /// Quintic Hermite on one interval from node values, slopes and curvatures: exact data at
+    /// the nodes and C2 between intervals. Hand-written for speed on the per-step path.
+    /// Returns `(V, dV/dL, d2V/dL2)`.
+    #[inline]
+    pub fn evaluate(&self, length: f64) -> (f64, f64, f64) {
+        let (i, t) = self.locate(length);
+        if self.volume.len() < 2 {
+            let v = self.volume.first().copied().unwrap_or(0.0);
+            let s = self.slope.first().copied().unwrap_or(0.0);
+            let c = self.curvature.first().copied().unwrap_or(0.0);
+            return (v, s, c);
+        }
+        // Local variable runs with t; length decreases, so x-derivatives carry h = -spacing.
+        let h = -self.spacing;
+        let (y0, y1) = (self.volume[i], self.volume[i + 1]);
+        let d0 = h * self.slope[i];
+        let d1 = h * self.slope[i + 1];
+        let a0 = h * h * self.curvature[i];
+        let a1 = h * h * self.curvature[i + 1];
+        let delta = y1 - y0;
+        let c2 = 0.5 * a0;
+        let c3 = 10.0 * delta - 6.0 * d0 - 4.0 * d1 - 1.5 * a0 + 0.5 * a1;
+        let c4 = -15.0 * delta + 8.0 * d0 + 7.0 * d1 + 1.5 * a0 - a1;
+        let c5 = 6.0 * delta - 3.0 * d0 - 3.0 * d1 - 0.5 * a0 + 0.5 * a1;
+        let p = y0 + t * (d0 + t * (c2 + t * (c3 + t * (c4 + t * c5))));
+        let dp = d0 + t * (2.0 * c2 + t * (3.0 * c3 + t * (4.0 * c4 + t * 5.0 * c5)));
+        let ddp = 2.0 * c2 + t * (6.0 * c3 + t * (12.0 * c4 + t * 20.0 * c5));
+        (p, dp / h, ddp / (h * h))
+    }
+
+    /// Largest ring radius at a length (m), linear between nodes.
+    pub fn max_radius(&self, length: f64) -> f64 {
+        let (i, t) = self.locate(length);
+        match (self.max_radius.get(i), self.max_radius.get(i + 1)) {
+            (Some(a), Some(b)) => a + t * (b - a),
+            (Some(a), None) => *a,
+            _ => self.geometry.min_radius,
+        }
+    }
+
+    /// Length of largest volume (zero force) if the table reaches it (m).
+    pub fn free_contraction_length(&self) -> Option<f64> {
+        let lengths: Vec<f64> = self.lengths().collect();
+        for i in 0..self.slope.len().saturating_sub(1) {
+            let (s0, s1) = (self.slope[i], self.slope[i + 1]);
+            if s0 < 0.0 && s1 >= 0.0 {
+                // Refine on the interpolant by bisection (capped).
+                let (mut hi, mut lo) = (lengths[i], lengths[i + 1]);
+                for _ in 0..60 {
+                    let mid = 0.5 * (hi + lo);
+                    if self.evaluate(mid).1 < 0.0 {
+                        hi = mid;
+                    } else {
+                        lo = mid;
+                    }
+                }
+                return Some(0.5 * (hi + lo));
+            }
+        }
+        None
+    }
+
+    /// Ring profile at a length: `(axial position from one clamp, radius)` pairs, in metres.
+    /// Re-follows the path from full extension (cost of one table build), for plots.
+    pub fn profile(&self, length: f64) -> Result<Vec<(f64, f64)>, String> {
+        if !length.is_finite() {
+            return Err(format!("length must be finite, got {length}"));
+        }
+        let length = length.clamp(self.min_length(), self.max_length);
+        let mut solver = Solver::new(&self.geometry);
+        let nodes = self.volume.len().saturating_sub(1).max(1);
+        follow_path(&self.geometry, &mut solver, length, nodes, Some(length))?;
+        let mut out = Vec::with_capacity(solver.radii.len());
+        let mut z = 0.0;
+        out.push((0.0, solver.radii[0]));
+        for pair in solver.radii.windows(2) {
+            let seg = self
+                .geometry
+                .segment(pair[0], pair[1])
+                .ok_or("profile: a segment does not close")?;
+            z += seg.l;
+            out.push((z, pair[1]));
+        }
+        Ok(out)
+    }
+}
+
+/// Follows the maximum from full extension to `end_length` in uniform steps of
+/// `(max - end) / nodes`, or in steps of the same size up to `stop_at` if given (the last step
+/// lands on it). Returns the converged nodes, full extension first.
+fn follow_path(
+    geom: &ShapeGeometry,
+    solver: &mut Solver,
+    end_length: f64,
+    nodes: usize,
+    stop_at: Option<f64>,
+) -> Result<Vec<PathPoint>, String> {
+    let l_max = geom.max_length();
+    let r = geom.min_radius;
+    let s = geom.row_strand_length;
+    let end = end_length.clamp(0.0, l_max);
+    let nodes = nodes.clamp(2, 100_000);
+    let step = (l_max - end) / nodes as f64;
+    let mut pts = Vec::with_capacity(nodes + 1);
+    // Full extension: the cylinder at r_min (eq. 1.5-1.7 with r = r_min).
+    pts.push(PathPoint {
+        length: l_max,
+        volume: PI * r * r * l_max,
+        slope: 3.0 * PI * r * r - r * s,
+        curvature: 0.0,
+        max_radius: r,
+    });
+    if !(step > 0.0) {
+        return Ok(pts);
+    }
+    let mut current = l_max;
+    let mut started = false;
+    let targets: Vec<f64> = match stop_at {
+        Some(stop) => {
+            let k = ((l_max - stop) / step).ceil().max(0.0) as usize;
+            (1..=k)
+                .map(|i| (l_max - i as f64 * step).max(stop))
+                .collect()
+        }
+        None => (1..=nodes).map(|i| l_max - i as f64 * step).collect(),
+    };
+    'nodes: for &target in &targets {
+        let mut sub = target - current;
+        let mut halvings = 0;
+        while current > target {
+            let aim = (current + sub).max(target);
+            let backup = solver.clone();
+            if !started {
+                solver.seed_pocket(geom, l_max - aim);
+            } else if let Some(last) = pts.last().filter(|p| p.curvature.is_finite()) {
+                // First-order predictor along dr/dL (left in y by the last sensitivity solve).
+                let dl = aim - current;
+                for j in 0..solver.radii.len() {
+                    if !solver.held[j] {
+                        solver.radii[j] = (solver.radii[j] + solver.y[j] * dl).max(geom.min_radius);
+                    }
+                }
+                solver.lambda += last.curvature * dl;
+            }
+            let outcome = if started {
+                solver.solve(geom, aim)
+            } else {
+                // Nucleation: try a centred pocket and a near-uniform bulge; keep the larger
+                // volume (both are local maxima reached by ascent).
+                let pocket = solver.solve(geom, aim);
+                let mut bulge_solver = backup.clone();
+                bulge_solver.seed_uniform(geom);
+                let bulge = bulge_solver.solve(geom, aim);
+                match (pocket, bulge) {
+                    (Ok(p), Ok(b)) if b.volume > p.volume => {
+                        *solver = bulge_solver;
+                        Ok(b)
+                    }
+                    (Err(_), Ok(b)) => {
+                        *solver = bulge_solver;
+                        Ok(b)
+                    }
+                    (p, _) => p,
+                }
+            };
+            match outcome {
+                Ok(p) => {
+                    current = aim;
+                    started = true;
+                    if current <= target {
+                        pts.push(p);
+                    }
+                }
+                Err(_why) => {
+                    *solver = backup;
+                    halvings += 1;
+                    if halvings > MAX_SUBSTEP_HALVINGS {
+                        break 'nodes;
+                    }
+                    sub *= 0.5;
+                }
+            }
+        }
+    }
+    if pts.len() < 2 {
+        return Err(
+            "non-cylindrical shape: the volume maximum could not be followed from full \
+                    extension"
+                .to_string(),
+        );
+    }
+    // Full extension's curvature: the right-hand limit, from a pocket solved just below it
+    // (falls back to the secant through the first node).
+    let probe_length = l_max - 1e-3 * step;
+    let mut probe = Solver::new(geom);
+    probe.seed_pocket(geom, l_max - probe_length);
+    let probe_point = probe.solve(geom, probe_length).ok();
+    let mut bulge = Solver::new(geom);
+    bulge.seed_uniform(geom);
+    let bulge_point = bulge.solve(geom, probe_length).ok();
+    let best = match (probe_point, bulge_point) {
+        (Some(a), Some(b)) => Some(if b.volume > a.volume { b } else { a }),
+        (a, b) => a.or(b),
+    };
+    pts[0].curvature = match best {
+        Some(p) if p.curvature.is_finite() => p.curvature,
+        _ => {
+            let p1 = pts[1];
+            let c0 = 2.0 * (p1.slope - pts[0].slope) / (p1.length - pts[0].length) - p1.curvature;
+            if c0.is_finite() {
+                c0
+            } else {
+                p1.curvature
+            }
+        }
+    };
+    Ok(pts)
+}
