@@ -4,9 +4,9 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
-SOURCES := $(shell find src modelDescription -type f) Cargo.toml build.rs
+SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps py-deps scene-schema
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized py-deps scene-schema
 
 all: fmus
 
@@ -25,8 +25,8 @@ deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libclang-dev; \
 	fi
 
-## Debian packages the FMPy suite needs: libtbb12 for ecospy's native library
-## (recipes/importers_ssp_libcosim_ecos.py) and chromium for the FMU pages' screenshot test.
+## Debian packages the FMPy suite needs: chromium for the FMU pages' screenshot test
+## (tests/fmpy/test_fmu_pages.py) and libtbb12 for ecospy (recipes/importers_ssp_libcosim_ecos.py).
 py-deps:
 	@missing=""; \
 	ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12' || missing="$$missing libtbb12"; \
@@ -38,12 +38,42 @@ py-deps:
 	    --no-install-recommends $$missing; \
 	fi
 
-$(LIB) target/release/package_fmus: $(SOURCES)
-	cargo build --release --lib --bin package_fmus
+$(LIB) target/release/package_fmus target/release/calibrate: $(SOURCES)
+	cargo build --release --lib -p actuator-fmus
+	cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
 
-## target/fmu/<Model>.fmu for every model in modelDescription/.
-fmus: $(LIB) target/release/package_fmus
-	target/release/package_fmus $(LIB) target/fmu
+## Cross toolchains for the win64 and aarch64-linux binaries, and the emulators the tests run them
+## under (wine, qemu-user); each installed only when missing.
+CROSS_DEBS := gcc-mingw-w64-x86-64 gcc-aarch64-linux-gnu libc6-dev-arm64-cross qemu-user wine64
+CROSS_TARGETS := x86_64-pc-windows-gnu aarch64-unknown-linux-gnu
+cross-deps:
+	@missing=$$(for p in $(CROSS_DEBS); do dpkg -s $$p >/dev/null 2>&1 || echo $$p; done); \
+	if [ -n "$$missing" ]; then \
+	  echo "installing $$missing (cross builds and their emulators)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq --no-install-recommends $$missing; \
+	fi
+	@installed=$$(rustup target list --installed); for t in $(CROSS_TARGETS); do \
+	  echo "$$installed" | grep -qx $$t || rustup target add $$t; done
+
+WIN_DLL := target/x86_64-pc-windows-gnu/release/actuator_fmus.dll
+ARM_SO := target/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
+
+$(WIN_DLL): $(SOURCES) | cross-deps
+	cargo build --release --lib --target x86_64-pc-windows-gnu
+
+$(ARM_SO): $(SOURCES) | cross-deps
+	cargo build --release --lib --target aarch64-unknown-linux-gnu
+
+## target/fmu/<Model>.fmu for every model in modelDescription/, with binaries for linux64, win64 and
+## aarch64-linux (`make fmus CROSS=0`: linux64 only, no cross toolchains needed).
+CROSS ?= 1
+ifeq ($(CROSS),1)
+CROSS_BINARIES := $(WIN_DLL) $(ARM_SO)
+CROSS_ARGS := win64=$(WIN_DLL) aarch64-linux=$(ARM_SO)
+endif
+fmus: $(LIB) target/release/package_fmus $(CROSS_BINARIES)
+	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
 
 DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
 
@@ -53,7 +83,7 @@ demo: fmus $(VENV)/.installed
 
 ## scenes/schema/scene.schema.json, the JSON Schema of scene files, from the Rust types in src/scene.rs.
 scene-schema:
-	cargo run --release --quiet --example run_scene -- --schema > scenes/schema/scene.schema.json
+	cargo run --release --quiet -p actuator-fmus-tools --example run_scene -- --schema > scenes/schema/scene.schema.json
 
 ## Any scene: make scene SCENE=scenes/<name>.json
 scene: fmus $(VENV)/.installed
@@ -63,10 +93,35 @@ scene: fmus $(VENV)/.installed
 figures: fmus $(VENV)/.installed
 	$(PY) scenes/catalogue.py
 
-test-rust: deps fmus
-	cargo test --release
+## Fits McKibbenMuscle to a datasheet (CSV pressure_kpa,contraction,force_n) with the FMU's own
+## physics, checks the result through the FMU: OUT/{params.json,params.ssv,report.md,fit.png}.
+## STARTS: starting points of the search (fewer is faster, e.g. 4 in the tests).
+DATA ?= data/festo/festo_dmsp40.csv
+LENGTH ?= 0.4
+DIAMETER ?= 0.04
+FIT ?= 0,600
+OUT ?= out/calibrate
+STARTS ?= 24
+calibrate: fmus target/release/calibrate $(VENV)/.installed
+	$(PY) calibration/calibrate.py $(DATA) $(LENGTH) $(DIAMETER) $(FIT) $(OUT) $(STARTS)
 
-test-fmpy: fmus $(VENV)/.installed py-deps
+## The Festo presets' fits (src/physics/festo.rs) and their reports: docs/calibration/dmsp{40,10}/.
+calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
+	$(PY) calibration/calibrate.py data/festo/festo_dmsp40.csv 0.4 0.04 0,600 docs/calibration/dmsp40
+	$(PY) calibration/calibrate.py data/festo/festo_dmsp10.csv 0.25 0.01 0,600 docs/calibration/dmsp10
+
+test-rust: deps fmus
+	cargo test --release --workspace
+
+## ecos (ecospy, tests/fmpy/test_interop.py) needs Debian's libtbb12.
+interop-deps:
+	@if ! ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12'; then \
+	  echo "installing libtbb12 (needed by ecospy)"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libtbb12; \
+	fi
+
+test-fmpy: fmus $(VENV)/.installed interop-deps py-deps
 	$(PY) -m pytest tests/fmpy -q
 
 ## All Rust tests and the FMPy suite.
@@ -76,6 +131,7 @@ test: test-rust test-fmpy
 bench: deps fmus
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
+	cargo bench --bench directional_derivative
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
@@ -83,9 +139,24 @@ report: deps fmus $(VENV)/.installed
 	cargo bench --bench accuracy_cost
 	$(PY) benches/report.py
 
+## docs/linearized-muscle.md: stiffness dF/dL and pressure gain dF/dP over the stroke of Table 2.1's
+## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
+linearized: fmus $(VENV)/.installed
+	$(PY) docs/linearized/generate.py > /dev/null
+
 clean:
 	cargo clean
 	rm -rf out $(VENV)
+
+## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
+## densities, strain drive and onion reorientation of the MultiferroicMotor FMU (issue 16).
+motor-docs: fmus $(VENV)/.installed
+	$(PY) examples/motor_characteristics.py
+
+## docs/knitted-bag.md and docs/img/knitted_bag.png: the section 1.4 prototype's polyethylene bag
+## and its stroke against the measured 42% and 51% (issue 16).
+knitted-bag-docs: fmus $(VENV)/.installed
+	$(PY) examples/knitted_bag.py
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
@@ -97,7 +168,7 @@ robot-joint: deps fmus $(VENV)/.installed
 ## docs/fmu/<Model>.png, then the FMUs again so that each documentation/ carries its plot.
 crosscheck: fmus $(VENV)/.installed
 	$(PY) crosscheck/generate.py
-	target/release/package_fmus $(LIB) target/fmu
+	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
 
 ## The robot joint as a system: out/systems/RobotJoint.ssp (fmpy simulate_ssp) and the container
 ## FMU out/systems/RobotJoint.fmu (fmu-manipulation-toolbox), both run and plotted against the

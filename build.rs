@@ -4,7 +4,7 @@
 //!   `<LogCategories>`, ModelStructure indices and GUID added (`build/model_description.rs`);
 //! - `model_tables.rs`: value references, metadata and the typed `Parameters`, `Inputs`,
 //!   `Outputs` and `CalculatedParameters` of each model (included by `src/variables.rs`);
-//! - `model_bindings.rs`: the export layer's copies between its value arrays and those structs,
+//! - `model_bindings.rs`: the export layer's access to those structs' fields by value reference,
 //!   and the registry of models (included by `src/fmi2/registry.rs`).
 //!
 //! The XML is the single source of truth: a renamed or removed variable breaks the model code at
@@ -20,8 +20,12 @@ use std::path::Path;
 
 fn main() {
     // A cdylib whose thread-local destructors outlive dlclose crashes the host at thread exit
-    // (rust-lang/rust#91979): never unload the code.
-    println!("cargo:rustc-cdylib-link-arg=-Wl,-z,nodelete");
+    // (rust-lang/rust#91979): never unload the code. `-z` is an ELF linker option (mingw's ld
+    // refuses it; a Windows DLL has no such problem).
+    let target_os = std::env::var("CARGO_CFG_TARGET_OS").unwrap_or_default();
+    if target_os != "windows" && target_os != "macos" {
+        println!("cargo:rustc-cdylib-link-arg=-Wl,-z,nodelete");
+    }
     println!("cargo:rerun-if-changed=modelDescription");
     println!("cargo:rerun-if-changed=build");
 
@@ -55,7 +59,7 @@ fn main() {
             .unwrap_or_else(|e| fail(path, &e.to_string()));
         codegen::tables(&model, &xml_path.display().to_string(), &mut tables)
             .unwrap_or_else(|e| fail(path, &e));
-        codegen::bindings(&model, &mut bindings);
+        codegen::bindings(&model, &mut bindings).unwrap_or_else(|e| fail(path, &e));
         models.push(model);
     }
     codegen::registry(&models, &mut bindings);

@@ -83,6 +83,18 @@ fn configurations() -> Vec<Config> {
             ],
         ));
     }
+    for nodes in [1, 2, 4, 8, 16] {
+        c.push(config(
+            "McKibbenMuscle",
+            "bladder_continuum",
+            nodes,
+            &[
+                a[0],
+                ("bladder_model", 3.0),
+                ("bladder_layers", nodes as f64),
+            ],
+        ));
+    }
     c.push(config(
         "McKibbenMuscle",
         "friction",

@@ -2,8 +2,8 @@
 //! - `model_tables.rs`, included by `src/variables.rs`: per model, the value references, the
 //!   variable metadata and the typed `Parameters`, `Inputs`, `Outputs` and
 //!   `CalculatedParameters` structs. It names nothing above the variables module.
-//! - `model_bindings.rs`, included by `src/fmi2/registry.rs`: per model, the copies between the
-//!   export layer's value arrays and those structs, and the registry of every model.
+//! - `model_bindings.rs`, included by `src/fmi2/registry.rs`: per model, the access by value
+//!   reference to those structs' fields, and the registry of every model.
 
 use crate::model_description::{field_name, Model, Variable, TYPES};
 use std::fmt::Write as _;
@@ -170,7 +170,10 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
 
     for (name, doc, causality) in GROUPS {
         let _ = writeln!(code, "    /// {doc}");
-        let _ = writeln!(code, "    #[derive(Clone, Debug, PartialEq)]");
+        let _ = writeln!(
+            code,
+            "    #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]"
+        );
         let _ = writeln!(code, "    pub struct {name} {{");
         let members: Vec<&Variable> = model
             .variables
@@ -191,6 +194,7 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
             );
         }
         let _ = writeln!(code, "    }}");
+        let _ = writeln!(code, "    #[allow(clippy::derivable_impls)]");
         let _ = writeln!(code, "    impl Default for {name} {{");
         let _ = writeln!(code, "        fn default() -> Self {{");
         let _ = writeln!(code, "            Self {{");
@@ -221,59 +225,80 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
     Ok(())
 }
 
-/// Appends the export layer's copies between value arrays and the typed structs of `model`
-/// (`model_bindings.rs`).
-pub fn bindings(model: &Model, code: &mut String) {
-    let module = module_name(&model.name);
-    let path = format!("crate::variables::{module}");
-    let _ = writeln!(code, "impl Bindings for {path}::Variables {{");
-    for (name, _, causality) in GROUPS {
-        let members: Vec<&Variable> = model
-            .variables
-            .iter()
-            .filter(|v| v.causality == causality)
-            .collect();
-        let snake = module_name(name);
-        let _ = writeln!(code, "    #[inline]");
-        let _ = writeln!(code, "    fn {snake}(_vars: &Vars) -> {path}::{name} {{");
-        let _ = writeln!(code, "        {path}::{name} {{");
-        for v in &members {
-            let array = ARRAYS[v.type_index];
-            let read = if v.type_index == 3 {
-                format!("_vars.{array}[{}].clone()", v.value_reference)
-            } else {
-                format!("_vars.{array}[{}]", v.value_reference)
-            };
-            let _ = writeln!(code, "            {}: {read},", ident(v));
+/// The field of the export layer's `Values` that holds a variable of this causality.
+fn group(causality: &str) -> Result<&'static str, String> {
+    Ok(match causality {
+        "parameter" => "parameters",
+        "input" => "inputs",
+        "output" => "outputs",
+        "calculatedParameter" => "calculated",
+        other => {
+            return Err(format!(
+                "causality '{other}' has no typed group yet (parameter, calculatedParameter, input, output)"
+            ))
         }
+    })
+}
+
+/// Appends the export layer's access by value reference to the typed values of `model`
+/// (`model_bindings.rs`): per type, one `match` from value reference to field.
+pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
+    let module = module_name(&model.name);
+    let _ = writeln!(
+        code,
+        "#[allow(unused_variables, clippy::single_match, clippy::match_single_binding)]"
+    );
+    let _ = writeln!(
+        code,
+        "impl Bindings for crate::variables::{module}::Variables {{"
+    );
+    for (t, array) in ARRAYS.iter().enumerate() {
+        let rust = RUST_TYPES[t];
+        let (get_type, default, set_type) = match t {
+            3 => ("&str", "\"\"", "&str"),
+            _ => (rust, "Default::default()", rust),
+        };
+        let mut arms = Vec::new();
+        for v in model.variables.iter().filter(|v| v.type_index == t) {
+            arms.push((v.value_reference, group(&v.causality)?, ident(v)));
+        }
+        let _ = writeln!(code, "    #[inline]");
+        let _ = writeln!(
+            code,
+            "    fn {array}(values: &Values<Self>, vr: usize) -> {get_type} {{"
+        );
+        let _ = writeln!(code, "        match vr {{");
+        for (vr, g, f) in &arms {
+            let read = if t == 3 {
+                format!("values.{g}.{f}.as_str()")
+            } else {
+                format!("values.{g}.{f}")
+            };
+            let _ = writeln!(code, "            {vr} => {read},");
+        }
+        let _ = writeln!(code, "            _ => {default},");
         let _ = writeln!(code, "        }}");
         let _ = writeln!(code, "    }}");
         let _ = writeln!(code, "    #[inline]");
         let _ = writeln!(
             code,
-            "    fn write_{snake}(_values: &{path}::{name}, _vars: &mut Vars) {{"
+            "    fn set_{array}(values: &mut Values<Self>, vr: usize, value: {set_type}) {{"
         );
-        for v in &members {
-            let array = ARRAYS[v.type_index];
-            if v.type_index == 3 {
-                let _ = writeln!(
-                    code,
-                    "        _vars.{array}[{}].clone_from(&_values.{});",
-                    v.value_reference,
-                    ident(v)
-                );
+        let _ = writeln!(code, "        match vr {{");
+        for (vr, g, f) in &arms {
+            let write = if t == 3 {
+                format!("values.{g}.{f} = value.to_string()")
             } else {
-                let _ = writeln!(
-                    code,
-                    "        _vars.{array}[{}] = _values.{};",
-                    v.value_reference,
-                    ident(v)
-                );
-            }
+                format!("values.{g}.{f} = value")
+            };
+            let _ = writeln!(code, "            {vr} => {write},");
         }
+        let _ = writeln!(code, "            _ => {{}}");
+        let _ = writeln!(code, "        }}");
         let _ = writeln!(code, "    }}");
     }
     let _ = writeln!(code, "}}\n");
+    Ok(())
 }
 
 /// The registry: one factory per model, the model type named after the description.

@@ -12,34 +12,13 @@ use sha2::{Digest, Sha256};
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write as _;
 
+#[path = "rules.rs"]
+pub mod rules;
+
 const GUID_PLACEHOLDER: &str = "@GUID@";
 
-/// The export layer's log categories (`src/fmi2` checks `fmi2SetDebugLogging` against them).
-pub const LOG_CATEGORIES: [(&str, &str); 5] = [
-    (
-        "logStatusWarning",
-        "Warnings: inputs outside the model's range, clamped",
-    ),
-    ("logStatusDiscard", "Steps that could not be completed"),
-    (
-        "logStatusError",
-        "Errors: bad arguments, illegal call order, bad parameters",
-    ),
-    ("logStatusFatal", "Fatal errors: internal faults"),
-    ("logCalls", "Every FMI function call (debug logging)"),
-];
-
-/// The capabilities of the export layer in `src/fmi2`, the same for every model.
-const CO_SIMULATION_CAPABILITIES: &str = r#"needsExecutionTool="false"
-    canHandleVariableCommunicationStepSize="true"
-    canInterpolateInputs="false"
-    maxOutputDerivativeOrder="0"
-    canRunAsynchronuously="false"
-    canBeInstantiatedOnlyOncePerProcess="false"
-    canNotUseMemoryManagementFunctions="true"
-    canGetAndSetFMUstate="true"
-    canSerializeFMUstate="true"
-    providesDirectionalDerivative="false""#;
+// The export layer's part of every shipped description: log categories and capabilities.
+include!("export_layer.rs");
 
 #[derive(Deserialize)]
 struct ModelDescription {
@@ -274,7 +253,10 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
         }
     }
     let (outputs, initial_unknowns) = resolve_structure(&md.model_structure, &variables)?;
+    rules::check(text)?;
     let rendered = shipped(text, stem, &variables, &outputs, &initial_unknowns)?;
+    // The rules again on what ships: the export layer's part and the resolved indices included.
+    rules::check(&rendered).map_err(|e| format!("shipped description: {e}"))?;
     let guid = guid_of(&rendered);
     Ok(Model {
         name: stem.to_string(),
@@ -575,12 +557,20 @@ fn shipped(
     initial_unknowns: &[ResolvedUnknown],
 ) -> Result<String, String> {
     let s = find_splices(text)?;
+    let derivatives = PROVIDE_DIRECTIONAL_DERIVATIVE.contains(&stem);
     let mut inserts: Vec<(usize, usize, String)> = Vec::new();
     inserts.push((
         s.after_root,
         s.after_root,
         format!(
-            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}/>"
+            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->{}\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}\n    providesDirectionalDerivative=\"{derivatives}\"/>",
+            if MODEL_EXCHANGE.contains(&stem) {
+                format!(
+                    "\n  <ModelExchange\n    modelIdentifier=\"{stem}\"\n    {MODEL_EXCHANGE_CAPABILITIES}\n    providesDirectionalDerivative=\"{derivatives}\"/>"
+                )
+            } else {
+                String::new()
+            }
         ),
     ));
     let mut log = String::from("<LogCategories>\n");

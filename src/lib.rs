@@ -12,7 +12,5 @@
 
 pub mod fmi2;
 pub mod models;
-pub mod package;
 pub mod physics;
-pub mod scene;
 pub mod variables;

@@ -89,6 +89,8 @@ impl ModelInfo {
     }
 }
 
+use serde::{de::DeserializeOwned, Serialize};
+
 /// One model's typed variable groups, generated per model description as
 /// `crate::variables::<model>::Variables`. Field names are the variable names in snake case, so a
 /// renamed variable is a compile error in the model that uses it.
@@ -97,13 +99,31 @@ impl ModelInfo {
 /// further associated types, generated from `<ModelStructure><Derivatives>`.
 pub trait Interface: 'static {
     /// Parameters (fixed or tunable); `Default` gives the start values.
-    type Parameters: Clone + std::fmt::Debug + Default + PartialEq;
+    type Parameters: Clone
+        + std::fmt::Debug
+        + Default
+        + PartialEq
+        + Send
+        + Serialize
+        + DeserializeOwned;
     /// Inputs; `Default` gives the start values.
-    type Inputs: Clone + std::fmt::Debug + Default + PartialEq;
+    type Inputs: Clone + std::fmt::Debug + Default + PartialEq + Send + Serialize + DeserializeOwned;
     /// Outputs; `Default` gives zeros (or declared start values).
-    type Outputs: Clone + std::fmt::Debug + Default + PartialEq;
+    type Outputs: Clone
+        + std::fmt::Debug
+        + Default
+        + PartialEq
+        + Send
+        + Serialize
+        + DeserializeOwned;
     /// Calculated parameters, written once when the model is built.
-    type CalculatedParameters: Clone + std::fmt::Debug + Default + PartialEq;
+    type CalculatedParameters: Clone
+        + std::fmt::Debug
+        + Default
+        + PartialEq
+        + Send
+        + Serialize
+        + DeserializeOwned;
     /// Metadata of every variable.
     const INFO: &'static ModelInfo;
 }

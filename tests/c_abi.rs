@@ -5,7 +5,7 @@ mod common;
 
 use common::mckibben::*;
 use common::*;
-use std::ffi::{c_char, c_void, CStr, CString};
+use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::sync::OnceLock;
 
 const MODEL: &str = "McKibbenMuscle";
@@ -95,13 +95,14 @@ fn bad_instantiate_arguments_return_null() {
 }
 
 #[test]
-fn model_exchange_is_refused() {
+fn model_exchange_is_accepted_and_other_types_refused() {
+    assert!(api().instantiate_as("m", &guid_of(MODEL), 0).is_ok());
     let log = api()
-        .instantiate_as("m", &guid_of(MODEL), 0)
+        .instantiate_as("m", &guid_of(MODEL), 2)
         .err()
-        .expect("Co-Simulation only");
+        .expect("not an fmi2Type");
     assert!(
-        log.contains("fmuType 0 is not supported: this FMU is Co-Simulation only"),
+        log.contains("fmuType 2 is not supported: not an fmi2Type"),
         "{:?}",
         log.lines()
     );
@@ -288,35 +289,49 @@ fn vacuum_leaves_the_sleeve_unloaded() {
 }
 
 #[test]
-fn length_beyond_the_sleeve_is_clamped_with_one_warning() {
+fn length_beyond_the_sleeve_is_clamped_flagged_and_logged_once_per_excursion() {
     let i = ready();
     assert_eq!(i.set_real(&[PRESSURE, LENGTH], &[4e5, 0.2]), OK);
     let mut t = 0.0;
     for _ in 0..5 {
-        assert_eq!(i.do_step(t, 0.01), WARNING);
+        // The default out-of-range policy: strict masters see fmi2OK.
+        assert_eq!(i.do_step(t, 0.01), OK);
         t += 0.01;
         assert_eq!(i.real(FORCE), gaylord_force(4e5, B, B, N));
         assert_eq!(i.real(VOLUME), 0.0);
+        assert!(i.boolean(INPUT_CLAMPED));
     }
-    let warnings = i
-        .log
-        .lines()
-        .iter()
-        .filter(|l| l.contains("until the inputs return"))
-        .count();
-    assert_eq!(warnings, 1, "{:?}", i.log.lines());
-    assert_eq!(i.set_real(&[LENGTH], &[0.1]), OK);
-    assert_eq!(i.do_step(t, 0.01), OK);
-    assert_eq!(i.set_real(&[LENGTH], &[0.3]), OK);
-    assert_eq!(i.do_step(t + 0.01, 0.01), WARNING, "a new excursion");
-    assert_eq!(
+    let explained = |i: &Instance| {
         i.log
             .lines()
             .iter()
             .filter(|l| l.contains("until the inputs return"))
-            .count(),
-        2
-    );
+            .count()
+    };
+    assert_eq!(explained(&i), 1, "{:?}", i.log.lines());
+    assert_eq!(i.set_real(&[LENGTH], &[0.1]), OK);
+    assert_eq!(i.do_step(t, 0.01), OK);
+    assert!(!i.boolean(INPUT_CLAMPED));
+    assert_eq!(i.set_real(&[LENGTH], &[0.3]), OK);
+    assert_eq!(i.do_step(t + 0.01, 0.01), OK, "a new excursion");
+    assert_eq!(explained(&i), 2);
+}
+
+#[test]
+fn out_of_range_policy_restores_the_warning_or_discards_the_step() {
+    for (policy, expected) in [(0, OK), (1, WARNING), (2, DISCARD)] {
+        let i = instance();
+        assert_eq!(i.setup(), OK);
+        assert_eq!(i.enter(), OK);
+        assert_eq!(i.set_integer(&[OUT_OF_RANGE_POLICY], &[policy]), OK);
+        assert_eq!(i.exit(), OK);
+        assert_eq!(i.set_real(&[PRESSURE, LENGTH], &[4e5, 0.2]), OK);
+        // Outside fmi2DoStep a discard means nothing: the getter warns instead.
+        let (status, _) = i.get_real(&[FORCE]);
+        assert_eq!(status, expected.min(WARNING), "policy {policy}");
+        assert!(i.boolean(INPUT_CLAMPED));
+        assert_eq!(i.do_step(0.0, 0.01), expected, "policy {policy}");
+    }
 }
 
 #[test]
@@ -392,10 +407,6 @@ fn unsupported_functions_say_why() {
     unsafe {
         use std::ptr::{null, null_mut};
         assert_eq!(
-            (api().fmi2GetDirectionalDerivative)(i.c, null(), 0, null(), 0, null(), null_mut()),
-            ERROR
-        );
-        assert_eq!(
             (api().fmi2SetRealInputDerivatives)(i.c, null(), 0, null(), null()),
             ERROR
         );
@@ -405,10 +416,72 @@ fn unsupported_functions_say_why() {
         );
         assert_eq!((api().fmi2CancelStep)(i.c), ERROR);
     }
-    assert!(i.log.contains(
-        "fmi2GetDirectionalDerivative: not supported: providesDirectionalDerivative is false"
-    ));
     assert!(i.log.contains("fmi2CancelStep: not supported"));
+}
+
+/// `fmi2GetDirectionalDerivative` over (pressure, length) -> (force, volume).
+fn directional(i: &Instance, unknown: &[u32], known: &[u32], seed: &[f64]) -> (c_int, Vec<f64>) {
+    let mut out = vec![f64::NAN; unknown.len()];
+    let status = unsafe {
+        (api().fmi2GetDirectionalDerivative)(
+            i.c,
+            unknown.as_ptr(),
+            unknown.len(),
+            known.as_ptr(),
+            known.len(),
+            seed.as_ptr(),
+            out.as_mut_ptr(),
+        )
+    };
+    (status, out)
+}
+
+#[test]
+fn directional_derivatives_are_eq_2_3_differentiated() {
+    let i = ready();
+    let (p, l) = (3e5, 0.09);
+    assert_eq!(i.set_real(&[PRESSURE, LENGTH], &[p, l]), OK);
+    // Eq. 2.3: dF/dP = (3 L^2 - b^2)/(4 pi n^2), dF/dL = 6 P L/(4 pi n^2); eq. 2.2: dV/dL.
+    let k = 1.0 / (4.0 * std::f64::consts::PI * N * N);
+    let (status, d) = directional(&i, &[FORCE, VOLUME], &[PRESSURE, LENGTH], &[1.0, 0.0]);
+    assert_eq!(status, OK);
+    assert!((d[0] - (3.0 * l * l - B * B) * k).abs() < 1e-15, "{d:?}");
+    assert_eq!(d[1], 0.0);
+    let (status, d) = directional(&i, &[FORCE, VOLUME], &[PRESSURE, LENGTH], &[0.0, 1.0]);
+    assert_eq!(status, OK);
+    assert!((d[0] - 6.0 * p * l * k).abs() < 1e-9 * d[0], "{d:?}");
+    assert!((d[1] - (B * B - 3.0 * l * l) * k).abs() < 1e-15, "{d:?}");
+    // A seed over both inputs is the sum (linearity); the order of the knowns does not matter.
+    let (_, both) = directional(&i, &[FORCE], &[LENGTH, PRESSURE], &[2.0, 1e-3]);
+    let expected = 2.0 * 6.0 * p * l * k + 1e-3 * (3.0 * l * l - B * B) * k;
+    assert!(
+        (both[0] - expected).abs() < 1e-12 * expected.abs(),
+        "{both:?}"
+    );
+}
+
+#[test]
+fn directional_derivatives_refuse_what_they_cannot_give() {
+    let i = ready();
+    // An output as a known, an input as an unknown, an unprovided output: each refused, logged.
+    let (status, _) = directional(&i, &[FORCE], &[FORCE], &[1.0]);
+    assert_eq!(status, ERROR);
+    assert!(i
+        .log
+        .contains("force (value reference 2) is not an input of McKibbenMuscle"));
+    let (status, _) = directional(&i, &[LENGTH], &[PRESSURE], &[1.0]);
+    assert_eq!(status, ERROR);
+    assert!(i.log.contains("is not an output"));
+    let (status, _) = directional(&i, &[STIFFNESS], &[PRESSURE], &[1.0]);
+    assert_eq!(status, ERROR);
+    assert!(i
+        .log
+        .contains("the partial derivatives of stiffness are not provided"));
+    let (status, _) = directional(&i, &[FORCE], &[PRESSURE], &[f64::NAN]);
+    assert_eq!(status, ERROR);
+    assert!(i.log.contains("dvKnown must be finite"));
+    let (status, _) = directional(&i, &[999], &[PRESSURE], &[1.0]);
+    assert_eq!(status, ERROR);
 }
 
 #[test]

@@ -131,12 +131,15 @@ fn model_structure_indices_are_generated() {
     // Every output in order (FMI 2.0 section 2.2.8)...
     assert_eq!(
         indices(&m.outputs),
-        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15]
+        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 33, 47, 48, 50]
     );
     // ...and the outputs with initial calculated plus the calculated parameters, ascending.
     assert_eq!(
         indices(&m.initial_unknowns),
-        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31]
+        [
+            3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31, 33, 34, 35, 36, 37, 38, 39, 40,
+            41, 42, 43, 47, 48, 50
+        ]
     );
     assert!(m.outputs.iter().all(|u| u.dependencies.is_none()));
     let xml = &m.shipped_xml;
@@ -285,4 +288,194 @@ fn the_guid_changes_with_any_variable() {
     )
     .unwrap();
     assert_ne!(shipped.guid, renamed.guid);
+}
+
+/// The rules of `build/rules.rs` (FMI 2.0 chapter 2, after the INTO-CPS VDMCheck inventory),
+/// which build.rs runs on the source and again on the shipped description: each one refuses a
+/// shipped description that breaks it.
+mod rules {
+    use super::{check, SOURCE};
+    use crate::model_description::rules;
+
+    fn shipped() -> String {
+        check(SOURCE, "McKibbenMuscle").unwrap().shipped_xml
+    }
+
+    /// The shipped McKibbenMuscle description with `from` replaced by `to` must fail with `reason`.
+    fn broken(from: &str, to: &str, reason: &str) {
+        let xml = shipped();
+        assert!(xml.contains(from), "test edit does not apply: {from}");
+        match rules::check(&xml.replacen(from, to, 1)) {
+            Ok(()) => panic!("accepted a description that should fail with '{reason}'"),
+            Err(e) => assert!(e.contains(reason), "error '{e}' does not say '{reason}'"),
+        }
+    }
+
+    #[test]
+    fn the_shipped_descriptions_pass_every_rule() {
+        rules::check(&shipped()).unwrap();
+        assert_eq!(rules::RULES.len(), 12);
+    }
+
+    #[test]
+    fn duplicate_unit_type_and_category_names_are_refused() {
+        let unit = r#"<Unit name="m"><BaseUnit m="1"/></Unit>"#;
+        broken(unit, &format!("{unit}{unit}"), "unit 'm' is defined twice");
+        broken(
+            "<LogCategories>",
+            "<TypeDefinitions><SimpleType name=\"T\"><Real/></SimpleType>\
+             <SimpleType name=\"T\"><Real/></SimpleType></TypeDefinitions>\n  <LogCategories>",
+            "type 'T' is defined twice",
+        );
+        broken(
+            "<LogCategories>",
+            "<LogCategories><Category name=\"logCalls\"/>",
+            "log category 'logCalls' is declared twice",
+        );
+    }
+
+    #[test]
+    fn base_units_need_integer_exponents_and_a_factor() {
+        broken(
+            r#"<BaseUnit m="1"/></Unit>"#,
+            r#"<BaseUnit m="1.5"/></Unit>"#,
+            "must be an integer",
+        );
+        broken(
+            r#"<BaseUnit m="1"/></Unit>"#,
+            r#"<BaseUnit m="1" factor="0"/></Unit>"#,
+            "factor must not be zero",
+        );
+    }
+
+    #[test]
+    fn default_experiment_must_be_runnable() {
+        let experiment = r#"<DefaultExperiment startTime="0" stopTime="1" stepSize="0.001"/>"#;
+        broken(
+            experiment,
+            r#"<DefaultExperiment startTime="2" stopTime="1" stepSize="0.001"/>"#,
+            "must be after startTime",
+        );
+        broken(
+            experiment,
+            r#"<DefaultExperiment startTime="0" stopTime="1" stepSize="0"/>"#,
+            "stepSize 0 must be positive",
+        );
+        broken(
+            experiment,
+            r#"<DefaultExperiment startTime="0" stopTime="1" tolerance="-1"/>"#,
+            "tolerance -1 must be positive",
+        );
+    }
+
+    #[test]
+    fn start_must_lie_within_min_and_max() {
+        let turns = r#"min="1e-3" max="1e4" start="3.74""#;
+        broken(
+            turns,
+            r#"min="1e-3" max="1" start="3.74""#,
+            "start 3.74 is outside",
+        );
+        broken(
+            turns,
+            r#"min="10" max="1" start="3.74""#,
+            "min 10 is above max 1",
+        );
+        broken(
+            r#"<Integer min="0" max="2" start="0"/>"#,
+            r#"<Integer min="1" max="2" start="0"/>"#,
+            "start 0 is outside",
+        );
+        broken(
+            turns,
+            r#"min="1e-3" max="1e4" nominal="0" start="3.74""#,
+            "nominal 0 must be positive",
+        );
+    }
+
+    #[test]
+    fn booleans_carry_no_numeric_attributes() {
+        broken(
+            r#"<Boolean start="false"/>"#,
+            r#"<Boolean min="0" start="false"/>"#,
+            "a Boolean has no attribute min",
+        );
+    }
+
+    #[test]
+    fn boolean_attributes_are_true_or_false() {
+        broken(
+            r#"canHandleVariableCommunicationStepSize="true""#,
+            r#"canHandleVariableCommunicationStepSize="yes""#,
+            "must be 'true' or 'false'",
+        );
+    }
+
+    #[test]
+    fn structured_names_follow_the_grammar() {
+        broken(
+            r#"name="force""#,
+            r#"name="force (N)""#,
+            "structured naming convention",
+        );
+        broken(
+            r#"name="force""#,
+            r#"name="1force""#,
+            "structured naming convention",
+        );
+        // Legal structured names pass.
+        rules::check(&shipped().replacen(r#"name="force""#, r#"name="muscle.force[1]""#, 1))
+            .unwrap();
+        rules::check(&shipped().replacen(r#"name="force""#, r#"name="der(muscle.'x y', 2)""#, 1))
+            .unwrap();
+    }
+
+    #[test]
+    fn unknowns_refer_to_variables_once() {
+        broken(
+            r#"<Unknown index="3"/>"#,
+            r#"<Unknown index="99"/>"#,
+            "Unknown index 99 is not a variable",
+        );
+        broken(
+            r#"<Unknown index="4"/>"#,
+            r#"<Unknown index="3"/>"#,
+            "Unknown index 3 is listed twice",
+        );
+    }
+
+    #[test]
+    fn dependencies_are_sorted_inputs_with_one_kind_each() {
+        let force = r#"<Unknown index="3"/>"#;
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="2 1"/>"#,
+            "must be ascending and unique",
+        );
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1 4"/>"#,
+            "may not depend on 'volume'",
+        );
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent"/>"#,
+            "1 dependenciesKind for 2 dependencies",
+        );
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1" dependenciesKind="linear"/>"#,
+            "dependenciesKind 'linear' is not one of",
+        );
+        broken(
+            force,
+            r#"<Unknown index="3" dependenciesKind="dependent"/>"#,
+            "dependenciesKind without dependencies",
+        );
+        broken(
+            force,
+            r#"<Unknown index="3" dependencies="1 x"/>"#,
+            "dependencies must be indices",
+        );
+    }
 }

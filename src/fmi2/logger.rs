@@ -37,6 +37,16 @@ impl Logger {
         if status < fmi2Status::Warning && !self.debug {
             return;
         }
+        self.send(status, category, message);
+    }
+
+    /// A message the importer should see although the call succeeds (an input evaluated at the
+    /// nearest valid point under the default out-of-range policy): fmi2OK, always logged.
+    pub fn notice(&self, message: &str) {
+        self.send(fmi2Status::OK, "logStatusWarning", message);
+    }
+
+    fn send(&self, status: fmi2Status, category: &str, message: &str) {
         let Some(callback) = self.callback else {
             return;
         };

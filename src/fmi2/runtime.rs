@@ -1,45 +1,46 @@
-//! The bridge between the C ABI and any [`Model`]: one instance's variable values and model,
-//! behind a trait object so that the exported functions are written once for every model.
+//! The bridge between the C ABI and any [`Model`]: one instance's typed variable values and
+//! model, behind a trait object so that the exported functions are written once for every model.
 
 use super::registry::Bindings;
 use crate::models::{Model, Report};
-use crate::variables::{Interface, ModelInfo, Start, VarType};
+use crate::variables::{Interface, ModelInfo};
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::marker::PhantomData;
 
-/// Current values of all variables, indexed by value reference within each type: what
-/// `fmi2GetXXX`/`fmi2SetXXX` read and write. Models never see it; [`Bindings`] copy between it
-/// and their typed groups.
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-pub struct Vars {
-    pub real: Vec<f64>,
-    pub integer: Vec<i32>,
-    pub boolean: Vec<bool>,
-    pub string: Vec<String>,
+/// One instance's variable values, typed: the model's generated groups themselves. The model
+/// reads and writes these fields directly; `fmi2GetXXX`/`fmi2SetXXX` reach them by value reference
+/// through the generated [`Bindings`] (one `match` per call, no copies around a step).
+#[derive(Serialize, Deserialize)]
+#[serde(bound = "")]
+pub struct Values<V: Interface> {
+    pub parameters: V::Parameters,
+    pub inputs: V::Inputs,
+    pub outputs: V::Outputs,
+    pub calculated: V::CalculatedParameters,
 }
 
-impl Vars {
-    /// Start values from the model description; variables without one start at zero.
-    pub fn from_start(info: &ModelInfo) -> Self {
-        let [nr, ni, nb, ns] = info.counts;
-        let mut v = Vars {
-            real: vec![0.0; nr],
-            integer: vec![0; ni],
-            boolean: vec![false; nb],
-            string: vec![String::new(); ns],
-        };
-        for var in info.variables {
-            let i = var.vr as usize;
-            match (var.kind, var.start) {
-                (VarType::Real, Start::Real(x)) => v.real[i] = x,
-                (VarType::Integer, Start::Integer(x)) => v.integer[i] = x,
-                (VarType::Boolean, Start::Boolean(x)) => v.boolean[i] = x,
-                (VarType::String, Start::String(x)) => v.string[i] = x.to_string(),
-                _ => {}
-            }
+// By hand: a derive would ask `V: Clone` of the marker type.
+impl<V: Interface> Clone for Values<V> {
+    fn clone(&self) -> Self {
+        Self {
+            parameters: self.parameters.clone(),
+            inputs: self.inputs.clone(),
+            outputs: self.outputs.clone(),
+            calculated: self.calculated.clone(),
         }
-        v
+    }
+}
+
+impl<V: Interface> Default for Values<V> {
+    /// The start values of the model description.
+    fn default() -> Self {
+        Self {
+            parameters: Default::default(),
+            inputs: Default::default(),
+            outputs: Default::default(),
+            calculated: Default::default(),
+        }
     }
 }
 
@@ -49,6 +50,8 @@ pub trait Factory: Sync {
     /// HTML fragment describing the model's equations.
     fn documentation(&self) -> &'static str;
     fn create(&self) -> Box<dyn Runtime>;
+    /// Whether the model serves Model Exchange ([`Model::ALGEBRAIC_MODEL_EXCHANGE`]).
+    fn model_exchange(&self) -> bool;
 }
 
 pub struct ModelFactory<M>(PhantomData<fn() -> M>);
@@ -67,20 +70,30 @@ where
     fn documentation(&self) -> &'static str {
         M::DOCUMENTATION
     }
+    fn model_exchange(&self) -> bool {
+        M::ALGEBRAIC_MODEL_EXCHANGE
+    }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
-            vars: Vars::from_start(M::Variables::INFO),
+            values: Values::default(),
             model: None,
             outputs_stale: true,
         })
     }
 }
 
-/// One instance's variables and model, independent of the model's type.
+/// One instance's variables and model, independent of the model's type. Values are read and
+/// written by value reference (the caller checks that `vr` is one of the model's); writes are
+/// followed by [`Runtime::changed`] so that outputs and the model follow them.
 pub trait Runtime: Send {
-    fn vars(&self) -> &Vars;
-    /// Writes go through [`Runtime::changed`] so that outputs and the model follow them.
-    fn vars_mut(&mut self) -> &mut Vars;
+    fn real(&self, vr: usize) -> f64;
+    fn set_real(&mut self, vr: usize, value: f64);
+    fn integer(&self, vr: usize) -> i32;
+    fn set_integer(&mut self, vr: usize, value: i32);
+    fn boolean(&self, vr: usize) -> bool;
+    fn set_boolean(&mut self, vr: usize, value: bool);
+    fn string(&self, vr: usize) -> &str;
+    fn set_string(&mut self, vr: usize, value: &str);
     /// Tells that inputs changed (outputs are stale) or that parameters did (the model is too).
     fn changed(&mut self, parameters: bool);
     fn is_built(&self) -> bool;
@@ -89,6 +102,18 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// Model Exchange: commits the history at the current inputs (completed integrator step or
+    /// event) and writes the outputs.
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report);
+    /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
+    /// ([`super::derivatives`]).
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String>;
     /// Start values, no model.
     fn reset(&mut self);
     fn snapshot(&self) -> Box<dyn Runtime>;
@@ -99,23 +124,51 @@ pub trait Runtime: Send {
     fn as_any(&self) -> &dyn Any;
 }
 
-#[derive(Clone, Serialize, Deserialize)]
+#[derive(Serialize, Deserialize)]
 #[serde(bound = "M: Model")]
 struct RuntimeOf<M: Model> {
-    vars: Vars,
+    values: Values<M::Variables>,
     model: Option<M>,
     outputs_stale: bool,
+}
+
+impl<M: Model> Clone for RuntimeOf<M> {
+    fn clone(&self) -> Self {
+        Self {
+            values: self.values.clone(),
+            model: self.model.clone(),
+            outputs_stale: self.outputs_stale,
+        }
+    }
 }
 
 impl<M: Model> Runtime for RuntimeOf<M>
 where
     M::Variables: Bindings,
 {
-    fn vars(&self) -> &Vars {
-        &self.vars
+    fn real(&self, vr: usize) -> f64 {
+        M::Variables::real(&self.values, vr)
     }
-    fn vars_mut(&mut self) -> &mut Vars {
-        &mut self.vars
+    fn set_real(&mut self, vr: usize, value: f64) {
+        M::Variables::set_real(&mut self.values, vr, value)
+    }
+    fn integer(&self, vr: usize) -> i32 {
+        M::Variables::integer(&self.values, vr)
+    }
+    fn set_integer(&mut self, vr: usize, value: i32) {
+        M::Variables::set_integer(&mut self.values, vr, value)
+    }
+    fn boolean(&self, vr: usize) -> bool {
+        M::Variables::boolean(&self.values, vr)
+    }
+    fn set_boolean(&mut self, vr: usize, value: bool) {
+        M::Variables::set_boolean(&mut self.values, vr, value)
+    }
+    fn string(&self, vr: usize) -> &str {
+        M::Variables::string(&self.values, vr)
+    }
+    fn set_string(&mut self, vr: usize, value: &str) {
+        M::Variables::set_string(&mut self.values, vr, value)
     }
     fn changed(&mut self, parameters: bool) {
         self.outputs_stale = true;
@@ -127,34 +180,54 @@ where
         self.model.is_some()
     }
     fn build(&mut self) -> Result<(), String> {
-        let parameters = M::Variables::parameters(&self.vars);
-        let start = M::Variables::inputs(&self.vars);
-        let model = M::new(&parameters, &start).map_err(|r| r.0)?;
-        M::Variables::write_calculated_parameters(&model.calculated_parameters(), &mut self.vars);
+        let v = &mut self.values;
+        let model = M::new(&v.parameters, &v.inputs).map_err(|r| r.0)?;
+        v.calculated = model.calculated_parameters();
         self.model = Some(model);
         self.outputs_stale = true;
         Ok(())
     }
     fn refresh_outputs(&mut self, report: &mut Report) {
         if let (true, Some(model)) = (self.outputs_stale, self.model.as_mut()) {
-            let inputs = M::Variables::inputs(&self.vars);
-            let mut outputs = M::Variables::outputs(&self.vars);
-            model.evaluate(&inputs, &mut outputs, report);
-            M::Variables::write_outputs(&outputs, &mut self.vars);
+            let v = &mut self.values;
+            model.evaluate(&v.inputs, &mut v.outputs, report);
+            report.evaluated = true;
             self.outputs_stale = false;
         }
     }
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
         if let Some(model) = self.model.as_mut() {
-            let inputs = M::Variables::inputs(&self.vars);
-            let mut outputs = M::Variables::outputs(&self.vars);
-            model.step(&inputs, &mut outputs, time, step, report);
-            M::Variables::write_outputs(&outputs, &mut self.vars);
+            let v = &mut self.values;
+            model.step(&v.inputs, &mut v.outputs, time, step, report);
+            report.evaluated = true;
             self.outputs_stale = false;
         }
     }
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report) {
+        if let Some(model) = self.model.as_mut() {
+            let v = &mut self.values;
+            model.update_discrete_states(&v.inputs, &mut v.outputs, time, report);
+            self.outputs_stale = false;
+        }
+    }
+    fn directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        super::derivatives::directional_derivative(
+            self.model.as_mut(),
+            &self.values.inputs,
+            unknown,
+            known,
+            dv_known,
+            dv_unknown,
+        )
+    }
     fn reset(&mut self) {
-        self.vars = Vars::from_start(M::Variables::INFO);
+        self.values = Values::default();
         self.model = None;
         self.outputs_stale = true;
     }
@@ -175,17 +248,6 @@ where
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
         let r: Self =
             postcard::from_bytes(bytes).map_err(|e| format!("corrupt model state: {e}"))?;
-        let [nr, ni, nb, ns] = M::Variables::INFO.counts;
-        let v = &r.vars;
-        if (
-            v.real.len(),
-            v.integer.len(),
-            v.boolean.len(),
-            v.string.len(),
-        ) != (nr, ni, nb, ns)
-        {
-            return Err("the variable counts do not match this model".into());
-        }
         Ok(Box::new(r))
     }
     fn as_any(&self) -> &dyn Any {

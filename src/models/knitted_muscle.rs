@@ -4,7 +4,7 @@
 //! is built once from the parameters; the non-cylindrical volume-length table exists only when
 //! that shape is selected. Strand friction (eq. 1.21, `friction`) is the shared stop-operator
 //! hysteresis; its state is part of the FMU state and advances only in `step`. The Mooney-Rivlin
-//! bladder of the McKibben muscle (`bladder_model` 1 thin wall, 2 thick wall; section 1.3.6) is the
+//! bladder of the McKibben muscle (`bladder_model` 1 thin, 2 thick, 3 continuum wall; section 1.3.6) is the
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
@@ -13,13 +13,15 @@ use crate::physics::bladder::{
     Bladder, BladderState, BladderTube, KnittedCylinder, SleeveGeometry,
 };
 use crate::physics::friction::{HysteresisState, StopOperator};
-use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
+use crate::physics::knitted::{
+    KnittedParams, KnittedSleeve, ShapeKind, ShapeModel, StrandFriction,
+};
+use crate::physics::knitted_bag::Bag;
 use crate::physics::mckibben::BladderModel;
 use crate::variables::knitted_muscle::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
 };
 use serde::{Deserialize, Serialize};
-use std::f64::consts::SQRT_2;
 
 /// With a bladder the force grows without bound where the rubber fills the sleeve; a length beyond
 /// such a limit is evaluated this fraction of the range inside it (finite, steep force), as in
@@ -43,6 +45,8 @@ pub struct KnittedMuscle {
     valid: (f64, f64),
     /// `None` when `friction` is off.
     friction: Option<Friction>,
+    /// Section 1.4's bag, `None` when `bag_diameter` is 0.
+    bag: Option<Bag>,
     /// Friction history (eq. 1.21), advanced only by accepted steps.
     history: HysteresisState,
     /// Whether the last evaluation was outside the valid lengths: its warning is logged once per
@@ -89,10 +93,8 @@ fn bladder(
     r: &Parameters,
     sleeve: &KnittedSleeve,
 ) -> Result<Option<Bladder<KnittedCylinder>>, String> {
-    let layers = match BladderModel::from_switch(r.bladder_model, r.bladder_layers)? {
-        BladderModel::None => return Ok(None),
-        BladderModel::ThinWall => 1,
-        BladderModel::ThickWall { layers } => layers,
+    let Some(wall) = BladderModel::from_switch(r.bladder_model, r.bladder_layers)?.wall() else {
+        return Ok(None);
     };
     let tube = BladderTube {
         inner_diameter: r.bladder_inner_diameter,
@@ -101,7 +103,7 @@ fn bladder(
         mooney_c1: r.mooney_c1,
         mooney_c2: r.mooney_c2,
     };
-    Bladder::knitted(sleeve, tube, layers).map(Some)
+    Bladder::knitted_wall(sleeve, tube, wall).map(Some)
 }
 
 /// The lengths evaluated: the sleeve's closed range, or the bladder's open range pulled in by a
@@ -146,7 +148,8 @@ fn shape_kind(p: &Parameters) -> Result<ShapeKind, String> {
 impl KnittedMuscle {
     /// The physics at the current inputs; a length outside `[min_length, max_length]` is
     /// evaluated at the nearer limit, where the sleeve is rigid (logged once per excursion).
-    fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Output {
+    /// `None` when the physics refuses (logged); the outputs then keep their values.
+    fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Option<Output> {
         let (pressure, length) = (inputs.pressure, inputs.length);
         let s = &self.sleeve;
         let (lo, hi) = self.valid;
@@ -158,28 +161,24 @@ impl KnittedMuscle {
         if l == length {
             self.out_of_range = false;
         } else {
-            if !self.out_of_range {
-                report.warn(format!(
+            report.clamp(!self.out_of_range, || {
+                format!(
                     "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
                      evaluating at length {l} m until the inputs return",
                     lo, hi, self.length_range.1
-                ));
-            }
-            report.status = report.status.max(Status::Warning);
+                )
+            });
             self.out_of_range = true;
         }
         if let Some(b) = &self.bladder {
             let (out, fallback) = self.compute_with_bladder(b, pressure, l);
             if let Some(reason) = &fallback {
-                if !self.collapsed {
-                    report.warn(format!(
-                        "{reason}; evaluating at zero gauge pressure until the inputs return"
-                    ));
-                }
-                report.status = report.status.max(Status::Warning);
+                report.clamp(!self.collapsed, || {
+                    format!("{reason}; evaluating at zero gauge pressure until the inputs return")
+                });
             }
             self.collapsed = fallback.is_some();
-            return out;
+            return Some(out);
         }
         // The thin bag inside the sleeve cannot pull it inwards: a vacuum acts as zero.
         let p_eff = if pressure.is_finite() {
@@ -187,42 +186,34 @@ impl KnittedMuscle {
         } else {
             0.0
         };
-        let (volume, dv, _) = s.volume_derivatives(l);
-        let frictionless = s.force(p_eff, l);
-        let frictionless_stiffness = s.stiffness(p_eff, l);
-        let mut out = Output {
-            force: frictionless,
-            volume,
-            effective_pressure: p_eff,
-            friction_force: 0.0,
-            max_radius: s.max_radius(l),
-            stiffness: frictionless_stiffness,
-            history: self.history,
-        };
-        if let Some(f) = &self.friction {
-            let next = f.operator.advance(&self.history, l);
-            let area = s.mean_area(l);
-            let (force, friction_force) = f.strand.total_force(frictionless, p_eff, area, next.z);
-            out.force = force;
-            out.friction_force = friction_force;
-            out.history = next;
-            if friction_force != 0.0 {
-                // F = (F0 + k P A) / (1 - k), k = sqrt(2) Cf z held; A = V / L.
-                let k = SQRT_2 * f.strand.coefficient * next.z;
-                let area_slope = if l > 0.0 {
-                    (dv * l - volume) / (l * l)
-                } else {
-                    0.0
-                };
-                let stiffness = (frictionless_stiffness + k * p_eff * area_slope) / (1.0 - k);
-                out.stiffness = if stiffness.is_finite() {
-                    stiffness
-                } else {
-                    frictionless_stiffness
-                };
+        let next = self
+            .friction
+            .as_ref()
+            .map(|f| f.operator.advance(&self.history, l));
+        let friction = self
+            .friction
+            .as_ref()
+            .zip(next)
+            .map(|(f, n)| (&f.strand, n.z));
+        match s.evaluate_in_bag(p_eff, l, friction, self.bag.as_ref()) {
+            Ok(state) => Some(Output {
+                force: state.force,
+                volume: state.volume,
+                effective_pressure: p_eff,
+                friction_force: state.friction_force,
+                max_radius: state.max_radius,
+                stiffness: state.stiffness,
+                history: next.unwrap_or(self.history),
+            }),
+            Err(reason) => {
+                // Unreachable with finite inputs in range.
+                report.add(
+                    Status::Error,
+                    format!("cannot evaluate the sleeve: {reason}"),
+                );
+                None
             }
         }
-        out
     }
 
     /// Section 1.3.6: the bladder's force (eq. 2.16-2.17 with the knitted cylinder) and, with
@@ -279,23 +270,22 @@ impl KnittedMuscle {
         };
         if let Some(f) = &self.friction {
             let next = f.operator.advance(&self.history, l);
-            // F = F_0 + k T with the strand tension T = F - (F_pressure + F_elastic): eq. 1.21's
-            // `total_force` with its `P A` term set to -(F_pressure + F_elastic).
+            // Eq. 1.21 fed by the strand tension T = F - (F_pressure + F_elastic), with
+            // d(offset)/dL = F_0' - T_0'.
             let offset = state.pressure_force + state.elastic_force;
-            let (force, friction_force) = f.strand.total_force(state.force, 1.0, -offset, next.z);
-            out.force = force;
-            out.friction_force = friction_force;
-            out.history = next;
-            if friction_force != 0.0 {
-                // dF/dL = (F_0' - k offset') / (1 - k) with offset' = F_0' - T_0'.
-                let k = SQRT_2 * f.strand.coefficient * next.z;
-                let offset_slope = state.stiffness - state.strand_stiffness;
-                let stiffness = (state.stiffness - k * offset_slope) / (1.0 - k);
-                out.stiffness = if stiffness.is_finite() {
-                    stiffness
-                } else {
-                    state.stiffness
-                };
+            let offset_slope = state.stiffness - state.strand_stiffness;
+            match f
+                .strand
+                .apply(state.force, state.stiffness, -offset, -offset_slope, next.z)
+            {
+                Ok(with) => {
+                    out.force = with.force;
+                    out.friction_force = with.friction_force;
+                    out.stiffness = with.stiffness;
+                    out.history = next;
+                }
+                // Unreachable for a finite bladder state; the frictionless force stands.
+                Err(reason) => fallback = Some(format!("eq. 1.21 friction skipped: {reason}")),
             }
         }
         (out, fallback)
@@ -313,12 +303,26 @@ impl KnittedMuscle {
 
 impl Model for KnittedMuscle {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("knitted_muscle.html");
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
         let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape_kind(p)?)?;
         let bladder = bladder(p, &sleeve)?;
         let valid = valid_lengths(&sleeve, bladder.as_ref());
+        let bag = match p.bag_diameter {
+            0.0 => None,
+            diameter => {
+                if bladder.is_some() || matches!(sleeve.shape(), ShapeModel::NonCylindrical(_)) {
+                    return Err(
+                        "bag_diameter needs a cylindrical sleeve (shape_model 0 or 1) \
+                                and no rubber bladder (bladder_model 0)"
+                            .into(),
+                    );
+                }
+                Some(Bag::new(diameter, p.bag_membrane_stiffness)?)
+            }
+        };
         let friction = if p.friction {
             Some(Friction {
                 strand: StrandFriction::new(p.friction_coefficient)?,
@@ -343,6 +347,7 @@ impl Model for KnittedMuscle {
             bladder,
             valid,
             friction,
+            bag,
             history,
             out_of_range: false,
             collapsed: false,
@@ -359,8 +364,9 @@ impl Model for KnittedMuscle {
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
-        let out = self.compute(inputs, report);
-        Self::write(outputs, &out);
+        if let Some(out) = self.compute(inputs, report) {
+            Self::write(outputs, &out);
+        }
     }
 
     fn step(
@@ -373,15 +379,18 @@ impl Model for KnittedMuscle {
     ) {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
-        let out = self.compute(inputs, report);
-        Self::write(outputs, &out);
-        self.history = out.history;
+        if let Some(out) = self.compute(inputs, report) {
+            Self::write(outputs, &out);
+            self.history = out.history;
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::models::Status;
+    use std::f64::consts::SQRT_2;
 
     fn parameters_with(shape: i32, friction: bool) -> Parameters {
         Parameters {
@@ -434,8 +443,9 @@ mod tests {
             let mut report = Report::default();
             inputs.length = length;
             m.evaluate(&inputs, &mut out, &mut report);
-            warned += report.messages.len();
-            assert_eq!(report.status > Status::Ok, !(lo..=hi).contains(&length));
+            warned += report.clamp_messages.len();
+            assert_eq!(report.status, Status::Ok);
+            assert_eq!(report.clamped, !(lo..=hi).contains(&length));
             if length > hi {
                 assert_eq!(out.force, at_limit.force);
             }

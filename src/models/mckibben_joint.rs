@@ -5,12 +5,16 @@
 //! Both muscles are [`McKibben`] physics instances built from the same parameters as the
 //! McKibbenMuscle FMU; the flexor's length is `L0f - r q`, the extensor's `L0e + r q`, so the
 //! torque `r (F_flexor - F_extensor)` turns the joint towards the flexor. `actuatorInput` is the
-//! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`.
+//! pressure difference around the common mode, each pressure saturated to `0 .. max_pressure`;
+//! with `command_mode` 1 it is a joint torque, met by solving for that difference through the same
+//! muscle physics ([`crate::physics::inverse::difference_for_torque`]).
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
+use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
+use crate::physics::inverse::{difference_for_torque, pair_pressures};
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
 };
@@ -39,6 +43,8 @@ pub struct McKibbenJoint {
     out_of_range: bool,
     /// Joint angles that keep both muscles inside their length range (rad).
     position_range: (f64, f64),
+    /// `actuatorInput` is a joint torque (N m) to meet, not a pressure difference (Pa).
+    torque_command: bool,
 }
 
 /// Both muscles' operating point at the current inputs.
@@ -47,11 +53,13 @@ struct Pair {
     extensor: McKibbenOutput,
     pressures: [f64; 2],
     lengths: [f64; 2],
+    /// Command mode 1: the commanded torque was out of reach.
+    saturated: bool,
 }
 
 fn muscle(p: &Parameters) -> Result<McKibben, String> {
     let model = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?;
-    let friction = p.friction.then(|| FrictionParams {
+    let friction = p.friction.then_some(FrictionParams {
         coefficient: p.friction_coefficient,
         presliding_length: p.presliding_length,
     });
@@ -74,8 +82,25 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
                 .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
             McKibben::from_geometry(&geometry, model, friction, 0.0)
         }
+        // The Festo muscles fitted to their datasheets carry their own rubber and thin wall.
+        k @ 5..=6 => {
+            let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
+            McKibben::new(
+                Sleeve::new(festo.strand_length, festo.turns)?,
+                BladderTube {
+                    inner_diameter: festo.bladder_inner_diameter,
+                    thickness: festo.bladder_thickness,
+                    unstretched_length: festo.bladder_length,
+                    mooney_c1: festo.mooney_c1,
+                    mooney_c2: festo.mooney_c2,
+                },
+                BladderModel::from_switch(festo.bladder_model, festo.bladder_layers)?,
+                friction,
+                0.0,
+            )
+        }
         k => Err(format!(
-            "preset must be 0 (none) or 1-4 (Table 2.1 A-D), got {k}"
+            "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10) or 6 (Festo DMSP-40), got {k}"
         )),
     }
 }
@@ -114,18 +139,69 @@ impl McKibbenJoint {
         self.muscle.evaluate(pressure, inside, history).ok()
     }
 
+    /// Force and dF/dP of one muscle, at the nearest valid length as [`Self::evaluate_muscle`].
+    fn force_and_slope(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Option<(f64, f64)> {
+        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
+        let margin = if self.muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        [length, inside]
+            .into_iter()
+            .find_map(|l| self.muscle.partials(pressure, l, history).ok())
+            .map(|(out, d)| (out.force, d.force[0]))
+    }
+
+    /// Torque of the pair at the pressures from `difference`, and its slope in the difference,
+    /// at the given lengths and histories.
+    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<(f64, f64), String> {
+        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
+        let p = pair_pressures(pc, difference, pmax);
+        // dP/d(difference) is +-1/2 where a pressure is not clipped.
+        let unclipped = |x: f64| if x > 0.0 && x < pmax { 0.5 } else { 0.0 };
+        let flexor = self.force_and_slope(p[0], lengths[0], &self.flexor_friction);
+        let extensor = self.force_and_slope(p[1], lengths[1], &self.extensor_friction);
+        match (flexor, extensor) {
+            (Some((f, df)), Some((e, de))) => Ok((
+                self.moment_arm * (f - e),
+                self.moment_arm
+                    * (df * unclipped(pc + 0.5 * difference)
+                        + de * unclipped(pc - 0.5 * difference)),
+            )),
+            _ => Err("a muscle cannot be evaluated at this jointPosition".into()),
+        }
+    }
+
     fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Option<Pair> {
         let (u, q) = (inputs.actuator_input, inputs.joint_position);
-        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
-        // f64::clamp would pass a NaN through; max/min map it to a bound (inputs are finite anyway).
-        let pressures = [
-            (pc + 0.5 * u).max(0.0).min(pmax),
-            (pc - 0.5 * u).max(0.0).min(pmax),
-        ];
         let lengths = [
             self.flexor_rest_length - self.moment_arm * q,
             self.extensor_rest_length + self.moment_arm * q,
         ];
+        let (difference, saturated) = if self.torque_command {
+            // The pressure difference that meets the torque, through the same muscle physics.
+            match difference_for_torque(|d| self.torque_at(d, lengths), u, self.max_pressure) {
+                Ok(solved) => (solved.argument, solved.saturated),
+                Err(reason) => {
+                    report.add(
+                        Status::Discard,
+                        format!("jointPosition {q} rad, torque command {u} N m: {reason}"),
+                    );
+                    return None;
+                }
+            }
+        } else {
+            (u, false)
+        };
+        // Each pressure clipped to 0 .. max_pressure (a NaN maps to a bound).
+        let pressures = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
         let mut clamped = None;
         let flexor = self.evaluate_muscle(
             pressures[0],
@@ -141,10 +217,9 @@ impl McKibbenJoint {
         );
         match clamped {
             Some(reason) => {
-                if !self.out_of_range {
-                    report.warn(format!("jointPosition {q} rad: {reason}"));
-                }
-                report.status = report.status.max(Status::Warning);
+                report.clamp(!self.out_of_range, || {
+                    format!("jointPosition {q} rad: {reason}")
+                });
                 self.out_of_range = true;
             }
             None => self.out_of_range = false,
@@ -154,7 +229,26 @@ impl McKibbenJoint {
             extensor: extensor?,
             pressures,
             lengths,
+            saturated,
         })
+    }
+
+    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: at a clamped length
+    /// the length no longer moves the force.
+    fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
+        if let Ok((_, d)) = self.muscle.partials(pressure, length, history) {
+            return d.force;
+        }
+        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
+        let margin = if self.muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        self.muscle
+            .partials(pressure, inside, history)
+            .map_or([0.0, 0.0], |(_, d)| [d.force[0], 0.0])
     }
 
     fn write(&self, out: &mut Outputs, pair: &Pair) {
@@ -165,11 +259,13 @@ impl McKibbenJoint {
         out.extensor_force = pair.extensor.force;
         out.flexor_length = pair.lengths[0];
         out.extensor_length = pair.lengths[1];
+        out.torque_saturated = pair.saturated;
     }
 }
 
 impl Model for McKibbenJoint {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("mckibben_joint.html");
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
@@ -199,6 +295,16 @@ impl Model for McKibbenJoint {
             ).into());
         }
         let q = start.joint_position;
+        let torque_command = match p.command_mode {
+            0 => false,
+            1 => true,
+            k => {
+                return Err(format!(
+                    "command_mode must be 0 (pressure difference, Pa) or 1 (joint torque, N m), got {k}"
+                )
+                .into())
+            }
+        };
         Ok(Self {
             muscle,
             moment_arm,
@@ -211,6 +317,7 @@ impl Model for McKibbenJoint {
             extensor_friction: HysteresisState::at_rest(extensor_rest_length + moment_arm * q),
             out_of_range: false,
             position_range: (min_position, max_position),
+            torque_command,
         })
     }
 
@@ -219,6 +326,57 @@ impl Model for McKibbenJoint {
             min_position: self.position_range.0,
             max_position: self.position_range.1,
         }
+    }
+
+    /// The chain rule through the pressure difference `d`, the split `P = pc +- d/2` (slope 0
+    /// where a pressure is clipped to 0 or max_pressure) and the lengths `L0 -+ r q`. With
+    /// `command_mode` 1, `d` solves `torque(d, q) = u`: `dd/du = 1/torque_d` and
+    /// `dd/dq = -torque_q/torque_d` (implicit function theorem), both 0 when saturated.
+    /// jointVelocity moves nothing.
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let q = inputs.joint_position;
+        let (pmax, r) = (self.max_pressure, self.moment_arm);
+        // The operating point as `evaluate` finds it (a copy: the warning state stays put).
+        let pair = self
+            .clone()
+            .compute(inputs, &mut Report::default())
+            .ok_or("a muscle cannot be evaluated at this jointPosition")?;
+        let [pf, pe] = pair.pressures;
+        let interior = |p: f64| p > 0.0 && p < pmax;
+        let dpf = if interior(pf) { 0.5 } else { 0.0 };
+        let dpe = if interior(pe) { -0.5 } else { 0.0 };
+        let lf = self.flexor_rest_length - r * q;
+        let le = self.extensor_rest_length + r * q;
+        let ff = self.muscle_partials(pf, lf, &self.flexor_friction);
+        let fe = self.muscle_partials(pe, le, &self.extensor_friction);
+        // Forces per unit d and per unit q at fixed d.
+        let (ff_d, fe_d) = (ff[0] * dpf, fe[0] * dpe);
+        let (ff_q, fe_q) = (-r * ff[1], r * fe[1]);
+        let (dd_du, dd_dq) = if !self.torque_command {
+            (1.0, 0.0)
+        } else {
+            let torque_d = r * (ff_d - fe_d);
+            if pair.saturated || torque_d == 0.0 {
+                (0.0, 0.0)
+            } else {
+                (1.0 / torque_d, -r * (ff_q - fe_q) / torque_d)
+            }
+        };
+        let flexor = [ff_d * dd_du, ff_d * dd_dq + ff_q];
+        let extensor = [fe_d * dd_du, fe_d * dd_dq + fe_q];
+        let mut p = Partials::default();
+        let row = |d: [f64; 2]| [("actuatorInput", d[0]), ("jointPosition", d[1])];
+        p.row(
+            "jointTorque",
+            &row([r * (flexor[0] - extensor[0]), r * (flexor[1] - extensor[1])]),
+        )
+        .row("flexor_force", &row(flexor))
+        .row("extensor_force", &row(extensor))
+        .row("flexor_pressure", &row([dpf * dd_du, dpf * dd_dq]))
+        .row("extensor_pressure", &row([dpe * dd_du, dpe * dd_dq]))
+        .row("flexor_length", &row([0.0, -r]))
+        .row("extensor_length", &row([0.0, r]));
+        Ok(p)
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {

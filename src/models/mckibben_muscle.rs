@@ -1,15 +1,19 @@
 //! McKibbenMuscle FMU: gauge pressure and length in, tension force out.
 //!
 //! Effects, each built only when switched on: the Mooney-Rivlin bladder (`bladder_model` 1 thin
-//! wall, 2 thick wall of `bladder_layers` layers), friction hysteresis (`friction`) and a series
-//! connector (`connector_stiffness` > 0). With all of them off a step is eq. 2.3 alone.
+//! wall, 2 thick wall of `bladder_layers` layers, 3 continuum wall of `bladder_layers` quadrature
+//! nodes), friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
+//! With all of them off a step is eq. 2.3 alone.
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report};
 use crate::physics::bladder::BladderTube;
+use crate::physics::calibration::MuscleParams;
+use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
+use crate::physics::inverse::pressure_for_force;
 use crate::physics::mckibben::{
-    BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
+    BladderModel, FrictionParams, McKibben, McKibbenOutput, McKibbenPartials, MuscleGeometry,
 };
 use crate::variables::mckibben_muscle::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
@@ -36,46 +40,108 @@ pub struct McKibbenMuscle {
     friction: HysteresisState,
     /// Whether the last evaluation needed the fallback: its warning is logged once per excursion.
     out_of_range: bool,
+    /// The parameters in use (the preset's or the user's), read back as `effective_*`.
+    effective: MuscleParams,
+    /// Which user-set parameters the preset replaced: a warning with the first outputs.
+    notice: Option<String>,
+    /// `pressure_solver` on: the muscle to invert and `max_pressure`.
+    solver: Option<(McKibben, f64)>,
 }
 
-fn geometry(p: &Parameters) -> Result<(Sleeve, BladderTube), String> {
-    let preset = match p.preset {
-        0 => None,
-        k @ 1..=4 => MuscleGeometry::preset((b'A' + k as u8 - 1) as char),
-        k => {
-            return Err(format!(
-                "preset must be 0 (none) or 1-4 (Table 2.1 A-D), got {k}"
-            ))
-        }
-    };
-    let tube = |length, inner_diameter, thickness| BladderTube {
-        inner_diameter,
-        thickness,
-        unstretched_length: length,
+/// The muscle the parameters (or the preset) describe, with the parameters the user set that
+/// the preset replaced.
+struct Resolved {
+    params: MuscleParams,
+    /// Parameters the user set that the preset replaced (logged once).
+    overridden: Vec<&'static str>,
+}
+
+/// Applies `preset`: 1-4 Table 2.1's geometry (the user's rubber and bladder model), 5-6 a Festo
+/// muscle fitted to its datasheet (geometry, rubber and thin wall; scaled to `nominal_length` if
+/// the user set it). Names the parameters the user set (away from their start values) that the
+/// preset replaces.
+fn geometry(p: &Parameters) -> Result<Resolved, String> {
+    let start = Parameters::default();
+    let own = MuscleParams {
+        nominal_length: p.nominal_length,
+        strand_length: p.strand_length,
+        turns: p.turns,
+        bladder_model: p.bladder_model,
+        bladder_layers: p.bladder_layers,
+        bladder_length: p.bladder_length,
+        bladder_inner_diameter: p.bladder_inner_diameter,
+        bladder_thickness: p.bladder_thickness,
         mooney_c1: p.mooney_c1,
         mooney_c2: p.mooney_c2,
     };
-    Ok(match preset {
-        Some(g) => (
-            g.sleeve()?,
-            tube(
-                g.bladder_length,
-                g.bladder_inner_diameter,
-                g.bladder_thickness,
+    let params = match p.preset {
+        0 => own,
+        k @ 1..=4 => {
+            let g = MuscleGeometry::preset((b'A' + k as u8 - 1) as char)
+                .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
+            MuscleParams {
+                nominal_length: g.length,
+                strand_length: g.strand_length,
+                turns: g.turns,
+                bladder_length: g.bladder_length,
+                bladder_inner_diameter: g.bladder_inner_diameter,
+                bladder_thickness: g.bladder_thickness,
+                ..own
+            }
+        }
+        k @ 5..=6 => {
+            let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
+            if p.nominal_length != start.nominal_length {
+                festo.scaled_to(p.nominal_length)
+            } else {
+                festo
+            }
+        }
+        k => {
+            return Err(format!(
+                "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10) or 6 (Festo DMSP-40), got {k}"
+            ))
+        }
+    };
+    let mut overridden = Vec::new();
+    if p.preset != 0 {
+        let mut replaced = vec![
+            ("strand_length", p.strand_length != start.strand_length),
+            ("turns", p.turns != start.turns),
+            ("bladder_length", p.bladder_length != start.bladder_length),
+            (
+                "bladder_inner_diameter",
+                p.bladder_inner_diameter != start.bladder_inner_diameter,
             ),
-        ),
-        None => (
-            Sleeve::new(p.strand_length, p.turns)?,
-            tube(
-                p.bladder_length,
-                p.bladder_inner_diameter,
-                p.bladder_thickness,
+            (
+                "bladder_thickness",
+                p.bladder_thickness != start.bladder_thickness,
             ),
-        ),
-    })
+        ];
+        if p.preset <= 4 {
+            replaced.push(("nominal_length", p.nominal_length != start.nominal_length));
+        } else {
+            replaced.push(("mooney_c1", p.mooney_c1 != start.mooney_c1));
+            replaced.push(("mooney_c2", p.mooney_c2 != start.mooney_c2));
+            let festo_model = BladderModel::from_switch(params.bladder_model, 1)?;
+            let own_model = BladderModel::from_switch(p.bladder_model, p.bladder_layers).ok();
+            replaced.push((
+                "bladder_model",
+                p.bladder_model != start.bladder_model && own_model != Some(festo_model),
+            ));
+        }
+        overridden.extend(replaced.iter().filter(|(_, set)| *set).map(|(n, _)| *n));
+    }
+    if !(params.nominal_length.is_finite() && params.nominal_length > 0.0) {
+        return Err(format!(
+            "nominal_length must be positive and finite, got {} m",
+            params.nominal_length
+        ));
+    }
+    Ok(Resolved { params, overridden })
 }
 
-/// The warning for an input without a solution: once per excursion, then only the status.
+/// An input without a solution: explained once per excursion, then only flagged.
 fn out_of_range(
     logged: &mut bool,
     report: &mut Report,
@@ -83,16 +149,15 @@ fn out_of_range(
     (lo, hi): (f64, f64),
     fallback: Option<(f64, f64)>,
 ) {
-    if !*logged {
+    report.clamp(!*logged, || {
         let what = match fallback {
             Some((p, l)) => format!("evaluating at pressure {p} Pa and length {l} m"),
             None => "holding the previous outputs".into(),
         };
-        report.warn(format!(
+        format!(
             "{reason} (valid lengths {lo} .. {hi} m, max_length {hi} m); {what} until the inputs return"
-        ));
-    }
-    report.status = report.status.max(Status::Warning);
+        )
+    });
     *logged = true;
 }
 
@@ -141,6 +206,12 @@ impl McKibbenMuscle {
         report: &mut Report,
         commit: bool,
     ) {
+        if let Some(notice) = self.notice.take() {
+            // A warning: OK-status messages reach the log only with debug logging on.
+            report.warn(notice);
+        }
+        let history = self.friction;
+        outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
                 sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report)
@@ -159,6 +230,35 @@ impl McKibbenMuscle {
                     }
                 }
             }
+        }
+        if let Some((muscle, max_pressure)) = &self.solver {
+            // Solved from the history the step started with, as the forward model is.
+            Self::solve_pressure(muscle, *max_pressure, &history, inputs, outputs);
+        }
+    }
+
+    /// `target_pressure`: the pressure that gives `target_force` at the input length (clamped
+    /// into the valid range as the forward model is), by the joint's torque-mode solver.
+    fn solve_pressure(
+        muscle: &McKibben,
+        max_pressure: f64,
+        history: &HysteresisState,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+    ) {
+        let (length, force) = (inputs.length, inputs.target_force);
+        let (lo, hi) = (muscle.min_length(), muscle.max_length());
+        let margin = if muscle.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        let inside = length.max(lo + margin).min(hi - margin);
+        let solved = pressure_for_force(muscle, length, force, max_pressure, history)
+            .or_else(|_| pressure_for_force(muscle, inside, force, max_pressure, history));
+        if let Ok(s) = solved {
+            outputs.target_pressure = s.argument;
+            outputs.target_force_saturated = s.saturated;
         }
     }
 
@@ -211,18 +311,111 @@ impl McKibbenMuscle {
     }
 }
 
+/// The partials as the FMU's rows, by variable name.
+fn partial_rows(d: &McKibbenPartials) -> Partials {
+    let mut p = Partials::default();
+    for (name, [dp, dl]) in [
+        ("force", d.force),
+        ("volume", d.volume),
+        ("effective_pressure", d.effective_pressure),
+        ("friction_force", d.friction_force),
+    ] {
+        p.row(name, &[("pressure", dp), ("length", dl)]);
+    }
+    p
+}
+
+impl McKibbenMuscle {
+    /// Partials on the branch [`Model::evaluate`] takes: out of range it evaluates at a clamped
+    /// length (and, under a vacuum it cannot hold, at zero pressure), which the input no longer
+    /// moves, so those columns are zero.
+    fn partials_at(&self, inputs: &Inputs) -> Result<McKibbenPartials, String> {
+        let (pressure, length) = (inputs.pressure, inputs.length);
+        match &self.pipeline {
+            Pipeline::Sleeve(s) => {
+                let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+                let inside = length <= s.max_length();
+                let l = length.min(s.max_length());
+                let per_pa = s.force(1.0, l);
+                let dl = if inside { 1.0 } else { 0.0 };
+                Ok(McKibbenPartials {
+                    force: [on * per_pa, dl * s.stiffness(pressure.max(0.0), l)],
+                    effective_pressure: [on, 0.0],
+                    friction_force: [0.0, 0.0],
+                    volume: [0.0, -dl * per_pa],
+                })
+            }
+            Pipeline::Full(m) => {
+                if let Ok((_, d)) = m.partials(pressure, length, &self.friction) {
+                    return Ok(d);
+                }
+                let (lo, hi) = (m.min_length(), m.max_length());
+                let margin = if m.bladder().is_some() {
+                    LIMIT_MARGIN * (hi - lo)
+                } else {
+                    0.0
+                };
+                let clamped = length.max(lo + margin).min(hi - margin);
+                let zero_l = |mut d: McKibbenPartials, zero_p: bool| {
+                    for y in [
+                        &mut d.force,
+                        &mut d.volume,
+                        &mut d.effective_pressure,
+                        &mut d.friction_force,
+                    ] {
+                        y[1] = 0.0;
+                        if zero_p {
+                            y[0] = 0.0;
+                        }
+                    }
+                    d
+                };
+                if let Ok((_, d)) = m.partials(pressure, clamped, &self.friction) {
+                    return Ok(zero_l(d, false));
+                }
+                m.partials(pressure.max(0.0), clamped, &self.friction)
+                    .map(|(_, d)| zero_l(d, true))
+            }
+        }
+    }
+}
+
 impl Model for McKibbenMuscle {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = include_str!("mckibben_muscle.html");
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
-        let (sleeve, tube) = geometry(p)?;
-        let model = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?;
-        let friction = p.friction.then(|| FrictionParams {
+        let Resolved { params, overridden } = geometry(p)?;
+        let sleeve = Sleeve::new(params.strand_length, params.turns)?;
+        let tube = BladderTube {
+            inner_diameter: params.bladder_inner_diameter,
+            thickness: params.bladder_thickness,
+            unstretched_length: params.bladder_length,
+            mooney_c1: params.mooney_c1,
+            mooney_c2: params.mooney_c2,
+        };
+        let model = BladderModel::from_switch(params.bladder_model, params.bladder_layers)?;
+        let notice = (!overridden.is_empty()).then(|| {
+            format!(
+                "preset {} replaces the value you set for {} (the effective_* calculated parameters show the values in use)",
+                p.preset,
+                overridden.join(", ")
+            )
+        });
+        let friction = p.friction.then_some(FrictionParams {
             coefficient: p.friction_coefficient,
             presliding_length: p.presliding_length,
         });
         let muscle = McKibben::new(sleeve, tube, model, friction, p.connector_stiffness)?;
+        if !(p.max_pressure.is_finite() && p.max_pressure >= 0.0) {
+            return Err(format!(
+                "max_pressure must be finite and >= 0 Pa, got {}",
+                p.max_pressure
+            )
+            .into());
+        }
+        let solver = p.pressure_solver.then(|| (muscle.clone(), p.max_pressure));
         // Friction starts relaxed (z = 0) at the initial length.
         let friction = HysteresisState::at_rest(start.length);
         let pipeline =
@@ -235,20 +428,32 @@ impl Model for McKibbenMuscle {
             pipeline,
             friction,
             out_of_range: false,
+            effective: params,
+            notice,
+            solver,
         })
     }
 
     fn calculated_parameters(&self) -> CalculatedParameters {
-        match &self.pipeline {
+        let (max_length, min_length) = match &self.pipeline {
             // The bare sleeve spans 0 .. b (eq. 2.3).
-            Pipeline::Sleeve(sleeve) => CalculatedParameters {
-                max_length: sleeve.max_length(),
-                min_length: 0.0,
-            },
-            Pipeline::Full(muscle) => CalculatedParameters {
-                max_length: muscle.max_length(),
-                min_length: muscle.min_length(),
-            },
+            Pipeline::Sleeve(sleeve) => (sleeve.max_length(), 0.0),
+            Pipeline::Full(muscle) => (muscle.max_length(), muscle.min_length()),
+        };
+        let e = &self.effective;
+        CalculatedParameters {
+            max_length,
+            min_length,
+            effective_nominal_length: e.nominal_length,
+            effective_strand_length: e.strand_length,
+            effective_turns: e.turns,
+            effective_bladder_length: e.bladder_length,
+            effective_bladder_inner_diameter: e.bladder_inner_diameter,
+            effective_bladder_thickness: e.bladder_thickness,
+            effective_mooney_c1: e.mooney_c1,
+            effective_mooney_c2: e.mooney_c2,
+            effective_braid_angle: e.braid_angle(),
+            effective_bladder_model: e.bladder_model,
         }
     }
 
@@ -267,5 +472,13 @@ impl Model for McKibbenMuscle {
         // Quasi-static: the held inputs at the end of the step fix the outputs; the friction
         // history follows the length path sampled at the communication points.
         self.outputs(inputs, outputs, report, true)
+    }
+
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let mut rows = self.partials_at(inputs).map(|d| partial_rows(&d))?;
+        // contraction = 1 - length / nominal_length.
+        let per_length = -1.0 / self.effective.nominal_length;
+        rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
+        Ok(rows)
     }
 }

@@ -34,6 +34,13 @@ pub enum Status {
 pub struct Report {
     pub status: Status,
     pub messages: Vec<(Status, String)>,
+    /// The model ran (evaluated or stepped): `clamped` describes the outputs it wrote.
+    pub evaluated: bool,
+    /// An input lay outside the model's solvable range and was evaluated at the nearest valid
+    /// point. The export layer turns this into a status by the `out_of_range_policy` parameter.
+    pub clamped: bool,
+    /// Why, logged once per excursion (the first call that leaves the range).
+    pub clamp_messages: Vec<String>,
 }
 
 impl Report {
@@ -43,6 +50,14 @@ impl Report {
     }
     pub fn warn(&mut self, message: impl Into<String>) {
         self.add(Status::Warning, message)
+    }
+    /// Records an input evaluated at the nearest valid point; `message` is built only on the
+    /// first call of an excursion (`first`), so that the log gets one line per excursion.
+    pub fn clamp(&mut self, first: bool, message: impl FnOnce() -> String) {
+        self.clamped = true;
+        if first {
+            self.clamp_messages.push(message());
+        }
     }
 }
 
@@ -69,6 +84,35 @@ impl From<&str> for Refusal {
     }
 }
 
+/// Exact partial derivatives of some outputs with respect to the inputs, by variable name, at one
+/// point: what `fmi2GetDirectionalDerivative` combines with the importer's seed. An output without
+/// a row is not provided; an input missing from a row does not affect that output.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Partials {
+    rows: Vec<(&'static str, Vec<(&'static str, f64)>)>,
+}
+
+impl Partials {
+    /// Adds the row of `output`: its partial with respect to each listed input.
+    pub fn row(&mut self, output: &'static str, by_input: &[(&'static str, f64)]) -> &mut Self {
+        self.rows.push((output, by_input.to_vec()));
+        self
+    }
+
+    /// The row of `output`, if provided.
+    pub fn get(&self, output: &str) -> Option<&[(&'static str, f64)]> {
+        self.rows
+            .iter()
+            .find(|(name, _)| *name == output)
+            .map(|(_, row)| row.as_slice())
+    }
+
+    /// The outputs that have a row.
+    pub fn outputs(&self) -> impl Iterator<Item = &'static str> + '_ {
+        self.rows.iter().map(|(name, _)| *name)
+    }
+}
+
 /// The typed variable groups of model `M`, generated from its model description.
 pub type Parameters<M> = <<M as Model>::Variables as Interface>::Parameters;
 pub type Inputs<M> = <<M as Model>::Variables as Interface>::Inputs;
@@ -80,9 +124,9 @@ pub type CalculatedParameters<M> = <<M as Model>::Variables as Interface>::Calcu
 /// owns its physics and its history (friction state, onion state, rotor state), which is part of
 /// the FMU state.
 ///
-/// Model Exchange can extend this without touching the co-simulation models: a subtrait
-/// `ModelExchange: Model` with the continuous states, derivatives, event updates and directional
-/// derivatives, and further associated types on [`Interface`].
+/// Model Exchange extends it through defaults that co-simulation-only models never write
+/// (`ALGEBRAIC_MODEL_EXCHANGE`, `update_discrete_states`, `partials`); continuous states would come
+/// as further associated types on [`Interface`].
 pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// The generated interface, `crate::variables::<model>::Variables`.
     type Variables: Interface;
@@ -113,4 +157,29 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
         step: f64,
         report: &mut Report,
     );
+
+    /// Whether the model serves FMI Model Exchange without continuous states: its outputs are
+    /// algebraic in the inputs and its history (friction) is a discrete state, committed by
+    /// [`Model::update_discrete_states`] at each completed integrator step and event.
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = false;
+
+    /// Model Exchange: commits the history at `inputs` and time `time` and writes the outputs
+    /// there. For a quasi-static model that is a step of zero length.
+    fn update_discrete_states(
+        &mut self,
+        inputs: &Inputs<Self>,
+        outputs: &mut Outputs<Self>,
+        time: f64,
+        report: &mut Report,
+    ) {
+        self.step(inputs, outputs, time, 0.0, report)
+    }
+
+    /// Exact partial derivatives of the outputs with respect to the inputs at `inputs` and the
+    /// current history, on the branch [`Model::evaluate`] takes there (analytic or forward-mode,
+    /// never finite differences). `Err` says why there are none: by default this model does not
+    /// provide them, and its model description says `providesDirectionalDerivative="false"`.
+    fn partials(&mut self, _inputs: &Inputs<Self>) -> Result<Partials, String> {
+        Err("this model does not provide partial derivatives".into())
+    }
 }

@@ -7,7 +7,7 @@
 
 use super::{Model, Refusal, Report, Status};
 use crate::physics::multiferroic::{
-    Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, SteppingSchedule,
+    drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, SteppingSchedule,
 };
 use crate::variables::multiferroic_motor::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
@@ -20,6 +20,8 @@ pub struct MultiferroicMotor {
     /// The built-in stepping schedule when `schedule = 1`.
     schedule: Option<SteppingSchedule>,
     rotor_locked: bool,
+    /// Young's modulus (Pa) when `strain_drive`: the `strain` input times it is the stress.
+    strain_drive: Option<f64>,
     state: MotorState,
     /// Largest magnitude of the ring's torque on the bar (N m), for [`Self::implausible`].
     max_torque: f64,
@@ -30,9 +32,14 @@ pub struct MultiferroicMotor {
 
 impl MultiferroicMotor {
     fn inputs(&self, inputs: &Inputs) -> MotorInputs {
+        // An unrepresentable strain gives a NaN stress, which the physics refuses with a reason.
+        let stress = match self.strain_drive {
+            Some(modulus) => drive::uniaxial_stress(inputs.strain, modulus).unwrap_or(f64::NAN),
+            None => inputs.stress,
+        };
         MotorInputs {
             strain_direction: inputs.strain_direction,
-            stress: inputs.stress,
+            stress,
             load_torque: inputs.load_torque,
             rotor_locked: self.rotor_locked,
             schedule: self.schedule,
@@ -140,12 +147,30 @@ impl Model for MultiferroicMotor {
             r.stress_amplitude,
         )?;
         let schedule = switch(r.schedule, "schedule")?.then_some(stepping);
+        let strain_drive = if r.strain_drive {
+            drive::uniaxial_stress(0.0, r.youngs_modulus)?;
+            Some(r.youngs_modulus)
+        } else {
+            None
+        };
+        let offset = r.initial_onion_offset;
+        if !(offset.is_finite() && offset.abs() <= 1e3) {
+            return Err(format!(
+                "initial_onion_offset must be finite and within 1e3 rad, got {offset}"
+            )
+            .into());
+        }
         let motor = Motor::new(params)?;
         Ok(Self {
             schedule,
             rotor_locked: r.rotor_locked,
-            // The rotor starts at rest with the onion state aligned with it, at angle 0.
-            state: MotorState::aligned(0.0),
+            strain_drive,
+            // The rotor starts at rest at angle 0, the onion state `initial_onion_offset` from
+            // alignment with it (the quasi-static one settles downhill at the first evaluation).
+            state: MotorState {
+                onion_angle: offset,
+                ..MotorState::aligned(0.0)
+            },
             max_torque: motor.ring_bar.max_torque().1.abs(),
             motor,
             accuracy_warned: false,

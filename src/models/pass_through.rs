@@ -1,7 +1,7 @@
 //! PassThrough FMU: `y = u`. A measurement baseline: an importer's cost per step measured on it
 //! is the share of any other FMU's step time that is not the model's (docs/accuracy-cost.md).
 
-use super::{Model, Refusal, Report};
+use super::{Model, Partials, Refusal, Report};
 use crate::variables::pass_through::{Inputs, Outputs, Parameters, Variables};
 use serde::{Deserialize, Serialize};
 
@@ -10,6 +10,7 @@ pub struct PassThrough;
 
 impl Model for PassThrough {
     type Variables = Variables;
+    const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
     const DOCUMENTATION: &'static str = "<h2>Equations</h2><p><code>y</code> = <code>u</code>. \
         A baseline for timing importers: the cost of a step of this FMU is the importer's and the \
         FMI layer's own.</p>";
@@ -24,5 +25,11 @@ impl Model for PassThrough {
 
     fn step(&mut self, inputs: &Inputs, outputs: &mut Outputs, _: f64, _: f64, _: &mut Report) {
         outputs.y = inputs.u;
+    }
+
+    fn partials(&mut self, _: &Inputs) -> Result<Partials, String> {
+        let mut p = Partials::default();
+        p.row("y", &[("u", 1.0)]);
+        Ok(p)
     }
 }

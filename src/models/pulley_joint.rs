@@ -5,7 +5,8 @@
 //! `examples/robot_joint.py`); out come the muscle lengths `L0 -/+ r q` and the PD pressure
 //! commands for the next step, so that two McKibbenMuscle FMUs wired to it by plain connections
 //! (SSP, container FMU) close the loop. Rigid-body mechanics and a controller, no dissertation
-//! physics: it lives here rather than in `src/physics/`.
+//! physics: it lives here rather than in `src/physics/`. With `external_pressures` the controller is
+//! bypassed and the pressure outputs pass on the `*_pressure_command` inputs (saturated).
 
 use super::{Model, Refusal, Report, Status};
 use crate::variables::pulley_joint::{Inputs, Outputs, Parameters, Variables};
@@ -39,6 +40,8 @@ struct Params {
     feedforward_gain: f64,
     segment_time: f64,
     waypoints: [f64; 5],
+    /// The pressures come from the `*_pressure_command` inputs instead of the PD controller.
+    external_pressures: bool,
     /// Largest stable Euler substep, from the stiffest linearized mode (s).
     max_substep: f64,
 }
@@ -87,8 +90,14 @@ impl PulleyJoint {
         let u =
             p.feedforward_gain * q_ref.sin() + p.kp * (q_ref - self.q) + p.kd * (dq_ref - self.dq);
         let (pc, pmax) = (p.common_mode_pressure, p.max_pressure);
-        out.flexor_pressure = (pc + 0.5 * u).max(0.0).min(pmax);
-        out.extensor_pressure = (pc - 0.5 * u).max(0.0).min(pmax);
+        if p.external_pressures {
+            // Your own commands, saturated (max/min map a NaN to a bound).
+            out.flexor_pressure = inputs.flexor_pressure_command.max(0.0).min(pmax);
+            out.extensor_pressure = inputs.extensor_pressure_command.max(0.0).min(pmax);
+        } else {
+            out.flexor_pressure = (pc + 0.5 * u).max(0.0).min(pmax);
+            out.extensor_pressure = (pc - 0.5 * u).max(0.0).min(pmax);
+        }
         out.flexor_length = p.rest_length - p.moment_arm * self.q;
         out.extensor_length = p.rest_length + p.moment_arm * self.q;
         out.joint_angle = self.q;
@@ -142,6 +151,7 @@ impl Model for PulleyJoint {
             feedforward_gain,
             segment_time: positive("segment_time", v.segment_time)?,
             waypoints,
+            external_pressures: v.external_pressures,
             max_substep,
         };
         Ok(Self {
@@ -153,7 +163,8 @@ impl Model for PulleyJoint {
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, _report: &mut Report) {
-        // Outputs at the current time: only the torque follows the inputs directly.
+        // Outputs at the current time: the torque follows the inputs directly, and so do the
+        // pressures with external_pressures.
         self.write(inputs, outputs);
     }
 

@@ -10,6 +10,7 @@
 // `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 use super::knitted_shape::{ShapeGeometry, ShapeTable, DEFAULT_TABLE_NODES};
+use crate::physics::knitted_bag::Bag;
 use std::f64::consts::{PI, SQRT_2};
 
 /// Sleeve parameters, SI units.
@@ -266,29 +267,116 @@ impl KnittedSleeve {
     /// `-P dV/dL` of the table (non-cylindrical).
     #[inline]
     pub fn force(&self, pressure: f64, length: f64) -> f64 {
-        let p = finite_or_zero(pressure);
         let l = self.clamp_length(length);
         let m = self.params.stitches_per_row;
         let n = self.params.rows;
         let s = self.params.row_strand_length;
-        let f = match &self.shape {
+        match &self.shape {
             ShapeModel::Ideal => {
-                -p / (4.0 * PI * n * n)
+                -pressure / (4.0 * PI * n * n)
                     * (12.0 * m * m * l * l - 8.0 * m * n * s * l + n * n * s * s)
             }
             ShapeModel::Tubular => {
-                -p / (4.0 * PI * n * n)
+                -pressure / (4.0 * PI * n * n)
                     * ((12.0 * m * m - 3.0) * l * l - 8.0 * s * m * n * l + n * n * s * s)
             }
-            ShapeModel::NonCylindrical(table) => -p * table.evaluate(l).1,
-        };
-        finite_or_zero(f)
+            ShapeModel::NonCylindrical(table) => -pressure * table.evaluate(l).1,
+        }
     }
 
     /// `dF/dL` (N/m) at the (clamped) length: `-P d2V/dL2`.
     #[inline]
     pub fn stiffness(&self, pressure: f64, length: f64) -> f64 {
-        finite_or_zero(-finite_or_zero(pressure) * self.volume_derivatives(length).2)
+        -pressure * self.volume_derivatives(length).2
+    }
+
+    /// Everything the sleeve without a bladder reports at gauge pressure `pressure` (Pa) and
+    /// `length` (m, clamped into the valid range), with eq. 1.21's strand friction at hysteresis
+    /// state `z` when `friction` is given. The tension feeding the friction is `F + P A` with the
+    /// mean area `A = V / L`. An error, never a silent zero, for a non-finite input or result.
+    pub fn evaluate(
+        &self,
+        pressure: f64,
+        length: f64,
+        friction: Option<(&StrandFriction, f64)>,
+    ) -> Result<SleeveState, String> {
+        self.evaluate_in_bag(pressure, length, friction, None)
+    }
+
+    /// [`Self::evaluate`] with the fluid held inside `bag` (section 1.4's polyethylene bag; see
+    /// [`crate::physics::knitted_bag`]): `F = -P dV/dL` of the capped volume.
+    pub fn evaluate_in_bag(
+        &self,
+        pressure: f64,
+        length: f64,
+        friction: Option<(&StrandFriction, f64)>,
+        bag: Option<&Bag>,
+    ) -> Result<SleeveState, String> {
+        if !pressure.is_finite() || !length.is_finite() {
+            return Err(format!(
+                "pressure and length must be finite, got {pressure} Pa and {length} m"
+            ));
+        }
+        let l = self.clamp_length(length);
+        let sleeve_volume = self.volume_derivatives(l);
+        let (volume, dv, ddv) = match bag {
+            Some(b) => b.volume_derivatives(self, pressure, l),
+            None => sleeve_volume,
+        };
+        let bag_binds = (volume, dv, ddv) != sleeve_volume;
+        let (frictionless, frictionless_stiffness) = if bag_binds {
+            (-pressure * dv, -pressure * ddv)
+        } else {
+            (self.force(pressure, l), self.stiffness(pressure, l))
+        };
+        let max_radius = match bag {
+            Some(b) => self.max_radius(l).min(b.radius_at(pressure)),
+            None => self.max_radius(l),
+        };
+        let mut state = SleeveState {
+            force: frictionless,
+            volume,
+            friction_force: 0.0,
+            max_radius,
+            stiffness: frictionless_stiffness,
+        };
+        if let Some((strand, z)) = friction {
+            // A = V / L, so d(P A)/dL = P (dV/dL L - V) / L^2.
+            let area = if l > 0.0 {
+                (volume / l).max(0.0)
+            } else {
+                self.mean_area(l)
+            };
+            let area_slope = if l > 0.0 {
+                (dv * l - volume) / (l * l)
+            } else {
+                0.0
+            };
+            let f = strand.apply(
+                frictionless,
+                frictionless_stiffness,
+                pressure * area,
+                pressure * area_slope,
+                z,
+            )?;
+            state.force = f.force;
+            state.friction_force = f.friction_force;
+            state.stiffness = f.stiffness;
+        }
+        let values = [
+            state.force,
+            state.volume,
+            state.friction_force,
+            state.max_radius,
+            state.stiffness,
+        ];
+        if values.iter().all(|x| x.is_finite()) {
+            Ok(state)
+        } else {
+            Err(format!(
+                "the sleeve has no finite state at {pressure} Pa and {length} m                  (force, volume, friction, radius, stiffness = {values:?})"
+            ))
+        }
     }
 
     /// Largest sleeve radius (m) at a length: the cylinder's radius (eq. 1.5, eq. 1.12), or the
@@ -355,6 +443,32 @@ impl KnittedSleeve {
     }
 }
 
+/// What the sleeve without a bladder reports at one point (see [`KnittedSleeve::evaluate`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SleeveState {
+    /// Tension (N), with friction when evaluated with it.
+    pub force: f64,
+    /// Volume inside the sleeve (m^3).
+    pub volume: f64,
+    /// Friction part of the tension (N).
+    pub friction_force: f64,
+    /// Largest sleeve radius (m).
+    pub max_radius: f64,
+    /// `dF/dL` (N/m) with the hysteresis state held.
+    pub stiffness: f64,
+}
+
+/// A tension with eq. 1.21's friction (see [`StrandFriction::apply`]).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Frictional {
+    /// Total tension (N).
+    pub force: f64,
+    /// Its friction part (N).
+    pub friction_force: f64,
+    /// `dF/dL` (N/m) with the hysteresis state held.
+    pub stiffness: f64,
+}
+
 /// Strand friction of eq. 1.21: `W = sqrt(2) (F + P A) C_f dL`, i.e. a friction force of
 /// magnitude `sqrt(2) C_f (F + P A)` opposing the motion, with `F + P A` the sleeve tension
 /// (clamped at zero: strands cannot push).
@@ -379,37 +493,64 @@ impl StrandFriction {
     /// and area (m^2).
     #[inline]
     pub fn magnitude(&self, muscle_force: f64, pressure: f64, area: f64) -> f64 {
-        finite_or_zero(SQRT_2 * self.coefficient * (muscle_force + pressure * area).max(0.0))
+        SQRT_2 * self.coefficient * (muscle_force + pressure * area).max(0.0)
     }
 
     /// Total tension with friction, `F = F_0 + z sqrt(2) C_f (F + P A)` solved for `F` (eq. 1.21
     /// with the friction fed by the actual tension): `z` in [-1, 1] is the hysteresis state,
     /// +1 while lengthening (friction adds tension), -1 while shortening. `F_0` is the
     /// frictionless force. Returns `(F, friction)`.
-    #[inline]
-    pub fn total_force(&self, frictionless: f64, pressure: f64, area: f64, z: f64) -> (f64, f64) {
-        let z = if z.is_nan() { 0.0 } else { z.clamp(-1.0, 1.0) };
-        let k = SQRT_2 * self.coefficient * z;
-        let pa = finite_or_zero(pressure * area);
-        let f0 = finite_or_zero(frictionless);
-        // Linear in F while the tension F + PA is positive; 1 - k > 0 by validation.
-        let f = (f0 + k * pa) / (1.0 - k);
-        let (f, fr) = if f + pa >= 0.0 {
-            (f, f - f0)
-        } else {
-            // Slack strands: no tension, no friction.
-            (f0, 0.0)
-        };
-        (finite_or_zero(f), finite_or_zero(fr))
+    pub fn total_force(
+        &self,
+        frictionless: f64,
+        pressure: f64,
+        area: f64,
+        z: f64,
+    ) -> Result<(f64, f64), String> {
+        self.apply(frictionless, 0.0, pressure * area, 0.0, z)
+            .map(|f| (f.force, f.friction_force))
     }
-}
 
-#[inline]
-fn finite_or_zero(x: f64) -> f64 {
-    if x.is_finite() {
-        x
-    } else {
-        0.0
+    /// Eq. 1.21 for a strand tension `F + offset`, where `F` is the total tension, `F_0` =
+    /// `frictionless` and `offset` is `P A` without a bladder (or minus the bladder's pressure and
+    /// elastic forces with one). With `k = sqrt(2) C_f z` held, `F = (F_0 + k offset) / (1 - k)`
+    /// and the stiffness in series form `dF/dL = (F_0' + k offset') / (1 - k)`. Slack strands
+    /// (`F + offset < 0`) carry no friction. An error for non-finite inputs.
+    pub fn apply(
+        &self,
+        frictionless: f64,
+        frictionless_stiffness: f64,
+        offset: f64,
+        offset_slope: f64,
+        z: f64,
+    ) -> Result<Frictional, String> {
+        let inputs = [
+            frictionless,
+            frictionless_stiffness,
+            offset,
+            offset_slope,
+            z,
+        ];
+        if !inputs.iter().all(|x| x.is_finite()) {
+            return Err(format!(
+                "eq. 1.21 needs finite force, stiffness, tension offset, its slope and hysteresis                  state, got {inputs:?}"
+            ));
+        }
+        let k = SQRT_2 * self.coefficient * z.clamp(-1.0, 1.0);
+        // Linear in F while the tension F + offset is positive; 1 - k > 0 by validation.
+        let force = (frictionless + k * offset) / (1.0 - k);
+        if force + offset < 0.0 {
+            return Ok(Frictional {
+                force: frictionless,
+                friction_force: 0.0,
+                stiffness: frictionless_stiffness,
+            });
+        }
+        Ok(Frictional {
+            force,
+            friction_force: force - frictionless,
+            stiffness: (frictionless_stiffness + k * offset_slope) / (1.0 - k),
+        })
     }
 }
 
@@ -659,7 +800,7 @@ mod tests {
         );
         // Self-consistent: friction = sqrt(2) Cf (F + PA) z with F the total.
         for z in [-1.0, -0.3, 0.0, 0.5, 1.0] {
-            let (f, frc) = fr.total_force(f0, p, a, z);
+            let (f, frc) = fr.total_force(f0, p, a, z).unwrap();
             assert_relative_eq!(
                 frc,
                 z * fr.magnitude(f, p, a),
@@ -669,10 +810,34 @@ mod tests {
             assert_relative_eq!(f, f0 + frc, max_relative = 1e-12);
         }
         // Extension above contraction (Fig. 1.18).
-        assert!(fr.total_force(f0, p, a, 1.0).0 > f0 && fr.total_force(f0, p, a, -1.0).0 < f0);
+        assert!(fr.total_force(f0, p, a, 1.0).unwrap().0 > f0);
+        assert!(fr.total_force(f0, p, a, -1.0).unwrap().0 < f0);
+        // Non-finite inputs are errors with a reason, not zeros.
+        assert!(fr.total_force(f64::NAN, p, a, 1.0).is_err());
+        assert!(fr.apply(f0, 0.0, f64::INFINITY, 0.0, 1.0).is_err());
+        assert!(k.evaluate(f64::NAN, l, None).is_err());
+        assert!(k.evaluate(p, f64::INFINITY, Some((&fr, 1.0))).is_err());
         assert!(StrandFriction::new(0.8).is_err());
         assert!(StrandFriction::new(-0.1).is_err());
         assert!(StrandFriction::new(f64::NAN).is_err());
+    }
+
+    #[test]
+    fn friction_stiffness_is_the_slope_with_z_held() {
+        // The series form (F_0' + k (P A)') / (1 - k) against central differences of the total
+        // tension at fixed z, for each cylinder and both directions.
+        let fr = StrandFriction::new(0.25).unwrap();
+        for kind in [ShapeKind::Ideal, ShapeKind::Tubular] {
+            let k = KnittedSleeve::new(KnittedParams::prototype(), kind).unwrap();
+            for z in [-1.0, 0.4, 1.0] {
+                let (p, l, h) = (14e3, 0.4, 1e-6);
+                let at = |l: f64| k.evaluate(p, l, Some((&fr, z))).unwrap();
+                let fd = (at(l + h).force - at(l - h).force) / (2.0 * h);
+                let s = at(l);
+                assert_relative_eq!(s.stiffness, fd, max_relative = 1e-6);
+                assert!(s.friction_force * z > 0.0);
+            }
+        }
     }
 
     #[test]
@@ -723,7 +888,11 @@ mod tests {
         .unwrap();
         let fr = StrandFriction::new(0.25).unwrap();
         let p = 14e3;
-        let with = |l: f64, z: f64| fr.total_force(nc.force(p, l), p, nc.mean_area(l), z).0;
+        let with = |l: f64, z: f64| {
+            fr.total_force(nc.force(p, l), p, nc.mean_area(l), z)
+                .unwrap()
+                .0
+        };
         let (mut lo, mut hi) = (nc.free_contraction_length(), nc.max_length());
         assert!(with(lo, -1.0) < 0.0 && with(hi, -1.0) > 0.0);
         for _ in 0..60 {

@@ -5,15 +5,19 @@
 //! Effects that are off are `None` and cost nothing: with no bladder, no friction and a rigid
 //! connector, [`McKibben::evaluate`] is eq. 2.3 and nothing else.
 
-use crate::physics::bladder::{Bladder, BladderTube, MOONEY_C1, MOONEY_C2};
+use crate::physics::bladder::{Bladder, BladderTube, Wall, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
+use crate::physics::root::{newton_bisection, RootOptions, Sample};
+
+mod partials;
+pub use partials::McKibbenPartials;
 
 /// Iteration caps of the connector solve (bracket search doubles its step; root is Newton-bisection).
 const BRACKET_STEPS: usize = 64;
 const ROOT_ITERATIONS: usize = 100;
 
-/// The bladder model switch (the FMU's `bladder_model` 0/1/2 with `bladder_layers`).
+/// The bladder model switch (the FMU's `bladder_model` 0/1/2/3 with `bladder_layers`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum BladderModel {
     /// Ideal sleeve, eq. 2.3.
@@ -22,10 +26,24 @@ pub enum BladderModel {
     ThinWall,
     /// `layers` nested thin tubes, eq. 2.19-2.20 (1 layer = thin wall).
     ThickWall { layers: usize },
+    /// The limit of infinitely many layers, by a `nodes`-point quadrature through the wall
+    /// ([`crate::physics::bladder::Wall::Continuum`]).
+    Continuum { nodes: usize },
 }
 
 impl BladderModel {
-    /// From the FMU's integer switch (0 none, 1 thin wall, 2 thick wall) and layer count.
+    /// How the wall is integrated, `None` without a bladder.
+    pub fn wall(self) -> Option<Wall> {
+        match self {
+            Self::None => None,
+            Self::ThinWall => Some(Wall::Layers(1)),
+            Self::ThickWall { layers } => Some(Wall::Layers(layers)),
+            Self::Continuum { nodes } => Some(Wall::Continuum(nodes)),
+        }
+    }
+
+    /// From the FMU's integer switch (0 none, 1 thin wall, 2 thick wall, 3 continuum wall) and
+    /// layer (or node) count.
     pub fn from_switch(model: i32, layers: i32) -> Result<Self, String> {
         match model {
             0 => Ok(Self::None),
@@ -33,9 +51,13 @@ impl BladderModel {
             2 if layers >= 1 => Ok(Self::ThickWall {
                 layers: layers as usize,
             }),
-            2 => Err(format!("bladder_layers must be >= 1, got {layers}")),
+            3 if layers >= 1 => Ok(Self::Continuum {
+                nodes: layers as usize,
+            }),
+            2 | 3 => Err(format!("bladder_layers must be >= 1, got {layers}")),
             _ => Err(format!(
-                "bladder_model must be 0 (none), 1 (thin wall) or 2 (thick wall), got {model}"
+                "bladder_model must be 0 (none), 1 (thin wall), 2 (thick wall) or 3 (continuum \
+                 wall), got {model}"
             )),
         }
     }
@@ -195,10 +217,9 @@ impl McKibben {
         friction: Option<FrictionParams>,
         connector_stiffness: f64,
     ) -> Result<Self, String> {
-        let bladder = match model {
-            BladderModel::None => None,
-            BladderModel::ThinWall => Some(Bladder::new(sleeve, tube, 1)?),
-            BladderModel::ThickWall { layers } => Some(Bladder::new(sleeve, tube, layers)?),
+        let bladder = match model.wall() {
+            None => None,
+            Some(wall) => Some(Bladder::with_wall(sleeve, tube, wall)?),
         };
         let friction = match friction {
             None => None,
@@ -457,42 +478,29 @@ impl McKibben {
                 self.max_length()
             ));
         };
-        let (mut lo, mut hi) = if upward {
+        let (lo, hi) = if upward {
             (inner, outer)
         } else {
             (outer, inner)
         };
-        let mut x = 0.5 * (lo + hi);
-        let mut best = None;
-        for _ in 0..ROOT_ITERATIONS {
-            let (h, core) = eval(x)?;
-            if h == 0.0 {
-                return Ok(core);
-            }
-            if h < 0.0 {
-                lo = x;
-            } else {
-                hi = x;
-            }
+        // h rises with L (slope 1 + c dF/dL > 0 on the stable branch). Converged when the length
+        // moves by less than rounding; F then changes by K times that.
+        let options = RootOptions {
+            absolute: 1e-17,
+            relative: 1e-14,
+            max_iterations: ROOT_ITERATIONS,
+        };
+        let root = newton_bisection(lo, hi, 0.5 * (lo + hi), true, options, |x| {
+            let (value, core) = eval(x)?;
             let slope = 1.0 + c * core.newton_slope;
-            let newton = x - h / slope;
-            let newton_ok = newton.is_finite() && slope > 0.0 && newton >= lo && newton <= hi;
-            let tol = 1e-14 * x.abs().max(1e-3);
-            if newton_ok && (newton - x).abs() <= tol {
-                // Converged: the length moves by less than rounding; F changes by K * tol.
-                return Ok(core);
-            }
-            best = Some(core);
-            if hi - lo <= tol {
-                break;
-            }
-            x = if newton_ok && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-        }
-        best.ok_or_else(|| "connector solve did not run".to_string())
+            Ok::<_, String>(Some(Sample {
+                value,
+                slope,
+                payload: core,
+            }))
+        })?;
+        root.payload
+            .ok_or_else(|| "connector solve did not run".to_string())
     }
 }
 
@@ -575,7 +583,12 @@ mod tests {
             BladderModel::ThinWall
         );
         assert!(BladderModel::from_switch(2, 0).is_err());
-        assert!(BladderModel::from_switch(3, 1).is_err());
+        assert_eq!(
+            BladderModel::from_switch(3, 8).unwrap(),
+            BladderModel::Continuum { nodes: 8 }
+        );
+        assert!(BladderModel::from_switch(3, 0).is_err());
+        assert!(BladderModel::from_switch(4, 1).is_err());
     }
 
     #[test]

@@ -3,9 +3,14 @@
 #![forbid(unsafe_code)]
 
 pub mod bladder;
+pub mod calibration;
+pub mod festo;
 pub mod friction;
 pub mod gaylord;
+pub mod inverse;
 pub mod knitted;
+pub mod knitted_bag;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
+pub mod root;

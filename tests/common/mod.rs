@@ -258,6 +258,16 @@ impl Instance<'_> {
     pub fn do_step(&self, t: f64, h: f64) -> c_int {
         unsafe { (self.api.fmi2DoStep)(self.c, t, h, 1) }
     }
+    pub fn set_integer(&self, vrs: &[u32], values: &[c_int]) -> c_int {
+        assert_eq!(vrs.len(), values.len());
+        unsafe { (self.api.fmi2SetInteger)(self.c, vrs.as_ptr(), vrs.len(), values.as_ptr()) }
+    }
+    pub fn boolean(&self, vr: u32) -> bool {
+        let mut out: c_int = -1;
+        let s = unsafe { (self.api.fmi2GetBoolean)(self.c, &vr, 1, &mut out) };
+        assert!(s <= WARNING, "fmi2GetBoolean({vr}) returned {s}");
+        out != 0
+    }
 }
 
 impl Drop for Instance<'_> {
@@ -276,6 +286,11 @@ pub mod mckibben {
     pub const STRAND_LENGTH: u32 = real::STRAND_LENGTH as u32;
     pub const TURNS: u32 = real::TURNS as u32;
     pub const MAX_LENGTH: u32 = real::MAX_LENGTH as u32;
+    pub const STIFFNESS: u32 = real::STIFFNESS as u32;
+    pub const INPUT_CLAMPED: u32 =
+        actuator_fmus::variables::mckibben_muscle::boolean::INPUT_CLAMPED as u32;
+    pub const OUT_OF_RANGE_POLICY: u32 =
+        actuator_fmus::variables::mckibben_muscle::integer::OUT_OF_RANGE_POLICY as u32;
 }
 
 /// Eq. 2.3, written out independently of the crate.

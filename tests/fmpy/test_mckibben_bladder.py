@@ -189,3 +189,22 @@ def test_length_reversals_at_every_point_of_the_stroke(model):
                 assert abs(force - previous[0]) <= bound, (turn, L, force, previous)
             previous = (force, stiffness, p_eff)
     m.close()
+
+
+def test_continuum_wall_is_the_layered_walls_limit():
+    # bladder_model 3: eq. 2.19-2.20 with infinitely many layers, by an 8-node quadrature through
+    # the wall. Independently, Richardson extrapolation of the layered wall (first order in
+    # 1/layers) from 512 and 1024 layers; muscle C at 450 kPa, the thickest, pre-strained wall.
+    CONTINUUM = 3
+    probe = muscle(preset=3, bladder_model=CONTINUUM, bladder_layers=8, length=0.08)
+    lo, hi = probe.get("min_length"), probe.get("max_length")
+    lengths = lo + (hi - lo) * np.linspace(0.05, 0.95, 7)
+    continuum = forces(probe, 4.5e5, lengths)
+    layered = {n: forces(muscle(preset=3, bladder_model=THICK, bladder_layers=n, length=0.08), 4.5e5, lengths)
+               for n in (512, 1024)}
+    limit = 2 * layered[1024] - layered[512]
+    peak = np.max(np.abs(limit))
+    assert np.max(np.abs(continuum - limit)) < 1e-5 * peak
+    # ... where 1024 layers are still 1e-4 away.
+    assert np.max(np.abs(layered[1024] - limit)) > 1e-4 * peak
+    probe.close()

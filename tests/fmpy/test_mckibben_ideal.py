@@ -88,10 +88,11 @@ def test_length_beyond_the_sleeve_is_clamped_and_logged(recording_log):
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
     fmu.setReal([vr["pressure"], vr["length"]], [4e5, 1.2 * B])
-    fmu.doStep(0.0, 0.1)  # fmi2Warning: FMPy carries on
+    fmu.doStep(0.0, 0.1)  # fmi2OK under the default out-of-range policy, flagged and logged
     force, volume = fmu.getReal([vr["force"], vr["volume"]])
     assert force == pytest.approx(gaylord(4e5, B), rel=1e-12) and volume == 0.0
     warnings = [(s, c) for s, c, m in recording_log.records if "evaluating at pressure 400000 Pa and length 0.1113 m" in m]
-    assert warnings == [(1, "logStatusWarning")]
+    assert warnings == [(0, "logStatusWarning")]
+    assert fmu.getBoolean([vr["input_clamped"]]) == [True]
     fmu.terminate()
     fmu.freeInstance()

@@ -92,9 +92,10 @@ def test_saturation_and_ranges():
 def test_out_of_range_angle_warns_and_stays_finite(recording_log):
     joint = Slave("McKibbenJoint", log=recording_log, preset=1, bladder_model=2)
     lo, hi = joint.get("min_position", "max_position")
-    for q in (hi + 1.0, lo - 1.0, 1e6):
+    for q in (hi + 1.0, lo - 1.0, 2 * math.pi):  # 2 pi: the declared maximum
         joint.step(actuatorInput=1e5, jointPosition=q)
         assert math.isfinite(joint.get("jointTorque"))
+        assert joint.get("input_clamped")
     assert recording_log.contains("jointPosition")
     joint.close()
 

@@ -5,6 +5,8 @@
 
 #[path = "../bad_input.rs"]
 mod bad_input;
+#[path = "../declared_ranges.rs"]
+mod declared_ranges;
 #[path = "../c_abi.rs"]
 mod c_abi;
 #[path = "../fmi_crate.rs"]
@@ -15,8 +17,6 @@ mod model_description_checker;
 mod motor_c_abi;
 #[path = "../robot_joint.rs"]
 mod robot_joint_test;
-#[path = "../scenes_fmi.rs"]
-mod scenes_fmi;
 
 /// Test files built elsewhere: `load.rs` is its own binary (Cargo.toml).
 const OWN_BINARY: &[&str] = &["load.rs"];

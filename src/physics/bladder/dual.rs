@@ -37,6 +37,44 @@ impl Dual {
         }
     }
     #[inline]
+    pub(super) fn ln(self) -> Self {
+        let d = 1.0 / self.v;
+        Self {
+            v: self.v.ln(),
+            dl: self.dl * d,
+            dx: self.dx * d,
+        }
+    }
+    #[inline]
+    pub(super) fn exp(self) -> Self {
+        let e = self.v.exp();
+        Self {
+            v: e,
+            dl: self.dl * e,
+            dx: self.dx * e,
+        }
+    }
+    #[inline]
+    pub(super) fn rsqrt(self) -> Self {
+        let r = 1.0 / self.v.sqrt();
+        let d = -0.5 * r * r * r;
+        Self {
+            v: r,
+            dl: self.dl * d,
+            dx: self.dx * d,
+        }
+    }
+    #[inline]
+    pub(super) fn sqrt(self) -> Self {
+        let r = self.v.sqrt();
+        let d = 0.5 / r;
+        Self {
+            v: r,
+            dl: self.dl * d,
+            dx: self.dx * d,
+        }
+    }
+    #[inline]
     pub(super) fn recip(self) -> Self {
         let r = 1.0 / self.v;
         let d = -r * r;

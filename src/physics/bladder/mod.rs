@@ -17,17 +17,24 @@
 //! (section 1.3.6: "the same results apply to a knitted muscle"). The bladder is generic over the
 //! geometry, so the helical path is monomorphised and costs what it did before the generalisation.
 
+mod continuum;
+#[cfg(test)]
+mod continuum_tests;
 mod dual;
 mod geometry;
 mod knitted_cylinder;
+mod partials;
 #[cfg(test)]
 mod tests;
 
 use crate::physics::gaylord::Sleeve;
 use crate::physics::knitted::KnittedSleeve;
+use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use continuum::WallNode;
 use dual::Dual;
 pub use geometry::SleeveGeometry;
 pub use knitted_cylinder::KnittedCylinder;
+pub use partials::BladderPartials;
 use std::f64::consts::PI;
 
 /// Mooney-Rivlin `C1` of natural latex used throughout chapter 2 (Fig. 2.9), Pa.
@@ -57,6 +64,17 @@ pub struct BladderTube {
     pub mooney_c2: f64,
 }
 
+/// How the wall is integrated through its thickness.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum Wall {
+    /// `n` nested thin layers, eq. 2.19-2.20 as written (1 = the thin wall of eq. 2.6-2.17);
+    /// first order in `1/n`.
+    Layers(usize),
+    /// The limit of infinitely many layers by an `n`-point Gauss-Legendre quadrature through the
+    /// wall (see `continuum.rs`); converges geometrically in `n`.
+    Continuum(usize),
+}
+
 /// Parameter-only constants of one nested layer (eq. 2.19-2.20), precomputed once.
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
 struct Layer {
@@ -77,7 +95,11 @@ struct Layer {
 pub struct Bladder<S = Sleeve> {
     sleeve: S,
     tube: BladderTube,
+    wall: Wall,
+    /// The layers of [`Wall::Layers`] (empty for the continuum).
     layers: Vec<Layer>,
+    /// The quadrature nodes of [`Wall::Continuum`] (empty for the layers).
+    nodes: Vec<WallNode>,
     outer_diameter: f64,
     rubber_volume: f64,
     min_length: f64,
@@ -141,12 +163,26 @@ impl Bladder<KnittedCylinder> {
     ) -> Result<Self, String> {
         Self::new(KnittedCylinder::new(sleeve)?, tube, layers)
     }
+
+    /// As [`Self::knitted`] with any [`Wall`].
+    pub fn knitted_wall(
+        sleeve: &KnittedSleeve,
+        tube: BladderTube,
+        wall: Wall,
+    ) -> Result<Self, String> {
+        Self::with_wall(KnittedCylinder::new(sleeve)?, tube, wall)
+    }
 }
 
 impl<S: SleeveGeometry> Bladder<S> {
     /// Builds a bladder of `layers` nested thin layers (1 = thin-walled model, eq. 2.6-2.17;
     /// more = thick-walled model, eq. 2.19-2.20) inside `sleeve`.
     pub fn new(sleeve: S, tube: BladderTube, layers: usize) -> Result<Self, String> {
+        Self::with_wall(sleeve, tube, Wall::Layers(layers))
+    }
+
+    /// Builds a bladder whose wall is integrated as `wall` says inside `sleeve`.
+    pub fn with_wall(sleeve: S, tube: BladderTube, wall: Wall) -> Result<Self, String> {
         let positive = |name: &str, v: f64| {
             if v.is_finite() && v > 0.0 {
                 Ok(())
@@ -162,14 +198,19 @@ impl<S: SleeveGeometry> Bladder<S> {
                 return Err(format!("{name} must be finite and >= 0 Pa, got {c}"));
             }
         }
-        if !(1..=MAX_LAYERS).contains(&layers) {
+        let (Wall::Layers(count) | Wall::Continuum(count)) = wall;
+        if !(1..=MAX_LAYERS).contains(&count) {
             return Err(format!(
-                "bladder layers must be 1..={MAX_LAYERS}, got {layers}"
+                "bladder layers (or quadrature nodes) must be 1..={MAX_LAYERS}, got {count}"
             ));
         }
         let d_ri = tube.inner_diameter;
         let d_ro = d_ri + 2.0 * tube.thickness;
-        let step = (d_ro - d_ri) / layers as f64;
+        let (layers, nodes) = match wall {
+            Wall::Layers(n) => (n, Vec::new()),
+            Wall::Continuum(n) => (0, continuum::wall_nodes(n)),
+        };
+        let step = (d_ro - d_ri) / layers.max(1) as f64;
         let layer_list: Vec<Layer> = (0..layers)
             .map(|i| {
                 let d0 = d_ri + i as f64 * step;
@@ -197,7 +238,9 @@ impl<S: SleeveGeometry> Bladder<S> {
         Ok(Self {
             sleeve,
             tube,
+            wall,
             layers: layer_list,
+            nodes,
             outer_diameter: d_ro,
             rubber_volume,
             min_length,
@@ -213,8 +256,13 @@ impl<S: SleeveGeometry> Bladder<S> {
         &self.tube
     }
 
+    /// Layers of [`Wall::Layers`], or quadrature nodes of [`Wall::Continuum`].
     pub fn layer_count(&self) -> usize {
-        self.layers.len()
+        self.layers.len() + self.nodes.len()
+    }
+
+    pub fn wall(&self) -> Wall {
+        self.wall
     }
 
     /// Rubber volume `V_R`, m^3 (eq. 2.6); constant because rubber is incompressible.
@@ -342,10 +390,19 @@ impl<S: SleeveGeometry> Bladder<S> {
         )
     }
 
+    /// The wall at muscle length `l` and bladder outer diameter `x`: layers or continuum.
+    #[inline]
+    fn kernel(&self, pressure: f64, l: Dual, x: Dual) -> Option<Kernel> {
+        match self.wall {
+            Wall::Layers(_) => self.layered_kernel(pressure, l, x),
+            Wall::Continuum(_) => self.continuum_kernel(pressure, l, x),
+        }
+    }
+
     /// The layer recursion of eq. 2.19-2.20 at muscle length `l` and bladder outer diameter `x`.
     /// `None` if a layer's squared hoop stretch is not positive (outside the geometry) or not finite.
     #[inline]
-    fn kernel(&self, pressure: f64, l: Dual, x: Dual) -> Option<Kernel> {
+    fn layered_kernel(&self, pressure: f64, l: Dual, x: Dual) -> Option<Kernel> {
         let c1x2 = 2.0 * self.tube.mooney_c1;
         let c2x2 = 2.0 * self.tube.mooney_c2;
         let lambda1 = l * (1.0 / self.tube.unstretched_length);
@@ -359,6 +416,8 @@ impl<S: SleeveGeometry> Bladder<S> {
         let mut a = Dual::constant(1.0);
         let mut c = Dual::constant(0.0);
         let mut elastic = Dual::constant(0.0);
+        // d(elastic)/dP at fixed (L, x): elastic is affine in P through each layer's p_in.
+        let mut elastic_dp = 0.0;
         let mut inner: Option<InnerLayer> = None;
         for layer in &self.layers {
             // Eq. 2.20 in squared form: lambda_2i^2 = (x^2 - (D_RO^2 - D_0i^2)/lambda_1) / D_0i^2.
@@ -377,6 +436,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             let p_in = a * pressure - c;
             // sigma_33 = -p_in; sigma_11 = sigma_33 + axial (eq. 2.17 for the layer).
             elastic = elastic + (axial - p_in) * inv_l * layer.rubber_volume;
+            elastic_dp -= a.v * inv_l.v * layer.rubber_volume;
             if inner.is_none() {
                 inner = Some(InnerLayer {
                     l2_sq,
@@ -398,6 +458,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             p_eff,
             threshold,
             elastic,
+            elastic_dp,
             inner,
         })
     }
@@ -541,37 +602,21 @@ impl<S: SleeveGeometry> Bladder<S> {
         if r_lo == 0.0 {
             return Ok(lo);
         }
-        let mut hi = hi;
-        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); any step
-        // leaving the bracket is replaced by bisection.
-        let mut x = lo;
-        for _ in 0..ROOT_ITERATIONS {
-            let Some((r, dr)) = residual(x) else {
-                // Cannot happen inside (x_min, x_contact]; bisect to stay safe.
-                x = 0.5 * (lo + hi);
-                continue;
-            };
-            if r == 0.0 {
-                return Ok(x);
-            }
-            if r > 0.0 {
-                lo = x;
-            } else {
-                hi = x;
-            }
-            let newton = x - r / dr;
-            let newton_ok = newton.is_finite() && newton >= lo && newton <= hi;
-            // Converged when the Newton correction is at rounding level (or the bracket is).
-            if (newton_ok && (newton - x).abs() <= 1e-14 * x) || hi - lo <= 1e-15 * hi {
-                return Ok(if newton_ok { newton } else { x });
-            }
-            x = if newton_ok && newton > lo && newton < hi {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-        }
-        Ok(0.5 * (lo + hi))
+        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); P_eff falls
+        // from positive at `lo` to negative at `hi`.
+        let options = RootOptions {
+            absolute: 0.0,
+            relative: 1e-14,
+            max_iterations: ROOT_ITERATIONS,
+        };
+        let root = newton_bisection(lo, hi, lo, false, options, |x| {
+            Ok::<_, ()>(residual(x).map(|(value, slope)| Sample {
+                value,
+                slope,
+                payload: (),
+            }))
+        });
+        Ok(root.map_or(0.5 * (lo + hi), |r| r.x))
     }
 }
 
@@ -640,5 +685,6 @@ struct Kernel {
     p_eff: Dual,
     threshold: f64,
     elastic: Dual,
+    elastic_dp: f64,
     inner: InnerLayer,
 }

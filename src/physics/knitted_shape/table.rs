@@ -251,6 +251,13 @@ fn follow_path(
                     started = true;
                     if current <= target {
                         pts.push(p);
+                        // Past the free contraction (dV/dL >= 0: no tension left) the volume
+                        // maximum soon stops being a maximum and the solves fail; a table that
+                        // reaches zero force has all the stroke, so it ends at the first node
+                        // there instead of spending its time on a failed tail.
+                        if stop_at.is_none() && p.slope >= 0.0 {
+                            break 'nodes;
+                        }
                     }
                 }
                 Err(_why) => {

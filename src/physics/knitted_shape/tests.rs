@@ -196,3 +196,26 @@ fn pocket_beats_cylinder_start_and_seed_baseline() {
     assert!((ls - l).abs() < 1e-9);
     assert!(v >= vs * (1.0 - 1e-6), "ours {v} seed {vs}");
 }
+
+#[test]
+fn table_ends_at_the_first_node_past_zero_force() {
+    // Past the free contraction the solves fail; the path stops at the first node with
+    // dV/dL >= 0 instead of spending its time on failed solves (issue 15), so the table still
+    // holds the zero-force point, in its last interval.
+    for segments in [49, 98] {
+        let g = prototype(segments);
+        let l_free_cylinder = g.rows * g.row_strand_length / (6.0 * g.stitches_per_row);
+        let end = l_free_cylinder - 0.1 * (g.max_length() - l_free_cylinder);
+        let t = ShapeTable::build(g, end, DEFAULT_TABLE_NODES).unwrap();
+        let last = t.slope.len() - 1;
+        assert!(
+            t.slope[last] >= 0.0 && t.slope[last - 1] < 0.0,
+            "{segments}"
+        );
+        let free = t.free_contraction_length().unwrap();
+        assert!(
+            free >= t.min_length() && free <= t.min_length() + t.spacing,
+            "{segments}"
+        );
+    }
+}

@@ -1,6 +1,7 @@
-//! Exponential Rosenbrock-Euler substeps with step doubling (see [`Motor::step`]).
+//! Exponential Rosenbrock substeps with an embedded error estimate (quasi-static onion) or step
+//! doubling (Gilbert onion); see [`Motor::step`].
 
-use super::{expm, Drive, Motor, StepRun, Vector, MAX_ANGLE};
+use super::{expm, phi, Drive, Motor, StepRun, Vector, MAX_ANGLE};
 
 impl Motor {
     /// Right-hand side and Jacobian of the ODE in `(phi, omega, psi, theta)`, for a substep `dt`.
@@ -121,8 +122,65 @@ impl Motor {
             out[2] = self.settle(&out, d);
             out[3] = 0.0;
         }
-        let sane = out[0].abs() <= MAX_ANGLE && out[2].abs() <= MAX_ANGLE && out[3].abs() <= 10.0;
-        (out.iter().all(|x| x.is_finite()) && sane).then_some(out)
+        self.sane(&out).then_some(out)
+    }
+
+    /// One error-controlled substep: the new state and its error relative to the tolerance.
+    /// The quasi-static rotor uses the embedded pair ([`Self::embedded_step`]); the Gilbert onion
+    /// (a 4x4 system) keeps step doubling.
+    pub(super) fn controlled_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<(Vector, f64)> {
+        if self.quasi_static() && !d.locked {
+            if let Some(result) = self.embedded_step(y, dt, d) {
+                return result;
+            }
+        }
+        self.doubled_step(y, dt, d)
+    }
+
+    /// The exponential Rosenbrock pair of order 2(3) of Hochbruck, Ostermann and Schweitzer
+    /// (exprb32, SIAM J. Numer. Anal. 47, 2009) on the rotor's 2x2 block: the exponential Euler
+    /// step `u1 = y + h phi_1(hJ) F(y)`, then with the linearization's defect
+    /// `D = F(u1) - F(y) - J (u1 - y)` the third-order `u3 = u1 + 2 h phi_3(hJ) D`, whose
+    /// correction is the error estimate of `u1`. Both `phi` functions come in closed form
+    /// ([`phi::Phi2x2`]). One right-hand side and two onion settles per substep, where step
+    /// doubling took three 3x3 matrix exponentials and three settles. `None` (use step doubling)
+    /// when the block's eigenvalues are complex or nearly equal; `Some(None)` if the step fails.
+    fn embedded_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<Option<(Vector, f64)>> {
+        let (f0, j) = self.rhs_jacobian(y, d, dt);
+        let a = [[dt * j[0][0], dt * j[0][1]], [dt * j[1][0], dt * j[1][1]]];
+        let phi = phi::Phi2x2::new(&a)?;
+        let step = phi.apply(1, &a, [dt * f0[0], dt * f0[1]]);
+        let mut u1 = *y;
+        u1[0] += step[0];
+        u1[1] += step[1];
+        u1[2] = self.settle(&u1, d);
+        u1[3] = 0.0;
+        if !self.sane(&u1) {
+            return Some(None);
+        }
+        let (f1, _) = self.rhs_jacobian(&u1, d, dt);
+        let defect = [
+            f1[0] - f0[0] - (j[0][0] * step[0] + j[0][1] * step[1]),
+            f1[1] - f0[1] - (j[1][0] * step[0] + j[1][1] * step[1]),
+        ];
+        let correction = phi.apply(3, &a, [2.0 * dt * defect[0], 2.0 * dt * defect[1]]);
+        let mut u3 = u1;
+        u3[0] += correction[0];
+        u3[1] += correction[1];
+        u3[2] = self.settle(&u3, d);
+        if !self.sane(&u3) {
+            return Some(None);
+        }
+        let tol = self.params.tolerance;
+        let err = (correction[0].abs() / tol).max(correction[1].abs() / (tol * self.speed_scale));
+        Some(Some((u3, err)))
+    }
+
+    fn sane(&self, y: &Vector) -> bool {
+        y.iter().all(|x| x.is_finite())
+            && y[0].abs() <= MAX_ANGLE
+            && y[2].abs() <= MAX_ANGLE
+            && y[3].abs() <= 10.0
     }
 
     /// Step doubling: returns the two-half-step result and its error relative to the tolerance.
@@ -160,7 +218,7 @@ impl Motor {
             return;
         }
         let forced = dt_try <= dt_min * (1.0 + 1e-12);
-        match self.doubled_step(&run.y, dt_try, d) {
+        match self.controlled_step(&run.y, dt_try, d) {
             Some((y_new, err)) if err <= 1.0 || forced => {
                 if err > 1.0 {
                     run.limited = true;

@@ -18,7 +18,10 @@
 //! linear system exactly with a matrix exponential, so the 2 ns inertial mode and the GHz onion
 //! precession never limit the substep (no stiffness instability; the overdamped first-order limit
 //! comes out by itself), while the quasi-static onion is re-solved at the end of every substep.
-//! The method is second order; step doubling estimates the local error and sizes the next substep.
+//! The method is second order. With the quasi-static onion the rotor block is 2x2, its `phi`
+//! functions come in closed form and the third-order member of an embedded exponential Rosenbrock
+//! pair (exprb32) estimates the local error; the Gilbert onion keeps step doubling. The estimate
+//! sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see [`MotorParams::max_substeps`]).
 //!
 //! Long steps (issue 5): a substep far longer than the relaxation time is never integrated
@@ -29,12 +32,16 @@
 //! turns; what is left is integrated, and a forced substep drops the negative stiffness so it
 //! cannot amplify. See [`Motor::step`].
 
+pub mod drive;
 pub mod expm;
 mod integrator;
 mod long_steps;
 pub mod magnetics;
 pub mod onion;
+#[cfg(test)]
+mod onion_tests;
 mod params;
+pub mod phi;
 pub mod schedule;
 #[cfg(test)]
 mod tests;
@@ -66,6 +73,8 @@ pub struct Motor {
     llg_rate: f64,
     /// `mu0 Ms^2 V_wall` (J): out-of-plane shape-anisotropy stiffness of the macrospin.
     tilt_stiffness: f64,
+    /// Bound on the third derivative of eq. 3.3 (J/rad^3), for the onion's safe march.
+    ring_bar_slope_bound: f64,
 }
 
 /// Inputs held over a communication step.
@@ -332,6 +341,7 @@ impl Motor {
             speed_scale: (alignment_stiffness / inertia).sqrt(),
             llg_rate,
             tilt_stiffness,
+            ring_bar_slope_bound: onion::curvature_slope_bound(&ring_bar),
             ring_bar,
             params,
         })
@@ -391,6 +401,7 @@ impl Motor {
             bar_angle,
             strain_direction,
             magnetoelastic: self.magnetoelastic_per_stress * stress,
+            ring_bar_slope_bound: self.ring_bar_slope_bound,
         }
     }
 
@@ -491,8 +502,8 @@ impl Motor {
     ///   relaxation times and the rotor ends it within [`MAX_SETTLE_RESIDUAL`] of its
     ///   equilibrium, on the exponential tail (agrees with resolved integration within 3e-7 rad
     ///   for the default schedule), at the cost of one substep;
-    /// - otherwise exponential substeps sized by the step-doubling error estimate (growth and
-    ///   shrink at most 5x per substep). The minimum substep is `remaining time / remaining
+    /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
+    ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
     ///   budget`; a substep at that minimum is accepted even if its error exceeds the tolerance
     ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]);
     /// - a slipping rotor (no equilibrium ahead) advances by whole overdamped turns

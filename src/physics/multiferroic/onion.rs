@@ -3,18 +3,49 @@
 //! nearest one, as the text says, unless a barrier lies between). When that minimum disappears
 //! (a fold), the same rule carries it downhill to the next one.
 //!
-//! Hand-written (expanding downhill bracket, then safeguarded Newton) rather than a library
-//! minimizer: it runs on the per-substep hot path, must respect the memory rule (a global
-//! minimizer would not), and every loop is capped.
+//! Hand-written (a downhill march whose strides provably cannot cross a root of the gradient,
+//! then the shared safeguarded Newton-bisection) rather than a library minimizer: it runs on the
+//! per-substep hot path, must respect the memory rule (a global minimizer would not), and every
+//! loop is capped.
+//!
+//! Why the march is safe (issue 16: a fixed 0.05 rad stride stepped over basins less than 1 degree
+//! wide near a fold, leaving the onion at a far minimum). Write `h(s) = dir U'(psi0 + dir s)`,
+//! negative while going downhill, with `h'(s) = U''(psi0 + dir s)` and `|h''| <= M`, a bound on
+//! the third derivative of U. With `a = -h(0)` and `c = h'(0)`:
+//! - `h` stays negative for `s < s_safe = (sqrt(c^2 + 2 M a) - c) / M`;
+//! - `h` is increasing on `[0, c / M)`, so a trial stride inside that window that ends with
+//!   `h >= 0` holds exactly one root (the first minimum), and one that ends with `h < 0` none.
+//!
+//! Either way no minimum is ever stepped over, and near a simple minimum `s_safe` is the Newton
+//! step to second order, so the march costs one or two evaluations in the usual case.
 
 use super::magnetics::RingBar;
+use crate::physics::root::{newton_bisection, RootOptions, Sample};
 
-/// Largest bracket stride (rad): small enough not to stride over a basin of the eq. 3.4 landscape
-/// (features are tens of degrees wide) except right at a fold, where the basin is vanishing.
-const MAX_STRIDE: f64 = 0.05;
-/// Expanding-search cap: more than a full turn at the largest stride.
-const MAX_BRACKET_STEPS: usize = 200;
-const MAX_REFINE_STEPS: usize = 100;
+/// Cap on the downhill march (a full turn far from any minimum takes a few dozen strides).
+const MAX_MARCH_STEPS: usize = 2000;
+const REFINE: RootOptions = RootOptions {
+    absolute: 1e-15,
+    relative: 1e-15,
+    max_iterations: 100,
+};
+/// Samples per turn for [`curvature_slope_bound`].
+const BOUND_SAMPLES: usize = 7200;
+
+/// An upper bound of the third derivative of eq. 3.3's ring-bar energy in the offset (J/rad^3):
+/// the sampled maximum of the stiffness's finite-difference slope with a 25% margin (the function
+/// is smooth on a scale of `(r - a) / r` rad, far coarser than the 0.05 degree samples).
+pub fn curvature_slope_bound(ring_bar: &RingBar) -> f64 {
+    let h = 2.0 * std::f64::consts::PI / BOUND_SAMPLES as f64;
+    let mut max = 0.0f64;
+    let mut previous = ring_bar.stiffness(-h);
+    for i in 0..=BOUND_SAMPLES {
+        let k = ring_bar.stiffness(i as f64 * h);
+        max = max.max((k - previous).abs() / h);
+        previous = k;
+    }
+    1.25 * max
+}
 
 /// Energy landscape of eq. 3.4 in the onion angle, for a fixed bar angle and strain.
 #[derive(Clone, Copy, Debug)]
@@ -26,6 +57,8 @@ pub struct Landscape<'a> {
     pub strain_direction: f64,
     /// `(3/2) lambda_s sigma V_wall` (J): the magnetoelastic energy is `E sin^2(psi - gamma)`.
     pub magnetoelastic: f64,
+    /// [`curvature_slope_bound`] of `ring_bar` (J/rad^3).
+    pub ring_bar_slope_bound: f64,
 }
 
 impl Landscape<'_> {
@@ -43,8 +76,20 @@ impl Landscape<'_> {
             + 2.0 * self.magnetoelastic * (2.0 * (onion - self.strain_direction)).cos()
     }
 
+    /// Energy relative to an arbitrary constant (J): eq. 3.3 plus eq. 3.4's wall term.
+    pub fn energy(&self, onion: f64) -> f64 {
+        let s = (onion - self.strain_direction).sin();
+        self.ring_bar.energy(onion - self.bar_angle) + self.magnetoelastic * s * s
+    }
+
+    /// Bound on the third derivative of U in psi (J/rad^3): the ring-bar's plus `4 |E|`.
+    fn third_derivative_bound(&self) -> f64 {
+        self.ring_bar_slope_bound + 4.0 * self.magnetoelastic.abs()
+    }
+
     /// The minimum reached downhill from `previous` (rad, unwrapped: the result stays on the same
-    /// branch, so the onion angle is continuous).
+    /// branch, so the onion angle is continuous). Never steps over a minimum (see the module
+    /// documentation), so the onion settles in the basin it is in, however narrow.
     pub fn settle(&self, previous: f64) -> f64 {
         let g0 = self.gradient(previous);
         let c0 = self.curvature(previous);
@@ -56,53 +101,49 @@ impl Landscape<'_> {
         }
         // Downhill direction; from a maximum (zero gradient, negative curvature) go forward.
         let dir = if g0 > tiny { -1.0 } else { 1.0 };
-        let mut stride = if c0 > 0.0 {
-            (1.5 * g0.abs() / c0).clamp(1e-9, MAX_STRIDE)
-        } else {
-            1e-3
-        };
-        let mut lo = previous;
-        let mut hi = previous;
-        let mut bracketed = false;
-        for _ in 0..MAX_BRACKET_STEPS {
-            hi = lo + dir * stride;
-            if dir * self.gradient(hi) >= 0.0 {
-                bracketed = true;
-                break;
-            }
-            lo = hi;
-            stride = (2.0 * stride).min(MAX_STRIDE);
-        }
-        if !bracketed {
-            // A landscape flat to rounding over a full turn: nothing pulls the onion state.
+        let m = self.third_derivative_bound();
+        if !(m.is_finite() && m > 0.0) {
             return previous;
         }
-        self.refine(lo, hi, dir)
+        let (mut x, mut g, mut c) = (previous, g0, c0);
+        for _ in 0..MAX_MARCH_STEPS {
+            // h(0) = dir g = -a <= 0 (downhill), h'(0) = c.
+            let a = (-dir * g).max(0.0);
+            let safe = ((c * c + 2.0 * m * a).sqrt() - c) / m;
+            let window = 0.99 * c / m;
+            // Inside the monotone window a longer trial is safe; outside it only `safe` is.
+            let stride = if c > 0.0 && window > safe {
+                (2.0 * safe).min(window)
+            } else {
+                safe
+            };
+            if !(stride.is_finite() && stride > 0.0) {
+                break;
+            }
+            let end = x + dir * stride;
+            if end == x {
+                break;
+            }
+            let g_end = self.gradient(end);
+            if dir * g_end >= 0.0 {
+                return self.refine(x, end);
+            }
+            (x, g, c) = (end, g_end, self.curvature(end));
+        }
+        // A landscape flat to rounding, or a degenerate fold: stay where the march stopped.
+        x
     }
 
-    /// Root of the gradient between `lo` (downhill side, `dir * g < 0`) and `hi` (`dir * g >= 0`).
-    fn refine(&self, mut lo: f64, mut hi: f64, dir: f64) -> f64 {
-        let mut x = 0.5 * (lo + hi);
-        for _ in 0..MAX_REFINE_STEPS {
-            let g = self.gradient(x);
-            let c = self.curvature(x);
-            let converged = c > 0.0 && (g / c).abs() <= 1e-15 * (1.0 + x.abs());
-            if converged || (hi - lo).abs() <= 1e-15 * (1.0 + x.abs()) {
-                return x;
-            }
-            if dir * g < 0.0 {
-                lo = x;
-            } else {
-                hi = x;
-            }
-            let newton = x - g / c;
-            let inside = (newton - lo) * (newton - hi) < 0.0;
-            x = if c > 0.0 && newton.is_finite() && inside {
-                newton
-            } else {
-                0.5 * (lo + hi)
-            };
-        }
-        x
+    /// The minimum between `a` and `b`, where the gradient changes sign from downhill to uphill.
+    fn refine(&self, a: f64, b: f64) -> f64 {
+        // Left of a minimum the gradient is negative, right of it positive: rising.
+        let root = newton_bisection(a, b, 0.5 * (a + b), true, REFINE, |x| {
+            Ok::<_, ()>(Some(Sample {
+                value: self.gradient(x),
+                slope: self.curvature(x),
+                payload: (),
+            }))
+        });
+        root.map_or(0.5 * (a + b), |r| r.x)
     }
 }

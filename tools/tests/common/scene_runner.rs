@@ -1,7 +1,7 @@
-//! Runs a scene (`scenes/*.json`, `actuator_fmus::scene`) through the `fmi` crate, with FMPy's
+//! Runs a scene (`scenes/*.json`, `actuator_fmus_tools::scene`) through the `fmi` crate, with FMPy's
 //! recording convention: inputs are applied at t, the step runs to t + h, outputs are read at t + h.
 
-use actuator_fmus::scene::{Check, Scene, Signal, Value};
+use actuator_fmus_tools::scene::{Check, Scene, Signal, Value};
 use fmi::fmi2::import::Fmi2Import;
 use fmi::fmi2::instance::{CoSimulation, Common};
 use fmi::schema::fmi2::ScalarVariableElement;

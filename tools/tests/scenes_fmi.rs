@@ -1,17 +1,15 @@
 //! Every catalogue scene, in its fast variant, through the `fmi` crate: it runs, its outputs are
 //! finite and the dissertation's numbers it names hold (the FMPy runner checks the same in pytest).
 
-mod common;
 #[allow(dead_code)]
 #[path = "common/scene_runner.rs"]
 mod scene_runner;
 
-use actuator_fmus::scene::Scene;
-use std::path::Path;
+use actuator_fmus_tools::scene::Scene;
 
 #[test]
 fn catalogue_scenes_run_and_match_the_dissertation() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = &actuator_fmus_tools::repository_root();
     let mut scenes: Vec<_> = std::fs::read_dir(root.join("scenes"))
         .unwrap()
         .map(|e| e.unwrap().path())
@@ -46,7 +44,7 @@ fn catalogue_scenes_run_and_match_the_dissertation() {
 
 #[test]
 fn csv_input_signal_through_the_fmi_crate() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = &actuator_fmus_tools::repository_root();
     let dir = std::env::temp_dir().join(format!("scene-csv-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     std::fs::write(dir.join("u.csv"), "time,u\n0,0\n0.5,1\n1,0\n").unwrap();

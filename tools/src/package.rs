@@ -1,7 +1,7 @@
 //! Writes `<Model>.fmu` archives: model description, binary, and generated documentation.
 
-use crate::fmi2::runtime::Factory;
-use crate::variables::{ModelInfo, Start, Variable};
+use actuator_fmus::fmi2::runtime::Factory;
+use actuator_fmus::variables::{ModelInfo, Start, Variable};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use zip::write::SimpleFileOptions;
@@ -9,16 +9,41 @@ use zip::write::SimpleFileOptions;
 /// Packs one FMU per registered model into `out_dir`, each with a copy of the shared library
 /// `binary` (one library serves every model; `fmi2Instantiate` picks the model by GUID).
 pub fn package_all(binary: &Path, out_dir: &Path) -> Result<Vec<PathBuf>, String> {
-    let so = std::fs::read(binary).map_err(|e| format!("cannot read {}: {e}", binary.display()))?;
+    package_all_platforms(&[("linux64".into(), binary.to_path_buf())], out_dir)
+}
+
+/// As [`package_all`], with one binary per platform folder: `linux64` (x86_64 Linux), `win64`
+/// (`.dll`), `aarch64-linux` (FMI 2.0.4 section 2.3 names other platforms as FMI 3.0 does).
+pub fn package_all_platforms(
+    binaries: &[(String, PathBuf)],
+    out_dir: &Path,
+) -> Result<Vec<PathBuf>, String> {
+    let binaries = binaries
+        .iter()
+        .map(|(platform, path)| {
+            let data =
+                std::fs::read(path).map_err(|e| format!("cannot read {}: {e}", path.display()))?;
+            let extension = if platform.starts_with("win") || platform.ends_with("-windows") {
+                "dll"
+            } else {
+                "so"
+            };
+            Ok((platform.clone(), extension, data))
+        })
+        .collect::<Result<Vec<_>, String>>()?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-    crate::fmi2::REGISTRY
+    actuator_fmus::fmi2::REGISTRY
         .iter()
-        .map(|f| package(*f, &so, out_dir))
+        .map(|f| package(*f, &binaries, out_dir))
         .collect()
 }
 
-fn package(factory: &dyn Factory, so: &[u8], out_dir: &Path) -> Result<PathBuf, String> {
+fn package(
+    factory: &dyn Factory,
+    binaries: &[(String, &str, Vec<u8>)],
+    out_dir: &Path,
+) -> Result<PathBuf, String> {
     let info = factory.info();
     let path = out_dir.join(format!("{}.fmu", info.name));
     let file = std::fs::File::create(&path)
@@ -26,7 +51,7 @@ fn package(factory: &dyn Factory, so: &[u8], out_dir: &Path) -> Result<PathBuf, 
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     // A plot of the model's cross-check run (crosscheck/generate.py), shipped when present.
-    let plot_path = Path::new(env!("CARGO_MANIFEST_DIR"))
+    let plot_path = crate::repository_root()
         .join("docs/fmu")
         .join(format!("{}.png", info.name));
     let plot = std::fs::read(&plot_path).ok();
@@ -45,9 +70,14 @@ fn package(factory: &dyn Factory, so: &[u8], out_dir: &Path) -> Result<PathBuf, 
             "modelDescription.xml".into(),
             info.model_description_xml.as_bytes(),
         ),
-        (format!("binaries/linux64/{}.so", info.name), so),
         ("documentation/index.html".into(), doc.as_bytes()),
     ];
+    for (platform, extension, data) in binaries {
+        entries.push((
+            format!("binaries/{platform}/{}.{extension}", info.name),
+            data,
+        ));
+    }
     if let Some(png) = &plot {
         entries.push(("documentation/plot.png".into(), png));
     }

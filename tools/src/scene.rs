@@ -316,7 +316,7 @@ mod tests {
 
     #[test]
     fn every_catalogue_scene_parses() {
-        let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes");
+        let dir = crate::repository_root().join("scenes");
         let mut n = 0;
         for entry in std::fs::read_dir(dir).unwrap() {
             let path = entry.unwrap().path();
@@ -388,8 +388,7 @@ mod tests {
 
     #[test]
     fn shipped_schema_is_the_generated_one() {
-        let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
-            .join("scenes/schema/scene.schema.json");
+        let path = crate::repository_root().join("scenes/schema/scene.schema.json");
         let shipped = std::fs::read_to_string(&path).unwrap_or_default();
         assert!(
             shipped == json_schema(),

@@ -1,12 +1,12 @@
 //! Runs scene files through the `fmi` crate (the Rust-side importer) and writes
-//! `<out>/<scene>_fmi.csv`: `cargo run --release --example run_scene -- scenes/<scene>.json [--fast]`.
+//! `<out>/<scene>_fmi.csv`: `cargo run --release -p actuator-fmus-tools --example run_scene -- scenes/<scene>.json [--fast]`.
 //! `--schema` prints the JSON Schema of scene files instead (`scenes/schema/scene.schema.json`).
 
 #[allow(dead_code)]
 #[path = "../tests/common/scene_runner.rs"]
 mod scene_runner;
 
-use actuator_fmus::scene::{json_schema, Scene};
+use actuator_fmus_tools::scene::{json_schema, Scene};
 use std::path::{Path, PathBuf};
 
 fn main() {
@@ -16,7 +16,7 @@ fn main() {
         print!("{}", json_schema());
         return;
     }
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = &actuator_fmus_tools::repository_root();
     let mut failed = 0;
     for path in args
         .iter()

@@ -1,0 +1,122 @@
+//! `fmi2GetDirectionalDerivative`: the importer's seed `dv_known` over inputs, times the model's
+//! exact partials ([`Model::partials`]), gives `dv_unknown` over outputs. No finite differences:
+//! a model that has no partials says so and the call is refused.
+
+use super::instance::{allowed, Instance};
+use super::registry::Bindings;
+use super::types::fmi2Status;
+use crate::models::{Inputs, Model};
+use crate::variables::{Causality, Interface, VarType};
+
+/// `dv_unknown[i] = sum_j d(unknown_i)/d(known_j) dv_known[j]` for model `M` at the current inputs.
+pub(super) fn directional_derivative<M: Model>(
+    model: Option<&mut M>,
+    inputs: &Inputs<M>,
+    unknown: &[u32],
+    known: &[u32],
+    dv_known: &[f64],
+    dv_unknown: &mut [f64],
+) -> Result<(), String>
+where
+    M::Variables: Bindings,
+{
+    let info = M::Variables::INFO;
+    let name = |vr: u32, causality: Causality, role: &str| {
+        let var = info
+            .variable(VarType::Real, vr)
+            .ok_or_else(|| format!("{vr} is not the value reference of a Real variable"))?;
+        if var.causality == causality {
+            Ok(var.name)
+        } else {
+            Err(format!(
+                "{} (value reference {vr}) is not an {role} of {}",
+                var.name, info.name
+            ))
+        }
+    };
+    let knowns = known
+        .iter()
+        .map(|&vr| name(vr, Causality::Input, "input"))
+        .collect::<Result<Vec<_>, _>>()?;
+    let unknowns = unknown
+        .iter()
+        .map(|&vr| name(vr, Causality::Output, "output"))
+        .collect::<Result<Vec<_>, _>>()?;
+    if let Some(bad) = dv_known.iter().find(|v| !v.is_finite()) {
+        return Err(format!("dvKnown must be finite, got {bad}"));
+    }
+    let model = model.ok_or("no model yet: call it in initialization mode or later")?;
+    let partials = model.partials(inputs)?;
+    for (slot, output) in dv_unknown.iter_mut().zip(&unknowns) {
+        let row = partials
+            .get(output)
+            .ok_or_else(|| format!("the partial derivatives of {output} are not provided"))?;
+        let value: f64 = knowns
+            .iter()
+            .zip(dv_known)
+            .filter_map(|(input, seed)| {
+                row.iter()
+                    .find(|(name, _)| name == input)
+                    .map(|(_, d)| d * seed)
+            })
+            .sum();
+        if !value.is_finite() {
+            return Err(format!("the derivative of {output} overflows"));
+        }
+        *slot = value;
+    }
+    Ok(())
+}
+
+impl Instance {
+    pub fn get_directional_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> fmi2Status {
+        const F: &str = "fmi2GetDirectionalDerivative";
+        if !self.allowed(F, allowed::GET) {
+            return fmi2Status::Error;
+        }
+        // Builds the model in initialization mode (as fmi2GetReal does); the partials need no
+        // fresh outputs, so a built model skips that evaluation.
+        let status = if self.runtime.is_built() {
+            fmi2Status::OK
+        } else {
+            self.refresh_outputs(F)
+        };
+        if status >= fmi2Status::Error {
+            return status;
+        }
+        match self
+            .runtime
+            .directional_derivative(unknown, known, dv_known, dv_unknown)
+        {
+            Ok(()) => status,
+            Err(why) => self.error(&format!("{F}: {why}")),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::REGISTRY;
+
+    #[test]
+    fn the_shipped_capabilities_match_the_models() {
+        for factory in REGISTRY {
+            let info = factory.info();
+            let mut runtime = factory.create();
+            runtime.build().unwrap();
+            let provided = runtime.directional_derivative(&[], &[], &[], &mut []);
+            let flag = info
+                .model_description_xml
+                .contains(r#"providesDirectionalDerivative="true""#);
+            assert_eq!(provided.is_ok(), flag, "{}: {provided:?}", info.name);
+            let model_exchange = info.model_description_xml.contains("<ModelExchange");
+            assert_eq!(factory.model_exchange(), model_exchange, "{}", info.name);
+        }
+    }
+}

@@ -1,0 +1,237 @@
+//! The call-sequence state machine of FMI 2.0.4 section 4.2.4: which function may be called in
+//! which state, and the functions that move between states (initialization, stepping, reset).
+
+use super::Instance;
+use crate::fmi2::types::fmi2Status;
+use crate::models::Report;
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+pub enum MachineState {
+    Instantiated,
+    InitializationMode,
+    StepComplete,
+    StepFailed,
+    Terminated,
+    Error,
+    Fatal,
+    /// Model Exchange (`src/fmi2/model_exchange.rs`); after the others so that saved states keep
+    /// their encoding.
+    EventMode,
+    ContinuousTimeMode,
+}
+
+impl MachineState {
+    pub(super) const fn bit(self) -> u32 {
+        1 << self as u32
+    }
+}
+
+/// Which states each function may be called in (FMI 2.0.4 section 4.2.4; asynchronous states
+/// never occur because `canRunAsynchronuously` is false).
+pub mod allowed {
+    use super::MachineState::*;
+    const fn mask(states: &[super::MachineState]) -> u32 {
+        let mut m = 0;
+        let mut i = 0;
+        while i < states.len() {
+            m |= states[i].bit();
+            i += 1;
+        }
+        m
+    }
+    pub const ALL_BUT_FATAL: u32 = mask(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        StepFailed,
+        Terminated,
+        Error,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const SETUP_EXPERIMENT: u32 = mask(&[Instantiated]);
+    pub const ENTER_INITIALIZATION: u32 = mask(&[Instantiated]);
+    pub const EXIT_INITIALIZATION: u32 = mask(&[InitializationMode]);
+    pub const TERMINATE: u32 = mask(&[StepComplete, StepFailed, EventMode, ContinuousTimeMode]);
+    pub const GET: u32 = mask(&[
+        InitializationMode,
+        StepComplete,
+        StepFailed,
+        Terminated,
+        Error,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const SET: u32 = mask(&[
+        Instantiated,
+        InitializationMode,
+        StepComplete,
+        EventMode,
+        ContinuousTimeMode,
+    ]);
+    pub const EVENT_MODE: u32 = mask(&[EventMode]);
+    pub const CONTINUOUS_TIME_MODE: u32 = mask(&[ContinuousTimeMode]);
+    pub const EVENT_OR_CONTINUOUS_TIME_MODE: u32 = mask(&[EventMode, ContinuousTimeMode]);
+    /// The continuous-state getters (FMI 2.0.4 section 3.2.3).
+    pub const GET_STATES: u32 = mask(&[
+        InitializationMode,
+        EventMode,
+        ContinuousTimeMode,
+        Terminated,
+        Error,
+    ]);
+    pub const DO_STEP: u32 = mask(&[StepComplete]);
+    pub const STATUS: u32 = mask(&[StepComplete, StepFailed, Terminated]);
+}
+
+impl Instance {
+    pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> fmi2Status {
+        if !self.allowed("fmi2SetDebugLogging", allowed::ALL_BUT_FATAL) {
+            return fmi2Status::Error;
+        }
+        if let Some(unknown) = categories
+            .iter()
+            .find(|c| !self.info.log_categories.contains(c))
+        {
+            return self.error(&format!(
+                "fmi2SetDebugLogging: unknown log category '{unknown}' (known: {})",
+                self.info.log_categories.join(", ")
+            ));
+        }
+        // Warnings and errors are always logged; the switch is about call tracing.
+        self.logger.debug = on && (categories.is_empty() || categories.contains(&"logCalls"));
+        fmi2Status::OK
+    }
+
+    pub fn setup_experiment(
+        &mut self,
+        tolerance: Option<f64>,
+        start: f64,
+        stop: Option<f64>,
+    ) -> fmi2Status {
+        if !self.allowed("fmi2SetupExperiment", allowed::SETUP_EXPERIMENT) {
+            return fmi2Status::Error;
+        }
+        if !start.is_finite()
+            || stop.is_some_and(|s| !s.is_finite())
+            || tolerance.is_some_and(|t| t.is_nan() || t <= 0.0)
+        {
+            return self.error(&format!(
+                "fmi2SetupExperiment: startTime {start}, stopTime {stop:?} and tolerance {tolerance:?} must be finite (tolerance positive)"
+            ));
+        }
+        if let Some(stop) = stop.filter(|&s| s < start) {
+            return self.error(&format!(
+                "fmi2SetupExperiment: stopTime {stop} is before startTime {start}"
+            ));
+        }
+        self.start_time = start;
+        self.time = start;
+        self.stop_time = stop;
+        fmi2Status::OK
+    }
+
+    pub fn enter_initialization_mode(&mut self) -> fmi2Status {
+        if !self.allowed("fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION) {
+            return fmi2Status::Error;
+        }
+        self.state = MachineState::InitializationMode;
+        fmi2Status::OK
+    }
+
+    pub fn exit_initialization_mode(&mut self) -> fmi2Status {
+        if !self.allowed("fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION) {
+            return fmi2Status::Error;
+        }
+        let status = self.refresh_outputs("fmi2ExitInitializationMode");
+        if status >= fmi2Status::Error {
+            // Bad parameters: the instance can be reset (or freed).
+            self.state = MachineState::Error;
+            return status;
+        }
+        self.state = if self.model_exchange {
+            MachineState::EventMode
+        } else {
+            MachineState::StepComplete
+        };
+        status
+    }
+
+    pub fn terminate(&mut self) -> fmi2Status {
+        if !self.allowed("fmi2Terminate", allowed::TERMINATE) {
+            return fmi2Status::Error;
+        }
+        self.state = MachineState::Terminated;
+        fmi2Status::OK
+    }
+
+    /// Back to the state after instantiation: start values, no model, time zero.
+    pub fn reset(&mut self) -> fmi2Status {
+        if !self.allowed("fmi2Reset", allowed::ALL_BUT_FATAL) {
+            return fmi2Status::Error;
+        }
+        self.runtime.reset();
+        self.state = MachineState::Instantiated;
+        self.time = 0.0;
+        self.start_time = 0.0;
+        self.stop_time = None;
+        fmi2Status::OK
+    }
+
+    pub fn do_step(&mut self, time: f64, step: f64) -> fmi2Status {
+        const F: &str = "fmi2DoStep";
+        if !self.allowed(F, allowed::DO_STEP) {
+            return fmi2Status::Error;
+        }
+        if !(step > 0.0 && step.is_finite()) {
+            return self.error(&format!(
+                "{F}: communicationStepSize = {step} must be positive and finite"
+            ));
+        }
+        // The importer's clock and ours may differ by rounding only; adopt the importer's. The
+        // allowance scales with the clocks, not the step: a long step must not excuse a wrong
+        // communication point.
+        let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs());
+        if !time.is_finite() || (time - self.time).abs() > tolerance {
+            return self.error(&format!(
+                "{F}: expected currentCommunicationPoint = {:.16e} but was {time:.16e}",
+                self.time
+            ));
+        }
+        if let Some(stop) = self.stop_time {
+            // A step computed as stop - time may overshoot by rounding of either.
+            let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
+            if time + step > stop + tolerance {
+                return self.error(&format!(
+                    "{F}: a step to {:.16e} would pass the stop time {stop:.16e}",
+                    time + step
+                ));
+            }
+        }
+        let mut report = Report::default();
+        self.runtime.step(time, step, &mut report);
+        let status = self.forward(F, report, true);
+        match status {
+            fmi2Status::OK | fmi2Status::Warning => self.time = time + step,
+            fmi2Status::Discard => self.state = MachineState::StepFailed,
+            _ => self.state = MachineState::Error,
+        }
+        status
+    }
+
+    pub fn last_successful_time(&self) -> Result<f64, fmi2Status> {
+        if !self.allowed("fmi2GetRealStatus", allowed::STATUS) {
+            return Err(fmi2Status::Error);
+        }
+        Ok(self.time)
+    }
+
+    pub fn status_check(&self, function: &str) -> bool {
+        self.allowed(function, allowed::STATUS)
+    }
+
+    pub fn unsupported(&self, function: &str, why: &str) -> fmi2Status {
+        self.error(&format!("{function}: not supported: {why}"))
+    }
+}

@@ -1,0 +1,164 @@
+//! One FMU instance: its core (this file), the FMI 2.0.4 Co-Simulation call-sequence state
+//! machine (section 4.2.4, `machine`), the rules for which variables may be set when (section
+//! 2.2.7, `values`) and FMU states (`fmu_state`). The code here works on Rust slices and
+//! references; `exports.rs` turns the importer's C pointers into them. The only `unsafe` here is in
+//! `fmu_state`, on the state pointers this instance handed out itself.
+
+mod fmu_state;
+mod machine;
+#[cfg(test)]
+mod tests;
+mod values;
+
+pub use fmu_state::FmuState;
+pub use machine::{allowed, MachineState};
+pub use values::{CBoolean, Value};
+
+use super::logger::Logger;
+use super::out_of_range::OutOfRange;
+use super::runtime::{Factory, Runtime};
+use super::types::fmi2Status;
+use crate::models::{Report, Status};
+use crate::variables::{ModelInfo, VarType, Variable};
+use std::collections::HashSet;
+use std::ffi::CString;
+
+/// Marks a live instance, so that a stale or foreign pointer is refused rather than used.
+pub const MAGIC: u64 = 0x6163_7475_6174_6f72;
+
+pub struct Instance {
+    pub magic: u64,
+    pub logger: Logger,
+    info: &'static ModelInfo,
+    /// Variables by type and value reference (value references are dense per type).
+    by_type: [Vec<&'static Variable>; 4],
+    pub state: MachineState,
+    /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
+    pub(super) model_exchange: bool,
+    pub(super) time: f64,
+    start_time: f64,
+    stop_time: Option<f64>,
+    pub(super) runtime: Box<dyn Runtime>,
+    /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
+    string_values: Vec<CString>,
+    /// The FMU states this instance handed out and has not freed; others are refused.
+    fmu_states: HashSet<usize>,
+    out_of_range: OutOfRange,
+}
+
+fn type_index(kind: VarType) -> usize {
+    match kind {
+        VarType::Real => 0,
+        VarType::Integer => 1,
+        VarType::Boolean => 2,
+        VarType::String => 3,
+    }
+}
+
+fn to_fmi(status: Status) -> fmi2Status {
+    match status {
+        Status::Ok => fmi2Status::OK,
+        Status::Warning => fmi2Status::Warning,
+        Status::Discard => fmi2Status::Discard,
+        Status::Error => fmi2Status::Error,
+    }
+}
+
+impl Instance {
+    pub fn new(factory: &'static dyn Factory, logger: Logger) -> Self {
+        let info = factory.info();
+        let by_type = std::array::from_fn(|t| {
+            (0..info.counts[t])
+                .filter_map(|vr| {
+                    info.variables
+                        .iter()
+                        .find(|v| type_index(v.kind) == t && v.vr as usize == vr)
+                })
+                .collect()
+        });
+        Self {
+            magic: MAGIC,
+            logger,
+            info,
+            by_type,
+            state: MachineState::Instantiated,
+            model_exchange: false,
+            time: 0.0,
+            start_time: 0.0,
+            stop_time: None,
+            runtime: factory.create(),
+            string_values: Vec::new(),
+            fmu_states: HashSet::new(),
+            out_of_range: OutOfRange::new(info),
+        }
+    }
+
+    pub fn error(&self, message: &str) -> fmi2Status {
+        self.logger.log(fmi2Status::Error, message);
+        fmi2Status::Error
+    }
+
+    /// Logs and refuses a call that the current state does not allow.
+    pub fn allowed(&self, function: &str, mask: u32) -> bool {
+        if mask & self.state.bit() == 0 {
+            self.error(&format!(
+                "{function}: illegal call in state {:?}",
+                self.state
+            ));
+            return false;
+        }
+        if self.logger.debug {
+            self.logger.log(
+                fmi2Status::OK,
+                &format!("{function} in state {:?}", self.state),
+            );
+        }
+        true
+    }
+
+    /// Applies the out-of-range policy, passes a model's messages to the logger and turns its
+    /// status into an FMI status; `in_step` for fmi2DoStep.
+    pub(super) fn forward(
+        &mut self,
+        function: &str,
+        mut report: Report,
+        in_step: bool,
+    ) -> fmi2Status {
+        let notes = self
+            .out_of_range
+            .apply(self.runtime.as_mut(), &mut report, in_step);
+        for note in notes {
+            self.logger.notice(&format!("{function}: {note}"));
+        }
+        for (status, message) in &report.messages {
+            self.logger
+                .log(to_fmi(*status), &format!("{function}: {message}"));
+        }
+        to_fmi(report.status)
+    }
+
+    /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.
+    pub(super) fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
+        if !self.runtime.is_built() {
+            if self.state != MachineState::InitializationMode {
+                return fmi2Status::OK;
+            }
+            if let Err(reason) = self.runtime.build() {
+                return self.error(&format!("{function}: parameters rejected: {reason}"));
+            }
+        }
+        let mut report = Report::default();
+        self.runtime.refresh_outputs(&mut report);
+        self.forward(function, report, false)
+    }
+}
+
+impl Drop for Instance {
+    fn drop(&mut self) {
+        self.magic = 0;
+        for ptr in self.fmu_states.drain() {
+            // SAFETY: every pointer in the set came from Box::into_raw and was not freed.
+            drop(unsafe { Box::from_raw(ptr as *mut FmuState) });
+        }
+    }
+}

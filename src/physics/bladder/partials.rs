@@ -1,0 +1,76 @@
+//! Exact first partial derivatives of the bladder's outputs with respect to the gauge pressure and
+//! the muscle length, for the FMUs' directional derivatives.
+//!
+//! In contact the outer diameter is the sleeve's `D(L)` (eq. 2.7, 2.20), independent of `P`, and
+//! every layer's pressure is affine in `P` (eq. 2.12, 2.19), so `dP_eff/dP = a` and the elastic
+//! force's `P`-slope is summed in the same layer pass. When free, the diameter `x` solves
+//! `P_eff(P, L, x) = 0` (eq. 2.18): the implicit function theorem gives `dx/dP = -a / (dP_eff/dx)`
+//! and `dx/dL = -(dP_eff/dL) / (dP_eff/dx)`. At the contact threshold (`P_eff = 0`) the force
+//! kinks; the partials are those of the contact branch, which [`Bladder::evaluate`] selects there.
+
+use super::{Bladder, Dual, SleeveGeometry};
+
+/// `[d/dP, d/dL]` of the bladder's outputs, per Pa and per m.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct BladderPartials {
+    /// Muscle tension `F` (eq. 2.16 + 2.17), N/Pa and N/m.
+    pub force: [f64; 2],
+    /// Contact pressure `P_eff` (eq. 2.12, 2.19), 1 and Pa/m; zero when free.
+    pub effective_pressure: [f64; 2],
+    /// Gas volume `pi/4 D_in^2 L`, m^3/Pa and m^2.
+    pub fluid_volume: [f64; 2],
+}
+
+impl<S: SleeveGeometry> Bladder<S> {
+    /// The partials at `pressure` and `length`, on the branch [`Bladder::evaluate`] takes there.
+    pub fn partials(&self, pressure: f64, length: f64) -> Result<BladderPartials, String> {
+        if !pressure.is_finite() {
+            return Err(format!("pressure must be finite, got {pressure} Pa"));
+        }
+        self.check_length(length)?;
+        let (l, x) = self.contact_seed(length);
+        let contact = self
+            .kernel(pressure, l, x)
+            .ok_or_else(|| self.domain_error(length))?;
+        if contact.p_eff.v >= 0.0 {
+            // The seed carries the contact branch's total d/dL in `dl`.
+            let (g, g_slope) = self.sleeve.strand_area(length);
+            let area = self.fluid_area(contact.inner.l2_sq);
+            let a = contact.a.v;
+            return Ok(BladderPartials {
+                // F = P_eff g - P A_fluid + elastic (eq. 2.16, 2.17).
+                force: [
+                    a * g - area.v + contact.elastic_dp,
+                    contact.p_eff.dl * g + contact.p_eff.v * g_slope - pressure * area.dl
+                        + contact.elastic.dl,
+                ],
+                effective_pressure: [a, contact.p_eff.dl],
+                fluid_volume: [0.0, area.dl * length + area.v],
+            });
+        }
+        let x_root = self.free_outer_diameter(pressure, length, x.v)?;
+        let k = self
+            .kernel(pressure, Dual::var_l(length), Dual::var_x(x_root))
+            .ok_or_else(|| self.domain_error(length))?;
+        let area = self.fluid_area(k.inner.l2_sq);
+        let (dx_dp, dx_dl) = if k.p_eff.dx != 0.0 {
+            (-k.a.v / k.p_eff.dx, -k.p_eff.dl / k.p_eff.dx)
+        } else {
+            (0.0, 0.0)
+        };
+        // F = -P A_fluid(L, x) + elastic(P, L, x) with x = x(P, L).
+        let force_dx = -pressure * area.dx + k.elastic.dx;
+        let force_dl = -pressure * area.dl + k.elastic.dl;
+        Ok(BladderPartials {
+            force: [
+                -area.v + k.elastic_dp + force_dx * dx_dp,
+                force_dl + force_dx * dx_dl,
+            ],
+            effective_pressure: [0.0, 0.0],
+            fluid_volume: [
+                area.dx * dx_dp * length,
+                area.v + (area.dl + area.dx * dx_dl) * length,
+            ],
+        })
+    }
+}

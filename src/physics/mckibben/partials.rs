@@ -1,0 +1,263 @@
+//! Exact partial derivatives of the muscle's outputs with respect to its inputs (gauge pressure
+//! and reported length), for the FMU's directional derivatives.
+//!
+//! The muscle's own partials come from eq. 2.3 (no bladder) or from [`Bladder::partials`]; friction
+//! adds `C_f P_eff z` (eq. 2.4) with `z` the stop operator advanced to the length, whose slope is
+//! `1/presliding_length` in the direction of motion unless saturated there; the connector's
+//! `reported = L + F(P, L)/k` gives `dL/dP = -F_P / (k + F_L)` and `dL/dreported = k / (k + F_L)`.
+//!
+//! Where the model has a kink the partial is the one of the branch it evaluates: the contact
+//! branch at the threshold pressure (`P_eff = 0`, `bladder_contact` true), `P_eff = 0` for the bare
+//! sleeve at `P <= 0`, and at a friction reversal (length equal to the history's position) the
+//! slope for increasing length.
+
+use super::{McKibben, McKibbenOutput};
+use crate::physics::friction::HysteresisState;
+
+/// `[d/dP, d/dlength]` of the outputs, with `length` the input (reported) length.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct McKibbenPartials {
+    /// N/Pa and N/m.
+    pub force: [f64; 2],
+    /// 1 and Pa/m.
+    pub effective_pressure: [f64; 2],
+    /// N/Pa and N/m.
+    pub friction_force: [f64; 2],
+    /// m^3/Pa and m^2.
+    pub volume: [f64; 2],
+}
+
+impl McKibben {
+    /// The outputs of [`McKibben::evaluate`] and their partials at the same point.
+    pub fn partials(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Result<(McKibbenOutput, McKibbenPartials), String> {
+        let out = self.evaluate(pressure, length, history)?;
+        let l = out.actual_length;
+        // Partials with respect to (P, actual length).
+        let mut d = match &self.bladder {
+            None => {
+                let s = &self.sleeve;
+                let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+                // Eq. 2.3 and 2.2: F = P_eff (3L^2 - b^2)/(4 pi n^2), dV/dL = -F/P_eff.
+                let per_pa = s.force(1.0, l);
+                McKibbenPartials {
+                    force: [on * per_pa, s.stiffness(pressure.max(0.0), l)],
+                    effective_pressure: [on, 0.0],
+                    friction_force: [0.0, 0.0],
+                    volume: [0.0, -per_pa],
+                }
+            }
+            Some(b) => {
+                let p = b.partials(pressure, l)?;
+                McKibbenPartials {
+                    force: p.force,
+                    effective_pressure: p.effective_pressure,
+                    friction_force: [0.0, 0.0],
+                    volume: p.fluid_volume,
+                }
+            }
+        };
+        if let Some(f) = &self.friction {
+            let z = out.friction_state.z;
+            let direction = if l >= history.position { 1.0 } else { -1.0 };
+            let dz_dl = f.operator.slope(&out.friction_state, direction);
+            let cf = f.coefficient;
+            let pe = d.effective_pressure;
+            d.friction_force = [
+                cf * z * pe[0],
+                cf * (z * pe[1] + out.effective_pressure * dz_dl),
+            ];
+            d.force[0] += d.friction_force[0];
+            d.force[1] += d.friction_force[1];
+        }
+        if let Some(c) = self.connector_compliance {
+            // reported = L + c F(P, L): dL/dP = -c F_P / (1 + c F_L), dL/dreported = 1/(1 + c F_L).
+            let denom = 1.0 + c * d.force[1];
+            let (dl_dp, dl_dr) = (-c * d.force[0] / denom, 1.0 / denom);
+            for y in [
+                &mut d.force,
+                &mut d.effective_pressure,
+                &mut d.friction_force,
+                &mut d.volume,
+            ] {
+                *y = [y[0] + y[1] * dl_dp, y[1] * dl_dr];
+            }
+        }
+        let all = [d.force, d.effective_pressure, d.friction_force, d.volume];
+        if all.iter().flatten().all(|v| v.is_finite()) {
+            Ok((out, d))
+        } else {
+            Err(format!(
+                "partial derivatives overflow at length {length} m (too close to a length limit)"
+            ))
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{BladderModel, FrictionParams, MuscleGeometry};
+    use super::*;
+
+    /// Central differences of every output with respect to (P, length), steps `h`.
+    fn central(m: &McKibben, p: f64, l: f64, s: &HysteresisState, h: [f64; 2]) -> McKibbenPartials {
+        let f = |p: f64, l: f64| {
+            let o = m.evaluate(p, l, s).unwrap();
+            [o.force, o.effective_pressure, o.friction_force, o.volume]
+        };
+        let col = |i: usize| {
+            let (dp, dl) = if i == 0 { (h[0], 0.0) } else { (0.0, h[1]) };
+            let (a, b) = (f(p + dp, l + dl), f(p - dp, l - dl));
+            let w = 2.0 * if i == 0 { h[0] } else { h[1] };
+            [0, 1, 2, 3].map(|k| (a[k] - b[k]) / w)
+        };
+        let (cp, cl) = (col(0), col(1));
+        McKibbenPartials {
+            force: [cp[0], cl[0]],
+            effective_pressure: [cp[1], cl[1]],
+            friction_force: [cp[2], cl[2]],
+            volume: [cp[3], cl[3]],
+        }
+    }
+
+    /// Agreement of every partial with central differences, relative to the output's scale.
+    fn check(m: &McKibben, p: f64, l: f64, s: &HysteresisState, what: &str) -> f64 {
+        let (_, exact) = m.partials(p, l, s).unwrap();
+        let fd = central(m, p, l, s, [p.abs() * 1e-6 + 1e-3, l * 1e-7]);
+        let mut worst: f64 = 0.0;
+        for (name, e, c) in [
+            ("force", exact.force, fd.force),
+            (
+                "effective_pressure",
+                exact.effective_pressure,
+                fd.effective_pressure,
+            ),
+            ("friction_force", exact.friction_force, fd.friction_force),
+            ("volume", exact.volume, fd.volume),
+        ] {
+            for k in 0..2 {
+                let scale = e[k].abs().max(c[k].abs()).max(1e-12);
+                let err = (e[k] - c[k]).abs() / scale;
+                assert!(
+                    err < 2e-5 || (e[k] - c[k]).abs() < 1e-9 * (1.0 + scale),
+                    "{what}: d{name}/d{} exact {} vs central {} (relative {err:e})",
+                    ["P", "L"][k],
+                    e[k],
+                    c[k]
+                );
+                worst = worst.max(if scale > 1e-9 { err } else { 0.0 });
+            }
+        }
+        worst
+    }
+
+    fn muscle(g: &MuscleGeometry, model: BladderModel, friction: bool, k: f64) -> McKibben {
+        let f = friction.then_some(FrictionParams {
+            coefficient: 1e-5,
+            presliding_length: 1e-4,
+        });
+        McKibben::from_geometry(g, model, f, k).unwrap()
+    }
+
+    #[test]
+    fn partials_match_central_differences_across_effects() {
+        let models = [
+            BladderModel::None,
+            BladderModel::ThinWall,
+            BladderModel::ThickWall { layers: 8 },
+        ];
+        let mut worst: f64 = 0.0;
+        let (mut free_points, mut points) = (0, 0);
+        for (gi, g) in [
+            MuscleGeometry::muscle_a(),
+            MuscleGeometry::muscle_b(),
+            MuscleGeometry::muscle_c(),
+            MuscleGeometry::muscle_d(),
+        ]
+        .iter()
+        .enumerate()
+        {
+            for model in models {
+                for friction in [false, true] {
+                    for k in [0.0, 5e4] {
+                        let m = muscle(g, model, friction, k);
+                        let (lo, hi) = (m.min_length().max(0.0), m.max_length());
+                        for frac in [0.6, 0.75, 0.9] {
+                            let l = lo + frac * (hi - lo);
+                            // History behind the length: friction mid-presliding (z = 0.3).
+                            let s = HysteresisState::at_rest(l - 3e-5);
+                            for p in [5e4, 2e5, 4e5] {
+                                let Ok(o) = m.evaluate(p, l, &s) else {
+                                    continue;
+                                };
+                                if model != BladderModel::None {
+                                    let th = o.threshold_pressure;
+                                    // Keep the central difference off the contact kink.
+                                    if (p - th).abs() < 1e3 {
+                                        continue;
+                                    }
+                                    free_points += usize::from(!o.bladder_contact);
+                                }
+                                let what = format!(
+                                    "muscle {gi} {model:?} friction {friction} k {k} L {l} P {p}"
+                                );
+                                worst = worst.max(check(&m, p, l, &s, &what));
+                                points += 1;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        // Both bladder branches were exercised (thin-walled A is free at low pressure).
+        assert!(free_points > 0, "no free-bladder point was checked");
+        assert!(points > 300, "only {points} points checked");
+        eprintln!(
+            "{points} points ({free_points} free bladder): worst relative difference {worst:e}"
+        );
+    }
+
+    #[test]
+    fn contact_kink_returns_the_contact_branch() {
+        // At the threshold pressure P_eff = 0 but dP_eff/dP = a > 0: the contact branch.
+        let m = muscle(
+            &MuscleGeometry::muscle_a(),
+            BladderModel::ThinWall,
+            false,
+            0.0,
+        );
+        let l = 0.09;
+        let s = HysteresisState::at_rest(l);
+        let th = m.evaluate(0.0, l, &s).unwrap().threshold_pressure;
+        let (o, d) = m.partials(th, l, &s).unwrap();
+        assert!(o.bladder_contact);
+        assert!(d.effective_pressure[0] > 0.0);
+        // The one-sided difference from above agrees with it.
+        let h = 1e-3 * th.abs().max(1.0);
+        let above = (m.evaluate(th + h, l, &s).unwrap().force - o.force) / h;
+        assert!((above - d.force[0]).abs() < 1e-3 * d.force[0].abs());
+    }
+
+    #[test]
+    fn friction_reversal_returns_the_slope_for_increasing_length() {
+        // Saturated at z = +1 after extension: growing further adds no friction, shrinking does.
+        let m = muscle(&MuscleGeometry::muscle_c(), BladderModel::None, true, 0.0);
+        let l = 0.1;
+        let s = HysteresisState {
+            z: 1.0,
+            position: l,
+        };
+        let (_, d) = m.partials(3e5, l, &s).unwrap();
+        assert_eq!(d.friction_force[1], 0.0);
+        let mid = HysteresisState {
+            z: 0.0,
+            position: l,
+        };
+        let (_, d) = m.partials(3e5, l, &mid).unwrap();
+        assert!((d.friction_force[1] - 1e-5 * 3e5 / 1e-4).abs() < 1e-9);
+    }
+}
