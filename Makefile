@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized py-deps scene-schema
 
 all: fmus
 
@@ -23,6 +23,19 @@ deps:
 	  echo "installing libclang-dev (needed by the fmi crate's bindgen)"; \
 	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libclang-dev; \
+	fi
+
+## Debian packages the FMPy suite needs: chromium for the FMU pages' screenshot test
+## (tests/fmpy/test_fmu_pages.py) and libtbb12 for ecospy (recipes/importers_ssp_libcosim_ecos.py).
+py-deps:
+	@missing=""; \
+	ldconfig -p 2>/dev/null | grep -q 'libtbb\.so\.12' || missing="$$missing libtbb12"; \
+	command -v chromium >/dev/null || missing="$$missing chromium"; \
+	if [ -n "$$missing" ]; then \
+	  echo "installing$$missing"; \
+	  SUDO=$$( [ "$$(id -u)" = 0 ] || echo sudo ); \
+	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq \
+	    --no-install-recommends $$missing; \
 	fi
 
 $(LIB) target/release/package_fmus target/release/calibrate: $(SOURCES)
@@ -68,11 +81,15 @@ DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
 demo: fmus $(VENV)/.installed
 	$(PY) scenes/run.py $(DEFAULT_SCENE) --out out
 
+## scenes/schema/scene.schema.json, the JSON Schema of scene files, from the Rust types in src/scene.rs.
+scene-schema:
+	cargo run --release --quiet -p actuator-fmus-tools --example run_scene -- --schema > scenes/schema/scene.schema.json
+
 ## Any scene: make scene SCENE=scenes/<name>.json
 scene: fmus $(VENV)/.installed
 	$(PY) scenes/run.py $(SCENE) --out out
 
-## Every scene at full length, and docs/figures.md with the plots beside the seed's statements.
+## Every scene at full length, and docs/figures.md with the plots beside the dissertation's statements.
 figures: fmus $(VENV)/.installed
 	$(PY) scenes/catalogue.py
 
@@ -104,7 +121,7 @@ interop-deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libtbb12; \
 	fi
 
-test-fmpy: fmus $(VENV)/.installed interop-deps
+test-fmpy: fmus $(VENV)/.installed interop-deps py-deps
 	$(PY) -m pytest tests/fmpy -q
 
 ## All Rust tests and the FMPy suite.

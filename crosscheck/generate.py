@@ -110,26 +110,65 @@ def generate(model):
     print(f"{model}: {len(result)} rows, {start} .. {stop} s every {step} s -> {d}", file=sys.stderr)
 
 
+PREFIXES = [(1e-18, "a"), (1e-15, "f"), (1e-12, "p"), (1e-9, "n"), (1e-6, "µ"), (1e-3, "m"), (1.0, ""),
+            (1e3, "k"), (1e6, "M"), (1e9, "G")]
+
+
+def display_unit(unit, values):
+    """(label, factor): the unit a person reads, with an SI prefix that puts the largest value
+    between 1 and 1000 (torque 2.2e-18 N m -> aN m), degrees for radians."""
+    largest = float(np.max(np.abs(values))) if len(values) else 0.0
+    if unit == "rad":
+        return "degrees", 180.0 / np.pi
+    if unit in ("", "1"):
+        return "", 1.0
+    if unit == "m3":
+        for label, factor in (("cm³", 1e6), ("mm³", 1e9), ("µm³", 1e18)):
+            if largest * factor >= 1:
+                return label, factor
+        return "m³", 1.0
+    prefix_of = [(scale, p) for scale, p in PREFIXES if largest >= scale]
+    scale, prefix = prefix_of[-1] if prefix_of and largest > 0 else (1.0, "")
+    pretty = unit.replace(".", " ").replace("2", "²")
+    if prefix and (" " in pretty or "/" in pretty):
+        first, _, rest = pretty.partition(" " if " " in pretty else "/")
+        pretty = f"{prefix}{first}{' ' if ' ' in unit.replace('.', ' ') else '/'}{rest}"
+    else:
+        pretty = prefix + pretty
+    return pretty, 1.0 / scale
+
+
 def plot(model, md, signals, result, outputs):
+    """One panel per unit, inputs first, every curve in physical units."""
+    import textwrap
+
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    units = {v.name: v.unit or "" for v in md.modelVariables}
-    panels = ([signals.dtype.names[1:]] if signals is not None else []) + [outputs]
-    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 2.6 * len(panels) + 0.6), sharex=True, squeeze=False)
-    for ax, names in zip(axes[:, 0], panels):
-        source = signals if names is not outputs else result
+    units = {v.name: v.unit or (v.declaredType.unit if v.declaredType else "") or "" for v in md.modelVariables}
+    panels = []  # (title, source, names)
+    for title, source, names in ((["input"], signals, list(signals.dtype.names[1:]) if signals is not None else []),
+                                 (["output"], result, outputs)):
+        by_unit = {}
         for n in names:
-            y = source[n]
-            scale = np.max(np.abs(y)) or 1.0
-            ax.plot(source["time"], y / scale, label=f"{n} / {scale:.3g} {units.get(n, '')}")
-        ax.set_ylabel("inputs" if names is not outputs else "outputs")
-        ax.legend(fontsize=7, loc="upper right")
+            by_unit.setdefault(units.get(n, ""), []).append(n)
+        panels += [(title[0], source, group) for group in by_unit.values()]
+    fig, axes = plt.subplots(len(panels), 1, figsize=(8, 1.9 * len(panels) + 0.8), sharex=True, squeeze=False)
+    time_label, time_factor = display_unit("s", result["time"])
+    for ax, (kind, source, names) in zip(axes[:, 0], panels):
+        values = np.concatenate([np.asarray(source[n], dtype=float) for n in names])
+        label, factor = display_unit(units.get(names[0], ""), values)
+        for n in names:
+            ax.plot(source["time"] * time_factor, np.asarray(source[n], dtype=float) * factor,
+                    label=f"{n.replace('_', ' ')}" + (f" ({label})" if label else ""))
+        ylabel = f"{kind}s" + (f" ({label})" if label else "")
+        ax.set_ylabel(textwrap.fill(ylabel, 16), fontsize=8)
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.01, 1.0), borderaxespad=0)
         ax.grid(alpha=0.3)
-    axes[-1, 0].set_xlabel("time (s)")
-    fig.suptitle(f"{model}: cross-check run (default experiment, {model}_in.csv)", fontsize=10)
+    axes[-1, 0].set_xlabel(f"time ({time_label})")
+    fig.suptitle(f"{model}: cross-check run (default experiment, inputs from {model}_in.csv)", fontsize=10)
     fig.tight_layout()
     PLOTS.mkdir(parents=True, exist_ok=True)
     fig.savefig(PLOTS / f"{model}.png", dpi=80)

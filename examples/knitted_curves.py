@@ -58,11 +58,16 @@ def main():
         lengths = np.linspace(max(lo, 0.15), hi, 400)
         ax.plot(lengths * 1e3, force_curve(lengths, shape_model=shape), label=label)
     path, forces = friction_loop(shape_model=2)
-    ax.plot(path * 1e3, forces, "k--", lw=1, label="non-cylindrical, friction Cf = 0.25 (Fig. 1.18)")
+    rising = np.append(np.diff(path) > 0, np.diff(path)[-1] > 0)
+    ax.plot(path[rising] * 1e3, forces[rising], "k-", lw=1,
+            label="non-cylindrical, friction Cf = 0.25, extension (length rising, Fig. 1.18)")
+    ax.plot(path[~rising] * 1e3, forces[~rising], "k--", lw=1,
+            label="non-cylindrical, friction Cf = 0.25, contraction (length falling)")
     ax.axhline(0, color="grey", lw=0.5)
     ax.set_xlabel("length (mm)")
     ax.set_ylabel("force (N)")
-    ax.set_title("Knitted prototype (m = 22, n = 49, 514 mm) at 14 kPa; tubular ~ ideal at m = 22")
+    ax.set_title("Knitted prototype (m = 22, n = 49, 514 mm) at 14 kPa: force of each shape model;\n"
+                 "the tubular knit lies on the ideal cylinder at m = 22", fontsize=10)
     ax.legend(fontsize=8)
     fig.tight_layout()
     fig.savefig(out / "knitted_curves.png", dpi=120)

@@ -2,7 +2,7 @@
 - out/mckibben_muscles.png: isobaric force-length curves, thick-walled bladder (16 layers);
 - out/mckibben_hysteresis.png: a length cycle at constant pressure with friction on;
 - out/mckibben_work.csv and a printed table: net work per cycle, thin and thick wall, beside the
-  seed's statements about pre-strain."""
+  dissertation's statements about pre-strain."""
 
 import argparse
 import pathlib

@@ -153,8 +153,8 @@ def plot(rows, path):
     axes[1].legend()
     axes[2].plot(t, a[:, 6], label="flexor force (N)")
     axes[2].plot(t, a[:, 7], label="extensor force (N)")
-    axes[2].plot(t, 100 * a[:, 8], label="joint torque (N.m x 100)")
-    axes[2].set_ylabel("force / torque")
+    axes[2].plot(t, 100 * a[:, 8], label="joint torque (N cm)")
+    axes[2].set_ylabel("force (N), torque (N cm)")
     axes[2].set_xlabel("time (s)")
     axes[2].legend(fontsize=8)
     for ax in axes:

@@ -27,7 +27,7 @@ import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 LISTED_LENGTH = 0.10325  # Table 2.1, muscle A
-PRESSURE = 6.9e5  # 690 kPa, the seed's work figure
+PRESSURE = 6.9e5  # 690 kPa, the dissertation's work figure
 MUSCLE_A = {"strand_length": 0.1113, "turns": 3.74, "bladder_inner_diameter": 0.0016}
 
 

@@ -1,33 +1,94 @@
-"""Which pressure makes a Festo DMSP-40 pull 2000 N at 10% contraction? One call, then checked by
-simulating the muscle at that pressure.  Run after `make fmus`:
-    .venv/bin/python recipes/pressure_for_force.py
+"""Recipe: the gauge pressure that makes McKibbenMuscle pull a given force at a given contraction.
+
+Muscle A of Table 2.1 (the dissertation), thick-walled bladder (bladder_model 2, 16 layers: its
+1.6 mm wall on a 1.6 mm bore is thick, Fig. 2.11). Contraction counts from the length at rest,
+unpressurized and unloaded. Two readings of that length, both printed:
+
+1. the listed 103.25 mm, measured between the attachment points, so the connectors are part of
+   it: with `connector_stiffness` = 2000 N/m the model reaches it (the `length` input is then the
+   measured length, eq. section 2.4);
+2. a rigid connector, where the rubber fills the sleeve at `max_length` (97.30 mm): contraction
+   then counts from `max_length`.
+
+Run after `make fmus`: .venv/bin/python recipes/pressure_for_force.py [force_N] [contraction]
 """
-
-import pathlib
+import shutil
 import sys
+from pathlib import Path
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from fmpy import simulate_fmu  # noqa: E402
+from fmpy import extract, read_model_description
+from fmpy.fmi2 import FMU2Slave
+from scipy.optimize import brentq
 
-from calibration.inverse import FMU, pressure_for_force  # noqa: E402
+FMU = Path(__file__).resolve().parents[1] / "target" / "fmu" / "McKibbenMuscle.fmu"
+LISTED_LENGTH = 0.10325  # m, Table 2.1 muscle A
 
-DMSP_40 = {"preset": 6}  # fitted to the datasheet, nominal length 0.4 m
-NOMINAL = 0.4
 
-length = NOMINAL * (1 - 0.10)
-p, saturated = pressure_for_force(2000.0, length, DMSP_40)
-print(f"DMSP-40 at 10% contraction pulls 2000 N at {p / 1e3:.2f} kPa (out of reach: {saturated})")
+class Muscle:
+    """One instance, initialized once; the force follows pressure and length between steps."""
 
-# Check: the forward model at that pressure.
-r = simulate_fmu(str(FMU), start_values={**DMSP_40, "pressure": p, "length": length}, stop_time=0.001,
-                 output=["force"])
-print(f"forward check: force at {p / 1e3:.2f} kPa = {r['force'][-1]:.6f} N")
-assert not saturated and abs(r["force"][-1] - 2000.0) < 1e-6 * 2000.0
+    def __init__(self, **parameters):
+        self.md = read_model_description(FMU)
+        self.vr = {v.name: v.valueReference for v in self.md.modelVariables}
+        self.dir = extract(FMU)
+        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
+                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName="m")
+        self.fmu.instantiate()
+        self.fmu.setupExperiment(startTime=0.0)
+        self.fmu.enterInitializationMode()
+        ints = {k: v for k, v in parameters.items() if k in ("preset", "bladder_model", "bladder_layers")}
+        reals = {k: v for k, v in parameters.items() if k not in ints}
+        self.fmu.setInteger([self.vr[k] for k in ints], list(ints.values()))
+        self.fmu.setReal([self.vr[k] for k in reals], list(reals.values()))
+        self.fmu.exitInitializationMode()
 
-# A whole stroke at once, and a force out of reach (more than 600 kPa can give).
-lengths = [NOMINAL * (1 - c) for c in (0.0, 0.05, 0.10, 0.15, 0.25)]
-pressures, flags = pressure_for_force([1500.0] * len(lengths), lengths, DMSP_40, max_pressure=6e5)
-for c, p, s in zip((0, 5, 10, 15, 25), pressures, flags):
-    print(f"  1500 N at {c:2d}% contraction: {p / 1e3:7.2f} kPa{'  (out of reach: nearest force)' if s else ''}")
-assert all(b >= a for a, b in zip(pressures, pressures[1:])), "a shorter muscle needs more pressure"
-assert flags[-1] and not flags[0]
+    def get(self, name):
+        return self.fmu.getReal([self.vr[name]])[0]
+
+    def force(self, pressure, length):
+        self.fmu.setReal([self.vr["pressure"], self.vr["length"]], [pressure, length])
+        return self.get("force")
+
+    def close(self):
+        self.fmu.terminate()
+        self.fmu.freeInstance()
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+
+def pressure_for(muscle, force, length, p_max=1.0e6):
+    """Bisection-safe root of force(P) - target on [0, p_max] (force rises with pressure)."""
+    lo = muscle.force(0.0, length) - force
+    hi = muscle.force(p_max, length) - force
+    if lo > 0 or hi < 0:
+        return None, lo + force, hi + force
+    return brentq(lambda p: muscle.force(p, length) - force, 0.0, p_max, xtol=1.0), None, None
+
+
+def main():
+    target = float(sys.argv[1]) if len(sys.argv) > 1 else 20.0
+    contraction = float(sys.argv[2]) if len(sys.argv) > 2 else 0.08
+    print(f"McKibbenMuscle, Table 2.1 muscle A, thick wall (16 layers): {target:g} N at "
+          f"{100 * contraction:g}% contraction")
+    results = []
+    for label, connector in (("listed length, 2000 N/m connector", 2000.0),
+                             ("max_length, rigid connector", 0.0)):
+        m = Muscle(preset=1, bladder_model=2, bladder_layers=16, connector_stiffness=connector)
+        rest = LISTED_LENGTH if connector > 0 else m.get("max_length")
+        length = rest * (1.0 - contraction)
+        p, f0, fmax = pressure_for(m, target, length)
+        if p is None:
+            print(f"  {label}: rest {1e3 * rest:.2f} mm, length {1e3 * length:.2f} mm: no pressure in "
+                  f"0-1000 kPa gives {target:g} N (force {f0:.1f} N at 0 kPa, {fmax:.1f} N at 1000 kPa)")
+            sys.exit(1)
+        check = m.force(p, length)
+        print(f"  {label}: rest {1e3 * rest:.2f} mm, length {1e3 * length:.2f} mm -> "
+              f"pressure {p / 1e3:.1f} kPa (force there {check:.3f} N, "
+              f"effective pressure {m.get('effective_pressure') / 1e3:.1f} kPa)")
+        assert abs(check - target) < 0.01 * target, (check, target)
+        results.append(p)
+        m.close()
+    assert all(0.0 < p < 1.0e6 for p in results)
+
+
+if __name__ == "__main__":
+    main()

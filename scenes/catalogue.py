@@ -1,5 +1,5 @@
 """Runs every scene in scenes/ (full length) and writes docs/figures.md with each plot beside what
-the seed says, and the seed's numbers beside ours. `make figures`."""
+the dissertation says, and the dissertation's numbers beside ours. `make figures`."""
 
 import pathlib
 import re
@@ -17,8 +17,11 @@ def main():
     lines = [
         "# Figure catalogue",
         "",
-        "Each scene in `scenes/` reproduces the model side of one of the seed's figures. Regenerate this",
-        "page with `make figures`; run one scene with `.venv/bin/python scenes/run.py scenes/<scene>.json`.",
+        "Each scene in `scenes/` reproduces the model side of one of the figures of E. Ball, *Novel Methods in",
+        "Meso-Scale and Nano-Scale Actuation*, M.S. thesis, Cornell University, 2014 (\"the dissertation\"; the",
+        "README's [The source](../README.md#the-source) says how to obtain it). Regenerate this page with",
+        "`make figures`; run one scene with `.venv/bin/python scenes/run.py scenes/<scene>.json`. The scene",
+        "format is [`scenes/schema/scene.schema.json`](../scenes/schema/scene.schema.json).",
         "",
     ]
     def figure_order(path):

@@ -1,5 +1,5 @@
-"""Runs a scene file (scenes/*.json, format in src/scene.rs) under FMPy: writes <out>/<scene>.csv and
-<out>/<scene>.png, prints the seed's numbers beside ours, exits 1 if a check fails.
+"""Runs a scene file (scenes/*.json, format: scenes/schema/scene.schema.json) under FMPy: writes <out>/<scene>.csv and
+<out>/<scene>.png, prints the dissertation's numbers beside ours, exits 1 if a check fails.
 
     python scenes/run.py scenes/fig2_3_ideal_mckibben.json [--fast] [--out out]
 """
@@ -17,11 +17,61 @@ import numpy as np
 ROOT = pathlib.Path(__file__).resolve().parents[1]
 FMU_DIR = ROOT / "target" / "fmu"
 LONG_RUN_STEPS = 1000  # runs with more communication steps than this show a progress bar
+SCHEMA = ROOT / "scenes" / "schema" / "scene.schema.json"
+
+
+class SceneError(ValueError):
+    """A scene file that does not follow scenes/schema/scene.schema.json."""
+
+
+def _dotted(path):
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".") or "(top level)"
+
+
+def _innermost(error):
+    """Descends into oneOf/anyOf: the branch whose `type`/`kind` tag matched, else the branch
+    that failed least, so that the message names the field, not the whole signal or check."""
+    while error.context:
+        branches = {}
+        for sub in error.context:
+            branches.setdefault(sub.relative_schema_path[0], []).append(sub)
+        tagged = [errs for errs in branches.values()
+                  if not any(e.validator in ("const", "enum") for e in errs)]
+        if not tagged:  # an unknown `type` or `kind`: list the known ones
+            tags = [e for errs in branches.values() for e in errs if e.validator == "const"]
+            if tags:
+                tags[0].message = (f"{tags[0].instance!r} is not one of "
+                                   + ", ".join(repr(e.validator_value) for e in tags))
+                return tags[0]
+        errors = tagged[0] if len(tagged) == 1 else min(branches.values(), key=len)
+        error = max(errors, key=lambda e: len(e.absolute_path))
+    return error
+
+
+def schema_errors(scene):
+    """One line per problem, each naming the field's path, e.g. `inputs.pressure.valu: unknown field`."""
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(json.loads(SCHEMA.read_text()))
+    lines = []
+    for error in sorted(validator.iter_errors(scene), key=lambda e: list(map(str, e.absolute_path))):
+        error = _innermost(error)
+        path = list(error.absolute_path)
+        if error.validator in ("additionalProperties", "unevaluatedProperties"):
+            known = set(error.schema.get("properties", {}))
+            for name in sorted(set(error.instance) - known):
+                lines.append(f"{_dotted(path + [name])}: unknown field")
+            continue
+        lines.append(f"{_dotted(path)}: {error.message}")
+    return lines
 
 
 def load_scene(path, fast=False):
     path = pathlib.Path(path)
     scene = json.loads(path.read_text())
+    errors = schema_errors(scene)
+    if errors:
+        raise SceneError(f"{path}: not a valid scene (scenes/schema/scene.schema.json):\n  " + "\n  ".join(errors))
     scene["_name"] = path.stem
     scene["_dir"] = path.parent
     if fast and scene.get("fast"):
@@ -136,30 +186,90 @@ def zero_crossing(x, y):
     return float(x[i] - y[i] * (x[i + 1] - x[i]) / (y[i + 1] - y[i]))
 
 
+def units(scene):
+    """Unit of every variable of the scene's FMU, from its model description."""
+    from fmpy import read_model_description
+
+    md = read_model_description(str(FMU_DIR / f"{scene['fmu']}.fmu"))
+    return {v.name: v.unit or (v.declaredType.unit if v.declaredType else "") or "" for v in md.modelVariables}
+
+
+# SI unit -> (display unit, factor from SI): what a person reads at a glance.
+DISPLAY = {"Pa": ("kPa", 1e-3), "m": ("mm", 1e3), "rad": ("degrees", 180 / math.pi), "N.m": ("N m", 1.0),
+           "m3": ("cm³", 1e6)}
+
+
+def quantity(value, unit):
+    """`value` (SI) in the unit a person reads: 172000 Pa -> "172 kPa", 0.7854 rad -> "45 degrees"."""
+    if unit == "s":
+        for name, factor in (("s", 1.0), ("ms", 1e3), ("µs", 1e6), ("ns", 1e9)):
+            if value == 0 or abs(value) * factor >= 1:
+                return f"{value * factor:.4g} {name}"
+        return f"{value:.4g} s"
+    if unit in ("", "1"):
+        return f"{value:.4g}"
+    name, factor = DISPLAY.get(unit, (unit.replace(".", " "), 1.0))
+    return f"{value * factor:.4g} {name}"
+
+
+def run_label(scene, value, unit_of):
+    if value is None:
+        return ""
+    variable = scene["sweep"]["variable"]
+    return f"{variable} = {quantity(value, unit_of.get(variable, ''))}"
+
+
 def evaluate_checks(scene, runs):
-    """Returns a list of (passed, text) for the scene's checks."""
+    """Returns a list of (passed, text) for the scene's checks; numbers in SI units."""
+    unit_of = units(scene) if scene.get("sweep") else {}
     results = []
     for check in scene.get("checks", []):
         kind, out = check["kind"], check["output"]
         if kind == "max":
             got = max(float(np.max(r[out])) for _, r in runs)
             ok = abs(got - check["expect"]) <= check["rel_tol"] * abs(check["expect"])
-            results.append((ok, f"max {out} = {got:.6g}, seed {check['expect']:.6g} ({check['source']})"))
+            results.append((ok, f"max {out} = {got:.6g}, dissertation {check['expect']:.6g} ({check['source']})"))
         elif kind == "zero_crossing":
             for value, r in runs:
                 got = zero_crossing(r[check["x"]], r[out])
                 ok = abs(got - check["expect"]) <= check["rel_tol"] * abs(check["expect"])
-                results.append((ok, f"{out} = 0 at {check['x']} = {got:.6g}, seed {check['expect']:.6g} "
-                                    f"(run {value}; {check['source']})"))
+                run = run_label(scene, value, unit_of)
+                results.append((ok, f"{out} = 0 at {check['x']} = {got:.6g}, dissertation {check['expect']:.6g} "
+                                    f"({run + '; ' if run else ''}{check['source']})"))
         elif kind == "final":
             for value, r in runs:
                 got = float(r[out][-1])
                 ok = abs(got - check["expect"]) <= check["abs_tol"]
-                results.append((ok, f"final {out} = {got:.6g}, seed {check['expect']:.6g} "
-                                    f"(run {value}; {check['source']})"))
+                run = run_label(scene, value, unit_of)
+                results.append((ok, f"final {out} = {got:.6g}, dissertation {check['expect']:.6g} "
+                                    f"({run + '; ' if run else ''}{check['source']})"))
         else:
             results.append((False, f"unknown check kind {kind}"))
     return results
+
+
+def title_of(scene, width=80):
+    """The figure number and the description's first sentence, wrapped, never cut."""
+    import textwrap
+
+    figure, _, said = scene["description"].partition(": ")
+    first_sentence = re.split(r"\.\s+(?=[A-Z])", said)[0].rstrip(".")
+    return textwrap.fill(f"{figure}: {first_sentence}", width=width)
+
+
+def branches(x):
+    """Index ranges where x rises and where it falls: [(slice, rising)], for cycle inputs."""
+    dx = np.diff(x)
+    if x.size < 3 or np.all(dx >= 0) or np.all(dx <= 0):
+        return [(slice(0, x.size), None)]
+    rising = dx >= 0
+    out, start = [], 0
+    for k in range(1, rising.size):
+        if rising[k] != rising[k - 1]:
+            out.append((slice(start, k + 1), bool(rising[k - 1])))
+            start = k
+    out.append((slice(start, x.size), bool(rising[-1])))
+    return out
 
 
 def write_outputs(scene, runs, out):
@@ -179,23 +289,40 @@ def write_outputs(scene, runs, out):
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.lines import Line2D
 
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    for value, r in runs:
-        for y in plot["y"]:
-            label = " ".join(s for s in [f"{sweep['variable']} = {value:g}" if sweep else "", y if len(plot["y"]) > 1 else ""] if s)
-            ax.plot(r[plot["x"]] * plot.get("x_scale", 1.0), r[y] * plot.get("y_scale", 1.0), label=label or None)
+    unit_of = units(scene)
+    x_name = plot["x"]
+    fig, ax = plt.subplots(figsize=(7.5, 5))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    handles, directions = [], set()
+    curves = [(value, y) for value, _ in runs for y in plot["y"]]
+    for k, ((value, y), r) in enumerate(zip(curves, [r for _, r in runs for _ in plot["y"]])):
+        colour = colours[k % len(colours)]
+        xs = r[x_name] * plot.get("x_scale", 1.0)
+        ys = r[y] * plot.get("y_scale", 1.0)
+        for part, rising in branches(xs):
+            ax.plot(xs[part], ys[part], color=colour, linestyle="--" if rising is False else "-")
+            if rising is not None:
+                directions.add(rising)
+        label = ", ".join(s for s in [run_label(scene, value, unit_of),
+                                      y.replace("_", " ") if len(plot["y"]) > 1 else ""] if s)
+        if label:
+            handles.append(Line2D([], [], color=colour, label=label))
+    if directions == {True, False}:
+        what = x_name.replace("_", " ")
+        rise, fall = (("extension (length rising)", "contraction (length falling)") if x_name == "length"
+                      else (f"{what} rising", f"{what} falling"))
+        handles += [Line2D([], [], color="0.3", linestyle="-", label=rise),
+                    Line2D([], [], color="0.3", linestyle="--", label=fall)]
     ax.set_xlabel(plot["x_label"])
     ax.set_ylabel(plot["y_label"])
     if plot.get("y_limits"):
         ax.set_ylim(*plot["y_limits"])
-    figure, _, said = scene["description"].partition(": ")
-    first_sentence = re.split(r"\.\s+(?=[A-Z])", said)[0]
-    title = f"{figure}: {first_sentence}"
-    ax.set_title(title if len(title) < 90 else title[:87] + "...", fontsize=9)
+    ax.set_title(title_of(scene), fontsize=9)
     ax.grid(alpha=0.3)
-    if sweep or len(plot["y"]) > 1:
-        ax.legend(fontsize=8)
+    if handles:
+        ax.legend(handles=handles, fontsize=8)
     fig.tight_layout()
     fig.savefig(out / f"{scene['_name']}.png", dpi=110)
     plt.close(fig)
@@ -209,7 +336,11 @@ def main():
     args = parser.parse_args()
     failed = 0
     for path in args.scene:
-        scene = load_scene(path, fast=args.fast)
+        try:
+            scene = load_scene(path, fast=args.fast)
+        except SceneError as e:
+            print(e, file=sys.stderr)
+            sys.exit(2)
         runs = run_scene(scene)
         write_outputs(scene, runs, pathlib.Path(args.out))
         for ok, text in evaluate_checks(scene, runs):

@@ -50,8 +50,8 @@ impl KnittedParams {
     /// Fig. 1.16 muscle, ideal geometry: stretched length 110 mm and 14.6 mm diameter at free
     /// contraction. Eq. 1.4 at `L_free = L_max / 3` gives `C = 2 S_row / 3`, so
     /// `S_row = 1.5 pi D` = 68.8 mm, and eq. 1.10 gives `n / m = 2 L_max / S_row` = 3.198. The
-    /// seed does not give `m`; we take `m = 8` (Fig. 1.1's small muscle), so `n` = 25.58.
-    /// `strand_thickness` is the caller's (the seed's bladder curve uses 0.2 mm).
+    /// dissertation does not give `m`; we take `m = 8` (Fig. 1.1's small muscle), so `n` = 25.58.
+    /// `strand_thickness` is the caller's (the dissertation's bladder curve uses 0.2 mm).
     pub fn fig_1_16(strand_thickness: f64) -> Self {
         let m = 8.0;
         let s = 1.5 * PI * 0.0146;
@@ -772,9 +772,9 @@ mod tests {
         let w_mk = integrate(&|l| mk.force(p, l), lf_mk, b);
         assert_relative_eq!(w_k, p * k.volume(lf), max_relative = 1e-9);
         assert_relative_eq!(w_mk, p * mk.volume(lf_mk), max_relative = 1e-9);
-        // Our numbers (DESIGN.md: 3.38 J vs 5.85 J; 69 N vs 276 N). The seed's "McKibben peak
+        // Our numbers (DESIGN.md: 3.38 J vs 5.85 J; 69 N vs 276 N). The dissertation's "McKibben peak
         // about twice the knitted" and 2.6 J vs 2.3 J include bladder effects; ideal, the
-        // McKibben peak is 4.0 times the knitted and does more work, as the seed also says.
+        // McKibben peak is 4.0 times the knitted and does more work, as the dissertation also says.
         assert_relative_eq!(w_k, 3.376, max_relative = 1e-3);
         assert_relative_eq!(w_mk, 5.848, max_relative = 1e-3);
         let peak_k = k.force(p, 2.0 * k.max_length() / 3.0);

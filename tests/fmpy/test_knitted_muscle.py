@@ -229,7 +229,7 @@ def test_knitted_against_mckibben_section_1_3_6():
     peak_mk = mk.at("force", pressure=p, length=b)
     print(f"110 mm, 14.6 mm, 550 kPa, ideal: stroke knitted {stroke_k:.4f} vs McKibben {stroke_mk:.4f}; "
           f"work {work_k:.3f} J vs {work_mk:.3f} J; peak {peak_k:.2f} N vs {peak_mk:.2f} N "
-          f"(ratio {peak_mk / peak_k:.3f}; the seed, with bladders: ratio about 2, work 2.6 J knitted vs 2.3 J McKibben)")
+          f"(ratio {peak_mk / peak_k:.3f}; the dissertation, with bladders: ratio about 2, work 2.6 J knitted vs 2.3 J McKibben)")
     assert stroke_k == pytest.approx(2 / 3, rel=1e-12)
     assert stroke_mk == pytest.approx(1 - 1 / math.sqrt(3), rel=1e-12)  # 42%
     # Ideal, the McKibben peak is P b^2 / (2 pi turns^2) and the knitted one P S^2 / (12 pi).
@@ -280,9 +280,9 @@ def test_bad_parameters_fail_initialization(parameters):
 # comparison. A 1/4 in (6.4 mm) bore with a 0.8 mm wall (OD 8.0 mm) slides into either sleeve at
 # free contraction (14.6 mm), and must inflate to a hoop stretch of 14.6/6.4 = 2.3 there, within
 # the stretches for which chapter 2's Mooney-Rivlin latex is used; its 110 mm unstretched length is
-# the muscles' nominal length ("no pre-strain", as the seed's green curves). Rubber volume
+# the muscles' nominal length ("no pre-strain", as the dissertation's green curves). Rubber volume
 # 1.99 cm^3: 32% of the knitted sleeve's largest volume, 19% of the McKibben's. Thick-walled model,
-# 16 layers (Fig. 2.8). The seed's knitted curve also has a 0.2 mm strand. Caveat: the rubber fills
+# 16 layers (Fig. 2.8). The dissertation's knitted curve also has a 0.2 mm strand. Caveat: the rubber fills
 # the knitted sleeve at 82 mm, so there the 110 mm tube is always axially compressed (lambda_1 <=
 # 0.75), which the model takes as Mooney-Rivlin compression without buckling.
 BLADDER = dict(bladder_model=2, bladder_layers=16, bladder_length=0.110,
@@ -413,9 +413,9 @@ def test_knitted_against_mckibben_with_bladder_section_1_3_6():
     print(f"reach with bladder (rubber fills the sleeve): knitted {reach['knitted'] * 1e3:.2f} mm, "
           f"McKibben {reach['McKibben'] * 1e3:.2f} mm")
     print(f"peak ratio McKibben/knitted: ideal {ideal['McKibben'][2] / ideal['knitted'][2]:.2f}, "
-          f"bladder {bladder['McKibben'][2] / bladder['knitted'][2]:.2f} (seed: about 2); work knitted vs McKibben: "
+          f"bladder {bladder['McKibben'][2] / bladder['knitted'][2]:.2f} (dissertation: about 2); work knitted vs McKibben: "
           f"ideal {ideal['knitted'][3]:.2f} J vs {ideal['McKibben'][3]:.2f} J, bladder {bladder['knitted'][3]:.2f} J "
-          f"vs {bladder['McKibben'][3]:.2f} J (seed, with bladders: 2.6 J vs 2.3 J)")
+          f"vs {bladder['McKibben'][3]:.2f} J (dissertation, with bladders: 2.6 J vs 2.3 J)")
     # Ideal: peak ratio 6 b^2 / (turns^2 S^2) = 4 exactly for this geometry; work = P V(L_free).
     assert ideal["McKibben"][2] / ideal["knitted"][2] == pytest.approx(4.0, rel=1e-9)
     assert ideal["knitted"][3] == pytest.approx(3.376, rel=1e-3)
@@ -429,14 +429,14 @@ def test_knitted_against_mckibben_with_bladder_section_1_3_6():
         assert bladder[name][1] > ideal[name][1]
         assert bladder[name][3] < 0.6 * ideal[name][3]
     # "Higher initial force": the knitted peak with the bladder exceeds the ideal one, and the
-    # McKibben/knitted peak ratio falls from 4 towards the seed's "about twice" (computed 2.43).
+    # McKibben/knitted peak ratio falls from 4 towards the dissertation's "about twice" (computed 2.43).
     assert bladder["knitted"][2] > ideal["knitted"][2]
     assert 2.0 < bladder["McKibben"][2] / bladder["knitted"][2] < 3.0
-    # Disagreement with the seed: it has the knitted muscle doing MORE work with its bladder
+    # Disagreement with the dissertation: it has the knitted muscle doing MORE work with its bladder
     # (2.6 J) than the McKibben (2.3 J). With the same tube in both we compute the opposite
     # (0.88 J vs 2.91 J): the knitted sleeve's volume falls like (L_max - L)^2 near full
     # extension (eq. 1.6) against (b - L) for the McKibben (eq. 2.2), so the rubber fills it much
-    # earlier and its stroke starts far shorter (63.7 mm against 97.2 mm). The seed's knitted
+    # earlier and its stroke starts far shorter (63.7 mm against 97.2 mm). The dissertation's knitted
     # figure is 77% of our ideal 3.38 J, its McKibben one 39% of 5.85 J: its two bladders cannot
     # have been the same tube. Less rubber narrows the gap but never reverses it:
     print("same bore/wall in both (knitted work vs McKibben work):")

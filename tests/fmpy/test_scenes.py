@@ -1,7 +1,9 @@
 """Every catalogue scene (scenes/*.json), fast variant, under FMPy: it runs, writes its CSV and plot,
-gives finite outputs, and the seed's numbers it names hold."""
+gives finite outputs, and the dissertation's numbers it names hold."""
 
+import json
 import pathlib
+import subprocess
 import sys
 
 import numpy as np
@@ -46,3 +48,26 @@ def test_csv_input_signal(tmp_path):
     expected = np.interp(result["time"] - 0.125, [0, 0.5, 1], [0, 1, 0])
     assert np.allclose(result["y"][1:], expected[1:])
     assert np.array_equal(result["u"], result["y"])
+
+
+def test_a_misspelt_or_mistyped_field_is_refused_with_its_path(tmp_path):
+    scene = json.loads((ROOT / "scenes" / "fig2_3_ideal_mckibben.json").read_text())
+    scene["inputs"]["length"]["form"] = scene["inputs"]["length"].pop("from")
+    scene["step"] = "0.01"
+    scene["plot"]["y_limit"] = [0, 1]
+    scene["checks"][0]["kind"] = "zero"
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(scene))
+    with pytest.raises(scenes.SceneError) as refused:
+        scenes.load_scene(path)
+    text = str(refused.value)
+    for line in ["inputs.length.form: unknown field", "step: '0.01' is not of type 'number'",
+                 "plot.y_limit: unknown field", "checks[0].kind: 'zero' is not one of"]:
+        assert line in text, text
+    run = subprocess.run([sys.executable, str(ROOT / "scenes" / "run.py"), str(path)],
+                         capture_output=True, text=True)
+    assert run.returncode == 2 and "inputs.length.form: unknown field" in run.stderr
+
+
+def test_the_shipped_schema_accepts_every_catalogue_scene():
+    assert all(scenes.schema_errors(json.loads(p.read_text())) == [] for p in SCENES)

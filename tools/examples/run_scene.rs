@@ -1,16 +1,21 @@
 //! Runs scene files through the `fmi` crate (the Rust-side importer) and writes
 //! `<out>/<scene>_fmi.csv`: `cargo run --release -p actuator-fmus-tools --example run_scene -- scenes/<scene>.json [--fast]`.
+//! `--schema` prints the JSON Schema of scene files instead (`scenes/schema/scene.schema.json`).
 
 #[allow(dead_code)]
 #[path = "../tests/common/scene_runner.rs"]
 mod scene_runner;
 
-use actuator_fmus_tools::scene::Scene;
+use actuator_fmus_tools::scene::{json_schema, Scene};
 use std::path::{Path, PathBuf};
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let fast = args.iter().any(|a| a == "--fast");
+    if args.iter().any(|a| a == "--schema") {
+        print!("{}", json_schema());
+        return;
+    }
     let root = &actuator_fmus_tools::repository_root();
     let mut failed = 0;
     for path in args
@@ -20,7 +25,13 @@ fn main() {
     {
         let text =
             std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
-        let scene = Scene::from_json(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let scene = match Scene::from_json(&text) {
+            Ok(scene) => scene,
+            Err(e) => {
+                eprintln!("{}: {e}", path.display());
+                std::process::exit(2);
+            }
+        };
         let scene = if fast { scene.fast() } else { scene };
         let dir = path.parent().unwrap_or(Path::new("."));
         let runs = scene_runner::run(&scene, dir, &root.join("target/fmu"))

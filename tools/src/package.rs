@@ -99,11 +99,51 @@ fn escape(s: &str) -> String {
 fn start_text(v: &Variable) -> String {
     match v.start {
         Start::None => String::new(),
-        Start::Real(x) => format!("{x}"),
+        Start::Real(x) => number(x),
         Start::Integer(x) => format!("{x}"),
         Start::Boolean(x) => format!("{x}"),
         Start::String(x) => escape(x),
     }
+}
+
+/// A number as a person reads it: plain between 0.001 and 1e6 with at most 6 significant digits
+/// (0.1113, 161000), otherwise 4 significant digits with an exponent (3.043e-22, 1e-12, 1e+12).
+/// The model description keeps the full value.
+pub fn number(x: f64) -> String {
+    if x == 0.0 || !x.is_finite() {
+        return format!("{x}");
+    }
+    let magnitude = x.abs();
+    if (1e-3..1e6).contains(&magnitude) {
+        let decimals = (5 - magnitude.log10().floor() as i32).max(0) as usize;
+        let text = format!("{x:.decimals$}");
+        if text.contains('.') {
+            text.trim_end_matches('0').trim_end_matches('.').to_string()
+        } else {
+            text
+        }
+    } else {
+        let text = format!("{x:.3e}");
+        let (mantissa, exponent) = text.split_once('e').unwrap_or((&text, "0"));
+        let mantissa = if mantissa.contains('.') {
+            mantissa.trim_end_matches('0').trim_end_matches('.')
+        } else {
+            mantissa
+        };
+        let exponent: i32 = exponent.parse().unwrap_or(0);
+        format!(
+            "{mantissa}e{}{exponent}",
+            if exponent > 0 { "+" } else { "" }
+        )
+    }
+}
+
+/// A unit as printed: `m3` as m³, `kg.m2` as kg m², `N.m.s` as N m s.
+fn unit_text(unit: &str) -> String {
+    escape(unit)
+        .replace('.', "\u{2009}")
+        .replace('2', "\u{b2}")
+        .replace('3', "\u{b3}")
 }
 
 /// `documentation/index.html`: what the model is, its variables, the equations it implements.
@@ -113,18 +153,18 @@ pub fn documentation(info: &ModelInfo, equations: &str) -> String {
         let range = match (v.min, v.max) {
             (None, None) => String::new(),
             (min, max) => format!(
-                "{} .. {}",
-                min.map_or("".into(), |x| x.to_string()),
-                max.map_or("".into(), |x| x.to_string())
+                "{}&nbsp;..&nbsp;{}",
+                min.map_or("".into(), number),
+                max.map_or("".into(), number)
             ),
         };
         rows.push_str(&format!(
-            "<tr><td><code>{}</code></td><td>{:?}</td><td>{:?}</td><td>{:?}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+            "<tr><td><code>{}</code></td><td>{:?}</td><td>{:?}</td><td>{:?}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>\n",
             v.name,
             v.causality,
             v.variability,
             v.kind,
-            escape(v.unit),
+            unit_text(v.unit),
             start_text(v),
             range,
             escape(v.description)
@@ -132,14 +172,44 @@ pub fn documentation(info: &ModelInfo, equations: &str) -> String {
     }
     format!(
         "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>{name}</title>\
-         <style>body{{font-family:sans-serif;max-width:60em;margin:2em auto}}table{{border-collapse:collapse}}\
-         td,th{{border:1px solid #ccc;padding:0.2em 0.5em}}</style></head><body>\n\
+         <style>body{{font-family:sans-serif;max-width:72em;margin:2em auto;padding:0 1em}}\
+         table{{border-collapse:collapse;width:100%}}\
+         td,th{{border:1px solid #ccc;padding:0.2em 0.4em;vertical-align:top;text-align:left}}\
+         td:first-child,td.n{{white-space:nowrap}}\
+         img{{max-width:100%}}</style></head><body>\n\
          <h1>{name}</h1>\n<p>{description}</p>\n<p>FMI 2.0 Co-Simulation, GUID <code>{guid}</code>.</p>\n\
-         <h2>Variables</h2>\n<table><tr><th>name</th><th>causality</th><th>variability</th><th>type</th>\
+         <h2>Variables</h2>\n<p>Values in SI units; the model description holds them to full precision.</p>\n\
+         <table><tr><th>name</th><th>causality</th><th>variability</th><th>type</th>\
          <th>unit</th><th>start</th><th>range</th><th>description</th></tr>\n{rows}</table>\n{equations}\n\
-         <p>Source: the dissertation the project is built on; equation numbers refer to it.</p>\n</body></html>\n",
+         <h2>Source</h2>\n<p>Equation, figure, section and table numbers refer to E. Ball, \
+         <i>Novel Methods in Meso-Scale and Nano-Scale Actuation</i>, M.S. thesis, Cornell University, \
+         2014, available from Cornell's eCommons repository \
+         (<a href=\"https://ecommons.cornell.edu\">ecommons.cornell.edu</a>; search for the title).</p>\n\
+         </body></html>\n",
         name = info.name,
         description = escape(info.description),
         guid = info.guid,
     )
+}
+
+#[cfg(test)]
+mod tests {
+    use super::number;
+
+    #[test]
+    fn numbers_read_at_a_glance() {
+        assert_eq!(number(3.043293741141106e-22), "3.043e-22");
+        assert_eq!(number(1e-12), "1e-12");
+        assert_eq!(number(1e12), "1e+12");
+        assert_eq!(number(-1e12), "-1e+12");
+        assert_eq!(number(0.1113), "0.1113");
+        assert_eq!(number(161000.0), "161000");
+        assert_eq!(number(-101325.0), "-101325");
+        assert_eq!(number(1.0471975511965976), "1.0472");
+        assert_eq!(number(0.0), "0");
+        assert_eq!(number(1.0), "1");
+        assert_eq!(number(4096.0), "4096");
+        assert_eq!(number(0.0010016), "0.0010016");
+        assert_eq!(number(2e8), "2e+8");
+    }
 }

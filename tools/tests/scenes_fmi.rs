@@ -1,5 +1,5 @@
 //! Every catalogue scene, in its fast variant, through the `fmi` crate: it runs, its outputs are
-//! finite and the seed's numbers it names hold (the FMPy runner checks the same in pytest).
+//! finite and the dissertation's numbers it names hold (the FMPy runner checks the same in pytest).
 
 #[allow(dead_code)]
 #[path = "common/scene_runner.rs"]
@@ -8,7 +8,7 @@ mod scene_runner;
 use actuator_fmus_tools::scene::Scene;
 
 #[test]
-fn catalogue_scenes_run_and_match_the_seed() {
+fn catalogue_scenes_run_and_match_the_dissertation() {
     let root = &actuator_fmus_tools::repository_root();
     let mut scenes: Vec<_> = std::fs::read_dir(root.join("scenes"))
         .unwrap()

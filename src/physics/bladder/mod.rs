@@ -480,7 +480,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         let area = self.fluid_area(k.inner.l2_sq);
         let pressure_force = area * (-pressure);
         let force = strands + pressure_force + k.elastic;
-        // The seed carried the contact branch's total d/dL in `dl`.
+        // The dual-number seed carried the contact branch's total d/dL in `dl`.
         self.state(
             pressure,
             length,

@@ -240,7 +240,7 @@ pub fn checks(scene: &Scene, runs: &[Run]) -> Vec<(bool, String)> {
                     .fold(f64::NEG_INFINITY, f64::max);
                 out.push((
                     (got - expect).abs() <= rel_tol * expect.abs(),
-                    format!("max {output} = {got:e}, seed {expect:e} ({source})"),
+                    format!("max {output} = {got:e}, dissertation {expect:e} ({source})"),
                 ));
             }
             Check::ZeroCrossing {
@@ -254,7 +254,7 @@ pub fn checks(scene: &Scene, runs: &[Run]) -> Vec<(bool, String)> {
                     let got = zero_crossing(&r.column(x), &r.column(output));
                     out.push((
                         (got - expect).abs() <= rel_tol * expect.abs(),
-                        format!("{output} = 0 at {x} = {got}, seed {expect} ({source})"),
+                        format!("{output} = 0 at {x} = {got}, dissertation {expect} ({source})"),
                     ));
                 }
             }
@@ -268,7 +268,7 @@ pub fn checks(scene: &Scene, runs: &[Run]) -> Vec<(bool, String)> {
                     let got = *r.column(output).last().unwrap_or(&f64::NAN);
                     out.push((
                         (got - expect).abs() <= *abs_tol,
-                        format!("final {output} = {got}, seed {expect} ({source})"),
+                        format!("final {output} = {got}, dissertation {expect} ({source})"),
                     ));
                 }
             }
