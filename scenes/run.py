@@ -125,6 +125,24 @@ class Progress:
         print(f"{'' if self.tty else self.label} done in {clock.time() - self.start:.1f} s", file=sys.stderr, flush=True)
 
 
+def sweep_runs(scene, indices=None):
+    """(k, swept value, parameters, inputs) for each run of the scene's sweep (one run without a
+    sweep): a swept input becomes a constant, a swept parameter and its `also` columns are set."""
+    sweep = scene.get("sweep")
+    values = sweep["values"] if sweep else [None]
+    for k in range(len(values)) if indices is None else indices:
+        parameters = dict(scene.get("parameters", {}))
+        inputs = dict(scene.get("inputs", {}))
+        if sweep:
+            if sweep["variable"] in inputs:
+                inputs[sweep["variable"]] = {"type": "constant", "value": values[k]}
+            else:
+                parameters[sweep["variable"]] = values[k]
+            for name, column in sweep.get("also", {}).items():
+                parameters[name] = column[k]
+        yield k, values[k], parameters, inputs
+
+
 def run_scene(scene, progress=True):
     """Returns a list of (sweep value or None, structured result array)."""
     from fmpy import simulate_fmu
@@ -136,16 +154,7 @@ def run_scene(scene, progress=True):
     n = int(round(stop / step))
     t = np.linspace(0.0, n * step, n + 1)
     runs = []
-    for k, value in enumerate(values):
-        parameters = dict(scene.get("parameters", {}))
-        inputs = dict(scene.get("inputs", {}))
-        if sweep:
-            if sweep["variable"] in inputs:
-                inputs[sweep["variable"]] = {"type": "constant", "value": value}
-            else:
-                parameters[sweep["variable"]] = value
-            for name, column in sweep.get("also", {}).items():
-                parameters[name] = column[k]
+    for k, value, parameters, inputs in sweep_runs(scene):
         signals = None
         if inputs:
             signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in inputs])

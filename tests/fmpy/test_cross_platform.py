@@ -50,17 +50,7 @@ def script_for(model):
         scene = scenes.load_scene(path, fast=True)
         if scene["fmu"] != model:
             continue
-        sweep = scene.get("sweep")
-        for k, value in enumerate(sweep["values"] if sweep else [None]):
-            parameters = dict(scene.get("parameters", {}))
-            inputs = dict(scene.get("inputs", {}))
-            if sweep:
-                if sweep["variable"] in inputs:
-                    inputs[sweep["variable"]] = {"type": "constant", "value": value}
-                else:
-                    parameters[sweep["variable"]] = value
-                for name, column in sweep.get("also", {}).items():
-                    parameters[name] = column[k]
+        for _, _, parameters, inputs in scenes.sweep_runs(scene):
             n = min(int(round(scene["stop_time"] / scene["step"])), CROSS_STEPS)
             t = np.arange(n + 1) * scene["step"]
             signals = {name: scenes.signal_values(s, t, scene["stop_time"], scene["_dir"])

@@ -50,18 +50,8 @@ def test_scene_model_exchange_matches_co_simulation(path):
     n = int(round(stop / step))
     t = np.linspace(0.0, n * step, n + 1)
     sweep = scene.get("sweep")
-    values = [sweep["values"][0], sweep["values"][-1]] if sweep else [None]
-    for value in values:
-        parameters = dict(scene.get("parameters", {}))
-        inputs = dict(scene.get("inputs", {}))
-        if sweep:
-            k = sweep["values"].index(value)
-            if sweep["variable"] in inputs:
-                inputs[sweep["variable"]] = {"type": "constant", "value": value}
-            else:
-                parameters[sweep["variable"]] = value
-            for name, column in sweep.get("also", {}).items():
-                parameters[name] = column[k]
+    first_and_last = [0, len(sweep["values"]) - 1] if sweep else None
+    for _, value, parameters, inputs in scenes.sweep_runs(scene, first_and_last):
         signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in inputs])
         signals["time"] = t
         for name, signal in inputs.items():
