@@ -1,5 +1,5 @@
-//! FMI 2.0 Co-Simulation FMUs of novel actuators: McKibben and knitted-sleeve pneumatic muscles and
-//! a multiferroic nano-motor, after the dissertation (E. Ball, *Novel Methods in Meso-Scale and
+//! FMI 2.0 Co-Simulation and Model Exchange FMUs of novel actuators: McKibben and knitted-sleeve
+//! pneumatic muscles and a multiferroic nano-motor, after the dissertation (E. Ball, *Novel Methods in Meso-Scale and
 //! Nano-Scale Actuation*, M.S. thesis, Cornell University,
 //! 2014; Cornell's eCommons repository).
 //!
