@@ -109,7 +109,8 @@ mod tests {
         for factory in REGISTRY {
             let info = factory.info();
             let mut runtime = factory.create();
-            runtime.build().unwrap();
+            let built = runtime.build();
+            assert!(built.is_ok(), "{}: {built:?}", info.name);
             let provided = runtime.directional_derivative(&[], &[], &[], &mut []);
             let flag = info
                 .model_description_xml
