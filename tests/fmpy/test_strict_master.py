@@ -117,3 +117,19 @@ def test_policy_restores_the_warning_or_asks_for_discard(policy, status):
         assert seen[-1] == "WARNING"
         assert fmu.getBoolean([vr["input_clamped"]]) == [True]
     fmu.freeInstance()
+
+
+def test_a_preset_overriding_user_values_is_noticed_at_fmi2ok(recording_log, strict):
+    # Festo DMSP-40 (preset 6) replaces the strand length and c1 the user set: the notice is logged
+    # once, at fmi2OK, and a strict master runs on. (recording_log restores FMPy's logger after.)
+    records = []
+
+    def logger(_env, _name, status, _category, message):
+        records.append((status, message.decode()))
+
+    r = fmpy.simulate_fmu(str(FMU_DIR / "McKibbenMuscle.fmu"), stop_time=0.01, output_interval=0.001,
+                          start_values=dict(preset=6, strand_length=0.3, mooney_c1=2e5, length=0.38),
+                          logger=logger)
+    assert np.isfinite(r["force"]).all()
+    notes = [rec for rec in records if "replaces the value you set" in rec[1]]
+    assert len(notes) == 1 and notes[0][0] == 0, notes

@@ -131,8 +131,12 @@ impl Instance {
             self.logger.notice(&format!("{function}: {note}"));
         }
         for (status, message) in &report.messages {
-            self.logger
-                .log(to_fmi(*status), &format!("{function}: {message}"));
+            let message = format!("{function}: {message}");
+            match status {
+                // A notice the user should read although nothing failed: always logged, at fmi2OK.
+                Status::Ok => self.logger.notice(&message),
+                _ => self.logger.log(to_fmi(*status), &message),
+            }
         }
         to_fmi(report.status)
     }
