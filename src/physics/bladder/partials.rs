@@ -33,7 +33,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             .kernel(pressure, l, x)
             .ok_or_else(|| self.domain_error(length))?;
         if contact.p_eff.v >= 0.0 {
-            // The seed carries the contact branch's total d/dL in `dl`.
+            // The dual numbers seeded by `contact_seed` carry the contact branch's total d/dL in `dl`.
             let (g, g_slope) = self.sleeve.strand_area(length);
             let area = self.fluid_area(contact.inner.l2_sq);
             let a = contact.a.v;
