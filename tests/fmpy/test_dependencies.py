@@ -2,7 +2,8 @@
 points with the effects on, each input is perturbed alone (relative 1e-3, absolute where zero) and
 the outputs are re-read WITHOUT stepping (fmi2GetReal after fmi2SetReal recomputes the direct
 feedthrough): an output that changes must declare the input, and each declared input must change
-its output at one tested point at least. Initial unknowns: each input and parameter is perturbed
+its output at one tested point at least. Discrete outputs (flags) change only where an input
+crosses a threshold: for them each input is also swept across its declared range. Initial unknowns: each input and parameter is perturbed
 before initialization and the initial unknowns compared after fmi2ExitInitializationMode.
 
 `python tests/fmpy/test_dependencies.py` prints the measured lists."""
@@ -113,6 +114,15 @@ def perturbed(v, value):
     return value + step
 
 
+def sweep(v, value):
+    """Values of a Real input across its declared range: multiples of the operating point and
+    fractions of the range."""
+    lo, hi = float(v.min), float(v.max)
+    values = [value * f for f in (-1.0, 0.0, 0.5, 0.9, 1.1, 2.0, 5.0, 10.0, 100.0)]
+    values += [lo + f * (hi - lo) for f in (0.0, 1e-6, 1e-4, 1e-3, 1e-2, 0.1, 0.5, 1.0)]
+    return [x for x in values if lo <= x <= hi]
+
+
 def measure_outputs(model):
     """{output: {inputs that changed it}} over every operating point."""
     seen = {o.name: set() for o in model.outputs}
@@ -139,6 +149,18 @@ def measure_outputs(model):
                     for o in model.outputs:
                         if after[o.name] != base[o.name]:
                             seen[o.name].add(i.name)
+                    assert model.get(s, model.outputs) == base, f"{i.name}: not restored"
+                # A discrete output moves only where its input crosses a threshold: each input is
+                # swept over its range instead, still without stepping.
+                discrete = [o for o in model.outputs if o.type != "Real"]
+                for i in model.inputs if discrete else []:
+                    for value in sweep(i, current[i.name]):
+                        model.set(s, {i.name: value})
+                        after = model.get(s, discrete)
+                        for o in discrete:
+                            if after[o.name] != base[o.name]:
+                                seen[o.name].add(i.name)
+                    model.set(s, {i.name: current[i.name]})
                     assert model.get(s, model.outputs) == base, f"{i.name}: not restored"
         finally:
             s.terminate()
