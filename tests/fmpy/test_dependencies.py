@@ -206,6 +206,14 @@ def measure_initial(model):
             for u in model.initial:
                 if after[u.name] != base[u.name]:
                     seen[u.name].add(c.name)
+        # Discrete initial unknowns (flags): each input swept across its declared range.
+        discrete = [u for u in model.initial if u.type != "Real"]
+        for i in model.inputs if discrete else []:
+            for value in sweep(i, float(values.get(i.name, i.start))):
+                after = initial_values(model, dict(values, **{i.name: value}))
+                for u in discrete if after is not None else []:
+                    if after[u.name] != base[u.name]:
+                        seen[u.name].add(i.name)
     return seen
 
 
