@@ -340,7 +340,7 @@ mod rules {
     #[test]
     fn the_shipped_descriptions_pass_every_rule() {
         rules::check(&shipped()).unwrap();
-        assert_eq!(rules::RULES.len(), 12);
+        assert_eq!(rules::RULES.len(), 13);
     }
 
     #[test]
@@ -467,6 +467,15 @@ mod rules {
             r#"<Unknown index="4" dependencies="1 2""#,
             r#"<Unknown index="3" dependencies="1 2""#,
             "Unknown index 3 is listed twice",
+        );
+    }
+
+    #[test]
+    fn every_unknown_declares_its_dependencies() {
+        broken(
+            r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent dependent"/>"#,
+            r#"<Unknown index="3"/>"#,
+            "Unknown 3 declares no dependencies",
         );
     }
 
