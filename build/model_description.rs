@@ -350,7 +350,7 @@ const DEPENDENCY_KINDS: [&str; 5] = ["dependent", "constant", "fixed", "tunable"
 
 /// FMI 2.0 section 2.2.8. Outputs: every output, in order. InitialUnknowns: outputs with initial
 /// calculated or approx and every calculated parameter, ascending. The source may list any of
-/// them by name to give their dependencies; the rest are written without a dependency list.
+/// them by name with their dependencies, and must: an unknown without a declared list is refused.
 fn resolve_structure(
     md: &ModelStructure,
     variables: &[Variable],
@@ -477,16 +477,20 @@ fn resolve_list(
             return Err(context(format!("'{name}' is listed twice")));
         }
     }
-    Ok(expected
+    // Issue 12: every output and initial unknown declares its dependencies (an empty list where
+    // it depends on none), so masters need not assume that everything depends on everything.
+    expected
         .iter()
-        .map(|&i| {
-            given.remove(&i).unwrap_or(ResolvedUnknown {
-                index: i + 1,
-                dependencies: None,
-                kinds: None,
-            })
+        .map(|&i| match given.remove(&i) {
+            Some(u) if u.dependencies.is_some() => Ok(u),
+            _ => Err(format!(
+                "ModelStructure/{list}: '{}' declares no dependencies; list it as <Unknown \
+                 name=\"{}\" dependencies=\"...\" dependenciesKind=\"...\"/> \
+                 (dependencies=\"\" where it depends on none)",
+                variables[i].name, variables[i].name
+            )),
         })
-        .collect())
+        .collect()
 }
 
 /// Byte offsets in the source where the export layer's parts go.

@@ -23,6 +23,7 @@ pub const RULES: &[&str] = &[
     "boolean attributes are 'true' or 'false' (2.2.1)",
     "variableNamingConvention 'structured' names follow the structured grammar (2.2.9)",
     "ModelStructure Unknown indices refer to existing variables, at most once per list (2.2.8)",
+    "every Outputs and InitialUnknowns entry declares its dependencies (issue 12)",
     "dependencies are ascending unique indices of inputs or the independent variable, \
      dependenciesKind has one valid kind per dependency (2.2.8)",
 ];
@@ -281,6 +282,10 @@ fn check_unknowns(
                 return Err(format!(
                     "{at}: Unknown {index} has dependenciesKind without dependencies"
                 ));
+            }
+            // Issue 12: without a list a master must assume the unknown depends on everything.
+            if list != "Derivatives" {
+                return Err(format!("{at}: Unknown {index} declares no dependencies"));
             }
             continue;
         };

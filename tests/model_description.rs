@@ -116,13 +116,17 @@ fn value_references_are_dense_and_names_unique() {
     );
 }
 
-/// The ModelStructure source part: dependencies by name, given for `force`.
+/// The source with `force`'s Outputs entry given `attributes` instead of its own.
 fn with_dependencies(attributes: &str) -> String {
     edited(
-        "<ModelStructure/>",
-        &format!("<ModelStructure><Outputs><Unknown name=\"force\" {attributes}/></Outputs></ModelStructure>"),
+        FORCE,
+        &format!("<Unknown name=\"force\" {attributes}/>"),
     )
 }
+
+/// The source's declaration of `force` among the Outputs (its first Unknown).
+const FORCE: &str =
+    r#"<Unknown name="force" dependencies="pressure length" dependenciesKind="dependent dependent"/>"#;
 
 #[test]
 fn model_structure_indices_are_generated() {
@@ -141,14 +145,15 @@ fn model_structure_indices_are_generated() {
             41, 42, 43, 47, 48, 50
         ]
     );
-    assert!(m.outputs.iter().all(|u| u.dependencies.is_none()));
+    assert!(m.outputs.iter().all(|u| u.dependencies.is_some()));
     let xml = &m.shipped_xml;
     assert!(xml.contains(
         r#"<CoSimulation
     modelIdentifier="McKibbenMuscle""#
     ));
     assert!(xml.contains(r#"<Category name="logCalls""#));
-    assert!(xml.contains(r#"<Unknown index="31"/> <!-- min_length -->"#));
+    assert!(xml.contains(r#"<Unknown index="31" dependencies=""#));
+    assert!(xml.contains(r#"<!-- min_length -->"#));
     assert!(xml.contains(&format!(r#"guid="{}""#, m.guid)));
 }
 
@@ -204,26 +209,47 @@ fn bad_model_structure_entries_fail() {
         "dependenciesKind without dependencies",
     );
     refused(
-        &edited(
-            "<ModelStructure/>",
-            r#"<ModelStructure><Outputs><Unknown index="3"/></Outputs></ModelStructure>"#,
-        ),
+        &edited("<Outputs>", r#"<Outputs><Unknown index="3"/>"#),
         "give the unknown by name",
     );
     refused(
-        &edited(
-            "<ModelStructure/>",
-            r#"<ModelStructure><Outputs><Unknown name="turns"/></Outputs></ModelStructure>"#,
-        ),
+        &edited("<Outputs>", r#"<Outputs><Unknown name="turns" dependencies=""/>"#),
         "'turns' does not belong in this list",
     );
     refused(
-        &edited(
-            "<ModelStructure/>",
-            r#"<ModelStructure><Outputs><Unknown name="force"/><Unknown name="force"/></Outputs></ModelStructure>"#,
-        ),
+        &edited("<Outputs>", r#"<Outputs><Unknown name="force" dependencies=""/>"#),
         "'force' is listed twice",
     );
+}
+
+#[test]
+fn every_output_and_initial_unknown_declares_its_dependencies() {
+    // Issue 12: an output left out, or listed without a dependency list, is refused...
+    refused(&edited(FORCE, ""), "'force' declares no dependencies");
+    refused(&with_dependencies(""), "'force' declares no dependencies");
+    // ...and so is an initial unknown (a calculated parameter here).
+    let min_length = SOURCE
+        .lines()
+        .find(|l| l.contains(r#"<Unknown name="min_length""#))
+        .expect("min_length is declared among the InitialUnknowns")
+        .trim();
+    refused(&edited(min_length, ""), "'min_length' declares no dependencies");
+    // Every shipped description declares them all.
+    for (name, text) in [
+        ("McKibbenMuscle", SOURCE),
+        ("KnittedMuscle", include_str!("../modelDescription/KnittedMuscle.xml")),
+        ("McKibbenJoint", include_str!("../modelDescription/McKibbenJoint.xml")),
+        ("PulleyJoint", include_str!("../modelDescription/PulleyJoint.xml")),
+        ("MultiferroicMotor", include_str!("../modelDescription/MultiferroicMotor.xml")),
+        ("PassThrough", include_str!("../modelDescription/PassThrough.xml")),
+    ] {
+        let m = check(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert!(m
+            .outputs
+            .iter()
+            .chain(&m.initial_unknowns)
+            .all(|u| u.dependencies.is_some() && u.kinds.is_some()));
+    }
 }
 
 #[test]
@@ -283,7 +309,7 @@ fn the_guid_changes_with_any_variable() {
     // The GUID build.rs ships is that of the whole shipped description.
     let shipped = check(SOURCE, "McKibbenMuscle").unwrap();
     let renamed = check(
-        &edited(r#"name="volume""#, r#"name="volume_m3""#),
+        &SOURCE.replace(r#"name="volume""#, r#"name="volume_m3""#),
         "McKibbenMuscle",
     )
     .unwrap();
@@ -314,7 +340,7 @@ mod rules {
     #[test]
     fn the_shipped_descriptions_pass_every_rule() {
         rules::check(&shipped()).unwrap();
-        assert_eq!(rules::RULES.len(), 12);
+        assert_eq!(rules::RULES.len(), 13);
     }
 
     #[test]
@@ -433,20 +459,29 @@ mod rules {
     #[test]
     fn unknowns_refer_to_variables_once() {
         broken(
-            r#"<Unknown index="3"/>"#,
-            r#"<Unknown index="99"/>"#,
+            r#"<Unknown index="3" dependencies="1 2""#,
+            r#"<Unknown index="99" dependencies="1 2""#,
             "Unknown index 99 is not a variable",
         );
         broken(
-            r#"<Unknown index="4"/>"#,
-            r#"<Unknown index="3"/>"#,
+            r#"<Unknown index="4" dependencies="1 2""#,
+            r#"<Unknown index="3" dependencies="1 2""#,
             "Unknown index 3 is listed twice",
         );
     }
 
     #[test]
+    fn every_unknown_declares_its_dependencies() {
+        broken(
+            r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent dependent"/>"#,
+            r#"<Unknown index="3"/>"#,
+            "Unknown 3 declares no dependencies",
+        );
+    }
+
+    #[test]
     fn dependencies_are_sorted_inputs_with_one_kind_each() {
-        let force = r#"<Unknown index="3"/>"#;
+        let force = r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent dependent"/>"#;
         broken(
             force,
             r#"<Unknown index="3" dependencies="2 1"/>"#,
