@@ -118,15 +118,11 @@ fn value_references_are_dense_and_names_unique() {
 
 /// The source with `force`'s Outputs entry given `attributes` instead of its own.
 fn with_dependencies(attributes: &str) -> String {
-    edited(
-        FORCE,
-        &format!("<Unknown name=\"force\" {attributes}/>"),
-    )
+    edited(FORCE, &format!("<Unknown name=\"force\" {attributes}/>"))
 }
 
 /// The source's declaration of `force` among the Outputs (its first Unknown).
-const FORCE: &str =
-    r#"<Unknown name="force" dependencies="pressure length" dependenciesKind="dependent dependent"/>"#;
+const FORCE: &str = r#"<Unknown name="force" dependencies="pressure length" dependenciesKind="dependent dependent"/>"#;
 
 #[test]
 fn model_structure_indices_are_generated() {
@@ -213,11 +209,17 @@ fn bad_model_structure_entries_fail() {
         "give the unknown by name",
     );
     refused(
-        &edited("<Outputs>", r#"<Outputs><Unknown name="turns" dependencies=""/>"#),
+        &edited(
+            "<Outputs>",
+            r#"<Outputs><Unknown name="turns" dependencies=""/>"#,
+        ),
         "'turns' does not belong in this list",
     );
     refused(
-        &edited("<Outputs>", r#"<Outputs><Unknown name="force" dependencies=""/>"#),
+        &edited(
+            "<Outputs>",
+            r#"<Outputs><Unknown name="force" dependencies=""/>"#,
+        ),
         "'force' is listed twice",
     );
 }
@@ -233,15 +235,33 @@ fn every_output_and_initial_unknown_declares_its_dependencies() {
         .find(|l| l.contains(r#"<Unknown name="min_length""#))
         .expect("min_length is declared among the InitialUnknowns")
         .trim();
-    refused(&edited(min_length, ""), "'min_length' declares no dependencies");
+    refused(
+        &edited(min_length, ""),
+        "'min_length' declares no dependencies",
+    );
     // Every shipped description declares them all.
     for (name, text) in [
         ("McKibbenMuscle", SOURCE),
-        ("KnittedMuscle", include_str!("../modelDescription/KnittedMuscle.xml")),
-        ("McKibbenJoint", include_str!("../modelDescription/McKibbenJoint.xml")),
-        ("PulleyJoint", include_str!("../modelDescription/PulleyJoint.xml")),
-        ("MultiferroicMotor", include_str!("../modelDescription/MultiferroicMotor.xml")),
-        ("PassThrough", include_str!("../modelDescription/PassThrough.xml")),
+        (
+            "KnittedMuscle",
+            include_str!("../modelDescription/KnittedMuscle.xml"),
+        ),
+        (
+            "McKibbenJoint",
+            include_str!("../modelDescription/McKibbenJoint.xml"),
+        ),
+        (
+            "PulleyJoint",
+            include_str!("../modelDescription/PulleyJoint.xml"),
+        ),
+        (
+            "MultiferroicMotor",
+            include_str!("../modelDescription/MultiferroicMotor.xml"),
+        ),
+        (
+            "PassThrough",
+            include_str!("../modelDescription/PassThrough.xml"),
+        ),
     ] {
         let m = check(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(m
@@ -481,7 +501,8 @@ mod rules {
 
     #[test]
     fn dependencies_are_sorted_inputs_with_one_kind_each() {
-        let force = r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent dependent"/>"#;
+        let force =
+            r#"<Unknown index="3" dependencies="1 2" dependenciesKind="dependent dependent"/>"#;
         broken(
             force,
             r#"<Unknown index="3" dependencies="2 1"/>"#,
