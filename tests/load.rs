@@ -81,7 +81,7 @@ fn run(api: &Api, info: &ModelInfo, k: usize, steps: usize) -> Vec<u64> {
 /// initialize, step, a serialized state restored
 /// and freed, a state left for fmi2FreeInstance, every Real read, free.
 fn cycle(api: &Api, info: &ModelInfo, k: usize) {
-    let i = ready(api, info, k % 100 == 0);
+    let i = ready(api, info, k.is_multiple_of(100));
     step_and_read(&i, info, k, 0);
     let bytes = serialized_state(&i);
     unsafe {

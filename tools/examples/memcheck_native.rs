@@ -9,10 +9,8 @@
 //!
 //! `cargo run --release --example memcheck_native` runs it without valgrind (a few seconds).
 
-#[allow(dead_code)]
 #[path = "../../tests/common/mod.rs"]
 mod common;
-#[allow(dead_code)]
 #[path = "../../tests/common/exercise.rs"]
 mod exercise;
 
