@@ -8,7 +8,7 @@
 //! switches) -> [`physics`] (pure equations). Beside them, [`variables`] holds what build.rs
 //! generates from `modelDescription/*.xml`: value references, metadata and each model's typed
 //! `Parameters`, `Inputs`, `Outputs` and `CalculatedParameters`; it names nothing above it.
-//! [`fmi2`] is the only module with `unsafe` code; `physics` and `models` forbid it.
+//! [`fmi2`] is the only module that allows `unsafe_code`; `physics` and `models` forbid it.
 
 pub mod fmi2;
 pub mod models;
