@@ -159,7 +159,14 @@ impl Instance {
         if n == 0 {
             return fmi2Status::OK;
         }
-        self.prepare(function)
+        // The hot path: only the time goes to the model; the outputs are not recomputed (an
+        // unbuilt model is built in initialization mode, as fmi2GetReal does).
+        self.runtime.set_time(self.time);
+        if self.runtime.is_built() {
+            fmi2Status::OK
+        } else {
+            self.refresh_outputs(function)
+        }
     }
 
     /// `fmi2GetContinuousStates`, `fmi2GetDerivatives`, `fmi2GetEventIndicators`,
