@@ -132,6 +132,7 @@ bench: deps fmus
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
 	cargo bench --bench directional_derivative
+	cargo bench --bench model_exchange
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
