@@ -596,6 +596,15 @@ mod continuous_states {
             &edited(r#"derivative="joint_angle""#, r#"derivative="inertia""#),
             "must be a continuous Real output or local",
         );
+        // A state's start comes from the model (initial calculated), not from a start value.
+        refused(
+            &edited(
+                r#"name="joint_angle" valueReference="6" causality="output" variability="continuous" initial="calculated""#,
+                r#"name="joint_angle" valueReference="6" causality="output" variability="continuous" initial="exact""#,
+            )
+            .replacen(r#"<Real quantity="Angle" unit="rad"/>"#, r#"<Real quantity="Angle" unit="rad" start="0"/>"#, 1),
+            "must have initial 'calculated'",
+        );
         // Two derivatives of one state.
         refused(
             &edited(
