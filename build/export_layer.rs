@@ -45,6 +45,7 @@ const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &["McKibbenJoint", "McKibbenMusc
 /// (`Model::ALGEBRAIC_MODEL_EXCHANGE`, `src/fmi2/model_exchange.rs`); a Rust test checks that the
 /// shipped block and the models agree.
 const MODEL_EXCHANGE: &[&str] = &[
+    "FreeBladder",
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",

@@ -70,7 +70,9 @@ impl FreeBladder {
             ("unstretched_length (m)", tube.unstretched_length),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(format!("bladder {name} must be positive and finite, got {v}"));
+                return Err(format!(
+                    "bladder {name} must be positive and finite, got {v}"
+                ));
             }
         }
         let (c1, c2) = (tube.mooney_c1, tube.mooney_c2);
@@ -130,7 +132,9 @@ impl FreeBladder {
             return Err(format!("pressure must be finite, got {pressure} Pa"));
         }
         if !(length.is_finite() && length > 0.0) {
-            return Err(format!("length must be positive and finite, got {length} m"));
+            return Err(format!(
+                "length must be positive and finite, got {length} m"
+            ));
         }
         let l1 = length / self.tube.unstretched_length;
         let a = self.modulus(l1);
@@ -153,7 +157,8 @@ impl FreeBladder {
         let l2 = (w / l1).sqrt();
         let l3 = 1.0 / (l1 * l2);
         let (c1, c2) = (self.tube.mooney_c1, self.tube.mooney_c2);
-        let mooney = |s: f64| 2.0 * c1 * (s * s - l3 * l3) - 2.0 * c2 * (1.0 / (s * s) - 1.0 / (l3 * l3));
+        let mooney =
+            |s: f64| 2.0 * c1 * (s * s - l3 * l3) - 2.0 * c2 * (1.0 / (s * s) - 1.0 / (l3 * l3));
         // Eq. 2.9 with sigma_33 = -P.
         let stress_axial = mooney(l1) - pressure;
         let stress_hoop = mooney(l2) - pressure;

@@ -41,11 +41,19 @@ fn solves_eq_2_18_and_eq_2_11_as_written() {
         let lhs = p * (l3 + l2 * d_ri / (d_ro - d_ri));
         let rhs = 2.0 * MOONEY_C1 * (l2 / l1 - 1.0 / (l1.powi(3) * l2.powi(3)))
             - 2.0 * MOONEY_C2 * (1.0 / (l1 * l2.powi(3)) - l1 * l2);
-        assert!((lhs - rhs).abs() <= 1e-12 * (MOONEY_C1 + p.abs()), "{p} {lam}: {lhs} {rhs}");
+        assert!(
+            (lhs - rhs).abs() <= 1e-12 * (MOONEY_C1 + p.abs()),
+            "{p} {lam}: {lhs} {rhs}"
+        );
         // Eq. 2.11 with P_eff = 0: the hoop stress carries the pressure across the wall.
         let hoop = p * s.inner_diameter / (l3 * (d_ro - d_ri));
         assert_relative_eq!(s.stress_hoop, hoop, max_relative = 1e-11, epsilon = 1e-6);
-        assert_relative_eq!(b.equilibrium_pressure(l1, l2), p, max_relative = 1e-12, epsilon = 1e-6);
+        assert_relative_eq!(
+            b.equilibrium_pressure(l1, l2),
+            p,
+            max_relative = 1e-12,
+            epsilon = 1e-6
+        );
     }
 }
 
@@ -63,8 +71,18 @@ fn is_the_mckibben_bladders_free_branch() {
         assert_relative_eq!(s.inner_diameter, m.inner_diameter, max_relative = 1e-12);
         assert_relative_eq!(s.outer_diameter, m.outer_diameter, max_relative = 1e-12);
         assert_relative_eq!(s.fluid_volume, m.fluid_volume, max_relative = 1e-12);
-        assert_relative_eq!(s.stress_axial, m.stress_axial, max_relative = 1e-10, epsilon = 1e-3);
-        assert_relative_eq!(s.stress_hoop, m.stress_hoop, max_relative = 1e-10, epsilon = 1e-3);
+        assert_relative_eq!(
+            s.stress_axial,
+            m.stress_axial,
+            max_relative = 1e-10,
+            epsilon = 1e-3
+        );
+        assert_relative_eq!(
+            s.stress_hoop,
+            m.stress_hoop,
+            max_relative = 1e-10,
+            epsilon = 1e-3
+        );
         assert_relative_eq!(s.force, m.force, max_relative = 1e-10, epsilon = 1e-9);
     }
 }
@@ -118,13 +136,21 @@ fn balloons_at_the_limit_of_eq_2_18() {
 
 #[test]
 fn compliance_is_the_pressure_slope_of_volume() {
-    for (t, p, lam) in [(TUBE_A, 2e5_f64, 1.0), (TUBE_D, 4e4, 1.3), (TUBE_D, -5e4, 0.9)] {
+    for (t, p, lam) in [
+        (TUBE_A, 2e5_f64, 1.0),
+        (TUBE_D, 4e4, 1.3),
+        (TUBE_D, -5e4, 0.9),
+    ] {
         let b = free(t);
         let l = lam * t.0;
         let v = |p: f64| b.evaluate(p, l).unwrap().fluid_volume;
         let h = 1e-5 * p.abs();
         let slope = (v(p + h) - v(p - h)) / (2.0 * h);
-        assert_relative_eq!(b.evaluate(p, l).unwrap().compliance, slope, max_relative = 1e-6);
+        assert_relative_eq!(
+            b.evaluate(p, l).unwrap().compliance,
+            slope,
+            max_relative = 1e-6
+        );
     }
 }
 
@@ -132,11 +158,27 @@ fn compliance_is_the_pressure_slope_of_volume() {
 fn rejects_bad_parameters_and_inputs() {
     let good = tube(TUBE_D);
     for bad in [
-        BladderTube { inner_diameter: 0.0, ..good },
-        BladderTube { thickness: f64::NAN, ..good },
-        BladderTube { unstretched_length: -1.0, ..good },
-        BladderTube { mooney_c1: 0.0, mooney_c2: 0.0, ..good },
-        BladderTube { mooney_c2: -1.0, ..good },
+        BladderTube {
+            inner_diameter: 0.0,
+            ..good
+        },
+        BladderTube {
+            thickness: f64::NAN,
+            ..good
+        },
+        BladderTube {
+            unstretched_length: -1.0,
+            ..good
+        },
+        BladderTube {
+            mooney_c1: 0.0,
+            mooney_c2: 0.0,
+            ..good
+        },
+        BladderTube {
+            mooney_c2: -1.0,
+            ..good
+        },
     ] {
         assert!(FreeBladder::new(bad).is_err(), "{bad:?}");
     }
