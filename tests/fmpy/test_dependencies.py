@@ -22,6 +22,13 @@ from conftest import fmu_path  # noqa: E402
 # Operating points: parameter overrides (the effects on) x input points.
 CONFIGS = {
     "PassThrough": ([{}], [{}, {"u": 0.7}]),
+    # The first point lies just below (C2 38719.67 Pa) and just above (38679.73 Pa) the clamp at
+    # 0.999 of the ballooning pressure, so that the initial input_clamped shows each parameter.
+    "FreeBladder": (
+        [{}, {"mooney_c2": 38719.67}, {"mooney_c2": 38679.73}],
+        [{"pressure": 5.25e4, "length": 0.1336}, {"pressure": 3e4, "length": 0.16},
+         {"pressure": -5e4, "length": 0.12}],
+    ),
     "McKibbenMuscle": (
         [{}, {"bladder_model": 1}, {"friction": True}, {"bladder_model": 1, "friction": True},
          {"pressure_solver": True}],

@@ -19,7 +19,7 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scenes"))
 import run as scenes  # noqa: E402
 
-MODEL_EXCHANGE = ["KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough"]
+MODEL_EXCHANGE = ["FreeBladder", "KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough"]
 CO_SIMULATION_ONLY = ["MultiferroicMotor", "PulleyJoint"]
 TOLERANCE = 1e-9
 SCENES = [
