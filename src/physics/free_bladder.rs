@@ -142,7 +142,7 @@ impl FreeBladder {
         let ballooning = a / r;
         // (A - P r) w^2 - P w - A = 0: the positive root, in the form without cancellation.
         let lead = a - pressure * r;
-        if !(lead > 0.0) {
+        if lead <= 0.0 {
             return Err(format!(
                 "pressure {pressure} Pa is at or above the ballooning pressure {ballooning} Pa at \
                  length {length} m: eq. 2.18 has no equilibrium, the free tube inflates without bound"
