@@ -17,7 +17,7 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 sys.path.insert(0, __import__("os").path.dirname(__file__))
-from conftest import fmu_path  # noqa: E402
+from conftest import ROOT, fmu_path  # noqa: E402
 
 # Operating points: parameter overrides (the effects on) x input points.
 CONFIGS = {
@@ -230,6 +230,12 @@ def compare(declared, measured, what):
     assert not undeclared, f"{what}: undeclared dependencies {undeclared}"
     assert not unshown, f"{what}: declared dependencies that never showed {unshown}"
     return sum(len(d) for d in declared.values())
+
+
+def test_every_model_has_operating_points():
+    # A model missing from CONFIGS would have its declared dependencies never measured.
+    shipped = {p.stem for p in (ROOT / "modelDescription").glob("*.xml")}
+    assert set(CONFIGS) == shipped, f"CONFIGS lacks {sorted(shipped - set(CONFIGS))}"
 
 
 @pytest.mark.parametrize("name", MODELS)

@@ -82,6 +82,11 @@ def test_joint_model_exchange_matches_co_simulation():
     assert max(worst.values()) <= TOLERANCE, worst
 
 
+def test_every_model_is_in_one_list():
+    shipped = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
+    assert sorted(MODEL_EXCHANGE + CO_SIMULATION_ONLY) == shipped
+
+
 @pytest.mark.parametrize("model", MODEL_EXCHANGE + CO_SIMULATION_ONLY)
 def test_both_interfaces_validate_clean(model):
     assert validate_fmu(fmu_path(model)) == []
