@@ -22,6 +22,8 @@
 
 mod baseline;
 mod geometry;
+#[cfg(test)]
+mod reference;
 mod solver;
 mod table;
 #[cfg(test)]
