@@ -22,6 +22,7 @@
 
 mod baseline;
 mod geometry;
+mod newton;
 #[cfg(test)]
 mod reference;
 mod solver;
@@ -30,5 +31,5 @@ mod table;
 mod tests;
 
 pub use baseline::{seed_gradient_volume_curve, SeedAlgorithmOptions};
-pub use geometry::ShapeGeometry;
+pub use geometry::{ShapeGeometry, MAX_SEGMENTS};
 pub use table::{ShapeTable, DEFAULT_TABLE_NODES};

@@ -31,6 +31,10 @@ pub(super) struct Solver {
     pub(super) x: Vec<f64>,
     pub(super) y: Vec<f64>,
     pub(super) c: Vec<f64>,
+    /// Radii before the fast path's last Newton step.
+    pub(super) base: Vec<f64>,
+    /// Releases of each ring from the floor in the current fast solve.
+    pub(super) releases: Vec<u8>,
 }
 
 /// Converged point on the path.
@@ -62,7 +66,9 @@ impl Solver {
             ol: z.clone(),
             x: z.clone(),
             y: z.clone(),
-            c: z,
+            c: z.clone(),
+            base: z,
+            releases: vec![0; rings],
         }
     }
 
