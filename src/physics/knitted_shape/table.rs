@@ -221,18 +221,21 @@ fn follow_path(
         }
         None => (1..=nodes).map(|i| l_max - i as f64 * step).collect(),
     };
+    // The last converged state (restored on failure) and the prediction (the fallback's start).
+    let mut backup = solver.clone();
+    let mut predicted = solver.clone();
     'nodes: for &target in &targets {
         let mut sub = target - current;
         let mut halvings = 0;
         while current > target {
             let aim = (current + sub).max(target);
-            let backup = solver.clone();
+            backup.copy_from(solver);
             let outcome = if started {
                 predict(geom, solver, &backup, aim - current, last_curvature, &edges);
                 // Late in the stroke the edge runs out to the clamps faster than predicted
                 // and moves about one ring per iteration; allow for a share of the rings.
                 let iterations = MAX_PATH_ITERATIONS + solver.radii.len() / 16;
-                solve_from(geom, solver, aim, iterations)
+                solve_from(geom, solver, &mut predicted, aim, iterations)
             } else {
                 nucleate(geom, solver, aim)
             };
@@ -254,7 +257,7 @@ fn follow_path(
                     }
                 }
                 Err(_why) => {
-                    *solver = backup;
+                    solver.copy_from(&backup);
                     halvings += 1;
                     if halvings > MAX_SUBSTEP_HALVINGS {
                         break 'nodes;
@@ -337,14 +340,15 @@ fn predict(
 fn solve_from(
     geom: &ShapeGeometry,
     solver: &mut Solver,
+    start: &mut Solver,
     aim: f64,
     max_iterations: usize,
 ) -> Result<PathPoint, &'static str> {
-    let predicted = solver.clone();
+    start.copy_from(solver);
     if let Some(p) = solver.solve_newton(geom, aim, max_iterations) {
         return Ok(p);
     }
-    *solver = predicted;
+    solver.copy_from(start);
     solver.solve(geom, aim)
 }
 
@@ -360,10 +364,11 @@ fn nucleate(
     // its width, a share of the rings.
     let iterations = MAX_PATH_ITERATIONS + solver.radii.len() / 8;
     let mut bulge_solver = solver.clone();
+    let mut start = solver.clone();
     solver.seed_pocket(geom, geom.max_length() - aim);
-    let pocket = solve_from(geom, solver, aim, iterations);
+    let pocket = solve_from(geom, solver, &mut start, aim, iterations);
     bulge_solver.seed_uniform(geom);
-    let bulge = solve_from(geom, &mut bulge_solver, aim, iterations);
+    let bulge = solve_from(geom, &mut bulge_solver, &mut start, aim, iterations);
     match (pocket, bulge) {
         (Ok(p), Ok(b)) if b.volume > p.volume => {
             *solver = bulge_solver;

@@ -1,0 +1,69 @@
+"""Time of `fmi2ExitInitializationMode` of KnittedMuscle with the non-cylindrical shape (the
+table is built there), through FMPy, for the section 1.4 prototype at 49 and 1,568 segments
+(issue 15's goals: 3 ms and 100 ms). Each figure is the best of `repeats` fresh instances.
+
+    .venv/bin/python benches/knitted_shape_init.py [OTHER.fmu]
+
+With another KnittedMuscle.fmu (for example one packaged from an older commit), the two are
+timed interleaved, so that a loaded machine slows both alike, and their ratio is printed."""
+
+import pathlib
+import sys
+import time
+
+ROOT = pathlib.Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
+from conftest import FMU_DIR  # noqa: E402
+
+GOALS = {49: 3e-3, 1568: 100e-3}
+
+
+def instance(path):
+    from fmpy import extract, read_model_description
+    from fmpy.fmi2 import FMU2Slave
+
+    md = read_model_description(str(path))
+    directory = extract(str(path))
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+
+    def exit_time(segments):
+        fmu = FMU2Slave(guid=md.guid, unzipDirectory=directory,
+                        modelIdentifier=md.coSimulation.modelIdentifier, instanceName="k")
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.setInteger([vr["shape_model"], vr["shape_segments"]], [2, segments])
+        start = time.perf_counter()
+        fmu.exitInitializationMode()
+        elapsed = time.perf_counter() - start
+        fmu.terminate()
+        fmu.freeInstance()
+        return elapsed
+
+    return exit_time
+
+
+def measure(paths, segments, repeats):
+    """Best time per FMU (s), instances interleaved."""
+    timers = [instance(p) for p in paths]
+    best = [float("inf")] * len(paths)
+    for _ in range(repeats):
+        for k, timer in enumerate(timers):
+            best[k] = min(best[k], timer(segments))
+    return best
+
+
+def main():
+    paths = [FMU_DIR / "KnittedMuscle.fmu"] + [pathlib.Path(p) for p in sys.argv[1:2]]
+    for segments, goal in GOALS.items():
+        repeats = 20 if segments < 200 else 5
+        best = measure(paths, segments, repeats)
+        line = f"{segments} segments: {best[0] * 1e3:.2f} ms (goal {goal * 1e3:.0f} ms, " \
+               f"{'met' if best[0] <= goal else 'missed'})"
+        if len(best) > 1:
+            line += f"; other FMU {best[1] * 1e3:.2f} ms, {best[1] / best[0]:.1f}x slower"
+        print(line)
+
+
+if __name__ == "__main__":
+    main()
