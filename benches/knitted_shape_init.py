@@ -5,7 +5,8 @@ table is built there), through FMPy, for the section 1.4 prototype at 49 and 1,5
     .venv/bin/python benches/knitted_shape_init.py [OTHER.fmu]
 
 With another KnittedMuscle.fmu (for example one packaged from an older commit), the two are
-timed interleaved, so that a loaded machine slows both alike, and their ratio is printed."""
+timed interleaved, so that a loaded machine slows both alike, and their ratio is printed.
+Prints a Markdown table over 49 to 1,568 segments."""
 
 import pathlib
 import sys
@@ -53,16 +54,29 @@ def measure(paths, segments, repeats):
     return best
 
 
+SEGMENTS = (49, 98, 196, 392, 784, 1568)
+
+
+def rows(paths):
+    """Markdown rows over SEGMENTS, and the best times of the first FMU by segments."""
+    header = "| segments | time | goal |" + (" other FMU | ratio |" if len(paths) > 1 else "")
+    out = [header, "|---" * (header.count("|") - 1) + "|"]
+    times = {}
+    for segments in SEGMENTS:
+        best = measure(paths, segments, 20 if segments < 200 else 5)
+        times[segments] = best[0]
+        goal = GOALS.get(segments)
+        verdict = f"<= {goal * 1e3:.0f} ms: {'met' if best[0] <= goal else 'missed'}" if goal else ""
+        line = f"| {segments:,} | {best[0] * 1e3:.2f} ms | {verdict} |"
+        if len(best) > 1:
+            line += f" {best[1] * 1e3:.2f} ms | {best[1] / best[0]:.1f}x |"
+        out.append(line)
+    return out, times
+
+
 def main():
     paths = [FMU_DIR / "KnittedMuscle.fmu"] + [pathlib.Path(p) for p in sys.argv[1:2]]
-    for segments, goal in GOALS.items():
-        repeats = 20 if segments < 200 else 5
-        best = measure(paths, segments, repeats)
-        line = f"{segments} segments: {best[0] * 1e3:.2f} ms (goal {goal * 1e3:.0f} ms, " \
-               f"{'met' if best[0] <= goal else 'missed'})"
-        if len(best) > 1:
-            line += f"; other FMU {best[1] * 1e3:.2f} ms, {best[1] / best[0]:.1f}x slower"
-        print(line)
+    print("\n".join(rows(paths)[0]))
 
 
 if __name__ == "__main__":
