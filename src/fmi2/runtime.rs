@@ -93,10 +93,16 @@ pub trait Runtime: Send {
     fn boolean(&self, vr: usize) -> bool;
     fn set_boolean(&mut self, vr: usize, value: bool);
     fn string(&self, vr: usize) -> &str;
+    /// `out[i] = real(vrs[i])`: fmi2GetReal in one dynamic call.
+    fn reals(&self, vrs: &[u32], out: &mut [f64]);
+    /// `set_real(vrs[i], values[i])`, then [`Runtime::changed`]: fmi2SetReal in one dynamic call.
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool);
     fn set_string(&mut self, vr: usize, value: &str);
     /// Tells that inputs changed (outputs are stale) or that parameters did (the model is too).
     fn changed(&mut self, parameters: bool);
     fn is_built(&self) -> bool;
+    /// Built, and no input or parameter changed since the outputs were last written.
+    fn outputs_current(&self) -> bool;
     /// Builds the model from the current parameters, with only the effects they switch on.
     fn build(&mut self) -> Result<(), String>;
     /// Recomputes the outputs if an input changed since they were last written.
@@ -170,6 +176,17 @@ where
     fn string(&self, vr: usize) -> &str {
         M::Variables::string(&self.values, vr)
     }
+    fn reals(&self, vrs: &[u32], out: &mut [f64]) {
+        for (&vr, slot) in vrs.iter().zip(out) {
+            *slot = M::Variables::real(&self.values, vr as usize);
+        }
+    }
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool) {
+        for (&vr, &value) in vrs.iter().zip(values) {
+            M::Variables::set_real(&mut self.values, vr as usize, value);
+        }
+        self.changed(parameters);
+    }
     fn set_string(&mut self, vr: usize, value: &str) {
         M::Variables::set_string(&mut self.values, vr, value)
     }
@@ -181,6 +198,9 @@ where
     }
     fn is_built(&self) -> bool {
         self.model.is_some()
+    }
+    fn outputs_current(&self) -> bool {
+        !self.outputs_stale && self.model.is_some()
     }
     fn build(&mut self) -> Result<(), String> {
         let v = &mut self.values;
