@@ -208,7 +208,8 @@ fn knitted_initialization(api: &'static common::Api, segments: i32, repeats: usi
             .instantiate("parity", knitted.guid)
             .unwrap_or_else(|log| panic!("instantiate: {:?}", log.lines()));
         let vrs = [vr(knitted, "shape_model"), vr(knitted, "shape_segments")];
-        let status = unsafe { (api.fmi2SetInteger)(inst.c, vrs.as_ptr(), 2, [2, segments].as_ptr()) };
+        let status =
+            unsafe { (api.fmi2SetInteger)(inst.c, vrs.as_ptr(), 2, [2, segments].as_ptr()) };
         assert_eq!(status, common::OK, "{:?}", inst.log.lines());
         assert_eq!(inst.setup(), common::OK);
         assert_eq!(inst.enter(), common::OK);
@@ -310,7 +311,10 @@ fn main() {
     let figure = |name: &str| {
         let i = cases.iter().position(|c| c.name == name)?;
         let s = &samples[i];
-        Some((s.iter().copied().fold(f64::INFINITY, f64::min), median(s.clone())))
+        Some((
+            s.iter().copied().fold(f64::INFINITY, f64::min),
+            median(s.clone()),
+        ))
     };
 
     // The knitted shape table is built once, at initialization: time that call through the FMU.
@@ -322,7 +326,9 @@ fn main() {
         json_init.push((segments, t));
     }
 
-    println!("\nGoals of issue 15 (ratios within this run; the motor FMPy goal is in `make report`):");
+    println!(
+        "\nGoals of issue 15 (ratios within this run; the motor FMPy goal is in `make report`):"
+    );
     let goal = |text: &str, measured: Option<f64>, target: f64, shown: &dyn Fn(f64) -> String| {
         match measured {
             Some(m) => println!("  {text:<58} {:>12}  {}", shown(m), verdict(m, target)),
@@ -331,19 +337,49 @@ fn main() {
     };
     let ratio = |name: &str| figure(name).map(|(min, _)| min / c_min);
     let x = |r: f64| format!("{r:.2}x");
-    goal("PassThrough <= 1.1x the C pass-through (min)", ratio("PassThrough"), 1.1, &x);
-    goal("ideal McKibben <= 1.3x the C pass-through (min)", ratio("McKibbenMuscle, ideal"), 1.3, &x);
+    goal(
+        "PassThrough <= 1.1x the C pass-through (min)",
+        ratio("PassThrough"),
+        1.1,
+        &x,
+    );
+    goal(
+        "ideal McKibben <= 1.3x the C pass-through (min)",
+        ratio("McKibbenMuscle, ideal"),
+        1.3,
+        &x,
+    );
     let walls = figure("McKibbenMuscle, continuum wall, 8 nodes")
         .zip(figure("McKibbenMuscle, layered wall, 16 layers"))
         .map(|(c, l)| c.1 / l.1);
-    goal("continuum wall, 8 nodes <= 16 layers (median ratio)", walls, 1.0, &x);
+    goal(
+        "continuum wall, 8 nodes <= 16 layers (median ratio)",
+        walls,
+        1.0,
+        &x,
+    );
     let us = |t: f64| format!("{:.2} us", t * 1e6);
     let motor = figure("MultiferroicMotor, 1 us step").map(|(_, med)| med);
-    goal("motor, 1 us communication step <= 2 us natively (median)", motor, 2e-6, &us);
+    goal(
+        "motor, 1 us communication step <= 2 us natively (median)",
+        motor,
+        2e-6,
+        &us,
+    );
     let ms = |t: f64| format!("{:.2} ms", t * 1e3);
     let init_of = |n: i32| json_init.iter().find(|(s, _)| *s == n).map(|(_, t)| *t);
-    goal("knitted prototype (49 rows) initialization <= 3 ms", init_of(49), 3e-3, &ms);
-    goal("knitted table, 1,568 rows, initialization <= 100 ms", init_of(1568), 0.1, &ms);
+    goal(
+        "knitted prototype (49 rows) initialization <= 3 ms",
+        init_of(49),
+        3e-3,
+        &ms,
+    );
+    goal(
+        "knitted table, 1,568 rows, initialization <= 100 ms",
+        init_of(1568),
+        0.1,
+        &ms,
+    );
 
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/parity");
     std::fs::create_dir_all(&dir).unwrap();

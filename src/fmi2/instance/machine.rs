@@ -25,6 +25,19 @@ impl MachineState {
     pub(super) const fn bit(self) -> u32 {
         1 << self as u32
     }
+
+    /// Every state, for tables indexed by state.
+    pub(super) const ALL: [MachineState; 9] = [
+        MachineState::Instantiated,
+        MachineState::InitializationMode,
+        MachineState::StepComplete,
+        MachineState::StepFailed,
+        MachineState::Terminated,
+        MachineState::Error,
+        MachineState::Fatal,
+        MachineState::EventMode,
+        MachineState::ContinuousTimeMode,
+    ];
 }
 
 /// Which states each function may be called in (FMI 2.0.4 section 4.2.4; asynchronous states

@@ -32,6 +32,8 @@ pub struct Instance {
     info: &'static ModelInfo,
     /// Variables by type and value reference (value references are dense per type).
     by_type: [Vec<&'static Variable>; 4],
+    /// What fmi2SetXXX checks, by type and value reference, flattened for the per-step path.
+    set_rules: [Vec<values::SetRule>; 4],
     pub state: MachineState,
     /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
     pub(super) model_exchange: bool,
@@ -67,7 +69,7 @@ fn to_fmi(status: Status) -> fmi2Status {
 impl Instance {
     pub fn new(factory: &'static dyn Factory, logger: Logger) -> Self {
         let info = factory.info();
-        let by_type = std::array::from_fn(|t| {
+        let by_type: [Vec<&'static Variable>; 4] = std::array::from_fn(|t| {
             (0..info.counts[t])
                 .filter_map(|vr| {
                     info.variables
@@ -76,11 +78,18 @@ impl Instance {
                 })
                 .collect()
         });
+        let set_rules = std::array::from_fn(|t| {
+            by_type[t]
+                .iter()
+                .map(|var: &&'static Variable| values::SetRule::new(var))
+                .collect()
+        });
         Self {
             magic: MAGIC,
             logger,
             info,
             by_type,
+            set_rules,
             state: MachineState::Instantiated,
             model_exchange: false,
             time: 0.0,

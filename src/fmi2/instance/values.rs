@@ -12,6 +12,11 @@ pub trait Value {
     const KIND: VarType;
     /// A reason to refuse the value for this variable, if any.
     fn invalid_for(&self, var: &Variable) -> Option<String>;
+    /// Whether the value passes [`Value::invalid_for`], by the flattened bounds of a [`SetRule`].
+    #[inline]
+    fn within(&self, _min: f64, _max: f64) -> bool {
+        true
+    }
     fn store(&self, runtime: &mut dyn Runtime, vr: usize);
     /// Stores every value, then tells the runtime what changed.
     fn store_all(runtime: &mut dyn Runtime, vrs: &[u32], values: &[Self], parameters: bool)
@@ -27,6 +32,10 @@ pub trait Value {
 
 impl Value for f64 {
     const KIND: VarType = VarType::Real;
+    #[inline]
+    fn within(&self, min: f64, max: f64) -> bool {
+        self.is_finite() && *self >= min && *self <= max
+    }
     #[inline]
     fn invalid_for(&self, var: &Variable) -> Option<String> {
         if !self.is_finite() {
@@ -47,6 +56,11 @@ impl Value for f64 {
 
 impl Value for i32 {
     const KIND: VarType = VarType::Integer;
+    #[inline]
+    fn within(&self, min: f64, max: f64) -> bool {
+        let x = *self as f64;
+        x >= min && x <= max
+    }
     fn invalid_for(&self, var: &Variable) -> Option<String> {
         range_check(*self as f64, var)
     }
@@ -113,6 +127,52 @@ fn range_message(x: f64, var: &Variable, below: bool) -> String {
     format!("{} = {x}{unit} is {what} {bound}{unit}", var.name)
 }
 
+/// FMI 2.0.4 section 2.2.7: whether `var` may be set in `state`.
+fn settable_in(var: &Variable, state: MachineState) -> bool {
+    if var.variability == Variability::Constant {
+        return false;
+    }
+    let input = var.causality == Causality::Input;
+    match state {
+        MachineState::Instantiated => {
+            input || matches!(var.initial, Initial::Exact | Initial::Approx)
+        }
+        MachineState::InitializationMode => input || var.initial == Initial::Exact,
+        MachineState::StepComplete | MachineState::EventMode => {
+            input
+                || (var.causality == Causality::Parameter
+                    && var.variability == Variability::Tunable)
+        }
+        MachineState::ContinuousTimeMode => input,
+        _ => false,
+    }
+}
+
+/// One variable's checks for fmi2SetXXX, computed once per instance: the states it may be set in
+/// (a mask of [`MachineState::bit`]) and its bounds (infinite where none is declared).
+pub struct SetRule {
+    var: &'static Variable,
+    states: u32,
+    min: f64,
+    max: f64,
+    parameter: bool,
+}
+
+impl SetRule {
+    pub fn new(var: &'static Variable) -> Self {
+        Self {
+            var,
+            states: MachineState::ALL
+                .iter()
+                .filter(|&&s| settable_in(var, s))
+                .fold(0, |mask, s| mask | s.bit()),
+            min: var.min.unwrap_or(f64::NEG_INFINITY),
+            max: var.max.unwrap_or(f64::INFINITY),
+            parameter: var.causality == Causality::Parameter,
+        }
+    }
+}
+
 impl Instance {
     #[inline]
     fn lookup(
@@ -136,46 +196,25 @@ impl Instance {
         ))
     }
 
-    /// FMI 2.0.4 section 2.2.7: what may be set in which state.
-    #[inline]
-    fn settable(&self, var: &Variable) -> bool {
-        if var.variability == Variability::Constant {
-            return false;
-        }
-        let input = var.causality == Causality::Input;
-        match self.state {
-            MachineState::Instantiated => {
-                input || matches!(var.initial, Initial::Exact | Initial::Approx)
-            }
-            MachineState::InitializationMode => input || var.initial == Initial::Exact,
-            MachineState::StepComplete | MachineState::EventMode => {
-                input
-                    || (var.causality == Causality::Parameter
-                        && var.variability == Variability::Tunable)
-            }
-            MachineState::ContinuousTimeMode => input,
-            _ => false,
-        }
-    }
-
     /// Sets all values or, if any is refused, none (the old values are kept).
     pub fn set<T: Value>(&mut self, function: &str, vrs: &[u32], values: &[T]) -> fmi2Status {
         if !self.allowed(function, allowed::SET) {
             return fmi2Status::Error;
         }
+        let rules = &self.set_rules[type_index(T::KIND)];
+        let state = self.state.bit();
         let mut parameters_changed = false;
         for (&vr, value) in vrs.iter().zip(values) {
-            let var = match self.lookup(function, T::KIND, vr) {
-                Ok(v) => v,
-                Err(status) => return status,
+            let Some(rule) = rules.get(vr as usize) else {
+                return self.unknown_reference(function, T::KIND, vr);
             };
-            if !self.settable(var) {
-                return self.not_settable(function, var);
+            if rule.states & state == 0 {
+                return self.not_settable(function, rule.var);
             }
-            if let Some(reason) = value.invalid_for(var) {
-                return self.refuse_value(function, &reason);
+            if !value.within(rule.min, rule.max) {
+                return self.refuse_value(function, value, rule.var);
             }
-            parameters_changed |= var.causality == Causality::Parameter;
+            parameters_changed |= rule.parameter;
         }
         let before = self.before_retune(parameters_changed);
         T::store_all(self.runtime.as_mut(), vrs, values, parameters_changed);
@@ -193,7 +232,10 @@ impl Instance {
 
     #[cold]
     #[inline(never)]
-    fn refuse_value(&self, function: &str, reason: &str) -> fmi2Status {
+    fn refuse_value<T: Value>(&self, function: &str, value: &T, var: &Variable) -> fmi2Status {
+        let reason = value
+            .invalid_for(var)
+            .unwrap_or_else(|| format!("{} is out of its declared range", var.name));
         self.error(&format!("{function}: {reason}; the value is kept"))
     }
 
@@ -278,24 +320,29 @@ impl Instance {
         if !self.allowed(F, allowed::GET) {
             return fmi2Status::Error;
         }
-        let mut status = fmi2Status::OK;
-        if matches!(
+        let count = self.by_type[type_index(VarType::Real)].len();
+        if let Some(&vr) = vrs.iter().find(|&&vr| vr as usize >= count) {
+            return self.unknown_reference(F, VarType::Real, vr);
+        }
+        let refreshing = matches!(
             self.state,
             MachineState::InitializationMode
                 | MachineState::StepComplete
                 | MachineState::EventMode
                 | MachineState::ContinuousTimeMode
-        ) {
-            status = self.refresh_outputs(F);
-            if status >= fmi2Status::Error {
-                return status;
-            }
+        );
+        // After a step the outputs are current: one dynamic call reads them.
+        if refreshing && self.runtime.current_reals(vrs, out) {
+            return fmi2Status::OK;
         }
-        let count = self.by_type[type_index(VarType::Real)].len();
-        if let Some(&vr) = vrs.iter().find(|&&vr| vr as usize >= count) {
-            return self.unknown_reference(F, VarType::Real, vr);
+        let status = if refreshing {
+            self.refresh_outputs(F)
+        } else {
+            fmi2Status::OK
+        };
+        if status < fmi2Status::Error {
+            self.runtime.reals(vrs, out);
         }
-        self.runtime.reals(vrs, out);
         status
     }
 
