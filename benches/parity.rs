@@ -58,11 +58,16 @@ fn vr(info: &ModelInfo, name: &str) -> u32 {
         .vr
 }
 
-/// One timed case: runs `n` steps and returns their total time.
+/// One timed case: runs `n` steps and returns their total time; `evict` (when not null) is written
+/// over before each step and only the step is timed, as an importer's own work between steps
+/// (FMPy's interpreter) leaves the caches and branch predictors cold.
 struct Case {
     name: &'static str,
-    run: Box<dyn FnMut(u64) -> Duration>,
+    run: Box<dyn FnMut(u64, &mut [u8]) -> Duration>,
 }
+
+/// Bytes written between cold steps: past the L2 cache of these machines.
+const EVICT_BYTES: usize = 4 << 20;
 
 /// An instance stepped by `set(input) + doStep(h) + get(output)`, the input from `input(k)`.
 /// The loop is monomorphized per case: no dynamic call inside the timed region but the FMU's own.
@@ -75,12 +80,22 @@ fn case(
     input: impl Fn(u64) -> f64 + 'static,
 ) -> Case {
     let (mut t, mut k) = (0.0, 0u64);
-    let run = move |n: u64| {
+    let run = move |n: u64, evict: &mut [u8]| {
         let mut out = 0.0;
+        let mut cold = Duration::ZERO;
         let start = Instant::now();
         for _ in 0..n {
             k += 1;
             let x = input(k);
+            let step_start = if evict.is_empty() {
+                None
+            } else {
+                for byte in evict.iter_mut().step_by(64) {
+                    *byte = byte.wrapping_add(1);
+                }
+                black_box(&evict);
+                Some(Instant::now())
+            };
             unsafe {
                 let s1 = (api.fmi2SetReal)(inst, &vin, 1, &x);
                 let s2 = (api.fmi2DoStep)(inst, t, h, 1);
@@ -88,8 +103,15 @@ fn case(
                 let s3 = (api.fmi2GetReal)(inst, &vout, 1, &mut out);
                 black_box((s1, s2, s3, out));
             }
+            if let Some(s) = step_start {
+                cold += s.elapsed();
+            }
         }
-        start.elapsed()
+        if evict.is_empty() {
+            start.elapsed()
+        } else {
+            cold
+        }
     };
     Case {
         name,
@@ -262,8 +284,8 @@ fn main() {
     let batches: Vec<u64> = cases
         .iter_mut()
         .map(|c| {
-            (c.run)(2000);
-            let probe = (c.run)(2000).as_secs_f64() / 2000.0;
+            (c.run)(2000, &mut []);
+            let probe = (c.run)(2000, &mut []).as_secs_f64() / 2000.0;
             ((5e-4 / probe) as u64).clamp(20, 100_000)
         })
         .collect();
@@ -272,7 +294,7 @@ fn main() {
         for j in 0..cases.len() {
             let i = (j + round) % cases.len();
             let n = batches[i];
-            samples[i].push((cases[i].run)(n).as_secs_f64() / n as f64);
+            samples[i].push((cases[i].run)(n, &mut []).as_secs_f64() / n as f64);
         }
     }
     let c_min = samples[0].iter().copied().fold(f64::INFINITY, f64::min);
@@ -308,6 +330,26 @@ fn main() {
                 .join(", ")
         ));
     }
+    // The same steps with the caches evicted before each (one step timed at a time): what a step
+    // costs when the importer's own work runs between steps, as FMPy's interpreter does.
+    let mut evict = vec![0u8; EVICT_BYTES];
+    println!(
+        "\nCold steps ({} MB written between steps; median of 31 batches of 64):",
+        EVICT_BYTES >> 20
+    );
+    let mut cold = Vec::new();
+    for case in cases.iter_mut() {
+        let batches: Vec<f64> = (0..31)
+            .map(|_| (case.run)(64, &mut evict).as_secs_f64() / 64.0)
+            .collect();
+        let med = median(batches);
+        println!("{:<42} {:>10.1} ns", case.name, med * 1e9);
+        cold.push(format!(
+            "  {{\"case\": \"{}\", \"median_s\": {med:e}}}",
+            case.name
+        ));
+    }
+
     let figure = |name: &str| {
         let i = cases.iter().position(|c| c.name == name)?;
         let s = &samples[i];
@@ -384,8 +426,9 @@ fn main() {
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/parity");
     std::fs::create_dir_all(&dir).unwrap();
     let body = format!(
-        "{{\"rounds\": {rounds}, \"cases\": [\n{}\n], \"knitted_initialization\": [\n{}\n]}}\n",
+        "{{\"rounds\": {rounds}, \"cases\": [\n{}\n], \"cold\": [\n{}\n], \"knitted_initialization\": [\n{}\n]}}\n",
         json.join(",\n"),
+        cold.join(",\n"),
         init.join(",\n")
     );
     std::fs::write(dir.join("parity.json"), body).unwrap();
