@@ -63,8 +63,11 @@ fn vr(info: &ModelInfo, name: &str) -> u32 {
 /// (FMPy's interpreter) leaves the caches and branch predictors cold.
 struct Case {
     name: &'static str,
-    run: Box<dyn FnMut(u64, &mut [u8]) -> Duration>,
+    run: Box<Steps>,
 }
+
+/// `run(n, evict)`: see [`Case`].
+type Steps = dyn FnMut(u64, &mut [u8]) -> Duration;
 
 /// Bytes written between cold steps: past the L2 cache of these machines.
 const EVICT_BYTES: usize = 4 << 20;
