@@ -109,7 +109,10 @@ pub trait Runtime: Send {
     fn build(&mut self) -> Result<(), String>;
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
-    fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// Steps the model; with `clamp_flag` (the `input_clamped` output's value reference) also
+    /// writes that flag from the report, as [`super::out_of_range::OutOfRange::apply`] would,
+    /// within this one dynamic call.
+    fn step(&mut self, time: f64, step: f64, report: &mut Report, clamp_flag: Option<usize>);
     /// Model Exchange: commits the history at the current inputs (completed integrator step or
     /// event) and writes the outputs.
     fn update_discrete_states(&mut self, time: f64, report: &mut Report);
@@ -227,12 +230,15 @@ where
             self.outputs_stale = false;
         }
     }
-    fn step(&mut self, time: f64, step: f64, report: &mut Report) {
+    fn step(&mut self, time: f64, step: f64, report: &mut Report, clamp_flag: Option<usize>) {
         if let Some(model) = self.model.as_mut() {
             let v = &mut self.values;
             model.step(&v.inputs, &mut v.outputs, time, step, report);
             report.evaluated = true;
             self.outputs_stale = false;
+            if let Some(flag) = clamp_flag {
+                M::Variables::set_boolean(v, flag, report.clamped);
+            }
         }
     }
     fn update_discrete_states(&mut self, time: f64, report: &mut Report) {

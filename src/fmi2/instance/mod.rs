@@ -45,7 +45,7 @@ pub struct Instance {
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
     fmu_states: HashSet<usize>,
-    out_of_range: OutOfRange,
+    pub(super) out_of_range: OutOfRange,
 }
 
 fn type_index(kind: VarType) -> usize {
@@ -55,6 +55,12 @@ fn type_index(kind: VarType) -> usize {
         VarType::Boolean => 2,
         VarType::String => 3,
     }
+}
+
+/// A report with nothing to log and no clamp to apply the out-of-range policy to.
+#[inline]
+fn quiet(report: &Report) -> bool {
+    !report.clamped && report.messages.is_empty()
 }
 
 fn to_fmi(status: Status) -> fmi2Status {
@@ -160,7 +166,7 @@ impl Instance {
         report: &mut Report,
         in_step: bool,
     ) -> fmi2Status {
-        if !report.clamped && report.messages.is_empty() {
+        if quiet(report) {
             if report.evaluated {
                 self.out_of_range.clear_flag(self.runtime.as_mut());
             }
@@ -171,7 +177,7 @@ impl Instance {
 
     #[cold]
     #[inline(never)]
-    fn forward_messages(
+    pub(super) fn forward_messages(
         &mut self,
         function: &str,
         mut report: Report,
