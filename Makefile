@@ -139,6 +139,7 @@ bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
 	cargo bench --bench directional_derivative
+	cargo bench --bench model_exchange
 	cargo bench --bench parity
 
 .PHONY: parity

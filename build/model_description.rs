@@ -421,6 +421,12 @@ fn resolve_states(variables: &[Variable]) -> Result<Vec<(usize, usize)>, String>
                 "the state '{name}' must be a continuous Real output or local"
             )));
         }
+        if state.initial != "calculated" {
+            return Err(at(format!(
+                "the state '{name}' must have initial 'calculated': the model computes the start \
+                 state in Model::new (give a start value as a parameter)"
+            )));
+        }
         if state.derivative_of.is_some() {
             return Err(at(format!(
                 "the state '{name}' is itself a derivative; declare its own state variable"

@@ -3,6 +3,9 @@
 //! change to the variables.
 
 #[allow(dead_code)]
+#[path = "../build/codegen.rs"]
+mod codegen;
+#[allow(dead_code)]
 #[path = "../build/model_description.rs"]
 mod model_description;
 
@@ -600,6 +603,15 @@ mod continuous_states {
             &edited(r#"derivative="joint_angle""#, r#"derivative="inertia""#),
             "must be a continuous Real output or local",
         );
+        // A state's start comes from the model (initial calculated), not from a start value.
+        refused(
+            &edited(
+                r#"name="joint_angle" valueReference="6" causality="output" variability="continuous" initial="calculated""#,
+                r#"name="joint_angle" valueReference="6" causality="output" variability="continuous" initial="exact""#,
+            )
+            .replacen(r#"<Real quantity="Angle" unit="rad"/>"#, r#"<Real quantity="Angle" unit="rad" start="0"/>"#, 1),
+            "must have initial 'calculated'",
+        );
         // Two derivatives of one state.
         refused(
             &edited(
@@ -651,6 +663,34 @@ mod continuous_states {
             ),
             "numberOfEventIndicators must be a non-negative integer",
         );
+    }
+
+    #[test]
+    fn a_local_state_is_generated_into_the_state_mirror_and_its_derivative_into_the_derivatives() {
+        // joint_velocity made a local (not an output): the export layer reads it from the
+        // model's states, copied into `values.states`.
+        let text = edited(
+            r#"name="joint_velocity" valueReference="7" causality="output""#,
+            r#"name="joint_velocity" valueReference="7" causality="local""#,
+        )
+        .replacen(
+            r#"      <Unknown name="joint_velocity" dependencies="joint_velocity" dependenciesKind="dependent"/>
+"#,
+            "",
+            1,
+        );
+        let m = check(&text, "PulleyJoint").unwrap_or_else(|e| panic!("{e}"));
+        let (mut tables, mut bindings) = (String::new(), String::new());
+        super::codegen::tables(&m, "PulleyJoint.xml", &mut tables).unwrap();
+        super::codegen::bindings(&m, &mut bindings).unwrap();
+        assert!(tables.contains("pub struct States {"));
+        assert!(tables.contains("const COUNT: usize = 2;"));
+        assert!(tables.contains(r#"const DERIVATIVE_NAMES: &'static [&'static str] = &["der(joint_angle)", "der(joint_velocity)"];"#));
+        assert!(tables.contains("pub const DER_JOINT_VELOCITY: usize = 30;"));
+        assert!(bindings.contains("7 => values.states.joint_velocity,"));
+        assert!(bindings.contains("6 => values.outputs.joint_angle,"));
+        assert!(bindings.contains("29 => values.derivatives.joint_angle,"));
+        assert!(bindings.contains("30 => values.derivatives.joint_velocity,"));
     }
 
     #[test]
