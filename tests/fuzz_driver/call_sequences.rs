@@ -435,9 +435,10 @@ impl Driver {
         else {
             return Ok(());
         };
-        let selects_table = vrs.iter().zip(values).any(|(&vr, &x)| {
-            model.kind == VarType::Integer && vr == model.vr && x == 2
-        });
+        let selects_table = vrs
+            .iter()
+            .zip(values)
+            .any(|(&vr, &x)| model.kind == VarType::Integer && vr == model.vr && x == 2);
         if selects_table && !u.ratio(1, 16)? {
             let n: c_int = u.int_in_range(2..=8)?;
             let before = self.logged(k);

@@ -212,9 +212,25 @@ impl Instance {
             if let Err(s) = self.lookup(function, kind, vr) {
                 return s;
             }
+            // The last guard of "no output is ever NaN": the models check their own results,
+            // and a value that still is not finite is refused here, never handed out.
+            if kind == VarType::Real && !self.runtime.real(vr as usize).is_finite() {
+                return self.non_finite(function, vr);
+            }
             *slot = pick(self.runtime.as_ref(), vr as usize);
         }
         status
+    }
+
+    /// Refuses to hand out a non-finite Real, naming it: a model error, not the importer's.
+    #[cold]
+    fn non_finite(&self, function: &str, vr: u32) -> fmi2Status {
+        let x = self.runtime.real(vr as usize);
+        let name = self.by_type[0].get(vr as usize).map_or("?", |v| v.name);
+        self.error(&format!(
+            "{function}: {name} (value reference {vr}) is {x}: the model produced a non-finite \
+             value from the current parameters and inputs; it is not handed out"
+        ))
     }
 
     /// `fmi2GetString`: the returned strings live until the next call on this instance.
