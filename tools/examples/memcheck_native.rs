@@ -3,7 +3,7 @@
 //!
 //! - every model twice, with default parameters and with all effects on, over 40 steps of inputs
 //!   inside their declared ranges, through an FMU state get / serialize / deserialize / set (the
-//!   motor's substep budget bounded, see `SUBSTEPS_UNDER_VALGRIND`);
+//!   motor's substep budget bounded, see `exercise::EXERCISE_SUBSTEPS`);
 //! - every catalogue scene (`scenes/*.json`, fast variant) with its parameters, inputs and every
 //!   sweep value;
 //! - every instance and FMU state freed, so anything left is a leak of ours.
@@ -23,31 +23,8 @@ use std::ffi::c_int;
 use std::path::Path;
 use std::ptr::null_mut;
 
-/// Integrator substeps per communication step under valgrind. The exercise's inputs spin the
-/// motor's rotor hard (a load torque of 5e-8 N m), so each 1 us step uses the default budget of
-/// 20,000 substeps: 0.3-0.6 s natively, half a minute under valgrind. A small budget runs the
-/// same code, including the budget-exhausted path, at a fraction of the cost.
-const SUBSTEPS_UNDER_VALGRIND: c_int = 50;
-
-/// Like `exercise::ready`, with the substep budget (where the model has one) bounded.
-fn ready_bounded<'a>(api: &'a Api, info: &ModelInfo, effects: bool) -> Instance<'a> {
-    let i = api
-        .instantiate("memcheck", info.guid)
-        .unwrap_or_else(|log| panic!("{} refused: {:?}", info.name, log.lines()));
-    assert_eq!(i.setup(), OK);
-    assert_eq!(i.enter(), OK);
-    if effects {
-        all_effects_on(&i, info);
-    }
-    if let Some(v) = info.by_name("max_substeps") {
-        assert_eq!(i.set_integer(&[v.vr], &[SUBSTEPS_UNDER_VALGRIND]), OK);
-    }
-    assert_eq!(i.exit(), OK, "{}: {:?}", info.name, i.log.lines());
-    i
-}
-
 fn models_run(api: &Api, info: &ModelInfo, effects: bool) -> usize {
-    let i = ready_bounded(api, info, effects);
+    let i = ready(api, info, effects);
     let mut steps = 0;
     for n in 0..20 {
         step_and_read(&i, info, 0, n);
