@@ -221,7 +221,7 @@ fuzz:
 ## - fmpy: FMPy tests (MEMCHECK_TESTS) with memory errors checked, not leaks (the Python
 ##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so. The
 ##   default set drives every FMU: every scene and every cross-check input through a strict
-##   master, FMU states, threads and repeated load/unload, and validation of every FMU. The whole
+##   master, FMU states, threads and 20 load/unload cycles, and validation of every FMU. The whole
 ##   suite under valgrind takes hours on 2 cores: `make memcheck MEMCHECK_TESTS=tests/fmpy`.
 MEMCHECK_TESTS ?= tests/fmpy/test_strict_master.py tests/fmpy/test_fmi_behaviour.py \
   tests/fmpy/test_validation.py
@@ -240,7 +240,7 @@ memcheck: fmus $(VENV)/.installed
 	tail -1 $(MEMCHECK_DIR)/native.out; \
 	echo "native: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/native.log)"; \
 	grep -h 'definitely lost\|indirectly lost\|All heap blocks were freed' $(MEMCHECK_DIR)/native.log; \
-	PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
+	FMI_BEHAVIOUR_LOAD_CYCLES=20 PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
 	  --log-file=$(MEMCHECK_DIR)/fmpy.log \
 	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS) > $(MEMCHECK_DIR)/fmpy.out 2>&1; fmpy=$$?; \
 	tail -1 $(MEMCHECK_DIR)/fmpy.out; \
