@@ -127,16 +127,30 @@ test-fmpy: fmus $(VENV)/.installed interop-deps py-deps
 ## All Rust tests and the FMPy suite.
 test: test-rust test-fmpy
 
-## Native cost per FMI step (criterion), through the packaged FMU's C ABI.
-bench: deps fmus
+## The C pass-through FMU (FMI 2.0 Co-Simulation) that benches/parity.rs holds our FMI layer against.
+C_PASSTHROUGH := target/c_passthrough/PassThroughC.so
+$(C_PASSTHROUGH): benches/c_passthrough/passthrough.c
+	mkdir -p $(@D)
+	cc -O2 -shared -fPIC -o $@ $< -lm
+
+## Native cost per FMI step (criterion), through the packaged FMU's C ABI; then the FMI layer
+## against a C pass-through FMU and issue 15's goals, interleaved in one run (benches/parity.rs).
+bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
 	cargo bench --bench directional_derivative
+	cargo bench --bench parity
+
+.PHONY: parity
+## benches/parity.rs alone: the FMI layer against C, the walls, the motor and the knitted table.
+parity: deps fmus $(C_PASSTHROUGH)
+	cargo bench --bench parity
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
-report: deps fmus $(VENV)/.installed
+report: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	cargo bench --bench accuracy_cost
+	cargo bench --bench parity
 	$(PY) benches/report.py
 
 ## docs/linearized-muscle.md: stiffness dF/dL and pressure gain dF/dP over the stroke of Table 2.1's

@@ -46,6 +46,20 @@ impl OutOfRange {
         }
     }
 
+    /// The value reference of the `input_clamped` output, if the model has one.
+    #[inline]
+    pub fn flag(&self) -> Option<usize> {
+        self.flag
+    }
+
+    /// A report with nothing clamped: the flag says so (what [`OutOfRange::apply`] does then).
+    #[inline]
+    pub fn clear_flag(&self, runtime: &mut dyn Runtime) {
+        if let Some(i) = self.flag {
+            runtime.set_boolean(i, false);
+        }
+    }
+
     /// Writes the flag, turns the clamp into the policy's status and its explanations into
     /// messages of that status (logged even at fmi2OK: one line per excursion).
     pub fn apply(

@@ -104,15 +104,26 @@ pub trait Runtime: Send {
     fn boolean(&self, vr: usize) -> bool;
     fn set_boolean(&mut self, vr: usize, value: bool);
     fn string(&self, vr: usize) -> &str;
+    /// `out[i] = real(vrs[i])`: fmi2GetReal in one dynamic call.
+    fn reals(&self, vrs: &[u32], out: &mut [f64]);
+    /// [`Runtime::reals`] if [`Runtime::outputs_current`], else nothing: whether it read them.
+    fn current_reals(&self, vrs: &[u32], out: &mut [f64]) -> bool;
+    /// `set_real(vrs[i], values[i])`, then [`Runtime::changed`]: fmi2SetReal in one dynamic call.
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool);
     fn set_string(&mut self, vr: usize, value: &str);
     /// Tells that inputs changed (outputs are stale) or that parameters did (the model is too).
     fn changed(&mut self, parameters: bool);
     fn is_built(&self) -> bool;
+    /// Built, and no input or parameter changed since the outputs were last written.
+    fn outputs_current(&self) -> bool;
     /// Builds the model from the current parameters, with only the effects they switch on.
     fn build(&mut self) -> Result<(), String>;
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
-    fn step(&mut self, time: f64, step: f64, report: &mut Report);
+    /// Steps the model; with `clamp_flag` (the `input_clamped` output's value reference) also
+    /// writes that flag from the report, as [`super::out_of_range::OutOfRange::apply`] would,
+    /// within this one dynamic call.
+    fn step(&mut self, time: f64, step: f64, report: &mut Report, clamp_flag: Option<usize>);
     /// Model Exchange, event mode: commits the history at the current inputs and writes the
     /// outputs ([`Model::update_discrete_states`]).
     fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate;
@@ -245,6 +256,24 @@ where
     fn string(&self, vr: usize) -> &str {
         M::Variables::string(&self.values, vr)
     }
+    fn reals(&self, vrs: &[u32], out: &mut [f64]) {
+        for (&vr, slot) in vrs.iter().zip(out) {
+            *slot = M::Variables::real(&self.values, vr as usize);
+        }
+    }
+    fn current_reals(&self, vrs: &[u32], out: &mut [f64]) -> bool {
+        if !self.outputs_current() {
+            return false;
+        }
+        self.reals(vrs, out);
+        true
+    }
+    fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool) {
+        for (&vr, &value) in vrs.iter().zip(values) {
+            M::Variables::set_real(&mut self.values, vr as usize, value);
+        }
+        self.changed(parameters);
+    }
     fn set_string(&mut self, vr: usize, value: &str) {
         M::Variables::set_string(&mut self.values, vr, value)
     }
@@ -256,6 +285,9 @@ where
     }
     fn is_built(&self) -> bool {
         self.model.is_some()
+    }
+    fn outputs_current(&self) -> bool {
+        !self.outputs_stale && self.model.is_some()
     }
     fn build(&mut self) -> Result<(), String> {
         let v = &mut self.values;
@@ -277,12 +309,15 @@ where
             self.mirror_states();
         }
     }
-    fn step(&mut self, time: f64, step: f64, report: &mut Report) {
+    fn step(&mut self, time: f64, step: f64, report: &mut Report, clamp_flag: Option<usize>) {
         if let Some(model) = self.model.as_mut() {
             let v = &mut self.values;
             model.step(&v.inputs, &mut v.outputs, time, step, report);
             report.evaluated = true;
             self.outputs_stale = false;
+            if let Some(flag) = clamp_flag {
+                M::Variables::set_boolean(v, flag, report.clamped);
+            }
         }
     }
     fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate {

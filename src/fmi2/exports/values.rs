@@ -105,9 +105,13 @@ pub unsafe extern "C" fn fmi2GetReal(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
+    const F: &str = "fmi2GetReal";
     unsafe {
-        get_values(c, "fmi2GetReal", VarType::Real, vr, nvr, value, |v, i| {
-            v.real(i)
+        guarded(c, F, |inst| {
+            let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+                return null_argument(inst, F, "vr and value");
+            };
+            inst.get_reals(vrs, out)
         })
     }
 }

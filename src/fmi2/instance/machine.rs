@@ -25,6 +25,19 @@ impl MachineState {
     pub(super) const fn bit(self) -> u32 {
         1 << self as u32
     }
+
+    /// Every state, for tables indexed by state.
+    pub(super) const ALL: [MachineState; 9] = [
+        MachineState::Instantiated,
+        MachineState::InitializationMode,
+        MachineState::StepComplete,
+        MachineState::StepFailed,
+        MachineState::Terminated,
+        MachineState::Error,
+        MachineState::Fatal,
+        MachineState::EventMode,
+        MachineState::ContinuousTimeMode,
+    ];
 }
 
 /// Which states each function may be called in (FMI 2.0.4 section 4.2.4; asynchronous states
@@ -179,45 +192,75 @@ impl Instance {
         fmi2Status::OK
     }
 
+    /// The per-step path: the refusals below are tested inline, their messages built out of line.
+    #[inline]
     pub fn do_step(&mut self, time: f64, step: f64) -> fmi2Status {
         const F: &str = "fmi2DoStep";
         if !self.allowed(F, allowed::DO_STEP) {
             return fmi2Status::Error;
         }
         if !(step > 0.0 && step.is_finite()) {
-            return self.error(&format!(
-                "{F}: communicationStepSize = {step} must be positive and finite"
-            ));
+            return self.refuse_step(step);
         }
         // The importer's clock and ours may differ by rounding only; adopt the importer's. The
         // allowance scales with the clocks, not the step: a long step must not excuse a wrong
         // communication point.
         let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs());
         if !time.is_finite() || (time - self.time).abs() > tolerance {
-            return self.error(&format!(
-                "{F}: expected currentCommunicationPoint = {:.16e} but was {time:.16e}",
-                self.time
-            ));
+            return self.refuse_communication_point(time);
         }
         if let Some(stop) = self.stop_time {
             // A step computed as stop - time may overshoot by rounding of either.
             let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
             if time + step > stop + tolerance {
-                return self.error(&format!(
-                    "{F}: a step to {:.16e} would pass the stop time {stop:.16e}",
-                    time + step
-                ));
+                return self.refuse_past_stop(time + step, stop);
             }
         }
         let mut report = Report::default();
-        self.runtime.step(time, step, &mut report);
-        let status = self.forward(F, report, true);
+        let flag = self.out_of_range.flag();
+        self.runtime.step(time, step, &mut report, flag);
+        // The flag is written: only a report with something to say needs more.
+        let status = if super::quiet(&report) {
+            let status = super::to_fmi(report.status);
+            if report.messages.capacity() == 0 && report.clamp_messages.capacity() == 0 {
+                // Nothing to free: skip the out-of-line drop of the empty report.
+                std::mem::forget(report);
+            }
+            status
+        } else {
+            self.forward_messages(F, report, true)
+        };
         match status {
             fmi2Status::OK | fmi2Status::Warning => self.time = time + step,
             fmi2Status::Discard => self.state = MachineState::StepFailed,
             _ => self.state = MachineState::Error,
         }
         status
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn refuse_step(&self, step: f64) -> fmi2Status {
+        self.error(&format!(
+            "fmi2DoStep: communicationStepSize = {step} must be positive and finite"
+        ))
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn refuse_communication_point(&self, time: f64) -> fmi2Status {
+        self.error(&format!(
+            "fmi2DoStep: expected currentCommunicationPoint = {:.16e} but was {time:.16e}",
+            self.time
+        ))
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn refuse_past_stop(&self, end: f64, stop: f64) -> fmi2Status {
+        self.error(&format!(
+            "fmi2DoStep: a step to {end:.16e} would pass the stop time {stop:.16e}"
+        ))
     }
 
     pub fn last_successful_time(&self) -> Result<f64, fmi2Status> {

@@ -32,6 +32,8 @@ pub struct Instance {
     info: &'static ModelInfo,
     /// Variables by type and value reference (value references are dense per type).
     by_type: [Vec<&'static Variable>; 4],
+    /// What fmi2SetXXX checks, by type and value reference, flattened for the per-step path.
+    set_rules: [Vec<values::SetRule>; 4],
     pub state: MachineState,
     /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
     pub(super) model_exchange: bool,
@@ -43,7 +45,7 @@ pub struct Instance {
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
     fmu_states: HashSet<usize>,
-    out_of_range: OutOfRange,
+    pub(super) out_of_range: OutOfRange,
 }
 
 fn type_index(kind: VarType) -> usize {
@@ -53,6 +55,12 @@ fn type_index(kind: VarType) -> usize {
         VarType::Boolean => 2,
         VarType::String => 3,
     }
+}
+
+/// A report with nothing to log and no clamp to apply the out-of-range policy to.
+#[inline]
+fn quiet(report: &Report) -> bool {
+    !report.clamped && report.messages.is_empty()
 }
 
 fn to_fmi(status: Status) -> fmi2Status {
@@ -67,7 +75,7 @@ fn to_fmi(status: Status) -> fmi2Status {
 impl Instance {
     pub fn new(factory: &'static dyn Factory, logger: Logger) -> Self {
         let info = factory.info();
-        let by_type = std::array::from_fn(|t| {
+        let by_type: [Vec<&'static Variable>; 4] = std::array::from_fn(|t| {
             (0..info.counts[t])
                 .filter_map(|vr| {
                     info.variables
@@ -76,11 +84,18 @@ impl Instance {
                 })
                 .collect()
         });
+        let set_rules = std::array::from_fn(|t| {
+            by_type[t]
+                .iter()
+                .map(|var: &&'static Variable| values::SetRule::new(var))
+                .collect()
+        });
         Self {
             magic: MAGIC,
             logger,
             info,
             by_type,
+            set_rules,
             state: MachineState::Instantiated,
             model_exchange: false,
             time: 0.0,
@@ -98,27 +113,71 @@ impl Instance {
         fmi2Status::Error
     }
 
-    /// Logs and refuses a call that the current state does not allow.
+    /// Logs and refuses a call that the current state does not allow. Inlined: on the per-step
+    /// path it is one mask test and one flag test; the logging is out of line.
+    #[inline]
     pub fn allowed(&self, function: &str, mask: u32) -> bool {
         if mask & self.state.bit() == 0 {
-            self.error(&format!(
-                "{function}: illegal call in state {:?}",
-                self.state
-            ));
+            self.illegal_call(function);
             return false;
         }
         if self.logger.debug {
-            self.logger.log(
-                fmi2Status::OK,
-                &format!("{function} in state {:?}", self.state),
-            );
+            self.trace_call(function);
         }
         true
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn illegal_call(&self, function: &str) {
+        self.error(&format!(
+            "{function}: illegal call in state {:?}",
+            self.state
+        ));
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn trace_call(&self, function: &str) {
+        self.logger.log(
+            fmi2Status::OK,
+            &format!("{function} in state {:?}", self.state),
+        );
     }
 
     /// Applies the out-of-range policy, passes a model's messages to the logger and turns its
     /// status into an FMI status; `in_step` for fmi2DoStep.
     pub(super) fn forward(
+        &mut self,
+        function: &str,
+        mut report: Report,
+        in_step: bool,
+    ) -> fmi2Status {
+        self.settle(function, &mut report, in_step)
+    }
+
+    /// [`Instance::forward`] on a report in place (no copy of it on the per-step path). Inlined
+    /// for the common case, a report with nothing to log: then the only work is clearing the
+    /// `input_clamped` flag.
+    #[inline]
+    pub(super) fn settle(
+        &mut self,
+        function: &str,
+        report: &mut Report,
+        in_step: bool,
+    ) -> fmi2Status {
+        if quiet(report) {
+            if report.evaluated {
+                self.out_of_range.clear_flag(self.runtime.as_mut());
+            }
+            return to_fmi(report.status);
+        }
+        self.forward_messages(function, std::mem::take(report), in_step)
+    }
+
+    #[cold]
+    #[inline(never)]
+    pub(super) fn forward_messages(
         &mut self,
         function: &str,
         mut report: Report,
@@ -142,7 +201,17 @@ impl Instance {
     }
 
     /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.
+    #[inline]
     pub(super) fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
+        // After a step, or a get with no set since: nothing to recompute, nothing to report.
+        if self.runtime.outputs_current() {
+            return fmi2Status::OK;
+        }
+        self.recompute_outputs(function)
+    }
+
+    #[inline(never)]
+    fn recompute_outputs(&mut self, function: &str) -> fmi2Status {
         if !self.runtime.is_built() {
             if self.state != MachineState::InitializationMode {
                 return fmi2Status::OK;

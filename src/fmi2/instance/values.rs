@@ -12,24 +12,55 @@ pub trait Value {
     const KIND: VarType;
     /// A reason to refuse the value for this variable, if any.
     fn invalid_for(&self, var: &Variable) -> Option<String>;
+    /// Whether the value passes [`Value::invalid_for`], by the flattened bounds of a [`SetRule`].
+    #[inline]
+    fn within(&self, _min: f64, _max: f64) -> bool {
+        true
+    }
     fn store(&self, runtime: &mut dyn Runtime, vr: usize);
+    /// Stores every value, then tells the runtime what changed.
+    fn store_all(runtime: &mut dyn Runtime, vrs: &[u32], values: &[Self], parameters: bool)
+    where
+        Self: Sized,
+    {
+        for (&vr, value) in vrs.iter().zip(values) {
+            value.store(runtime, vr as usize);
+        }
+        runtime.changed(parameters);
+    }
 }
 
 impl Value for f64 {
     const KIND: VarType = VarType::Real;
+    #[inline]
+    fn within(&self, min: f64, max: f64) -> bool {
+        self.is_finite() && *self >= min && *self <= max
+    }
+    #[inline]
     fn invalid_for(&self, var: &Variable) -> Option<String> {
         if !self.is_finite() {
-            return Some(format!("{} = {self} is not finite", var.name));
+            return Some(not_finite(*self, var));
         }
         range_check(*self, var)
     }
+    #[inline]
     fn store(&self, runtime: &mut dyn Runtime, vr: usize) {
         runtime.set_real(vr, *self);
+    }
+    /// One dynamic call for the whole array (fmi2SetReal is on every step's path).
+    #[inline]
+    fn store_all(runtime: &mut dyn Runtime, vrs: &[u32], values: &[Self], parameters: bool) {
+        runtime.set_reals(vrs, values, parameters);
     }
 }
 
 impl Value for i32 {
     const KIND: VarType = VarType::Integer;
+    #[inline]
+    fn within(&self, min: f64, max: f64) -> bool {
+        let x = *self as f64;
+        x >= min && x <= max
+    }
     fn invalid_for(&self, var: &Variable) -> Option<String> {
         range_check(*self as f64, var)
     }
@@ -63,62 +94,106 @@ impl Value for String {
     }
 }
 
+#[cold]
+#[inline(never)]
+fn not_finite(x: f64, var: &Variable) -> String {
+    format!("{} = {x} is not finite", var.name)
+}
+
+/// A reason to refuse `x` for `var`'s declared range, if any. Inlined: two comparisons per value
+/// set; the message is built out of line, only on refusal.
+#[inline]
 pub(super) fn range_check(x: f64, var: &Variable) -> Option<String> {
-    let below = var
-        .min
-        .filter(|&min| x < min)
-        .map(|min| ("below its minimum", min));
-    let (what, bound) = below.or_else(|| {
-        var.max
-            .filter(|&max| x > max)
-            .map(|max| ("above its maximum", max))
-    })?;
-    // Formatting only on refusal: this runs for every value an importer sets.
+    let below = var.min.is_some_and(|min| x < min);
+    if below || var.max.is_some_and(|max| x > max) {
+        return Some(range_message(x, var, below));
+    }
+    None
+}
+
+#[cold]
+#[inline(never)]
+fn range_message(x: f64, var: &Variable, below: bool) -> String {
+    let (what, bound) = match (below, var.min, var.max) {
+        (true, Some(min), _) => ("below its minimum", min),
+        (_, _, Some(max)) => ("above its maximum", max),
+        _ => unreachable!("range_message is only called for a value out of a declared bound"),
+    };
     let unit = if var.unit.is_empty() || var.unit == "1" {
         String::new()
     } else {
         format!(" {}", var.unit)
     };
-    Some(format!("{} = {x}{unit} is {what} {bound}{unit}", var.name))
+    format!("{} = {x}{unit} is {what} {bound}{unit}", var.name)
+}
+
+/// FMI 2.0.4 section 2.2.7: whether `var` may be set in `state`.
+fn settable_in(var: &Variable, state: MachineState) -> bool {
+    if var.variability == Variability::Constant {
+        return false;
+    }
+    let input = var.causality == Causality::Input;
+    match state {
+        MachineState::Instantiated => {
+            input || matches!(var.initial, Initial::Exact | Initial::Approx)
+        }
+        MachineState::InitializationMode => input || var.initial == Initial::Exact,
+        MachineState::StepComplete | MachineState::EventMode => {
+            input
+                || (var.causality == Causality::Parameter
+                    && var.variability == Variability::Tunable)
+        }
+        MachineState::ContinuousTimeMode => input,
+        _ => false,
+    }
+}
+
+/// One variable's checks for fmi2SetXXX, computed once per instance: the states it may be set in
+/// (a mask of [`MachineState::bit`]) and its bounds (infinite where none is declared).
+pub struct SetRule {
+    var: &'static Variable,
+    states: u32,
+    min: f64,
+    max: f64,
+    parameter: bool,
+}
+
+impl SetRule {
+    pub fn new(var: &'static Variable) -> Self {
+        Self {
+            var,
+            states: MachineState::ALL
+                .iter()
+                .filter(|&&s| settable_in(var, s))
+                .fold(0, |mask, s| mask | s.bit()),
+            min: var.min.unwrap_or(f64::NEG_INFINITY),
+            max: var.max.unwrap_or(f64::INFINITY),
+            parameter: var.causality == Causality::Parameter,
+        }
+    }
 }
 
 impl Instance {
+    #[inline]
     fn lookup(
         &self,
         function: &str,
         kind: VarType,
         vr: u32,
     ) -> Result<&'static Variable, fmi2Status> {
-        self.by_type[type_index(kind)]
-            .get(vr as usize)
-            .copied()
-            .ok_or_else(|| {
-                self.error(&format!(
-                    "{function}: {vr} is not the value reference of a {kind:?} variable of {}",
-                    self.info.name
-                ))
-            })
+        match self.by_type[type_index(kind)].get(vr as usize) {
+            Some(var) => Ok(var),
+            None => Err(self.unknown_reference(function, kind, vr)),
+        }
     }
 
-    /// FMI 2.0.4 section 2.2.7: what may be set in which state.
-    fn settable(&self, var: &Variable) -> bool {
-        if var.variability == Variability::Constant {
-            return false;
-        }
-        let input = var.causality == Causality::Input;
-        match self.state {
-            MachineState::Instantiated => {
-                input || matches!(var.initial, Initial::Exact | Initial::Approx)
-            }
-            MachineState::InitializationMode => input || var.initial == Initial::Exact,
-            MachineState::StepComplete | MachineState::EventMode => {
-                input
-                    || (var.causality == Causality::Parameter
-                        && var.variability == Variability::Tunable)
-            }
-            MachineState::ContinuousTimeMode => input,
-            _ => false,
-        }
+    #[cold]
+    #[inline(never)]
+    fn unknown_reference(&self, function: &str, kind: VarType, vr: u32) -> fmi2Status {
+        self.error(&format!(
+            "{function}: {vr} is not the value reference of a {kind:?} variable of {}",
+            self.info.name
+        ))
     }
 
     /// Sets all values or, if any is refused, none (the old values are kept).
@@ -126,32 +201,46 @@ impl Instance {
         if !self.allowed(function, allowed::SET) {
             return fmi2Status::Error;
         }
+        let rules = &self.set_rules[type_index(T::KIND)];
+        let state = self.state.bit();
         let mut parameters_changed = false;
         for (&vr, value) in vrs.iter().zip(values) {
-            let var = match self.lookup(function, T::KIND, vr) {
-                Ok(v) => v,
-                Err(status) => return status,
+            let Some(rule) = rules.get(vr as usize) else {
+                return self.unknown_reference(function, T::KIND, vr);
             };
-            if !self.settable(var) {
-                return self.error(&format!(
-                    "{function}: {} ({:?}, {:?}) cannot be set in state {:?}",
-                    var.name, var.causality, var.variability, self.state
-                ));
+            if rule.states & state == 0 {
+                return self.not_settable(function, rule.var);
             }
-            if let Some(reason) = value.invalid_for(var) {
-                return self.error(&format!("{function}: {reason}; the value is kept"));
+            if !value.within(rule.min, rule.max) {
+                return self.refuse_value(function, value, rule.var);
             }
-            parameters_changed |= var.causality == Causality::Parameter;
+            parameters_changed |= rule.parameter;
         }
         let before = self.before_retune(parameters_changed);
-        for (&vr, value) in vrs.iter().zip(values) {
-            value.store(self.runtime.as_mut(), vr as usize);
-        }
-        self.runtime.changed(parameters_changed);
+        T::store_all(self.runtime.as_mut(), vrs, values, parameters_changed);
         self.rebuild_or_undo(function, before)
     }
 
+    #[cold]
+    #[inline(never)]
+    fn not_settable(&self, function: &str, var: &Variable) -> fmi2Status {
+        self.error(&format!(
+            "{function}: {} ({:?}, {:?}) cannot be set in state {:?}",
+            var.name, var.causality, var.variability, self.state
+        ))
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn refuse_value<T: Value>(&self, function: &str, value: &T, var: &Variable) -> fmi2Status {
+        let reason = value
+            .invalid_for(var)
+            .unwrap_or_else(|| format!("{} is out of its declared range", var.name));
+        self.error(&format!("{function}: {reason}; the value is kept"))
+    }
+
     /// A snapshot to undo a tunable parameter change with, if this set changes one between steps.
+    #[inline]
     fn before_retune(&self, parameters_changed: bool) -> Option<Box<dyn Runtime>> {
         (parameters_changed
             && matches!(
@@ -164,10 +253,16 @@ impl Instance {
     /// After a tunable parameter changed between steps: [`Model`](crate::models::Model) has no
     /// update hook, so the model is rebuilt from its parameters at once (its history restarts).
     /// Parameters it cannot be built from are refused and every value set by the call is undone.
+    #[inline]
     fn rebuild_or_undo(&mut self, function: &str, before: Option<Box<dyn Runtime>>) -> fmi2Status {
-        let Some(before) = before else {
-            return fmi2Status::OK;
-        };
+        match before {
+            None => fmi2Status::OK,
+            Some(before) => self.rebuild(function, before),
+        }
+    }
+
+    #[inline(never)]
+    fn rebuild(&mut self, function: &str, before: Box<dyn Runtime>) -> fmi2Status {
         match self.runtime.build() {
             Ok(()) => fmi2Status::OK,
             Err(reason) => {
@@ -220,6 +315,57 @@ impl Instance {
             *slot = pick(self.runtime.as_ref(), vr as usize);
         }
         status
+    }
+
+    /// `fmi2GetReal`: as [`Instance::get`], with the value references checked first and one call
+    /// into the runtime for all values (this is on every step's path).
+    #[inline]
+    pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
+        const F: &str = "fmi2GetReal";
+        if !self.allowed(F, allowed::GET) {
+            return fmi2Status::Error;
+        }
+        let count = self.by_type[type_index(VarType::Real)].len();
+        if let Some(&vr) = vrs.iter().find(|&&vr| vr as usize >= count) {
+            return self.unknown_reference(F, VarType::Real, vr);
+        }
+        let refreshing = matches!(
+            self.state,
+            MachineState::InitializationMode
+                | MachineState::StepComplete
+                | MachineState::EventMode
+                | MachineState::ContinuousTimeMode
+        );
+        // After a step the outputs are current: one dynamic call reads them.
+        if refreshing && self.runtime.current_reals(vrs, out) {
+            return self.finite_or_refused(F, vrs, out, fmi2Status::OK);
+        }
+        let status = if refreshing {
+            self.refresh_outputs(F)
+        } else {
+            fmi2Status::OK
+        };
+        if status < fmi2Status::Error {
+            self.runtime.reals(vrs, out);
+            return self.finite_or_refused(F, vrs, out, status);
+        }
+        status
+    }
+
+    /// The last guard of "no output is ever NaN" on the fmi2GetReal path: `status` if every
+    /// value is finite, else an error naming the first that is not.
+    #[inline]
+    fn finite_or_refused(
+        &self,
+        function: &str,
+        vrs: &[u32],
+        out: &[f64],
+        status: fmi2Status,
+    ) -> fmi2Status {
+        match out.iter().position(|x| !x.is_finite()) {
+            None => status,
+            Some(k) => self.non_finite(function, vrs[k]),
+        }
     }
 
     /// Refuses to hand out a non-finite Real, naming it: a model error, not the importer's.

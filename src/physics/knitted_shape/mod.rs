@@ -14,7 +14,9 @@
 //! At every length the shape maximizes the volume under the strand constraint with `r >= r_min`
 //! (eq. 1.1: the fluid's potential energy is least). [`ShapeTable::build`] follows that maximum from
 //! full extension down past free contraction with Newton steps on the Karush-Kuhn-Tucker system,
-//! whose Hessian is tridiagonal (eq. 1.19-1.20: a radius touches only its two segments); the
+//! whose Hessian is tridiagonal (eq. 1.19-1.20: a radius touches only its two segments), so a
+//! step costs O(segments); the rings held at `r_min` are updated within each step (`newton.rs`,
+//! with the slower line-searched solve of `solver.rs` as its fallback). The
 //! multiplier is `dV/dL` itself, and the sensitivity of the same system gives `d2V/dL2`, so the
 //! table holds exact `V`, `V'`, `V''` and is read through a quintic Hermite interpolant (C2).
 //! [`seed_gradient_volume_curve`] is the dissertation's slow one-row-at-a-time gradient exchange, kept as
@@ -22,11 +24,14 @@
 
 mod baseline;
 mod geometry;
+mod newton;
+#[cfg(test)]
+mod reference;
 mod solver;
 mod table;
 #[cfg(test)]
 mod tests;
 
 pub use baseline::{seed_gradient_volume_curve, SeedAlgorithmOptions};
-pub use geometry::ShapeGeometry;
+pub use geometry::{ShapeGeometry, MAX_SEGMENTS};
 pub use table::{ShapeTable, DEFAULT_TABLE_NODES};

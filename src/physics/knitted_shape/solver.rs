@@ -31,6 +31,10 @@ pub(super) struct Solver {
     pub(super) x: Vec<f64>,
     pub(super) y: Vec<f64>,
     pub(super) c: Vec<f64>,
+    /// Radii before the fast path's last Newton step.
+    pub(super) base: Vec<f64>,
+    /// Releases of each ring from the floor in the current fast solve.
+    pub(super) releases: Vec<u8>,
 }
 
 /// Converged point on the path.
@@ -62,8 +66,33 @@ impl Solver {
             ol: z.clone(),
             x: z.clone(),
             y: z.clone(),
-            c: z,
+            c: z.clone(),
+            base: z,
+            releases: vec![0; rings],
         }
+    }
+
+    /// Becomes a copy of `other`, reusing this solver's buffers (the path copies its state
+    /// twice per step; fresh allocations were a fifth of the table's time on long sleeves).
+    pub(super) fn copy_from(&mut self, other: &Solver) {
+        self.lambda = other.lambda;
+        for (to, from) in [
+            (&mut self.radii, &other.radii),
+            (&mut self.gv, &other.gv),
+            (&mut self.gl, &other.gl),
+            (&mut self.dv, &other.dv),
+            (&mut self.dl, &other.dl),
+            (&mut self.ov, &other.ov),
+            (&mut self.ol, &other.ol),
+            (&mut self.x, &other.x),
+            (&mut self.y, &other.y),
+            (&mut self.c, &other.c),
+            (&mut self.base, &other.base),
+        ] {
+            to.clone_from(from);
+        }
+        self.held.clone_from(&other.held);
+        self.releases.clone_from(&other.releases);
     }
 
     /// Gradients and tridiagonal Hessians of `V` and `L` (eq. 1.19-1.20 and their second

@@ -3,6 +3,7 @@
 // `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 use super::geometry::ShapeGeometry;
+use super::newton::MAX_PATH_ITERATIONS;
 use super::solver::{PathPoint, Solver, MAX_SUBSTEP_HALVINGS};
 use std::f64::consts::PI;
 
@@ -174,6 +175,12 @@ impl ShapeTable {
 /// Follows the maximum from full extension to `end_length` in uniform steps of
 /// `(max - end) / nodes`, or in steps of the same size up to `stop_at` if given (the last step
 /// lands on it). Returns the converged nodes, full extension first.
+///
+/// Each step starts from a prediction: the rings move along the tangent `dr/dL` of the last
+/// solve, and the pocket's edge, which the tangent cannot move (held rings stay held), moves on
+/// by the rings it crossed per metre over the last step. The fast Newton path
+/// ([`Solver::solve_newton`]) then converges in a few O(segments) sweeps; the robust solve is
+/// the fallback, then shorter steps.
 fn follow_path(
     geom: &ShapeGeometry,
     solver: &mut Solver,
@@ -201,6 +208,10 @@ fn follow_path(
     }
     let mut current = l_max;
     let mut started = false;
+    // d2V/dL2 of the last solve, and its pocket's left edge `(length, first free ring)` with
+    // the one before.
+    let mut last_curvature = f64::NAN;
+    let mut edges: [Option<(f64, usize)>; 2] = [None, None];
     let targets: Vec<f64> = match stop_at {
         Some(stop) => {
             let k = ((l_max - stop) / step).ceil().max(0.0) as usize;
@@ -210,49 +221,30 @@ fn follow_path(
         }
         None => (1..=nodes).map(|i| l_max - i as f64 * step).collect(),
     };
+    // The last converged state (restored on failure) and the prediction (the fallback's start).
+    let mut backup = solver.clone();
+    let mut predicted = solver.clone();
     'nodes: for &target in &targets {
         let mut sub = target - current;
         let mut halvings = 0;
         while current > target {
             let aim = (current + sub).max(target);
-            let backup = solver.clone();
-            if !started {
-                solver.seed_pocket(geom, l_max - aim);
-            } else if let Some(last) = pts.last().filter(|p| p.curvature.is_finite()) {
-                // First-order predictor along dr/dL (left in y by the last sensitivity solve).
-                let dl = aim - current;
-                for j in 0..solver.radii.len() {
-                    if !solver.held[j] {
-                        solver.radii[j] = (solver.radii[j] + solver.y[j] * dl).max(geom.min_radius);
-                    }
-                }
-                solver.lambda += last.curvature * dl;
-            }
+            backup.copy_from(solver);
             let outcome = if started {
-                solver.solve(geom, aim)
+                predict(geom, solver, &backup, aim - current, last_curvature, &edges);
+                // Late in the stroke the edge runs out to the clamps faster than predicted
+                // and moves about one ring per iteration; allow for a share of the rings.
+                let iterations = MAX_PATH_ITERATIONS + solver.radii.len() / 16;
+                solve_from(geom, solver, &mut predicted, aim, iterations)
             } else {
-                // Nucleation: try a centred pocket and a near-uniform bulge; keep the larger
-                // volume (both are local maxima reached by ascent).
-                let pocket = solver.solve(geom, aim);
-                let mut bulge_solver = backup.clone();
-                bulge_solver.seed_uniform(geom);
-                let bulge = bulge_solver.solve(geom, aim);
-                match (pocket, bulge) {
-                    (Ok(p), Ok(b)) if b.volume > p.volume => {
-                        *solver = bulge_solver;
-                        Ok(b)
-                    }
-                    (Err(_), Ok(b)) => {
-                        *solver = bulge_solver;
-                        Ok(b)
-                    }
-                    (p, _) => p,
-                }
+                nucleate(geom, solver, aim)
             };
             match outcome {
                 Ok(p) => {
                     current = aim;
                     started = true;
+                    last_curvature = p.curvature;
+                    edges = [Some((aim, solver.first_free())), edges[0]];
                     if current <= target {
                         pts.push(p);
                         // Past the free contraction (dV/dL >= 0: no tension left) the volume
@@ -265,7 +257,7 @@ fn follow_path(
                     }
                 }
                 Err(_why) => {
-                    *solver = backup;
+                    solver.copy_from(&backup);
                     halvings += 1;
                     if halvings > MAX_SUBSTEP_HALVINGS {
                         break 'nodes;
@@ -282,21 +274,12 @@ fn follow_path(
                 .to_string(),
         );
     }
-    // Full extension's curvature: the right-hand limit, from a pocket solved just below it
-    // (falls back to the secant through the first node).
+    // Full extension's curvature: the right-hand limit, from a solve just below it (falls back
+    // to the secant through the first node).
     let probe_length = l_max - 1e-3 * step;
     let mut probe = Solver::new(geom);
-    probe.seed_pocket(geom, l_max - probe_length);
-    let probe_point = probe.solve(geom, probe_length).ok();
-    let mut bulge = Solver::new(geom);
-    bulge.seed_uniform(geom);
-    let bulge_point = bulge.solve(geom, probe_length).ok();
-    let best = match (probe_point, bulge_point) {
-        (Some(a), Some(b)) => Some(if b.volume > a.volume { b } else { a }),
-        (a, b) => a.or(b),
-    };
-    pts[0].curvature = match best {
-        Some(p) if p.curvature.is_finite() => p.curvature,
+    pts[0].curvature = match nucleate(geom, &mut probe, probe_length) {
+        Ok(p) if p.curvature.is_finite() => p.curvature,
         _ => {
             let p1 = pts[1];
             let c0 = 2.0 * (p1.slope - pts[0].slope) / (p1.length - pts[0].length) - p1.curvature;
@@ -308,4 +291,93 @@ fn follow_path(
         }
     };
     Ok(pts)
+}
+
+/// Sets the start of the next solve, `dl` (negative) from the last: every free ring moves along
+/// `dr/dL` (left in `y` by the last solve) and `lambda` along `d2V/dL2`, shortened while a
+/// segment cannot close (near the clamps late in the stroke); the held rings that the pocket's
+/// edge is predicted to cross are released (the fast path holds them again if not).
+fn predict(
+    geom: &ShapeGeometry,
+    solver: &mut Solver,
+    last: &Solver,
+    dl: f64,
+    curvature: f64,
+    edges: &[Option<(f64, usize)>; 2],
+) {
+    if !curvature.is_finite() {
+        return;
+    }
+    let rings = solver.radii.len();
+    let mut dl_taken = dl;
+    for _ in 0..8 {
+        for j in 0..rings {
+            if !solver.held[j] {
+                solver.radii[j] = (last.radii[j] + last.y[j] * dl_taken).max(geom.min_radius);
+            }
+        }
+        if geom.length_and_volume(&solver.radii).is_some() {
+            break;
+        }
+        dl_taken *= 0.5;
+    }
+    solver.lambda = last.lambda + curvature * dl_taken;
+    if let [Some((l1, e1)), Some((l0, e0))] = *edges {
+        // Rings crossed per metre over the last step, extrapolated (the edge moves outward).
+        if e1 < e0 && l0 > l1 && e1 > 1 {
+            let crossed = (e0 - e1) as f64 * (-dl_taken) / (l0 - l1);
+            let edge = e1.saturating_sub(crossed.floor() as usize).max(1);
+            for j in edge..e1 {
+                solver.held[j] = false;
+                solver.held[rings - 1 - j] = false;
+            }
+        }
+    }
+}
+
+/// One solve on the path: the fast Newton path from the prediction, else the robust solve from
+/// the same start.
+fn solve_from(
+    geom: &ShapeGeometry,
+    solver: &mut Solver,
+    start: &mut Solver,
+    aim: f64,
+    max_iterations: usize,
+) -> Result<PathPoint, &'static str> {
+    start.copy_from(solver);
+    if let Some(p) = solver.solve_newton(geom, aim, max_iterations) {
+        return Ok(p);
+    }
+    solver.copy_from(start);
+    solver.solve(geom, aim)
+}
+
+/// Nucleation just below full extension: a centred pocket and a near-uniform bulge are solved
+/// from their seeds and the larger volume is kept (both are local maxima). Leaves the winner in
+/// `solver`.
+fn nucleate(
+    geom: &ShapeGeometry,
+    solver: &mut Solver,
+    aim: f64,
+) -> Result<PathPoint, &'static str> {
+    // The seeded pocket's edge moves out about one ring per Newton iteration while it finds
+    // its width, a share of the rings.
+    let iterations = MAX_PATH_ITERATIONS + solver.radii.len() / 8;
+    let mut bulge_solver = solver.clone();
+    let mut start = solver.clone();
+    solver.seed_pocket(geom, geom.max_length() - aim);
+    let pocket = solve_from(geom, solver, &mut start, aim, iterations);
+    bulge_solver.seed_uniform(geom);
+    let bulge = solve_from(geom, &mut bulge_solver, &mut start, aim, iterations);
+    match (pocket, bulge) {
+        (Ok(p), Ok(b)) if b.volume > p.volume => {
+            *solver = bulge_solver;
+            Ok(b)
+        }
+        (Err(_), Ok(b)) => {
+            *solver = bulge_solver;
+            Ok(b)
+        }
+        (p, _) => p,
+    }
 }

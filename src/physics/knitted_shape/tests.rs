@@ -147,6 +147,10 @@ fn rejects_bad_geometry() {
     assert!(ShapeGeometry::new(0.0, 49.0, 0.48, 0.003, 49).is_err());
     assert!(ShapeGeometry::new(22.0, 49.0, f64::NAN, 0.003, 49).is_err());
     assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, 1).is_err());
+    // Beyond the bound, refused with the reason (the clamp segments turn radial first).
+    assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS).is_ok());
+    let why = ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS + 1).unwrap_err();
+    assert!(why.contains("1600") && why.contains("radial"), "{why}");
 }
 
 proptest::proptest! {

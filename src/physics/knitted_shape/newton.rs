@@ -1,0 +1,253 @@
+//! The fast path of the table: plain Newton on the KKT system with a primal-dual active set.
+//!
+//! [`Solver::solve`] is robust but slow on long sleeves: it restores the length after every step,
+//! line-searches on the volume and releases one ring (and its twin) per converged solve, so the
+//! pocket's edge, which crosses about `segments / nodes` rings per table node, costs a full
+//! re-convergence per ring: quadratic in `segments` overall. Here the active set is updated in
+//! every Newton step from the complementarity of `r_j >= r_min` and `z_j = dV/dr_j - lambda
+//! dL/dr_j <= 0` (a ring is held when `(r_j - r_min) + z_j / |H_jj| < 0`: its Newton move would
+//! take it below the floor), and the length constraint enters the step itself, so a warm start
+//! from the tangent predictor converges in a few O(segments) iterations wherever the pocket's
+//! edge is. Anything unusual (no convergence, a saddle, a non-finite value) returns `None`, and
+//! the caller falls back to the robust solve from the same start.
+
+// `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
+#![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
+use super::geometry::ShapeGeometry;
+use super::solver::{PathPoint, Solver};
+
+/// Newton iterations on the path before giving up to the robust solve; a warm start needs 2-5.
+pub(super) const MAX_PATH_ITERATIONS: usize = 40;
+/// Releases of one ring from the floor within a solve before it stays there.
+const MAX_RELEASES: u8 = 3;
+/// Step halvings when a step leaves a segment unable to close.
+const MAX_BACKTRACKS: usize = 30;
+
+impl Solver {
+    /// Maximizes `V` at `L = target` from the current rings and multiplier (the predictor).
+    /// Converged to the robust solve's residual (`1e-10 S_row^2` per ring) with the length exact
+    /// to `1e-13 L_max`; leaves `dr/dL` in `y` as [`Solver::sensitivity`] does. `None` if the
+    /// start does not close or Newton does not reach a maximum.
+    pub(super) fn solve_newton(
+        &mut self,
+        geom: &ShapeGeometry,
+        target: f64,
+        max_iterations: usize,
+    ) -> Option<PathPoint> {
+        let rings = self.radii.len();
+        let r_min = geom.min_radius;
+        let r_ceiling = geom.radius_ceiling();
+        let s_row = geom.row_strand_length;
+        let grad_tol = 1e-10 * s_row * s_row;
+        let length_tol = 1e-13 * geom.max_length();
+        let step_cap = 0.05 * s_row;
+        let mut lambda = self.lambda;
+        if !lambda.is_finite() {
+            return None;
+        }
+        // The last step (base radii in `base`, direction in `x`), halved while it does not close.
+        let mut step: Option<(f64, f64, f64)> = None;
+        let mut backtracks = 0;
+        let mut last_residual = f64::INFINITY;
+        self.releases.iter_mut().for_each(|n| *n = 0);
+        for iteration in 0..max_iterations + MAX_BACKTRACKS {
+            let Some((length, volume)) = self.assemble(geom) else {
+                let (alpha, lambda0, dlambda) = step?;
+                backtracks += 1;
+                if backtracks > MAX_BACKTRACKS {
+                    return None;
+                }
+                let alpha = 0.5 * alpha;
+                self.take_step(alpha, r_min, r_ceiling);
+                lambda = lambda0 + alpha * dlambda;
+                step = Some((alpha, lambda0, dlambda));
+                continue;
+            };
+            // Active set from the complementarity function; a ring newly held above the floor is
+            // put on it and the system re-assembled. The first step keeps the predicted set:
+            // rings released at the floor ahead of the pocket's edge have no pull yet.
+            let first = iteration == 0;
+            let mut set_changed = first;
+            let mut projected = false;
+            let mut residual = 0.0f64;
+            let mut largest_term = 0.0f64;
+            for j in 1..rings - 1 {
+                let z = self.gv[j] - lambda * self.gl[j];
+                let curvature = (self.dv[j] - lambda * self.dl[j]).abs();
+                let hold = if first {
+                    self.held[j]
+                } else if self.radii[j] <= r_min {
+                    // A ring that keeps falling back to the floor (its pull is at roundoff) is
+                    // left there, as in the robust solve.
+                    z <= grad_tol || (self.held[j] && self.releases[j] >= MAX_RELEASES)
+                } else {
+                    (self.radii[j] - r_min) * curvature + z < 0.0
+                };
+                if hold != self.held[j] {
+                    set_changed = true;
+                    self.held[j] = hold;
+                    if !hold {
+                        self.releases[j] = self.releases[j].saturating_add(1);
+                    }
+                }
+                if hold && self.radii[j] > r_min {
+                    self.radii[j] = r_min;
+                    projected = true;
+                }
+                if !hold {
+                    residual = residual.max(z.abs());
+                    largest_term = largest_term.max(self.gv[j].abs());
+                }
+            }
+            step = None;
+            if projected {
+                continue;
+            }
+            if !residual.is_finite() {
+                return None;
+            }
+            let pos = self.shifted_solve(lambda, 0.0)?;
+            let (mut gx, mut gy) = (0.0, 0.0);
+            for j in 0..rings {
+                if !self.held[j] {
+                    gx += self.gl[j] * self.x[j];
+                    gy += self.gl[j] * self.y[j];
+                }
+            }
+            if !(gy.abs() > 0.0) {
+                return None;
+            }
+            // Converged at the tolerance, or at the roundoff floor: near-radial segments at the
+            // clamps (`L = sqrt(s^2 - d^2)` losing digits) hold the residual above it, at a part
+            // in 1e9 or less of their gradient, where the robust solve also stalls.
+            let floor = grad_tol.max(1e-9 * largest_term);
+            let stalled = residual <= 1e3 * floor && residual > 0.5 * last_residual;
+            last_residual = residual;
+            if !set_changed
+                && (residual <= grad_tol || stalled)
+                && (length - target).abs() <= length_tol
+            {
+                // Converged. A maximum has a negative definite reduced Hessian: the bordered
+                // matrix has exactly one positive eigenvalue. The pocket centred on the lattice
+                // can instead be a saddle whose one ascent is antisymmetric (a shift by part of a
+                // segment, worth far less volume than the table's accuracy); the robust solve,
+                // which releases rings in mirror pairs, stays on it too, so a symmetric profile
+                // is accepted if it is a maximum among symmetric profiles.
+                let maximum = pos + usize::from(gy < 0.0) == 1
+                    || (self.is_mirror_symmetric(r_ceiling)
+                        && self.symmetric_ascents(lambda) == Some(1));
+                if !maximum {
+                    return None;
+                }
+                self.lambda = self.multiplier()?;
+                let curvature = 1.0 / gy;
+                for yj in self.y.iter_mut() {
+                    *yj *= curvature;
+                }
+                let max_radius = self.radii.iter().cloned().fold(r_min, f64::max);
+                return curvature.is_finite().then_some(PathPoint {
+                    length,
+                    volume,
+                    slope: self.lambda,
+                    curvature,
+                    max_radius,
+                });
+            }
+            // Newton step on (r, lambda): H dr - g dlambda = -R, g . dr = target - L.
+            let dlambda = (target - length + gx) / gy;
+            let mut largest = 0.0f64;
+            for j in 0..rings {
+                if !self.held[j] {
+                    self.x[j] = -self.x[j] + dlambda * self.y[j];
+                    largest = largest.max(self.x[j].abs());
+                }
+            }
+            if !largest.is_finite() || !dlambda.is_finite() {
+                return None;
+            }
+            let alpha = if largest > step_cap {
+                step_cap / largest
+            } else {
+                1.0
+            };
+            self.base.copy_from_slice(&self.radii);
+            self.take_step(alpha, r_min, r_ceiling);
+            step = Some((alpha, lambda, dlambda));
+            lambda += alpha * dlambda;
+        }
+        None
+    }
+
+    /// Free rings at `base + alpha x`, kept within `[r_min, r_ceiling]`.
+    fn take_step(&mut self, alpha: f64, r_min: f64, r_ceiling: f64) {
+        for j in 0..self.radii.len() {
+            if !self.held[j] {
+                let r = self.base[j] + alpha * self.x[j];
+                self.radii[j] = crate::physics::bounds::limit(r, r_min, r_ceiling);
+            }
+        }
+    }
+
+    /// First ring off the floor from the left clamp (the pocket's edge); the last ring if none.
+    pub(super) fn first_free(&self) -> usize {
+        let rings = self.radii.len();
+        (1..rings - 1).find(|&j| !self.held[j]).unwrap_or(rings - 1)
+    }
+
+    /// Whether the profile equals its mirror image to roundoff.
+    fn is_mirror_symmetric(&self, scale: f64) -> bool {
+        let n = self.radii.len();
+        (0..n / 2).all(|j| {
+            self.held[j] == self.held[n - 1 - j]
+                && (self.radii[j] - self.radii[n - 1 - j]).abs() <= 1e-10 * scale
+        })
+    }
+
+    /// Positive eigenvalues of the bordered KKT matrix restricted to mirror-symmetric moves
+    /// (as assembled): the Hessian folded onto the first half of the rings. With `N` segments
+    /// and `m` the last ring of the half, the quadratic form halves to the same tridiagonal
+    /// entries except at the middle: for even `N` the middle ring pairs with itself (diagonal
+    /// and constraint entry halved), for odd `N` rings `m` and `m + 1` move together (the
+    /// middle segment's coupling joins the diagonal). Counted by an LDL^T sweep, which also
+    /// gives `g^T H^-1 g` (Haynsworth: the border adds one positive eigenvalue where it is
+    /// negative).
+    pub(super) fn symmetric_ascents(&self, lambda: f64) -> Option<usize> {
+        let rings = self.radii.len();
+        let segments = rings - 1;
+        let m = segments / 2;
+        let even = segments.is_multiple_of(2);
+        let entry = |j: usize| -> (f64, f64, f64) {
+            // (diagonal, coupling to j + 1, constraint gradient) of the folded system.
+            if self.held[j] {
+                return (1.0, 0.0, 0.0);
+            }
+            let diag = self.dv[j] - lambda * self.dl[j];
+            let couple = self.ov[j] - lambda * self.ol[j];
+            let next_free = j + 1 < rings && !self.held[j + 1];
+            match (j == m, even) {
+                (true, true) => (0.5 * diag, 0.0, 0.5 * self.gl[j]),
+                (true, false) => (diag + couple, 0.0, self.gl[j]),
+                _ => (diag, if next_free { couple } else { 0.0 }, self.gl[j]),
+            }
+        };
+        let mut positive = 0;
+        let (mut prev_d, mut prev_off, mut prev_w) = (1.0, 0.0, 0.0);
+        let mut quad = 0.0;
+        for j in 0..=m {
+            let (diag, off, g) = entry(j);
+            let l = prev_off / prev_d;
+            let d = diag - l * prev_off;
+            let w = g - l * prev_w;
+            if !(d.abs() > 0.0) || !d.is_finite() {
+                return None;
+            }
+            if !self.held[j] && d > 0.0 {
+                positive += 1;
+            }
+            quad += w * w / d;
+            (prev_d, prev_off, prev_w) = (d, off, w);
+        }
+        quad.is_finite()
+            .then_some(positive + usize::from(quad < 0.0))
+    }
+}
