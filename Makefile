@@ -233,9 +233,13 @@ fuzz:
 ## - native: tools/examples/memcheck_native.rs loads every FMU through its C ABI (no Python), runs
 ##   each with default parameters and with all effects on, and every scene; definite and
 ##   indirect leaks count as errors and nothing is suppressed.
-## - fmpy: the FMPy suite (MEMCHECK_TESTS) with memory errors checked, not leaks (the Python
-##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so.
-MEMCHECK_TESTS ?= tests/fmpy
+## - fmpy: FMPy tests (MEMCHECK_TESTS) with memory errors checked, not leaks (the Python
+##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so. The
+##   default set drives every FMU: every scene and every cross-check input through a strict
+##   master, FMU states, threads and 20 load/unload cycles, and validation of every FMU. The whole
+##   suite under valgrind takes hours on 2 cores: `make memcheck MEMCHECK_TESTS=tests/fmpy`.
+MEMCHECK_TESTS ?= tests/fmpy/test_strict_master.py tests/fmpy/test_fmi_behaviour.py \
+  tests/fmpy/test_validation.py
 MEMCHECK_DIR := out/memcheck
 VALGRIND := valgrind --tool=memcheck --error-exitcode=1 --num-callers=30
 memcheck: fmus $(VENV)/.installed
@@ -251,7 +255,7 @@ memcheck: fmus $(VENV)/.installed
 	tail -1 $(MEMCHECK_DIR)/native.out; \
 	echo "native: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/native.log)"; \
 	grep -h 'definitely lost\|indirectly lost\|All heap blocks were freed' $(MEMCHECK_DIR)/native.log; \
-	PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
+	FMI_BEHAVIOUR_LOAD_CYCLES=20 PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
 	  --log-file=$(MEMCHECK_DIR)/fmpy.log \
 	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS) > $(MEMCHECK_DIR)/fmpy.out 2>&1; fmpy=$$?; \
 	tail -1 $(MEMCHECK_DIR)/fmpy.out; \

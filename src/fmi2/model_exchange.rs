@@ -186,7 +186,15 @@ impl Instance {
             }
         };
         match result {
-            Ok(()) => status,
+            // The last guard of "no output is ever NaN", as in fmi2GetReal.
+            Ok(()) => match out.iter().position(|x| !x.is_finite()) {
+                None => status,
+                Some(k) => self.error(&format!(
+                    "{function}: {} element {k} is {}: the model produced a non-finite value",
+                    what.name(),
+                    out[k]
+                )),
+            },
             Err(why) => self.error(&format!("{function}: {why}")),
         }
     }

@@ -185,6 +185,13 @@ impl KnittedSleeve {
             ShapeModel::NonCylindrical(t) => t.min_length().max(l_min),
             _ => l_min,
         };
+        // `clamp_length` relies on ordered, finite limits: a table that ends above its own
+        // full extension is an error of the build, reported here rather than limited later.
+        if !(min_length.is_finite() && min_length <= max_length) {
+            return Err(format!(
+                "no stroke: shortest length {min_length} m is above full extension {max_length} m"
+            ));
+        }
         Ok(Self {
             params,
             shape,

@@ -65,9 +65,13 @@ unsafe extern "C" fn record(
 
 /// Path of a packaged FMU; `make fmus` writes them.
 pub fn fmu_path(model: &str) -> PathBuf {
-    let p = Path::new(env!("CARGO_MANIFEST_DIR"))
-        .join("target/fmu")
-        .join(format!("{model}.fmu"));
+    // The repository root, also when this module is built into tools/ (memcheck_native).
+    let manifest = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = manifest
+        .ancestors()
+        .find(|d| d.join("modelDescription").is_dir())
+        .unwrap_or(manifest);
+    let p = root.join("target/fmu").join(format!("{model}.fmu"));
     assert!(
         p.exists(),
         "{} is missing: run `make fmus` first",

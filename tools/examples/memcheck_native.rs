@@ -2,7 +2,8 @@
 //! run under valgrind with a leak check that counts definite and indirect leaks as errors.
 //!
 //! - every model twice, with default parameters and with all effects on, over 40 steps of inputs
-//!   inside their declared ranges, through an FMU state get / serialize / deserialize / set;
+//!   inside their declared ranges, through an FMU state get / serialize / deserialize / set (the
+//!   motor's substep budget bounded, see `exercise::EXERCISE_SUBSTEPS`);
 //! - every catalogue scene (`scenes/*.json`, fast variant) with its parameters, inputs and every
 //!   sweep value;
 //! - every instance and FMU state freed, so anything left is a leak of ours.
@@ -117,7 +118,8 @@ fn scene_run(api: &Api, info: &ModelInfo, scene: &Scene, sweep: Option<usize>) -
 }
 
 fn main() {
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    // The repository root (this example is built in tools/).
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
     let apis: Vec<(&ModelInfo, Api)> = models()
         .into_iter()
         .map(|info| (info, Api::load(&extract_binary(info.name))))
@@ -128,8 +130,16 @@ fn main() {
             .unwrap_or_else(|| panic!("no FMU {name}"))
     };
     for (info, api) in &apis {
-        let steps = models_run(api, info, false) + models_run(api, info, true);
-        println!("{}: default and all effects on, {steps} steps", info.name);
+        let t0 = std::time::Instant::now();
+        let steps = models_run(api, info, false);
+        let t1 = t0.elapsed();
+        let steps = steps + models_run(api, info, true);
+        println!(
+            "{}: default and all effects on, {steps} steps ({:.2?} + {:.2?})",
+            info.name,
+            t1,
+            t0.elapsed() - t1
+        );
     }
     let mut paths: Vec<_> = std::fs::read_dir(root.join("scenes"))
         .unwrap()

@@ -183,3 +183,62 @@ fn a_tunable_parameter_set_between_steps_takes_effect() {
     assert_eq!(inst.do_step(0.2, 0.1), fmi2Status::OK);
     assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
 }
+
+#[test]
+fn a_non_finite_output_is_refused_with_a_logged_reason_never_handed_out() {
+    use std::sync::atomic::{AtomicUsize, Ordering};
+    static ERRORS: AtomicUsize = AtomicUsize::new(0);
+    unsafe extern "C" fn count(
+        _: *mut std::ffi::c_void,
+        _: crate::fmi2::types::fmi2String,
+        status: std::ffi::c_int,
+        _: crate::fmi2::types::fmi2String,
+        _: crate::fmi2::types::fmi2String,
+    ) {
+        if status == fmi2Status::Error as std::ffi::c_int {
+            ERRORS.fetch_add(1, Ordering::Relaxed);
+        }
+    }
+    // SAFETY: called with exactly these five arguments, as the logger is (see the fuzz driver).
+    let logger = unsafe {
+        std::mem::transmute::<
+            unsafe extern "C" fn(
+                *mut std::ffi::c_void,
+                crate::fmi2::types::fmi2String,
+                std::ffi::c_int,
+                crate::fmi2::types::fmi2String,
+                crate::fmi2::types::fmi2String,
+            ),
+            crate::fmi2::types::fmi2CallbackLogger,
+        >(count)
+    };
+    let mut inst = Instance::new(
+        &FACTORY,
+        Logger::new(Some(logger), std::ptr::null_mut(), "t"),
+    );
+    assert_eq!(inst.setup_experiment(None, 0.0, None), fmi2Status::OK);
+    assert_eq!(inst.enter_initialization_mode(), fmi2Status::OK);
+    assert_eq!(inst.exit_initialization_mode(), fmi2Status::OK);
+    // Both finite and legal; their product overflows to +inf.
+    assert_eq!(
+        inst.set("fmi2SetReal", &[0, 1], &[1e300, 1e300]),
+        fmi2Status::OK
+    );
+    assert_eq!(inst.do_step(0.0, 0.1), fmi2Status::OK);
+    let before = ERRORS.load(Ordering::Relaxed);
+    let mut out = [7.0, 7.0];
+    let s = inst.get("fmi2GetReal", VarType::Real, &[1, 2], &mut out, |v, i| {
+        v.real(i)
+    });
+    assert_eq!(s, fmi2Status::Error);
+    assert_eq!(out[1], 7.0, "the infinity was written out");
+    assert!(out.iter().all(|x| x.is_finite()));
+    assert_eq!(
+        ERRORS.load(Ordering::Relaxed),
+        before + 1,
+        "refused without a reason"
+    );
+    // Back in range, the same instance hands out finite outputs again.
+    assert_eq!(inst.set("fmi2SetReal", &[1], &[2.0]), fmi2Status::OK);
+    assert_eq!(y(&mut inst), (fmi2Status::OK, 2e300));
+}

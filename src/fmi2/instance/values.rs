@@ -307,6 +307,11 @@ impl Instance {
             if let Err(s) = self.lookup(function, kind, vr) {
                 return s;
             }
+            // The last guard of "no output is ever NaN": the models check their own results,
+            // and a value that still is not finite is refused here, never handed out.
+            if kind == VarType::Real && !self.runtime.real(vr as usize).is_finite() {
+                return self.non_finite(function, vr);
+            }
             *slot = pick(self.runtime.as_ref(), vr as usize);
         }
         status
@@ -333,7 +338,7 @@ impl Instance {
         );
         // After a step the outputs are current: one dynamic call reads them.
         if refreshing && self.runtime.current_reals(vrs, out) {
-            return fmi2Status::OK;
+            return self.finite_or_refused(F, vrs, out, fmi2Status::OK);
         }
         let status = if refreshing {
             self.refresh_outputs(F)
@@ -342,8 +347,36 @@ impl Instance {
         };
         if status < fmi2Status::Error {
             self.runtime.reals(vrs, out);
+            return self.finite_or_refused(F, vrs, out, status);
         }
         status
+    }
+
+    /// The last guard of "no output is ever NaN" on the fmi2GetReal path: `status` if every
+    /// value is finite, else an error naming the first that is not.
+    #[inline]
+    fn finite_or_refused(
+        &self,
+        function: &str,
+        vrs: &[u32],
+        out: &[f64],
+        status: fmi2Status,
+    ) -> fmi2Status {
+        match out.iter().position(|x| !x.is_finite()) {
+            None => status,
+            Some(k) => self.non_finite(function, vrs[k]),
+        }
+    }
+
+    /// Refuses to hand out a non-finite Real, naming it: a model error, not the importer's.
+    #[cold]
+    fn non_finite(&self, function: &str, vr: u32) -> fmi2Status {
+        let x = self.runtime.real(vr as usize);
+        let name = self.by_type[0].get(vr as usize).map_or("?", |v| v.name);
+        self.error(&format!(
+            "{function}: {name} (value reference {vr}) is {x}: the model produced a non-finite \
+             value from the current parameters and inputs; it is not handed out"
+        ))
     }
 
     /// `fmi2GetString`: the returned strings live until the next call on this instance.
