@@ -262,6 +262,45 @@ impl McKibbenMuscle {
         }
     }
 
+    /// `[d/dlength, d/dtarget_force]` of `target_pressure`: by the implicit function theorem on
+    /// `F(P*, L) = target_force`, `dP*/dF = 1/F_P` and `dP*/dL = -F_L/F_P`, at the point and
+    /// length the solver used. Saturated (`P*` at 0 or `max_pressure`), or without the solver,
+    /// `target_pressure` does not move: zero. At a clamped length the length column is zero.
+    fn target_pressure_partials(&self, inputs: &Inputs) -> [f64; 2] {
+        let Some((muscle, max_pressure)) = &self.solver else {
+            return [0.0; 2];
+        };
+        let (length, force) = (inputs.length, inputs.target_force);
+        let solve = |l: f64| pressure_for_force(muscle, l, force, *max_pressure, &self.friction);
+        let (solved, l, inside) = match solve(length) {
+            Ok(s) => (s, length, true),
+            Err(_) => {
+                let (lo, hi) = (muscle.min_length(), muscle.max_length());
+                let margin = if muscle.bladder().is_some() {
+                    LIMIT_MARGIN * (hi - lo)
+                } else {
+                    0.0
+                };
+                let clamped = length.max(lo + margin).min(hi - margin);
+                match solve(clamped) {
+                    Ok(s) => (s, clamped, false),
+                    Err(_) => return [0.0; 2],
+                }
+            }
+        };
+        if solved.saturated {
+            return [0.0; 2];
+        }
+        match muscle.partials(solved.argument, l, &self.friction) {
+            Ok((_, d)) if d.force[0] != 0.0 => {
+                let per_force = 1.0 / d.force[0];
+                let per_length = if inside { -d.force[1] * per_force } else { 0.0 };
+                [per_length, per_force]
+            }
+            _ => [0.0; 2],
+        }
+    }
+
     /// The full model at the current inputs; out of range, the nearest point inside it (logged).
     fn compute(
         muscle: &McKibben,
@@ -314,12 +353,7 @@ impl McKibbenMuscle {
 /// The partials as the FMU's rows, by variable name.
 fn partial_rows(d: &McKibbenPartials) -> Partials {
     let mut p = Partials::default();
-    for (name, [dp, dl]) in [
-        ("force", d.force),
-        ("volume", d.volume),
-        ("effective_pressure", d.effective_pressure),
-        ("friction_force", d.friction_force),
-    ] {
+    for (name, [dp, dl]) in d.named() {
         p.row(name, &[("pressure", dp), ("length", dl)]);
     }
     p
@@ -343,6 +377,8 @@ impl McKibbenMuscle {
                     effective_pressure: [on, 0.0],
                     friction_force: [0.0, 0.0],
                     volume: [0.0, -dl * per_pa],
+                    // The bare sleeve's stretches and stresses are constants (no bladder).
+                    ..Default::default()
                 })
             }
             Pipeline::Full(m) => {
@@ -357,12 +393,7 @@ impl McKibbenMuscle {
                 };
                 let clamped = length.max(lo + margin).min(hi - margin);
                 let zero_l = |mut d: McKibbenPartials, zero_p: bool| {
-                    for y in [
-                        &mut d.force,
-                        &mut d.volume,
-                        &mut d.effective_pressure,
-                        &mut d.friction_force,
-                    ] {
+                    for y in d.rows_mut() {
                         y[1] = 0.0;
                         if zero_p {
                             y[0] = 0.0;
@@ -490,6 +521,15 @@ impl Model for McKibbenMuscle {
         // contraction = 1 - length / nominal_length.
         let per_length = -1.0 / self.effective.nominal_length;
         rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
+        let target = self.target_pressure_partials(inputs);
+        rows.row(
+            "target_pressure",
+            &[
+                ("pressure", 0.0),
+                ("length", target[0]),
+                ("target_force", target[1]),
+            ],
+        );
         Ok(rows)
     }
 }
