@@ -1,6 +1,7 @@
 //! Native cost of `fmi2GetDirectionalDerivative` against a co-simulation step, through the packaged
-//! McKibbenMuscle's C ABI, for each bladder model: set(P, L) + doStep + get(F), and set(P, L) + the
-//! two directional derivatives dF/dP and dF/dL (one seed each, a full 1x2 Jacobian row).
+//! McKibbenMuscle's C ABI, for each bladder model: set(P, L) + doStep + get(F), set(P, L) + one
+//! directional derivative dF/dP, and set(P, L) + the two directional derivatives dF/dP and dF/dL
+//! (one seed each, a full 1x2 Jacobian row: the second reuses the first's partials).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -14,6 +15,7 @@ const COMBINATIONS: &[(&str, [i32; 3])] = &[
     ("ideal", [1, 0, 16]),
     ("thin wall", [1, 1, 16]),
     ("thick wall, 16 layers", [1, 2, 16]),
+    ("continuum wall, 16 nodes", [1, 3, 16]),
 ];
 
 fn cost(c: &mut Criterion) {
@@ -51,6 +53,28 @@ fn cost(c: &mut Criterion) {
                 black_box(out[0])
             })
         });
+        let mut one = [0.0];
+        group.bench_function(
+            format!("{label}: set(P, L) + dF/dP (1 directional derivative)"),
+            |bench| {
+                bench.iter(|| unsafe {
+                    k = k.wrapping_add(1);
+                    let l = 0.072 + 1e-5 * (k % 1000) as f64;
+                    (api.fmi2SetReal)(inst.c, inputs.as_ptr(), 2, [4e5, l].as_ptr());
+                    let status = (api.fmi2GetDirectionalDerivative)(
+                        inst.c,
+                        [FORCE].as_ptr(),
+                        1,
+                        inputs.as_ptr(),
+                        2,
+                        [1.0, 0.0].as_ptr(),
+                        one.as_mut_ptr(),
+                    );
+                    debug_assert_eq!(status, 0);
+                    black_box(one)
+                })
+            },
+        );
         let mut row = [0.0; 2];
         group.bench_function(
             format!("{label}: set(P, L) + dF/dP + dF/dL (2 directional derivatives)"),

@@ -46,6 +46,25 @@ pub struct McKibbenMuscle {
     notice: Option<String>,
     /// `pressure_solver` on: the muscle to invert and `max_pressure`.
     solver: Option<(McKibben, f64)>,
+    /// The last partials and the point (inputs and friction history) they were taken at: the
+    /// further seeds of a Jacobian at the same point reuse them. Not part of the FMU state.
+    #[serde(skip)]
+    partials_cache: Option<(PartialsKey, Partials)>,
+}
+
+/// Bit patterns of what the partials depend on: pressure, length, target_force, friction z and
+/// position.
+type PartialsKey = [u64; 5];
+
+fn partials_key(inputs: &Inputs, history: &HysteresisState) -> PartialsKey {
+    [
+        inputs.pressure,
+        inputs.length,
+        inputs.target_force,
+        history.z,
+        history.position,
+    ]
+    .map(f64::to_bits)
 }
 
 /// The muscle the parameters (or the preset) describe, with the parameters the user set that
@@ -473,6 +492,7 @@ impl Model for McKibbenMuscle {
             effective: params,
             notice,
             solver,
+            partials_cache: None,
         })
     }
 
@@ -517,6 +537,20 @@ impl Model for McKibbenMuscle {
     }
 
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let key = partials_key(inputs, &self.friction);
+        if let Some((cached, rows)) = &self.partials_cache {
+            if *cached == key {
+                return Ok(rows.clone());
+            }
+        }
+        let rows = self.fresh_partials(inputs)?;
+        self.partials_cache = Some((key, rows.clone()));
+        Ok(rows)
+    }
+}
+
+impl McKibbenMuscle {
+    fn fresh_partials(&self, inputs: &Inputs) -> Result<Partials, String> {
         let mut rows = self.partials_at(inputs).map(|d| partial_rows(&d))?;
         // contraction = 1 - length / nominal_length.
         let per_length = -1.0 / self.effective.nominal_length;
@@ -531,5 +565,50 @@ impl Model for McKibbenMuscle {
             ],
         );
         Ok(rows)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cached partials are those of the current point: a further seed at the same inputs and
+    /// history reuses them, new inputs or a committed friction history recompute them.
+    #[test]
+    fn cached_partials_follow_the_inputs_and_the_history() {
+        let p = Parameters {
+            preset: 2,
+            friction: true,
+            ..Default::default()
+        };
+        let at = |length: f64| Inputs {
+            pressure: 3e5,
+            length,
+            ..Default::default()
+        };
+        let start = at(0.7
+            * McKibbenMuscle::new(&p, &at(0.0))
+                .unwrap()
+                .calculated_parameters()
+                .max_length);
+        let (a, b) = (at(start.length + 3e-5), at(start.length + 1e-4));
+        let mut m = McKibbenMuscle::new(&p, &start).unwrap();
+        let first = m.partials(&a).unwrap();
+        assert_eq!(m.partials(&a).unwrap(), first);
+        let other = m.partials(&b).unwrap();
+        assert_ne!(other, first);
+        assert_eq!(other, m.fresh_partials(&b).unwrap());
+        assert_eq!(m.partials(&a).unwrap(), first);
+        // A step to `b` moves the friction history: the partials at `a` change with it.
+        m.step(
+            &b,
+            &mut Outputs::default(),
+            0.0,
+            1e-3,
+            &mut Report::default(),
+        );
+        let after = m.partials(&a).unwrap();
+        assert_eq!(after, m.fresh_partials(&a).unwrap());
+        assert_ne!(after.get("friction_force"), first.get("friction_force"));
     }
 }

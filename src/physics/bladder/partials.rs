@@ -12,7 +12,7 @@
 //! `c/a` are functions of `(L, x)` (and `-P` for the stresses), so the same chain rule through
 //! `x(P, L)` gives them; the threshold is always taken at the contact diameter `D(L)`.
 
-use super::{Bladder, Dual, Kernel, SleeveGeometry};
+use super::{check_state, Bladder, BladderState, Dual, Kernel, SleeveGeometry};
 
 /// `[d/dP, d/dL]` of the bladder's outputs, per Pa and per m.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -43,6 +43,17 @@ fn chain(q: Dual, dx_dp: f64, dx_dl: f64) -> [f64; 2] {
 impl<S: SleeveGeometry> Bladder<S> {
     /// The partials at `pressure` and `length`, on the branch [`Bladder::evaluate`] takes there.
     pub fn partials(&self, pressure: f64, length: f64) -> Result<BladderPartials, String> {
+        self.evaluate_with_partials(pressure, length)
+            .map(|(_, d)| d)
+    }
+
+    /// [`Bladder::evaluate`] and [`Bladder::partials`] from one pass: one kernel in contact, one
+    /// root of eq. 2.18 when free (what a directional derivative costs beyond a step).
+    pub fn evaluate_with_partials(
+        &self,
+        pressure: f64,
+        length: f64,
+    ) -> Result<(BladderState, BladderPartials), String> {
         if !pressure.is_finite() {
             return Err(format!("pressure must be finite, got {pressure} Pa"));
         }
@@ -58,17 +69,21 @@ impl<S: SleeveGeometry> Bladder<S> {
             let a = contact.a.v;
             // Along the contact branch the seed's `dl` is already the total d/dL (x = D(L)).
             let kinematics = self.kinematic_partials(length, &contact, &contact, 0.0, 0.0);
-            return Ok(BladderPartials {
-                // F = P_eff g - P A_fluid + elastic (eq. 2.16, 2.17).
-                force: [
-                    a * g - area.v + contact.elastic_dp,
-                    contact.p_eff.dl * g + contact.p_eff.v * g_slope - pressure * area.dl
-                        + contact.elastic.dl,
-                ],
-                effective_pressure: [a, contact.p_eff.dl],
-                fluid_volume: [0.0, area.dl * length + area.v],
-                ..kinematics
-            });
+            let state = check_state(self.contact_state(pressure, length, &contact), length)?;
+            return Ok((
+                state,
+                BladderPartials {
+                    // F = P_eff g - P A_fluid + elastic (eq. 2.16, 2.17).
+                    force: [
+                        a * g - area.v + contact.elastic_dp,
+                        contact.p_eff.dl * g + contact.p_eff.v * g_slope - pressure * area.dl
+                            + contact.elastic.dl,
+                    ],
+                    effective_pressure: [a, contact.p_eff.dl],
+                    fluid_volume: [0.0, area.dl * length + area.v],
+                    ..kinematics
+                },
+            ));
         }
         let x_root = self.free_outer_diameter(pressure, length, x.v)?;
         let k = self
@@ -84,18 +99,25 @@ impl<S: SleeveGeometry> Bladder<S> {
         let force_dx = -pressure * area.dx + k.elastic.dx;
         let force_dl = -pressure * area.dl + k.elastic.dl;
         let kinematics = self.kinematic_partials(length, &contact, &k, dx_dp, dx_dl);
-        Ok(BladderPartials {
-            force: [
-                -area.v + k.elastic_dp + force_dx * dx_dp,
-                force_dl + force_dx * dx_dl,
-            ],
-            effective_pressure: [0.0, 0.0],
-            fluid_volume: [
-                area.dx * dx_dp * length,
-                area.v + (area.dl + area.dx * dx_dl) * length,
-            ],
-            ..kinematics
-        })
+        let state = check_state(
+            self.free_state(pressure, length, &k, contact.threshold),
+            length,
+        )?;
+        Ok((
+            state,
+            BladderPartials {
+                force: [
+                    -area.v + k.elastic_dp + force_dx * dx_dp,
+                    force_dl + force_dx * dx_dl,
+                ],
+                effective_pressure: [0.0, 0.0],
+                fluid_volume: [
+                    area.dx * dx_dp * length,
+                    area.v + (area.dl + area.dx * dx_dl) * length,
+                ],
+                ..kinematics
+            },
+        ))
     }
 
     /// Threshold (from the `contact` kernel), stretches and stresses (from `k`, at the diameter

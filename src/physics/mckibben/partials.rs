@@ -82,10 +82,26 @@ impl McKibben {
         length: f64,
         history: &HysteresisState,
     ) -> Result<(McKibbenOutput, McKibbenPartials), String> {
-        let out = self.evaluate(pressure, length, history)?;
+        // Without a connector the bladder's state and partials come from one pass; through a
+        // connector the actual length is a root first.
+        let (out, bladder) = match (&self.bladder, self.connector_compliance) {
+            (Some(b), None) if pressure.is_finite() && length.is_finite() => {
+                let (state, d) = b.evaluate_with_partials(pressure, length)?;
+                let out = self.assemble(pressure, length, history, Some(state))?.out;
+                (out, Some(d))
+            }
+            _ => {
+                let out = self.evaluate(pressure, length, history)?;
+                let d = match &self.bladder {
+                    Some(b) => Some(b.partials(pressure, out.actual_length)?),
+                    None => None,
+                };
+                (out, d)
+            }
+        };
         let l = out.actual_length;
         // Partials with respect to (P, actual length).
-        let mut d = match &self.bladder {
+        let mut d = match bladder {
             None => {
                 let s = &self.sleeve;
                 let on = if pressure > 0.0 { 1.0 } else { 0.0 };
@@ -99,22 +115,19 @@ impl McKibben {
                     ..Default::default()
                 }
             }
-            Some(b) => {
-                let p = b.partials(pressure, l)?;
-                McKibbenPartials {
-                    force: p.force,
-                    effective_pressure: p.effective_pressure,
-                    friction_force: [0.0, 0.0],
-                    volume: p.fluid_volume,
-                    threshold_pressure: p.threshold_pressure,
-                    stretch_axial: p.stretch_axial,
-                    stretch_hoop: p.stretch_hoop,
-                    stretch_radial: p.stretch_radial,
-                    stress_axial: p.stress_axial,
-                    stress_hoop: p.stress_hoop,
-                    stress_radial: p.stress_radial,
-                }
-            }
+            Some(p) => McKibbenPartials {
+                force: p.force,
+                effective_pressure: p.effective_pressure,
+                friction_force: [0.0, 0.0],
+                volume: p.fluid_volume,
+                threshold_pressure: p.threshold_pressure,
+                stretch_axial: p.stretch_axial,
+                stretch_hoop: p.stretch_hoop,
+                stretch_radial: p.stretch_radial,
+                stress_axial: p.stress_axial,
+                stress_hoop: p.stress_hoop,
+                stress_radial: p.stress_radial,
+            },
         };
         if let Some(f) = &self.friction {
             let z = out.friction_state.z;
