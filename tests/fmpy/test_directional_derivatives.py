@@ -127,7 +127,7 @@ def test_models_without_partials_declare_it():
 
     from conftest import fmu_path
 
-    for model in ["KnittedMuscle", "PulleyJoint", "MultiferroicMotor"]:
+    for model in ["PulleyJoint", "MultiferroicMotor"]:
         md = read_model_description(fmu_path(model))
         assert not md.coSimulation.providesDirectionalDerivative, model
 
@@ -169,5 +169,56 @@ def test_joint_partials_match_central_differences(parameters):
                     assert abs(e - central) <= 1e-5 * max(abs(e), abs(central)) + 1e-8, (
                         f"{parameters} u={u} q={q}: d{out}/d{name} exact {e} central {central}"
                     )
+    finally:
+        s.close()
+
+
+KNITTED_OUTPUTS = ["force", "volume", "effective_pressure", "friction_force", "max_radius", "stiffness"]
+KNITTED_CASES = {
+    "ideal": (dict(shape_model=0), [1.4e4, 5e4]),
+    "tubular, friction": (dict(shape_model=1, friction=True), [1.4e4, 5e4]),
+    "non-cylindrical table, friction": (dict(shape_model=2, friction=True), [1.4e4, 5e4]),
+    "Fig. 1.16 tubular, thin wall (free, contact)": (dict(preset=2, shape_model=1, bladder_model=1), [2e4, 5.5e5]),
+    "Fig. 1.16 ideal, thick wall, friction": (
+        dict(preset=2, shape_model=0, bladder_model=2, bladder_layers=6, friction=True), [1.5e5, 5.5e5],
+    ),
+    "Fig. 1.16 tubular, continuum wall": (
+        dict(preset=2, shape_model=1, bladder_model=3, bladder_layers=6), [2e4, 5.5e5],
+    ),
+}
+
+
+@pytest.mark.parametrize("case", KNITTED_CASES)
+def test_knitted_partials_match_central_differences(case):
+    """KnittedMuscle: every output (stiffness without a bladder) against central differences."""
+    parameters, pressures = KNITTED_CASES[case]
+    s = Slave("KnittedMuscle", **parameters)
+    assert s.md.coSimulation.providesDirectionalDerivative
+    assert s.md.modelExchange.providesDirectionalDerivative
+    bladder = parameters.get("bladder_model", 0) != 0
+    outputs = KNITTED_OUTPUTS[:-1] if bladder else KNITTED_OUTPUTS
+    lo, hi = s.get("min_length", "max_length")
+    try:
+        for frac in [0.4, 0.8]:
+            length = lo + frac * (hi - lo)
+            for pressure in pressures:
+                s.step(pressure=pressure, length=length - 3e-5)
+                base = dict(pressure=pressure, length=length)
+                for j, name in enumerate(INPUTS):
+                    h = 1e-6 * abs(base[name]) + (1e-3 if name == "pressure" else 0.0)
+                    s.set(**base)
+                    exact = directional(s, outputs, INPUTS, [1.0 if k == j else 0.0 for k in range(2)])
+                    up = s.at(*outputs, **{**base, name: base[name] + h})
+                    down = s.at(*outputs, **{**base, name: base[name] - h})
+                    for out, e, a, b in zip(outputs, exact, up, down):
+                        central = (a - b) / (2 * h)
+                        assert abs(e - central) <= 1e-5 * max(abs(e), abs(central)) + 1e-12, (
+                            f"{case} P={pressure} L={length}: d{out}/d{name} exact {e} central {central}"
+                        )
+        if bladder:
+            s.set(pressure=pressures[-1], length=lo + 0.5 * (hi - lo))
+            vr = [s.vars[n].valueReference for n in ("stiffness", "pressure")]
+            with pytest.raises(Exception):
+                s.fmu.getDirectionalDerivative([vr[0]], [vr[1]], [1.0])
     finally:
         s.close()

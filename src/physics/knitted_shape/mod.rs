@@ -22,6 +22,7 @@
 
 mod baseline;
 mod geometry;
+mod partials;
 mod solver;
 mod table;
 #[cfg(test)]
