@@ -745,18 +745,13 @@ mod tests {
                 };
                 let mut m = KnittedMuscle::new(p, &start).unwrap();
                 for &pressure in pressures {
-                    let x = Inputs {
-                        pressure,
-                        length,
-                        ..Default::default()
-                    };
+                    let x = Inputs { pressure, length };
                     let exact = m.partials(&x).unwrap();
                     let mut at = |dp: f64, dl: f64| {
                         let mut out = Outputs::default();
                         let y = Inputs {
                             pressure: pressure + dp,
                             length: length + dl,
-                            ..Default::default()
                         };
                         m.evaluate(&y, &mut out, &mut Report::default());
                         values(&out)
@@ -816,7 +811,6 @@ mod tests {
         let beyond = Inputs {
             pressure: 1e5,
             length: c.max_length + 0.01,
-            ..Default::default()
         };
         let d = m.partials(&beyond).unwrap();
         for name in OUTPUTS {

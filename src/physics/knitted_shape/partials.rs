@@ -25,7 +25,7 @@ impl ShapeTable {
     /// `d(max_radius)/dL` of the linear interpolant of [`ShapeTable::max_radius`], on the interval
     /// it evaluates at `length` (at a node, the interval towards shorter lengths).
     pub fn max_radius_slope(&self, length: f64) -> f64 {
-        if self.max_radius.len() < 2 || !(self.spacing > 0.0) {
+        if self.max_radius.len() < 2 || self.spacing <= 0.0 || self.spacing.is_nan() {
             return 0.0;
         }
         let (i, _) = self.locate(length);
