@@ -57,6 +57,10 @@ pub struct KnittedMuscle {
     collapsed: bool,
     /// The length range reported as `min_length`, `max_length` (m).
     length_range: (f64, f64),
+    /// The last partials and the point (pressure, length, friction z and position, as bits) they
+    /// were taken at: a Jacobian's further seeds reuse them. Not part of the FMU state.
+    #[serde(skip)]
+    partials_cache: Option<([u64; 4], Partials)>,
 }
 
 /// Outputs at one input point, with the friction history after moving there.
@@ -521,6 +525,7 @@ impl Model for KnittedMuscle {
             out_of_range: false,
             collapsed: false,
             length_range,
+            partials_cache: None,
         })
     }
 
@@ -554,7 +559,16 @@ impl Model for KnittedMuscle {
         }
     }
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
-        self.partials_at(inputs)
+        let h = &self.history;
+        let key = [inputs.pressure, inputs.length, h.z, h.position].map(f64::to_bits);
+        if let Some((cached, rows)) = &self.partials_cache {
+            if *cached == key {
+                return Ok(rows.clone());
+            }
+        }
+        let rows = self.partials_at(inputs)?;
+        self.partials_cache = Some((key, rows.clone()));
+        Ok(rows)
     }
 }
 
