@@ -1,8 +1,8 @@
 //! Native cost of `fmi2GetDirectionalDerivative` against a co-simulation step, through the packaged
-//! McKibbenMuscle's and KnittedMuscle's C ABI, for each bladder and shape model: set(P, L) + doStep
-//! + get(F), set(P, L) + one directional derivative dF/dP, and set(P, L) + the two directional
-//! derivatives dF/dP and dF/dL (one seed each, a full 1x2 Jacobian row: the second call reuses
-//! the first's partials).
+//! McKibbenMuscle's and KnittedMuscle's C ABI, for each bladder and shape model: a step (set(P, L),
+//! doStep, get(F)), set(P, L) and one directional derivative dF/dP, and set(P, L) and the two
+//! directional derivatives dF/dP and dF/dL (one seed each, a full 1x2 Jacobian row: the second
+//! call reuses the first's partials).
 
 #[path = "../tests/common/mod.rs"]
 mod common;
