@@ -262,3 +262,11 @@ memcheck: fmus $(VENV)/.installed
 	echo "fmpy: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/fmpy.log)"; \
 	echo "make memcheck: $$(( $$(date +%s) - start )) s; logs in $(MEMCHECK_DIR)/"; \
 	test $$native = 0 -a $$fmpy = 0
+
+.PHONY: compliance
+## The FMU Compliance Checker (modelica-tools/FMUComplianceChecker) on every FMU, XML and both
+## interfaces, driven by crosscheck/<Model>/ inputs: `make compliance FMUCHECKER=path/to/fmuCheck.linux64`.
+## Not on crates.io, PyPI or Debian: build it once from its repository (README, "FMU Compliance Checker").
+compliance: fmus
+	@test -n "$(FMUCHECKER)" || { echo "set FMUCHECKER=path/to/fmuCheck.linux64 (README: FMU Compliance Checker)"; exit 2; }
+	FMUCHECKER="$(FMUCHECKER)" tools/compliance.sh

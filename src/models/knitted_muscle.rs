@@ -8,7 +8,7 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{
     Bladder, BladderState, BladderTube, KnittedCylinder, SleeveGeometry,
 };
@@ -57,6 +57,10 @@ pub struct KnittedMuscle {
     collapsed: bool,
     /// The length range reported as `min_length`, `max_length` (m).
     length_range: (f64, f64),
+    /// The last partials and the point (pressure, length, friction z and position, as bits) they
+    /// were taken at: a Jacobian's further seeds reuse them. Not part of the FMU state.
+    #[serde(skip)]
+    partials_cache: Option<([u64; 4], Partials)>,
 }
 
 /// Outputs at one input point, with the friction history after moving there.
@@ -301,6 +305,167 @@ impl KnittedMuscle {
     }
 }
 
+/// `[d/dP, d/dL]` of the outputs at one point.
+#[derive(Default)]
+struct Rows {
+    force: [f64; 2],
+    volume: [f64; 2],
+    effective_pressure: [f64; 2],
+    friction_force: [f64; 2],
+    max_radius: [f64; 2],
+    /// `None` with a bladder: its stiffness is itself a derivative, and the bladder carries first
+    /// derivatives only.
+    stiffness: Option<[f64; 2]>,
+}
+
+impl KnittedMuscle {
+    /// Exact partials on the branch [`Self::compute`] takes (see the module's README section for
+    /// the one-sided choices): eq. 1.6-1.14 or the table's interpolant differentiated, the
+    /// bladder's [`Bladder::evaluate_with_partials`], eq. 1.21 with the stop operator's slope.
+    fn partials_at(&self, inputs: &Inputs) -> Result<Partials, String> {
+        let (pressure, length) = (inputs.pressure, inputs.length);
+        if !(pressure.is_finite() && length.is_finite()) {
+            return Err(format!(
+                "partials need finite inputs, got pressure {pressure} Pa and length {length} m"
+            ));
+        }
+        if self.bag.is_some() {
+            return Err(
+                "partial derivatives are not provided with the bag (bag_diameter > 0)".into(),
+            );
+        }
+        let (lo, hi) = self.valid;
+        let l = length.max(lo).min(hi);
+        // A clamped length no longer moves with the input.
+        let length_moves = if l == length { 1.0 } else { 0.0 };
+        let direction = if l >= self.history.position {
+            1.0
+        } else {
+            -1.0
+        };
+        let mut r = match &self.bladder {
+            Some(b) => self.bladder_rows(b, pressure, l, direction)?,
+            None => self.sleeve_rows(pressure, l, direction),
+        };
+        let mut table = Partials::default();
+        let mut add = |name: &'static str, row: &mut [f64; 2]| {
+            row[1] *= length_moves;
+            table.row(name, &[("pressure", row[0]), ("length", row[1])]);
+        };
+        add("force", &mut r.force);
+        add("volume", &mut r.volume);
+        add("effective_pressure", &mut r.effective_pressure);
+        add("friction_force", &mut r.friction_force);
+        add("max_radius", &mut r.max_radius);
+        if let Some(mut stiffness) = r.stiffness {
+            add("stiffness", &mut stiffness);
+        }
+        Ok(table)
+    }
+
+    /// The sleeve alone: `F_0 = -P_eff V'`, stiffness `-P_eff V''` (eq. 1.8, 1.14 or the table),
+    /// `P_eff = max(P, 0)` (slope 0 at `P = 0`), and eq. 1.21 with `k = sqrt(2) C_f z(L)`:
+    /// `F = (F_0 + k P_eff A) / (1 - k)`, `A = V / L`.
+    fn sleeve_rows(&self, pressure: f64, l: f64, direction: f64) -> Rows {
+        let s = &self.sleeve;
+        let p_eff = pressure.max(0.0);
+        let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+        let (v, v1, v2) = s.volume_derivatives(l);
+        let v3 = s.volume_third_derivative(l);
+        let mut r = Rows {
+            force: [-on * v1, -p_eff * v2],
+            volume: [0.0, v1],
+            effective_pressure: [on, 0.0],
+            friction_force: [0.0, 0.0],
+            max_radius: [0.0, s.max_radius_slope(l)],
+            stiffness: Some([-on * v2, -p_eff * v3]),
+        };
+        let Some(f) = &self.friction else {
+            return r;
+        };
+        let next = f.operator.advance(&self.history, l);
+        let k = std::f64::consts::SQRT_2 * f.strand.coefficient * next.z.clamp(-1.0, 1.0);
+        let dk_dl =
+            std::f64::consts::SQRT_2 * f.strand.coefficient * f.operator.slope(&next, direction);
+        // A = V / L and its slopes (eq. 1.21's pressure area).
+        let area = (v / l).max(0.0);
+        let area_1 = (v1 * l - v) / (l * l);
+        let area_2 = v2 / l - 2.0 * (v1 * l - v) / (l * l * l);
+        let (f0, f0_l) = (-p_eff * v1, -p_eff * v2);
+        let (offset, offset_l) = (p_eff * area, p_eff * area_1);
+        let force = (f0 + k * offset) / (1.0 - k);
+        if force + offset < 0.0 {
+            // Slack strands carry no friction (StrandFriction::apply).
+            return r;
+        }
+        let stiffness = (f0_l + k * offset_l) / (1.0 - k);
+        let force_p = (-on * v1 + k * on * area) / (1.0 - k);
+        let force_l = stiffness + dk_dl * (offset + force) / (1.0 - k);
+        let stiffness_p = (-on * v2 + k * on * area_1) / (1.0 - k);
+        let stiffness_l = (-p_eff * v3 + k * p_eff * area_2) / (1.0 - k)
+            + dk_dl * (offset_l + stiffness) / (1.0 - k);
+        r.friction_force = [force_p - r.force[0], force_l - r.force[1]];
+        r.force = [force_p, force_l];
+        r.stiffness = Some([stiffness_p, stiffness_l]);
+        r
+    }
+
+    /// With the bladder (section 1.3.6): its partials, from the same pass as its state; a vacuum
+    /// the free bladder cannot hold is evaluated at zero pressure (pressure column zero). Eq. 1.21
+    /// adds `k T / (1 - k)` with `T = P_eff g` the strand tension.
+    fn bladder_rows(
+        &self,
+        b: &Bladder<KnittedCylinder>,
+        pressure: f64,
+        l: f64,
+        direction: f64,
+    ) -> Result<Rows, String> {
+        let ((state, d), on) = match b.evaluate_with_partials(pressure, l) {
+            Ok(x) => (x, 1.0),
+            Err(_) => (b.evaluate_with_partials(0.0, l)?, 0.0),
+        };
+        let mut r = Rows {
+            force: d.force,
+            volume: d.fluid_volume,
+            effective_pressure: d.effective_pressure,
+            friction_force: [0.0, 0.0],
+            max_radius: [0.0, 0.5 * b.sleeve().diameter_and_slope(l).1],
+            stiffness: None,
+        };
+        if let Some(f) = &self.friction {
+            let next = f.operator.advance(&self.history, l);
+            let k = std::f64::consts::SQRT_2 * f.strand.coefficient * next.z.clamp(-1.0, 1.0);
+            let dk_dl = std::f64::consts::SQRT_2
+                * f.strand.coefficient
+                * f.operator.slope(&next, direction);
+            let tension = state.strand_force;
+            if tension >= 0.0 {
+                let (g, _) = b.sleeve().strand_area(l);
+                let tension_p = d.effective_pressure[0] * g;
+                let tension_l = state.strand_stiffness;
+                let gain = k / (1.0 - k);
+                r.friction_force = [
+                    gain * tension_p,
+                    gain * tension_l + dk_dl * tension / ((1.0 - k) * (1.0 - k)),
+                ];
+                r.force = [
+                    r.force[0] + r.friction_force[0],
+                    r.force[1] + r.friction_force[1],
+                ];
+            }
+        }
+        for row in [
+            &mut r.force,
+            &mut r.volume,
+            &mut r.effective_pressure,
+            &mut r.friction_force,
+        ] {
+            row[0] *= on;
+        }
+        Ok(r)
+    }
+}
+
 impl Model for KnittedMuscle {
     type Variables = Variables;
     const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
@@ -360,6 +525,7 @@ impl Model for KnittedMuscle {
             out_of_range: false,
             collapsed: false,
             length_range,
+            partials_cache: None,
         })
     }
 
@@ -391,6 +557,18 @@ impl Model for KnittedMuscle {
             Self::write(outputs, &out);
             self.history = out.history;
         }
+    }
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let h = &self.history;
+        let key = [inputs.pressure, inputs.length, h.z, h.position].map(f64::to_bits);
+        if let Some((cached, rows)) = &self.partials_cache {
+            if *cached == key {
+                return Ok(rows.clone());
+            }
+        }
+        let rows = self.partials_at(inputs)?;
+        self.partials_cache = Some((key, rows.clone()));
+        Ok(rows)
     }
 }
 
@@ -521,5 +699,137 @@ mod tests {
         p.shape_segments = -3;
         p.strand_thickness = 2e-4;
         assert!(KnittedMuscle::new(&p, &Inputs::default()).is_err());
+    }
+
+    const OUTPUTS: [&str; 6] = [
+        "force",
+        "volume",
+        "effective_pressure",
+        "friction_force",
+        "max_radius",
+        "stiffness",
+    ];
+
+    fn values(o: &Outputs) -> [f64; 6] {
+        [
+            o.force,
+            o.volume,
+            o.effective_pressure,
+            o.friction_force,
+            o.max_radius,
+            o.stiffness,
+        ]
+    }
+
+    /// Every partial against central differences of the model's own outputs, at points across
+    /// every shape model, friction, and the bladder's walls (free and in contact). A point where
+    /// the one-sided differences disagree straddles a kink (contact threshold, a table node) and
+    /// is skipped; few may be.
+    #[test]
+    fn partials_match_central_differences_across_shapes_and_effects() {
+        let mut configs = Vec::new();
+        for shape in [0, 1, 2] {
+            for friction in [false, true] {
+                configs.push((parameters_with(shape, friction), vec![1.4e4, 5e4, -2e4]));
+            }
+        }
+        for shape in [0, 1] {
+            for bladder_model in [1, 2, 3] {
+                for friction in [false, true] {
+                    let mut p = parameters_with(shape, friction);
+                    p.preset = 2;
+                    p.bladder_model = bladder_model;
+                    p.bladder_layers = 6;
+                    configs.push((p, vec![2e4, 1.5e5, 5.5e5]));
+                }
+            }
+        }
+        let (mut checked, mut skipped, mut worst) = (0, 0, 0.0f64);
+        for (p, pressures) in &configs {
+            let calculated = KnittedMuscle::new(p, &Inputs::default())
+                .unwrap()
+                .calculated_parameters();
+            let (lo, hi) = (calculated.min_length, calculated.max_length);
+            for frac in [0.3, 0.6, 0.85] {
+                let length = lo + frac * (hi - lo);
+                // History 30 um behind: friction mid-presliding (0.1 mm), off the reversal.
+                let start = Inputs {
+                    length: length - 3e-5,
+                    ..Default::default()
+                };
+                let mut m = KnittedMuscle::new(p, &start).unwrap();
+                for &pressure in pressures {
+                    let x = Inputs { pressure, length };
+                    let exact = m.partials(&x).unwrap();
+                    let mut at = |dp: f64, dl: f64| {
+                        let mut out = Outputs::default();
+                        let y = Inputs {
+                            pressure: pressure + dp,
+                            length: length + dl,
+                        };
+                        m.evaluate(&y, &mut out, &mut Report::default());
+                        values(&out)
+                    };
+                    let base = at(0.0, 0.0);
+                    let h = [1e-6 * pressure.abs() + 1e-3, 1e-7 * length];
+                    let steps = [[h[0], 0.0], [0.0, h[1]]];
+                    for (j, input) in ["pressure", "length"].into_iter().enumerate() {
+                        let (up, down) =
+                            (at(steps[j][0], steps[j][1]), at(-steps[j][0], -steps[j][1]));
+                        for (k, name) in OUTPUTS.into_iter().enumerate() {
+                            let Some(row) = exact.get(name) else {
+                                assert!(p.bladder_model != 0 && name == "stiffness", "{name}");
+                                continue;
+                            };
+                            let e = row.iter().find(|(n, _)| *n == input).unwrap().1;
+                            let central = (up[k] - down[k]) / (2.0 * h[j]);
+                            let (right, left) =
+                                ((up[k] - base[k]) / h[j], (base[k] - down[k]) / h[j]);
+                            let scale = e.abs().max(central.abs()).max(1e-300);
+                            if (right - left).abs() > 1e-3 * scale + 1e-9 {
+                                skipped += 1;
+                                continue;
+                            }
+                            let err = (e - central).abs() / scale;
+                            assert!(
+                                err < 1e-5 || (e - central).abs() < 1e-10 * (1.0 + base[k].abs()),
+                                "shape {} bladder {} friction {} P {pressure} L {length}: \
+                                 d{name}/d{input} exact {e} central {central}",
+                                p.shape_model,
+                                p.bladder_model,
+                                p.friction
+                            );
+                            checked += 1;
+                            if (e - central).abs() > 1e-10 * (1.0 + base[k].abs()) {
+                                worst = worst.max(err);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        eprintln!("{checked} partials checked, {skipped} at kinks skipped, worst {worst:e}");
+        assert!(
+            checked > 800 && skipped * 20 < checked,
+            "{checked} {skipped}"
+        );
+    }
+
+    #[test]
+    fn partials_are_refused_with_the_bag_and_zero_out_of_range() {
+        let mut p = parameters_with(0, false);
+        p.bag_diameter = 0.02;
+        let mut m = KnittedMuscle::new(&p, &Inputs::default()).unwrap();
+        assert!(m.partials(&Inputs::default()).is_err());
+        let (mut m, _, _, c) = built(&parameters_with(1, false));
+        let beyond = Inputs {
+            pressure: 1e5,
+            length: c.max_length + 0.01,
+        };
+        let d = m.partials(&beyond).unwrap();
+        for name in OUTPUTS {
+            assert_eq!(d.get(name).unwrap()[1], ("length", 0.0), "{name}");
+        }
+        assert!(d.get("force").unwrap()[0].1 != 0.0);
     }
 }

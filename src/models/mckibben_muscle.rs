@@ -46,6 +46,25 @@ pub struct McKibbenMuscle {
     notice: Option<String>,
     /// `pressure_solver` on: the muscle to invert and `max_pressure`.
     solver: Option<(McKibben, f64)>,
+    /// The last partials and the point (inputs and friction history) they were taken at: the
+    /// further seeds of a Jacobian at the same point reuse them. Not part of the FMU state.
+    #[serde(skip)]
+    partials_cache: Option<(PartialsKey, Partials)>,
+}
+
+/// Bit patterns of what the partials depend on: pressure, length, target_force, friction z and
+/// position.
+type PartialsKey = [u64; 5];
+
+fn partials_key(inputs: &Inputs, history: &HysteresisState) -> PartialsKey {
+    [
+        inputs.pressure,
+        inputs.length,
+        inputs.target_force,
+        history.z,
+        history.position,
+    ]
+    .map(f64::to_bits)
 }
 
 /// The muscle the parameters (or the preset) describe, with the parameters the user set that
@@ -262,6 +281,45 @@ impl McKibbenMuscle {
         }
     }
 
+    /// `[d/dlength, d/dtarget_force]` of `target_pressure`: by the implicit function theorem on
+    /// `F(P*, L) = target_force`, `dP*/dF = 1/F_P` and `dP*/dL = -F_L/F_P`, at the point and
+    /// length the solver used. Saturated (`P*` at 0 or `max_pressure`), or without the solver,
+    /// `target_pressure` does not move: zero. At a clamped length the length column is zero.
+    fn target_pressure_partials(&self, inputs: &Inputs) -> [f64; 2] {
+        let Some((muscle, max_pressure)) = &self.solver else {
+            return [0.0; 2];
+        };
+        let (length, force) = (inputs.length, inputs.target_force);
+        let solve = |l: f64| pressure_for_force(muscle, l, force, *max_pressure, &self.friction);
+        let (solved, l, inside) = match solve(length) {
+            Ok(s) => (s, length, true),
+            Err(_) => {
+                let (lo, hi) = (muscle.min_length(), muscle.max_length());
+                let margin = if muscle.bladder().is_some() {
+                    LIMIT_MARGIN * (hi - lo)
+                } else {
+                    0.0
+                };
+                let clamped = length.max(lo + margin).min(hi - margin);
+                match solve(clamped) {
+                    Ok(s) => (s, clamped, false),
+                    Err(_) => return [0.0; 2],
+                }
+            }
+        };
+        if solved.saturated {
+            return [0.0; 2];
+        }
+        match muscle.partials(solved.argument, l, &self.friction) {
+            Ok((_, d)) if d.force[0] != 0.0 => {
+                let per_force = 1.0 / d.force[0];
+                let per_length = if inside { -d.force[1] * per_force } else { 0.0 };
+                [per_length, per_force]
+            }
+            _ => [0.0; 2],
+        }
+    }
+
     /// The full model at the current inputs; out of range, the nearest point inside it (logged).
     fn compute(
         muscle: &McKibben,
@@ -314,12 +372,7 @@ impl McKibbenMuscle {
 /// The partials as the FMU's rows, by variable name.
 fn partial_rows(d: &McKibbenPartials) -> Partials {
     let mut p = Partials::default();
-    for (name, [dp, dl]) in [
-        ("force", d.force),
-        ("volume", d.volume),
-        ("effective_pressure", d.effective_pressure),
-        ("friction_force", d.friction_force),
-    ] {
+    for (name, [dp, dl]) in d.named() {
         p.row(name, &[("pressure", dp), ("length", dl)]);
     }
     p
@@ -343,6 +396,8 @@ impl McKibbenMuscle {
                     effective_pressure: [on, 0.0],
                     friction_force: [0.0, 0.0],
                     volume: [0.0, -dl * per_pa],
+                    // The bare sleeve's stretches and stresses are constants (no bladder).
+                    ..Default::default()
                 })
             }
             Pipeline::Full(m) => {
@@ -357,12 +412,7 @@ impl McKibbenMuscle {
                 };
                 let clamped = length.max(lo + margin).min(hi - margin);
                 let zero_l = |mut d: McKibbenPartials, zero_p: bool| {
-                    for y in [
-                        &mut d.force,
-                        &mut d.volume,
-                        &mut d.effective_pressure,
-                        &mut d.friction_force,
-                    ] {
+                    for y in d.rows_mut() {
                         y[1] = 0.0;
                         if zero_p {
                             y[0] = 0.0;
@@ -442,6 +492,7 @@ impl Model for McKibbenMuscle {
             effective: params,
             notice,
             solver,
+            partials_cache: None,
         })
     }
 
@@ -486,10 +537,78 @@ impl Model for McKibbenMuscle {
     }
 
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let key = partials_key(inputs, &self.friction);
+        if let Some((cached, rows)) = &self.partials_cache {
+            if *cached == key {
+                return Ok(rows.clone());
+            }
+        }
+        let rows = self.fresh_partials(inputs)?;
+        self.partials_cache = Some((key, rows.clone()));
+        Ok(rows)
+    }
+}
+
+impl McKibbenMuscle {
+    fn fresh_partials(&self, inputs: &Inputs) -> Result<Partials, String> {
         let mut rows = self.partials_at(inputs).map(|d| partial_rows(&d))?;
         // contraction = 1 - length / nominal_length.
         let per_length = -1.0 / self.effective.nominal_length;
         rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
+        let target = self.target_pressure_partials(inputs);
+        rows.row(
+            "target_pressure",
+            &[
+                ("pressure", 0.0),
+                ("length", target[0]),
+                ("target_force", target[1]),
+            ],
+        );
         Ok(rows)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The cached partials are those of the current point: a further seed at the same inputs and
+    /// history reuses them, new inputs or a committed friction history recompute them.
+    #[test]
+    fn cached_partials_follow_the_inputs_and_the_history() {
+        let p = Parameters {
+            preset: 2,
+            friction: true,
+            ..Default::default()
+        };
+        let at = |length: f64| Inputs {
+            pressure: 3e5,
+            length,
+            ..Default::default()
+        };
+        let start = at(0.7
+            * McKibbenMuscle::new(&p, &at(0.0))
+                .unwrap()
+                .calculated_parameters()
+                .max_length);
+        let (a, b) = (at(start.length + 3e-5), at(start.length + 1e-4));
+        let mut m = McKibbenMuscle::new(&p, &start).unwrap();
+        let first = m.partials(&a).unwrap();
+        assert_eq!(m.partials(&a).unwrap(), first);
+        let other = m.partials(&b).unwrap();
+        assert_ne!(other, first);
+        assert_eq!(other, m.fresh_partials(&b).unwrap());
+        assert_eq!(m.partials(&a).unwrap(), first);
+        // A step to `b` moves the friction history: the partials at `a` change with it.
+        m.step(
+            &b,
+            &mut Outputs::default(),
+            0.0,
+            1e-3,
+            &mut Report::default(),
+        );
+        let after = m.partials(&a).unwrap();
+        assert_eq!(after, m.fresh_partials(&a).unwrap());
+        assert_ne!(after.get("friction_force"), first.get("friction_force"));
     }
 }

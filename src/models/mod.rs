@@ -90,13 +90,18 @@ impl From<&str> for Refusal {
 /// a row is not provided; an input missing from a row does not affect that output.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Partials {
-    rows: Vec<(&'static str, Vec<(&'static str, f64)>)>,
+    /// Each output with the range of its row in `entries`: two allocations for the whole
+    /// Jacobian, so that building (and caching) it costs little beside the physics.
+    rows: Vec<(&'static str, std::ops::Range<usize>)>,
+    entries: Vec<(&'static str, f64)>,
 }
 
 impl Partials {
     /// Adds the row of `output`: its partial with respect to each listed input.
     pub fn row(&mut self, output: &'static str, by_input: &[(&'static str, f64)]) -> &mut Self {
-        self.rows.push((output, by_input.to_vec()));
+        let start = self.entries.len();
+        self.entries.extend_from_slice(by_input);
+        self.rows.push((output, start..self.entries.len()));
         self
     }
 
@@ -105,7 +110,7 @@ impl Partials {
         self.rows
             .iter()
             .find(|(name, _)| *name == output)
-            .map(|(_, row)| row.as_slice())
+            .map(|(_, range)| &self.entries[range.clone()])
     }
 
     /// The outputs that have a row.

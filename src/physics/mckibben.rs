@@ -5,7 +5,7 @@
 //! Effects that are off are `None` and cost nothing: with no bladder, no friction and a rigid
 //! connector, [`McKibben::evaluate`] is eq. 2.3 and nothing else.
 
-use crate::physics::bladder::{Bladder, BladderTube, Wall, MOONEY_C1, MOONEY_C2};
+use crate::physics::bladder::{Bladder, BladderState, BladderTube, Wall, MOONEY_C1, MOONEY_C2};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
 use crate::physics::root::{newton_bisection, RootOptions, Sample};
@@ -201,8 +201,8 @@ pub struct McKibbenOutput {
 }
 
 /// Muscle outputs at an actual length, before the connector.
-struct Core {
-    out: McKibbenOutput,
+pub(super) struct Core {
+    pub(super) out: McKibbenOutput,
     /// `dF/dL_actual` including the presliding slope in the direction of motion (Newton slope).
     newton_slope: f64,
 }
@@ -350,6 +350,18 @@ impl McKibben {
         l: f64,
         history: &HysteresisState,
     ) -> Result<Core, String> {
+        self.assemble(pressure, l, history, None)
+    }
+
+    /// [`Self::at_actual_length`], with the bladder's state given when already evaluated.
+    #[inline]
+    pub(super) fn assemble(
+        &self,
+        pressure: f64,
+        l: f64,
+        history: &HysteresisState,
+        bladder_state: Option<BladderState>,
+    ) -> Result<Core, String> {
         let (mut out, peff_slope) = match &self.bladder {
             None => {
                 if !(0.0..=self.sleeve.strand_length).contains(&l) {
@@ -381,7 +393,10 @@ impl McKibben {
                 (out, 0.0)
             }
             Some(b) => {
-                let s = b.evaluate(pressure, l)?;
+                let s = match bladder_state {
+                    Some(s) => s,
+                    None => b.evaluate(pressure, l)?,
+                };
                 let out = McKibbenOutput {
                     force: s.force,
                     volume: s.fluid_volume,

@@ -12,6 +12,7 @@ pub mod gaylord;
 pub mod inverse;
 pub mod knitted;
 pub mod knitted_bag;
+pub mod knitted_partials;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;

@@ -1,12 +1,16 @@
 """fmi2GetDirectionalDerivative through FMPy against central differences of the FMU's own outputs,
 at points across every effect of McKibbenMuscle (ideal sleeve; thin and thick wall in contact and
-free; pre-strain; friction mid-presliding; connector spring) and for PassThrough."""
+free; continuum wall; pre-strain; friction mid-presliding; connector spring; the pressure solver) and for
+PassThrough."""
 
 import pytest
 
 from conftest import Slave
 
-OUTPUTS = ["force", "volume", "effective_pressure", "friction_force"]
+OUTPUTS = [
+    "force", "volume", "effective_pressure", "friction_force", "threshold_pressure", "stretch_axial",
+    "stretch_hoop", "stretch_radial", "stress_axial", "stress_hoop", "stress_radial", "contraction",
+]
 INPUTS = ["pressure", "length"]
 
 # (parameters, points (pressure Pa, length as a fraction of the min..max range)).
@@ -14,6 +18,9 @@ CASES = {
     "ideal A": (dict(preset=1), [(3e5, 0.8), (-2e4, 0.7)]),
     "thin wall A (free, contact)": (dict(preset=1, bladder_model=1), [(5e4, 0.95), (4e5, 0.4)]),
     "thick wall A, 8 layers": (dict(preset=1, bladder_model=2, bladder_layers=8), [(4e5, 0.5), (1e5, 0.9)]),
+    "continuum wall A, 6 nodes (free, contact)": (
+        dict(preset=1, bladder_model=3, bladder_layers=6), [(5e4, 0.95), (4e5, 0.5)],
+    ),
     "pre-strained C, thin wall": (dict(preset=3, bladder_model=1), [(2e5, 0.6), (6e5, 0.8)]),
     "B, thick wall, friction": (
         dict(preset=2, bladder_model=2, bladder_layers=4, friction=True),
@@ -64,6 +71,41 @@ def test_muscle_partials_match_central_differences(case):
         s.close()
 
 
+@pytest.mark.parametrize(
+    "parameters",
+    [dict(preset=2, bladder_model=1), dict(preset=4, bladder_model=2, bladder_layers=4, connector_stiffness=5e4)],
+    ids=["B thin wall", "D thick wall + connector"],
+)
+def test_target_pressure_partials_match_central_differences(parameters):
+    """target_pressure solves F(P, L) = target_force: dP/dF = 1/F_P, dP/dL = -F_L/F_P."""
+    s = Slave("McKibbenMuscle", pressure_solver=True, max_pressure=8e5, **parameters)
+    lo, hi = s.get("min_length", "max_length")
+    knowns = ["pressure", "length", "target_force"]
+    try:
+        for frac in [0.3, 0.5]:
+            length = lo + frac * (hi - lo)
+            # A force the muscle reaches at 4 bar: the solver must find that pressure.
+            force = s.at("force", pressure=4e5, length=length)
+            base = dict(pressure=2e5, length=length, target_force=force)
+            s.set(**base)
+            assert not s.get("target_force_saturated")
+            assert s.get("target_pressure") == pytest.approx(4e5, rel=1e-9)
+            for j, name in enumerate(knowns):
+                h = 1e-6 * abs(base[name]) + (1e-3 if name == "pressure" else 0.0)
+                s.set(**base)
+                exact = directional(s, ["target_pressure"], knowns, [1.0 if k == j else 0.0 for k in range(3)])[0]
+                up = s.at("target_pressure", **{**base, name: base[name] + h})
+                down = s.at("target_pressure", **{**base, name: base[name] - h})
+                central = (up - down) / (2 * h)
+                # Absolute slack: the solver meets the force to its tolerance (1e-12 relative).
+                assert abs(exact - central) <= 1e-5 * max(abs(exact), abs(central)) + 1e-4, (
+                    f"{parameters} F={force}: dtarget_pressure/d{name} exact {exact} central {central}"
+                )
+                assert (exact != 0.0) == (name != "pressure")
+    finally:
+        s.close()
+
+
 def test_seed_combines_linearly_and_pass_through_is_identity():
     s = Slave("McKibbenMuscle", preset=1, bladder_model=1)
     try:
@@ -85,7 +127,7 @@ def test_models_without_partials_declare_it():
 
     from conftest import fmu_path
 
-    for model in ["KnittedMuscle", "MultiferroicMotor"]:
+    for model in ["MultiferroicMotor", "FreeBladder"]:
         md = read_model_description(fmu_path(model))
         assert not md.coSimulation.providesDirectionalDerivative, model
 
@@ -127,5 +169,56 @@ def test_joint_partials_match_central_differences(parameters):
                     assert abs(e - central) <= 1e-5 * max(abs(e), abs(central)) + 1e-8, (
                         f"{parameters} u={u} q={q}: d{out}/d{name} exact {e} central {central}"
                     )
+    finally:
+        s.close()
+
+
+KNITTED_OUTPUTS = ["force", "volume", "effective_pressure", "friction_force", "max_radius", "stiffness"]
+KNITTED_CASES = {
+    "ideal": (dict(shape_model=0), [1.4e4, 5e4]),
+    "tubular, friction": (dict(shape_model=1, friction=True), [1.4e4, 5e4]),
+    "non-cylindrical table, friction": (dict(shape_model=2, friction=True), [1.4e4, 5e4]),
+    "Fig. 1.16 tubular, thin wall (free, contact)": (dict(preset=2, shape_model=1, bladder_model=1), [2e4, 5.5e5]),
+    "Fig. 1.16 ideal, thick wall, friction": (
+        dict(preset=2, shape_model=0, bladder_model=2, bladder_layers=6, friction=True), [1.5e5, 5.5e5],
+    ),
+    "Fig. 1.16 tubular, continuum wall": (
+        dict(preset=2, shape_model=1, bladder_model=3, bladder_layers=6), [2e4, 5.5e5],
+    ),
+}
+
+
+@pytest.mark.parametrize("case", KNITTED_CASES)
+def test_knitted_partials_match_central_differences(case):
+    """KnittedMuscle: every output (stiffness without a bladder) against central differences."""
+    parameters, pressures = KNITTED_CASES[case]
+    s = Slave("KnittedMuscle", **parameters)
+    assert s.md.coSimulation.providesDirectionalDerivative
+    assert s.md.modelExchange.providesDirectionalDerivative
+    bladder = parameters.get("bladder_model", 0) != 0
+    outputs = KNITTED_OUTPUTS[:-1] if bladder else KNITTED_OUTPUTS
+    lo, hi = s.get("min_length", "max_length")
+    try:
+        for frac in [0.4, 0.8]:
+            length = lo + frac * (hi - lo)
+            for pressure in pressures:
+                s.step(pressure=pressure, length=length - 3e-5)
+                base = dict(pressure=pressure, length=length)
+                for j, name in enumerate(INPUTS):
+                    h = 1e-6 * abs(base[name]) + (1e-3 if name == "pressure" else 0.0)
+                    s.set(**base)
+                    exact = directional(s, outputs, INPUTS, [1.0 if k == j else 0.0 for k in range(2)])
+                    up = s.at(*outputs, **{**base, name: base[name] + h})
+                    down = s.at(*outputs, **{**base, name: base[name] - h})
+                    for out, e, a, b in zip(outputs, exact, up, down):
+                        central = (a - b) / (2 * h)
+                        assert abs(e - central) <= 1e-5 * max(abs(e), abs(central)) + 1e-12, (
+                            f"{case} P={pressure} L={length}: d{out}/d{name} exact {e} central {central}"
+                        )
+        if bladder:
+            s.set(pressure=pressures[-1], length=lo + 0.5 * (hi - lo))
+            vr = [s.vars[n].valueReference for n in ("stiffness", "pressure")]
+            with pytest.raises(Exception):
+                s.fmu.getDirectionalDerivative([vr[0]], [vr[1]], [1.0])
     finally:
         s.close()

@@ -152,8 +152,8 @@ impl<S: SleeveGeometry> Bladder<S> {
             elastic_dp: -phi_in.v * inv_d_in.v,
             inner: InnerLayer {
                 l2_sq: l2_in,
-                stress_axial: axial_in.v - pressure,
-                stress_hoop: hoop_in.v - pressure,
+                axial: axial_in,
+                hoop: hoop_in,
             },
         })
     }

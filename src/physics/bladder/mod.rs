@@ -438,11 +438,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             elastic = elastic + (axial - p_in) * inv_l * layer.rubber_volume;
             elastic_dp -= a.v * inv_l.v * layer.rubber_volume;
             if inner.is_none() {
-                inner = Some(InnerLayer {
-                    l2_sq,
-                    stress_axial: axial.v - pressure,
-                    stress_hoop: hoop.v - pressure,
-                });
+                inner = Some(InnerLayer { l2_sq, axial, hoop });
             }
             // Eq. 2.12 for the layer: p_out = p_in - sigma_22 k with sigma_22 = -p_in + hoop.
             let one_k = k + 1.0;
@@ -550,8 +546,8 @@ impl<S: SleeveGeometry> Bladder<S> {
             stretch_axial: lambda1,
             stretch_hoop: lambda2,
             stretch_radial: 1.0 / (lambda1 * lambda2),
-            stress_axial: k.inner.stress_axial,
-            stress_hoop: k.inner.stress_hoop,
+            stress_axial: k.inner.axial.v - pressure,
+            stress_hoop: k.inner.hoop.v - pressure,
             stress_radial: -pressure,
             stiffness: p.stiffness,
         }
@@ -673,10 +669,12 @@ struct Parts {
     stiffness: f64,
 }
 
+/// The innermost layer: squared hoop stretch, and the axial and hoop stresses without the
+/// radial one (eq. 2.9a-b; the true stresses subtract the gauge pressure).
 struct InnerLayer {
     l2_sq: Dual,
-    stress_axial: f64,
-    stress_hoop: f64,
+    axial: Dual,
+    hoop: Dual,
 }
 
 struct Kernel {

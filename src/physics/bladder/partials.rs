@@ -7,8 +7,12 @@
 //! `P_eff(P, L, x) = 0` (eq. 2.18): the implicit function theorem gives `dx/dP = -a / (dP_eff/dx)`
 //! and `dx/dL = -(dP_eff/dL) / (dP_eff/dx)`. At the contact threshold (`P_eff = 0`) the force
 //! kinks; the partials are those of the contact branch, which [`Bladder::evaluate`] selects there.
+//!
+//! The innermost layer's stretches and stresses (eq. 2.8a-c, 2.9a-b) and the threshold pressure
+//! `c/a` are functions of `(L, x)` (and `-P` for the stresses), so the same chain rule through
+//! `x(P, L)` gives them; the threshold is always taken at the contact diameter `D(L)`.
 
-use super::{Bladder, Dual, SleeveGeometry};
+use super::{check_state, Bladder, BladderState, Dual, Kernel, SleeveGeometry};
 
 /// `[d/dP, d/dL]` of the bladder's outputs, per Pa and per m.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -19,11 +23,37 @@ pub struct BladderPartials {
     pub effective_pressure: [f64; 2],
     /// Gas volume `pi/4 D_in^2 L`, m^3/Pa and m^2.
     pub fluid_volume: [f64; 2],
+    /// Threshold pressure `c/a` at the contact diameter, 1 and Pa/m (its `P`-slope is zero).
+    pub threshold_pressure: [f64; 2],
+    /// Stretches of the innermost layer (eq. 2.8a-c), 1/Pa and 1/m.
+    pub stretch_axial: [f64; 2],
+    pub stretch_hoop: [f64; 2],
+    pub stretch_radial: [f64; 2],
+    /// True stresses of the innermost layer (eq. 2.9a-b; radial `-P`), 1 and Pa/m.
+    pub stress_axial: [f64; 2],
+    pub stress_hoop: [f64; 2],
+    pub stress_radial: [f64; 2],
+}
+
+/// `[d/dP, d/dL]` of a function of `(L, x)` through `x = x(P, L)`.
+fn chain(q: Dual, dx_dp: f64, dx_dl: f64) -> [f64; 2] {
+    [q.dx * dx_dp, q.dl + q.dx * dx_dl]
 }
 
 impl<S: SleeveGeometry> Bladder<S> {
     /// The partials at `pressure` and `length`, on the branch [`Bladder::evaluate`] takes there.
     pub fn partials(&self, pressure: f64, length: f64) -> Result<BladderPartials, String> {
+        self.evaluate_with_partials(pressure, length)
+            .map(|(_, d)| d)
+    }
+
+    /// [`Bladder::evaluate`] and [`Bladder::partials`] from one pass: one kernel in contact, one
+    /// root of eq. 2.18 when free (what a directional derivative costs beyond a step).
+    pub fn evaluate_with_partials(
+        &self,
+        pressure: f64,
+        length: f64,
+    ) -> Result<(BladderState, BladderPartials), String> {
         if !pressure.is_finite() {
             return Err(format!("pressure must be finite, got {pressure} Pa"));
         }
@@ -37,16 +67,23 @@ impl<S: SleeveGeometry> Bladder<S> {
             let (g, g_slope) = self.sleeve.strand_area(length);
             let area = self.fluid_area(contact.inner.l2_sq);
             let a = contact.a.v;
-            return Ok(BladderPartials {
-                // F = P_eff g - P A_fluid + elastic (eq. 2.16, 2.17).
-                force: [
-                    a * g - area.v + contact.elastic_dp,
-                    contact.p_eff.dl * g + contact.p_eff.v * g_slope - pressure * area.dl
-                        + contact.elastic.dl,
-                ],
-                effective_pressure: [a, contact.p_eff.dl],
-                fluid_volume: [0.0, area.dl * length + area.v],
-            });
+            // Along the contact branch the seed's `dl` is already the total d/dL (x = D(L)).
+            let kinematics = self.kinematic_partials(length, &contact, &contact, 0.0, 0.0);
+            let state = check_state(self.contact_state(pressure, length, &contact), length)?;
+            return Ok((
+                state,
+                BladderPartials {
+                    // F = P_eff g - P A_fluid + elastic (eq. 2.16, 2.17).
+                    force: [
+                        a * g - area.v + contact.elastic_dp,
+                        contact.p_eff.dl * g + contact.p_eff.v * g_slope - pressure * area.dl
+                            + contact.elastic.dl,
+                    ],
+                    effective_pressure: [a, contact.p_eff.dl],
+                    fluid_volume: [0.0, area.dl * length + area.v],
+                    ..kinematics
+                },
+            ));
         }
         let x_root = self.free_outer_diameter(pressure, length, x.v)?;
         let k = self
@@ -61,16 +98,62 @@ impl<S: SleeveGeometry> Bladder<S> {
         // F = -P A_fluid(L, x) + elastic(P, L, x) with x = x(P, L).
         let force_dx = -pressure * area.dx + k.elastic.dx;
         let force_dl = -pressure * area.dl + k.elastic.dl;
-        Ok(BladderPartials {
-            force: [
-                -area.v + k.elastic_dp + force_dx * dx_dp,
-                force_dl + force_dx * dx_dl,
-            ],
-            effective_pressure: [0.0, 0.0],
-            fluid_volume: [
-                area.dx * dx_dp * length,
-                area.v + (area.dl + area.dx * dx_dl) * length,
-            ],
-        })
+        let kinematics = self.kinematic_partials(length, &contact, &k, dx_dp, dx_dl);
+        let state = check_state(
+            self.free_state(pressure, length, &k, contact.threshold),
+            length,
+        )?;
+        Ok((
+            state,
+            BladderPartials {
+                force: [
+                    -area.v + k.elastic_dp + force_dx * dx_dp,
+                    force_dl + force_dx * dx_dl,
+                ],
+                effective_pressure: [0.0, 0.0],
+                fluid_volume: [
+                    area.dx * dx_dp * length,
+                    area.v + (area.dl + area.dx * dx_dl) * length,
+                ],
+                ..kinematics
+            },
+        ))
+    }
+
+    /// Threshold (from the `contact` kernel), stretches and stresses (from `k`, at the diameter
+    /// the branch uses, whose partials are `dx_dp`, `dx_dl`); the other fields zero.
+    fn kinematic_partials(
+        &self,
+        length: f64,
+        contact: &Kernel,
+        k: &Kernel,
+        dx_dp: f64,
+        dx_dl: f64,
+    ) -> BladderPartials {
+        let (a, c) = (contact.a, contact.c);
+        let threshold = [0.0, (c.dl * a.v - c.v * a.dl) / (a.v * a.v)];
+        // lambda_1 = L / L_R0, lambda_2 = sqrt(l2_sq), lambda_3 = 1 / (lambda_1 lambda_2).
+        let lambda1 = length / self.tube.unstretched_length;
+        let lambda1_d = [0.0, 1.0 / self.tube.unstretched_length];
+        let l2_sq = chain(k.inner.l2_sq, dx_dp, dx_dl);
+        let lambda2 = k.inner.l2_sq.v.sqrt();
+        let lambda2_d = l2_sq.map(|d| d / (2.0 * lambda2));
+        let product = lambda1 * lambda2;
+        let radial = [0, 1]
+            .map(|i| -(lambda1_d[i] * lambda2 + lambda1 * lambda2_d[i]) / (product * product));
+        let stress = |q: Dual| {
+            let [dp, dl] = chain(q, dx_dp, dx_dl);
+            [dp - 1.0, dl]
+        };
+        BladderPartials {
+            threshold_pressure: threshold,
+            stretch_axial: lambda1_d,
+            stretch_hoop: lambda2_d,
+            stretch_radial: radial,
+            stress_axial: stress(k.inner.axial),
+            stress_hoop: stress(k.inner.hoop),
+            stress_radial: [-1.0, 0.0],
+            ..Default::default()
+        }
     }
 }

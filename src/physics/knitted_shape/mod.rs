@@ -25,6 +25,7 @@
 mod baseline;
 mod geometry;
 mod newton;
+mod partials;
 #[cfg(test)]
 mod reference;
 mod solver;

@@ -71,7 +71,7 @@ impl ShapeTable {
 
     /// Interval index and local coordinate for a length, clamped into the table.
     #[inline]
-    fn locate(&self, length: f64) -> (usize, f64) {
+    pub(super) fn locate(&self, length: f64) -> (usize, f64) {
         let last = self.volume.len().saturating_sub(1);
         if last == 0 || !(self.spacing > 0.0) {
             return (0, 0.0);
