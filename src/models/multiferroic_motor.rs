@@ -5,7 +5,8 @@
 //! maps the variables onto [`MotorParams`] and [`MotorInputs`] and keeps the [`MotorState`], which
 //! is serialized with the FMU state.
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report, Status};
+use crate::physics::multiferroic::model_exchange::{by, MeGradient, MePartials};
 use crate::physics::multiferroic::{
     drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, ScheduleSwitch,
     SteppingSchedule,
@@ -101,6 +102,39 @@ fn write_outputs(out: &mut Outputs, o: &MotorOutputs) {
         &mut out.applied_strain_direction,
         o.applied_strain_direction,
     );
+}
+
+/// The rows of `fmi2GetDirectionalDerivative` from the physics' partials: by each input (and, in
+/// Model Exchange, by each state). With `strain_drive` the stress comes from the `strain` input.
+fn partial_rows(
+    p: &MePartials,
+    strain_modulus: Option<f64>,
+    states: &[(&'static str, usize)],
+) -> Partials {
+    let mut rows = Partials::default();
+    let stress = |g: &MeGradient| g[by::STRESS];
+    for (name, g) in [
+        ("torque", &p.torque),
+        ("rotor_angle", &p.rotor_angle),
+        ("rotor_speed", &p.rotor_speed),
+        ("onion_angle", &p.onion_angle),
+        ("offset_angle", &p.offset_angle),
+        ("magnetostatic_energy", &p.magnetostatic_energy),
+        ("magnetoelastic_energy", &p.magnetoelastic_energy),
+        ("applied_strain_direction", &p.applied_strain_direction),
+    ] {
+        let mut row = vec![
+            ("strain_direction", g[by::STRAIN_DIRECTION]),
+            ("load_torque", g[by::LOAD_TORQUE]),
+        ];
+        match strain_modulus {
+            Some(modulus) => row.extend([("stress", 0.0), ("strain", modulus * stress(g))]),
+            None => row.extend([("stress", stress(g)), ("strain", 0.0)]),
+        }
+        row.extend(states.iter().map(|&(state, i)| (state, g[i])));
+        rows.row(name, &row);
+    }
+    rows
 }
 
 /// An Integer switch that must be 0 or 1 (the model description's bounds say so too).
@@ -202,6 +236,20 @@ impl Model for MultiferroicMotor {
             // Unreachable with inputs inside their declared bounds; the outputs keep their values.
             Err(e) => report.add(Status::Error, format!("cannot evaluate the motor: {e}")),
         }
+    }
+
+    /// Co-Simulation: the outputs by the inputs at the current history, on the branch
+    /// [`Model::evaluate`] takes (the quasi-static onion settled for the present inputs first, by
+    /// the memory rule; then the implicit function theorem on its minimum).
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let inputs = self.inputs(inputs);
+        let outputs = self.motor.outputs(&self.state, &inputs)?;
+        let settled = MotorState {
+            onion_angle: outputs.onion_angle,
+            ..self.state
+        };
+        let p = self.motor.me_partials(&settled, &inputs, settled.time)?;
+        Ok(partial_rows(&p, self.strain_drive, &[]))
     }
 
     fn step(
