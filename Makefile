@@ -133,6 +133,11 @@ bench: deps fmus
 	cargo bench --bench knitted_shape
 	cargo bench --bench directional_derivative
 
+## The motor's Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step.
+.PHONY: bench-motor
+bench-motor: deps
+	cargo bench --bench motor_model_exchange
+
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
 report: deps fmus $(VENV)/.installed
