@@ -454,3 +454,37 @@ fn partials_past_the_fold_follow_the_ghost() {
     // Well past it, so the central differences stay on the ghost.
     check_partials(&m, &s, &inputs(stress + 2e6), "ghost");
 }
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+    /// From a minimum of a nearby landscape, following the branch finds the minimum the
+    /// Co-Simulation settle finds unless the branch vanished; then the settle jumps away.
+    #[test]
+    fn follow_agrees_with_settle_or_reports_the_fold(
+        phi in -3.0f64..3.0,
+        direction in -3.2f64..3.2,
+        stress in 0.0f64..600e6,
+        start in -3.2f64..3.2,
+        dphi in -0.1f64..0.1,
+        dstress in -20e6f64..20e6,
+    ) {
+        let m = motor();
+        let anchor = m.landscape(phi, direction, stress).settle(start);
+        let moved = m.landscape(phi + dphi, direction, stress + dstress);
+        let settled = moved.settle(anchor);
+        match moved.follow(anchor) {
+            Branch::Minimum { angle, curvature } => {
+                proptest::prop_assert!((angle - settled).abs() < 1e-9, "{} {}", angle, settled);
+                proptest::prop_assert!(curvature >= 0.0);
+            }
+            Branch::Vanished { ghost, gradient } => {
+                proptest::prop_assert!(moved.curvature(ghost).abs() < 1e-6 * m.alignment_stiffness);
+                proptest::prop_assert!(gradient != 0.0);
+                // The settle crossed the ghost to another minimum.
+                proptest::prop_assert!((settled - ghost).abs() > 1e-3, "{} {}", settled, ghost);
+                let again = moved.follow(settled);
+                proptest::prop_assert!((again.angle() - settled).abs() < 1e-9, "{:?}", again);
+            }
+        }
+    }
+}
