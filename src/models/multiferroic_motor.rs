@@ -30,7 +30,11 @@ pub struct MultiferroicMotor {
     /// Whether the accuracy warning was logged: it is logged once per run, later limited steps
     /// only return `fmi2Warning` (a 1 s step over thousands of switches is limited every time).
     accuracy_warned: bool,
+    /// Model Exchange's discrete states (see [`model_exchange`]).
+    me: model_exchange::Discrete,
 }
+
+mod model_exchange;
 
 impl MultiferroicMotor {
     fn inputs(&self, inputs: &Inputs) -> MotorInputs {
@@ -154,6 +158,7 @@ impl Model for MultiferroicMotor {
         Motor::validate_state(&saved.state).map_err(|e| format!("motor state: {e}"))?;
         self.state = saved.state;
         self.accuracy_warned = saved.accuracy_warned;
+        self.me = saved.me.validated()?;
         Ok(())
     }
 
@@ -216,6 +221,7 @@ impl Model for MultiferroicMotor {
             max_torque: motor.ring_bar.max_torque().1.abs(),
             motor,
             accuracy_warned: false,
+            me: model_exchange::Discrete::default(),
         })
     }
 
@@ -231,6 +237,10 @@ impl Model for MultiferroicMotor {
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        if self.model_exchange_active() {
+            // Between events the onion stays on its branch (Model Exchange never jumps it here).
+            return self.me_outputs(inputs, outputs, report);
+        }
         match self.motor.outputs(&self.state, &self.inputs(inputs)) {
             Ok(o) => write_outputs(outputs, &o),
             // Unreachable with inputs inside their declared bounds; the outputs keep their values.
