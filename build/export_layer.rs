@@ -44,14 +44,16 @@ const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &[
     "McKibbenMuscle",
     "MultiferroicMotor",
     "PassThrough",
+    "PulleyJoint",
 ];
 
-/// The models that also serve Model Exchange, without continuous states
-/// (`Model::ALGEBRAIC_MODEL_EXCHANGE`, `src/fmi2/model_exchange.rs`); a Rust test checks that the
+/// The models that also serve Model Exchange (`Model::MODEL_EXCHANGE`: algebraic models, and
+/// models with continuous states, `src/fmi2/model_exchange.rs`); a Rust test checks that the
 /// shipped block and the models agree.
 const MODEL_EXCHANGE: &[&str] = &[
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",
     "PassThrough",
+    "PulleyJoint",
 ];
