@@ -54,6 +54,7 @@ const MODEL_EXCHANGE: &[&str] = &[
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",
+    "MultiferroicMotor",
     "PassThrough",
     "PulleyJoint",
 ];

@@ -5,14 +5,14 @@
 //! maps the variables onto [`MotorParams`] and [`MotorInputs`] and keeps the [`MotorState`], which
 //! is serialized with the FMU state.
 
-use super::{Model, Partials, Refusal, Report, Status};
+use super::{EventUpdate, Model, Partials, Refusal, Report, Status};
 use crate::physics::multiferroic::model_exchange::{by, MeGradient, MePartials};
 use crate::physics::multiferroic::{
     drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, ScheduleSwitch,
     SteppingSchedule,
 };
 use crate::variables::multiferroic_motor::{
-    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+    CalculatedParameters, Inputs, Outputs, Parameters, States, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -248,10 +248,99 @@ impl Model for MultiferroicMotor {
         }
     }
 
+    const MODEL_EXCHANGE: bool = true;
+
+    fn states(&self) -> States {
+        let x = self.me_states();
+        States {
+            rotor_angle: x[0],
+            rotor_speed: x[1],
+            onion_state_angle: x[2],
+            onion_tilt: x[3],
+        }
+    }
+
+    fn set_states(&mut self, x: &States) -> Result<(), String> {
+        self.me_set_states(&[
+            x.rotor_angle,
+            x.rotor_speed,
+            x.onion_state_angle,
+            x.onion_tilt,
+        ])
+    }
+
+    fn set_time(&mut self, time: f64) {
+        self.state.time = time;
+    }
+
+    fn derivatives(&mut self, inputs: &Inputs) -> Result<States, String> {
+        let d = self.me_derivatives(inputs)?;
+        Ok(States {
+            rotor_angle: d[0],
+            rotor_speed: d[1],
+            onion_state_angle: d[2],
+            onion_tilt: d[3],
+        })
+    }
+
+    /// The quasi-static onion's fold (see [`model_exchange`]).
+    fn event_indicators(&mut self, inputs: &Inputs, out: &mut [f64]) -> Result<(), String> {
+        let z = self.me_event_indicators(inputs)?;
+        out.iter_mut().zip(z).for_each(|(slot, z)| *slot = z);
+        Ok(())
+    }
+
+    fn next_time_event(&self, _time: f64) -> Option<f64> {
+        self.me_next_time_event()
+    }
+
+    /// Event mode: the schedule's direction in effect, the quasi-static onion settled by the
+    /// Co-Simulation rule (to the next minimum past a fold).
+    fn update_discrete_states(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        time: f64,
+        report: &mut Report,
+    ) -> EventUpdate {
+        match self.me_event(inputs, time) {
+            Ok(states_changed) => {
+                self.me_outputs(inputs, outputs, report);
+                EventUpdate {
+                    states_changed,
+                    ..EventUpdate::default()
+                }
+            }
+            Err(e) => {
+                report.add(Status::Error, format!("motor event at t = {time} s: {e}"));
+                EventUpdate::default()
+            }
+        }
+    }
+
+    /// The onion's anchor moves along its branch; nothing jumps outside event mode.
+    fn completed_integrator_step(
+        &mut self,
+        inputs: &Inputs,
+        _outputs: &mut Outputs,
+        time: f64,
+        report: &mut Report,
+    ) -> bool {
+        self.state.time = time;
+        if let Err(e) = self.me_completed_step(inputs) {
+            report.add(Status::Error, format!("motor at t = {time} s: {e}"));
+        }
+        false
+    }
+
     /// Co-Simulation: the outputs by the inputs at the current history, on the branch
     /// [`Model::evaluate`] takes (the quasi-static onion settled for the present inputs first, by
-    /// the memory rule; then the implicit function theorem on its minimum).
+    /// the memory rule; then the implicit function theorem on its minimum). Model Exchange: also
+    /// by the states, and the state derivatives, on the branch the onion follows.
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        if self.model_exchange_active() {
+            return self.me_partials(inputs);
+        }
         let inputs = self.inputs(inputs);
         let outputs = self.motor.outputs(&self.state, &inputs)?;
         let settled = MotorState {

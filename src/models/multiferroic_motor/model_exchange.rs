@@ -9,10 +9,6 @@
 //! events at the onion's angle at the last event and zero tilt, with zero derivatives. The
 //! description's state count is fixed, hence four in both options.
 
-// Until the generic Model Exchange layer with continuous states calls these through the `Model`
-// trait, only the tests and `evaluate` do.
-#![allow(dead_code)]
-
 use super::{partial_rows, write_outputs, MultiferroicMotor};
 use crate::models::{Partials, Report, Status};
 use crate::physics::multiferroic::model_exchange::{by, MeEvaluation};
@@ -78,11 +74,10 @@ impl MultiferroicMotor {
         }
     }
 
-    /// Takes the importer's state vector at `time`; refuses a non-finite one or one beyond the
+    /// Takes the importer's state vector; refuses a non-finite one or one beyond the
     /// motor's bounds, keeping the old.
-    pub(super) fn me_set_states(&mut self, x: &[f64; 4], time: f64) -> Result<(), String> {
+    pub(super) fn me_set_states(&mut self, x: &[f64; 4]) -> Result<(), String> {
         let mut next = self.state;
-        next.time = time;
         next.rotor_angle = x[0];
         next.rotor_speed = x[1];
         if self.gilbert() {
@@ -151,9 +146,10 @@ impl MultiferroicMotor {
     }
 
     /// The next switch of the schedule, if one runs.
-    pub(super) fn me_next_time_event(&self, inputs: &Inputs) -> Option<f64> {
-        self.motor
-            .me_next_time_event(&self.inputs(inputs), self.me.schedule_time)
+    pub(super) fn me_next_time_event(&self) -> Option<f64> {
+        self.schedule
+            .get()
+            .map(|s| s.next_switch_after(self.me.schedule_time))
     }
 
     /// Exact partials of the outputs and of the state derivatives by the inputs and the states,
@@ -220,14 +216,15 @@ mod tests {
         let mut next_sample = every;
         while t < until * (1.0 - 1e-12) {
             let target = model
-                .me_next_time_event(&inputs)
+                .me_next_time_event()
                 .unwrap_or(f64::INFINITY)
                 .min(next_sample);
             let dt = h.min(target - t);
             let x0 = model.me_states();
             let z0 = model.me_event_indicators(&inputs).unwrap()[0];
             let stage = |x: [f64; 4], tt: f64, m: &mut MultiferroicMotor| {
-                m.me_set_states(&x, tt).unwrap();
+                m.set_time(tt);
+                m.me_set_states(&x).unwrap();
                 m.me_derivatives(&inputs).unwrap()
             };
             let add = |x: [f64; 4], k: [f64; 4], f: f64| -> [f64; 4] {
@@ -244,10 +241,11 @@ mod tests {
             } else {
                 t + dt
             };
-            model.me_set_states(&add(x0, k, dt), t).unwrap();
+            model.set_time(t);
+            model.me_set_states(&add(x0, k, dt)).unwrap();
             let z1 = model.me_event_indicators(&inputs).unwrap()[0];
             model.me_completed_step(&inputs).unwrap();
-            let time_event = model.me_next_time_event(&inputs).is_some_and(|e| t >= e);
+            let time_event = model.me_next_time_event().is_some_and(|e| t >= e);
             if time_event || (z0 > 0.0 && z1 <= 0.0) {
                 model.me_event(&inputs, t).unwrap();
             }
@@ -293,7 +291,8 @@ mod tests {
     fn partial_rows_cover_outputs_and_derivatives_by_inputs_and_states() {
         let mut m = stepping(1e-4, false);
         m.me_event(&Inputs::default(), 0.0).unwrap();
-        m.me_set_states(&[0.3, 100.0, 0.0, 0.0], 1e-5).unwrap();
+        m.set_time(1e-5);
+        m.me_set_states(&[0.3, 100.0, 0.0, 0.0]).unwrap();
         let p = m.me_partials(&Inputs::default()).unwrap();
         let row = p.get("der(rotor_speed)").unwrap();
         let by_name = |n: &str| row.iter().find(|(k, _)| *k == n).unwrap().1;
