@@ -51,6 +51,7 @@ const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &[
 /// models with continuous states, `src/fmi2/model_exchange.rs`); a Rust test checks that the
 /// shipped block and the models agree.
 const MODEL_EXCHANGE: &[&str] = &[
+    "FreeBladder",
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",

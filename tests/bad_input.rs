@@ -184,6 +184,8 @@ fn impossible_parameters(model: &str) -> Vec<(&'static str, Value)> {
             ("bladder_model", Value::I(1)),
             ("bladder_thickness", Value::R(0.01)),
         ],
+        // Rubber without stiffness: eq. 2.18 holds no pressure at any diameter.
+        "FreeBladder" => vec![("mooney_c1", Value::R(0.0)), ("mooney_c2", Value::R(0.0))],
         _ => Vec::new(),
     }
 }

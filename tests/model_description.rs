@@ -262,6 +262,10 @@ fn every_output_and_initial_unknown_declares_its_dependencies() {
             "PassThrough",
             include_str!("../modelDescription/PassThrough.xml"),
         ),
+        (
+            "FreeBladder",
+            include_str!("../modelDescription/FreeBladder.xml"),
+        ),
     ] {
         let m = check(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(m

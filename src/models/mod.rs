@@ -10,6 +10,7 @@
 use crate::variables::Interface;
 use serde::{de::DeserializeOwned, Serialize};
 
+pub mod free_bladder;
 pub mod knitted_muscle;
 pub mod mckibben_joint;
 pub mod mckibben_muscle;

@@ -6,6 +6,7 @@ pub mod bladder;
 pub mod bounds;
 pub mod calibration;
 pub mod festo;
+pub mod free_bladder;
 pub mod friction;
 pub mod gaylord;
 pub mod inverse;

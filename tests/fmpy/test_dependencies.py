@@ -17,11 +17,18 @@ from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
 sys.path.insert(0, __import__("os").path.dirname(__file__))
-from conftest import fmu_path  # noqa: E402
+from conftest import ROOT, fmu_path  # noqa: E402
 
 # Operating points: parameter overrides (the effects on) x input points.
 CONFIGS = {
     "PassThrough": ([{}], [{}, {"u": 0.7}]),
+    # The first point lies just below (C2 38719.67 Pa) and just above (38679.73 Pa) the clamp at
+    # 0.999 of the ballooning pressure, so that the initial input_clamped shows each parameter.
+    "FreeBladder": (
+        [{}, {"mooney_c2": 38719.67}, {"mooney_c2": 38679.73}],
+        [{"pressure": 5.25e4, "length": 0.1336}, {"pressure": 3e4, "length": 0.16},
+         {"pressure": -5e4, "length": 0.12}],
+    ),
     "McKibbenMuscle": (
         [{}, {"bladder_model": 1}, {"friction": True}, {"bladder_model": 1, "friction": True},
          {"pressure_solver": True}],
@@ -226,6 +233,12 @@ def compare(declared, measured, what):
     assert not undeclared, f"{what}: undeclared dependencies {undeclared}"
     assert not unshown, f"{what}: declared dependencies that never showed {unshown}"
     return sum(len(d) for d in declared.values())
+
+
+def test_every_model_has_operating_points():
+    # A model missing from CONFIGS would have its declared dependencies never measured.
+    shipped = {p.stem for p in (ROOT / "modelDescription").glob("*.xml")}
+    assert set(CONFIGS) == shipped, f"CONFIGS lacks {sorted(shipped - set(CONFIGS))}"
 
 
 @pytest.mark.parametrize("name", MODELS)

@@ -19,8 +19,16 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scenes"))
 import run as scenes  # noqa: E402
 
-MODEL_EXCHANGE = ["KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "MultiferroicMotor", "PassThrough", "PulleyJoint"]
-ALGEBRAIC = ["KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough"]
+MODEL_EXCHANGE = [
+    "FreeBladder",
+    "KnittedMuscle",
+    "McKibbenJoint",
+    "McKibbenMuscle",
+    "MultiferroicMotor",
+    "PassThrough",
+    "PulleyJoint",
+]
+ALGEBRAIC = ["FreeBladder", "KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough"]
 CO_SIMULATION_ONLY = []
 TOLERANCE = 1e-9
 # The motor's scenes (continuous states, events) are compared in test_motor_model_exchange.py.
@@ -84,6 +92,11 @@ def test_joint_model_exchange_matches_co_simulation():
         stop,
     )
     assert max(worst.values()) <= TOLERANCE, worst
+
+
+def test_every_model_is_in_one_list():
+    shipped = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
+    assert sorted(MODEL_EXCHANGE + CO_SIMULATION_ONLY) == shipped
 
 
 @pytest.mark.parametrize("model", MODEL_EXCHANGE + CO_SIMULATION_ONLY)
