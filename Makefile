@@ -147,6 +147,12 @@ bench: deps fmus $(C_PASSTHROUGH)
 parity: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench parity
 
+## The motor's Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step.
+.PHONY: bench-motor
+bench-motor: deps fmus $(VENV)/.installed
+	cargo bench --bench motor_model_exchange
+	$(PY) benches/motor_me_fmpy.py
+
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
 report: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)

@@ -43,6 +43,7 @@ const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &[
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",
+    "MultiferroicMotor",
     "PassThrough",
     "PulleyJoint",
 ];
@@ -55,6 +56,7 @@ const MODEL_EXCHANGE: &[&str] = &[
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",
+    "MultiferroicMotor",
     "PassThrough",
     "PulleyJoint",
 ];

@@ -5,13 +5,14 @@
 //! maps the variables onto [`MotorParams`] and [`MotorInputs`] and keeps the [`MotorState`], which
 //! is serialized with the FMU state.
 
-use super::{Model, Refusal, Report, Status};
+use super::{EventUpdate, Model, Partials, Refusal, Report, Status};
+use crate::physics::multiferroic::model_exchange::{by, MeGradient, MePartials};
 use crate::physics::multiferroic::{
     drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, ScheduleSwitch,
     SteppingSchedule,
 };
 use crate::variables::multiferroic_motor::{
-    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+    CalculatedParameters, Inputs, Outputs, Parameters, States, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -29,7 +30,11 @@ pub struct MultiferroicMotor {
     /// Whether the accuracy warning was logged: it is logged once per run, later limited steps
     /// only return `fmi2Warning` (a 1 s step over thousands of switches is limited every time).
     accuracy_warned: bool,
+    /// Model Exchange's discrete states (see [`model_exchange`]).
+    me: model_exchange::Discrete,
 }
+
+mod model_exchange;
 
 impl MultiferroicMotor {
     fn inputs(&self, inputs: &Inputs) -> MotorInputs {
@@ -103,6 +108,39 @@ fn write_outputs(out: &mut Outputs, o: &MotorOutputs) {
     );
 }
 
+/// The rows of `fmi2GetDirectionalDerivative` from the physics' partials: by each input (and, in
+/// Model Exchange, by each state). With `strain_drive` the stress comes from the `strain` input.
+fn partial_rows(
+    p: &MePartials,
+    strain_modulus: Option<f64>,
+    states: &[(&'static str, usize)],
+) -> Partials {
+    let mut rows = Partials::default();
+    let stress = |g: &MeGradient| g[by::STRESS];
+    for (name, g) in [
+        ("torque", &p.torque),
+        ("rotor_angle", &p.rotor_angle),
+        ("rotor_speed", &p.rotor_speed),
+        ("onion_angle", &p.onion_angle),
+        ("offset_angle", &p.offset_angle),
+        ("magnetostatic_energy", &p.magnetostatic_energy),
+        ("magnetoelastic_energy", &p.magnetoelastic_energy),
+        ("applied_strain_direction", &p.applied_strain_direction),
+    ] {
+        let mut row = vec![
+            ("strain_direction", g[by::STRAIN_DIRECTION]),
+            ("load_torque", g[by::LOAD_TORQUE]),
+        ];
+        match strain_modulus {
+            Some(modulus) => row.extend([("stress", 0.0), ("strain", modulus * stress(g))]),
+            None => row.extend([("stress", stress(g)), ("strain", 0.0)]),
+        }
+        row.extend(states.iter().map(|&(state, i)| (state, g[i])));
+        rows.row(name, &row);
+    }
+    rows
+}
+
 /// An Integer switch that must be 0 or 1 (the model description's bounds say so too).
 fn switch(value: i32, name: &str) -> Result<bool, String> {
     match value {
@@ -120,6 +158,7 @@ impl Model for MultiferroicMotor {
         Motor::validate_state(&saved.state).map_err(|e| format!("motor state: {e}"))?;
         self.state = saved.state;
         self.accuracy_warned = saved.accuracy_warned;
+        self.me = saved.me.validated()?;
         Ok(())
     }
 
@@ -182,6 +221,7 @@ impl Model for MultiferroicMotor {
             max_torque: motor.ring_bar.max_torque().1.abs(),
             motor,
             accuracy_warned: false,
+            me: model_exchange::Discrete::default(),
         })
     }
 
@@ -197,11 +237,118 @@ impl Model for MultiferroicMotor {
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        if self.model_exchange_active() {
+            // Between events the onion stays on its branch (Model Exchange never jumps it here).
+            return self.me_outputs(inputs, outputs, report);
+        }
         match self.motor.outputs(&self.state, &self.inputs(inputs)) {
             Ok(o) => write_outputs(outputs, &o),
             // Unreachable with inputs inside their declared bounds; the outputs keep their values.
             Err(e) => report.add(Status::Error, format!("cannot evaluate the motor: {e}")),
         }
+    }
+
+    const MODEL_EXCHANGE: bool = true;
+
+    fn states(&self) -> States {
+        let x = self.me_states();
+        States {
+            rotor_angle: x[0],
+            rotor_speed: x[1],
+            onion_state_angle: x[2],
+            onion_tilt: x[3],
+        }
+    }
+
+    fn set_states(&mut self, x: &States) -> Result<(), String> {
+        self.me_set_states(&[
+            x.rotor_angle,
+            x.rotor_speed,
+            x.onion_state_angle,
+            x.onion_tilt,
+        ])
+    }
+
+    fn set_time(&mut self, time: f64) {
+        self.state.time = time;
+    }
+
+    fn derivatives(&mut self, inputs: &Inputs) -> Result<States, String> {
+        let d = self.me_derivatives(inputs)?;
+        Ok(States {
+            rotor_angle: d[0],
+            rotor_speed: d[1],
+            onion_state_angle: d[2],
+            onion_tilt: d[3],
+        })
+    }
+
+    /// The quasi-static onion's fold (see [`model_exchange`]).
+    fn event_indicators(&mut self, inputs: &Inputs, out: &mut [f64]) -> Result<(), String> {
+        let z = self.me_event_indicators(inputs)?;
+        out.iter_mut().zip(z).for_each(|(slot, z)| *slot = z);
+        Ok(())
+    }
+
+    fn next_time_event(&self, _time: f64) -> Option<f64> {
+        self.me_next_time_event()
+    }
+
+    /// Event mode: the schedule's direction in effect, the quasi-static onion settled by the
+    /// Co-Simulation rule (to the next minimum past a fold).
+    fn update_discrete_states(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        time: f64,
+        report: &mut Report,
+    ) -> EventUpdate {
+        match self.me_event(inputs, time) {
+            Ok(states_changed) => {
+                self.me_outputs(inputs, outputs, report);
+                EventUpdate {
+                    states_changed,
+                    ..EventUpdate::default()
+                }
+            }
+            Err(e) => {
+                report.add(Status::Error, format!("motor event at t = {time} s: {e}"));
+                EventUpdate::default()
+            }
+        }
+    }
+
+    /// The onion's anchor moves along its branch; nothing jumps outside event mode.
+    fn completed_integrator_step(
+        &mut self,
+        inputs: &Inputs,
+        _outputs: &mut Outputs,
+        time: f64,
+        report: &mut Report,
+    ) -> bool {
+        self.state.time = time;
+        if let Err(e) = self.me_completed_step(inputs) {
+            report.add(Status::Error, format!("motor at t = {time} s: {e}"));
+        }
+        false
+    }
+
+    /// Co-Simulation: the outputs by the inputs at the current history, on the branch
+    /// [`Model::evaluate`] takes (the quasi-static onion settled for the present inputs first, by
+    /// the memory rule; then the implicit function theorem on its minimum). Model Exchange: also
+    /// by the states, and the state derivatives, on the branch the onion follows.
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        if self.model_exchange_active() {
+            return self.me_partials(inputs);
+        }
+        let inputs = self.inputs(inputs);
+        let outputs = self.motor.outputs(&self.state, &inputs)?;
+        let settled = MotorState {
+            onion_angle: outputs.onion_angle,
+            ..self.state
+        };
+        let p = self.motor.me_partials(&settled, &inputs, settled.time)?;
+        Ok(partial_rows(&p, self.strain_drive, &[]))
     }
 
     fn step(

@@ -127,7 +127,7 @@ def test_models_without_partials_declare_it():
 
     from conftest import fmu_path
 
-    for model in ["MultiferroicMotor", "FreeBladder"]:
+    for model in ["FreeBladder"]:
         md = read_model_description(fmu_path(model))
         assert not md.coSimulation.providesDirectionalDerivative, model
 

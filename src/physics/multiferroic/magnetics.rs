@@ -103,6 +103,22 @@ impl RingBar {
                 + 3.0 * ar * s * s * (1.0 / (b2 * b2 * b) - 1.0 / (a2 * a2 * a)))
     }
 
+    /// `d^3 U_m / d beta^3` (N m / rad^2): the slope of [`Self::stiffness`], for the quasi-static
+    /// onion's fold (where its minimum vanishes, the inflection's motion depends on it).
+    pub fn stiffness_slope(&self, offset: f64) -> f64 {
+        let (a, b, ar) = self.distances(offset);
+        let (s, c) = offset.sin_cos();
+        let (ia, ib) = (1.0 / a, 1.0 / b);
+        let (ia3, ib3) = (ia * ia * ia, ib * ib * ib);
+        let (ia5, ib5) = (ia3 * ia * ia, ib3 * ib * ib);
+        let (ia7, ib7) = (ia5 * ia * ia, ib5 * ib * ib);
+        self.coupling
+            * ar
+            * (-s * (ia3 + ib3)
+                + 9.0 * ar * s * c * (ib5 - ia5)
+                + 15.0 * ar * ar * s * s * s * (ia7 + ib7))
+    }
+
     /// The largest torque and the offset where it occurs (Fig. 3.3a): the root of the stiffness
     /// in (0, pi/2), found by bisection (the stiffness falls through zero once there). Eq. 3.3
     /// is odd about pi/2 (A and B swap), so the torque has the same peak again at `pi - beta`.

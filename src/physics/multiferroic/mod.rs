@@ -32,11 +32,15 @@
 //! turns; what is left is integrated, and a forced substep drops the negative stiffness so it
 //! cannot amplify. See [`Motor::step`].
 
+pub mod branch;
 pub mod drive;
 pub mod expm;
 mod integrator;
 mod long_steps;
 pub mod magnetics;
+pub mod model_exchange;
+#[cfg(test)]
+mod model_exchange_tests;
 pub mod onion;
 #[cfg(test)]
 mod onion_tests;

@@ -83,8 +83,14 @@ impl Landscape<'_> {
     }
 
     /// Bound on the third derivative of U in psi (J/rad^3): the ring-bar's plus `4 |E|`.
-    fn third_derivative_bound(&self) -> f64 {
+    pub(super) fn third_derivative_bound(&self) -> f64 {
         self.ring_bar_slope_bound + 4.0 * self.magnetoelastic.abs()
+    }
+
+    /// Gradients below this are zero to rounding (J/rad): the torques involved are ~1e-18 N m.
+    pub(super) fn gradient_tolerance(&self) -> f64 {
+        1e-12 * (self.ring_bar.coupling / self.ring_bar.wall_radius).abs()
+            + 1e-12 * self.magnetoelastic.abs()
     }
 
     /// The minimum reached downhill from `previous` (rad, unwrapped: the result stays on the same
@@ -93,9 +99,7 @@ impl Landscape<'_> {
     pub fn settle(&self, previous: f64) -> f64 {
         let g0 = self.gradient(previous);
         let c0 = self.curvature(previous);
-        // Gradients below this are zero to rounding: the torques involved are ~1e-18 N m.
-        let tiny = 1e-12 * (self.ring_bar.coupling / self.ring_bar.wall_radius).abs()
-            + 1e-12 * self.magnetoelastic.abs();
+        let tiny = self.gradient_tolerance();
         if g0.abs() <= tiny && c0 > 0.0 {
             return previous;
         }
@@ -126,7 +130,7 @@ impl Landscape<'_> {
             }
             let g_end = self.gradient(end);
             if dir * g_end >= 0.0 {
-                return self.refine(x, end);
+                return self.refine_minimum(x, end);
             }
             (x, g, c) = (end, g_end, self.curvature(end));
         }
@@ -135,7 +139,7 @@ impl Landscape<'_> {
     }
 
     /// The minimum between `a` and `b`, where the gradient changes sign from downhill to uphill.
-    fn refine(&self, a: f64, b: f64) -> f64 {
+    pub(super) fn refine_minimum(&self, a: f64, b: f64) -> f64 {
         // Left of a minimum the gradient is negative, right of it positive: rising.
         let root = newton_bisection(a, b, 0.5 * (a + b), true, REFINE, |x| {
             Ok::<_, ()>(Some(Sample {

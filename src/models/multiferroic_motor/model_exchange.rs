@@ -1,0 +1,306 @@
+//! Model Exchange of the motor (issue 13): four continuous states, one event indicator (the
+//! quasi-static onion's fold), time events at the schedule's switches. The physics is
+//! [`crate::physics::multiferroic::model_exchange`].
+//!
+//! States, in order: rotor angle and speed, then the onion's angle and tilt. In the Gilbert option
+//! the last two are integrated (the LLG macrospin). In the quasi-static option the onion is not
+//! integrated: its angle follows its branch's minimum at every evaluation (from the model's own
+//! anchor, refreshed at every completed integrator step), so the last two states are held between
+//! events at the onion's angle at the last event and zero tilt, with zero derivatives. The
+//! description's state count is fixed, hence four in both options.
+
+use super::{partial_rows, write_outputs, MultiferroicMotor};
+use crate::models::{Partials, Report, Status};
+use crate::physics::multiferroic::model_exchange::{by, MeEvaluation};
+use crate::physics::multiferroic::{Motor, OnionModel};
+use crate::variables::multiferroic_motor::{Inputs, Outputs};
+use serde::{Deserialize, Serialize};
+
+/// The continuous states by name, with their column in the physics' partials.
+pub const STATES: [(&str, usize); 4] = [
+    ("rotor_angle", by::ROTOR_ANGLE),
+    ("rotor_speed", by::ROTOR_SPEED),
+    ("onion_state_angle", by::ONION_ANGLE),
+    ("onion_tilt", by::ONION_TILT),
+];
+
+/// Model Exchange's discrete states, part of the FMU state.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
+pub(super) struct Discrete {
+    /// The instance serves Model Exchange: its outputs follow the onion's branch, never jumping
+    /// outside event mode. Set at the first event (the initial event iteration).
+    active: bool,
+    /// Time of the last event (s): the schedule's direction is the one in effect then, so it
+    /// changes only at its switches, which are time events.
+    schedule_time: f64,
+    /// Quasi-static option: the values of the onion's two states, held between events.
+    held: [f64; 2],
+}
+
+impl Discrete {
+    pub(super) fn validated(self) -> Result<Self, String> {
+        if self.schedule_time.is_finite() && self.held.iter().all(|x| x.is_finite()) {
+            Ok(self)
+        } else {
+            Err(format!(
+                "Model Exchange discrete state is not finite: {self:?}"
+            ))
+        }
+    }
+}
+
+impl MultiferroicMotor {
+    fn gilbert(&self) -> bool {
+        self.motor.params.onion_model == OnionModel::Gilbert
+    }
+
+    /// Whether the instance runs Model Exchange (see [`Discrete::active`]).
+    pub(super) fn model_exchange_active(&self) -> bool {
+        self.me.active
+    }
+
+    /// The continuous state vector.
+    pub(super) fn me_states(&self) -> [f64; 4] {
+        let s = &self.state;
+        if self.gilbert() {
+            [s.rotor_angle, s.rotor_speed, s.onion_angle, s.onion_tilt]
+        } else {
+            [
+                s.rotor_angle,
+                s.rotor_speed,
+                self.me.held[0],
+                self.me.held[1],
+            ]
+        }
+    }
+
+    /// Takes the importer's state vector; refuses a non-finite one or one beyond the
+    /// motor's bounds, keeping the old.
+    pub(super) fn me_set_states(&mut self, x: &[f64; 4]) -> Result<(), String> {
+        let mut next = self.state;
+        next.rotor_angle = x[0];
+        next.rotor_speed = x[1];
+        if self.gilbert() {
+            next.onion_angle = x[2];
+            next.onion_tilt = x[3];
+        } else if !(x[2].is_finite() && x[3].is_finite()) {
+            return Err(format!(
+                "the onion's states must be finite, got {} and {}",
+                x[2], x[3]
+            ));
+        }
+        Motor::validate_state(&next)?;
+        self.state = next;
+        if !self.gilbert() {
+            self.me.held = [x[2], x[3]];
+        }
+        Ok(())
+    }
+
+    fn me_evaluation(&self, inputs: &Inputs) -> Result<MeEvaluation, String> {
+        self.motor
+            .me_evaluate(&self.state, &self.inputs(inputs), self.me.schedule_time)
+    }
+
+    /// Time derivatives of the states.
+    pub(super) fn me_derivatives(&self, inputs: &Inputs) -> Result<[f64; 4], String> {
+        self.me_evaluation(inputs).map(|e| e.derivatives)
+    }
+
+    /// The fold indicator: positive while the quasi-static onion's minimum exists.
+    pub(super) fn me_event_indicators(&self, inputs: &Inputs) -> Result<[f64; 1], String> {
+        self.me_evaluation(inputs).map(|e| [e.fold_indicator])
+    }
+
+    /// Outputs in continuous-time mode: on the onion's branch, never jumping.
+    pub(super) fn me_outputs(&self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
+        match self.me_evaluation(inputs) {
+            Ok(e) => write_outputs(outputs, &e.outputs),
+            Err(e) => report.add(Status::Error, format!("cannot evaluate the motor: {e}")),
+        }
+    }
+
+    /// Completed integrator step: the anchor moves along the branch (not past a fold).
+    pub(super) fn me_completed_step(&mut self, inputs: &Inputs) -> Result<(), String> {
+        let inputs = self.inputs(inputs);
+        self.motor
+            .me_follow_branch(&mut self.state, &inputs, self.me.schedule_time)
+    }
+
+    /// Event mode at `time`: the schedule's direction in effect then, the onion settled by the
+    /// Co-Simulation rule. Returns whether a continuous state's value changed.
+    pub(super) fn me_event(&mut self, inputs: &Inputs, time: f64) -> Result<bool, String> {
+        let inputs = self.inputs(inputs);
+        let mut next = self.state;
+        next.time = time;
+        let mut changed = self.motor.me_event_update(&mut next, &inputs)?;
+        self.state = next;
+        self.me.active = true;
+        self.me.schedule_time = time;
+        if !self.gilbert() {
+            let held = [next.onion_angle, 0.0];
+            changed |= held != self.me.held;
+            self.me.held = held;
+        }
+        Ok(changed)
+    }
+
+    /// The next switch of the schedule, if one runs.
+    pub(super) fn me_next_time_event(&self) -> Option<f64> {
+        self.schedule
+            .get()
+            .map(|s| s.next_switch_after(self.me.schedule_time))
+    }
+
+    /// Exact partials of the outputs and of the state derivatives by the inputs and the states,
+    /// on the branch the evaluation takes. Rows by output name, and by `der(state)` for the
+    /// derivatives.
+    pub(super) fn me_partials(&self, inputs: &Inputs) -> Result<Partials, String> {
+        let inputs = self.inputs(inputs);
+        let p = self
+            .motor
+            .me_partials(&self.state, &inputs, self.me.schedule_time)?;
+        let mut rows = partial_rows(&p, self.strain_drive, &STATES);
+        for (k, (state, _)) in STATES.iter().enumerate() {
+            let g = &p.derivatives[k];
+            let mut row = vec![
+                ("strain_direction", g[by::STRAIN_DIRECTION]),
+                ("load_torque", g[by::LOAD_TORQUE]),
+            ];
+            match self.strain_drive {
+                Some(modulus) => row.extend([("stress", 0.0), ("strain", modulus * g[by::STRESS])]),
+                None => row.extend([("stress", g[by::STRESS]), ("strain", 0.0)]),
+            }
+            row.extend(STATES.iter().map(|&(name, i)| (name, g[i])));
+            rows.row(derivative_name(state), &row);
+        }
+        Ok(rows)
+    }
+}
+
+/// The name of a state's derivative row (`der(x)`, Modelica's convention).
+fn derivative_name(state: &str) -> &'static str {
+    match state {
+        "rotor_angle" => "der(rotor_angle)",
+        "rotor_speed" => "der(rotor_speed)",
+        "onion_state_angle" => "der(onion_state_angle)",
+        _ => "der(onion_tilt)",
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::Model;
+    use crate::variables::multiferroic_motor::Parameters;
+
+    fn stepping(period: f64, gilbert: bool) -> MultiferroicMotor {
+        let p = Parameters {
+            schedule: 1,
+            step_period: period,
+            onion_model: i32::from(gilbert),
+            ..Parameters::default()
+        };
+        MultiferroicMotor::new(&p, &Inputs::default()).unwrap()
+    }
+
+    /// What an importer does through the model's Model Exchange methods: the initial event, RK4
+    /// steps of `h` (cut at time events), a completed step after each, an event at each switch
+    /// and where the fold indicator changes sign. Returns the rotor angle at each multiple of
+    /// `every`.
+    fn importer(model: &mut MultiferroicMotor, h: f64, until: f64, every: f64) -> Vec<f64> {
+        let inputs = Inputs::default();
+        let mut t = 0.0;
+        model.me_event(&inputs, t).unwrap();
+        let mut angles = vec![];
+        let mut next_sample = every;
+        while t < until * (1.0 - 1e-12) {
+            let target = model
+                .me_next_time_event()
+                .unwrap_or(f64::INFINITY)
+                .min(next_sample);
+            let dt = h.min(target - t);
+            let x0 = model.me_states();
+            let z0 = model.me_event_indicators(&inputs).unwrap()[0];
+            let stage = |x: [f64; 4], tt: f64, m: &mut MultiferroicMotor| {
+                m.set_time(tt);
+                m.me_set_states(&x).unwrap();
+                m.me_derivatives(&inputs).unwrap()
+            };
+            let add = |x: [f64; 4], k: [f64; 4], f: f64| -> [f64; 4] {
+                std::array::from_fn(|i| x[i] + f * k[i])
+            };
+            let k1 = stage(x0, t, model);
+            let k2 = stage(add(x0, k1, 0.5 * dt), t + 0.5 * dt, model);
+            let k3 = stage(add(x0, k2, 0.5 * dt), t + 0.5 * dt, model);
+            let k4 = stage(add(x0, k3, dt), t + dt, model);
+            let k: [f64; 4] =
+                std::array::from_fn(|i| (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0);
+            t = if (target - (t + dt)).abs() < 1e-12 * target {
+                target
+            } else {
+                t + dt
+            };
+            model.set_time(t);
+            model.me_set_states(&add(x0, k, dt)).unwrap();
+            let z1 = model.me_event_indicators(&inputs).unwrap()[0];
+            model.me_completed_step(&inputs).unwrap();
+            let time_event = model.me_next_time_event().is_some_and(|e| t >= e);
+            if time_event || (z0 > 0.0 && z1 <= 0.0) {
+                model.me_event(&inputs, t).unwrap();
+            }
+            if t >= next_sample * (1.0 - 1e-12) {
+                angles.push(model.me_states()[0]);
+                next_sample += every;
+            }
+        }
+        angles
+    }
+
+    #[test]
+    fn the_model_exchange_loop_matches_co_simulation_at_every_switch() {
+        // The quasi-static rotor over three 25 us periods (it follows each 60 degree step); the
+        // Gilbert onion's GHz precession needs ps steps, so two 2 us periods.
+        for (gilbert, period, h, periods) in [(false, 25e-6, 2e-10, 3), (true, 2e-6, 4e-12, 2)] {
+            let mut me = stepping(period, gilbert);
+            let angles = importer(&mut me, h, periods as f64 * period, period);
+            let mut cs = stepping(period, gilbert);
+            let mut out = Outputs::default();
+            let mut report = Report::default();
+            let steps = (period / 1e-6).round() as usize;
+            for (k, angle) in angles.iter().enumerate() {
+                for j in 0..steps {
+                    let t = (k * steps + j) as f64 * 1e-6;
+                    cs.step(&Inputs::default(), &mut out, t, 1e-6, &mut report);
+                }
+                assert!(report.status <= Status::Warning, "{:?}", report.messages);
+                assert!(
+                    (angle - out.rotor_angle).abs() < 1e-4,
+                    "gilbert {gilbert}, period {k}: {angle} {}",
+                    out.rotor_angle
+                );
+            }
+            assert_eq!(angles.len(), periods);
+            if !gilbert {
+                assert!(angles[periods - 1].to_degrees() > 150.0, "{angles:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn partial_rows_cover_outputs_and_derivatives_by_inputs_and_states() {
+        let mut m = stepping(1e-4, false);
+        m.me_event(&Inputs::default(), 0.0).unwrap();
+        m.set_time(1e-5);
+        m.me_set_states(&[0.3, 100.0, 0.0, 0.0]).unwrap();
+        let p = m.me_partials(&Inputs::default()).unwrap();
+        let row = p.get("der(rotor_speed)").unwrap();
+        let by_name = |n: &str| row.iter().find(|(k, _)| *k == n).unwrap().1;
+        // I w' = tau - c w: d/dw = -c/I, and the schedule makes stress no input.
+        let c_over_i = m.motor.drag / m.motor.inertia;
+        assert!((by_name("rotor_speed") + c_over_i).abs() < 1e-9 * c_over_i);
+        assert_eq!(by_name("stress"), 0.0);
+        assert!(by_name("rotor_angle") < 0.0, "a restoring stiffness");
+        assert!(p.get("torque").is_some() && p.get("der(onion_tilt)").is_some());
+    }
+}

@@ -1,0 +1,326 @@
+//! The motor as an ODE for Model Exchange: the importer's integrator advances the states, the
+//! motor gives their derivatives, its outputs, an event indicator and the event update, and exact
+//! partial derivatives of all of them.
+//!
+//! Continuous states: rotor angle `phi` and speed `omega` (section 3.2.2's rotor,
+//! `I phi'' = tau_bar(psi - phi) + tau_load - c phi'`), and in the Gilbert option the onion's `psi`
+//! and `theta` (see [`Motor::onion_relaxation_time`]).
+//!
+//! With the quasi-static onion, `psi` is not integrated: it sits at its branch's minimum of eq. 3.3
+//! plus eq. 3.4, found from the stored onion angle by [`Landscape::follow`](super::onion::Landscape::follow), which never jumps to
+//! another branch. The stored angle (an anchor on the branch) is a discrete state: refreshed along
+//! the branch at completed integrator steps ([`Motor::me_follow_branch`]) and moved at events
+//! ([`Motor::me_event_update`]). Where the branch's minimum vanishes (a fold: the curvature there
+//! reaches zero) the event indicator [`MeEvaluation::fold_indicator`] changes sign; in event mode
+//! the onion then settles downhill to the next minimum by the rule Co-Simulation uses
+//! ([`Landscape::settle`](super::onion::Landscape::settle)). The schedule's direction is a discrete state too: it is read at the
+//! time of the last event, so it changes only at its switches, which are time events.
+
+use super::branch::Branch;
+use super::{Drive, Motor, MotorInputs, MotorOutputs, MotorState, OnionModel};
+
+/// Indices of the independent variables of an [`MeGradient`]: the four states (the last two only
+/// in the Gilbert option) and the three real inputs of [`MotorInputs`].
+pub mod by {
+    pub const ROTOR_ANGLE: usize = 0;
+    pub const ROTOR_SPEED: usize = 1;
+    pub const ONION_ANGLE: usize = 2;
+    pub const ONION_TILT: usize = 3;
+    pub const STRAIN_DIRECTION: usize = 4;
+    pub const STRESS: usize = 5;
+    pub const LOAD_TORQUE: usize = 6;
+    pub const COUNT: usize = 7;
+}
+
+/// Partial derivatives of one quantity with respect to the variables of [`by`].
+pub type MeGradient = [f64; by::COUNT];
+
+/// Everything Model Exchange reads at one state.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MeEvaluation {
+    /// Time derivatives of (phi, omega, psi, theta); the onion's are 0 in the quasi-static option.
+    pub derivatives: [f64; 4],
+    pub outputs: MotorOutputs,
+    /// The quasi-static onion's branch (`None` in the Gilbert option).
+    pub branch: Option<Branch>,
+    /// Event indicator: the branch's [`Branch::fold_distance`] over the alignment stiffness
+    /// (dimensionless, 1 at alignment without stress); negative once the minimum has vanished.
+    /// 1 in the Gilbert option, which has no folds.
+    pub fold_indicator: f64,
+}
+
+/// Exact partials at one state, on the branch the evaluation takes.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MePartials {
+    /// Of the time derivatives of (phi, omega, psi, theta).
+    pub derivatives: [MeGradient; 4],
+    pub torque: MeGradient,
+    pub rotor_angle: MeGradient,
+    pub rotor_speed: MeGradient,
+    pub onion_angle: MeGradient,
+    pub offset_angle: MeGradient,
+    pub magnetostatic_energy: MeGradient,
+    pub magnetoelastic_energy: MeGradient,
+    pub applied_strain_direction: MeGradient,
+}
+
+/// `a * x + b * y` elementwise.
+fn combine(a: f64, x: &MeGradient, b: f64, y: &MeGradient) -> MeGradient {
+    std::array::from_fn(|i| a * x[i] + b * y[i])
+}
+
+fn unit(i: usize) -> MeGradient {
+    let mut g = [0.0; by::COUNT];
+    g[i] = 1.0;
+    g
+}
+
+/// The state at which everything is evaluated: rotor, onion (solved or integrated) and drive.
+struct Point {
+    y: [f64; 4],
+    drive: Drive,
+    branch: Option<Branch>,
+}
+
+impl Motor {
+    /// Number of continuous states: 2 (rotor), 4 with the Gilbert onion.
+    pub fn me_state_count(&self) -> usize {
+        if self.quasi_static() {
+            2
+        } else {
+            4
+        }
+    }
+
+    /// The next switch of the schedule after the one in effect at `schedule_time` (the time of the
+    /// last event), if a schedule runs: the next time event.
+    pub fn me_next_time_event(&self, inputs: &MotorInputs, schedule_time: f64) -> Option<f64> {
+        inputs
+            .schedule
+            .get()
+            .map(|s| s.next_switch_after(schedule_time))
+    }
+
+    fn me_point(
+        &self,
+        state: &MotorState,
+        inputs: &MotorInputs,
+        schedule_time: f64,
+    ) -> Result<Point, String> {
+        self.validate_inputs(inputs)?;
+        Self::validate_state(state)?;
+        let drive = self.drive_at(inputs, schedule_time);
+        let speed = if drive.locked { 0.0 } else { state.rotor_speed };
+        let mut y = [
+            state.rotor_angle,
+            speed,
+            state.onion_angle,
+            state.onion_tilt,
+        ];
+        let branch = self.quasi_static().then(|| {
+            self.landscape(y[0], drive.direction, drive.stress)
+                .follow(state.onion_angle)
+        });
+        if let Some(b) = branch {
+            y[2] = b.angle();
+            y[3] = 0.0;
+        }
+        Ok(Point { y, drive, branch })
+    }
+
+    /// Derivatives, outputs and the fold indicator at `state` (its time is not used; the schedule
+    /// is read at `schedule_time`, the time of the last event). Nothing is stored.
+    pub fn me_evaluate(
+        &self,
+        state: &MotorState,
+        inputs: &MotorInputs,
+        schedule_time: f64,
+    ) -> Result<MeEvaluation, String> {
+        let Point {
+            y,
+            drive: d,
+            branch,
+        } = self.me_point(state, inputs, schedule_time)?;
+        let mut derivatives = [0.0; 4];
+        let beta = y[2] - y[0];
+        if !d.locked {
+            derivatives[0] = y[1];
+            derivatives[1] =
+                (self.ring_bar.torque(beta) + d.load - self.drag * y[1]) / self.inertia;
+        }
+        if self.params.onion_model == OnionModel::Gilbert {
+            let (g, a, t) = (
+                self.llg_rate,
+                self.params.gilbert_damping,
+                self.tilt_stiffness,
+            );
+            let e = self.magnetoelastic_per_stress * d.stress;
+            let grad = self.ring_bar.torque(beta) + e * (2.0 * (y[2] - d.direction)).sin();
+            derivatives[2] = g * (-t * y[3] - a * grad);
+            derivatives[3] = g * (grad - a * t * y[3]);
+        }
+        let fold_indicator = match branch {
+            Some(b) => {
+                let m = self
+                    .landscape(y[0], d.direction, d.stress)
+                    .third_derivative_bound();
+                b.fold_distance(m) / self.alignment_stiffness.abs()
+            }
+            None => 1.0,
+        };
+        Ok(MeEvaluation {
+            derivatives,
+            outputs: self.outputs_at(&y, &d),
+            branch,
+            fold_indicator,
+        })
+    }
+
+    /// Completed integrator step: moves the stored onion angle along its branch to the present
+    /// minimum, so that the next evaluations start next to it. Past a fold (the event is due) the
+    /// anchor stays. Nothing else changes.
+    pub fn me_follow_branch(
+        &self,
+        state: &mut MotorState,
+        inputs: &MotorInputs,
+        schedule_time: f64,
+    ) -> Result<(), String> {
+        if let Some(Branch::Minimum { angle, .. }) =
+            self.me_point(state, inputs, schedule_time)?.branch
+        {
+            state.onion_angle = angle;
+        }
+        Ok(())
+    }
+
+    /// Event mode at `state.time`: the schedule's direction becomes the one in effect then, the
+    /// quasi-static onion settles downhill from where it was (the Co-Simulation rule: at a fold it
+    /// moves to the next minimum, else it stays on its branch), a locked rotor stands still.
+    /// Returns whether a continuous state changed (only a locked rotor's speed can).
+    pub fn me_event_update(
+        &self,
+        state: &mut MotorState,
+        inputs: &MotorInputs,
+    ) -> Result<bool, String> {
+        self.validate_inputs(inputs)?;
+        Self::validate_state(state)?;
+        let d = self.drive_at(inputs, state.time);
+        let mut y = [
+            state.rotor_angle,
+            state.rotor_speed,
+            state.onion_angle,
+            state.onion_tilt,
+        ];
+        self.constrain(&mut y, &d);
+        let changed = y[1] != state.rotor_speed;
+        state.rotor_speed = y[1];
+        state.onion_angle = y[2];
+        Ok(changed)
+    }
+
+    /// Exact partials of the derivatives and outputs with respect to the states and inputs at
+    /// `state`, on the branch [`Self::me_evaluate`] takes: the quasi-static onion's by the
+    /// implicit function theorem on `dU/dpsi = 0` at its minimum (on `d2U/dpsi2 = 0` at the ghost
+    /// past a fold, the extension evaluated until the event fires). At the fold itself the
+    /// one-sided partials are infinite; the curvature is then floored at 1e-9 of the alignment
+    /// stiffness so they stay finite.
+    pub fn me_partials(
+        &self,
+        state: &MotorState,
+        inputs: &MotorInputs,
+        schedule_time: f64,
+    ) -> Result<MePartials, String> {
+        let Point {
+            y,
+            drive: d,
+            branch,
+        } = self.me_point(state, inputs, schedule_time)?;
+        let scheduled = inputs.schedule.get().is_some();
+        // The drive's direction, stress (and the energy scale E = m sigma) by the variables.
+        let direction = if scheduled {
+            [0.0; by::COUNT]
+        } else {
+            unit(by::STRAIN_DIRECTION)
+        };
+        let stress = if scheduled {
+            [0.0; by::COUNT]
+        } else {
+            unit(by::STRESS)
+        };
+        let m = self.magnetoelastic_per_stress;
+        let e = m * d.stress;
+        let phi = unit(by::ROTOR_ANGLE);
+        let psi_now = y[2];
+        let beta = psi_now - y[0];
+        let k_bar = self.ring_bar.stiffness(beta);
+        let (s2, c2) = (2.0 * (psi_now - d.direction)).sin_cos();
+        let k_me = 2.0 * e * c2;
+        let floor = 1e-9 * self.alignment_stiffness.abs();
+        let psi = match branch {
+            // F(psi, phi, E, gamma) = 0 with F = dU/dpsi at the minimum, d2U/dpsi2 at the ghost:
+            // dpsi = -(F_phi dphi + F_E dE + F_gamma dgamma) / F_psi.
+            Some(b) => {
+                let (f_psi, f_phi, f_e, f_gamma) = match b {
+                    Branch::Minimum { .. } => (k_bar + k_me, -k_bar, s2, -k_me),
+                    Branch::Vanished { .. } => {
+                        let slope = self.ring_bar.stiffness_slope(beta);
+                        (slope - 4.0 * e * s2, -slope, 2.0 * c2, 4.0 * e * s2)
+                    }
+                };
+                let f_psi = if f_psi.abs() < floor {
+                    floor.copysign(f_psi)
+                } else {
+                    f_psi
+                };
+                let de = stress.map(|x| m * x);
+                std::array::from_fn(|i| {
+                    -(f_phi * phi[i] + f_e * de[i] + f_gamma * direction[i]) / f_psi
+                })
+            }
+            None => unit(by::ONION_ANGLE),
+        };
+        let offset = combine(1.0, &psi, -1.0, &phi);
+        let torque = offset.map(|x| k_bar * x);
+        let speed = if d.locked {
+            [0.0; by::COUNT]
+        } else {
+            unit(by::ROTOR_SPEED)
+        };
+        let mut derivatives = [[0.0; by::COUNT]; 4];
+        if !d.locked {
+            derivatives[0] = speed;
+            let (i, c) = (self.inertia, self.drag);
+            let load = unit(by::LOAD_TORQUE);
+            derivatives[1] = std::array::from_fn(|j| (torque[j] + load[j] - c * speed[j]) / i);
+        }
+        if self.params.onion_model == OnionModel::Gilbert {
+            let (g, a, t) = (
+                self.llg_rate,
+                self.params.gilbert_damping,
+                self.tilt_stiffness,
+            );
+            // grad = tau(beta) + E sin(2 (psi - gamma)).
+            let grad: MeGradient = std::array::from_fn(|j| {
+                torque[j] + m * stress[j] * s2 + k_me * (psi[j] - direction[j])
+            });
+            let tilt = unit(by::ONION_TILT);
+            derivatives[2] = std::array::from_fn(|j| g * (-t * tilt[j] - a * grad[j]));
+            derivatives[3] = std::array::from_fn(|j| g * (grad[j] - a * t * tilt[j]));
+        }
+        let tau = self.ring_bar.torque(beta);
+        let sin2 = (psi_now - d.direction).sin().powi(2);
+        Ok(MePartials {
+            derivatives,
+            torque,
+            rotor_angle: phi,
+            rotor_speed: speed,
+            onion_angle: psi,
+            offset_angle: offset,
+            magnetostatic_energy: offset.map(|x| tau * x),
+            magnetoelastic_energy: std::array::from_fn(|j| {
+                m * sin2 * stress[j] + e * s2 * (psi[j] - direction[j])
+            }),
+            applied_strain_direction: direction,
+        })
+    }
+}

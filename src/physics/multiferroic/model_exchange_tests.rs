@@ -1,0 +1,490 @@
+//! Model Exchange form of the motor: the right-hand side integrated by a fine reference Runge-Kutta
+//! with its events against [`Motor::step`], the fold's event indicator, and the exact partials
+//! against central differences.
+
+use super::branch::Branch;
+use super::model_exchange::{by, MeGradient};
+use super::*;
+
+fn motor() -> Motor {
+    Motor::new(MotorParams::table_3_1()).unwrap()
+}
+
+fn gilbert() -> Motor {
+    let mut p = MotorParams::table_3_1();
+    p.onion_model = OnionModel::Gilbert;
+    Motor::new(p).unwrap()
+}
+
+fn scheduled(period: f64) -> MotorInputs {
+    let s = SteppingSchedule::new(
+        (-30f64).to_radians(),
+        60f64.to_radians(),
+        period,
+        CALIBRATION_STRESS,
+    )
+    .unwrap();
+    MotorInputs {
+        schedule: ScheduleSwitch::on(s),
+        ..MotorInputs::fixed(0.0, 0.0)
+    }
+}
+
+/// What a Model Exchange importer does, done finely: classical RK4 with step `h` on the motor's
+/// states, the anchor refreshed after every completed step, time events at the schedule's
+/// switches, and state events located by bisection on the step length (to 1e-6 of `h`). Returns
+/// the state at `until` and the number of state events.
+fn reference_run(
+    m: &Motor,
+    inputs: &MotorInputs,
+    start: MotorState,
+    h: f64,
+    until: f64,
+) -> (MotorState, usize) {
+    let n = m.me_state_count();
+    let mut s = start;
+    let mut schedule_time = s.time;
+    m.me_event_update(&mut s, inputs).unwrap();
+    let mut events = 0;
+    let rk4 = |s: &MotorState, dt: f64, schedule_time: f64| -> MotorState {
+        let eval = |y: &MotorState| m.me_evaluate(y, inputs, schedule_time).unwrap().derivatives;
+        let shift = |k: &[f64; 4], f: f64| {
+            let mut y = *s;
+            y.rotor_angle += f * k[0];
+            y.rotor_speed += f * k[1];
+            if n == 4 {
+                y.onion_angle += f * k[2];
+                y.onion_tilt += f * k[3];
+            }
+            y
+        };
+        let k1 = eval(s);
+        let k2 = eval(&shift(&k1, 0.5 * dt));
+        let k3 = eval(&shift(&k2, 0.5 * dt));
+        let k4 = eval(&shift(&k3, dt));
+        let k: [f64; 4] =
+            std::array::from_fn(|i| (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0);
+        let mut y = shift(&k, dt);
+        y.time = s.time + dt;
+        y
+    };
+    while s.time < until * (1.0 - 1e-14) {
+        let next_event = m
+            .me_next_time_event(inputs, schedule_time)
+            .unwrap_or(f64::INFINITY);
+        let target = next_event.min(until);
+        let dt = h.min(target - s.time);
+        let before = m
+            .me_evaluate(&s, inputs, schedule_time)
+            .unwrap()
+            .fold_indicator;
+        let mut next = rk4(&s, dt, schedule_time);
+        let after = m
+            .me_evaluate(&next, inputs, schedule_time)
+            .unwrap()
+            .fold_indicator;
+        let mut event = false;
+        if before > 0.0 && after <= 0.0 {
+            let (mut lo, mut hi) = (0.0, dt);
+            while hi - lo > 1e-6 * h {
+                let mid = 0.5 * (lo + hi);
+                let y = rk4(&s, mid, schedule_time);
+                if m.me_evaluate(&y, inputs, schedule_time)
+                    .unwrap()
+                    .fold_indicator
+                    > 0.0
+                {
+                    lo = mid;
+                } else {
+                    hi = mid;
+                }
+            }
+            next = rk4(&s, hi, schedule_time);
+            event = true;
+            events += 1;
+        }
+        s = next;
+        if (target - s.time).abs() <= 1e-12 * target.abs().max(1e-300) {
+            s.time = target;
+        }
+        if event || s.time >= next_event {
+            schedule_time = s.time;
+            m.me_event_update(&mut s, inputs).unwrap();
+        } else {
+            m.me_follow_branch(&mut s, inputs, schedule_time).unwrap();
+        }
+    }
+    (s, events)
+}
+
+fn co_simulation(
+    m: &Motor,
+    inputs: &MotorInputs,
+    start: MotorState,
+    h: f64,
+    until: f64,
+) -> MotorState {
+    let mut s = start;
+    while s.time < until * (1.0 - 1e-12) {
+        let dt = h.min(until - s.time);
+        m.step(&mut s, inputs, dt).unwrap();
+    }
+    s
+}
+
+#[test]
+fn stiffness_slope_is_the_stiffness_derivative() {
+    let m = motor();
+    for i in -40..=40 {
+        let beta = i as f64 * 0.077;
+        let h = 1e-6;
+        let fd = (m.ring_bar.stiffness(beta + h) - m.ring_bar.stiffness(beta - h)) / (2.0 * h);
+        let exact = m.ring_bar.stiffness_slope(beta);
+        assert!(
+            (exact - fd).abs() <= 1e-6 * m.ring_bar.stiffness(0.0).abs(),
+            "{beta}: {exact:e} {fd:e}"
+        );
+    }
+}
+
+#[test]
+fn following_the_branch_agrees_with_settling_away_from_folds() {
+    let m = motor();
+    // A locked sweep below the fold of tension at -10 degrees (the fold is near 150 MPa): the
+    // minimum found from the previous one is the one the Co-Simulation rule settles to.
+    let mut anchor = 0.0;
+    for i in 0..=100 {
+        let stress = 1e6 * i as f64;
+        let l = m.landscape(0.0, (-10f64).to_radians(), stress);
+        let settled = l.settle(anchor);
+        match l.follow(anchor) {
+            Branch::Minimum { angle, curvature } => {
+                assert!(
+                    (angle - settled).abs() < 1e-12,
+                    "{stress}: {angle} {settled}"
+                );
+                assert!(curvature > 0.0);
+            }
+            other => panic!("{stress}: {other:?}"),
+        }
+        anchor = settled;
+    }
+}
+
+/// Tension at -10 degrees on a locked rotor: the branch near alignment folds at a critical stress
+/// (`onion_jumps_when_its_minimum_disappears`). The indicator falls to zero there and turns negative
+/// just beyond, continuously; the event update then moves the onion to the far minimum, the one
+/// Co-Simulation jumps to.
+#[test]
+fn fold_indicator_changes_sign_where_the_minimum_vanishes() {
+    let m = motor();
+    let direction = (-10f64).to_radians();
+    let locked = |stress| MotorInputs {
+        rotor_locked: true,
+        ..MotorInputs::fixed(direction, stress)
+    };
+    let mut s = MotorState::aligned(0.0);
+    let mut previous = f64::INFINITY;
+    let mut stress = 100e6;
+    let mut crossing = None;
+    while stress < 300e6 {
+        let e = m.me_evaluate(&s, &locked(stress), 0.0).unwrap();
+        assert!(
+            e.fold_indicator < previous,
+            "{stress}: {}",
+            e.fold_indicator
+        );
+        if e.fold_indicator <= 0.0 {
+            crossing = Some((stress, previous, e.fold_indicator));
+            break;
+        }
+        previous = e.fold_indicator;
+        m.me_follow_branch(&mut s, &locked(stress), 0.0).unwrap();
+        stress += 1e4;
+    }
+    let (critical, last_positive, first_negative) = crossing.expect("a fold below 300 MPa");
+    // Both sides of the crossing are small: the indicator is continuous there.
+    assert!(
+        last_positive < 0.05 && first_negative > -0.05,
+        "{last_positive} {first_negative}"
+    );
+    // The fold's stress from the equilibrium curve (maximum of the branch's stress).
+    let e = m.magnetoelastic_per_stress;
+    let equilibrium_stress = |b: f64| m.ring_bar.torque(b) / (-e * (2.0 * (b - direction)).sin());
+    let mut fold = 0.0;
+    for i in 1..20000 {
+        let s = equilibrium_stress(i as f64 * 1e-4);
+        if s < fold {
+            break;
+        }
+        fold = s;
+    }
+    assert!((critical - fold).abs() <= 2e4, "{critical:e} {fold:e}");
+    // Event: the Co-Simulation rule from the same stored onion.
+    let inputs = locked(critical);
+    let mut cs = s;
+    m.step(&mut cs, &inputs, 1e-9).unwrap();
+    let mut me = s;
+    m.me_event_update(&mut me, &inputs).unwrap();
+    assert!((me.onion_angle - cs.onion_angle).abs() < 1e-12);
+    assert!(me.onion_angle.to_degrees() > 60.0, "{}", me.onion_angle);
+    let after = m.me_evaluate(&me, &inputs, 0.0).unwrap();
+    assert!(after.fold_indicator > 0.0);
+}
+
+#[test]
+fn right_hand_side_integrates_to_the_co_simulation_rotor() {
+    let m = motor();
+    // Tension at -45 degrees from alignment: the rotor follows the onion over ~20 us.
+    let inputs = MotorInputs::fixed((-45f64).to_radians(), 200e6);
+    let start = MotorState::aligned(0.0);
+    let (me, events) = reference_run(&m, &inputs, start, 1e-10, 20e-6);
+    let cs = co_simulation(&m, &inputs, start, 1e-6, 20e-6);
+    assert_eq!(events, 0);
+    assert!(me.rotor_angle.abs() > 0.1, "{}", me.rotor_angle);
+    assert!(
+        (me.rotor_angle - cs.rotor_angle).abs() < 1e-5,
+        "{} {}",
+        me.rotor_angle,
+        cs.rotor_angle
+    );
+    assert!((me.onion_angle - cs.onion_angle).abs() < 1e-5);
+}
+
+#[test]
+fn schedule_switches_are_time_events_matching_co_simulation() {
+    let m = motor();
+    // 20 us periods (several relaxation times): three switches of 60 degrees.
+    let inputs = scheduled(20e-6);
+    let start = MotorState::aligned(0.0);
+    let (me, _) = reference_run(&m, &inputs, start, 1e-10, 70e-6);
+    let cs = co_simulation(&m, &inputs, start, 1e-6, 70e-6);
+    assert!(
+        me.rotor_angle.to_degrees() > 150.0,
+        "{}",
+        me.rotor_angle.to_degrees()
+    );
+    assert!(
+        (me.rotor_angle - cs.rotor_angle).abs() < 1e-4,
+        "{} {}",
+        me.rotor_angle,
+        cs.rotor_angle
+    );
+}
+
+#[test]
+fn a_slipping_rotor_folds_the_onion_with_state_events_as_in_co_simulation() {
+    let m = motor();
+    // A load beyond the largest torque drags the rotor backwards under the onion, which the
+    // tension holds; when the offset passes the fold the onion snaps over (a state event), as in
+    // Co-Simulation. Over 100 us the rotor slips more than a turn.
+    let (_, peak) = m.ring_bar.max_torque();
+    let inputs = MotorInputs {
+        load_torque: -1.5 * peak,
+        ..MotorInputs::fixed((-45f64).to_radians(), 200e6)
+    };
+    let start = MotorState::aligned(0.0);
+    let until = 100e-6;
+    let (me, events) = reference_run(&m, &inputs, start, 2e-10, until);
+    let cs = co_simulation(&m, &inputs, start, 1e-7, until);
+    assert!(events >= 1, "{events}");
+    assert!(me.rotor_angle < -6.5, "{}", me.rotor_angle);
+    assert!(
+        (me.rotor_angle - cs.rotor_angle).abs() < 1e-4,
+        "{} {}",
+        me.rotor_angle,
+        cs.rotor_angle
+    );
+    assert!((me.onion_angle - cs.onion_angle).abs() < 1e-3);
+}
+
+#[test]
+fn gilbert_right_hand_side_integrates_to_the_co_simulation_rotor() {
+    let m = gilbert();
+    let inputs = MotorInputs::fixed((-45f64).to_radians(), 200e6);
+    let start = MotorState::aligned(0.0);
+    let (me, events) = reference_run(&m, &inputs, start, 4e-12, 2e-6);
+    let cs = co_simulation(&m, &inputs, start, 1e-8, 2e-6);
+    assert_eq!(events, 0);
+    assert!(me.rotor_angle.abs() > 0.01);
+    for (a, b) in [
+        (me.rotor_angle, cs.rotor_angle),
+        (me.onion_angle, cs.onion_angle),
+        (me.onion_tilt, cs.onion_tilt),
+    ] {
+        assert!((a - b).abs() < 1e-5, "{a} {b}");
+    }
+}
+
+/// Central differences of every derivative and output by every state and input.
+fn check_partials(m: &Motor, state: &MotorState, inputs: &MotorInputs, what: &str) {
+    let p = m.me_partials(state, inputs, state.time).unwrap();
+    let exact: Vec<(&str, MeGradient)> = vec![
+        ("d rotor_angle/dt", p.derivatives[0]),
+        ("d rotor_speed/dt", p.derivatives[1]),
+        ("d onion_angle/dt", p.derivatives[2]),
+        ("d onion_tilt/dt", p.derivatives[3]),
+        ("torque", p.torque),
+        ("rotor_angle", p.rotor_angle),
+        ("rotor_speed", p.rotor_speed),
+        ("onion_angle", p.onion_angle),
+        ("offset_angle", p.offset_angle),
+        ("magnetostatic_energy", p.magnetostatic_energy),
+        ("magnetoelastic_energy", p.magnetoelastic_energy),
+        ("applied_strain_direction", p.applied_strain_direction),
+    ];
+    let values = |s: &MotorState, i: &MotorInputs| -> Vec<f64> {
+        let e = m.me_evaluate(s, i, s.time).unwrap();
+        let o = e.outputs;
+        let mut v = e.derivatives.to_vec();
+        v.extend([
+            o.torque,
+            o.rotor_angle,
+            o.rotor_speed,
+            o.onion_angle,
+            o.offset_angle,
+            o.magnetostatic_energy,
+            o.magnetoelastic_energy,
+            o.applied_strain_direction,
+        ]);
+        v
+    };
+    let scale_of = |j: usize| match j {
+        by::ROTOR_SPEED => 1e3,
+        by::STRESS => 1e5,
+        by::LOAD_TORQUE => 1e-21,
+        _ => 1e-5,
+    };
+    for j in 0..by::COUNT {
+        let h = scale_of(j);
+        let moved = |f: f64| {
+            let (mut s, mut i) = (*state, *inputs);
+            match j {
+                by::ROTOR_ANGLE => s.rotor_angle += f * h,
+                by::ROTOR_SPEED => s.rotor_speed += f * h,
+                by::ONION_ANGLE => s.onion_angle += f * h,
+                by::ONION_TILT => s.onion_tilt += f * h,
+                by::STRAIN_DIRECTION => i.strain_direction += f * h,
+                by::STRESS => i.stress += f * h,
+                _ => i.load_torque += f * h,
+            }
+            values(&s, &i)
+        };
+        let (plus, minus) = (moved(1.0), moved(-1.0));
+        for (k, (name, gradient)) in exact.iter().enumerate() {
+            let fd = (plus[k] - minus[k]) / (2.0 * h);
+            let d = gradient[j];
+            // Relative to the larger of the two, with a floor: a millionth of the largest change
+            // any variable's perturbation makes in this quantity.
+            let size = d.abs().max(fd.abs());
+            let floor = (0..by::COUNT)
+                .map(|i| (gradient[i] * scale_of(i)).abs())
+                .fold(0.0, f64::max)
+                * 1e-6
+                / h
+                + 1e-300;
+            assert!(
+                (d - fd).abs() <= 2e-5 * size + floor,
+                "{what}: d {name} / d var {j}: exact {d:e}, central difference {fd:e}"
+            );
+        }
+    }
+}
+
+#[test]
+fn partials_match_central_differences() {
+    let m = motor();
+    let direction = (-45f64).to_radians();
+    let free = MotorInputs {
+        load_torque: 3e-19,
+        ..MotorInputs::fixed(direction, 200e6)
+    };
+    let at = |phi: f64, omega: f64, psi: f64| MotorState {
+        rotor_angle: phi,
+        rotor_speed: omega,
+        onion_angle: psi,
+        ..MotorState::aligned(0.0)
+    };
+    // Near alignment, at the torque peak's side, and moving.
+    check_partials(&m, &at(0.0, 0.0, 0.0), &free, "aligned");
+    check_partials(&m, &at(0.3, 2e3, 0.1), &free, "offset, moving");
+    check_partials(&m, &at(-0.2, -5e4, -0.5), &free, "far offset, fast");
+    // Locked rotor, then the schedule (its direction and stress are not inputs).
+    let locked = MotorInputs {
+        rotor_locked: true,
+        ..free
+    };
+    check_partials(&m, &at(0.1, 0.0, 0.0), &locked, "locked");
+    let sched = MotorInputs {
+        load_torque: -2e-19,
+        ..scheduled(1e-4)
+    };
+    check_partials(&m, &at(0.2, 1e3, 0.9), &sched, "schedule");
+    // Gilbert onion: psi and theta are states.
+    let g = gilbert();
+    let gs = MotorState {
+        onion_tilt: 1e-3,
+        ..at(0.2, 1e3, 0.5)
+    };
+    check_partials(&g, &gs, &free, "gilbert");
+    check_partials(&g, &gs, &locked, "gilbert locked");
+}
+
+#[test]
+fn partials_past_the_fold_follow_the_ghost() {
+    // Trial evaluations just beyond a fold see the ghost (the inflection the minimum left); its
+    // partials are those of the inflection's position.
+    let m = motor();
+    let direction = (-10f64).to_radians();
+    let mut s = MotorState::aligned(0.0);
+    let mut stress = 100e6;
+    let inputs = |stress| MotorInputs {
+        rotor_locked: true,
+        ..MotorInputs::fixed(direction, stress)
+    };
+    loop {
+        let e = m.me_evaluate(&s, &inputs(stress), 0.0).unwrap();
+        if let Some(Branch::Vanished { .. }) = e.branch {
+            break;
+        }
+        m.me_follow_branch(&mut s, &inputs(stress), 0.0).unwrap();
+        stress += 1e5;
+        assert!(stress < 300e6);
+    }
+    // Well past it, so the central differences stay on the ghost.
+    check_partials(&m, &s, &inputs(stress + 2e6), "ghost");
+}
+
+proptest::proptest! {
+    #![proptest_config(proptest::prelude::ProptestConfig::with_cases(2000))]
+    /// From a minimum of a nearby landscape, following the branch finds the minimum the
+    /// Co-Simulation settle finds unless the branch vanished; then the settle jumps away.
+    #[test]
+    fn follow_agrees_with_settle_or_reports_the_fold(
+        phi in -3.0f64..3.0,
+        direction in -3.2f64..3.2,
+        stress in 0.0f64..600e6,
+        start in -3.2f64..3.2,
+        dphi in -0.1f64..0.1,
+        dstress in -20e6f64..20e6,
+    ) {
+        let m = motor();
+        let anchor = m.landscape(phi, direction, stress).settle(start);
+        let moved = m.landscape(phi + dphi, direction, stress + dstress);
+        let settled = moved.settle(anchor);
+        match moved.follow(anchor) {
+            Branch::Minimum { angle, curvature } => {
+                proptest::prop_assert!((angle - settled).abs() < 1e-9, "{} {}", angle, settled);
+                proptest::prop_assert!(curvature >= 0.0);
+            }
+            Branch::Vanished { ghost, gradient } => {
+                proptest::prop_assert!(moved.curvature(ghost).abs() < 1e-6 * m.alignment_stiffness);
+                proptest::prop_assert!(gradient != 0.0);
+                // The settle crossed the ghost to another minimum.
+                proptest::prop_assert!((settled - ghost).abs() > 1e-3, "{} {}", settled, ghost);
+                let again = moved.follow(settled);
+                proptest::prop_assert!((again.angle() - settled).abs() < 1e-9, "{:?}", again);
+            }
+        }
+    }
+}
