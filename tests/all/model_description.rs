@@ -3,12 +3,12 @@
 //! change to the variables.
 
 #[allow(dead_code)]
-#[path = "../build/model_description.rs"]
+#[path = "../../build/model_description.rs"]
 mod model_description;
 
 use model_description::{check, guid_of, ResolvedUnknown};
 
-const SOURCE: &str = include_str!("../modelDescription/McKibbenMuscle.xml");
+const SOURCE: &str = include_str!("../../modelDescription/McKibbenMuscle.xml");
 
 /// The McKibben description with `from` replaced by `to` (which must occur).
 fn edited(from: &str, to: &str) -> String {
@@ -244,23 +244,23 @@ fn every_output_and_initial_unknown_declares_its_dependencies() {
         ("McKibbenMuscle", SOURCE),
         (
             "KnittedMuscle",
-            include_str!("../modelDescription/KnittedMuscle.xml"),
+            include_str!("../../modelDescription/KnittedMuscle.xml"),
         ),
         (
             "McKibbenJoint",
-            include_str!("../modelDescription/McKibbenJoint.xml"),
+            include_str!("../../modelDescription/McKibbenJoint.xml"),
         ),
         (
             "PulleyJoint",
-            include_str!("../modelDescription/PulleyJoint.xml"),
+            include_str!("../../modelDescription/PulleyJoint.xml"),
         ),
         (
             "MultiferroicMotor",
-            include_str!("../modelDescription/MultiferroicMotor.xml"),
+            include_str!("../../modelDescription/MultiferroicMotor.xml"),
         ),
         (
             "PassThrough",
-            include_str!("../modelDescription/PassThrough.xml"),
+            include_str!("../../modelDescription/PassThrough.xml"),
         ),
     ] {
         let m = check(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -340,8 +340,8 @@ fn the_guid_changes_with_any_variable() {
 /// which build.rs runs on the source and again on the shipped description: each one refuses a
 /// shipped description that breaks it.
 mod rules {
+    use super::model_description::rules;
     use super::{check, SOURCE};
-    use crate::model_description::rules;
 
     fn shipped() -> String {
         check(SOURCE, "McKibbenMuscle").unwrap().shipped_xml
