@@ -210,7 +210,7 @@ SANITIZER ?= address
 ## niced run on a loaded machine waits many times that for a core.
 FUZZ_TIMEOUT ?= 120
 ## Fuzzes random FMI call sequences on all six models for FUZZ_SECONDS (cargo-fuzz, nightly Rust),
-## with the harness of tests/fuzz_driver/ (tests/fuzz_corpus.rs replays the committed corpus in
+## with the harness of tests/fuzz_driver/ (tests/all/fuzz_corpus.rs replays the committed corpus in
 ## `make test`). The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go
 ## to the ignored fuzz/corpus-run/, findings to the ignored fuzz/artifacts/. The summary line
 ## counts the sequences run ("stat::number_of_executed_units"). The tracked fuzz/Cargo.lock must
