@@ -44,8 +44,15 @@ fn ident(v: &Variable) -> String {
     }
 }
 
+/// `a.b` -> `A_B`, `der(x)` -> `DER_X`.
 fn const_name(v: &Variable) -> String {
-    v.name.to_uppercase().replace('.', "_")
+    let upper: String = v
+        .name
+        .to_uppercase()
+        .chars()
+        .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+        .collect();
+    upper.trim_end_matches('_').to_string()
 }
 
 const RUST_TYPES: [&str; 4] = ["f64", "i32", "bool", "String"];
@@ -210,6 +217,7 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
         let _ = writeln!(code, "        }}");
         let _ = writeln!(code, "    }}");
     }
+    states(model, code)?;
     let _ = writeln!(
         code,
         "    /// The interface of `{stem}`: its typed variable groups and metadata."
@@ -219,25 +227,139 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
     for (name, _, _) in GROUPS {
         let _ = writeln!(code, "        type {name} = {name};");
     }
+    let _ = writeln!(code, "        type States = States;");
+    let _ = writeln!(
+        code,
+        "        const EVENT_INDICATORS: usize = {};",
+        model.event_indicators
+    );
     let _ = writeln!(code, "        const INFO: &'static ModelInfo = &INFO;");
     let _ = writeln!(code, "    }}");
     let _ = writeln!(code, "}}\n");
     Ok(())
 }
 
-/// The field of the export layer's `Values` that holds a variable of this causality.
-fn group(causality: &str) -> Result<&'static str, String> {
-    Ok(match causality {
+/// The `States` struct of a model (named fields in state-vector order, also used for the
+/// derivatives) and its [`ContinuousStates`] implementation; an empty struct without states.
+fn states(model: &Model, code: &mut String) -> Result<(), String> {
+    let n = model.states.len();
+    let vars = &model.variables;
+    let _ = writeln!(
+        code,
+        "    /// The continuous states, in the order of <ModelStructure><Derivatives>; the same struct holds their derivatives."
+    );
+    let _ = writeln!(
+        code,
+        "    #[derive(Clone, Copy, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]"
+    );
+    let _ = writeln!(code, "    pub struct States {{");
+    for &(s, _) in &model.states {
+        let v = &vars[s];
+        let unit = v.unit.as_deref().unwrap_or("1");
+        let _ = writeln!(code, "        /// {} ({unit})", v.description);
+        let _ = writeln!(code, "        pub {}: f64,", ident(v));
+    }
+    let _ = writeln!(code, "    }}");
+    let names = |which: fn(&(usize, usize)) -> usize| -> Vec<&str> {
+        model
+            .states
+            .iter()
+            .map(|p| vars[which(p)].name.as_str())
+            .collect()
+    };
+    let vrs = |which: fn(&(usize, usize)) -> usize| -> Vec<u32> {
+        model
+            .states
+            .iter()
+            .map(|p| vars[which(p)].value_reference)
+            .collect()
+    };
+    let nominals = model
+        .states
+        .iter()
+        .map(|&(s, _)| real_literal(vars[s].nominal.as_deref().unwrap_or("1")))
+        .collect::<Result<Vec<_>, _>>()?;
+    let fields: Vec<String> = model.states.iter().map(|&(s, _)| ident(&vars[s])).collect();
+    let _ = writeln!(code, "    #[allow(unused_variables)]");
+    let _ = writeln!(code, "    impl ContinuousStates for States {{");
+    let _ = writeln!(code, "        const COUNT: usize = {n};");
+    let _ = writeln!(
+        code,
+        "        const NAMES: &'static [&'static str] = &{:?};",
+        names(|p| p.0)
+    );
+    let _ = writeln!(
+        code,
+        "        const DERIVATIVE_NAMES: &'static [&'static str] = &{:?};",
+        names(|p| p.1)
+    );
+    let _ = writeln!(
+        code,
+        "        const VALUE_REFERENCES: &'static [u32] = &{:?};",
+        vrs(|p| p.0)
+    );
+    let _ = writeln!(
+        code,
+        "        const DERIVATIVE_VALUE_REFERENCES: &'static [u32] = &{:?};",
+        vrs(|p| p.1)
+    );
+    let _ = writeln!(
+        code,
+        "        const NOMINALS: &'static [f64] = &[{}];",
+        nominals.join(", ")
+    );
+    let _ = writeln!(code, "        #[inline]");
+    let _ = writeln!(code, "        fn from_slice(x: &[f64]) -> Self {{");
+    let _ = writeln!(code, "            Self {{");
+    for (i, f) in fields.iter().enumerate() {
+        let _ = writeln!(code, "                {f}: x[{i}],");
+    }
+    let _ = writeln!(code, "            }}");
+    let _ = writeln!(code, "        }}");
+    let _ = writeln!(code, "        #[inline]");
+    let _ = writeln!(code, "        fn write_to(&self, x: &mut [f64]) {{");
+    for (i, f) in fields.iter().enumerate() {
+        let _ = writeln!(code, "            x[{i}] = self.{f};");
+    }
+    let _ = writeln!(code, "        }}");
+    let _ = writeln!(code, "    }}");
+    let _ = writeln!(code, "    impl From<[f64; {n}]> for States {{");
+    let _ = writeln!(code, "        fn from(x: [f64; {n}]) -> Self {{");
+    let _ = writeln!(code, "            Self::from_slice(&x)");
+    let _ = writeln!(code, "        }}");
+    let _ = writeln!(code, "    }}");
+    let _ = writeln!(code, "    impl From<States> for [f64; {n}] {{");
+    let _ = writeln!(code, "        fn from(s: States) -> Self {{");
+    let _ = writeln!(code, "            let mut x = [0.0; {n}];");
+    let _ = writeln!(code, "            s.write_to(&mut x);");
+    let _ = writeln!(code, "            x");
+    let _ = writeln!(code, "        }}");
+    let _ = writeln!(code, "    }}");
+    Ok(())
+}
+
+/// The place in the export layer's `Values` that holds variable `i`: its causality's group, or
+/// for a local the state mirror or the derivatives (by the state's field).
+fn place(model: &Model, i: usize) -> Result<(&'static str, String), String> {
+    let v = &model.variables[i];
+    let group = match v.causality.as_str() {
         "parameter" => "parameters",
         "input" => "inputs",
         "output" => "outputs",
         "calculatedParameter" => "calculated",
+        "local" => {
+            if let Some(&(s, _)) = model.states.iter().find(|&&(_, d)| d == i) {
+                return Ok(("derivatives", ident(&model.variables[s])));
+            }
+            "states"
+        }
         other => {
             return Err(format!(
-                "causality '{other}' has no typed group yet (parameter, calculatedParameter, input, output)"
+                "causality '{other}' has no typed group (parameter, calculatedParameter, input, output, local state or derivative)"
             ))
         }
-    })
+    };
+    Ok((group, ident(v)))
 }
 
 /// Appends the export layer's access by value reference to the typed values of `model`
@@ -259,8 +381,11 @@ pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
             _ => (rust, "Default::default()", rust),
         };
         let mut arms = Vec::new();
-        for v in model.variables.iter().filter(|v| v.type_index == t) {
-            arms.push((v.value_reference, group(&v.causality)?, ident(v)));
+        for (i, v) in model.variables.iter().enumerate() {
+            if v.type_index == t {
+                let (g, f) = place(model, i)?;
+                arms.push((v.value_reference, g, f));
+            }
         }
         let _ = writeln!(code, "    #[inline]");
         let _ = writeln!(

@@ -39,14 +39,20 @@ const MODEL_EXCHANGE_CAPABILITIES: &str = r#"needsExecutionTool="false"
 /// The models whose `Model::partials` gives exact partial derivatives (`src/models`), so that
 /// the export layer serves `fmi2GetDirectionalDerivative` for them; a Rust test checks that the
 /// shipped flag and the models agree.
-const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &["McKibbenJoint", "McKibbenMuscle", "PassThrough"];
+const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &[
+    "McKibbenJoint",
+    "McKibbenMuscle",
+    "PassThrough",
+    "PulleyJoint",
+];
 
-/// The models that also serve Model Exchange, without continuous states
-/// (`Model::ALGEBRAIC_MODEL_EXCHANGE`, `src/fmi2/model_exchange.rs`); a Rust test checks that the
+/// The models that also serve Model Exchange (`Model::MODEL_EXCHANGE`: algebraic models, and
+/// models with continuous states, `src/fmi2/model_exchange.rs`); a Rust test checks that the
 /// shipped block and the models agree.
 const MODEL_EXCHANGE: &[&str] = &[
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",
     "PassThrough",
+    "PulleyJoint",
 ];

@@ -30,6 +30,8 @@ struct ModelDescription {
     guid: String,
     #[serde(rename = "@description", default)]
     description: String,
+    #[serde(rename = "@numberOfEventIndicators")]
+    number_of_event_indicators: Option<String>,
     #[serde(rename = "CoSimulation")]
     co_simulation: Option<IgnoredAny>,
     #[serde(rename = "ModelExchange")]
@@ -105,14 +107,20 @@ struct TypeAttributes {
     unit: Option<String>,
     #[serde(rename = "@declaredType")]
     declared_type: Option<String>,
+    /// In the source, the NAME of the state this variable is the derivative of; the shipped
+    /// description gets its index.
+    #[serde(rename = "@derivative")]
+    derivative: Option<String>,
+    #[serde(rename = "@nominal")]
+    nominal: Option<String>,
 }
 
 #[derive(Deserialize, Default)]
 struct ModelStructure {
     #[serde(rename = "Outputs", default)]
     outputs: Unknowns,
-    #[serde(rename = "Derivatives")]
-    derivatives: Option<IgnoredAny>,
+    #[serde(rename = "Derivatives", default)]
+    derivatives: Unknowns,
     #[serde(rename = "InitialUnknowns", default)]
     initial_unknowns: Unknowns,
 }
@@ -153,6 +161,9 @@ pub struct Variable {
     pub min: Option<String>,
     pub max: Option<String>,
     pub unit: Option<String>,
+    /// The state this variable is the derivative of (source: by name).
+    pub derivative_of: Option<String>,
+    pub nominal: Option<String>,
 }
 
 /// One ModelStructure entry with 1-based indices.
@@ -175,6 +186,13 @@ pub struct Model {
     pub outputs: Vec<ResolvedUnknown>,
     #[allow(dead_code)]
     pub initial_unknowns: Vec<ResolvedUnknown>,
+    #[allow(dead_code)]
+    pub derivatives: Vec<ResolvedUnknown>,
+    /// The continuous states in state-vector order: (state, derivative) variable indices
+    /// (0-based into `variables`), ordered as the derivatives are declared.
+    pub states: Vec<(usize, usize)>,
+    /// `numberOfEventIndicators`.
+    pub event_indicators: usize,
     /// The model description as shipped in the FMU, GUID filled in.
     pub shipped_xml: String,
     pub guid: String,
@@ -199,7 +217,6 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
         (md.co_simulation.is_some(), "CoSimulation"),
         (md.model_exchange.is_some(), "ModelExchange"),
         (md.log_categories.is_some(), "LogCategories"),
-        (md.model_structure.derivatives.is_some(), "Derivatives"),
     ] {
         if present {
             return Err(format!(
@@ -252,9 +269,22 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
             ));
         }
     }
-    let (outputs, initial_unknowns) = resolve_structure(&md.model_structure, &variables)?;
+    let states = resolve_states(&variables)?;
+    let event_indicators = match md.number_of_event_indicators.as_deref() {
+        None => 0,
+        Some(n) => n.trim().parse::<usize>().map_err(|_| {
+            format!("numberOfEventIndicators must be a non-negative integer, got '{n}'")
+        })?,
+    };
+    let (outputs, derivatives, initial_unknowns) =
+        resolve_structure(&md.model_structure, &variables, &states)?;
     rules::check(text)?;
-    let rendered = shipped(text, stem, &variables, &outputs, &initial_unknowns)?;
+    let structure = [
+        ("Outputs", outputs.as_slice()),
+        ("Derivatives", derivatives.as_slice()),
+        ("InitialUnknowns", initial_unknowns.as_slice()),
+    ];
+    let rendered = shipped(text, stem, &variables, &states, &structure)?;
     // The rules again on what ships: the export layer's part and the resolved indices included.
     rules::check(&rendered).map_err(|e| format!("shipped description: {e}"))?;
     let guid = guid_of(&rendered);
@@ -265,6 +295,9 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
         counts,
         outputs,
         initial_unknowns,
+        derivatives,
+        states,
+        event_indicators,
         shipped_xml: rendered.replacen(GUID_PLACEHOLDER, &guid, 1),
         guid,
     })
@@ -343,35 +376,126 @@ fn check_variable(v: &ScalarVariable, units: &BTreeSet<&str>) -> Result<Variable
         min: attrs.min.clone(),
         max: attrs.max.clone(),
         unit: attrs.unit.clone(),
+        derivative_of: attrs.derivative.clone(),
+        nominal: attrs.nominal.clone(),
     })
+}
+
+/// FMI 2.0 sections 2.2.7 and 3.1: the continuous states are the variables that a derivative
+/// variable names in its `derivative` attribute (here by name). Returns (state, derivative) pairs
+/// in the order the derivatives are declared, which is the state-vector order.
+fn resolve_states(variables: &[Variable]) -> Result<Vec<(usize, usize)>, String> {
+    let mut states: Vec<(usize, usize)> = Vec::new();
+    for (d, v) in variables.iter().enumerate() {
+        let Some(name) = v.derivative_of.as_deref() else {
+            continue;
+        };
+        let at = |e: String| format!("variable '{}': {e}", v.name);
+        if name.trim().parse::<usize>().is_ok() {
+            return Err(at(format!(
+                "derivative=\"{name}\": name the state; build.rs writes its index"
+            )));
+        }
+        let s = variables
+            .iter()
+            .position(|x| x.name == name)
+            .ok_or_else(|| at(format!("derivative=\"{name}\" is not a variable")))?;
+        let state = &variables[s];
+        if v.type_index != 0 || v.variability != "continuous" {
+            return Err(at("a derivative must be a continuous Real".into()));
+        }
+        if v.causality != "local" || v.initial != "calculated" {
+            return Err(at(
+                "a derivative must be a local with initial 'calculated' (the model computes it)"
+                    .into(),
+            ));
+        }
+        if s == d {
+            return Err(at("a variable cannot be its own derivative".into()));
+        }
+        if state.type_index != 0
+            || state.variability != "continuous"
+            || !matches!(state.causality.as_str(), "output" | "local")
+        {
+            return Err(at(format!(
+                "the state '{name}' must be a continuous Real output or local"
+            )));
+        }
+        if state.derivative_of.is_some() {
+            return Err(at(format!(
+                "the state '{name}' is itself a derivative; declare its own state variable"
+            )));
+        }
+        if let Some(&(_, other)) = states.iter().find(|(x, _)| *x == s) {
+            return Err(at(format!(
+                "the state '{name}' already has the derivative '{}'",
+                variables[other].name
+            )));
+        }
+        states.push((s, d));
+    }
+    for (i, v) in variables.iter().enumerate() {
+        if v.causality == "local" && !states.iter().any(|&(s, d)| s == i || d == i) {
+            return Err(format!(
+                "variable '{}': a local must be a continuous state or a state derivative \
+                 (other locals have no typed group)",
+                v.name
+            ));
+        }
+    }
+    Ok(states)
 }
 
 const DEPENDENCY_KINDS: [&str; 5] = ["dependent", "constant", "fixed", "tunable", "discrete"];
 
-/// FMI 2.0 section 2.2.8. Outputs: every output, in order. InitialUnknowns: outputs with initial
-/// calculated or approx and every calculated parameter, ascending. The source may list any of
-/// them by name with their dependencies, and must: an unknown without a declared list is refused.
+type Structure = (
+    Vec<ResolvedUnknown>,
+    Vec<ResolvedUnknown>,
+    Vec<ResolvedUnknown>,
+);
+
+/// FMI 2.0 section 2.2.8. Outputs: every output, in order. Derivatives: every state derivative,
+/// in state order. InitialUnknowns: outputs and locals (states, derivatives) with initial
+/// calculated or approx and every calculated parameter, ascending. The source lists each by name
+/// with its dependencies, and must: an unknown without a declared list is refused. Outputs and
+/// derivatives depend on the knowns: inputs and continuous states.
 fn resolve_structure(
     md: &ModelStructure,
     variables: &[Variable],
-) -> Result<(Vec<ResolvedUnknown>, Vec<ResolvedUnknown>), String> {
+    states: &[(usize, usize)],
+) -> Result<Structure, String> {
     let expected_outputs: Vec<usize> = (0..variables.len())
         .filter(|&i| variables[i].causality == "output")
         .collect();
+    let expected_derivatives: Vec<usize> = states.iter().map(|&(_, d)| d).collect();
     let expected_initial: Vec<usize> = (0..variables.len())
         .filter(|&i| {
             let v = &variables[i];
-            (v.causality == "output" && matches!(v.initial, "calculated" | "approx"))
+            (matches!(v.causality.as_str(), "output" | "local")
+                && matches!(v.initial, "calculated" | "approx"))
                 || v.causality == "calculatedParameter"
         })
         .collect();
+    let state_names: Vec<&str> = states
+        .iter()
+        .map(|&(s, _)| variables[s].name.as_str())
+        .collect();
+    let known = |v: &Variable| v.causality == "input" || state_names.contains(&v.name.as_str());
     let outputs = resolve_list(
         "Outputs",
         &md.outputs,
         &expected_outputs,
         variables,
-        |v| v.causality == "input",
-        "an input",
+        known,
+        "an input or a continuous state",
+    )?;
+    let derivatives = resolve_list(
+        "Derivatives",
+        &md.derivatives,
+        &expected_derivatives,
+        variables,
+        known,
+        "an input or a continuous state",
     )?;
     let initial = resolve_list(
         "InitialUnknowns",
@@ -381,7 +505,7 @@ fn resolve_structure(
         |v| v.causality == "input" || v.initial == "exact",
         "an input or a variable with initial 'exact'",
     )?;
-    Ok((outputs, initial))
+    Ok((outputs, derivatives, initial))
 }
 
 fn resolve_list(
@@ -557,8 +681,8 @@ fn shipped(
     text: &str,
     stem: &str,
     variables: &[Variable],
-    outputs: &[ResolvedUnknown],
-    initial_unknowns: &[ResolvedUnknown],
+    states: &[(usize, usize)],
+    lists: &[(&str, &[ResolvedUnknown])],
 ) -> Result<String, String> {
     let s = find_splices(text)?;
     let derivatives = PROVIDE_DIRECTIONAL_DERIVATIVE.contains(&stem);
@@ -591,7 +715,7 @@ fn shipped(
         inserts.push((at, at, format!("<!-- {} -->", i + 1)));
     }
     let mut structure = String::from("<ModelStructure>\n");
-    for (list, unknowns) in [("Outputs", outputs), ("InitialUnknowns", initial_unknowns)] {
+    for &(list, unknowns) in lists {
         if unknowns.is_empty() {
             continue;
         }
@@ -633,6 +757,17 @@ fn shipped(
         cursor = end;
     }
     out.push_str(&text[cursor..]);
+    // Each derivative names its state in the source; the shipped description gives the index.
+    for &(state, derivative) in states {
+        let named = format!("derivative=\"{}\"", variables[state].name);
+        if out.matches(&named).count() != 1 {
+            return Err(format!(
+                "variable '{}': {named} must appear exactly once in the description",
+                variables[derivative].name
+            ));
+        }
+        out = out.replacen(&named, &format!("derivative=\"{}\"", state + 1), 1);
+    }
     Ok(out)
 }
 

@@ -24,13 +24,20 @@ pub const RULES: &[&str] = &[
     "variableNamingConvention 'structured' names follow the structured grammar (2.2.9)",
     "ModelStructure Unknown indices refer to existing variables, at most once per list (2.2.8)",
     "every Outputs and InitialUnknowns entry declares its dependencies (issue 12)",
-    "dependencies are ascending unique indices of inputs or the independent variable, \
-     dependenciesKind has one valid kind per dependency (2.2.8)",
+    "dependencies are ascending unique indices of knowns: inputs, continuous states (Outputs and \
+     Derivatives) or the independent variable, dependenciesKind has one valid kind per \
+     dependency (2.2.8)",
+    "a Real's derivative attribute is the index of a continuous Real output or local, and each \
+     Derivatives entry is a variable that has one (2.2.7, 2.2.8)",
 ];
 
 struct Variable {
     name: String,
     causality: String,
+    /// The index its `derivative` attribute gives (shipped description; a source names the state).
+    derivative: Option<usize>,
+    /// Real with variability continuous.
+    continuous_real: bool,
 }
 
 fn attributes(e: &BytesStart) -> Result<BTreeMap<String, String>, String> {
@@ -205,11 +212,27 @@ pub fn check(text: &str) -> Result<(), String> {
                         .get("causality")
                         .cloned()
                         .unwrap_or_else(|| "local".into()),
+                    derivative: None,
+                    continuous_real: attrs.get("variability").is_none_or(|v| v == "continuous"),
                 });
             }
             ("ScalarVariable", kind @ ("Real" | "Integer" | "Boolean" | "String")) => {
                 let var = variables.last().map_or("?", |v| v.name.as_str());
                 let at = format!("variable '{var}'");
+                if kind != "Real" {
+                    if let Some(last) = variables.last_mut() {
+                        last.continuous_real = false;
+                    }
+                }
+                if let Some(d) = attrs.get("derivative") {
+                    if kind != "Real" {
+                        return Err(format!("{at}: only a Real has a derivative attribute"));
+                    }
+                    // A source names the state (build.rs resolves it); a shipped one indexes it.
+                    if let (Ok(index), Some(last)) = (d.trim().parse(), variables.last_mut()) {
+                        last.derivative = Some(index);
+                    }
+                }
                 if matches!(kind, "Boolean" | "String") {
                     if let Some(key) = ["min", "max", "unit", "nominal", "quantity"]
                         .into_iter()
@@ -249,7 +272,49 @@ pub fn check(text: &str) -> Result<(), String> {
             path.push(tag);
         }
     }
+    check_derivatives(&variables, &unknowns)?;
     check_unknowns(&variables, &unknowns)
+}
+
+/// The continuous states: the variables a `derivative` attribute points to, 1-based.
+fn states(variables: &[Variable]) -> Result<BTreeSet<usize>, String> {
+    let mut states = BTreeSet::new();
+    for v in variables {
+        let Some(s) = v.derivative else { continue };
+        let state = s.checked_sub(1).and_then(|i| variables.get(i));
+        if !state.is_some_and(|x| {
+            x.continuous_real && matches!(x.causality.as_str(), "output" | "local")
+        }) {
+            return Err(format!(
+                "variable '{}': derivative=\"{s}\" is not the index of a continuous Real \
+                 output or local",
+                v.name
+            ));
+        }
+        if !states.insert(s) {
+            return Err(format!("variable {s} is the state of two derivatives"));
+        }
+    }
+    Ok(states)
+}
+
+fn check_derivatives(
+    variables: &[Variable],
+    unknowns: &[(String, BTreeMap<String, String>)],
+) -> Result<(), String> {
+    states(variables)?;
+    for (list, attrs) in unknowns {
+        let index = attrs.get("index").and_then(|i| i.parse::<usize>().ok());
+        if let (Some(i), "Derivatives") = (index, list.as_str()) {
+            let v = i.checked_sub(1).and_then(|i| variables.get(i));
+            if v.is_none_or(|v| v.derivative.is_none()) {
+                return Err(format!(
+                    "ModelStructure/Derivatives: Unknown {i} is not a variable with a derivative attribute"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 fn check_unknowns(
@@ -257,6 +322,7 @@ fn check_unknowns(
     unknowns: &[(String, BTreeMap<String, String>)],
 ) -> Result<(), String> {
     let mut seen: BTreeSet<(&str, usize)> = BTreeSet::new();
+    let states = states(variables)?;
     for (list, attrs) in unknowns {
         let at = format!("ModelStructure/{list}");
         if !attrs.contains_key("index") && attrs.contains_key("name") {
@@ -305,13 +371,14 @@ fn check_unknowns(
                     "{at}: Unknown {index}: dependency {d} is not a variable"
                 ));
             };
-            // Co-Simulation without states: outputs depend on inputs (and time); initial
-            // unknowns also on the parameters and start values (FMI 2.0 section 2.2.8).
+            // Outputs and derivatives depend on the knowns: inputs, continuous states and time;
+            // initial unknowns on the inputs, parameters and start values (FMI 2.0 section 2.2.8).
             let allowed = match list.as_str() {
                 "InitialUnknowns" => {
                     matches!(v.causality.as_str(), "input" | "parameter" | "independent")
+                        || states.contains(&d)
                 }
-                _ => matches!(v.causality.as_str(), "input" | "independent"),
+                _ => matches!(v.causality.as_str(), "input" | "independent") || states.contains(&d),
             };
             if !allowed {
                 return Err(format!(

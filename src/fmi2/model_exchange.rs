@@ -13,7 +13,7 @@
 use super::exports::{guarded, null_argument, slice, slice_mut};
 use super::instance::{allowed, Instance, MachineState};
 use super::types::*;
-use crate::models::Report;
+use crate::models::{EventUpdate, Report};
 
 /// `fmi2EventInfo` (fmi2FunctionTypes.h).
 #[repr(C)]
@@ -40,15 +40,35 @@ impl Instance {
         self.allowed(function, mask)
     }
 
-    /// Commits the discrete state (friction history) at the current inputs and time.
-    fn commit(&mut self, function: &str) -> fmi2Status {
-        let status = self.refresh_outputs(function);
+    /// Gives the model the current time and builds it in initialization mode (as fmi2GetReal
+    /// does); outputs are refreshed if inputs, states or time made them stale.
+    fn prepare(&mut self, function: &str) -> fmi2Status {
+        self.runtime.set_time(self.time);
+        self.refresh_outputs(function)
+    }
+
+    /// Commits the discrete state at the current inputs and time: event mode or a completed
+    /// integrator step.
+    fn commit(&mut self, function: &str, event_mode: bool) -> (fmi2Status, EventUpdate, bool) {
+        let status = self.prepare(function);
         if status >= fmi2Status::Error {
-            return status;
+            return (status, EventUpdate::default(), false);
         }
         let mut report = Report::default();
-        self.runtime.update_discrete_states(self.time, &mut report);
-        status.max(self.forward(function, report, false))
+        let (update, event) = if event_mode {
+            let update = self.runtime.update_discrete_states(self.time, &mut report);
+            (update, false)
+        } else {
+            let event = self
+                .runtime
+                .completed_integrator_step(self.time, &mut report);
+            (EventUpdate::default(), event)
+        };
+        (
+            status.max(self.forward(function, report, false)),
+            update,
+            event,
+        )
     }
 
     pub fn enter_event_mode(&mut self) -> fmi2Status {
@@ -60,20 +80,23 @@ impl Instance {
         fmi2Status::OK
     }
 
-    /// One event iteration: commits the history; no continuous states, no time events.
+    /// One event iteration: commits the history, lets the model update its discrete states (and
+    /// reinitialize continuous ones), and gives the next time event.
     pub fn new_discrete_states(&mut self, info: &mut fmi2EventInfo) -> fmi2Status {
         const F: &str = "fmi2NewDiscreteStates";
         if !self.me_allowed(F, allowed::EVENT_MODE) {
             return fmi2Status::Error;
         }
-        let status = self.commit(F);
+        let (status, update, _) = self.commit(F, true);
+        let next = self.runtime.next_time_event(self.time);
+        let flag = |b: bool| if b { FMI2_TRUE } else { FMI2_FALSE };
         *info = fmi2EventInfo {
-            new_discrete_states_needed: FMI2_FALSE,
-            terminate_simulation: FMI2_FALSE,
+            new_discrete_states_needed: flag(update.iterate),
+            terminate_simulation: flag(update.terminate),
             nominals_of_continuous_states_changed: FMI2_FALSE,
-            values_of_continuous_states_changed: FMI2_FALSE,
-            next_event_time_defined: FMI2_FALSE,
-            next_event_time: 0.0,
+            values_of_continuous_states_changed: flag(update.states_changed),
+            next_event_time_defined: flag(next.is_some()),
+            next_event_time: next.unwrap_or(0.0),
         };
         status
     }
@@ -87,13 +110,14 @@ impl Instance {
         fmi2Status::OK
     }
 
-    /// Commits the history at the accepted point; never asks for an event.
+    /// Commits the history at the accepted point; the model may ask for an event there.
     pub fn completed_integrator_step(&mut self) -> (fmi2Status, bool) {
         const F: &str = "fmi2CompletedIntegratorStep";
         if !self.me_allowed(F, allowed::CONTINUOUS_TIME_MODE) {
             return (fmi2Status::Error, false);
         }
-        (self.commit(F), false)
+        let (status, _, event) = self.commit(F, false);
+        (status, event)
     }
 
     pub fn set_time(&mut self, time: f64) -> fmi2Status {
@@ -105,21 +129,100 @@ impl Instance {
             return self.error(&format!("{F}: time must be finite, got {time}"));
         }
         self.time = time;
+        self.runtime.set_time(time);
         fmi2Status::OK
     }
 
-    /// The continuous-state vectors: none, so only `n = 0` is accepted.
-    pub fn states(&self, function: &str, mask: u32, n: usize, what: &str) -> fmi2Status {
+    /// Checks a state-sized (or event-indicator-sized) vector call: interface, machine state,
+    /// length; then builds the model if initialization needs it.
+    fn vector_call(&mut self, function: &str, mask: u32, n: usize, what: Vector) -> fmi2Status {
         if !self.me_allowed(function, mask) {
             return fmi2Status::Error;
         }
-        if n != 0 {
+        let (expected, count) = match what {
+            Vector::EventIndicators => (
+                self.runtime.event_indicator_count(),
+                "numberOfEventIndicators",
+            ),
+            _ => (self.runtime.state_count(), "numberOfContinuousStates"),
+        };
+        if n != expected {
+            let has = match expected {
+                0 => "none".to_string(),
+                _ => expected.to_string(),
+            };
             return self.error(&format!(
-                "{function}: {n} {what} requested, but this model has none \
-                 (numberOfContinuousStates and numberOfEventIndicators are 0)"
+                "{function}: {n} {} requested, but this model has {has} ({count} is {expected})",
+                what.name()
             ));
         }
-        fmi2Status::OK
+        if n == 0 {
+            return fmi2Status::OK;
+        }
+        // The hot path: only the time goes to the model; the outputs are not recomputed (an
+        // unbuilt model is built in initialization mode, as fmi2GetReal does).
+        self.runtime.set_time(self.time);
+        if self.runtime.is_built() {
+            fmi2Status::OK
+        } else {
+            self.refresh_outputs(function)
+        }
+    }
+
+    /// `fmi2GetContinuousStates`, `fmi2GetDerivatives`, `fmi2GetEventIndicators`,
+    /// `fmi2GetNominalsOfContinuousStates` on a checked buffer.
+    pub fn get_vector(&mut self, function: &str, what: Vector, out: &mut [f64]) -> fmi2Status {
+        let status = self.vector_call(function, allowed::GET_STATES, out.len(), what);
+        if status >= fmi2Status::Error || out.is_empty() {
+            return status;
+        }
+        let result = match what {
+            Vector::States => self.runtime.continuous_states(out),
+            Vector::Derivatives => self.runtime.derivatives(out),
+            Vector::EventIndicators => self.runtime.event_indicators(out),
+            Vector::Nominals => {
+                self.runtime.nominals(out);
+                Ok(())
+            }
+        };
+        match result {
+            Ok(()) => status,
+            Err(why) => self.error(&format!("{function}: {why}")),
+        }
+    }
+
+    /// `fmi2SetContinuousStates`: finite values the model accepts, or an error and the states
+    /// kept.
+    pub fn set_continuous_states(&mut self, x: &[f64]) -> fmi2Status {
+        const F: &str = "fmi2SetContinuousStates";
+        let status = self.vector_call(F, allowed::CONTINUOUS_TIME_MODE, x.len(), Vector::States);
+        if status >= fmi2Status::Error || x.is_empty() {
+            return status;
+        }
+        match self.runtime.set_continuous_states(x) {
+            Ok(()) => status,
+            Err(why) => self.error(&format!("{F}: {why}")),
+        }
+    }
+}
+
+/// The state-sized vectors of Model Exchange (and the event indicators).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Vector {
+    States,
+    Derivatives,
+    EventIndicators,
+    Nominals,
+}
+
+impl Vector {
+    fn name(self) -> &'static str {
+        match self {
+            Vector::States => "states",
+            Vector::Derivatives => "derivatives",
+            Vector::EventIndicators => "event indicators",
+            Vector::Nominals => "nominals",
+        }
     }
 }
 
@@ -193,30 +296,29 @@ pub unsafe extern "C" fn fmi2SetContinuousStates(
     unsafe {
         guarded(c, F, |inst| {
             // SAFETY: the importer passes nx readable values (or NULL, refused here).
-            if slice(x, nx).is_none() {
-                return null_argument(inst, F, "x");
+            match slice(x, nx) {
+                Some(x) => inst.set_continuous_states(x),
+                None => null_argument(inst, F, "x"),
             }
-            inst.states(F, allowed::CONTINUOUS_TIME_MODE, nx, "states")
         })
     }
 }
 
-/// The getters of state-sized vectors: none to write.
+/// The getters of state-sized vectors, on the importer's buffer of n values.
 unsafe fn get_vector(
     c: fmi2Component,
     function: &'static str,
-    mask: u32,
+    what: Vector,
     values: *mut fmi2Real,
     n: usize,
-    what: &'static str,
 ) -> fmi2Status {
     unsafe {
         guarded(c, function, |inst| {
             // SAFETY: the importer passes n writable values (or NULL, refused here).
-            if slice_mut(values, n).is_none() {
-                return null_argument(inst, function, what);
+            match slice_mut(values, n) {
+                Some(out) => inst.get_vector(function, what, out),
+                None => null_argument(inst, function, what.name()),
             }
-            inst.states(function, mask, n, what)
         })
     }
 }
@@ -231,10 +333,9 @@ pub unsafe extern "C" fn fmi2GetDerivatives(
         get_vector(
             c,
             "fmi2GetDerivatives",
-            allowed::GET_STATES,
+            Vector::Derivatives,
             derivatives,
             nx,
-            "derivatives",
         )
     }
 }
@@ -249,10 +350,9 @@ pub unsafe extern "C" fn fmi2GetEventIndicators(
         get_vector(
             c,
             "fmi2GetEventIndicators",
-            allowed::GET_STATES,
+            Vector::EventIndicators,
             indicators,
             ni,
-            "event indicators",
         )
     }
 }
@@ -263,16 +363,7 @@ pub unsafe extern "C" fn fmi2GetContinuousStates(
     x: *mut fmi2Real,
     nx: usize,
 ) -> fmi2Status {
-    unsafe {
-        get_vector(
-            c,
-            "fmi2GetContinuousStates",
-            allowed::GET_STATES,
-            x,
-            nx,
-            "states",
-        )
-    }
+    unsafe { get_vector(c, "fmi2GetContinuousStates", Vector::States, x, nx) }
 }
 
 #[no_mangle]
@@ -285,10 +376,9 @@ pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
         get_vector(
             c,
             "fmi2GetNominalsOfContinuousStates",
-            allowed::GET_STATES,
+            Vector::Nominals,
             nominals,
             nx,
-            "nominals",
         )
     }
 }

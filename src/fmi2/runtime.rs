@@ -2,8 +2,8 @@
 //! model, behind a trait object so that the exported functions are written once for every model.
 
 use super::registry::Bindings;
-use crate::models::{Model, Report};
-use crate::variables::{Interface, ModelInfo};
+use crate::models::{EventUpdate, Model, Report};
+use crate::variables::{ContinuousStates, Interface, ModelInfo};
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::marker::PhantomData;
@@ -18,6 +18,12 @@ pub struct Values<V: Interface> {
     pub inputs: V::Inputs,
     pub outputs: V::Outputs,
     pub calculated: V::CalculatedParameters,
+    /// Model Exchange: the model's states (read by `fmi2GetReal` for the local ones) and their
+    /// derivatives (`der(x)`) as last computed. Copies of what the model owns, so not saved.
+    #[serde(skip)]
+    pub states: V::States,
+    #[serde(skip)]
+    pub derivatives: V::States,
 }
 
 // By hand: a derive would ask `V: Clone` of the marker type.
@@ -28,6 +34,8 @@ impl<V: Interface> Clone for Values<V> {
             inputs: self.inputs.clone(),
             outputs: self.outputs.clone(),
             calculated: self.calculated.clone(),
+            states: self.states,
+            derivatives: self.derivatives,
         }
     }
 }
@@ -40,6 +48,8 @@ impl<V: Interface> Default for Values<V> {
             inputs: Default::default(),
             outputs: Default::default(),
             calculated: Default::default(),
+            states: Default::default(),
+            derivatives: Default::default(),
         }
     }
 }
@@ -50,7 +60,7 @@ pub trait Factory: Sync {
     /// HTML fragment describing the model's equations.
     fn documentation(&self) -> &'static str;
     fn create(&self) -> Box<dyn Runtime>;
-    /// Whether the model serves Model Exchange ([`Model::ALGEBRAIC_MODEL_EXCHANGE`]).
+    /// Whether the model serves Model Exchange ([`Model::MODEL_EXCHANGE`]).
     fn model_exchange(&self) -> bool;
 }
 
@@ -71,13 +81,14 @@ where
         M::DOCUMENTATION
     }
     fn model_exchange(&self) -> bool {
-        M::ALGEBRAIC_MODEL_EXCHANGE
+        M::MODEL_EXCHANGE
     }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
             values: Values::default(),
             model: None,
             outputs_stale: true,
+            time: None,
         })
     }
 }
@@ -102,9 +113,28 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
-    /// Model Exchange: commits the history at the current inputs (completed integrator step or
-    /// event) and writes the outputs.
-    fn update_discrete_states(&mut self, time: f64, report: &mut Report);
+    /// Model Exchange, event mode: commits the history at the current inputs and writes the
+    /// outputs ([`Model::update_discrete_states`]).
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate;
+    /// Model Exchange: the integrator accepted a step; whether the model asks for an event.
+    fn completed_integrator_step(&mut self, time: f64, report: &mut Report) -> bool;
+    /// `numberOfContinuousStates` and `numberOfEventIndicators`.
+    fn state_count(&self) -> usize;
+    fn event_indicator_count(&self) -> usize;
+    /// Model Exchange: the independent variable (passed on to the model once it is built).
+    fn set_time(&mut self, time: f64);
+    /// The built model's states into `x` (`state_count` values).
+    fn continuous_states(&self, x: &mut [f64]) -> Result<(), String>;
+    /// Gives the built model the states `x` (`state_count` finite values).
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String>;
+    /// The state derivatives into `dx` (`state_count` values), finite or an `Err`.
+    fn derivatives(&mut self, dx: &mut [f64]) -> Result<(), String>;
+    /// The event indicators into `z` (`event_indicator_count` values), finite or an `Err`.
+    fn event_indicators(&mut self, z: &mut [f64]) -> Result<(), String>;
+    /// The states' nominal values into `x` (`state_count` values).
+    fn nominals(&self, x: &mut [f64]);
+    /// The next time event after `time`, if any.
+    fn next_time_event(&self, time: f64) -> Option<f64>;
     /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
     /// ([`super::derivatives`]).
     fn directional_derivative(
@@ -133,6 +163,50 @@ struct RuntimeOf<M: Model> {
     values: Values<M::Variables>,
     model: Option<M>,
     outputs_stale: bool,
+    /// Model Exchange's time, given to the model when it is built (`None` for Co-Simulation).
+    /// Not saved: the model keeps its own time, and the instance its.
+    #[serde(skip)]
+    time: Option<f64>,
+}
+
+impl<M: Model> RuntimeOf<M>
+where
+    M::Variables: Bindings,
+{
+    /// Copies the model's states and derivatives into the values `fmi2GetReal` reads (models with
+    /// continuous states only; a derivative the model cannot give keeps its last value).
+    fn mirror_states(&mut self) {
+        if States::<M>::COUNT == 0 {
+            return;
+        }
+        if let Some(model) = self.model.as_mut() {
+            let v = &mut self.values;
+            v.states = model.states();
+            if let Ok(dx) = model.derivatives(&v.inputs) {
+                v.derivatives = dx;
+            }
+        }
+    }
+
+    fn built(&mut self) -> Result<&mut M, String> {
+        self.model
+            .as_mut()
+            .ok_or_else(|| "no model yet: call it in initialization mode or later".to_string())
+    }
+}
+
+type States<M> = <<M as Model>::Variables as Interface>::States;
+
+/// `Err` naming the first non-finite value of `values`.
+fn finite(what: &str, names: &[&str], values: &[f64]) -> Result<(), String> {
+    match values.iter().position(|x| !x.is_finite()) {
+        None => Ok(()),
+        Some(i) => Err(format!(
+            "{what} {} is {}",
+            names.get(i).copied().unwrap_or("?"),
+            values[i]
+        )),
+    }
 }
 
 impl<M: Model> Clone for RuntimeOf<M> {
@@ -141,6 +215,7 @@ impl<M: Model> Clone for RuntimeOf<M> {
             values: self.values.clone(),
             model: self.model.clone(),
             outputs_stale: self.outputs_stale,
+            time: self.time,
         }
     }
 }
@@ -184,8 +259,11 @@ where
     }
     fn build(&mut self) -> Result<(), String> {
         let v = &mut self.values;
-        let model = M::new(&v.parameters, &v.inputs).map_err(|r| r.0)?;
+        let mut model = M::new(&v.parameters, &v.inputs).map_err(|r| r.0)?;
         v.calculated = model.calculated_parameters();
+        if let Some(time) = self.time {
+            model.set_time(time);
+        }
         self.model = Some(model);
         self.outputs_stale = true;
         Ok(())
@@ -196,6 +274,7 @@ where
             model.evaluate(&v.inputs, &mut v.outputs, report);
             report.evaluated = true;
             self.outputs_stale = false;
+            self.mirror_states();
         }
     }
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
@@ -206,12 +285,88 @@ where
             self.outputs_stale = false;
         }
     }
-    fn update_discrete_states(&mut self, time: f64, report: &mut Report) {
-        if let Some(model) = self.model.as_mut() {
-            let v = &mut self.values;
-            model.update_discrete_states(&v.inputs, &mut v.outputs, time, report);
-            self.outputs_stale = false;
+    fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate {
+        let Some(model) = self.model.as_mut() else {
+            return EventUpdate::default();
+        };
+        let v = &mut self.values;
+        let update = model.update_discrete_states(&v.inputs, &mut v.outputs, time, report);
+        self.outputs_stale = false;
+        self.mirror_states();
+        update
+    }
+    fn completed_integrator_step(&mut self, time: f64, report: &mut Report) -> bool {
+        let Some(model) = self.model.as_mut() else {
+            return false;
+        };
+        let v = &mut self.values;
+        let event = model.completed_integrator_step(&v.inputs, &mut v.outputs, time, report);
+        self.outputs_stale = false;
+        self.mirror_states();
+        event
+    }
+    fn state_count(&self) -> usize {
+        States::<M>::COUNT
+    }
+    fn event_indicator_count(&self) -> usize {
+        M::Variables::EVENT_INDICATORS
+    }
+    fn set_time(&mut self, time: f64) {
+        if self.time == Some(time) {
+            return;
         }
+        self.time = Some(time);
+        if let Some(model) = self.model.as_mut() {
+            model.set_time(time);
+            // Outputs depend on time only through states or schedules.
+            if States::<M>::COUNT > 0 {
+                self.outputs_stale = true;
+            }
+        }
+    }
+    fn continuous_states(&self, x: &mut [f64]) -> Result<(), String> {
+        let model = self
+            .model
+            .as_ref()
+            .ok_or("no model yet: call it in initialization mode or later")?;
+        model.states().write_to(x);
+        Ok(())
+    }
+    fn set_continuous_states(&mut self, x: &[f64]) -> Result<(), String> {
+        finite("state", States::<M>::NAMES, x)?;
+        let states = States::<M>::from_slice(x);
+        self.built()?.set_states(&states)?;
+        self.values.states = states;
+        self.outputs_stale = true;
+        Ok(())
+    }
+    fn derivatives(&mut self, dx: &mut [f64]) -> Result<(), String> {
+        let model = self
+            .model
+            .as_mut()
+            .ok_or("no model yet: call it in initialization mode or later")?;
+        let derivatives = model.derivatives(&self.values.inputs)?;
+        derivatives.write_to(dx);
+        finite("derivative", States::<M>::DERIVATIVE_NAMES, dx)?;
+        self.values.derivatives = derivatives;
+        Ok(())
+    }
+    fn event_indicators(&mut self, z: &mut [f64]) -> Result<(), String> {
+        let model = self
+            .model
+            .as_mut()
+            .ok_or("no model yet: call it in initialization mode or later")?;
+        model.event_indicators(&self.values.inputs, z)?;
+        finite("event indicator", &[], z)
+    }
+    fn nominals(&self, x: &mut [f64]) {
+        x.copy_from_slice(States::<M>::NOMINALS);
+    }
+    fn next_time_event(&self, time: f64) -> Option<f64> {
+        self.model
+            .as_ref()
+            .and_then(|m| m.next_time_event(time))
+            .filter(|t| t.is_finite() && *t > time)
     }
     fn directional_derivative(
         &mut self,
@@ -233,6 +388,7 @@ where
         self.values = Values::default();
         self.model = None;
         self.outputs_stale = true;
+        self.time = None;
     }
     fn snapshot(&self) -> Box<dyn Runtime> {
         Box::new(self.clone())
@@ -252,6 +408,7 @@ where
         if let Some(saved) = self.model.take() {
             self.model = Some(rebuilt(&self.values, &saved)?);
         }
+        self.mirror_states();
         Ok(())
     }
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {

@@ -118,15 +118,47 @@ pub type Parameters<M> = <<M as Model>::Variables as Interface>::Parameters;
 pub type Inputs<M> = <<M as Model>::Variables as Interface>::Inputs;
 pub type Outputs<M> = <<M as Model>::Variables as Interface>::Outputs;
 pub type CalculatedParameters<M> = <<M as Model>::Variables as Interface>::CalculatedParameters;
+/// The continuous states of model `M` (and their derivatives), generated from the variables that
+/// carry a `derivative` attribute; an empty struct for models without states.
+pub type States<M> = <<M as Model>::Variables as Interface>::States;
+
+/// What an event update (`fmi2NewDiscreteStates`) did, for `fmi2EventInfo`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct EventUpdate {
+    /// The continuous states jumped: the importer must read them again
+    /// (`valuesOfContinuousStatesChanged`).
+    pub states_changed: bool,
+    /// Another event iteration is needed at the same time (`newDiscreteStatesNeeded`).
+    pub iterate: bool,
+    /// The model cannot go on (`terminateSimulation`); say why in the report.
+    pub terminate: bool,
+}
 
 /// A co-simulation model. It sees its variables only as the typed structs generated from its
 /// model description (`crate::variables::<model>`); the export layer owns their values. The model
 /// owns its physics and its history (friction state, onion state, rotor state), which is part of
 /// the FMU state.
 ///
-/// Model Exchange extends it through defaults that co-simulation-only models never write
-/// (`ALGEBRAIC_MODEL_EXCHANGE`, `update_discrete_states`, `partials`); continuous states would come
-/// as further associated types on [`Interface`].
+/// Model Exchange extends it through defaults that co-simulation-only models never write, so an
+/// algebraic model compiles unchanged. A model with continuous states (declared in its model
+/// description: a `local` Real `der(x)` with `derivative="x"`, and x listed in `<Derivatives>`)
+/// implements, besides `new`, `evaluate` and `step`:
+/// - [`Model::MODEL_EXCHANGE`] `= true` (and its name in `build/export_layer.rs`'s list);
+/// - [`Model::states`] and [`Model::set_states`]: the model owns its states (they are its
+///   co-simulation history too, so FMU states save them with the model);
+/// - [`Model::set_time`]: the independent variable; [`Model::evaluate`] then writes the outputs
+///   at the current states, time and inputs;
+/// - [`Model::derivatives`]: `dx/dt` at the current states, time and inputs (no allocation: it
+///   is the integrator's hot path);
+/// - optionally [`Model::next_time_event`], [`Model::event_indicators`] (as many as
+///   `numberOfEventIndicators`), [`Model::update_discrete_states`] (event mode: may move the
+///   states, say so in [`EventUpdate`]) and [`Model::completed_integrator_step`];
+/// - optionally [`Model::partials`] with rows for the outputs and the derivative variables
+///   (`"der(x)"`) and columns for the inputs and the states (`"x"`): the export layer then serves
+///   `fmi2GetDirectionalDerivative` for Model Exchange's Jacobian.
+///
+/// The export layer calls, for one right-hand side: `set_time`, `set_states` (only when the
+/// importer set them), then `derivatives`, `event_indicators` or `evaluate` in any order.
 pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// The generated interface, `crate::variables::<model>::Variables`.
     type Variables: Interface;
@@ -163,20 +195,76 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// [`Model::update_discrete_states`] at each completed integrator step and event.
     const ALGEBRAIC_MODEL_EXCHANGE: bool = false;
 
-    /// Model Exchange: commits the history at `inputs` and time `time` and writes the outputs
-    /// there. For a quasi-static model that is a step of zero length.
+    /// Whether the model serves FMI Model Exchange: algebraic models, and models with continuous
+    /// states that implement the methods below.
+    const MODEL_EXCHANGE: bool = Self::ALGEBRAIC_MODEL_EXCHANGE;
+
+    /// Model Exchange, event mode (`fmi2NewDiscreteStates`): commits the history at `inputs` and
+    /// time `time`, may move the continuous states (reinit) and writes the outputs there. The
+    /// default is a step of zero length, right for a quasi-static model.
     fn update_discrete_states(
         &mut self,
         inputs: &Inputs<Self>,
         outputs: &mut Outputs<Self>,
         time: f64,
         report: &mut Report,
-    ) {
-        self.step(inputs, outputs, time, 0.0, report)
+    ) -> EventUpdate {
+        self.step(inputs, outputs, time, 0.0, report);
+        EventUpdate::default()
     }
 
-    /// Exact partial derivatives of the outputs with respect to the inputs at `inputs` and the
-    /// current history, on the branch [`Model::evaluate`] takes there (analytic or forward-mode,
+    /// Model Exchange: the integrator accepted its step at `time` (`fmi2CompletedIntegratorStep`).
+    /// Returns whether the model needs an event there (`enterEventMode`). The default commits the
+    /// history as [`Model::update_discrete_states`] does and asks for no event; a model whose
+    /// discrete states may change only at events overrides it.
+    fn completed_integrator_step(
+        &mut self,
+        inputs: &Inputs<Self>,
+        outputs: &mut Outputs<Self>,
+        time: f64,
+        report: &mut Report,
+    ) -> bool {
+        self.update_discrete_states(inputs, outputs, time, report);
+        false
+    }
+
+    /// The continuous states now (none by default).
+    fn states(&self) -> States<Self> {
+        Default::default()
+    }
+
+    /// Takes the states the integrator proposes (`fmi2SetContinuousStates`; finite, checked by
+    /// the export layer). A state the model cannot take (outside its domain) is an `Err` saying
+    /// why; the model then keeps its previous states.
+    fn set_states(&mut self, _states: &States<Self>) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// Model Exchange: the independent variable is now `time` (`fmi2SetTime`, and the start
+    /// time when the model is built for Model Exchange).
+    fn set_time(&mut self, _time: f64) {}
+
+    /// The state derivatives `dx/dt` at the current states and time and at `inputs`. An `Err`
+    /// says why there are none (the export layer logs it and returns fmi2Error); a finite result
+    /// is checked by the export layer.
+    fn derivatives(&mut self, _inputs: &Inputs<Self>) -> Result<States<Self>, String> {
+        Ok(Default::default())
+    }
+
+    /// The event indicators at the current states and time and at `inputs`, into `out`
+    /// (`numberOfEventIndicators` values): an event happens where one changes sign.
+    fn event_indicators(&mut self, _inputs: &Inputs<Self>, _out: &mut [f64]) -> Result<(), String> {
+        Ok(())
+    }
+
+    /// The next time event after the event at `time` (`nextEventTime`), if any.
+    fn next_time_event(&self, _time: f64) -> Option<f64> {
+        None
+    }
+
+    /// Exact partial derivatives of the outputs (and, with states, of the derivative variables
+    /// `der(x)`) with respect to the inputs (and the states `x`) at `inputs` and the current
+    /// history, on the branch [`Model::evaluate`] takes there (analytic or forward-mode,
     /// never finite differences). `Err` says why there are none: by default this model does not
     /// provide them, and its model description says `providesDirectionalDerivative="false"`.
     fn partials(&mut self, _inputs: &Inputs<Self>) -> Result<Partials, String> {

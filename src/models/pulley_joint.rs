@@ -7,9 +7,14 @@
 //! (SSP, container FMU) close the loop. Rigid-body mechanics and a controller, no dissertation
 //! physics: it lives here rather than in `src/physics/`. With `external_pressures` the controller is
 //! bypassed and the pressure outputs pass on the `*_pressure_command` inputs (saturated).
+//!
+//! Model Exchange integrates the same ODE with the importer's solver: the continuous states are
+//! `joint_angle` and `joint_velocity`, the forces are inputs at every right-hand side, and the
+//! reference trajectory's segment boundaries are time events (the quintic is C2 there, but its
+//! third derivative jumps, so a step-size controller is better off restarting there).
 
-use super::{Model, Refusal, Report, Status};
-use crate::variables::pulley_joint::{Inputs, Outputs, Parameters, Variables};
+use super::{EventUpdate, Model, Partials, Refusal, Report, Status};
+use crate::variables::pulley_joint::{Inputs, Outputs, Parameters, States, Variables};
 use serde::{Deserialize, Serialize};
 
 /// Substep cap: a long communication step is split so that each Euler substep stays well
@@ -68,6 +73,30 @@ impl Params {
         let shape = s * s * s * (10.0 - 15.0 * s + 6.0 * s * s);
         let slope = 30.0 * s * s * (1.0 - s) * (1.0 - s);
         (w[k] + dq * shape, dq * slope / period)
+    }
+
+    /// The segment boundaries of [`Params::reference`]: moves start at k T, k = 0 .. 3, and
+    /// the last ends at 4 T.
+    fn next_boundary(&self, t: f64) -> Option<f64> {
+        let period = self.segment_time;
+        (1..self.waypoints.len())
+            .map(|k| k as f64 * period)
+            .find(|&boundary| boundary > t)
+    }
+
+    /// The angular acceleration `(torque - c dq - m g l sin q) / I` of the joint.
+    fn acceleration(&self, torque: f64, q: f64, dq: f64) -> f64 {
+        (torque - self.damping * dq - self.gravity_torque * q.sin()) / self.inertia
+    }
+
+    /// Slope of the saturation `x.max(0).min(max_pressure)` at `x`: 1 strictly inside, else 0
+    /// (the one-sided slope of the saturated side at the kinks).
+    fn saturation_slope(&self, x: f64) -> f64 {
+        if x > 0.0 && x < self.max_pressure {
+            1.0
+        } else {
+            0.0
+        }
     }
 }
 
@@ -221,7 +250,7 @@ impl Model for PulleyJoint {
         let h = step / n as f64;
         let (mut q, mut dq) = (self.q, self.dq);
         for _ in 0..n {
-            dq += h * (torque - p.damping * dq - p.gravity_torque * q.sin()) / p.inertia;
+            dq += h * p.acceleration(torque, q, dq);
             q += h * dq;
         }
         if !(p.representable(q, dq) && torque.is_finite()) {
@@ -236,4 +265,124 @@ impl Model for PulleyJoint {
         self.time = time + step;
         self.write(inputs, outputs);
     }
+
+    const MODEL_EXCHANGE: bool = true;
+
+    fn states(&self) -> States {
+        States {
+            joint_angle: self.q,
+            joint_velocity: self.dq,
+        }
+    }
+
+    fn set_states(&mut self, x: &States) -> Result<(), String> {
+        if !self.p.representable(x.joint_angle, x.joint_velocity) {
+            return Err(format!(
+                "joint angle {} rad gives muscle lengths that overflow",
+                x.joint_angle
+            ));
+        }
+        self.q = x.joint_angle;
+        self.dq = x.joint_velocity;
+        Ok(())
+    }
+
+    fn set_time(&mut self, time: f64) {
+        self.time = time;
+    }
+
+    /// `q' = dq`, `I dq' = r (F_f - F_e) - c dq - m g l sin q`, the forces being the inputs now.
+    fn derivatives(&mut self, inputs: &Inputs) -> Result<States, String> {
+        let torque = self.torque(inputs);
+        if !torque.is_finite() {
+            return Err(format!(
+                "the joint torque overflows (moment arm {} m times the force difference)",
+                self.p.moment_arm
+            ));
+        }
+        Ok(States {
+            joint_angle: self.dq,
+            joint_velocity: self.p.acceleration(torque, self.q, self.dq),
+        })
+    }
+
+    fn next_time_event(&self, time: f64) -> Option<f64> {
+        self.p.next_boundary(time)
+    }
+
+    /// Nothing jumps at the segment boundaries: the event only restarts the integrator.
+    fn update_discrete_states(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        time: f64,
+        report: &mut Report,
+    ) -> EventUpdate {
+        self.time = time;
+        self.evaluate(inputs, outputs, report);
+        EventUpdate::default()
+    }
+
+    /// Exact partials of the outputs and of `der(joint_angle)`, `der(joint_velocity)` with
+    /// respect to the inputs and the states, on the branch `write` takes (saturated pressures
+    /// have slope 0, including at the kinks).
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let p = &self.p;
+        let (r, inertia) = (p.moment_arm, p.inertia);
+        let (q_ref, dq_ref) = p.reference(self.time);
+        let u =
+            p.feedforward_gain * q_ref.sin() + p.kp * (q_ref - self.q) + p.kd * (dq_ref - self.dq);
+        let mut d = Partials::default();
+        d.row("flexor_length", &[("joint_angle", -r)])
+            .row("extensor_length", &[("joint_angle", r)]);
+        if p.external_pressures {
+            let flexor = p.saturation_slope(inputs.flexor_pressure_command);
+            let extensor = p.saturation_slope(inputs.extensor_pressure_command);
+            d.row("flexor_pressure", &[("flexor_pressure_command", flexor)])
+                .row(
+                    "extensor_pressure",
+                    &[("extensor_pressure_command", extensor)],
+                );
+        } else {
+            // p = pc +/- u/2 with du/dq = -kp, du/d(dq) = -kd.
+            let flexor = 0.5 * p.saturation_slope(p.common_mode_pressure + 0.5 * u);
+            let extensor = -0.5 * p.saturation_slope(p.common_mode_pressure - 0.5 * u);
+            d.row(
+                "flexor_pressure",
+                &[
+                    ("joint_angle", -p.kp * flexor),
+                    ("joint_velocity", -p.kd * flexor),
+                ],
+            )
+            .row(
+                "extensor_pressure",
+                &[
+                    ("joint_angle", -p.kp * extensor),
+                    ("joint_velocity", -p.kd * extensor),
+                ],
+            );
+        }
+        d.row("joint_angle", &[("joint_angle", 1.0)])
+            .row("joint_velocity", &[("joint_velocity", 1.0)])
+            .row("reference_angle", &[])
+            .row(
+                "joint_torque",
+                &[("flexor_force", r), ("extensor_force", -r)],
+            )
+            .row("der(joint_angle)", &[("joint_velocity", 1.0)])
+            .row(
+                "der(joint_velocity)",
+                &[
+                    ("flexor_force", r / inertia),
+                    ("extensor_force", -r / inertia),
+                    ("joint_angle", -p.gravity_torque * self.q.cos() / inertia),
+                    ("joint_velocity", -p.damping / inertia),
+                ],
+            );
+        Ok(d)
+    }
 }
+
+#[cfg(test)]
+#[path = "pulley_joint_tests.rs"]
+mod tests;

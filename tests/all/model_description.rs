@@ -360,7 +360,7 @@ mod rules {
     #[test]
     fn the_shipped_descriptions_pass_every_rule() {
         rules::check(&shipped()).unwrap();
-        assert_eq!(rules::RULES.len(), 13);
+        assert_eq!(rules::RULES.len(), 14);
     }
 
     #[test]
@@ -532,6 +532,156 @@ mod rules {
             force,
             r#"<Unknown index="3" dependencies="1 x"/>"#,
             "dependencies must be indices",
+        );
+    }
+}
+
+/// Continuous states for Model Exchange: a source declares each by a derivative variable that
+/// names it (`derivative="joint_angle"`); build.rs numbers the states, writes the index and the
+/// `<Derivatives>` list, and refuses every inconsistent declaration.
+mod continuous_states {
+    use super::check;
+    use super::model_description::rules;
+
+    const PULLEY: &str = include_str!("../modelDescription/PulleyJoint.xml");
+
+    fn edited(from: &str, to: &str) -> String {
+        assert!(PULLEY.contains(from), "test edit does not apply: {from}");
+        PULLEY.replacen(from, to, 1)
+    }
+
+    fn refused(text: &str, reason: &str) {
+        match check(text, "PulleyJoint") {
+            Ok(_) => panic!("accepted a description that should fail with '{reason}'"),
+            Err(e) => assert!(e.contains(reason), "error '{e}' does not say '{reason}'"),
+        }
+    }
+
+    #[test]
+    fn states_are_numbered_in_derivative_order_and_indexed_in_the_shipped_description() {
+        let m = check(PULLEY, "PulleyJoint").unwrap();
+        let names: Vec<(&str, &str)> = m
+            .states
+            .iter()
+            .map(|&(s, d)| (m.variables[s].name.as_str(), m.variables[d].name.as_str()))
+            .collect();
+        assert_eq!(
+            names,
+            [
+                ("joint_angle", "der(joint_angle)"),
+                ("joint_velocity", "der(joint_velocity)")
+            ]
+        );
+        // joint_angle is variable 7, joint_velocity 8 (1-based).
+        assert!(m.shipped_xml.contains(r#"unit="rad/s" derivative="7"/>"#));
+        assert!(m.shipped_xml.contains(r#"derivative="8"/>"#));
+        assert_eq!(m.derivatives.len(), 2);
+        assert_eq!(m.derivatives[1].dependencies, Some(vec![1, 2, 7, 8]));
+        assert_eq!(m.event_indicators, 0);
+        rules::check(&m.shipped_xml).unwrap();
+    }
+
+    #[test]
+    fn inconsistent_state_declarations_are_refused() {
+        refused(
+            &edited(r#"derivative="joint_angle""#, r#"derivative="nothing""#),
+            "derivative=\"nothing\" is not a variable",
+        );
+        refused(
+            &edited(r#"derivative="joint_angle""#, r#"derivative="7""#),
+            "name the state",
+        );
+        // A parameter cannot be a state.
+        refused(
+            &edited(r#"derivative="joint_angle""#, r#"derivative="inertia""#),
+            "must be a continuous Real output or local",
+        );
+        // Two derivatives of one state.
+        refused(
+            &edited(
+                r#"derivative="joint_velocity""#,
+                r#"derivative="joint_angle""#,
+            ),
+            "already has the derivative",
+        );
+        // A derivative must be a calculated local.
+        refused(
+            &edited(
+                r#"name="der(joint_angle)" valueReference="29" causality="local""#,
+                r#"name="der(joint_angle)" valueReference="29" causality="output""#,
+            ),
+            "a derivative must be a local",
+        );
+        // A local that is neither a state nor a derivative has no typed group.
+        refused(
+            &edited(r#" derivative="joint_angle""#, ""),
+            "a local must be a continuous state or a state derivative",
+        );
+        // Every derivative declares its dependencies, on knowns only.
+        refused(
+            &edited(
+                r#"<Unknown name="der(joint_angle)" dependencies="joint_velocity" dependenciesKind="dependent"/>"#,
+                "",
+            ),
+            "'der(joint_angle)' declares no dependencies",
+        );
+        refused(
+            &edited(
+                r#"<Unknown name="der(joint_angle)" dependencies="joint_velocity""#,
+                r#"<Unknown name="der(joint_angle)" dependencies="inertia""#,
+            ),
+            "may depend only on an input or a continuous state",
+        );
+        // An output may depend on a state, not on another output.
+        refused(
+            &edited(
+                r#"<Unknown name="flexor_length" dependencies="joint_angle""#,
+                r#"<Unknown name="flexor_length" dependencies="reference_angle""#,
+            ),
+            "may depend only on an input or a continuous state",
+        );
+        refused(
+            &PULLEY.replace(
+                r#"numberOfEventIndicators="0""#,
+                r#"numberOfEventIndicators="-1""#,
+            ),
+            "numberOfEventIndicators must be a non-negative integer",
+        );
+    }
+
+    #[test]
+    fn the_rules_check_the_shipped_derivative_indices() {
+        let shipped = check(PULLEY, "PulleyJoint").unwrap().shipped_xml;
+        let broken = |from: &str, to: &str, reason: &str| {
+            assert!(shipped.contains(from), "test edit does not apply: {from}");
+            match rules::check(&shipped.replacen(from, to, 1)) {
+                Ok(()) => panic!("accepted a description that should fail with '{reason}'"),
+                Err(e) => assert!(e.contains(reason), "error '{e}' does not say '{reason}'"),
+            }
+        };
+        // external_pressures (variable 28) is a Boolean; flexor_pressure_command (29) an input.
+        for not_a_state in ["28", "29"] {
+            broken(
+                r#"derivative="7""#,
+                &format!(r#"derivative="{not_a_state}""#),
+                "is not the index of a continuous Real output or local",
+            );
+        }
+        broken(
+            r#"derivative="8""#,
+            r#"derivative="7""#,
+            "is the state of two derivatives",
+        );
+        broken(
+            r#"<Unknown index="31" dependencies="8""#,
+            r#"<Unknown index="30" dependencies="8""#,
+            "is not a variable with a derivative attribute",
+        );
+        // An output may depend on a state (7), not on a parameter (11).
+        broken(
+            r#"<Unknown index="3" dependencies="7""#,
+            r#"<Unknown index="3" dependencies="11""#,
+            "may not depend on 'moment_arm'",
         );
     }
 }

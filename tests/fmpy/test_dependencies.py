@@ -67,7 +67,10 @@ class Model:
         self.initial = [u.variable for u in self.md.initialUnknowns]
 
     def declared(self, unknowns):
-        return {u.variable.name: {d.name for d in (u.dependencies or [])} for u in unknowns}
+        """The declared inputs and parameters; continuous states (Model Exchange's other knowns)
+        cannot be perturbed through Co-Simulation and are checked by the derivative tests."""
+        return {u.variable.name: {d.name for d in (u.dependencies or []) if d.causality in ("input", "parameter")}
+                for u in unknowns}
 
     def slave(self):
         s = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,

@@ -85,7 +85,7 @@ def test_models_without_partials_declare_it():
 
     from conftest import fmu_path
 
-    for model in ["KnittedMuscle", "PulleyJoint", "MultiferroicMotor"]:
+    for model in ["KnittedMuscle", "MultiferroicMotor"]:
         md = read_model_description(fmu_path(model))
         assert not md.coSimulation.providesDirectionalDerivative, model
 

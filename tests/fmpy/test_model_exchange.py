@@ -19,8 +19,9 @@ ROOT = pathlib.Path(__file__).resolve().parents[2]
 sys.path.insert(0, str(ROOT / "scenes"))
 import run as scenes  # noqa: E402
 
-MODEL_EXCHANGE = ["KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough"]
-CO_SIMULATION_ONLY = ["MultiferroicMotor", "PulleyJoint"]
+MODEL_EXCHANGE = ["KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough", "PulleyJoint"]
+ALGEBRAIC = ["KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough"]
+CO_SIMULATION_ONLY = ["MultiferroicMotor"]
 TOLERANCE = 1e-9
 SCENES = [
     p for p in sorted((ROOT / "scenes").glob("*.json")) if scenes.load_scene(p)["fmu"] in MODEL_EXCHANGE
@@ -89,20 +90,22 @@ def test_both_interfaces_validate_clean(model):
     assert md.coSimulation is not None
     assert (md.modelExchange is not None) == (model in MODEL_EXCHANGE)
     if md.modelExchange:
-        assert md.numberOfContinuousStates == 0 and md.numberOfEventIndicators == 0
+        states = {"PulleyJoint": 2}.get(model, 0)
+        assert md.numberOfContinuousStates == states and md.numberOfEventIndicators == 0
         assert not md.modelExchange.completedIntegratorStepNotNeeded
 
 
-def test_co_simulation_only_models_refuse_model_exchange():
+@pytest.mark.parametrize("model", CO_SIMULATION_ONLY)
+def test_co_simulation_only_models_refuse_model_exchange(model):
     from fmpy.fmi2 import FMU2Model
     from fmpy import extract
 
-    md = read_model_description(fmu_path("PulleyJoint"))
+    md = read_model_description(fmu_path(model))
     fmu = FMU2Model(
         guid=md.guid,
-        unzipDirectory=extract(fmu_path("PulleyJoint")),
+        unzipDirectory=extract(fmu_path(model)),
         modelIdentifier=md.coSimulation.modelIdentifier,
-        instanceName="pulley",
+        instanceName="co-simulation only",
     )
     with pytest.raises(Exception, match="Failed to instantiate"):
         fmu.instantiate()
@@ -181,3 +184,192 @@ def test_a_co_simulation_state_is_not_restored_into_model_exchange(recording_log
     for fmu in (cs, me):
         fmu.terminate()
         fmu.freeInstance()
+
+
+# PulleyJoint: continuous states (joint angle and velocity), time events at the reference's segment
+# boundaries. Co-Simulation steps the ODE by semi-implicit Euler, FMPy's Euler by explicit Euler,
+# CVode to 1e-10: each agrees with the others to first order in the step h, and the Richardson
+# extrapolations 2 x(h/2) - x(h) agree to second order. FMPy holds each input over the output
+# interval in all three (CVode's right-hand side does not re-apply inputs), so runs with the
+# same h see the same forces. There is no PulleyJoint scene in the catalogue: these two loads
+# (constant forces under the PD controller; sinusoidal forces with external pressures) stand in.
+PULLEY_OUTPUTS = ["joint_angle", "joint_velocity", "flexor_pressure", "extensor_pressure",
+                  "flexor_length", "extensor_length", "reference_angle", "joint_torque"]
+PULLEY_STOP = 1.5  # with segment_time 0.5: time events at 0.5 and 1.0 s
+PULLEY_LOADS = {
+    "constant_forces_pd_controller": (
+        {}, lambda t: (10.0 + 0 * t, 5.0 + 0 * t)),
+    "sinusoidal_forces_external_pressures": (
+        {"external_pressures": True}, lambda t: (20.0 + 10.0 * np.sin(3.0 * t), 5.0 + 0 * t)),
+}
+
+
+def pulley_run(load, kind, h):
+    """Outputs every 10 ms of one run: kind 'CS', or 'CVode' / 'Euler' (Model Exchange), with
+    step (and output interval) h. Event instants recorded twice by FMPy keep the later row."""
+    parameters, forces = PULLEY_LOADS[load]
+    t = np.arange(0.0, PULLEY_STOP + h / 2, h)
+    names = ["flexor_force", "extensor_force", "flexor_pressure_command", "extensor_pressure_command"]
+    signals = np.zeros(t.size, dtype=[("time", float)] + [(n, float) for n in names])
+    signals["time"] = t
+    signals["flexor_force"], signals["extensor_force"] = forces(t)
+    signals["flexor_pressure_command"] = 3e5 + 1e5 * np.sin(2 * np.pi * t)
+    signals["extensor_pressure_command"] = 3e5
+    kw = dict(start_values=dict(parameters, segment_time=0.5), input=signals, output=PULLEY_OUTPUTS,
+              stop_time=PULLEY_STOP, output_interval=h)
+    if kind == "CS":
+        r = simulate_fmu(fmu_path("PulleyJoint"), **kw)
+    else:
+        r = simulate_fmu(fmu_path("PulleyJoint"), fmi_type="ModelExchange", solver=kind,
+                         step_size=h if kind == "Euler" else None, relative_tolerance=1e-10, **kw)
+        r = r[np.r_[r["time"][1:] != r["time"][:-1], True]]
+    every = int(round(1e-2 / h))
+    assert np.allclose(r["time"][::every], np.arange(0.0, PULLEY_STOP + 1e-9, 1e-2))
+    return r[::every]
+
+
+def pulley_differences(load, a, b, h):
+    """Largest differences, relative to each output's largest magnitude, between kinds a and b:
+    at the same step h/2, and between their Richardson extrapolations from h and h/2."""
+    runs = {k: (pulley_run(load, k, h), pulley_run(load, k, h / 2)) for k in (a, b)}
+    same, extrapolated = {}, {}
+    for name in PULLEY_OUTPUTS:
+        (a1, a2), (b1, b2) = runs[a], runs[b]
+        scale = max(np.abs(b2[name]).max(), 1e-300)
+        same[name] = np.abs(a2[name] - b2[name]).max() / scale
+        extrapolated[name] = np.abs((2 * a2[name] - a1[name]) - (2 * b2[name] - b1[name])).max() / scale
+    print(f"{load} {a} vs {b}: same step {max(same.values()):.1e}, "
+          f"extrapolated {max(extrapolated.values()):.1e}")
+    return same, extrapolated
+
+
+@pytest.mark.parametrize("solver", ["CVode", "Euler"])
+def test_pulley_model_exchange_matches_co_simulation_under_constant_forces(solver):
+    # Measured: same step (1e-4 s) 3.0e-4 (CVode) and 3.7e-4 (Euler); extrapolated 5.3e-7, 4.4e-7.
+    same, extrapolated = pulley_differences("constant_forces_pd_controller", solver, "CS", 2e-4)
+    assert max(same.values()) <= 1e-3, same
+    assert max(extrapolated.values()) <= 2e-6, extrapolated
+
+
+def test_pulley_model_exchange_matches_co_simulation_under_varying_forces():
+    # Euler against CS: both hold the forces over each step. Measured 5.6e-4, extrapolated 4.4e-7;
+    # CVode against CS at 1 ms, 3.1e-3.
+    same, extrapolated = pulley_differences("sinusoidal_forces_external_pressures", "Euler", "CS", 2e-4)
+    assert max(same.values()) <= 1e-3, same
+    assert max(extrapolated.values()) <= 2e-6, extrapolated
+    # CVode at the catalogue's usual 1 ms output interval: first order in the 1 ms hold.
+    cvode, cs = (pulley_run("sinusoidal_forces_external_pressures", k, 1e-3) for k in ("CVode", "CS"))
+    worst = max(np.abs(cvode[n] - cs[n]).max() / max(np.abs(cs[n]).max(), 1e-300) for n in PULLEY_OUTPUTS)
+    print(f"CVode vs CS at 1 ms: {worst:.1e}")
+    assert worst <= 1e-2
+
+
+def test_pulley_jacobian_matches_central_differences(recording_log):
+    """fmi2GetDirectionalDerivative on a Model Exchange instance: unknowns the outputs and the state
+    derivatives, knowns the inputs and the states, against central differences of fmi2GetReal and
+    fmi2GetDerivatives after fmi2SetReal / fmi2SetContinuousStates."""
+    import ctypes
+
+    from fmpy import extract
+    from fmpy.fmi2 import FMU2Model
+
+    path = fmu_path("PulleyJoint")
+    md = read_model_description(path)
+    assert md.modelExchange.providesDirectionalDerivative
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    states = [d.variable.derivative.name for d in md.derivatives]
+    assert states == ["joint_angle", "joint_velocity"]
+    derivatives = [d.variable.name for d in md.derivatives]
+    inputs = ["flexor_force", "extensor_force", "flexor_pressure_command", "extensor_pressure_command"]
+    outputs = [o.variable.name for o in md.outputs]
+    knowns, unknowns = inputs + states, outputs + derivatives
+    fmu = FMU2Model(guid=md.guid, unzipDirectory=extract(path), modelIdentifier="PulleyJoint", instanceName="jac")
+    fmu.instantiate(callbacks=recording_log.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    fmu.newDiscreteStates()
+    fmu.enterContinuousTimeMode()
+
+    def ptr(a):
+        return a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+    def unknown_values(point):
+        fmu.setReal([vr[n] for n in inputs], point[:4])
+        fmu.setContinuousStates(ptr(np.array(point[4:])), 2)
+        dx = np.zeros(2)
+        fmu.getDerivatives(ptr(dx), 2)
+        return np.r_[fmu.getReal([vr[n] for n in outputs]), dx]
+
+    checked = 0
+    for time, point in [(0.3, [120.0, 45.0, 2e5, 3e5, 0.1, 0.3]), (2.5, [30.0, 80.0, 1e5, 4e5, -0.2, -1.0])]:
+        fmu.setTime(time)
+        unknown_values(point)
+        for j, known in enumerate(knowns):
+            seed = [1.0 if k == j else 0.0 for k in range(len(knowns))]
+            unknown_values(point)
+            exact = fmu.getDirectionalDerivative([vr[n] for n in unknowns], [vr[n] for n in knowns], seed)
+            h = 1e-6 * max(abs(point[j]), 1e-2)
+            up, down = ([x + (s if k == j else 0.0) for k, x in enumerate(point)] for s in (h, -h))
+            central = (unknown_values(up) - unknown_values(down)) / (2 * h)
+            for name, e, c in zip(unknowns, exact, central):
+                assert abs(e - c) <= 1e-6 * max(abs(e), abs(c), 1.0), f"d {name} / d {known} at t={time}: {e} vs {c}"
+                checked += 1
+    assert checked == 2 * len(knowns) * len(unknowns)
+    fmu.terminate()
+    fmu.freeInstance()
+
+
+def test_pulley_state_calls_are_checked_and_states_survive_fmu_state_round_trips(recording_log):
+    import ctypes
+
+    from fmpy import extract
+    from fmpy.fmi2 import FMU2Model
+
+    path = fmu_path("PulleyJoint")
+    md = read_model_description(path)
+    fmu = FMU2Model(guid=md.guid, unzipDirectory=extract(path), modelIdentifier="PulleyJoint", instanceName="states")
+    fmu.instantiate(callbacks=recording_log.callbacks)
+    fmu.setupExperiment(startTime=0.0)
+    fmu.enterInitializationMode()
+    fmu.exitInitializationMode()
+    info = fmu.newDiscreteStates()
+    # The first time event is the end of the first move (segment_time 1 s).
+    assert info[4] and info[5] == 1.0
+    fmu.enterContinuousTimeMode()
+    ptr = lambda a: a.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+    x = np.array([0.25, -0.5])
+    fmu.setContinuousStates(ptr(x), 2)
+    got = np.zeros(2)
+    fmu.getContinuousStates(ptr(got), 2)
+    assert list(got) == [0.25, -0.5]
+    nominals = np.zeros(2)
+    fmu.getNominalsOfContinuousStates(ptr(nominals), 2)
+    assert list(nominals) == [1.0, 1.0]
+    # The states are the outputs joint_angle and joint_velocity, and der(joint_angle) reads dq/dt.
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    assert fmu.getReal([vr["joint_angle"], vr["joint_velocity"], vr["der(joint_angle)"]]) == [0.25, -0.5, -0.5]
+    # Wrong lengths and non-finite states are refused with the reason; the states are kept.
+    assert fmu.dll.fmi2GetDerivatives(fmu.component, ptr(np.zeros(3)), 3) == 3
+    assert recording_log.contains("3 derivatives requested, but this model has 2")
+    assert fmu.dll.fmi2GetEventIndicators(fmu.component, ptr(np.zeros(1)), 1) == 3
+    assert recording_log.contains("1 event indicators requested, but this model has none")
+    assert fmu.dll.fmi2SetContinuousStates(fmu.component, ptr(np.array([np.nan, 0.0])), 2) == 3
+    assert recording_log.contains("fmi2SetContinuousStates: state joint_angle is NaN")
+    assert fmu.dll.fmi2SetContinuousStates(fmu.component, None, 2) == 3
+    assert recording_log.contains("fmi2SetContinuousStates: x must not be NULL")
+    fmu.getContinuousStates(ptr(got), 2)
+    assert list(got) == [0.25, -0.5]
+    # An FMU state saves the continuous states; serialized and back, too.
+    saved = fmu.getFMUstate()
+    serialized = fmu.serializeFMUstate(saved)
+    fmu.setContinuousStates(ptr(np.array([1.0, 2.0])), 2)
+    fmu.setFMUstate(saved)
+    fmu.getContinuousStates(ptr(got), 2)
+    assert list(got) == [0.25, -0.5]
+    fmu.setContinuousStates(ptr(np.array([1.0, 2.0])), 2)
+    fmu.setFMUstate(fmu.deSerializeFMUstate(serialized))
+    fmu.getContinuousStates(ptr(got), 2)
+    assert list(got) == [0.25, -0.5]
+    fmu.terminate()
+    fmu.freeInstance()

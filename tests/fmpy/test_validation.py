@@ -41,7 +41,7 @@ def test_archive_layout(fmu):
 def test_units_are_si_and_declared(fmu):
     md = read_model_description(str(fmu))
     declared = {u.name for u in md.unitDefinitions}
-    si = {"1", "m", "m2", "m3", "N", "Pa", "N/m", "s", "rad", "rad/s", "N.m", "J", "kg", "kg.m2", "N.m.s", "A/m", "kg/m3", "Pa.s", "m/s2", "Pa/rad", "Pa.s/rad"}
+    si = {"1", "m", "m2", "m3", "N", "Pa", "N/m", "s", "rad", "rad/s", "N.m", "J", "kg", "kg.m2", "N.m.s", "A/m", "kg/m3", "Pa.s", "m/s2", "Pa/rad", "Pa.s/rad", "rad/s2"}
     for v in md.modelVariables:
         if v.type == "Real":
             assert v.unit in declared, f"{v.name}: unit {v.unit} undeclared"

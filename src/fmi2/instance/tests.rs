@@ -94,6 +94,8 @@ impl Interface for GainVariables {
     type Inputs = f64;
     type Outputs = f64;
     type CalculatedParameters = ();
+    type States = ();
+    const EVENT_INDICATORS: usize = 0;
     const INFO: &'static ModelInfo = &INFO;
 }
 impl Bindings for GainVariables {

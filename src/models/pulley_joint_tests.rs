@@ -1,0 +1,224 @@
+//! PulleyJoint's Model Exchange: the derivatives are the ODE Co-Simulation steps, the time events
+//! are the reference's segment boundaries, and the exact partials agree with central differences.
+
+use super::*;
+
+fn joint(parameters: &Parameters) -> PulleyJoint {
+    PulleyJoint::new(parameters, &Inputs::default()).expect("valid parameters")
+}
+
+/// Every unknown of the Jacobian: the outputs and the state derivatives, by variable name.
+fn unknowns(m: &mut PulleyJoint, inputs: &Inputs) -> Vec<(&'static str, f64)> {
+    let mut o = Outputs::default();
+    m.evaluate(inputs, &mut o, &mut Report::default());
+    let d = m.derivatives(inputs).expect("finite torque");
+    vec![
+        ("flexor_length", o.flexor_length),
+        ("extensor_length", o.extensor_length),
+        ("flexor_pressure", o.flexor_pressure),
+        ("extensor_pressure", o.extensor_pressure),
+        ("joint_angle", o.joint_angle),
+        ("joint_velocity", o.joint_velocity),
+        ("reference_angle", o.reference_angle),
+        ("joint_torque", o.joint_torque),
+        ("der(joint_angle)", d.joint_angle),
+        ("der(joint_velocity)", d.joint_velocity),
+    ]
+}
+
+/// The knowns: the inputs and the states, each as a setter on (inputs, states).
+type Setter = fn(&mut Inputs, &mut States, f64);
+const KNOWNS: [(&str, Setter); 6] = [
+    ("flexor_force", |i, _, x| i.flexor_force = x),
+    ("extensor_force", |i, _, x| i.extensor_force = x),
+    ("flexor_pressure_command", |i, _, x| {
+        i.flexor_pressure_command = x
+    }),
+    ("extensor_pressure_command", |i, _, x| {
+        i.extensor_pressure_command = x
+    }),
+    ("joint_angle", |_, s, x| s.joint_angle = x),
+    ("joint_velocity", |_, s, x| s.joint_velocity = x),
+];
+
+fn known_value(name: &str, inputs: &Inputs, states: &States) -> f64 {
+    match name {
+        "flexor_force" => inputs.flexor_force,
+        "extensor_force" => inputs.extensor_force,
+        "flexor_pressure_command" => inputs.flexor_pressure_command,
+        "extensor_pressure_command" => inputs.extensor_pressure_command,
+        "joint_angle" => states.joint_angle,
+        _ => states.joint_velocity,
+    }
+}
+
+/// Central differences of every unknown with respect to every known at (inputs, states, time),
+/// against `partials` (a known missing from a row has slope 0).
+fn check_partials(parameters: &Parameters, inputs: &Inputs, states: &States, time: f64) {
+    let mut m = joint(parameters);
+    m.set_time(time);
+    m.set_states(states).expect("valid state");
+    let partials = m.partials(inputs).expect("provided");
+    for (known, set) in KNOWNS {
+        let x = known_value(known, inputs, states);
+        let h = 1e-6 * x.abs().max(1e-2);
+        let at = |x: f64| {
+            let (mut i, mut s) = (inputs.clone(), *states);
+            set(&mut i, &mut s, x);
+            let mut m = joint(parameters);
+            m.set_time(time);
+            m.set_states(&s).expect("valid state");
+            unknowns(&mut m, &i)
+        };
+        let (up, down) = (at(x + h), at(x - h));
+        for ((unknown, a), (_, b)) in up.iter().zip(&down) {
+            let numeric = (a - b) / (2.0 * h);
+            let row = partials
+                .get(unknown)
+                .unwrap_or_else(|| panic!("no row for {unknown}"));
+            let exact = row
+                .iter()
+                .find(|(name, _)| *name == known)
+                .map_or(0.0, |(_, d)| *d);
+            let scale = numeric.abs().max(exact.abs()).max(1.0);
+            assert!(
+                (exact - numeric).abs() <= 1e-6 * scale,
+                "d {unknown} / d {known} at {states:?}, t = {time}: exact {exact}, central difference {numeric}"
+            );
+        }
+    }
+}
+
+#[test]
+fn partials_match_central_differences_across_the_controller_and_the_mechanics() {
+    let inputs = Inputs {
+        flexor_force: 120.0,
+        extensor_force: 45.0,
+        flexor_pressure_command: 2e5,
+        extensor_pressure_command: 3e5,
+    };
+    let default = Parameters::default();
+    // Mid-move (the controller unsaturated), past the last waypoint, and far from the
+    // reference (both pressures saturated, so their rows vanish).
+    for (q, dq, time) in [
+        (0.1, 0.3, 0.4),
+        (-0.2, -1.0, 2.5),
+        (0.05, 0.0, 5.0),
+        (1.5, 4.0, 0.5),
+    ] {
+        let states = States {
+            joint_angle: q,
+            joint_velocity: dq,
+        };
+        check_partials(&default, &inputs, &states, time);
+        let external = Parameters {
+            external_pressures: true,
+            ..default.clone()
+        };
+        check_partials(&external, &inputs, &states, time);
+    }
+}
+
+#[test]
+fn the_saturated_pressures_have_no_slope_and_the_free_ones_the_gains() {
+    let mut m = joint(&Parameters::default());
+    // Far below the reference: u is huge, the flexor at max_pressure, the extensor at zero.
+    m.set_states(&States {
+        joint_angle: -2.0,
+        joint_velocity: 0.0,
+    })
+    .expect("valid");
+    let d = m.partials(&Inputs::default()).expect("provided");
+    for row in ["flexor_pressure", "extensor_pressure"] {
+        assert!(
+            d.get(row).expect("row").iter().all(|(_, v)| *v == 0.0),
+            "{row}"
+        );
+    }
+    // At rest on the reference: both inside, slopes -/+ kp/2 and -/+ kd/2.
+    let mut m = joint(&Parameters::default());
+    let d = m.partials(&Inputs::default()).expect("provided");
+    let p = Parameters::default();
+    assert_eq!(
+        d.get("flexor_pressure").expect("row"),
+        &[
+            ("joint_angle", -0.5 * p.kp),
+            ("joint_velocity", -0.5 * p.kd)
+        ]
+    );
+    assert_eq!(
+        d.get("extensor_pressure").expect("row"),
+        &[("joint_angle", 0.5 * p.kp), ("joint_velocity", 0.5 * p.kd)]
+    );
+}
+
+#[test]
+fn the_derivatives_are_the_ode_that_co_simulation_steps() {
+    // Semi-implicit Euler: dq1 = dq0 + h a(q0, dq0), q1 = q0 + h dq1, so one short step gives the
+    // acceleration Model Exchange reports, to rounding.
+    let inputs = Inputs {
+        flexor_force: 80.0,
+        extensor_force: 20.0,
+        ..Inputs::default()
+    };
+    let mut me = joint(&Parameters::default());
+    let start = States {
+        joint_angle: 0.3,
+        joint_velocity: -0.7,
+    };
+    me.set_states(&start).expect("valid");
+    let dx = me.derivatives(&inputs).expect("finite");
+    assert_eq!(dx.joint_angle, start.joint_velocity);
+    let mut cs = me.clone();
+    let h = 1e-4;
+    cs.step(
+        &inputs,
+        &mut Outputs::default(),
+        0.0,
+        h,
+        &mut Report::default(),
+    );
+    let after = cs.states();
+    let acceleration = (after.joint_velocity - start.joint_velocity) / h;
+    assert!(
+        (acceleration - dx.joint_velocity).abs() <= 1e-9 * dx.joint_velocity.abs(),
+        "{acceleration} vs {}",
+        dx.joint_velocity
+    );
+    // The hand check of the ODE: (r (F_f - F_e) - c dq - m g l sin q) / I.
+    let p = Parameters::default();
+    let expected = (p.moment_arm * 60.0
+        - p.damping * -0.7
+        - p.mass * p.gravity * p.com_distance * 0.3_f64.sin())
+        / p.inertia;
+    assert!((dx.joint_velocity - expected).abs() <= 1e-12 * expected.abs());
+}
+
+#[test]
+fn time_events_fall_on_the_segment_boundaries_and_stop_after_the_last_move() {
+    let m = joint(&Parameters {
+        segment_time: 0.5,
+        ..Parameters::default()
+    });
+    assert_eq!(m.next_time_event(0.0), Some(0.5));
+    assert_eq!(m.next_time_event(0.5), Some(1.0));
+    assert_eq!(m.next_time_event(1.2), Some(1.5));
+    assert_eq!(m.next_time_event(1.5), Some(2.0));
+    assert_eq!(m.next_time_event(2.0), None);
+}
+
+#[test]
+fn a_state_whose_outputs_cannot_be_represented_is_refused_and_the_old_one_kept() {
+    let mut m = joint(&Parameters::default());
+    let good = States {
+        joint_angle: 0.2,
+        joint_velocity: 0.1,
+    };
+    m.set_states(&good).expect("valid");
+    let bad = States {
+        joint_angle: 0.2,
+        joint_velocity: f64::INFINITY,
+    };
+    assert!(m.set_states(&bad).is_err());
+    assert_eq!(m.states(), good);
+}
