@@ -543,7 +543,7 @@ mod continuous_states {
     use super::check;
     use super::model_description::rules;
 
-    const PULLEY: &str = include_str!("../modelDescription/PulleyJoint.xml");
+    const PULLEY: &str = include_str!("../../modelDescription/PulleyJoint.xml");
 
     fn edited(from: &str, to: &str) -> String {
         assert!(PULLEY.contains(from), "test edit does not apply: {from}");
