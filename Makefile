@@ -39,7 +39,7 @@ py-deps:
 	fi
 
 ## One recipe for the three files (`&:`): under `make -j` it must run once, not once per file.
-## `+`: cargo shares make's job slots.
+## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
 $(LIB) target/release/package_fmus target/release/calibrate &: $(SOURCES)
 	+cargo build --release --lib -p actuator-fmus
 	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
