@@ -38,9 +38,11 @@ py-deps:
 	    --no-install-recommends $$missing; \
 	fi
 
-$(LIB) target/release/package_fmus target/release/calibrate: $(SOURCES)
-	cargo build --release --lib -p actuator-fmus
-	cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
+## One recipe for the three files (`&:`): under `make -j` it must run once, not once per file.
+## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
+$(LIB) target/release/package_fmus target/release/calibrate &: $(SOURCES)
+	+cargo build --release --lib -p actuator-fmus
+	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
 
 ## Cross toolchains for the win64 and aarch64-linux binaries, and the emulators the tests run them
 ## under (wine, qemu-user); each installed only when missing.
@@ -56,14 +58,17 @@ cross-deps:
 	@installed=$$(rustup target list --installed); for t in $(CROSS_TARGETS); do \
 	  echo "$$installed" | grep -qx $$t || rustup target add $$t; done
 
-WIN_DLL := target/x86_64-pc-windows-gnu/release/actuator_fmus.dll
-ARM_SO := target/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
+## Both cross targets in one cargo run, in their own target directory: cargo locks its target
+## directory for a whole run, so in target/ they would wait for the host build (and the Rust tests'
+## build) instead of running beside it under `make -j`. The price is compiling the build script's
+## host dependencies once more.
+CROSS_TARGET_DIR := target/cross
+WIN_DLL := $(CROSS_TARGET_DIR)/x86_64-pc-windows-gnu/release/actuator_fmus.dll
+ARM_SO := $(CROSS_TARGET_DIR)/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
 
-$(WIN_DLL): $(SOURCES) | cross-deps
-	cargo build --release --lib --target x86_64-pc-windows-gnu
-
-$(ARM_SO): $(SOURCES) | cross-deps
-	cargo build --release --lib --target aarch64-unknown-linux-gnu
+$(WIN_DLL) $(ARM_SO) &: $(SOURCES) | cross-deps
+	+cargo build --release --lib --target-dir $(CROSS_TARGET_DIR) \
+	  --target x86_64-pc-windows-gnu --target aarch64-unknown-linux-gnu
 
 ## target/fmu/<Model>.fmu for every model in modelDescription/, with binaries for linux64, win64 and
 ## aarch64-linux (`make fmus CROSS=0`: linux64 only, no cross toolchains needed).
@@ -111,7 +116,7 @@ calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
 	$(PY) calibration/calibrate.py data/festo/festo_dmsp10.csv 0.25 0.01 0,600 docs/calibration/dmsp10
 
 test-rust: deps fmus
-	cargo test --release --workspace
+	+cargo test --release --workspace
 
 ## ecos (ecospy, tests/fmpy/test_interop.py) needs Debian's libtbb12.
 interop-deps:
@@ -121,11 +126,20 @@ interop-deps:
 	  $$SUDO apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$SUDO apt-get install -y -qq libtbb12; \
 	fi
 
+## PYTEST_WORKERS processes (pytest-xdist); a test file stays in one worker (`--dist loadfile`), so
+## that its module fixtures are built once and files that share a scratch directory (wine's
+## prefix) never run beside themselves. PYTEST_WORKERS=0: one process.
+PYTEST_WORKERS ?= 2
 test-fmpy: fmus $(VENV)/.installed interop-deps py-deps
-	$(PY) -m pytest tests/fmpy -q
+	$(PY) -m pytest tests/fmpy -q $(if $(filter-out 0,$(PYTEST_WORKERS)),-n $(PYTEST_WORKERS) --dist loadfile)
 
-## All Rust tests and the FMPy suite.
-test: test-rust test-fmpy
+## All Rust tests and the FMPy suite. The apt checks run first, one at a time (dpkg has one lock);
+## then everything else runs TEST_JOBS wide: the host build beside the cross builds and the venv,
+## then the Rust tests beside the FMPy suite (docs: README "Tests (`make test`)").
+TEST_JOBS ?= 3
+test:
+	@$(MAKE) --no-print-directory deps cross-deps interop-deps py-deps
+	+@$(MAKE) --no-print-directory -j$(TEST_JOBS) test-rust test-fmpy
 
 ## The C pass-through FMU (FMI 2.0 Co-Simulation) that benches/parity.rs holds our FMI layer against.
 C_PASSTHROUGH := target/c_passthrough/PassThroughC.so
@@ -183,7 +197,7 @@ knitted-bag-docs: fmus $(VENV)/.installed
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
 robot-joint: deps fmus $(VENV)/.installed
 	$(PY) examples/robot_joint.py --out out
-	cargo run --release --example robot_joint
+	cargo run --release -p actuator-fmus-tools --example robot_joint
 
 ## FMI cross-check files crosscheck/<Model>/<Model>_{in,ref}.csv, _ref.opt and the plots
 ## docs/fmu/<Model>.png, then the FMUs again so that each documentation/ carries its plot.
@@ -217,7 +231,7 @@ SANITIZER ?= address
 ## niced run on a loaded machine waits many times that for a core.
 FUZZ_TIMEOUT ?= 120
 ## Fuzzes random FMI call sequences on all six models for FUZZ_SECONDS (cargo-fuzz, nightly Rust),
-## with the harness of tests/fuzz_driver/ (tests/fuzz_corpus.rs replays the committed corpus in
+## with the harness of tests/fuzz_driver/ (tests/all/fuzz_corpus.rs replays the committed corpus in
 ## `make test`). The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go
 ## to the ignored fuzz/corpus-run/, findings to the ignored fuzz/artifacts/. The summary line
 ## counts the sequences run ("stat::number_of_executed_units"). The tracked fuzz/Cargo.lock must

@@ -2,7 +2,8 @@
 - out/knitted_curves.png: force-length at 14 kPa for each shape model (ideal cylinder, tubular
   knit, non-cylindrical), and the non-cylindrical one with friction Cf = 0.25 (Fig. 1.18);
 - out/knitted_profile.png: the non-cylindrical radius profile at several lengths (Fig. 1.12).
-  The FMU cannot return a profile: it comes from `cargo run --release --example knitted_profile`,
+  The FMU cannot return a profile: it comes from
+  `cargo run --release -p actuator-fmus-tools --bin knitted_profile`,
   which prints it as CSV from the crate's physics."""
 
 import argparse
@@ -73,8 +74,8 @@ def main():
     fig.savefig(out / "knitted_curves.png", dpi=120)
     print(f"wrote {out / 'knitted_curves.png'}")
 
-    csv = subprocess.run(["cargo", "run", "-q", "--release", "--example", "knitted_profile"], cwd=ROOT,
-                         check=True, capture_output=True, text=True).stdout
+    profile = ["cargo", "run", "-q", "--release", "-p", "actuator-fmus-tools", "--bin", "knitted_profile"]
+    csv = subprocess.run(profile, cwd=ROOT, check=True, capture_output=True, text=True).stdout
     data = np.loadtxt(io.StringIO(csv), delimiter=",", skiprows=1)
     fig, ax = plt.subplots(figsize=(10, 3.6))
     for length in np.unique(data[:, 0])[::-1]:

@@ -1,5 +1,5 @@
 """Robot joint driven by an antagonistic pair of McKibbenMuscle FMUs, co-simulated with FMPy's
-FMU2Slave API. `examples/robot_joint.rs` runs the same algorithm through the `fmi` crate; both
+FMU2Slave API. `tools/examples/robot_joint.rs` runs the same algorithm through the `fmi` crate; both
 read `examples/robot_joint.json` and must give the same trajectory.
 
 The joint: a pulley of radius r (`moment_arm`) carries a pendulum (inertia I, viscous damping c,

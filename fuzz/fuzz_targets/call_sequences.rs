@@ -1,5 +1,5 @@
 //! libFuzzer entry point: the logic is in `tests/fuzz_driver/call_sequences.rs`, which
-//! `tests/fuzz_corpus.rs` also runs over the committed corpus in `make test`.
+//! `tests/all/fuzz_corpus.rs` also runs over the committed corpus in `make test`.
 #![no_main]
 
 #[path = "../../tests/fuzz_driver/call_sequences.rs"]

@@ -2,7 +2,7 @@
 //! harness: "all effects on" parameters and deterministic inputs inside the declared ranges.
 #![allow(dead_code)]
 
-use crate::common::*;
+use super::common::*;
 use actuator_fmus::fmi2::REGISTRY;
 use actuator_fmus::variables::{Causality, ModelInfo, Start, VarType};
 use std::ffi::{c_char, c_int};

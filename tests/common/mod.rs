@@ -98,11 +98,22 @@ pub fn read_entry(fmu: &Path, name: &str) -> Vec<u8> {
 }
 
 /// Extracts the binary of `model` into a fresh directory and returns its path.
+///
+/// The directory is claimed with `create_dir`, which fails if it exists: `tests/all` holds several
+/// copies of this module, each with its own counter, and rewriting a library another test has
+/// loaded from the same path would pull its code from under it (SIGSEGV).
 pub fn extract_binary(model: &str) -> PathBuf {
     static COUNTER: std::sync::atomic::AtomicUsize = std::sync::atomic::AtomicUsize::new(0);
-    let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
-    let dir = std::env::temp_dir().join(format!("actuator-fmus-test-{}-{n}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
+    let dir = loop {
+        let n = COUNTER.fetch_add(1, std::sync::atomic::Ordering::SeqCst);
+        let dir =
+            std::env::temp_dir().join(format!("actuator-fmus-test-{}-{n}", std::process::id()));
+        match std::fs::create_dir(&dir) {
+            Ok(()) => break dir,
+            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
+            Err(e) => panic!("{}: {e}", dir.display()),
+        }
+    };
     let so = dir.join(format!("{model}.so"));
     std::fs::write(
         &so,

@@ -1,5 +1,5 @@
 //! The fuzz harness's logic, shared by `fuzz/fuzz_targets/call_sequences.rs` (libFuzzer) and
-//! `tests/fuzz_corpus.rs` (the committed corpus replayed in `make test`).
+//! `tests/all/fuzz_corpus.rs` (the committed corpus replayed in `make test`).
 //!
 //! Interprets the fuzzer's bytes as a sequence of FMI 2.0 calls on up to four instances of any
 //! model in the binary, with random value references, NaN/inf/huge values, NULL or valid buffers,

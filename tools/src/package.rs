@@ -46,8 +46,11 @@ fn package(
 ) -> Result<PathBuf, String> {
     let info = factory.info();
     let path = out_dir.join(format!("{}.fmu", info.name));
-    let file = std::fs::File::create(&path)
-        .map_err(|e| format!("cannot create {}: {e}", path.display()))?;
+    // Written beside and renamed over the FMU whole: a reader of the previous FMU (a test running
+    // beside `make calibrate`, which repackages, under `make -j`) keeps reading it intact.
+    let partial = out_dir.join(format!(".{}.fmu.{}.partial", info.name, std::process::id()));
+    let file = std::fs::File::create(&partial)
+        .map_err(|e| format!("cannot create {}: {e}", partial.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     // A plot of the model's cross-check run (crosscheck/generate.py), shipped when present.
@@ -87,6 +90,13 @@ fn package(
         zip.write_all(data).map_err(|e| e.to_string())?;
     }
     zip.finish().map_err(|e| e.to_string())?;
+    std::fs::rename(&partial, &path).map_err(|e| {
+        format!(
+            "cannot move {} to {}: {e}",
+            partial.display(),
+            path.display()
+        )
+    })?;
     Ok(path)
 }
 

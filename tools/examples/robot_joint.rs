@@ -2,12 +2,12 @@
 //! instances on a pulley, the same controller and integrator, parameters from
 //! `examples/robot_joint.json`. Writes `out/robot_joint_fmi.csv`, and runs the same loop with
 //! the McKibbenJoint FMU in place of the two muscles (`out/robot_joint_joint_fmu.csv`):
-//! `cargo run --release --example robot_joint [-- --stop-time 2.0]`.
+//! `cargo run --release -p actuator-fmus-tools --example robot_joint [-- --stop-time 2.0]`.
+//! It lives in `tools/` so that `make robot-joint` compiles only the `fmi` crate beside the
+//! library, not the root crate's test-only dependencies (criterion, proptest, ...).
 
-#[path = "../tests/common/robot_joint.rs"]
+#[path = "../../tests/common/robot_joint.rs"]
 mod robot_joint;
-
-use std::path::Path;
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -19,7 +19,7 @@ fn main() {
             s.parse::<f64>()
                 .expect("--stop-time takes a number of seconds")
         });
-    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let root = &actuator_fmus_tools::repository_root();
     let p = robot_joint::Parameters::load(&root.join("examples/robot_joint.json"))
         .unwrap_or_else(|e| panic!("{e}"));
     let rows = robot_joint::simulate(&p, &root.join("target/fmu"), stop_time)

@@ -2,9 +2,9 @@
 //! lengths, as CSV on stdout: `length,z,radius` in metres, one row per ring. The FMU cannot
 //! return a profile, so `examples/knitted_curves.py` runs this to plot it.
 //!
-//! Usage: `cargo run --release --example knitted_profile [segments] [length ...]`; without
-//! lengths, eight from full extension to free contraction. Defaults: the section 1.4 prototype,
-//! 49 segments (one per row).
+//! Usage: `cargo run --release -p actuator-fmus-tools --bin knitted_profile [segments]
+//! [length ...]`; without lengths, eight from full extension to free contraction. Defaults: the
+//! section 1.4 prototype, 49 segments (one per row).
 
 use actuator_fmus::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
 use std::io::Write;

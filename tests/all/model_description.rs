@@ -3,15 +3,15 @@
 //! change to the variables.
 
 #[allow(dead_code)]
-#[path = "../build/codegen.rs"]
+#[path = "../../build/codegen.rs"]
 mod codegen;
 #[allow(dead_code)]
-#[path = "../build/model_description.rs"]
+#[path = "../../build/model_description.rs"]
 mod model_description;
 
 use model_description::{check, guid_of, ResolvedUnknown};
 
-const SOURCE: &str = include_str!("../modelDescription/McKibbenMuscle.xml");
+const SOURCE: &str = include_str!("../../modelDescription/McKibbenMuscle.xml");
 
 /// The McKibben description with `from` replaced by `to` (which must occur).
 fn edited(from: &str, to: &str) -> String {
@@ -247,27 +247,27 @@ fn every_output_and_initial_unknown_declares_its_dependencies() {
         ("McKibbenMuscle", SOURCE),
         (
             "KnittedMuscle",
-            include_str!("../modelDescription/KnittedMuscle.xml"),
+            include_str!("../../modelDescription/KnittedMuscle.xml"),
         ),
         (
             "McKibbenJoint",
-            include_str!("../modelDescription/McKibbenJoint.xml"),
+            include_str!("../../modelDescription/McKibbenJoint.xml"),
         ),
         (
             "PulleyJoint",
-            include_str!("../modelDescription/PulleyJoint.xml"),
+            include_str!("../../modelDescription/PulleyJoint.xml"),
         ),
         (
             "MultiferroicMotor",
-            include_str!("../modelDescription/MultiferroicMotor.xml"),
+            include_str!("../../modelDescription/MultiferroicMotor.xml"),
         ),
         (
             "PassThrough",
-            include_str!("../modelDescription/PassThrough.xml"),
+            include_str!("../../modelDescription/PassThrough.xml"),
         ),
         (
             "FreeBladder",
-            include_str!("../modelDescription/FreeBladder.xml"),
+            include_str!("../../modelDescription/FreeBladder.xml"),
         ),
     ] {
         let m = check(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -347,8 +347,8 @@ fn the_guid_changes_with_any_variable() {
 /// which build.rs runs on the source and again on the shipped description: each one refuses a
 /// shipped description that breaks it.
 mod rules {
+    use super::model_description::rules;
     use super::{check, SOURCE};
-    use crate::model_description::rules;
 
     fn shipped() -> String {
         check(SOURCE, "McKibbenMuscle").unwrap().shipped_xml
@@ -550,7 +550,7 @@ mod continuous_states {
     use super::check;
     use super::model_description::rules;
 
-    const PULLEY: &str = include_str!("../modelDescription/PulleyJoint.xml");
+    const PULLEY: &str = include_str!("../../modelDescription/PulleyJoint.xml");
 
     fn edited(from: &str, to: &str) -> String {
         assert!(PULLEY.contains(from), "test edit does not apply: {from}");

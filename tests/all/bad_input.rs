@@ -7,6 +7,7 @@
 //! outputs of a fresh instance. One test runs everything and lists every failing case at once;
 //! it prints how many cases were tried (the README quotes the count).
 
+#[path = "../common/mod.rs"]
 mod common;
 
 use common::*;

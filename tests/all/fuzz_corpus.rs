@@ -3,7 +3,7 @@
 //! input makes any FMU return fmi2Fatal, crash, refuse without a logged reason or hand out a NaN.
 //! Inputs that once were findings live there too (`make fuzz` writes them to `fuzz/artifacts/`).
 
-#[path = "fuzz_driver/call_sequences.rs"]
+#[path = "../fuzz_driver/call_sequences.rs"]
 mod driver;
 
 use std::path::Path;

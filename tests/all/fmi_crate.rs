@@ -1,6 +1,7 @@
 //! A second, independent importer: the `fmi` crate loads the packaged FMU and must see eq. 2.3 and
 //! working FMU states, as FMPy does.
 
+#[path = "../common/mod.rs"]
 mod common;
 
 use common::gaylord_force;
