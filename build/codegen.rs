@@ -5,7 +5,7 @@
 //! - `model_bindings.rs`, included by `src/fmi2/registry.rs`: per model, the access by value
 //!   reference to those structs' fields, and the registry of every model.
 
-use crate::model_description::{field_name, Model, Variable, TYPES};
+use super::model_description::{field_name, Model, Variable, TYPES};
 use std::fmt::Write as _;
 
 /// `McKibbenMuscle` -> `mckibben_muscle`: a word break comes before a capital that follows a
