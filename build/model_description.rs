@@ -1,6 +1,6 @@
 //! Parsing and checking of `modelDescription/<Model>.xml`, and the shipped model description that
 //! build.rs writes from it. Used by build.rs (with `build/codegen.rs`, which writes the Rust
-//! code), and by `tests/all/model_description.rs` to prove that bad descriptions fail.
+//! code), and by `tests/all/shipped_descriptions.rs` to prove that bad descriptions fail.
 //!
 //! A source description holds only the model's own: its variables, units, default experiment and
 //! output dependencies (by variable name). The export layer's part is written here: the
@@ -182,7 +182,7 @@ pub struct Model {
     pub variables: Vec<Variable>,
     /// Number of Real, Integer, Boolean and String variables.
     pub counts: [usize; 4],
-    #[allow(dead_code)] // read by tests/all/model_description.rs
+    #[allow(dead_code)] // read by tests/all/shipped_descriptions.rs
     pub outputs: Vec<ResolvedUnknown>,
     #[allow(dead_code)]
     pub initial_unknowns: Vec<ResolvedUnknown>,

@@ -1,7 +1,7 @@
 //! FMI 2.0 chapter 2 rules that conformance checkers test (the INTO-CPS VDMCheck inventory) and
 //! that the structural checker in `model_description.rs` does not cover. They read the XML as
 //! events, so they hold whatever shape the generator's own structs take. Each rule has a test in
-//! `tests/all/model_description.rs` that feeds it a bad description.
+//! `tests/all/shipped_descriptions.rs` that feeds it a bad description.
 
 // `!(x > y)` is deliberate: it also refuses NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]

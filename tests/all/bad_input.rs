@@ -7,8 +7,7 @@
 //! outputs of a fresh instance. One test runs everything and lists every failing case at once;
 //! it prints how many cases were tried (the README quotes the count).
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 
 use common::*;
 use std::ffi::{c_char, c_int, c_void, CString};

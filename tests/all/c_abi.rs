@@ -1,8 +1,7 @@
 //! The packaged McKibbenMuscle binary driven through its C ABI: call order, bad arguments, logging,
 //! FMU state, threads. Every refusal must come with a logged reason and a non-OK status.
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 
 use common::mckibben::*;
 use common::*;

@@ -6,8 +6,7 @@
 //! finite outputs). Every value inside the declared range must be accepted by the setters.
 //! Prints how many cases ran (the README quotes the count).
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 
 use common::*;
 use std::collections::BTreeMap;

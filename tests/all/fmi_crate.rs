@@ -1,8 +1,7 @@
 //! A second, independent importer: the `fmi` crate loads the packaged FMU and must see eq. 2.3 and
 //! working FMU states, as FMPy does.
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 
 use common::gaylord_force;
 use common::mckibben::*;

@@ -1,6 +1,6 @@
 //! The integration tests in one binary: linking one release binary per `tests/*.rs` file cost
 //! `make test` a link of the whole crate and its dependencies each. Each file here is the module it
-//! was as a binary (with its own copy of `tests/common`). `tests/load.rs` and
+//! was as a binary; they share one copy of `tests/common`. `tests/load.rs` and
 //! `tests/model_exchange_states.rs` keep their own processes: their `#[global_allocator]` counts
 //! every allocation the process makes, which other tests running beside them would disturb. A new `tests/*.rs` file still builds as its own binary; list it here
 //! (after `git mv` into `tests/all/`) to join this one.
@@ -9,15 +9,19 @@
 // C's (`c_int`): the same C ABI, declared twice now that both are in one binary.
 #![allow(clashing_extern_declarations)]
 
+/// One copy of the shared helpers for every module (`use crate::common`).
+#[path = "../common/mod.rs"]
+mod common;
+
 mod bad_input;
 mod c_abi;
 mod declared_ranges;
 mod fmi_crate;
 mod fuzz_corpus;
-mod model_description;
 mod motor_c_abi;
 mod restore_validation;
-mod robot_joint;
+mod robot_joint_runs;
+mod shipped_descriptions;
 
 /// Every file in `tests/all/` is a module of this binary: a file dropped here but not listed
 /// above would silently never run.

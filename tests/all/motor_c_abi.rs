@@ -2,8 +2,7 @@
 //! FMU, FMU state round trips with the motor's history, and finiteness over communication steps
 //! from 1e-12 s to 1 s.
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 
 use actuator_fmus::variables::multiferroic_motor::{boolean, integer, real};
 use common::*;

@@ -5,8 +5,7 @@
 //! `max_length` and resealed used to deserialize, and the next `fmi2DoStep` panicked in
 //! `f64::clamp` and returned fmi2Fatal (found by `make fuzz SANITIZER=none`).
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 #[path = "../common/exercise.rs"]
 mod exercise;
 

@@ -1,5 +1,5 @@
 """The robot joint under FMPy's FMU2Slave (examples/robot_joint.py) reproduces the committed
-trajectory tests/data/robot_joint_ref.csv, which tests/all/robot_joint.rs checks the `fmi` crate
+trajectory tests/data/robot_joint_ref.csv, which tests/all/robot_joint_runs.rs checks the `fmi` crate
 against: both importers give the same trajectory."""
 
 import importlib.util

@@ -2,8 +2,7 @@
 //! reference `tests/data/robot_joint_ref.csv` was written by `examples/robot_joint.py` (FMPy's
 //! FMU2Slave), and `tests/fmpy/test_robot_joint.py` checks FMPy against the same file.
 
-#[path = "../common/mod.rs"]
-mod common;
+use crate::common;
 #[allow(dead_code)]
 #[path = "../common/robot_joint.rs"]
 mod robot_joint;
