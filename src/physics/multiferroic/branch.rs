@@ -83,16 +83,9 @@ impl Landscape<'_> {
         let (mut x, mut g, mut c) = (anchor, g0, c0);
         for _ in 0..MAX_STRIDES {
             let a = (-dir * g).max(0.0);
-            let safe = ((c * c + 2.0 * m * a).sqrt() - c) / m;
-            let window = 0.99 * c / m;
             // Inside the window the curvature stays positive and `h` rises: a stride that ends
             // uphill holds exactly the minimum. Outside it only `safe` is sure not to hold a root.
-            let in_window = c > 0.0 && window > safe;
-            let stride = if in_window {
-                (2.0 * safe).min(window)
-            } else {
-                safe
-            };
+            let (stride, in_window) = super::onion::downhill_stride(a, c, m);
             if !(stride.is_finite() && stride > 0.0) {
                 break;
             }

@@ -113,14 +113,7 @@ impl Landscape<'_> {
         for _ in 0..MAX_MARCH_STEPS {
             // h(0) = dir g = -a <= 0 (downhill), h'(0) = c.
             let a = (-dir * g).max(0.0);
-            let safe = ((c * c + 2.0 * m * a).sqrt() - c) / m;
-            let window = 0.99 * c / m;
-            // Inside the monotone window a longer trial is safe; outside it only `safe` is.
-            let stride = if c > 0.0 && window > safe {
-                (2.0 * safe).min(window)
-            } else {
-                safe
-            };
+            let (stride, _) = downhill_stride(a, c, m);
             if !(stride.is_finite() && stride > 0.0) {
                 break;
             }
@@ -150,4 +143,21 @@ impl Landscape<'_> {
         });
         root.map_or(0.5 * (a + b), |r| r.x)
     }
+}
+
+/// The stride a downhill march may take from a point where the gradient along the march is `-a`
+/// (`a >= 0`) and the curvature `c`, when the third derivative is bounded by `m`: `safe` is the
+/// root of `-a + c s + m s^2 / 2`, the shortest distance at which the minimum could lie. Inside
+/// the monotone window (the curvature stays positive) twice that is still safe, so the second
+/// value says whether the stride lies inside it.
+pub(super) fn downhill_stride(a: f64, c: f64, m: f64) -> (f64, bool) {
+    let safe = ((c * c + 2.0 * m * a).sqrt() - c) / m;
+    let window = 0.99 * c / m;
+    let in_window = c > 0.0 && window > safe;
+    let stride = if in_window {
+        (2.0 * safe).min(window)
+    } else {
+        safe
+    };
+    (stride, in_window)
 }
