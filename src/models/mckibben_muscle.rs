@@ -266,13 +266,7 @@ impl McKibbenMuscle {
         outputs: &mut Outputs,
     ) {
         let (length, force) = (inputs.length, inputs.target_force);
-        let (lo, hi) = (muscle.min_length(), muscle.max_length());
-        let margin = if muscle.bladder().is_some() {
-            LIMIT_MARGIN * (hi - lo)
-        } else {
-            0.0
-        };
-        let inside = length.max(lo + margin).min(hi - margin);
+        let inside = solvable_length(muscle, length);
         let solved = pressure_for_force(muscle, length, force, max_pressure, history)
             .or_else(|_| pressure_for_force(muscle, inside, force, max_pressure, history));
         if let Ok(s) = solved {
@@ -294,13 +288,7 @@ impl McKibbenMuscle {
         let (solved, l, inside) = match solve(length) {
             Ok(s) => (s, length, true),
             Err(_) => {
-                let (lo, hi) = (muscle.min_length(), muscle.max_length());
-                let margin = if muscle.bladder().is_some() {
-                    LIMIT_MARGIN * (hi - lo)
-                } else {
-                    0.0
-                };
-                let clamped = length.max(lo + margin).min(hi - margin);
+                let clamped = solvable_length(muscle, length);
                 match solve(clamped) {
                     Ok(s) => (s, clamped, false),
                     Err(_) => return [0.0; 2],
@@ -566,6 +554,18 @@ impl McKibbenMuscle {
         );
         Ok(rows)
     }
+}
+
+/// The nearest length the pressure solver works at: inside the muscle's limits, and by
+/// `LIMIT_MARGIN` of the stroke inside them when a bladder makes the limits singular.
+fn solvable_length(muscle: &McKibben, length: f64) -> f64 {
+    let (lo, hi) = (muscle.min_length(), muscle.max_length());
+    let margin = if muscle.bladder().is_some() {
+        LIMIT_MARGIN * (hi - lo)
+    } else {
+        0.0
+    };
+    length.max(lo + margin).min(hi - margin)
 }
 
 #[cfg(test)]
