@@ -4,6 +4,7 @@
 
 use super::branch::Branch;
 use super::model_exchange::{by, MeGradient};
+use super::tests::{motor_with, schedule};
 use super::*;
 
 fn motor() -> Motor {
@@ -11,29 +12,9 @@ fn motor() -> Motor {
 }
 
 fn gilbert() -> Motor {
-    let mut p = MotorParams::table_3_1();
-    p.onion_model = OnionModel::Gilbert;
-    Motor::new(p).unwrap()
+    motor_with(|p| p.onion_model = OnionModel::Gilbert)
 }
 
-fn scheduled(period: f64) -> MotorInputs {
-    let s = SteppingSchedule::new(
-        (-30f64).to_radians(),
-        60f64.to_radians(),
-        period,
-        CALIBRATION_STRESS,
-    )
-    .unwrap();
-    MotorInputs {
-        schedule: ScheduleSwitch::on(s),
-        ..MotorInputs::fixed(0.0, 0.0)
-    }
-}
-
-/// What a Model Exchange importer does, done finely: classical RK4 with step `h` on the motor's
-/// states, the anchor refreshed after every completed step, time events at the schedule's
-/// switches, and state events located by bisection on the step length (to 1e-6 of `h`). Returns
-/// the state at `until` and the number of state events.
 fn reference_run(
     m: &Motor,
     inputs: &MotorInputs,
@@ -255,7 +236,7 @@ fn right_hand_side_integrates_to_the_co_simulation_rotor() {
 fn schedule_switches_are_time_events_matching_co_simulation() {
     let m = motor();
     // 20 us periods (several relaxation times): three switches of 60 degrees.
-    let inputs = scheduled(20e-6);
+    let inputs = schedule(20e-6);
     let start = MotorState::aligned(0.0);
     let (me, _) = reference_run(&m, &inputs, start, 1e-10, 70e-6);
     let cs = co_simulation(&m, &inputs, start, 1e-6, 70e-6);
@@ -417,7 +398,7 @@ fn partials_match_central_differences() {
     check_partials(&m, &at(0.1, 0.0, 0.0), &locked, "locked");
     let sched = MotorInputs {
         load_torque: -2e-19,
-        ..scheduled(1e-4)
+        ..schedule(1e-4)
     };
     check_partials(&m, &at(0.2, 1e3, 0.9), &sched, "schedule");
     // Gilbert onion: psi and theta are states.

@@ -6,14 +6,14 @@ fn motor() -> Motor {
     Motor::new(MotorParams::table_3_1()).unwrap()
 }
 
-fn motor_with(f: impl FnOnce(&mut MotorParams)) -> Motor {
+pub(super) fn motor_with(f: impl FnOnce(&mut MotorParams)) -> Motor {
     let mut p = MotorParams::table_3_1();
     f(&mut p);
     Motor::new(p).unwrap()
 }
 
 /// The stepping schedule starting at -30 degrees, so the first magnetoelastic minimum is at +60.
-fn schedule(period: f64) -> MotorInputs {
+pub(super) fn schedule(period: f64) -> MotorInputs {
     let s = SteppingSchedule::new(
         (-30f64).to_radians(),
         60f64.to_radians(),
