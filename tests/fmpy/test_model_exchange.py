@@ -29,7 +29,6 @@ MODEL_EXCHANGE = [
     "PulleyJoint",
 ]
 ALGEBRAIC = ["FreeBladder", "KnittedMuscle", "McKibbenJoint", "McKibbenMuscle", "PassThrough"]
-CO_SIMULATION_ONLY = []
 TOLERANCE = 1e-9
 # The motor's scenes (continuous states, events) are compared in test_motor_model_exchange.py.
 SCENES = [
@@ -105,39 +104,44 @@ def test_joint_model_exchange_matches_co_simulation():
     assert max(worst.values()) <= TOLERANCE, worst
 
 
-def test_every_model_is_in_one_list():
-    shipped = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
-    assert sorted(MODEL_EXCHANGE + CO_SIMULATION_ONLY) == shipped
+SHIPPED = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
 
 
-@pytest.mark.parametrize("model", MODEL_EXCHANGE + CO_SIMULATION_ONLY)
+def test_every_model_is_in_the_list():
+    assert sorted(MODEL_EXCHANGE) == SHIPPED
+
+
+@pytest.mark.parametrize("model", MODEL_EXCHANGE)
 def test_both_interfaces_validate_clean(model):
     assert validate_fmu(fmu_path(model)) == []
     md = read_model_description(fmu_path(model))
-    assert md.coSimulation is not None
-    assert (md.modelExchange is not None) == (model in MODEL_EXCHANGE)
-    if md.modelExchange:
-        states = {"PulleyJoint": 2, "MultiferroicMotor": 4}.get(model, 0)
-        indicators = {"MultiferroicMotor": 1}.get(model, 0)
-        assert md.numberOfContinuousStates == states and md.numberOfEventIndicators == indicators
-        assert not md.modelExchange.completedIntegratorStepNotNeeded
+    assert md.coSimulation is not None and md.modelExchange is not None
+    states = {"PulleyJoint": 2, "MultiferroicMotor": 4}.get(model, 0)
+    indicators = {"MultiferroicMotor": 1}.get(model, 0)
+    assert md.numberOfContinuousStates == states and md.numberOfEventIndicators == indicators
+    assert not md.modelExchange.completedIntegratorStepNotNeeded
 
 
-@pytest.mark.parametrize("model", CO_SIMULATION_ONLY)
-def test_co_simulation_only_models_refuse_model_exchange(model):
-    from fmpy.fmi2 import FMU2Model
+@pytest.mark.parametrize("model", SHIPPED)
+def test_every_fmu_serves_both_interfaces(model):
+    """Every shipped FMU declares both interfaces under one model identifier, and its binary
+    instantiates, initializes and terminates as either (no FMU is Co-Simulation only)."""
     from fmpy import extract
+    from fmpy.fmi2 import FMU2Model, FMU2Slave
 
     md = read_model_description(fmu_path(model))
-    fmu = FMU2Model(
-        guid=md.guid,
-        unzipDirectory=extract(fmu_path(model)),
-        modelIdentifier=md.coSimulation.modelIdentifier,
-        instanceName="co-simulation only",
-    )
-    with pytest.raises(Exception, match="Failed to instantiate"):
+    assert md.modelExchange is not None, f"{model} does not declare Model Exchange"
+    assert md.coSimulation is not None, f"{model} does not declare Co-Simulation"
+    assert md.modelExchange.modelIdentifier == md.coSimulation.modelIdentifier == model
+    where = extract(fmu_path(model))
+    for cls in (FMU2Model, FMU2Slave):
+        fmu = cls(guid=md.guid, unzipDirectory=where, modelIdentifier=model, instanceName=cls.__name__)
         fmu.instantiate()
-    fmu.freeLibrary()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        fmu.terminate()
+        fmu.freeInstance()
 
 
 def test_model_exchange_calls_are_checked(recording_log):
