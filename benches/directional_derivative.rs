@@ -2,7 +2,8 @@
 //! McKibbenMuscle's and KnittedMuscle's C ABI, for each bladder and shape model: a step (set(P, L),
 //! doStep, get(F)), set(P, L) and one directional derivative dF/dP, and set(P, L) and the two
 //! directional derivatives dF/dP and dF/dL (one seed each, a full 1x2 Jacobian row: the second
-//! call reuses the first's partials).
+//! call reuses the first's partials), and set(P, L) and one call for d(F, stiffness)/dP: the
+//! stiffness's row is a second derivative of the force, a second-order pass through a bladder.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -25,6 +26,7 @@ struct Refs {
     pressure: u32,
     length: u32,
     force: u32,
+    stiffness: u32,
     min_length: u32,
     max_length: u32,
 }
@@ -45,6 +47,7 @@ fn mckibben() -> (Refs, Vec<Case>) {
             pressure: real::PRESSURE as u32,
             length: real::LENGTH as u32,
             force: real::FORCE as u32,
+            stiffness: real::STIFFNESS as u32,
             min_length: real::MIN_LENGTH as u32,
             max_length: real::MAX_LENGTH as u32,
         },
@@ -85,6 +88,7 @@ fn knitted() -> (Refs, Vec<Case>) {
             pressure: real::PRESSURE as u32,
             length: real::LENGTH as u32,
             force: real::FORCE as u32,
+            stiffness: real::STIFFNESS as u32,
             min_length: real::MIN_LENGTH as u32,
             max_length: real::MAX_LENGTH as u32,
         },
@@ -188,6 +192,26 @@ fn cost(c: &mut Criterion) {
                         (api.fmi2SetReal)(inst.c, inputs.as_ptr(), 2, [pressure, l].as_ptr());
                         derivative([1.0, 0.0], &mut row[..1]);
                         derivative([0.0, 1.0], &mut row[1..]);
+                        black_box(row)
+                    })
+                },
+            );
+            group.bench_function(
+                format!("{label}: set(P, L) + d(F, stiffness)/dP (1 call, stiffness row)"),
+                |bench| {
+                    bench.iter(|| unsafe {
+                        let l = next_length();
+                        (api.fmi2SetReal)(inst.c, inputs.as_ptr(), 2, [pressure, l].as_ptr());
+                        let status = (api.fmi2GetDirectionalDerivative)(
+                            inst.c,
+                            [refs.force, refs.stiffness].as_ptr(),
+                            2,
+                            inputs.as_ptr(),
+                            2,
+                            [1.0, 0.0].as_ptr(),
+                            row.as_mut_ptr(),
+                        );
+                        debug_assert_eq!(status, common::OK);
                         black_box(row)
                     })
                 },
