@@ -469,16 +469,15 @@ impl KnittedMuscle {
                 }
             }
         }
-        let stiffness = r.stiffness.as_mut();
         for row in [
             &mut r.force,
             &mut r.volume,
             &mut r.effective_pressure,
             &mut r.friction_force,
-        ]
-        .into_iter()
-        .chain(stiffness)
-        {
+        ] {
+            row[0] *= on;
+        }
+        if let Some(row) = r.stiffness.as_mut() {
             row[0] *= on;
         }
         Ok(r)

@@ -155,7 +155,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             threshold: c.value() / a.value(),
             elastic,
             // Only the last term of `elastic` depends on P (at fixed L and x).
-            elastic_dp: phi_in * inv_d_in * -1.0,
+            elastic_dp: [phi_in, inv_d_in],
             inner: InnerLayer {
                 l2_sq: l2_in,
                 axial: axial_in,

@@ -452,8 +452,6 @@ impl<S: SleeveGeometry> Bladder<S> {
         let inner = inner?;
         let p_eff = a * pressure - c;
         let threshold = c.value() / a.value();
-        // d(elastic)/dP at fixed (L, x).
-        let elastic_dp = a_sum * inv_l * -1.0;
         let elastic = (axial_sum - a_sum * pressure) * inv_l;
         Some(Kernel {
             a,
@@ -461,7 +459,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             p_eff,
             threshold,
             elastic,
-            elastic_dp,
+            elastic_dp: [a_sum, inv_l],
             inner,
         })
     }
@@ -690,7 +688,20 @@ struct Kernel<T = Dual> {
     p_eff: T,
     threshold: f64,
     elastic: T,
-    /// `d(elastic)/dP` at fixed `(L, x)` (elastic is affine in `P`).
-    elastic_dp: T,
+    /// `d(elastic)/dP` at fixed `(L, x)` (elastic is affine in `P`) is minus the product of
+    /// these two: kept as factors so that the first order multiplies their values only.
+    elastic_dp: [T; 2],
     inner: InnerLayer<T>,
+}
+
+impl<T: KernelScalar> Kernel<T> {
+    /// `d(elastic)/dP` at fixed `(L, x)`.
+    fn elastic_dp(&self) -> T {
+        self.elastic_dp[0] * self.elastic_dp[1] * -1.0
+    }
+
+    /// Its value alone.
+    fn elastic_dp_value(&self) -> f64 {
+        -(self.elastic_dp[0].value() * self.elastic_dp[1].value())
+    }
 }

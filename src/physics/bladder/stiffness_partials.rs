@@ -65,7 +65,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             ];
             BladderCurvature {
                 stiffness: [
-                    strand[0] - area.d[0] + k.elastic_dp.d[0],
+                    strand[0] - area.d[0] + k.elastic_dp().d[0],
                     strand[1] - pressure * area.h[0] + k.elastic.h[0],
                 ],
                 effective_pressure_slope: [a.d[0], pe.h[0]],
@@ -93,8 +93,9 @@ impl<S: SleeveGeometry> Bladder<S> {
             let f = area * -pressure + k.elastic;
             let [_, f_x] = f.d;
             let [f_ll, f_lx, f_xx] = f.h;
-            let f_lp = -area.d[0] + k.elastic_dp.d[0];
-            let f_xp = -area.d[1] + k.elastic_dp.d[1];
+            let elastic_dp = k.elastic_dp();
+            let f_lp = -area.d[0] + elastic_dp.d[0];
+            let f_xp = -area.d[1] + elastic_dp.d[1];
             BladderCurvature {
                 stiffness: [
                     f_lp + f_lx * x_p + (f_xp + f_xx * x_p) * x_l + f_x * x_lp,

@@ -91,7 +91,13 @@ impl McKibben {
                 *y = [y[0] + y[1] * dl_dp, y[1] * dl_dr];
             }
         }
-        finite(d, length).map(|d| (out, d))
+        if finite(&d) {
+            Ok((out, d))
+        } else {
+            Err(format!(
+                "partial derivatives overflow at length {length} m (too close to a length limit)"
+            ))
+        }
     }
 
     /// The outputs and their partials with respect to `(P, L)`, `L` the muscle's own length
@@ -221,17 +227,10 @@ impl McKibben {
     }
 }
 
-fn finite(d: McKibbenPartials, length: f64) -> Result<McKibbenPartials, String> {
-    if d.named()
+fn finite(d: &McKibbenPartials) -> bool {
+    d.named()
         .iter()
         .all(|(_, v)| v.iter().all(|x| x.is_finite()))
-    {
-        Ok(d)
-    } else {
-        Err(format!(
-            "partial derivatives overflow at length {length} m (too close to a length limit)"
-        ))
-    }
 }
 
 #[cfg(test)]
