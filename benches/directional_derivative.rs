@@ -3,7 +3,8 @@
 //! step (set(P, L),
 //! doStep, get(F)), set(P, L) and one directional derivative dF/dP, and set(P, L) and the two
 //! directional derivatives dF/dP and dF/dL (one seed each, a full 1x2 Jacobian row: the second
-//! call reuses the first's partials).
+//! call reuses the first's partials), and set(P, L) and one call for d(F, stiffness)/dP: the
+//! stiffness's row is a second derivative of the force, a second-order pass through a bladder.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -29,6 +30,8 @@ struct Refs {
     force: u32,
     /// min_length and max_length, for the muscles.
     limits: Option<[u32; 2]>,
+    /// The muscles' `stiffness` (dF/dL), whose row is a second derivative.
+    stiffness: Option<u32>,
 }
 
 fn mckibben() -> (Refs, Vec<Case>) {
@@ -48,6 +51,7 @@ fn mckibben() -> (Refs, Vec<Case>) {
             length: real::LENGTH as u32,
             force: real::FORCE as u32,
             limits: Some([real::MIN_LENGTH as u32, real::MAX_LENGTH as u32]),
+            stiffness: Some(real::STIFFNESS as u32),
         },
         vec![
             case("ideal", vec![(preset, 1)]),
@@ -87,6 +91,7 @@ fn knitted() -> (Refs, Vec<Case>) {
             length: real::LENGTH as u32,
             force: real::FORCE as u32,
             limits: Some([real::MIN_LENGTH as u32, real::MAX_LENGTH as u32]),
+            stiffness: Some(real::STIFFNESS as u32),
         },
         vec![
             sleeve("ideal", vec![(integer::SHAPE_MODEL, 0)]),
@@ -115,6 +120,7 @@ fn free_bladder() -> (Refs, Vec<Case>) {
             length: real::LENGTH as u32,
             force: real::FORCE as u32,
             limits: None,
+            stiffness: None,
         },
         // Muscle D's tube at 40 kPa (3/4 of its ballooning pressure), stretched 1.0-1.1 times.
         vec![Case {
@@ -205,6 +211,29 @@ fn cost(c: &mut Criterion) {
                         (api.fmi2SetReal)(inst.c, inputs.as_ptr(), 2, [pressure, l].as_ptr());
                         derivative([1.0, 0.0], &mut row[..1]);
                         derivative([0.0, 1.0], &mut row[1..]);
+                        black_box(row)
+                    })
+                },
+            );
+            let Some(stiffness) = refs.stiffness else {
+                continue;
+            };
+            group.bench_function(
+                format!("{label}: set(P, L) + d(F, stiffness)/dP (1 call, stiffness row)"),
+                |bench| {
+                    bench.iter(|| unsafe {
+                        let l = next_length();
+                        (api.fmi2SetReal)(inst.c, inputs.as_ptr(), 2, [pressure, l].as_ptr());
+                        let status = (api.fmi2GetDirectionalDerivative)(
+                            inst.c,
+                            [refs.force, stiffness].as_ptr(),
+                            2,
+                            inputs.as_ptr(),
+                            2,
+                            [1.0, 0.0].as_ptr(),
+                            row.as_mut_ptr(),
+                        );
+                        debug_assert_eq!(status, common::OK);
                         black_box(row)
                     })
                 },
