@@ -898,6 +898,49 @@ mod tests {
     }
 
     #[test]
+    fn at_the_bags_binding_length_the_partials_are_the_sleeves() {
+        // The bag binds strictly below the binding length: there the sleeve's branch, whose
+        // force slope is the one-sided difference towards longer lengths.
+        let mut p = parameters_with(0, false);
+        p.preset = 1;
+        p.bag_diameter = 0.085;
+        let (mut m, _, _, _) = built(&p);
+        let pressure = 14e3;
+        let l = m.bag.unwrap().binding_length(&m.sleeve, pressure);
+        let force = |m: &mut KnittedMuscle, length: f64| {
+            let mut out = Outputs::default();
+            m.evaluate(
+                &Inputs { pressure, length },
+                &mut out,
+                &mut Report::default(),
+            );
+            out.force
+        };
+        let d = m
+            .partials(&Inputs {
+                pressure,
+                length: l,
+            })
+            .unwrap();
+        let exact = d.get("force").unwrap()[1].1;
+        let h = 1e-7 * l;
+        let above = (force(&mut m, l + h) - force(&mut m, l)) / h;
+        assert!(
+            (above - exact).abs() < 1e-4 * exact.abs(),
+            "{above} {exact}"
+        );
+        // Just below, the bag carries the end load, F = -P pi R^2 (the force jumps there), with
+        // no length slope.
+        let bag_force = -pressure * std::f64::consts::PI * 0.0425f64.powi(2);
+        assert!((force(&mut m, l - h) - bag_force).abs() < 1e-12 * bag_force.abs());
+        let d = m.partials(&Inputs {
+            pressure,
+            length: l - h,
+        });
+        assert_eq!(d.unwrap().get("force").unwrap()[1], ("length", 0.0));
+    }
+
+    #[test]
     fn partials_are_zero_out_of_range() {
         let (mut m, _, _, c) = built(&parameters_with(1, false));
         let beyond = Inputs {

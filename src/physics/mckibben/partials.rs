@@ -415,6 +415,30 @@ mod tests {
     }
 
     #[test]
+    fn stiffness_partials_at_the_contact_kink_are_the_contact_branch() {
+        // At the threshold pressure the stiffness's pressure slope jumps (free below, contact
+        // above): the call returns the contact branch's, the one-sided difference from above.
+        for model in [BladderModel::ThinWall, BladderModel::Continuum { nodes: 6 }] {
+            let m = muscle(&MuscleGeometry::muscle_a(), model, false, 0.0);
+            let l = 0.09;
+            let s = HysteresisState::at_rest(l);
+            let th = m.evaluate(0.0, l, &s).unwrap().threshold_pressure;
+            let exact = m.stiffness_partials(th, l, &s).unwrap();
+            let k = |p: f64| m.evaluate(p, l, &s).unwrap().stiffness;
+            let h = 1e-4 * th.abs().max(1.0);
+            let (above, below) = ((k(th + h) - k(th)) / h, (k(th) - k(th - h)) / h);
+            assert!(
+                (above - exact[0]).abs() < 1e-3 * exact[0].abs(),
+                "{above} {exact:?}"
+            );
+            assert!(
+                (below - exact[0]).abs() > 1e-2 * exact[0].abs(),
+                "{below} {exact:?}"
+            );
+        }
+    }
+
+    #[test]
     fn friction_reversal_returns_the_slope_for_increasing_length() {
         // Saturated at z = +1 after extension: growing further adds no friction, shrinking does.
         let m = muscle(&MuscleGeometry::muscle_c(), BladderModel::None, true, 0.0);
