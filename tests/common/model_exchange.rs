@@ -208,6 +208,19 @@ pub fn me_run(
     k: usize,
     steps: usize,
 ) -> MeRun {
+    me_run_with(api, me, info, effects, k, steps, &|_| {})
+}
+
+/// As [`me_run`], calling `before_step(n)` before step `n` (threads wait at a barrier there).
+pub fn me_run_with(
+    api: &Api,
+    me: &MeApi,
+    info: &ModelInfo,
+    effects: bool,
+    k: usize,
+    steps: usize,
+    before_step: &dyn Fn(usize),
+) -> MeRun {
     let shape = me_shape(info);
     let i = ready_as(api, info, effects, 0);
     let (nx, nz) = (shape.states.len(), shape.event_indicators);
@@ -252,6 +265,7 @@ pub fn me_run(
     let h = me_step_of(info);
     let mut t = 0.0;
     for n in 0..steps {
+        before_step(n);
         let time_event = event.next_event_time_defined != 0
             && (n == steps / 2 || t + h >= event.next_event_time);
         t = if time_event {
