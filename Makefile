@@ -251,15 +251,26 @@ fuzz:
 ## Valgrind memcheck, two halves, each with its whole log kept in out/memcheck/ and its summary
 ## printed; any error in either fails:
 ## - native: tools/examples/memcheck_native.rs loads every FMU through its C ABI (no Python), runs
-##   each with default parameters and with all effects on, and every scene; definite and
-##   indirect leaks count as errors and nothing is suppressed.
+##   each with default parameters and with all effects on in both interfaces (Model Exchange with
+##   states, events and directional derivatives), and every scene; definite and indirect leaks
+##   count as errors and nothing is suppressed.
 ## - fmpy: FMPy tests (MEMCHECK_TESTS) with memory errors checked, not leaks (the Python
 ##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so. The
 ##   default set drives every FMU: every scene and every cross-check input through a strict
-##   master, FMU states, threads and 20 load/unload cycles, and validation of every FMU. The whole
-##   suite under valgrind takes hours on 2 cores: `make memcheck MEMCHECK_TESTS=tests/fmpy`.
+##   master, FMU states, threads and 20 load/unload cycles, and validation of every FMU; and Model
+##   Exchange under FMPy: the checked calls, state round trips, Jacobians, a CVode run of the
+##   motor with its events. The whole suite under valgrind takes hours on 2 cores:
+##   `make memcheck MEMCHECK_TESTS=tests/fmpy`.
+MEMCHECK_ME_TESTS := $(addprefix tests/fmpy/test_model_exchange.py::,test_model_exchange_calls_are_checked \
+  test_a_co_simulation_state_is_not_restored_into_model_exchange \
+  test_pulley_jacobian_matches_central_differences \
+  test_pulley_state_calls_are_checked_and_states_survive_fmu_state_round_trips) \
+  $(addprefix tests/fmpy/test_motor_model_exchange.py::,test_motor_partials_match_central_differences \
+  test_motor_model_exchange_jacobian_matches_central_differences \
+  test_the_motor_serves_model_exchange_with_states_and_an_event_indicator \
+  'test_motor_scene_model_exchange_matches_co_simulation[fig3_3b_motor_offset]')
 MEMCHECK_TESTS ?= tests/fmpy/test_strict_master.py tests/fmpy/test_fmi_behaviour.py \
-  tests/fmpy/test_validation.py
+  tests/fmpy/test_validation.py $(MEMCHECK_ME_TESTS)
 MEMCHECK_DIR := out/memcheck
 VALGRIND := valgrind --tool=memcheck --error-exitcode=1 --num-callers=30
 memcheck: fmus $(VENV)/.installed
