@@ -258,17 +258,14 @@ fuzz:
 ##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so. The
 ##   default set drives every FMU: every scene and every cross-check input through a strict
 ##   master, FMU states, threads and 20 load/unload cycles, and validation of every FMU; and Model
-##   Exchange under FMPy: the checked calls, state round trips, Jacobians, a CVode run of the
-##   motor with its events. The whole suite under valgrind takes hours on 2 cores:
+##   Exchange under FMPy (MEMCHECK_ME_TESTS): every scene through CVode, the checked calls,
+##   state round trips, Jacobians, the motor's events, all but the four longest runs (2-5 s each
+##   without valgrind). The whole suite under valgrind takes hours on 2 cores:
 ##   `make memcheck MEMCHECK_TESTS=tests/fmpy`.
-MEMCHECK_ME_TESTS := $(addprefix tests/fmpy/test_model_exchange.py::,test_model_exchange_calls_are_checked \
-  test_a_co_simulation_state_is_not_restored_into_model_exchange \
-  test_pulley_jacobian_matches_central_differences \
-  test_pulley_state_calls_are_checked_and_states_survive_fmu_state_round_trips) \
-  $(addprefix tests/fmpy/test_motor_model_exchange.py::,test_motor_partials_match_central_differences \
-  test_motor_model_exchange_jacobian_matches_central_differences \
-  test_the_motor_serves_model_exchange_with_states_and_an_event_indicator \
-  'test_motor_scene_model_exchange_matches_co_simulation[fig3_3b_motor_offset]')
+MEMCHECK_ME_TESTS := tests/fmpy/test_model_exchange.py tests/fmpy/test_motor_model_exchange.py \
+  $(addprefix --deselect ,'tests/fmpy/test_motor_model_exchange.py::test_motor_scene_model_exchange_matches_co_simulation[motor_stepping]' \
+  tests/fmpy/test_model_exchange.py::test_pulley_model_exchange_matches_co_simulation_under_varying_forces \
+  tests/fmpy/test_model_exchange.py::test_pulley_model_exchange_matches_co_simulation_under_constant_forces)
 MEMCHECK_TESTS ?= tests/fmpy/test_strict_master.py tests/fmpy/test_fmi_behaviour.py \
   tests/fmpy/test_validation.py $(MEMCHECK_ME_TESTS)
 MEMCHECK_DIR := out/memcheck
@@ -283,13 +280,13 @@ memcheck: fmus $(VENV)/.installed
 	$(VALGRIND) --leak-check=full --errors-for-leak-kinds=definite,indirect \
 	  --show-leak-kinds=definite,indirect --log-file=$(MEMCHECK_DIR)/native.log \
 	  target/release/examples/memcheck_native > $(MEMCHECK_DIR)/native.out 2>&1; native=$$?; \
-	tail -1 $(MEMCHECK_DIR)/native.out; \
+	tail -n $$( [ $$native = 0 ] && echo 1 || echo 20 ) $(MEMCHECK_DIR)/native.out; \
 	echo "native: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/native.log)"; \
 	grep -h 'definitely lost\|indirectly lost\|All heap blocks were freed' $(MEMCHECK_DIR)/native.log; \
 	FMI_BEHAVIOUR_LOAD_CYCLES=20 PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
 	  --log-file=$(MEMCHECK_DIR)/fmpy.log \
 	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS) > $(MEMCHECK_DIR)/fmpy.out 2>&1; fmpy=$$?; \
-	tail -1 $(MEMCHECK_DIR)/fmpy.out; \
+	tail -n $$( [ $$fmpy = 0 ] && echo 1 || echo 20 ) $(MEMCHECK_DIR)/fmpy.out; \
 	echo "fmpy: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/fmpy.log)"; \
 	echo "make memcheck: $$(( $$(date +%s) - start )) s; logs in $(MEMCHECK_DIR)/"; \
 	test $$native = 0 -a $$fmpy = 0
