@@ -220,7 +220,8 @@ sweep: fmus $(VENV)/.installed
 ## ---- Reliability jobs (issue 8): longer runs, not part of `make test`. ----
 .PHONY: fuzz memcheck load
 
-## tests/load.rs with its 10,000-cycle heap test of every FMU (ignored by `make test`: minutes of CPU).
+## tests/load.rs with its 10,000-cycle heap test of every FMU in both interfaces (ignored by
+## `make test`: a minute of CPU, most of it the motor).
 load: fmus
 	cargo test --release --test load -- --include-ignored --nocapture
 
