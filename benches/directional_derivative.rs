@@ -1,8 +1,10 @@
 //! Native cost of `fmi2GetDirectionalDerivative` against a co-simulation step, through the packaged
-//! McKibbenMuscle's and KnittedMuscle's C ABI, for each bladder and shape model: a step (set(P, L),
+//! McKibbenMuscle's, KnittedMuscle's and FreeBladder's C ABI, for each bladder and shape model: a
+//! step (set(P, L),
 //! doStep, get(F)), set(P, L) and one directional derivative dF/dP, and set(P, L) and the two
 //! directional derivatives dF/dP and dF/dL (one seed each, a full 1x2 Jacobian row: the second
-//! call reuses the first's partials).
+//! call reuses the first's partials), and set(P, L) and one call for d(F, stiffness)/dP: the
+//! stiffness's row is a second derivative of the force, a second-order pass through a bladder.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -11,7 +13,8 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::time::Duration;
 
 /// One muscle configuration: its label, Integer parameters, and the pressure (Pa) at which the
-/// length sweeps `range` (fractions of min_length .. max_length).
+/// length sweeps `range` (fractions of min_length .. max_length, or lengths in m for a model
+/// without them).
 struct Case {
     label: &'static str,
     integers: Vec<(usize, i32)>,
@@ -25,8 +28,10 @@ struct Refs {
     pressure: u32,
     length: u32,
     force: u32,
-    min_length: u32,
-    max_length: u32,
+    /// min_length and max_length, for the muscles.
+    limits: Option<[u32; 2]>,
+    /// The muscles' `stiffness` (dF/dL), whose row is a second derivative.
+    stiffness: Option<u32>,
 }
 
 fn mckibben() -> (Refs, Vec<Case>) {
@@ -45,8 +50,8 @@ fn mckibben() -> (Refs, Vec<Case>) {
             pressure: real::PRESSURE as u32,
             length: real::LENGTH as u32,
             force: real::FORCE as u32,
-            min_length: real::MIN_LENGTH as u32,
-            max_length: real::MAX_LENGTH as u32,
+            limits: Some([real::MIN_LENGTH as u32, real::MAX_LENGTH as u32]),
+            stiffness: Some(real::STIFFNESS as u32),
         },
         vec![
             case("ideal", vec![(preset, 1)]),
@@ -85,8 +90,8 @@ fn knitted() -> (Refs, Vec<Case>) {
             pressure: real::PRESSURE as u32,
             length: real::LENGTH as u32,
             force: real::FORCE as u32,
-            min_length: real::MIN_LENGTH as u32,
-            max_length: real::MAX_LENGTH as u32,
+            limits: Some([real::MIN_LENGTH as u32, real::MAX_LENGTH as u32]),
+            stiffness: Some(real::STIFFNESS as u32),
         },
         vec![
             sleeve("ideal", vec![(integer::SHAPE_MODEL, 0)]),
@@ -106,8 +111,29 @@ fn knitted() -> (Refs, Vec<Case>) {
     )
 }
 
+fn free_bladder() -> (Refs, Vec<Case>) {
+    use actuator_fmus::variables::free_bladder::real;
+    (
+        Refs {
+            model: "FreeBladder",
+            pressure: real::PRESSURE as u32,
+            length: real::LENGTH as u32,
+            force: real::FORCE as u32,
+            limits: None,
+            stiffness: None,
+        },
+        // Muscle D's tube at 40 kPa (3/4 of its ballooning pressure), stretched 1.0-1.1 times.
+        vec![Case {
+            label: "muscle D's tube",
+            integers: vec![],
+            pressure: 4e4,
+            range: (0.1336, 0.147),
+        }],
+    )
+}
+
 fn cost(c: &mut Criterion) {
-    for (refs, cases) in [mckibben(), knitted()] {
+    for (refs, cases) in [mckibben(), knitted(), free_bladder()] {
         let api = common::Api::load(&common::extract_binary(refs.model));
         let mut group = c.benchmark_group(refs.model);
         let inputs = [refs.pressure, refs.length];
@@ -124,14 +150,11 @@ fn cost(c: &mut Criterion) {
                 }
             }
             inst.initialize();
-            let mut limits = [0.0; 2];
-            unsafe {
-                (api.fmi2GetReal)(
-                    inst.c,
-                    [refs.min_length, refs.max_length].as_ptr(),
-                    2,
-                    limits.as_mut_ptr(),
-                );
+            let mut limits = [0.0, 1.0];
+            if let Some(vrs) = refs.limits {
+                unsafe {
+                    (api.fmi2GetReal)(inst.c, vrs.as_ptr(), 2, limits.as_mut_ptr());
+                }
             }
             let span = limits[1] - limits[0];
             let (from, width) = (
@@ -188,6 +211,29 @@ fn cost(c: &mut Criterion) {
                         (api.fmi2SetReal)(inst.c, inputs.as_ptr(), 2, [pressure, l].as_ptr());
                         derivative([1.0, 0.0], &mut row[..1]);
                         derivative([0.0, 1.0], &mut row[1..]);
+                        black_box(row)
+                    })
+                },
+            );
+            let Some(stiffness) = refs.stiffness else {
+                continue;
+            };
+            group.bench_function(
+                format!("{label}: set(P, L) + d(F, stiffness)/dP (1 call, stiffness row)"),
+                |bench| {
+                    bench.iter(|| unsafe {
+                        let l = next_length();
+                        (api.fmi2SetReal)(inst.c, inputs.as_ptr(), 2, [pressure, l].as_ptr());
+                        let status = (api.fmi2GetDirectionalDerivative)(
+                            inst.c,
+                            [refs.force, stiffness].as_ptr(),
+                            2,
+                            inputs.as_ptr(),
+                            2,
+                            [1.0, 0.0].as_ptr(),
+                            row.as_mut_ptr(),
+                        );
+                        debug_assert_eq!(status, common::OK);
                         black_box(row)
                     })
                 },

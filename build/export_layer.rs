@@ -40,6 +40,7 @@ const MODEL_EXCHANGE_CAPABILITIES: &str = r#"needsExecutionTool="false"
 /// the export layer serves `fmi2GetDirectionalDerivative` for them; a Rust test checks that the
 /// shipped flag and the models agree.
 const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &[
+    "FreeBladder",
     "KnittedMuscle",
     "McKibbenJoint",
     "McKibbenMuscle",

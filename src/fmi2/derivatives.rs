@@ -71,7 +71,7 @@ where
         return Err(format!("dvKnown must be finite, got {bad}"));
     }
     let model = model.ok_or("no model yet: call it in initialization mode or later")?;
-    let partials = model.partials(inputs)?;
+    let partials = model.partials_for(inputs, &unknowns)?;
     for (slot, output) in dv_unknown.iter_mut().zip(&unknowns) {
         let row = partials
             .get(output)

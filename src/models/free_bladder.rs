@@ -6,7 +6,7 @@
 //! Exchange. Inputs outside the solvable range are evaluated at the nearest valid point and
 //! flagged (`input_clamped`, `out_of_range_policy`), each excursion logged once.
 
-use super::{Model, Refusal, Report, Status};
+use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::free_bladder::{FreeBladder as Tube, FreeBladderState};
 use crate::variables::free_bladder::{Inputs, Outputs, Parameters, Variables};
@@ -27,35 +27,70 @@ pub struct FreeBladder {
     out_of_range: bool,
 }
 
+/// The point the model evaluates for some inputs: the inputs clamped into the solvable range,
+/// with the slopes of that clamp (what the partials chain through).
+struct OperatingPoint {
+    pressure: f64,
+    length: f64,
+    /// `d pressure / d (input pressure, input length)`: `(1, 0)` inside the range; at the
+    /// ballooning clamp the pressure follows the length through `ballooning_pressure(length)`.
+    pressure_slope: [f64; 2],
+    /// `d length / d input length`: 1 inside the range, 0 where it is clamped.
+    length_slope: f64,
+}
+
 impl FreeBladder {
+    /// The inputs clamped into the solvable range: NaN at the start value's default, a pressure
+    /// below absolute vacuum at vacuum, one at or above the ballooning pressure 0.1% below it, the
+    /// axial stretch into 0.1 .. 10. A bound itself is inside (its slopes are the interior's).
+    fn operating_point(&self, inputs: &Inputs) -> OperatingPoint {
+        let l0 = self.tube.tube().unstretched_length;
+        let (lo, hi) = (STRETCH_RANGE.0 * l0, STRETCH_RANGE.1 * l0);
+        let (length, length_slope) = if inputs.length.is_nan() {
+            (l0, 0.0)
+        } else if (lo..=hi).contains(&inputs.length) {
+            (inputs.length, 1.0)
+        } else {
+            (inputs.length.clamp(lo, hi), 0.0)
+        };
+        let top = self.tube.ballooning_pressure(length) * (1.0 - BALLOON_MARGIN);
+        let (pressure, pressure_slope) = if inputs.pressure.is_nan() {
+            (0.0, [0.0; 2])
+        } else if inputs.pressure > top {
+            let d_top = (1.0 - BALLOON_MARGIN) * self.tube.ballooning_pressure_slope(length);
+            (top, [0.0, d_top * length_slope])
+        } else if inputs.pressure < VACUUM {
+            (VACUUM, [0.0; 2])
+        } else {
+            (inputs.pressure, [1.0, 0.0])
+        };
+        OperatingPoint {
+            pressure,
+            length,
+            pressure_slope,
+            length_slope,
+        }
+    }
+
     /// The tube at the inputs, clamped into the solvable range (`report` says why, once per
     /// excursion). `None` if the physics still refuses (logged; unreachable for finite
     /// parameters), and the outputs then keep their values.
     fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Option<FreeBladderState> {
-        let l0 = self.tube.tube().unstretched_length;
-        let (lo, hi) = (STRETCH_RANGE.0 * l0, STRETCH_RANGE.1 * l0);
-        let length = if inputs.length.is_nan() {
-            l0
-        } else {
-            inputs.length.clamp(lo, hi)
-        };
-        let top = self.tube.ballooning_pressure(length) * (1.0 - BALLOON_MARGIN);
-        let pressure = if inputs.pressure.is_nan() {
-            0.0
-        } else {
-            inputs.pressure.clamp(VACUUM, top)
-        };
+        let OperatingPoint {
+            pressure, length, ..
+        } = self.operating_point(inputs);
         if (pressure, length) == (inputs.pressure, inputs.length) {
             self.out_of_range = false;
         } else {
+            let l0 = self.tube.tube().unstretched_length;
+            let (lo, hi) = (STRETCH_RANGE.0 * l0, STRETCH_RANGE.1 * l0);
+            let balloon = self.tube.ballooning_pressure(length);
             report.clamp(!self.out_of_range, || {
                 format!(
                     "pressure {} Pa, length {} m lie outside the solvable range (absolute vacuum \
-                     .. ballooning pressure {} Pa, length {lo} .. {hi} m); evaluating at {pressure} \
-                     Pa, {length} m until the inputs return",
-                    inputs.pressure,
-                    inputs.length,
-                    top / (1.0 - BALLOON_MARGIN)
+                     .. ballooning pressure {balloon} Pa, length {lo} .. {hi} m); evaluating at \
+                     {pressure} Pa, {length} m until the inputs return",
+                    inputs.pressure, inputs.length,
                 )
             });
             self.out_of_range = true;
@@ -115,6 +150,67 @@ impl Model for FreeBladder {
         report: &mut Report,
     ) {
         self.evaluate(inputs, outputs, report)
+    }
+
+    /// Every Real output by `pressure` and `length`, exact (the free bladder's implicit function
+    /// theorem on eq. 2.18), chained through the input clamp: a clamped input's column is 0, and
+    /// at the ballooning clamp the pressure evaluated follows the length.
+    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        let point = self.operating_point(inputs);
+        let (_, d) = self
+            .tube
+            .evaluate_with_partials(point.pressure, point.length)?;
+        let by_pressure = d.along(point.pressure_slope[0], 0.0);
+        let by_length = d.along(point.pressure_slope[1], point.length_slope);
+        let mut p = Partials::default();
+        for (output, dp, dl) in [
+            (
+                "inner_diameter",
+                by_pressure.inner_diameter,
+                by_length.inner_diameter,
+            ),
+            (
+                "outer_diameter",
+                by_pressure.outer_diameter,
+                by_length.outer_diameter,
+            ),
+            ("volume", by_pressure.fluid_volume, by_length.fluid_volume),
+            ("compliance", by_pressure.compliance, by_length.compliance),
+            (
+                "stretch_axial",
+                by_pressure.stretch_axial,
+                by_length.stretch_axial,
+            ),
+            (
+                "stretch_hoop",
+                by_pressure.stretch_hoop,
+                by_length.stretch_hoop,
+            ),
+            (
+                "stretch_radial",
+                by_pressure.stretch_radial,
+                by_length.stretch_radial,
+            ),
+            (
+                "stress_axial",
+                by_pressure.stress_axial,
+                by_length.stress_axial,
+            ),
+            (
+                "stress_hoop",
+                by_pressure.stress_hoop,
+                by_length.stress_hoop,
+            ),
+            ("force", by_pressure.force, by_length.force),
+            (
+                "ballooning_pressure",
+                by_pressure.ballooning_pressure,
+                by_length.ballooning_pressure,
+            ),
+        ] {
+            p.row(output, &[("pressure", dp), ("length", dl)]);
+        }
+        Ok(p)
     }
 
     fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
@@ -188,6 +284,90 @@ mod tests {
         assert_eq!(volumes[0], volumes[1]);
         assert_eq!(volumes[3], volumes[4]);
         assert!(volumes[0] > 50.0 * volumes[2] && volumes[3] < volumes[5]);
+    }
+
+    /// The Real outputs by name.
+    fn reals(o: &Outputs) -> [(&'static str, f64); 11] {
+        [
+            ("inner_diameter", o.inner_diameter),
+            ("outer_diameter", o.outer_diameter),
+            ("volume", o.volume),
+            ("compliance", o.compliance),
+            ("stretch_axial", o.stretch_axial),
+            ("stretch_hoop", o.stretch_hoop),
+            ("stretch_radial", o.stretch_radial),
+            ("stress_axial", o.stress_axial),
+            ("stress_hoop", o.stress_hoop),
+            ("force", o.force),
+            ("ballooning_pressure", o.ballooning_pressure),
+        ]
+    }
+
+    #[test]
+    fn partials_match_central_differences_through_the_input_clamp() {
+        // Muscle D's tube (thin) and muscle A's (thick, Table 2.1): inside the range, near
+        // ballooning, pre-strained, and with each input clamped (above the ballooning pressure the
+        // evaluated pressure follows the length; below vacuum and past the stretch range a
+        // column is 0).
+        let thick = Parameters {
+            bladder_length: 0.1005,
+            bladder_inner_diameter: 1.6e-3,
+            bladder_thickness: 1.6e-3,
+            ..Parameters::default()
+        };
+        let mut zero_columns = 0;
+        for p in [Parameters::default(), thick] {
+            let l0 = p.bladder_length;
+            let mut m = FreeBladder::new(&p, &Inputs::default()).unwrap();
+            for (lambda, fraction) in [
+                (1.0, 0.5),
+                (1.4, 0.99),
+                (0.7, -0.3),
+                (1.2, 1.5),
+                (1.0, -3.0),
+                (12.0, 0.3),
+                (0.05, 0.3),
+            ] {
+                let length = lambda * l0;
+                let top = m
+                    .tube
+                    .ballooning_pressure(length.clamp(0.1 * l0, 10.0 * l0));
+                let pressure = fraction * top;
+                let inputs = Inputs { pressure, length };
+                let partials = m.partials(&inputs).unwrap();
+                let gap = if fraction < 1.0 { 1.0 - fraction } else { 1.0 };
+                for (input, h) in [("pressure", 1e-5 * gap * top), ("length", 1e-7 * l0)] {
+                    let at = |sign: f64| {
+                        let mut shifted = inputs.clone();
+                        match input {
+                            "pressure" => shifted.pressure += sign * h,
+                            _ => shifted.length += sign * h,
+                        }
+                        run(&p, shifted.pressure, shifted.length).0
+                    };
+                    let (up, down) = (at(1.0), at(-1.0));
+                    for ((name, hi), (_, lo)) in reals(&up).into_iter().zip(reals(&down)) {
+                        let central = (hi - lo) / (2.0 * h);
+                        let exact = partials
+                            .get(name)
+                            .and_then(|row| row.iter().find(|(n, _)| *n == input))
+                            .map(|(_, d)| *d)
+                            .unwrap_or_else(|| panic!("no partial of {name} by {input}"));
+                        let size = hi.abs().max(lo.abs()).max(1e-30);
+                        let scale = exact.abs().max(central.abs()) + 1e-8 * size / h.max(1e-30);
+                        assert!(
+                            (exact - central).abs() <= 1e-6 * scale,
+                            "lambda {lambda}, P {pressure}: d{name}/d{input} exact {exact}, \
+                             central {central}"
+                        );
+                        zero_columns += usize::from(exact == 0.0 && central == 0.0);
+                    }
+                }
+            }
+        }
+        // The clamped columns are zero: vacuum's pressure column and the stretch clamps' length
+        // columns (11 outputs each), beside the outputs that never depend on the input.
+        assert!(zero_columns >= 2 * 3 * 11, "{zero_columns}");
     }
 
     #[test]

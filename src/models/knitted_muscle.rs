@@ -57,10 +57,11 @@ pub struct KnittedMuscle {
     collapsed: bool,
     /// The length range reported as `min_length`, `max_length` (m).
     length_range: (f64, f64),
-    /// The last partials and the point (pressure, length, friction z and position, as bits) they
-    /// were taken at: a Jacobian's further seeds reuse them. Not part of the FMU state.
+    /// The last partials, the point (pressure, length, friction z and position, as bits) they
+    /// were taken at, and whether they hold the bladder's stiffness row (a second-order pass): a
+    /// Jacobian's further seeds reuse them. Not part of the FMU state.
     #[serde(skip)]
-    partials_cache: Option<([u64; 4], Partials)>,
+    partials_cache: Option<([u64; 4], bool, Partials)>,
 }
 
 /// Outputs at one input point, with the friction history after moving there.
@@ -313,26 +314,23 @@ struct Rows {
     effective_pressure: [f64; 2],
     friction_force: [f64; 2],
     max_radius: [f64; 2],
-    /// `None` with a bladder: its stiffness is itself a derivative, and the bladder carries first
-    /// derivatives only.
+    /// `None` with a bladder unless asked for: its stiffness is itself a derivative, whose
+    /// partials need the bladder's second-order pass.
     stiffness: Option<[f64; 2]>,
 }
 
 impl KnittedMuscle {
     /// Exact partials on the branch [`Self::compute`] takes (see the module's README section for
     /// the one-sided choices): eq. 1.6-1.14 or the table's interpolant differentiated, the
-    /// bladder's [`Bladder::evaluate_with_partials`], eq. 1.21 with the stop operator's slope.
-    fn partials_at(&self, inputs: &Inputs) -> Result<Partials, String> {
+    /// bladder's [`Bladder::evaluate_with_partials`], eq. 1.21 with the stop operator's slope;
+    /// with a bladder, the stiffness's row only if `stiffness` (from
+    /// [`Bladder::stiffness_partials`]).
+    fn partials_at(&self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
         let (pressure, length) = (inputs.pressure, inputs.length);
         if !(pressure.is_finite() && length.is_finite()) {
             return Err(format!(
                 "partials need finite inputs, got pressure {pressure} Pa and length {length} m"
             ));
-        }
-        if self.bag.is_some() {
-            return Err(
-                "partial derivatives are not provided with the bag (bag_diameter > 0)".into(),
-            );
         }
         let (lo, hi) = self.valid;
         let l = length.max(lo).min(hi);
@@ -344,7 +342,7 @@ impl KnittedMuscle {
             -1.0
         };
         let mut r = match &self.bladder {
-            Some(b) => self.bladder_rows(b, pressure, l, direction)?,
+            Some(b) => self.bladder_rows(b, pressure, l, direction, stiffness)?,
             None => self.sleeve_rows(pressure, l, direction),
         };
         let mut table = Partials::default();
@@ -370,6 +368,11 @@ impl KnittedMuscle {
         let s = &self.sleeve;
         let p_eff = pressure.max(0.0);
         let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+        if let Some(bag) = &self.bag {
+            if let Some(rows) = bag_rows(s, bag, p_eff, l, on) {
+                return rows;
+            }
+        }
         let (v, v1, v2) = s.volume_derivatives(l);
         let v3 = s.volume_third_derivative(l);
         let mut r = Rows {
@@ -419,10 +422,16 @@ impl KnittedMuscle {
         pressure: f64,
         l: f64,
         direction: f64,
+        stiffness: bool,
     ) -> Result<Rows, String> {
-        let ((state, d), on) = match b.evaluate_with_partials(pressure, l) {
-            Ok(x) => (x, 1.0),
-            Err(_) => (b.evaluate_with_partials(0.0, l)?, 0.0),
+        let ((state, d), on, used) = match b.evaluate_with_partials(pressure, l) {
+            Ok(x) => (x, 1.0, pressure),
+            Err(_) => (b.evaluate_with_partials(0.0, l)?, 0.0, 0.0),
+        };
+        let curvature = if stiffness {
+            Some(b.stiffness_partials(used, l)?)
+        } else {
+            None
         };
         let mut r = Rows {
             force: d.force,
@@ -430,7 +439,7 @@ impl KnittedMuscle {
             effective_pressure: d.effective_pressure,
             friction_force: [0.0, 0.0],
             max_radius: [0.0, 0.5 * b.sleeve().diameter_and_slope(l).1],
-            stiffness: None,
+            stiffness: curvature.map(|c| c.stiffness),
         };
         if let Some(f) = &self.friction {
             let next = f.operator.advance(&self.history, l);
@@ -452,6 +461,12 @@ impl KnittedMuscle {
                     r.force[0] + r.friction_force[0],
                     r.force[1] + r.friction_force[1],
                 ];
+                // Stiffness S + k T_L / (1 - k) (eq. 1.21 with z held), T_L the strand slope.
+                if let (Some(row), Some(c)) = (r.stiffness.as_mut(), curvature) {
+                    let t = c.strand_stiffness;
+                    row[0] += gain * t[0];
+                    row[1] += gain * t[1] + dk_dl * tension_l / ((1.0 - k) * (1.0 - k));
+                }
             }
         }
         for row in [
@@ -460,6 +475,9 @@ impl KnittedMuscle {
             &mut r.effective_pressure,
             &mut r.friction_force,
         ] {
+            row[0] *= on;
+        }
+        if let Some(row) = r.stiffness.as_mut() {
             row[0] *= on;
         }
         Ok(r)
@@ -559,17 +577,60 @@ impl Model for KnittedMuscle {
         }
     }
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+        self.cached_partials(inputs, true)
+    }
+
+    fn partials_for(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &[&'static str],
+    ) -> Result<Partials, String> {
+        // With a bladder the stiffness's row costs a second-order pass: only when asked.
+        self.cached_partials(inputs, outputs.contains(&"stiffness"))
+    }
+}
+
+impl KnittedMuscle {
+    fn cached_partials(&mut self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
         let h = &self.history;
         let key = [inputs.pressure, inputs.length, h.z, h.position].map(f64::to_bits);
-        if let Some((cached, rows)) = &self.partials_cache {
-            if *cached == key {
+        if let Some((cached, has_stiffness, rows)) = &self.partials_cache {
+            if *cached == key && (*has_stiffness || !stiffness) {
                 return Ok(rows.clone());
             }
         }
-        let rows = self.partials_at(inputs)?;
-        self.partials_cache = Some((key, rows.clone()));
+        let rows = self.partials_at(inputs, stiffness)?;
+        self.partials_cache = Some((key, stiffness, rows.clone()));
         Ok(rows)
     }
+}
+
+/// Section 1.4's bag where it binds (`pi R(P)^2 L` below the sleeve's volume, see
+/// [`Bag::volume_derivatives`]): `V = A(P) L` with `A = pi R^2`, `F = -P_eff A` pushing the
+/// clamps apart, no stiffness, and the strands slack (eq. 1.21's tension `F + P A` is zero, so
+/// no friction); the largest radius is the bag's. `None` where the sleeve sets the volume: the
+/// sleeve's rows hold there, the largest radius being the sleeve's (the bag is wider).
+fn bag_rows(s: &KnittedSleeve, bag: &Bag, p_eff: f64, l: f64, on: f64) -> Option<Rows> {
+    if bag.volume_derivatives(s, p_eff, l) == s.volume_derivatives(l) {
+        return None;
+    }
+    let r = bag.radius_at(p_eff);
+    let area = std::f64::consts::PI * r * r;
+    // dA/dP = 2 pi R dR/dP; R = R0 (1 + P R0 / (E t)) for P > 0.
+    let area_p = on * 2.0 * std::f64::consts::PI * r * bag.radius_slope(p_eff);
+    let max_radius = if r <= s.max_radius(l) {
+        [on * bag.radius_slope(p_eff), 0.0]
+    } else {
+        [0.0, s.max_radius_slope(l)]
+    };
+    Some(Rows {
+        force: [-on * area - p_eff * area_p, 0.0],
+        volume: [area_p * l, area],
+        effective_pressure: [on, 0.0],
+        friction_force: [0.0, 0.0],
+        max_radius,
+        stiffness: Some([0.0, 0.0]),
+    })
 }
 
 #[cfg(test)]
@@ -744,7 +805,21 @@ mod tests {
                 }
             }
         }
+        // Section 1.4's prototype in its 85 mm bag, inextensible and stretching (E t = 1e4 N/m):
+        // the bag binds at the shorter lengths.
+        for shape in [0, 1] {
+            for membrane in [0.0, 1e4] {
+                for friction in [false, true] {
+                    let mut p = parameters_with(shape, friction);
+                    p.preset = 1;
+                    p.bag_diameter = 0.085;
+                    p.bag_membrane_stiffness = membrane;
+                    configs.push((p, vec![1.4e4, 5e4, -2e4]));
+                }
+            }
+        }
         let (mut checked, mut skipped, mut worst) = (0, 0, 0.0f64);
+        let mut bag_binds = 0;
         for (p, pressures) in &configs {
             let calculated = KnittedMuscle::new(p, &Inputs::default())
                 .unwrap()
@@ -761,6 +836,11 @@ mod tests {
                 for &pressure in pressures {
                     let x = Inputs { pressure, length };
                     let exact = m.partials(&x).unwrap();
+                    if let Some(bag) = &m.bag {
+                        let p_eff = pressure.max(0.0);
+                        bag_binds +=
+                            usize::from(bag_rows(&m.sleeve, bag, p_eff, length, 1.0).is_some());
+                    }
                     let mut at = |dp: f64, dl: f64| {
                         let mut out = Outputs::default();
                         let y = Inputs {
@@ -777,10 +857,7 @@ mod tests {
                         let (up, down) =
                             (at(steps[j][0], steps[j][1]), at(-steps[j][0], -steps[j][1]));
                         for (k, name) in OUTPUTS.into_iter().enumerate() {
-                            let Some(row) = exact.get(name) else {
-                                assert!(p.bladder_model != 0 && name == "stiffness", "{name}");
-                                continue;
-                            };
+                            let row = exact.get(name).unwrap();
                             let e = row.iter().find(|(n, _)| *n == input).unwrap().1;
                             let central = (up[k] - down[k]) / (2.0 * h[j]);
                             let (right, left) =
@@ -793,10 +870,11 @@ mod tests {
                             let err = (e - central).abs() / scale;
                             assert!(
                                 err < 1e-5 || (e - central).abs() < 1e-10 * (1.0 + base[k].abs()),
-                                "shape {} bladder {} friction {} P {pressure} L {length}: \
+                                "shape {} bladder {} bag {} friction {} P {pressure} L {length}: \
                                  d{name}/d{input} exact {e} central {central}",
                                 p.shape_model,
                                 p.bladder_model,
+                                p.bag_diameter,
                                 p.friction
                             );
                             checked += 1;
@@ -808,7 +886,11 @@ mod tests {
                 }
             }
         }
-        eprintln!("{checked} partials checked, {skipped} at kinks skipped, worst {worst:e}");
+        eprintln!(
+            "{checked} partials checked ({bag_binds} points where the bag binds), {skipped} at \
+             kinks skipped, worst {worst:e}"
+        );
+        assert!(bag_binds >= 8, "{bag_binds}");
         assert!(
             checked > 800 && skipped * 20 < checked,
             "{checked} {skipped}"
@@ -816,11 +898,7 @@ mod tests {
     }
 
     #[test]
-    fn partials_are_refused_with_the_bag_and_zero_out_of_range() {
-        let mut p = parameters_with(0, false);
-        p.bag_diameter = 0.02;
-        let mut m = KnittedMuscle::new(&p, &Inputs::default()).unwrap();
-        assert!(m.partials(&Inputs::default()).is_err());
+    fn partials_are_zero_out_of_range() {
         let (mut m, _, _, c) = built(&parameters_with(1, false));
         let beyond = Inputs {
             pressure: 1e5,

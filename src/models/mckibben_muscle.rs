@@ -46,10 +46,11 @@ pub struct McKibbenMuscle {
     notice: Option<String>,
     /// `pressure_solver` on: the muscle to invert and `max_pressure`.
     solver: Option<(McKibben, f64)>,
-    /// The last partials and the point (inputs and friction history) they were taken at: the
-    /// further seeds of a Jacobian at the same point reuse them. Not part of the FMU state.
+    /// The last partials, the point (inputs and friction history) they were taken at, and
+    /// whether they hold the stiffness's (second-order) row: the further seeds of a Jacobian at
+    /// the same point reuse them. Not part of the FMU state.
     #[serde(skip)]
-    partials_cache: Option<(PartialsKey, Partials)>,
+    partials_cache: Option<(PartialsKey, bool, Partials)>,
 }
 
 /// Bit patterns of what the partials depend on: pressure, length, target_force, friction z and
@@ -366,7 +367,54 @@ fn partial_rows(d: &McKibbenPartials) -> Partials {
     p
 }
 
+/// Runs `at` on the branch [`McKibbenMuscle::compute`] takes: at the inputs, or out of range at
+/// the clamped length (whose column the input no longer moves) and, under a vacuum the muscle
+/// cannot hold there, at zero pressure (neither column moves). Returns `at`'s result with
+/// whether the length and the pressure columns move.
+fn on_branch<T>(
+    m: &McKibben,
+    pressure: f64,
+    length: f64,
+    at: impl Fn(f64, f64) -> Result<T, String>,
+) -> Result<(T, bool, bool), String> {
+    if let Ok(d) = at(pressure, length) {
+        return Ok((d, true, true));
+    }
+    let clamped = solvable_length(m, length);
+    if let Ok(d) = at(pressure, clamped) {
+        return Ok((d, false, true));
+    }
+    at(pressure.max(0.0), clamped).map(|d| (d, false, false))
+}
+
 impl McKibbenMuscle {
+    /// `[d/dpressure, d/dlength]` of `stiffness`, on the branch [`Model::evaluate`] takes (see
+    /// [`Self::partials_at`]): eq. 2.3's for the bare sleeve, else
+    /// [`McKibben::stiffness_partials`] (a second-order pass through the bladder).
+    fn stiffness_row(&self, inputs: &Inputs) -> Result<[f64; 2], String> {
+        let (pressure, length) = (inputs.pressure, inputs.length);
+        match &self.pipeline {
+            Pipeline::Sleeve(s) => {
+                let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+                let inside = if length <= s.max_length() { 1.0 } else { 0.0 };
+                let l = length.min(s.max_length());
+                // Eq. 2.3's stiffness 6 P_eff L / (4 pi n^2) is bilinear in P_eff and L.
+                Ok([
+                    on * s.stiffness(1.0, l),
+                    inside * s.stiffness(pressure.max(0.0), 1.0),
+                ])
+            }
+            Pipeline::Full(m) => {
+                let at = |p: f64, l: f64| m.stiffness_partials(p, l, &self.friction);
+                let (row, by_l, by_p) = on_branch(m, pressure, length, at)?;
+                Ok([
+                    if by_p { row[0] } else { 0.0 },
+                    if by_l { row[1] } else { 0.0 },
+                ])
+            }
+        }
+    }
+
     /// Partials on the branch [`Model::evaluate`] takes: out of range it evaluates at a clamped
     /// length (and, under a vacuum it cannot hold, at zero pressure), which the input no longer
     /// moves, so those columns are zero.
@@ -389,30 +437,13 @@ impl McKibbenMuscle {
                 })
             }
             Pipeline::Full(m) => {
-                if let Ok((_, d)) = m.partials(pressure, length, &self.friction) {
-                    return Ok(d);
+                let at = |p: f64, l: f64| m.partials(p, l, &self.friction).map(|(_, d)| d);
+                let (mut d, by_l, by_p) = on_branch(m, pressure, length, at)?;
+                for y in d.rows_mut() {
+                    y[0] *= f64::from(u8::from(by_p));
+                    y[1] *= f64::from(u8::from(by_l));
                 }
-                let (lo, hi) = (m.min_length(), m.max_length());
-                let margin = if m.bladder().is_some() {
-                    LIMIT_MARGIN * (hi - lo)
-                } else {
-                    0.0
-                };
-                let clamped = length.max(lo + margin).min(hi - margin);
-                let zero_l = |mut d: McKibbenPartials, zero_p: bool| {
-                    for y in d.rows_mut() {
-                        y[1] = 0.0;
-                        if zero_p {
-                            y[0] = 0.0;
-                        }
-                    }
-                    d
-                };
-                if let Ok((_, d)) = m.partials(pressure, clamped, &self.friction) {
-                    return Ok(zero_l(d, false));
-                }
-                m.partials(pressure.max(0.0), clamped, &self.friction)
-                    .map(|(_, d)| zero_l(d, true))
+                Ok(d)
             }
         }
     }
@@ -525,21 +556,40 @@ impl Model for McKibbenMuscle {
     }
 
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
-        let key = partials_key(inputs, &self.friction);
-        if let Some((cached, rows)) = &self.partials_cache {
-            if *cached == key {
-                return Ok(rows.clone());
-            }
-        }
-        let rows = self.fresh_partials(inputs)?;
-        self.partials_cache = Some((key, rows.clone()));
-        Ok(rows)
+        self.cached_partials(inputs, true)
+    }
+
+    fn partials_for(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &[&'static str],
+    ) -> Result<Partials, String> {
+        // The stiffness's row costs a second-order pass through the bladder: only when asked.
+        self.cached_partials(inputs, outputs.contains(&"stiffness"))
     }
 }
 
 impl McKibbenMuscle {
-    fn fresh_partials(&self, inputs: &Inputs) -> Result<Partials, String> {
+    fn cached_partials(&mut self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
+        let key = partials_key(inputs, &self.friction);
+        if let Some((cached, has_stiffness, rows)) = &self.partials_cache {
+            if *cached == key && (*has_stiffness || !stiffness) {
+                return Ok(rows.clone());
+            }
+        }
+        let rows = self.fresh_partials(inputs, stiffness)?;
+        self.partials_cache = Some((key, stiffness, rows.clone()));
+        Ok(rows)
+    }
+
+    /// Every row; the stiffness's only if `stiffness` (or, for the bare sleeve, always: it is
+    /// eq. 2.3's closed form).
+    fn fresh_partials(&self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
         let mut rows = self.partials_at(inputs).map(|d| partial_rows(&d))?;
+        if stiffness || matches!(self.pipeline, Pipeline::Sleeve(_)) {
+            let [dp, dl] = self.stiffness_row(inputs)?;
+            rows.row("stiffness", &[("pressure", dp), ("length", dl)]);
+        }
         // contraction = 1 - length / nominal_length.
         let per_length = -1.0 / self.effective.nominal_length;
         rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
@@ -597,7 +647,7 @@ mod tests {
         assert_eq!(m.partials(&a).unwrap(), first);
         let other = m.partials(&b).unwrap();
         assert_ne!(other, first);
-        assert_eq!(other, m.fresh_partials(&b).unwrap());
+        assert_eq!(other, m.fresh_partials(&b, true).unwrap());
         assert_eq!(m.partials(&a).unwrap(), first);
         // A step to `b` moves the friction history: the partials at `a` change with it.
         m.step(
@@ -608,7 +658,41 @@ mod tests {
             &mut Report::default(),
         );
         let after = m.partials(&a).unwrap();
-        assert_eq!(after, m.fresh_partials(&a).unwrap());
+        assert_eq!(after, m.fresh_partials(&a, true).unwrap());
         assert_ne!(after.get("friction_force"), first.get("friction_force"));
+    }
+
+    /// The stiffness's row (a second-order pass through the bladder) is built only for a call that
+    /// asks for it, and then equals the physics' partials; a later call for it is not served
+    /// from a cache that lacks it.
+    #[test]
+    fn stiffness_row_only_when_asked() {
+        let p = Parameters {
+            preset: 4,
+            bladder_model: 2,
+            bladder_layers: 4,
+            friction: true,
+            connector_stiffness: 5e4,
+            ..Default::default()
+        };
+        let x = Inputs {
+            pressure: 3e5,
+            length: 0.12,
+            ..Default::default()
+        };
+        let mut m = McKibbenMuscle::new(&p, &x).unwrap();
+        let first = m.partials_for(&x, &["force"]).unwrap();
+        assert!(first.get("stiffness").is_none());
+        let with = m.partials_for(&x, &["force", "stiffness"]).unwrap();
+        let Pipeline::Full(muscle) = &m.pipeline else {
+            panic!("a bladder needs the full pipeline");
+        };
+        let exact = muscle.stiffness_partials(3e5, 0.12, &m.friction).unwrap();
+        let row = with.get("stiffness").unwrap();
+        assert_eq!(row, &[("pressure", exact[0]), ("length", exact[1])]);
+        assert!(exact.iter().all(|d| *d != 0.0));
+        assert_eq!(with.get("force"), first.get("force"));
+        // Served from the cache, stiffness included.
+        assert_eq!(m.partials_for(&x, &["force"]).unwrap(), with);
     }
 }

@@ -277,6 +277,17 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
         Err("this model does not provide partial derivatives".into())
     }
 
+    /// [`Model::partials`] for a call that reads only the rows of `outputs`: a model whose rows
+    /// differ in cost (the stiffness's second derivatives) may leave out the costly rows nobody
+    /// asked for. By default, every row.
+    fn partials_for(
+        &mut self,
+        inputs: &Inputs<Self>,
+        _outputs: &[&'static str],
+    ) -> Result<Partials, String> {
+        self.partials(inputs)
+    }
+
     /// Takes over the history of `saved`, a model deserialized from an importer's bytes, after
     /// checking it against the model's invariants. `self` was rebuilt by [`Model::new`] from the
     /// parameters that came with `saved`, so nothing derived from parameters (limits, geometry,

@@ -117,11 +117,41 @@ impl FreeBladder {
         self.modulus(length / self.tube.unstretched_length) / self.slenderness
     }
 
+    /// `d ballooning_pressure / d length`, Pa/m: `2 (C2 - C1/lambda_1^2) / (r L_R0)`.
+    pub fn ballooning_pressure_slope(&self, length: f64) -> f64 {
+        let l1 = length / self.tube.unstretched_length;
+        let da_dl1 = 2.0 * (self.tube.mooney_c2 - self.tube.mooney_c1 / (l1 * l1));
+        da_dl1 / (self.slenderness * self.tube.unstretched_length)
+    }
+
     /// The gauge pressure (Pa) that holds the tube at hoop stretch `stretch_hoop` when its axial
     /// stretch is `stretch_axial`: eq. 2.18 solved for `P`.
     pub fn equilibrium_pressure(&self, stretch_axial: f64, stretch_hoop: f64) -> f64 {
         let w = stretch_axial * stretch_hoop * stretch_hoop;
         self.modulus(stretch_axial) * (w * w - 1.0) / (self.slenderness * w * w + w)
+    }
+
+    /// Eq. 2.18's modulus `A` and its root `w = lambda_1 lambda_2^2` at `pressure` and `length`
+    /// (checked finite and positive by the caller). `Err` at or above the ballooning pressure.
+    fn volume_ratio(&self, pressure: f64, length: f64) -> Result<(f64, f64), String> {
+        let a = self.modulus(length / self.tube.unstretched_length);
+        let r = self.slenderness;
+        // (A - P r) w^2 - P w - A = 0: the positive root, in the form without cancellation.
+        let lead = a - pressure * r;
+        if lead <= 0.0 {
+            return Err(format!(
+                "pressure {pressure} Pa is at or above the ballooning pressure {} Pa at length \
+                 {length} m: eq. 2.18 has no equilibrium, the free tube inflates without bound",
+                a / r
+            ));
+        }
+        let root = (pressure * pressure + 4.0 * a * lead).sqrt();
+        let w = if pressure > 0.0 {
+            (pressure + root) / (2.0 * lead)
+        } else {
+            2.0 * a / (root - pressure)
+        };
+        Ok((a, w))
     }
 
     /// The tube at gauge pressure `pressure` (Pa) with its ends `length` (m) apart. `Err` for a
@@ -137,23 +167,9 @@ impl FreeBladder {
             ));
         }
         let l1 = length / self.tube.unstretched_length;
-        let a = self.modulus(l1);
+        let (a, w) = self.volume_ratio(pressure, length)?;
         let r = self.slenderness;
         let ballooning = a / r;
-        // (A - P r) w^2 - P w - A = 0: the positive root, in the form without cancellation.
-        let lead = a - pressure * r;
-        if lead <= 0.0 {
-            return Err(format!(
-                "pressure {pressure} Pa is at or above the ballooning pressure {ballooning} Pa at \
-                 length {length} m: eq. 2.18 has no equilibrium, the free tube inflates without bound"
-            ));
-        }
-        let root = (pressure * pressure + 4.0 * a * lead).sqrt();
-        let w = if pressure > 0.0 {
-            (pressure + root) / (2.0 * lead)
-        } else {
-            2.0 * a / (root - pressure)
-        };
         let l2 = (w / l1).sqrt();
         let l3 = 1.0 / (l1 * l2);
         let (c1, c2) = (self.tube.mooney_c1, self.tube.mooney_c2);
@@ -202,6 +218,10 @@ impl FreeBladder {
         }
     }
 }
+
+#[path = "free_bladder_partials.rs"]
+mod partials;
+pub use partials::FreeBladderPartials;
 
 #[cfg(test)]
 #[path = "free_bladder_tests.rs"]

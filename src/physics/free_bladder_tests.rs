@@ -187,3 +187,139 @@ fn rejects_bad_parameters_and_inputs() {
     assert!(b.evaluate(0.0, 0.0).is_err());
     assert!(b.evaluate(0.0, f64::INFINITY).is_err());
 }
+
+/// Every field of a state, named, in one order (for comparing partials field by field).
+fn fields(s: &FreeBladderState) -> [(&'static str, f64); 11] {
+    [
+        ("inner_diameter", s.inner_diameter),
+        ("outer_diameter", s.outer_diameter),
+        ("fluid_volume", s.fluid_volume),
+        ("compliance", s.compliance),
+        ("stretch_axial", s.stretch_axial),
+        ("stretch_hoop", s.stretch_hoop),
+        ("stretch_radial", s.stretch_radial),
+        ("stress_axial", s.stress_axial),
+        ("stress_hoop", s.stress_hoop),
+        ("force", s.force),
+        ("ballooning_pressure", s.ballooning_pressure),
+    ]
+}
+
+#[test]
+fn partials_match_central_differences_across_the_range() {
+    // Both tubes of Table 2.1 (thin D, thick A), vacuum to 99.9% of the ballooning pressure,
+    // compressed, relaxed and pre-strained (axial stretch 0.5 to 3).
+    let mut worst: f64 = 0.0;
+    let mut checked = 0;
+    for t in [TUBE_A, TUBE_D] {
+        let b = free(t);
+        for lam in [0.5, 0.8, 1.0, 1.3, 2.0, 3.0] {
+            let l = lam * t.0;
+            let top = b.ballooning_pressure(l);
+            for p in [
+                -101_325.0,
+                -3e4,
+                0.0,
+                0.2 * top,
+                0.6 * top,
+                0.9 * top,
+                0.99 * top,
+                0.999 * top,
+            ] {
+                let (state, partials) = b.evaluate_with_partials(p, l).unwrap();
+                // Natural sizes of the fields: diameters, volumes, compliance, stretches, stresses
+                // (Pa), force (N), ballooning pressure.
+                let d_ro = t.1 + 2.0 * t.2;
+                let stress = MOONEY_C1 + MOONEY_C2 + p.abs();
+                let floors = [
+                    d_ro,
+                    d_ro,
+                    state.fluid_volume,
+                    state.compliance,
+                    1.0,
+                    1.0,
+                    1.0,
+                    stress,
+                    stress,
+                    stress * b.rubber_volume() / l,
+                    stress,
+                ];
+                assert_eq!(state, b.evaluate(p, l).unwrap());
+                // Steps well inside the distance to the ballooning pressure, where w blows up
+                // (the length moves that pressure: 1e-6 of the length is 1e-3 of the gap at
+                // 0.999 of it).
+                let gap = (top - p).min(top) / top;
+                let hp = 1e-4 * gap * top;
+                let hl = 1e-4 * gap.min(1e-2) * l;
+                let at = |p: f64, l: f64| fields(&b.evaluate(p, l).unwrap());
+                for (h, input_scale, up, down, exact) in [
+                    (
+                        hp,
+                        top,
+                        at(p + hp, l),
+                        at(p - hp, l),
+                        fields(&partials.by_pressure),
+                    ),
+                    (
+                        hl,
+                        l,
+                        at(p, l + hl),
+                        at(p, l - hl),
+                        fields(&partials.by_length),
+                    ),
+                ] {
+                    let zipped = up.iter().zip(&down).zip(&exact).zip(floors);
+                    for ((((name, hi), (_, lo)), (_, e)), floor) in zipped {
+                        let central = (hi - lo) / (2.0 * h);
+                        // Relative, with an absolute floor for partials that vanish (the hoop
+                        // stress's at zero pressure): 1e-8 of the output's natural size per the
+                        // input's, above the differences' rounding.
+                        let scale = e.abs().max(central.abs()) + 1e-2 * floor / input_scale;
+                        let err = (e - central).abs() / scale;
+                        assert!(
+                            err < 1e-6,
+                            "{t:?} P={p} lambda={lam}: d{name} exact {e}, central {central}"
+                        );
+                        worst = worst.max(err);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+    }
+    eprintln!("free bladder partials: {checked} against central differences, worst {worst:.1e}");
+    assert!(checked > 900);
+}
+
+#[test]
+fn partials_are_eq_2_18s_slopes_where_known_in_closed_form() {
+    let b = free(TUBE_D);
+    let l = TUBE_D.0;
+    let (s, d) = b.evaluate_with_partials(2e4, l).unwrap();
+    // Compliance is dV/dP (the field and the partial are one formula apart).
+    assert_relative_eq!(
+        d.by_pressure.fluid_volume,
+        s.compliance,
+        max_relative = 1e-12
+    );
+    // The axial stretch and the ballooning pressure do not depend on the pressure.
+    assert_eq!(d.by_pressure.stretch_axial, 0.0);
+    assert_eq!(d.by_pressure.ballooning_pressure, 0.0);
+    assert_eq!(d.by_length.stretch_axial, 1.0 / l);
+    // Relaxed tube (P = 0, lambda = 1): lambda_2 = lambda_1^-1/2, so dlambda_2/dL = -1/(2 L_0),
+    // and the uniaxial clamp force's slope is 6 (C1 + C2) A_0 / L_0 (Fig. 2.9 at lambda = 1).
+    let (_, d) = b.evaluate_with_partials(0.0, l).unwrap();
+    assert_relative_eq!(d.by_length.stretch_hoop, -0.5 / l, max_relative = 1e-12);
+    let a0 = b.rubber_volume() / l;
+    assert_relative_eq!(
+        d.by_length.force,
+        6.0 * (MOONEY_C1 + MOONEY_C2) * a0 / l,
+        max_relative = 1e-12
+    );
+    let along = d.along(2.0, -3.0);
+    assert_relative_eq!(
+        along.force,
+        2.0 * d.by_pressure.force - 3.0 * d.by_length.force,
+        max_relative = 1e-15
+    );
+}

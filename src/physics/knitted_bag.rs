@@ -52,6 +52,16 @@ impl Bag {
         self.radius * (1.0 + pressure.max(0.0) * self.radius / self.membrane_stiffness)
     }
 
+    /// `dR/dP` at gauge pressure `pressure` (Pa), m/Pa: `R0^2 / (E t)` above zero, zero for a
+    /// vacuum (the branch [`Self::radius_at`] takes at zero) or an inextensible bag.
+    pub fn radius_slope(&self, pressure: f64) -> f64 {
+        if pressure > 0.0 {
+            self.radius * self.radius / self.membrane_stiffness
+        } else {
+            0.0
+        }
+    }
+
     /// `(V, dV/dL, d2V/dL2)` of the fluid at `pressure` (Pa): the sleeve's, capped at the bag's
     /// cylinder `pi R^2 L`.
     pub fn volume_derivatives(

@@ -17,7 +17,7 @@
 //! unstretched wall, and an `n`-point Gauss-Legendre rule converges like `rho^-2n` where the
 //! layered sum (a left Riemann sum) converges like `1/n`.
 
-use super::dual::Dual;
+use super::hyper_dual::KernelScalar;
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
 use std::f64::consts::PI;
 
@@ -76,7 +76,12 @@ impl<S: SleeveGeometry> Bladder<S> {
     /// The continuum wall at muscle length `l` and outer diameter `x`: the same [`Kernel`] as the
     /// layer recursion, from the closed form above. `None` where a squared hoop stretch is not
     /// positive or not finite.
-    pub(super) fn continuum_kernel(&self, pressure: f64, l: Dual, x: Dual) -> Option<Kernel> {
+    pub(super) fn continuum_kernel<T: KernelScalar>(
+        &self,
+        pressure: f64,
+        l: T,
+        x: T,
+    ) -> Option<Kernel<T>> {
         let c1x2 = 2.0 * self.tube.mooney_c1;
         let c2x2 = 2.0 * self.tube.mooney_c2;
         let lambda1 = l * (1.0 / self.tube.unstretched_length);
@@ -87,8 +92,9 @@ impl<S: SleeveGeometry> Bladder<S> {
         let x_cu = x_sq * x;
         // The hoop and axial Mooney-Rivlin differences at a squared hoop stretch (eq. 2.9b, 2.9a
         // without the radial stress).
-        let mooney = |l2_sq: Dual, inv_l2_sq: Dual| {
-            if !(l2_sq.v > 0.0 && l2_sq.v.is_finite() && inv_l2_sq.v.is_finite()) {
+        let mooney = |l2_sq: T, inv_l2_sq: T| {
+            let (v, inv) = (l2_sq.value(), inv_l2_sq.value());
+            if !(v > 0.0 && v.is_finite() && inv.is_finite()) {
                 return None;
             }
             let l3_sq = inv_lambda1_sq * inv_l2_sq;
@@ -105,7 +111,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         let (hoop_in, axial_in) = mooney(l2_in, l2_in.recip())?;
         let d_in = d_in_sq.sqrt();
         let inv_d_in = d_in.recip();
-        let zero = Dual::constant(0.0);
+        let zero = T::constant(0.0);
         // Through the wall in the squared deformed diameter u = d^2 (du = 2 s ds / lambda_1):
         // int g ds = int h / (2 d^3) du, int g Phi ds = pi/6 int h (x^3 - d^3) / (2 d^3) du and
         // int sigma_axial w ds = pi/4 int sigma_axial du. The integrands are singular where d = 0
@@ -114,7 +120,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         // wall's own bore dominates. So the nodes are placed evenly in ln(u - u_0) with u_0 the
         // nearer singular point: each integrand is then smooth on the scale of the interval.
         let u_s = x_sq - lambda1.recip() * (d_ro * d_ro);
-        let u_0 = if u_s.v > 0.0 { u_s } else { zero };
+        let u_0 = if u_s.value() > 0.0 { u_s } else { zero };
         let ln_in = (d_in_sq - u_0).ln();
         let span = (x_sq - u_0).ln() - ln_in;
         let (mut h_sum, mut hoop_sum, mut axial_sum) = (zero, zero, zero);
@@ -146,10 +152,10 @@ impl<S: SleeveGeometry> Bladder<S> {
             a,
             c,
             p_eff,
-            threshold: c.v / a.v,
+            threshold: c.value() / a.value(),
             elastic,
             // Only the last term of `elastic` depends on P (at fixed L and x).
-            elastic_dp: -phi_in.v * inv_d_in.v,
+            elastic_dp: [phi_in, inv_d_in],
             inner: InnerLayer {
                 l2_sq: l2_in,
                 axial: axial_in,

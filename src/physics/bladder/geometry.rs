@@ -14,6 +14,9 @@ pub trait SleeveGeometry {
     /// `(A - dV/dL, d/dL of it)` with `A = pi D^2/4`, m^2 and m: the strand force per unit
     /// effective pressure (eq. 2.16 generalised).
     fn strand_area(&self, length: f64) -> (f64, f64);
+    /// `(d2D/dL2, d2(A - dV/dL)/dL2)` at `length`, 1/m and 1: the second derivatives the
+    /// partials of the stiffness need.
+    fn curvatures(&self, length: f64) -> (f64, f64);
     /// `(min, max)` lengths, m, between which the rubber of volume `V_R` fits the sleeve (eq. 2.7's
     /// inner diameter is positive) and the sleeve itself is valid; `None` if nowhere.
     fn fill_lengths(&self, rubber_volume: f64) -> Option<(f64, f64)>;
@@ -39,6 +42,15 @@ impl SleeveGeometry for Sleeve {
         // pi/4 (b^2 - L^2)/(n pi)^2 - (b^2 - 3 L^2)/(4 pi n^2) = L^2 / (2 pi n^2) (eq. 2.16).
         let k = 1.0 / (2.0 * PI * self.turns * self.turns);
         (length * length * k, 2.0 * length * k)
+    }
+    fn curvatures(&self, length: f64) -> (f64, f64) {
+        // D^2 = (b^2 - L^2)/(n pi)^2: D D'' = (D^2)''/2 - D'^2; strand area L^2 / (2 pi n^2).
+        let npi_sq = (self.turns * PI).powi(2);
+        let (d, slope) = self.diameter_and_slope(length);
+        (
+            (-1.0 / npi_sq - slope * slope) / d,
+            1.0 / (PI * self.turns * self.turns),
+        )
     }
     fn fill_lengths(&self, rubber_volume: f64) -> Option<(f64, f64)> {
         fill_lengths(self, rubber_volume)

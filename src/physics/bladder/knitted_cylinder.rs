@@ -96,6 +96,13 @@ impl SleeveGeometry for KnittedCylinder {
             -PI / 4.0 * (c1 + 4.0 * c2 * length),
         )
     }
+    #[inline]
+    fn curvatures(&self, length: f64) -> (f64, f64) {
+        // D D'' = (D^2)''/2 - D'^2 with (D^2)'' = 2 c2; the strand area's is -pi c2.
+        let c2 = self.d_sq[2];
+        let (d, slope) = self.diameter_and_slope(length);
+        ((c2 - slope * slope) / d, -PI * c2)
+    }
     /// Bracketed bisection on the spare volume on each side of its maximum (it rises, then falls,
     /// over the sleeve's range); at initialization only. A side where the sleeve's own limit comes
     /// first keeps that limit.

@@ -22,8 +22,10 @@ mod continuum;
 mod continuum_tests;
 mod dual;
 mod geometry;
+mod hyper_dual;
 mod knitted_cylinder;
 mod partials;
+mod stiffness_partials;
 #[cfg(test)]
 mod tests;
 
@@ -33,9 +35,11 @@ use crate::physics::root::{newton_bisection, RootOptions, Sample};
 use continuum::WallNode;
 use dual::Dual;
 pub use geometry::SleeveGeometry;
+use hyper_dual::KernelScalar;
 pub use knitted_cylinder::KnittedCylinder;
 pub use partials::BladderPartials;
 use std::f64::consts::PI;
+pub use stiffness_partials::BladderCurvature;
 
 /// Mooney-Rivlin `C1` of natural latex used throughout chapter 2 (Fig. 2.9), Pa.
 pub const MOONEY_C1: f64 = 161e3;
@@ -392,7 +396,7 @@ impl<S: SleeveGeometry> Bladder<S> {
 
     /// The wall at muscle length `l` and bladder outer diameter `x`: layers or continuum.
     #[inline]
-    fn kernel(&self, pressure: f64, l: Dual, x: Dual) -> Option<Kernel> {
+    fn kernel<T: KernelScalar>(&self, pressure: f64, l: T, x: T) -> Option<Kernel<T>> {
         match self.wall {
             Wall::Layers(_) => self.layered_kernel(pressure, l, x),
             Wall::Continuum(_) => self.continuum_kernel(pressure, l, x),
@@ -402,7 +406,7 @@ impl<S: SleeveGeometry> Bladder<S> {
     /// The layer recursion of eq. 2.19-2.20 at muscle length `l` and bladder outer diameter `x`.
     /// `None` if a layer's squared hoop stretch is not positive (outside the geometry) or not finite.
     #[inline]
-    fn layered_kernel(&self, pressure: f64, l: Dual, x: Dual) -> Option<Kernel> {
+    fn layered_kernel<T: KernelScalar>(&self, pressure: f64, l: T, x: T) -> Option<Kernel<T>> {
         let c1x2 = 2.0 * self.tube.mooney_c1;
         let c2x2 = 2.0 * self.tube.mooney_c2;
         let lambda1 = l * (1.0 / self.tube.unstretched_length);
@@ -413,16 +417,17 @@ impl<S: SleeveGeometry> Bladder<S> {
         let x_sq = x * x;
         // Pressure inside the current layer is a P - c (linear in P, a > 0), so the threshold
         // pressure c/a of the whole stack falls out of the same pass.
-        let mut a = Dual::constant(1.0);
-        let mut c = Dual::constant(0.0);
-        let mut elastic = Dual::constant(0.0);
-        // d(elastic)/dP at fixed (L, x): elastic is affine in P through each layer's p_in.
-        let mut elastic_dp = 0.0;
-        let mut inner: Option<InnerLayer> = None;
+        let mut a = T::constant(1.0);
+        let mut c = T::constant(0.0);
+        // Eq. 2.17 summed over the layers, sigma_11 = axial - p_in with p_in = a P - c: the
+        // rubber's axial force is (sum (axial + c) V_i - P sum a V_i) / L, affine in P.
+        let mut axial_sum = T::constant(0.0);
+        let mut a_sum = T::constant(0.0);
+        let mut inner: Option<InnerLayer<T>> = None;
         for layer in &self.layers {
             // Eq. 2.20 in squared form: lambda_2i^2 = (x^2 - (D_RO^2 - D_0i^2)/lambda_1) / D_0i^2.
             let l2_sq = (x_sq - inv_lambda1 * layer.excess_sq) * layer.inv_d0_sq;
-            if !(l2_sq.v > 0.0 && l2_sq.v.is_finite()) {
+            if !(l2_sq.value() > 0.0 && l2_sq.value().is_finite()) {
                 return None;
             }
             let inv_l2_sq = l2_sq.recip();
@@ -433,10 +438,9 @@ impl<S: SleeveGeometry> Bladder<S> {
             let axial = (lambda1_sq - l3_sq) * c1x2 - (inv_lambda1_sq - inv_l3_sq) * c2x2;
             // lambda_3 / lambda_2 * Delta D / D_0i of eq. 2.19.
             let k = inv_lambda1 * inv_l2_sq * layer.wall_ratio;
-            let p_in = a * pressure - c;
             // sigma_33 = -p_in; sigma_11 = sigma_33 + axial (eq. 2.17 for the layer).
-            elastic = elastic + (axial - p_in) * inv_l * layer.rubber_volume;
-            elastic_dp -= a.v * inv_l.v * layer.rubber_volume;
+            axial_sum = axial_sum + (axial + c) * layer.rubber_volume;
+            a_sum = a_sum + a * layer.rubber_volume;
             if inner.is_none() {
                 inner = Some(InnerLayer { l2_sq, axial, hoop });
             }
@@ -447,19 +451,20 @@ impl<S: SleeveGeometry> Bladder<S> {
         }
         let inner = inner?;
         let p_eff = a * pressure - c;
-        let threshold = c.v / a.v;
+        let threshold = c.value() / a.value();
+        let elastic = (axial_sum - a_sum * pressure) * inv_l;
         Some(Kernel {
             a,
             c,
             p_eff,
             threshold,
             elastic,
-            elastic_dp,
+            elastic_dp: [a_sum, inv_l],
             inner,
         })
     }
 
-    fn fluid_area(&self, inner_l2_sq: Dual) -> Dual {
+    fn fluid_area<T: KernelScalar>(&self, inner_l2_sq: T) -> T {
         let d_ri = self.tube.inner_diameter;
         inner_l2_sq * (PI / 4.0 * d_ri * d_ri)
     }
@@ -671,18 +676,32 @@ struct Parts {
 
 /// The innermost layer: squared hoop stretch, and the axial and hoop stresses without the
 /// radial one (eq. 2.9a-b; the true stresses subtract the gauge pressure).
-struct InnerLayer {
-    l2_sq: Dual,
-    axial: Dual,
-    hoop: Dual,
+struct InnerLayer<T = Dual> {
+    l2_sq: T,
+    axial: T,
+    hoop: T,
 }
 
-struct Kernel {
-    a: Dual,
-    c: Dual,
-    p_eff: Dual,
+struct Kernel<T = Dual> {
+    a: T,
+    c: T,
+    p_eff: T,
     threshold: f64,
-    elastic: Dual,
-    elastic_dp: f64,
-    inner: InnerLayer,
+    elastic: T,
+    /// `d(elastic)/dP` at fixed `(L, x)` (elastic is affine in `P`) is minus the product of
+    /// these two: kept as factors so that the first order multiplies their values only.
+    elastic_dp: [T; 2],
+    inner: InnerLayer<T>,
+}
+
+impl<T: KernelScalar> Kernel<T> {
+    /// `d(elastic)/dP` at fixed `(L, x)`.
+    fn elastic_dp(&self) -> T {
+        self.elastic_dp[0] * self.elastic_dp[1] * -1.0
+    }
+
+    /// Its value alone.
+    fn elastic_dp_value(&self) -> f64 {
+        -(self.elastic_dp[0].value() * self.elastic_dp[1].value())
+    }
 }

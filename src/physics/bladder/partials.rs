@@ -75,7 +75,7 @@ impl<S: SleeveGeometry> Bladder<S> {
                 BladderPartials {
                     // F = P_eff g - P A_fluid + elastic (eq. 2.16, 2.17).
                     force: [
-                        a * g - area.v + contact.elastic_dp,
+                        a * g - area.v + contact.elastic_dp_value(),
                         contact.p_eff.dl * g + contact.p_eff.v * g_slope - pressure * area.dl
                             + contact.elastic.dl,
                     ],
@@ -107,7 +107,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             state,
             BladderPartials {
                 force: [
-                    -area.v + k.elastic_dp + force_dx * dx_dp,
+                    -area.v + k.elastic_dp_value() + force_dx * dx_dp,
                     force_dl + force_dx * dx_dl,
                 ],
                 effective_pressure: [0.0, 0.0],

@@ -82,6 +82,32 @@ impl McKibben {
         length: f64,
         history: &HysteresisState,
     ) -> Result<(McKibbenOutput, McKibbenPartials), String> {
+        let (out, mut d) = self.own_partials(pressure, length, history)?;
+        if let Some(c) = self.connector_compliance {
+            // reported = L + c F(P, L): dL/dP = -c F_P / (1 + c F_L), dL/dreported = 1/(1 + c F_L).
+            let denom = 1.0 + c * d.force[1];
+            let (dl_dp, dl_dr) = (-c * d.force[0] / denom, 1.0 / denom);
+            for y in d.rows_mut() {
+                *y = [y[0] + y[1] * dl_dp, y[1] * dl_dr];
+            }
+        }
+        if finite(&d) {
+            Ok((out, d))
+        } else {
+            Err(format!(
+                "partial derivatives overflow at length {length} m (too close to a length limit)"
+            ))
+        }
+    }
+
+    /// The outputs and their partials with respect to `(P, L)`, `L` the muscle's own length
+    /// (through a connector, the root [`McKibben::evaluate`] finds).
+    fn own_partials(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Result<(McKibbenOutput, McKibbenPartials), String> {
         // Without a connector the bladder's state and partials come from one pass; through a
         // connector the actual length is a root first.
         let (out, bladder) = match (&self.bladder, self.connector_compliance) {
@@ -142,25 +168,69 @@ impl McKibben {
             d.force[0] += d.friction_force[0];
             d.force[1] += d.friction_force[1];
         }
-        if let Some(c) = self.connector_compliance {
-            // reported = L + c F(P, L): dL/dP = -c F_P / (1 + c F_L), dL/dreported = 1/(1 + c F_L).
-            let denom = 1.0 + c * d.force[1];
-            let (dl_dp, dl_dr) = (-c * d.force[0] / denom, 1.0 / denom);
-            for y in d.rows_mut() {
-                *y = [y[0] + y[1] * dl_dp, y[1] * dl_dr];
+        Ok((out, d))
+    }
+
+    /// `[d/dP, d/dlength]` of `stiffness` (`length` the input, reported length), from the
+    /// bladder's second-order pass ([`crate::physics::bladder::BladderCurvature`]) or eq. 2.3's
+    /// `6 P_eff L / (4 pi n^2)`. Friction adds `C_f z dP_eff/dL` (z held in the stiffness), whose
+    /// length slope brings the stop operator's slope `z_L dP_eff/dL`. Through the connector the
+    /// series stiffness `K = K_m / (1 + K_m / k)` changes by `1 / (1 + K_m / k)^2` times `K_m`'s
+    /// change, with the muscle length `L(P, reported)` as in [`McKibben::partials`].
+    pub fn stiffness_partials(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Result<[f64; 2], String> {
+        let (out, own) = self.own_partials(pressure, length, history)?;
+        let l = out.actual_length;
+        let mut k_m = match &self.bladder {
+            None => {
+                let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+                let s = &self.sleeve;
+                // Eq. 2.3's stiffness is bilinear in P_eff and L.
+                [
+                    on * s.stiffness(1.0, l),
+                    s.stiffness(pressure.max(0.0), 1.0),
+                ]
             }
+            Some(b) => {
+                let c = b.stiffness_partials(pressure, l)?;
+                let mut row = c.stiffness;
+                if let Some(f) = &self.friction {
+                    let next = out.friction_state;
+                    let direction = if l >= history.position { 1.0 } else { -1.0 };
+                    let z_l = f.operator.slope(&next, direction);
+                    let (slope, by) = (own.effective_pressure[1], c.effective_pressure_slope);
+                    row[0] += f.coefficient * next.z * by[0];
+                    row[1] += f.coefficient * (z_l * slope + next.z * by[1]);
+                }
+                row
+            }
+        };
+        if let Some(c) = self.connector_compliance {
+            // K = K_m / (1 + c K_m), so K_m = K / (1 - c K); L(P, reported) as in `partials`.
+            let muscle = out.stiffness / (1.0 - c * out.stiffness);
+            let denom = 1.0 + c * own.force[1];
+            let (dl_dp, dl_dr) = (-c * own.force[0] / denom, 1.0 / denom);
+            let series = 1.0 / (1.0 + c * muscle).powi(2);
+            k_m = [(k_m[0] + k_m[1] * dl_dp) * series, k_m[1] * dl_dr * series];
         }
-        if d.named()
-            .iter()
-            .all(|(_, v)| v.iter().all(|x| x.is_finite()))
-        {
-            Ok((out, d))
+        if k_m.iter().all(|x| x.is_finite()) {
+            Ok(k_m)
         } else {
             Err(format!(
-                "partial derivatives overflow at length {length} m (too close to a length limit)"
+                "stiffness partials overflow at length {length} m (too close to a length limit)"
             ))
         }
     }
+}
+
+fn finite(d: &McKibbenPartials) -> bool {
+    d.named()
+        .iter()
+        .all(|(_, v)| v.iter().all(|x| x.is_finite()))
 }
 
 #[cfg(test)]
@@ -223,6 +293,36 @@ mod tests {
         worst
     }
 
+    /// Agreement of the stiffness's partials with central differences of the stiffness output.
+    fn check_stiffness(m: &McKibben, p: f64, l: f64, s: &HysteresisState, what: &str) -> f64 {
+        let exact = m.stiffness_partials(p, l, s).unwrap();
+        let k = |p: f64, l: f64| m.evaluate(p, l, s).unwrap().stiffness;
+        let h = [p.abs() * 1e-6 + 1e-3, l * 1e-6];
+        let central = [
+            (k(p + h[0], l) - k(p - h[0], l)) / (2.0 * h[0]),
+            (k(p, l + h[1]) - k(p, l - h[1])) / (2.0 * h[1]),
+        ];
+        // As for the first partials: the connector's root is noisier.
+        let tolerance = if m.has_connector() { 1e-4 } else { 2e-5 };
+        let mut worst: f64 = 0.0;
+        for j in 0..2 {
+            let (e, c) = (exact[j], central[j]);
+            let scale = e.abs().max(c.abs()).max(1e-12);
+            let err = (e - c).abs() / scale;
+            // Rounding of the stiffness over the step.
+            let floor = 1e-15 * (1.0 + k(p, l).abs()) / h[j];
+            assert!(
+                err < tolerance || (e - c).abs() < floor,
+                "{what}: dstiffness/d{} exact {e} vs central {c} (relative {err:e})",
+                ["P", "L"][j]
+            );
+            if (e - c).abs() >= floor {
+                worst = worst.max(err);
+            }
+        }
+        worst
+    }
+
     fn muscle(g: &MuscleGeometry, model: BladderModel, friction: bool, k: f64) -> McKibben {
         let f = friction.then_some(FrictionParams {
             coefficient: 1e-5,
@@ -239,7 +339,7 @@ mod tests {
             BladderModel::ThickWall { layers: 8 },
             BladderModel::Continuum { nodes: 6 },
         ];
-        let mut worst: f64 = 0.0;
+        let (mut worst, mut worst_stiffness) = (0.0f64, 0.0f64);
         let (mut free_points, mut points) = (0, 0);
         for (gi, g) in [
             MuscleGeometry::muscle_a(),
@@ -275,6 +375,8 @@ mod tests {
                                     "muscle {gi} {model:?} friction {friction} k {k} L {l} P {p}"
                                 );
                                 worst = worst.max(check(&m, p, l, &s, &what));
+                                worst_stiffness =
+                                    worst_stiffness.max(check_stiffness(&m, p, l, &s, &what));
                                 points += 1;
                             }
                         }
@@ -286,7 +388,8 @@ mod tests {
         assert!(free_points > 0, "no free-bladder point was checked");
         assert!(points > 300, "only {points} points checked");
         eprintln!(
-            "{points} points ({free_points} free bladder): worst relative difference {worst:e}"
+            "{points} points ({free_points} free bladder): worst relative difference {worst:e}, \
+             of the stiffness's partials {worst_stiffness:e}"
         );
     }
 
