@@ -220,7 +220,8 @@ sweep: fmus $(VENV)/.installed
 ## ---- Reliability jobs (issue 8): longer runs, not part of `make test`. ----
 .PHONY: fuzz memcheck load
 
-## tests/load.rs with its 10,000-cycle heap test of every FMU (ignored by `make test`: minutes of CPU).
+## tests/load.rs with its 10,000-cycle heap test of every FMU in both interfaces (ignored by
+## `make test`: a minute of CPU, most of it the motor).
 load: fmus
 	cargo test --release --test load -- --include-ignored --nocapture
 
@@ -251,15 +252,23 @@ fuzz:
 ## Valgrind memcheck, two halves, each with its whole log kept in out/memcheck/ and its summary
 ## printed; any error in either fails:
 ## - native: tools/examples/memcheck_native.rs loads every FMU through its C ABI (no Python), runs
-##   each with default parameters and with all effects on, and every scene; definite and
-##   indirect leaks count as errors and nothing is suppressed.
+##   each with default parameters and with all effects on in both interfaces (Model Exchange with
+##   states, events and directional derivatives), and every scene; definite and indirect leaks
+##   count as errors and nothing is suppressed.
 ## - fmpy: FMPy tests (MEMCHECK_TESTS) with memory errors checked, not leaks (the Python
 ##   process's own); tests/valgrind-python.supp names only CPython, _json, lxml and ld.so. The
 ##   default set drives every FMU: every scene and every cross-check input through a strict
-##   master, FMU states, threads and 20 load/unload cycles, and validation of every FMU. The whole
-##   suite under valgrind takes hours on 2 cores: `make memcheck MEMCHECK_TESTS=tests/fmpy`.
+##   master, FMU states, threads and 20 load/unload cycles, and validation of every FMU; and Model
+##   Exchange under FMPy (MEMCHECK_ME_TESTS): every scene through CVode, the checked calls,
+##   state round trips, Jacobians, the motor's events, all but the four longest runs (2-5 s each
+##   without valgrind). The whole suite under valgrind takes hours on 2 cores:
+##   `make memcheck MEMCHECK_TESTS=tests/fmpy`.
+MEMCHECK_ME_TESTS := tests/fmpy/test_model_exchange.py tests/fmpy/test_motor_model_exchange.py \
+  $(addprefix --deselect ,'tests/fmpy/test_motor_model_exchange.py::test_motor_scene_model_exchange_matches_co_simulation[motor_stepping]' \
+  tests/fmpy/test_model_exchange.py::test_pulley_model_exchange_matches_co_simulation_under_varying_forces \
+  tests/fmpy/test_model_exchange.py::test_pulley_model_exchange_matches_co_simulation_under_constant_forces)
 MEMCHECK_TESTS ?= tests/fmpy/test_strict_master.py tests/fmpy/test_fmi_behaviour.py \
-  tests/fmpy/test_validation.py
+  tests/fmpy/test_validation.py $(MEMCHECK_ME_TESTS)
 MEMCHECK_DIR := out/memcheck
 VALGRIND := valgrind --tool=memcheck --error-exitcode=1 --num-callers=30
 memcheck: fmus $(VENV)/.installed
@@ -272,13 +281,13 @@ memcheck: fmus $(VENV)/.installed
 	$(VALGRIND) --leak-check=full --errors-for-leak-kinds=definite,indirect \
 	  --show-leak-kinds=definite,indirect --log-file=$(MEMCHECK_DIR)/native.log \
 	  target/release/examples/memcheck_native > $(MEMCHECK_DIR)/native.out 2>&1; native=$$?; \
-	tail -1 $(MEMCHECK_DIR)/native.out; \
+	tail -n $$( [ $$native = 0 ] && echo 1 || echo 20 ) $(MEMCHECK_DIR)/native.out; \
 	echo "native: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/native.log)"; \
 	grep -h 'definitely lost\|indirectly lost\|All heap blocks were freed' $(MEMCHECK_DIR)/native.log; \
 	FMI_BEHAVIOUR_LOAD_CYCLES=20 PYTHONMALLOC=malloc $(VALGRIND) --leak-check=no --suppressions=tests/valgrind-python.supp \
 	  --log-file=$(MEMCHECK_DIR)/fmpy.log \
 	  $(PY) -m pytest -q -p no:cacheprovider $(MEMCHECK_TESTS) > $(MEMCHECK_DIR)/fmpy.out 2>&1; fmpy=$$?; \
-	tail -1 $(MEMCHECK_DIR)/fmpy.out; \
+	tail -n $$( [ $$fmpy = 0 ] && echo 1 || echo 20 ) $(MEMCHECK_DIR)/fmpy.out; \
 	echo "fmpy: $$(grep -h 'ERROR SUMMARY' $(MEMCHECK_DIR)/fmpy.log)"; \
 	echo "make memcheck: $$(( $$(date +%s) - start )) s; logs in $(MEMCHECK_DIR)/"; \
 	test $$native = 0 -a $$fmpy = 0

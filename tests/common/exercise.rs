@@ -54,8 +54,18 @@ pub const EXERCISE_SUBSTEPS: c_int = 50;
 
 /// Instantiates, sets all effects on (if asked), bounds the substep budget and initializes.
 pub fn ready<'a>(api: &'a Api, info: &ModelInfo, effects: bool) -> Instance<'a> {
+    ready_as(api, info, effects, 1)
+}
+
+/// As [`ready`], for `fmu_type` 0 (Model Exchange: the instance ends in event mode) or 1.
+pub fn ready_as<'a>(
+    api: &'a Api,
+    info: &ModelInfo,
+    effects: bool,
+    fmu_type: c_int,
+) -> Instance<'a> {
     let i = api
-        .instantiate("exercise", info.guid)
+        .instantiate_as("exercise", info.guid, fmu_type)
         .unwrap_or_else(|log| panic!("{} refused: {:?}", info.name, log.lines()));
     assert_eq!(i.setup(), OK);
     assert_eq!(i.enter(), OK);

@@ -3,7 +3,12 @@
 //!
 //! - every model twice, with default parameters and with all effects on, over 40 steps of inputs
 //!   inside their declared ranges, through an FMU state get / serialize / deserialize / set (the
-//!   motor's substep budget bounded, see `exercise::EXERCISE_SUBSTEPS`);
+//!   motor's substep budget bounded, see `exercise::EXERCISE_SUBSTEPS`), with directional
+//!   derivatives of every output;
+//! - every model twice more through Model Exchange (`model_exchange::me_run`): event iteration,
+//!   states, derivatives, event indicators, nominals, Euler steps, completed integrator steps,
+//!   a time event (the motor's schedule switch, the pulley reference's segment end), directional
+//!   derivatives of outputs and state derivatives, an FMU state round trip;
 //! - every catalogue scene (`scenes/*.json`, fast variant) with its parameters, inputs and every
 //!   sweep value;
 //! - every instance and FMU state freed, so anything left is a leak of ours.
@@ -14,11 +19,14 @@
 mod common;
 #[path = "../../tests/common/exercise.rs"]
 mod exercise;
+#[path = "../../tests/common/model_exchange.rs"]
+mod model_exchange;
 
 use actuator_fmus::variables::{ModelInfo, VarType};
 use actuator_fmus_tools::scene::{Scene, Value};
 use common::*;
 use exercise::*;
+use model_exchange::*;
 use std::ffi::c_int;
 use std::path::Path;
 use std::ptr::null_mut;
@@ -30,6 +38,7 @@ fn models_run(api: &Api, info: &ModelInfo, effects: bool) -> usize {
         step_and_read(&i, info, 0, n);
         steps += 1;
     }
+    directional_derivatives(&i, info, None);
     // Through a serialized state and back, then on.
     let bytes = serialized_state(&i);
     unsafe {
@@ -120,16 +129,20 @@ fn scene_run(api: &Api, info: &ModelInfo, scene: &Scene, sweep: Option<usize>) -
 fn main() {
     // The repository root (this example is built in tools/).
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).parent().unwrap();
-    let apis: Vec<(&ModelInfo, Api)> = models()
+    let apis: Vec<(&ModelInfo, Api, MeApi)> = models()
         .into_iter()
-        .map(|info| (info, Api::load(&extract_binary(info.name))))
+        .map(|info| {
+            let path = extract_binary(info.name);
+            (info, Api::load(&path), MeApi::load(&path))
+        })
         .collect();
     let api_of = |name: &str| {
         apis.iter()
-            .find(|(i, _)| i.name == name)
+            .find(|(i, _, _)| i.name == name)
+            .map(|(i, api, _)| (i, api))
             .unwrap_or_else(|| panic!("no FMU {name}"))
     };
-    for (info, api) in &apis {
+    for (info, api, me) in &apis {
         let t0 = std::time::Instant::now();
         let steps = models_run(api, info, false);
         let t1 = t0.elapsed();
@@ -139,6 +152,22 @@ fn main() {
             info.name,
             t1,
             t0.elapsed() - t1
+        );
+        let t0 = std::time::Instant::now();
+        const ME_STEPS: usize = 40;
+        let runs = [
+            me_run(api, me, info, false, 0, ME_STEPS),
+            me_run(api, me, info, true, 1, ME_STEPS),
+        ];
+        println!(
+            "{}: Model Exchange, {} states, default and all effects on, {} steps, {} time and {} \
+             state events ({:.2?})",
+            info.name,
+            me_shape(info).states.len(),
+            2 * ME_STEPS,
+            runs.iter().map(|r| r.time_events).sum::<usize>(),
+            runs.iter().map(|r| r.state_events).sum::<usize>(),
+            t0.elapsed()
         );
     }
     let mut paths: Vec<_> = std::fs::read_dir(root.join("scenes"))
