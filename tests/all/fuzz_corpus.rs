@@ -33,3 +33,25 @@ fn the_fuzz_corpus_finds_nothing() {
         inputs.len()
     );
 }
+
+/// The harness names models by a stable id (`MODEL_IDS`), not by registry position: every model
+/// in the registry must have one, and each id must name a model of the registry (the harness
+/// panics otherwise, but only when an input picks that id).
+#[test]
+fn every_model_has_a_stable_fuzz_id() {
+    use actuator_fmus::fmi2::REGISTRY;
+    for factory in REGISTRY {
+        let name = factory.info().name;
+        assert!(
+            driver::MODEL_IDS.contains(&Some(name)),
+            "{name} has no id in MODEL_IDS (tests/fuzz_driver/call_sequences.rs): give it the \
+             reserved one, never reorder"
+        );
+    }
+    for name in driver::MODEL_IDS.iter().flatten() {
+        assert!(
+            REGISTRY.iter().any(|f| f.info().name == *name),
+            "MODEL_IDS names {name}, which the registry lacks"
+        );
+    }
+}
