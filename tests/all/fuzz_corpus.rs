@@ -55,3 +55,21 @@ fn every_model_has_a_stable_fuzz_id() {
         );
     }
 }
+
+/// The harness reads the Model Exchange sizes from the shipped model description, as an
+/// importer does; the right sizes are what let its calls pass the size checks.
+#[test]
+fn the_harness_reads_the_model_exchange_sizes() {
+    use actuator_fmus::fmi2::REGISTRY;
+    let sizes = |name: &str| {
+        let info = REGISTRY
+            .iter()
+            .find(|f| f.info().name == name)
+            .unwrap()
+            .info();
+        driver::me_sizes(info)
+    };
+    assert_eq!(sizes("PulleyJoint"), (2, 0)); // joint angle and velocity
+    assert_eq!(sizes("MultiferroicMotor"), (4, 1)); // rotor and onion angles; the fold
+    assert_eq!(sizes("McKibbenMuscle"), (0, 0));
+}
