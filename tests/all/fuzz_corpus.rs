@@ -1,7 +1,9 @@
 //! The committed fuzz corpus (`fuzz/corpus/call_sequences/`, kept small with `cargo fuzz cmin`)
-//! replayed through the fuzz harness's own logic, without libFuzzer or a nightly toolchain: no
-//! input makes any FMU return fmi2Fatal, crash, refuse without a logged reason or hand out a NaN.
-//! Inputs that once were findings live there too (`make fuzz` writes them to `fuzz/artifacts/`).
+//! and the inputs that once were findings (`fuzz/regressions/call_sequences/`, kept out of the
+//! corpus so that `cmin` cannot drop them) replayed through the fuzz harness's own logic, without
+//! libFuzzer or a nightly toolchain: no input makes any FMU return fmi2Fatal, crash, refuse
+//! without a logged reason or hand out a NaN. `make fuzz` writes new findings to
+//! `fuzz/artifacts/`.
 
 #[path = "../fuzz_driver/call_sequences.rs"]
 mod driver;
@@ -10,12 +12,17 @@ use std::path::Path;
 
 #[test]
 fn the_fuzz_corpus_finds_nothing() {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/corpus/call_sequences");
-    let mut inputs: Vec<_> = std::fs::read_dir(&dir)
-        .unwrap()
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz");
+    let mut inputs: Vec<_> = ["corpus", "regressions"]
+        .iter()
+        .flat_map(|dir| std::fs::read_dir(root.join(dir).join("call_sequences")).unwrap())
         .map(|e| e.unwrap().path())
         .collect();
     inputs.sort();
+    assert!(
+        inputs.iter().any(|p| p.to_string_lossy().contains("regressions")),
+        "the regression inputs are missing"
+    );
     let mut calls = 0;
     for path in &inputs {
         let data = std::fs::read(path).unwrap();

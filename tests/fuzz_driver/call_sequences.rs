@@ -286,7 +286,11 @@ fn cheap_integer(u: &mut Unstructured, name: &str, x: c_int) -> Result<c_int> {
 /// fuzzing time.
 fn few_segments(x: c_int) -> c_int {
     let x = x.unsigned_abs();
-    (if x % 16 == 0 { 3 + (x / 16) % 6 } else { 2 }) as c_int
+    (if x.is_multiple_of(16) {
+        3 + (x / 16) % 6
+    } else {
+        2
+    }) as c_int
 }
 
 fn time_step(u: &mut Unstructured) -> Result<f64> {
