@@ -1,11 +1,13 @@
 //! The fuzz harness's logic, shared by `fuzz/fuzz_targets/call_sequences.rs` (libFuzzer) and
 //! `tests/all/fuzz_corpus.rs` (the committed corpus replayed in `make test`).
 //!
-//! Interprets the fuzzer's bytes as a sequence of FMI 2.0 calls on up to four instances of any
-//! model in the binary, with random value references, NaN/inf/huge values, NULL or valid buffers,
-//! and random call order. The FMU must never crash or hang, never return fmi2Fatal (a caught
-//! panic), never refuse without logging why, and never hand out a NaN or infinity from
-//! fmi2GetReal with an OK or Warning status.
+//! Interprets the fuzzer's bytes as a sequence of FMI 2.0 calls, Co-Simulation and Model Exchange,
+//! on up to four instances of any model in the binary (named by a stable id, [`MODEL_IDS`]), with
+//! random value references, NaN/inf/huge values and states, right and wrong vector sizes, NULL or
+//! valid buffers, and random call order. The FMU must never crash or hang, never return fmi2Fatal
+//! (a caught panic), never refuse without logging why, and never hand out a NaN or infinity with
+//! an OK or Warning status (fmi2GetReal, the state-sized Model Exchange getters, directional
+//! derivatives, the next event time).
 //!
 //! Pointers passed are only NULL or valid buffers of the declared size, live instances and live
 //! FMU states: anything else would be undefined behaviour on the importer's side, not ours.
