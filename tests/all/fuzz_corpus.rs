@@ -20,7 +20,9 @@ fn the_fuzz_corpus_finds_nothing() {
         .collect();
     inputs.sort();
     assert!(
-        inputs.iter().any(|p| p.to_string_lossy().contains("regressions")),
+        inputs
+            .iter()
+            .any(|p| p.to_string_lossy().contains("regressions")),
         "the regression inputs are missing"
     );
     let mut calls = 0;
