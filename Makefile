@@ -231,9 +231,13 @@ SANITIZER ?= address
 ## Per-sequence limit in wall-clock seconds: the longest sequences take ~0.3 s of CPU, but a
 ## niced run on a loaded machine waits many times that for a core.
 FUZZ_TIMEOUT ?= 120
-## Fuzzes random FMI call sequences on all six models for FUZZ_SECONDS (cargo-fuzz, nightly Rust),
+# Each sanitizer builds in its own target directory, so that switching does not rebuild.
+FUZZ_TARGET_DIR = $(if $(filter none,$(SANITIZER)),,--target-dir fuzz/target-$(SANITIZER))
+## Fuzzes random FMI call sequences (Co-Simulation and Model Exchange) on all seven models for
+## FUZZ_SECONDS (cargo-fuzz, nightly Rust),
 ## with the harness of tests/fuzz_driver/ (tests/all/fuzz_corpus.rs replays the committed corpus in
-## `make test`). The committed seeds in fuzz/corpus/call_sequences are only read; new inputs go
+## `make test`). The committed seeds in fuzz/corpus/call_sequences and the past findings in
+## fuzz/regressions/call_sequences are only read; new inputs go
 ## to the ignored fuzz/corpus-run/, findings to the ignored fuzz/artifacts/. The summary line
 ## counts the sequences run ("stat::number_of_executed_units"). The tracked fuzz/Cargo.lock must
 ## come out unchanged (a dependency change shows here, to be committed).
@@ -241,8 +245,9 @@ fuzz:
 	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
 	mkdir -p fuzz/corpus-run/call_sequences fuzz/logs
-	cargo +nightly fuzz run -s $(SANITIZER) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
-	  $(CURDIR)/fuzz/corpus/call_sequences -- -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
+	cargo +nightly fuzz run -s $(SANITIZER) $(FUZZ_TARGET_DIR) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
+	  $(CURDIR)/fuzz/corpus/call_sequences $(CURDIR)/fuzz/regressions/call_sequences \
+	  -- -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
 	  -rss_limit_mb=2048 -print_final_stats=1 \
 	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; test $${PIPESTATUS[0]} = 0
 	@grep -h 'stat::number_of_executed_units' fuzz/logs/$(SANITIZER).log \

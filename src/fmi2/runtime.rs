@@ -89,6 +89,7 @@ where
             model: None,
             outputs_stale: true,
             time: None,
+            rejected: None,
         })
     }
 }
@@ -178,6 +179,11 @@ struct RuntimeOf<M: Model> {
     /// Not saved: the model keeps its own time, and the instance its.
     #[serde(skip)]
     time: Option<f64>,
+    /// Why the last build failed, until a value changes: a rejected KnittedMuscle builds its
+    /// whole shape table before a later check refuses it, and initialization mode retries the
+    /// build at every get.
+    #[serde(skip)]
+    rejected: Option<String>,
 }
 
 impl<M: Model> RuntimeOf<M>
@@ -227,6 +233,7 @@ impl<M: Model> Clone for RuntimeOf<M> {
             model: self.model.clone(),
             outputs_stale: self.outputs_stale,
             time: self.time,
+            rejected: self.rejected.clone(),
         }
     }
 }
@@ -279,6 +286,7 @@ where
     }
     fn changed(&mut self, parameters: bool) {
         self.outputs_stale = true;
+        self.rejected = None;
         if parameters {
             self.model = None;
         }
@@ -290,8 +298,14 @@ where
         !self.outputs_stale && self.model.is_some()
     }
     fn build(&mut self) -> Result<(), String> {
+        if let Some(why) = &self.rejected {
+            return Err(why.clone());
+        }
         let v = &mut self.values;
-        let mut model = M::new(&v.parameters, &v.inputs).map_err(|r| r.0)?;
+        let mut model = match M::new(&v.parameters, &v.inputs) {
+            Ok(model) => model,
+            Err(why) => return Err(self.rejected.insert(why.0).clone()),
+        };
         v.calculated = model.calculated_parameters();
         if let Some(time) = self.time {
             model.set_time(time);
@@ -424,6 +438,7 @@ where
         self.model = None;
         self.outputs_stale = true;
         self.time = None;
+        self.rejected = None;
     }
     fn snapshot(&self) -> Box<dyn Runtime> {
         Box::new(self.clone())

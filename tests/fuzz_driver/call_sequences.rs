@@ -1,19 +1,22 @@
 //! The fuzz harness's logic, shared by `fuzz/fuzz_targets/call_sequences.rs` (libFuzzer) and
 //! `tests/all/fuzz_corpus.rs` (the committed corpus replayed in `make test`).
 //!
-//! Interprets the fuzzer's bytes as a sequence of FMI 2.0 calls on up to four instances of any
-//! model in the binary, with random value references, NaN/inf/huge values, NULL or valid buffers,
-//! and random call order. The FMU must never crash or hang, never return fmi2Fatal (a caught
-//! panic), never refuse without logging why, and never hand out a NaN or infinity from
-//! fmi2GetReal with an OK or Warning status.
+//! Interprets the fuzzer's bytes as a sequence of FMI 2.0 calls, Co-Simulation and Model Exchange,
+//! on up to four instances of any model in the binary (named by a stable id, [`MODEL_IDS`]), with
+//! random value references, NaN/inf/huge values and states, right and wrong vector sizes, NULL or
+//! valid buffers, and random call order. The FMU must never crash or hang, never return fmi2Fatal
+//! (a caught panic), never refuse without logging why, and never hand out a NaN or infinity with
+//! an OK or Warning status (fmi2GetReal, the state-sized Model Exchange getters, directional
+//! derivatives, the next event time).
 //!
 //! Pointers passed are only NULL or valid buffers of the declared size, live instances and live
 //! FMU states: anything else would be undefined behaviour on the importer's side, not ours.
 #![allow(dead_code)]
 
+use actuator_fmus::fmi2::runtime::Factory;
 use actuator_fmus::fmi2::types::*;
 use actuator_fmus::fmi2::REGISTRY;
-use actuator_fmus::variables::{ModelInfo, Start, VarType};
+use actuator_fmus::variables::{Causality, ModelInfo, Start, VarType};
 use arbitrary::{Result, Unstructured};
 use std::ffi::{c_char, c_int, c_void, CStr, CString};
 use std::ptr::{null, null_mut};
@@ -89,6 +92,71 @@ extern "C" {
     fn fmi2GetIntegerStatus(c: fmi2Component, kind: c_int, v: *mut c_int) -> fmi2Status;
     fn fmi2GetBooleanStatus(c: fmi2Component, kind: c_int, v: *mut c_int) -> fmi2Status;
     fn fmi2GetStringStatus(c: fmi2Component, kind: c_int, v: *mut fmi2String) -> fmi2Status;
+    fn fmi2GetDirectionalDerivative(
+        c: fmi2Component,
+        unknown: *const u32,
+        n_unknown: usize,
+        known: *const u32,
+        n_known: usize,
+        dv_known: *const f64,
+        dv_unknown: *mut f64,
+    ) -> fmi2Status;
+    fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status;
+    fn fmi2NewDiscreteStates(c: fmi2Component, info: *mut EventInfo) -> fmi2Status;
+    fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status;
+    fn fmi2CompletedIntegratorStep(
+        c: fmi2Component,
+        no_prior: fmi2Boolean,
+        enter_event_mode: *mut fmi2Boolean,
+        terminate: *mut fmi2Boolean,
+    ) -> fmi2Status;
+    fn fmi2SetTime(c: fmi2Component, t: f64) -> fmi2Status;
+    fn fmi2SetContinuousStates(c: fmi2Component, x: *const f64, nx: usize) -> fmi2Status;
+    fn fmi2GetContinuousStates(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status;
+    fn fmi2GetDerivatives(c: fmi2Component, dx: *mut f64, nx: usize) -> fmi2Status;
+    fn fmi2GetEventIndicators(c: fmi2Component, z: *mut f64, ni: usize) -> fmi2Status;
+    fn fmi2GetNominalsOfContinuousStates(c: fmi2Component, x: *mut f64, nx: usize) -> fmi2Status;
+}
+
+/// `fmi2EventInfo` as the importer declares it (fmi2FunctionTypes.h).
+#[repr(C)]
+#[derive(Default)]
+struct EventInfo {
+    new_discrete_states_needed: fmi2Boolean,
+    terminate_simulation: fmi2Boolean,
+    nominals_of_continuous_states_changed: fmi2Boolean,
+    values_of_continuous_states_changed: fmi2Boolean,
+    next_event_time_defined: fmi2Boolean,
+    next_event_time: f64,
+}
+
+/// The Model Exchange sizes of a model, (continuous states, event indicators), read once from
+/// the model description it ships: the harness knows only what an importer knows.
+pub fn me_sizes(info: &ModelInfo) -> (usize, usize) {
+    static SIZES: std::sync::OnceLock<Vec<(&'static str, usize, usize)>> =
+        std::sync::OnceLock::new();
+    let sizes = SIZES.get_or_init(|| {
+        REGISTRY
+            .iter()
+            .map(|f| {
+                let xml = f.info().model_description_xml;
+                // A state's derivative declares it: derivative="<index>".
+                let nx = xml
+                    .match_indices("derivative=\"")
+                    .filter(|(at, m)| xml[at + m.len()..].starts_with(|c: char| c.is_ascii_digit()))
+                    .count();
+                let ni = xml
+                    .split_once("numberOfEventIndicators=\"")
+                    .and_then(|(_, rest)| rest.split('"').next()?.parse().ok())
+                    .unwrap_or(0);
+                (f.info().name, nx, ni)
+            })
+            .collect()
+    });
+    sizes
+        .iter()
+        .find(|s| s.0 == info.name)
+        .map_or((0, 0), |s| (s.1, s.2))
 }
 
 /// Messages logged for one instance.
@@ -135,6 +203,8 @@ struct Slot {
     log: Box<Counter>,
     /// Whether the importer gave a logger (without one, refusals cannot be logged).
     logging: bool,
+    /// Instantiated for Model Exchange.
+    model_exchange: bool,
     _callbacks: Box<fmi2CallbackFunctions>,
 }
 
@@ -198,13 +268,31 @@ fn integer(u: &mut Unstructured) -> Result<c_int> {
 /// `shape_model` 2 builds its shape table (tens of ms for the default 49 segments, more for
 /// more) each time its parameters change, which made such sequences thousands of times dearer
 /// than the rest and cut the fuzzing rate to a few hundred sequences a second. Valid segment
-/// counts above 8 are therefore folded to 2..=8, except one time in 64; refused values
+/// counts above 8 are therefore folded to [`few_segments`], except one time in 64; refused values
 /// (below 2, above the maximum) pass as they are, since refusing is cheap.
 fn cheap_integer(u: &mut Unstructured, name: &str, x: c_int) -> Result<c_int> {
     Ok(match name {
-        "shape_segments" if (9..=20_000).contains(&x) && !u.ratio(1, 64)? => 2 + x % 7,
+        "shape_segments" if (9..=20_000).contains(&x) && !u.ratio(1, 64)? => few_segments(x),
+        // Even a 2-segment table costs a whole sequence's time or more under the fuzzer's
+        // instrumentation: the table is asked for at a quarter of the rate, the sleeve's
+        // cylinder (1) otherwise.
+        "shape_model" if x == 2 && !u.ratio(1, 4)? => 1,
         _ => x,
     })
+}
+
+/// A cheap segment count for a KnittedMuscle shape table: 2 (about 0.05 ms a table for the
+/// prototype sleeve, uninstrumented), and 3..=8 (0.05-0.5 ms, some sleeves 10x more) one time in
+/// 16. The default 49 segments take 3.5 ms, and libFuzzer favours the table builds (their many
+/// comparisons are many features): with every count 2..=8 alike, table builds took half of the
+/// fuzzing time.
+fn few_segments(x: c_int) -> c_int {
+    let x = x.unsigned_abs();
+    (if x.is_multiple_of(16) {
+        3 + (x / 16) % 6
+    } else {
+        2
+    }) as c_int
 }
 
 fn time_step(u: &mut Unstructured) -> Result<f64> {
@@ -223,6 +311,37 @@ fn time_step(u: &mut Unstructured) -> Result<f64> {
         2e3,
     ];
     Ok(steps[u.choose_index(steps.len())?])
+}
+
+/// The models by stable id. A model is chosen by one byte of the input, `b % 8` its id here, so
+/// that each committed seed keeps driving the model it was found with when models are added (the
+/// registry is in name order: FreeBladder's arrival once shifted every seed to another model).
+/// Never reorder or remove an entry. A new model takes the reserved id (`None`: a GUID that no
+/// model has, which must be refused); past 8 models the table must grow, and the committed
+/// corpus be re-targeted with it. Bit 3 of the byte asks `ready` for Model Exchange (the
+/// committed seeds from before Model Exchange was fuzzed have it clear).
+pub const MODEL_IDS: [Option<&str>; 8] = [
+    Some("KnittedMuscle"),
+    Some("McKibbenJoint"),
+    Some("McKibbenMuscle"),
+    Some("MultiferroicMotor"),
+    Some("PassThrough"),
+    Some("PulleyJoint"),
+    Some("FreeBladder"),
+    None,
+];
+
+/// The model an input byte names (None for the reserved id), and whether `ready` is to
+/// instantiate it for Model Exchange.
+fn model(u: &mut Unstructured) -> Result<(Option<&'static dyn Factory>, bool)> {
+    let b: u8 = u.arbitrary()?;
+    let factory = MODEL_IDS[usize::from(b % 8)].map(|name| {
+        *REGISTRY
+            .iter()
+            .find(|f| f.info().name == name)
+            .unwrap_or_else(|| panic!("MODEL_IDS names {name}, which the registry lacks"))
+    });
+    Ok((factory, b & 8 != 0))
 }
 
 impl Driver {
@@ -257,12 +376,45 @@ impl Driver {
         }
     }
 
+    /// The reserved model id: instantiation with a GUID that no model has must be refused,
+    /// with a logged reason.
+    fn unknown_model(&mut self, k: usize) -> Result<()> {
+        let log = Counter::default();
+        let callbacks = fmi2CallbackFunctions {
+            logger: Some(logger()),
+            allocate_memory: None,
+            free_memory: None,
+            step_finished: None,
+            component_environment: &log as *const Counter as *mut c_void,
+        };
+        let c = unsafe {
+            fmi2Instantiate(
+                c"unknown".as_ptr(),
+                1,
+                c"{00000000-0000-0000-0000-000000000000}".as_ptr(),
+                null(),
+                &callbacks,
+                0,
+                0,
+            )
+        };
+        self.calls += 1;
+        assert!(c.is_null(), "an unknown GUID was instantiated (slot {k})");
+        assert!(
+            log.0.load(Ordering::Relaxed) > 0,
+            "unknown GUID refused without a logged reason"
+        );
+        Ok(())
+    }
+
     fn instantiate(&mut self, u: &mut Unstructured) -> Result<()> {
         let k = self.slot(u)?;
         if let Some(old) = self.slots[k].take() {
             unsafe { fmi2FreeInstance(old.c) };
         }
-        let factory = REGISTRY[u.choose_index(REGISTRY.len())?];
+        let Some(factory) = model(u)?.0 else {
+            return self.unknown_model(k);
+        };
         let info = factory.info();
         let guid = match u.int_in_range(0..=7)? {
             0 => None,
@@ -332,6 +484,7 @@ impl Driver {
                 states: Vec::new(),
                 log,
                 logging: callbacks.logger.is_some(),
+                model_exchange: kind == FMI2_MODEL_EXCHANGE,
                 _callbacks: callbacks,
             });
         }
@@ -417,7 +570,7 @@ impl Driver {
         Ok(())
     }
 
-    /// Before `shape_model` 2 is set on a KnittedMuscle, sets `shape_segments` to 2..=8 too
+    /// Before `shape_model` 2 is set on a KnittedMuscle, sets `shape_segments` to [`few_segments`] too
     /// (15 times in 16), so that the default 49-segment table is built only at a low rate (see
     /// `cheap_integer`).
     fn fewer_shape_segments(
@@ -440,7 +593,7 @@ impl Driver {
             .zip(values)
             .any(|(&vr, &x)| model.kind == VarType::Integer && vr == model.vr && x == 2);
         if selects_table && !u.ratio(1, 16)? {
-            let n: c_int = u.int_in_range(2..=8)?;
+            let n = few_segments(c_int::from(u.arbitrary::<u8>()?));
             let before = self.logged(k);
             let status = unsafe { fmi2SetInteger(self.component(k), &segments.vr, 1, &n) };
             self.check(k, before, status, "fmi2SetInteger(shape_segments)");
@@ -511,6 +664,9 @@ impl Driver {
 
     fn do_step(&mut self, u: &mut Unstructured) -> Result<()> {
         let k = self.slot(u)?;
+        if self.slots[k].as_ref().is_some_and(|s| s.model_exchange) {
+            return self.model_exchange(u, k);
+        }
         let h = time_step(u)?;
         let believed = self.slots[k].as_ref().map_or(0.0, |s| s.time);
         let t = match u.int_in_range(0..=7)? {
@@ -533,9 +689,18 @@ impl Driver {
         let k = self.slot(u)?;
         let c = self.component(k);
         let before = self.logged(k);
-        let which = u.int_in_range(0..=6)?;
+        // One byte, `% 7` for the seven calls below as before Model Exchange was fuzzed; the four
+        // values that `% 7` over-represents (252..=255) make the Model Exchange calls and the
+        // directional derivative on any instance (also Co-Simulation ones, and NULL), so that the
+        // committed seeds keep their meaning.
+        let which: u8 = u.arbitrary()?;
+        match which {
+            252 | 253 => return self.directional_derivative(u, k),
+            254 | 255 => return self.model_exchange(u, k),
+            _ => {}
+        }
         let (status, what) = unsafe {
-            match which {
+            match which % 7 {
                 0 => {
                     let stop_def = u.arbitrary::<bool>()?;
                     let (tol, start, stop) = (real(u, None)?, real(u, None)?, real(u, None)?);
@@ -817,7 +982,11 @@ impl Driver {
         if let Some(old) = self.slots[k].take() {
             unsafe { fmi2FreeInstance(old.c) };
         }
-        let info = REGISTRY[u.choose_index(REGISTRY.len())?].info();
+        let (Some(factory), model_exchange) = model(u)? else {
+            return self.unknown_model(k);
+        };
+        let model_exchange = model_exchange && factory.model_exchange();
+        let info = factory.info();
         let log = Box::new(Counter::default());
         let callbacks = Box::new(fmi2CallbackFunctions {
             logger: Some(logger()),
@@ -830,7 +999,11 @@ impl Driver {
         let c = unsafe {
             fmi2Instantiate(
                 c"ready".as_ptr(),
-                1,
+                if model_exchange {
+                    FMI2_MODEL_EXCHANGE
+                } else {
+                    FMI2_CO_SIMULATION
+                },
                 guid.as_ptr(),
                 null(),
                 &*callbacks,
@@ -846,6 +1019,7 @@ impl Driver {
             states: Vec::new(),
             log,
             logging: true,
+            model_exchange,
             _callbacks: callbacks,
         });
         unsafe {
@@ -900,6 +1074,326 @@ impl Driver {
             13 => self.status(u),
             _ => self.fmu_state(u),
         }
+    }
+}
+
+/// Model Exchange and directional derivatives: on ME instances (with and without continuous
+/// states), on Co-Simulation ones and on NULL, in any state, with right and wrong vector sizes
+/// (the buffer always holds the size passed), NULL vectors, and NaN/inf/huge states and times.
+impl Driver {
+    /// A vector size for slot `k`: mostly the model's own, sometimes any small one.
+    fn size(&self, u: &mut Unstructured, right: usize) -> Result<usize> {
+        Ok(if u.ratio(1, 4)? {
+            u.int_in_range(0..=8)?
+        } else {
+            right
+        })
+    }
+
+    fn sizes(&self, k: usize) -> (usize, usize) {
+        self.slots[k].as_ref().map_or((0, 0), |s| me_sizes(s.info))
+    }
+
+    /// A state-sized getter; every value it hands out with OK or Warning must be finite.
+    fn get_vector(
+        &mut self,
+        k: usize,
+        n: usize,
+        null_buffer: bool,
+        (getter, what): (
+            unsafe extern "C" fn(fmi2Component, *mut f64, usize) -> fmi2Status,
+            &str,
+        ),
+    ) -> (fmi2Status, Vec<f64>) {
+        let mut out = vec![0.0; n];
+        let p = if null_buffer {
+            null_mut()
+        } else {
+            out.as_mut_ptr()
+        };
+        let before = self.logged(k);
+        let status = unsafe { getter(self.component(k), p, n) };
+        self.check(k, before, status, what);
+        if status <= fmi2Status::Warning {
+            assert!(
+                out.iter().all(|x| x.is_finite()),
+                "{what} gave {out:?} with {status:?}"
+            );
+        }
+        (status, out)
+    }
+
+    fn set_time(&mut self, k: usize, t: f64) -> fmi2Status {
+        let before = self.logged(k);
+        let status = unsafe { fmi2SetTime(self.component(k), t) };
+        self.check(k, before, status, "fmi2SetTime");
+        if status <= fmi2Status::Warning {
+            if let Some(s) = self.slots[k].as_mut() {
+                s.time = t;
+            }
+        }
+        status
+    }
+
+    fn set_states(&mut self, k: usize, x: &[f64], null_buffer: bool) -> fmi2Status {
+        let p = if null_buffer { null() } else { x.as_ptr() };
+        let before = self.logged(k);
+        let status = unsafe { fmi2SetContinuousStates(self.component(k), p, x.len()) };
+        self.check(k, before, status, "fmi2SetContinuousStates");
+        status
+    }
+
+    /// An event iteration as an importer runs it (at most 4 rounds); returns its last status.
+    fn event_iteration(&mut self, k: usize) -> fmi2Status {
+        let mut status = fmi2Status::OK;
+        for _ in 0..4 {
+            let mut info = EventInfo::default();
+            let before = self.logged(k);
+            status = unsafe { fmi2NewDiscreteStates(self.component(k), &mut info) };
+            self.check(k, before, status, "fmi2NewDiscreteStates");
+            if status <= fmi2Status::Warning && info.next_event_time_defined != 0 {
+                assert!(
+                    info.next_event_time.is_finite(),
+                    "fmi2NewDiscreteStates gave the next event at {} with {status:?}",
+                    info.next_event_time
+                );
+            }
+            if status > fmi2Status::Warning || info.new_discrete_states_needed == 0 {
+                break;
+            }
+        }
+        status
+    }
+
+    fn model_exchange(&mut self, u: &mut Unstructured, k: usize) -> Result<()> {
+        let (nx, ni) = self.sizes(k);
+        let null_buffer = u.ratio(1, 16)?;
+        let which = u.int_in_range(0..=12)?;
+        let c = self.component(k);
+        let before = self.logged(k);
+        let (status, what) = unsafe {
+            match which {
+                0 => {
+                    let believed = self.slots[k].as_ref().map_or(0.0, |s| s.time);
+                    let t = match u.int_in_range(0..=3)? {
+                        0 => real(u, None)?,
+                        _ => believed + time_step(u)?,
+                    };
+                    self.set_time(k, t);
+                    return Ok(());
+                }
+                1 => {
+                    // The current states (when they can be had), each kept, nudged or replaced.
+                    let n = self.size(u, nx)?;
+                    let (_, mut x) = self.get_vector(
+                        k,
+                        n,
+                        false,
+                        (fmi2GetContinuousStates, "fmi2GetContinuousStates"),
+                    );
+                    for x in x.iter_mut() {
+                        *x = match u.int_in_range(0..=3)? {
+                            0 => real(u, None)?,
+                            1 => *x * (1.0 + f64::from(u.arbitrary::<i8>()?) / 64.0),
+                            _ => *x,
+                        };
+                    }
+                    self.set_states(k, &x, null_buffer);
+                    return Ok(());
+                }
+                2..=5 => {
+                    let (right, getter) = match which {
+                        2 => (
+                            nx,
+                            (fmi2GetContinuousStates as _, "fmi2GetContinuousStates"),
+                        ),
+                        3 => (nx, (fmi2GetDerivatives as _, "fmi2GetDerivatives")),
+                        4 => (ni, (fmi2GetEventIndicators as _, "fmi2GetEventIndicators")),
+                        _ => (
+                            nx,
+                            (
+                                fmi2GetNominalsOfContinuousStates as _,
+                                "fmi2GetNominalsOfContinuousStates",
+                            ),
+                        ),
+                    };
+                    let n = self.size(u, right)?;
+                    self.get_vector(k, n, null_buffer, getter);
+                    return Ok(());
+                }
+                6 => (fmi2EnterEventMode(c), "fmi2EnterEventMode"),
+                7 => {
+                    if null_buffer {
+                        (
+                            fmi2NewDiscreteStates(c, null_mut()),
+                            "fmi2NewDiscreteStates",
+                        )
+                    } else {
+                        self.event_iteration(k);
+                        return Ok(());
+                    }
+                }
+                8 => (
+                    fmi2EnterContinuousTimeMode(c),
+                    "fmi2EnterContinuousTimeMode",
+                ),
+                9 => {
+                    let (mut enter, mut terminate) = (0, 0);
+                    let p = |b: &mut fmi2Boolean| {
+                        if null_buffer {
+                            null_mut()
+                        } else {
+                            b as *mut _
+                        }
+                    };
+                    (
+                        fmi2CompletedIntegratorStep(
+                            c,
+                            c_int::from(u.arbitrary::<bool>()?),
+                            p(&mut enter),
+                            p(&mut terminate),
+                        ),
+                        "fmi2CompletedIntegratorStep",
+                    )
+                }
+                10 => return self.directional_derivative(u, k),
+                11 => return self.integrate(u, k),
+                _ => {
+                    // A Co-Simulation call on a Model Exchange instance.
+                    let t = self.slots[k].as_ref().map_or(0.0, |s| s.time);
+                    (fmi2DoStep(c, t, time_step(u)?, 0), "fmi2DoStep")
+                }
+            }
+        };
+        self.check(k, before, status, what);
+        Ok(())
+    }
+
+    /// What an importer's explicit Euler integrator does: (leave initialization, event
+    /// iteration, continuous-time mode,) then up to 8 steps of states, derivatives, time, new
+    /// states, indicators and completed step, with an event iteration where the FMU asks for
+    /// one. Stops at the first refusal.
+    fn integrate(&mut self, u: &mut Unstructured, k: usize) -> Result<()> {
+        let (nx, ni) = self.sizes(k);
+        let c = self.component(k);
+        if u.arbitrary()? {
+            let before = self.logged(k);
+            let status = unsafe { fmi2ExitInitializationMode(c) };
+            self.check(k, before, status, "fmi2ExitInitializationMode");
+            self.event_iteration(k);
+            let before = self.logged(k);
+            let status = unsafe { fmi2EnterContinuousTimeMode(c) };
+            self.check(k, before, status, "fmi2EnterContinuousTimeMode");
+        }
+        let h = [1e-6, 1e-4, 1e-3, 1e-2, 1e-9, 0.1][u.choose_index(6)?];
+        for _ in 0..u.int_in_range(1..=8)? {
+            let (s1, x) = self.get_vector(
+                k,
+                nx,
+                false,
+                (fmi2GetContinuousStates, "fmi2GetContinuousStates"),
+            );
+            let (s2, dx) =
+                self.get_vector(k, nx, false, (fmi2GetDerivatives, "fmi2GetDerivatives"));
+            if s1.max(s2) > fmi2Status::Warning {
+                return Ok(());
+            }
+            let t = self.slots[k].as_ref().map_or(0.0, |s| s.time) + h;
+            let x: Vec<f64> = x.iter().zip(&dx).map(|(x, dx)| x + h * dx).collect();
+            if self.set_time(k, t) > fmi2Status::Warning
+                || self.set_states(k, &x, false) > fmi2Status::Warning
+            {
+                return Ok(());
+            }
+            self.get_vector(
+                k,
+                ni,
+                false,
+                (fmi2GetEventIndicators, "fmi2GetEventIndicators"),
+            );
+            let (mut enter, mut terminate) = (0, 0);
+            let before = self.logged(k);
+            let status = unsafe { fmi2CompletedIntegratorStep(c, 1, &mut enter, &mut terminate) };
+            self.check(k, before, status, "fmi2CompletedIntegratorStep");
+            if status > fmi2Status::Warning {
+                return Ok(());
+            }
+            if enter != 0 {
+                let before = self.logged(k);
+                let status = unsafe { fmi2EnterEventMode(c) };
+                self.check(k, before, status, "fmi2EnterEventMode");
+                self.event_iteration(k);
+                let before = self.logged(k);
+                let status = unsafe { fmi2EnterContinuousTimeMode(c) };
+                self.check(k, before, status, "fmi2EnterContinuousTimeMode");
+            }
+        }
+        Ok(())
+    }
+
+    /// Value references for a directional derivative: mostly Reals of the right causality
+    /// (unknowns: outputs and locals such as state derivatives; knowns: inputs and locals such
+    /// as states), sometimes any.
+    fn derivative_vrs(&self, u: &mut Unstructured, k: usize, unknown: bool) -> Result<Vec<u32>> {
+        let Some(info) = self.slots[k].as_ref().map(|s| s.info) else {
+            return self.vrs(u, k, VarType::Real);
+        };
+        if u.ratio(1, 4)? {
+            return self.vrs(u, k, VarType::Real);
+        }
+        let wanted: Vec<u32> = info
+            .variables
+            .iter()
+            .filter(|v| {
+                v.kind == VarType::Real
+                    && match v.causality {
+                        Causality::Output => unknown,
+                        Causality::Input => !unknown,
+                        Causality::Local => true,
+                        _ => false,
+                    }
+            })
+            .map(|v| v.vr)
+            .collect();
+        if wanted.is_empty() {
+            return Ok(Vec::new());
+        }
+        (0..u.int_in_range(0..=4)?)
+            .map(|_| Ok(wanted[u.choose_index(wanted.len())?]))
+            .collect()
+    }
+
+    fn directional_derivative(&mut self, u: &mut Unstructured, k: usize) -> Result<()> {
+        let unknown = self.derivative_vrs(u, k, true)?;
+        let known = self.derivative_vrs(u, k, false)?;
+        let seeds = known
+            .iter()
+            .map(|_| Ok(if u.ratio(1, 4)? { real(u, None)? } else { 1.0 }))
+            .collect::<Result<Vec<f64>>>()?;
+        let mut out = vec![0.0; unknown.len()];
+        let null_buffers = u.ratio(1, 16)?;
+        let p = |v: &[u32]| if null_buffers { null() } else { v.as_ptr() };
+        let before = self.logged(k);
+        let status = unsafe {
+            fmi2GetDirectionalDerivative(
+                self.component(k),
+                p(&unknown),
+                unknown.len(),
+                p(&known),
+                known.len(),
+                seeds.as_ptr(),
+                out.as_mut_ptr(),
+            )
+        };
+        self.check(k, before, status, "fmi2GetDirectionalDerivative");
+        if status <= fmi2Status::Warning {
+            assert!(
+                out.iter().all(|x| x.is_finite()),
+                "fmi2GetDirectionalDerivative({unknown:?} by {known:?}, {seeds:?}) gave {out:?} \
+                 with {status:?}"
+            );
+        }
+        Ok(())
     }
 }
 

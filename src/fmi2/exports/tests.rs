@@ -64,3 +64,65 @@ fn resource_locations() {
     assert!(resource_path("http://example.org/x").is_err());
     assert!(resource_path("file:///bad%zz").is_err());
 }
+
+/// A rejected parameter set is remembered rather than rebuilt at every get in initialization mode (a KnittedMuscle
+/// builds its whole shape table before a later check refuses it), but a changed value is tried
+/// again at once.
+#[test]
+fn a_rejected_build_is_tried_again_after_a_change() {
+    let log: Log = Mutex::new(Vec::new());
+    // SAFETY (test only): the FMU calls the logger with exactly these five arguments.
+    let logger = unsafe {
+        std::mem::transmute::<
+            unsafe extern "C" fn(*mut std::ffi::c_void, fmi2String, c_int, fmi2String, fmi2String),
+            fmi2CallbackLogger,
+        >(record)
+    };
+    let functions = fmi2CallbackFunctions {
+        logger: Some(logger),
+        allocate_memory: None,
+        free_memory: None,
+        step_finished: None,
+        component_environment: &log as *const _ as *mut std::ffi::c_void,
+    };
+    let info = REGISTRY
+        .iter()
+        .find(|f| f.info().name == "MultiferroicMotor")
+        .unwrap()
+        .info();
+    let bar = info.by_name("bar_length").unwrap().vr;
+    let guid = std::ffi::CString::new(info.guid).unwrap();
+    // SAFETY: valid strings and callbacks that outlive the instance, which is freed at the end.
+    unsafe {
+        let c = fmi2Instantiate(
+            c"t".as_ptr(),
+            1,
+            guid.as_ptr(),
+            std::ptr::null(),
+            &functions,
+            0,
+            0,
+        );
+        assert!(!c.is_null());
+        assert_eq!(fmi2SetupExperiment(c, 0, 0.0, 0.0, 0, 0.0), fmi2Status::OK);
+        assert_eq!(fmi2EnterInitializationMode(c), fmi2Status::OK);
+        let mut length = 0.0;
+        assert_eq!(values::fmi2GetReal(c, &bar, 1, &mut length), fmi2Status::OK);
+        // Longer than the ring's hole is wide: the motor cannot be built.
+        assert_eq!(values::fmi2SetReal(c, &bar, 1, &600e-9), fmi2Status::OK);
+        let mut x = 0.0;
+        for _ in 0..2 {
+            assert_eq!(values::fmi2GetReal(c, &bar, 1, &mut x), fmi2Status::Error);
+        }
+        let lines = log.lock().unwrap().clone();
+        let last = &lines[lines.len() - 1].1;
+        assert!(last.contains("parameters rejected"), "{lines:?}");
+        assert_eq!(&lines[lines.len() - 2].1, last);
+        // Changed back: built at once.
+        assert_eq!(values::fmi2SetReal(c, &bar, 1, &length), fmi2Status::OK);
+        assert_eq!(values::fmi2GetReal(c, &bar, 1, &mut x), fmi2Status::OK);
+        assert_eq!(x, length);
+        assert_eq!(fmi2ExitInitializationMode(c), fmi2Status::OK);
+        fmi2FreeInstance(c);
+    }
+}
