@@ -38,10 +38,13 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Runs `body` on the instance `c`; a panic is logged, the instance becomes fatal.
+/// Runs `body` on the instance `c`; a panic is logged, the instance becomes fatal. Inlined into
+/// every export: on the per-step path only the instance check and the body run here, the panic
+/// arm is out of line.
 ///
 /// # Safety
 /// As [`instance`]: `c` must be NULL or a pointer returned by `fmi2Instantiate`.
+#[inline(always)]
 pub(super) unsafe fn guarded(
     c: fmi2Component,
     function: &str,
@@ -55,16 +58,29 @@ pub(super) unsafe fn guarded(
     // SAFETY: `ptr` is live for the whole call; the closure's borrow ends before the panic arm.
     match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *ptr }))) {
         Ok(status) => status,
-        Err(payload) => {
-            let inst = unsafe { &mut *ptr };
-            inst.state = super::instance::MachineState::Fatal;
-            inst.logger.log(
-                fmi2Status::Fatal,
-                &format!("{function}: internal error: {}", panic_text(&*payload)),
-            );
-            fmi2Status::Fatal
-        }
+        Err(payload) => unsafe { panicked(ptr, function, payload) },
     }
+}
+
+/// A panic in `function`: logged, the instance becomes fatal.
+///
+/// # Safety
+/// `ptr` is a live instance (checked by [`guarded`]) that nothing else borrows.
+#[cold]
+#[inline(never)]
+unsafe fn panicked(
+    ptr: *mut Instance,
+    function: &str,
+    payload: Box<dyn std::any::Any + Send>,
+) -> fmi2Status {
+    // SAFETY: the caller's promise.
+    let inst = unsafe { &mut *ptr };
+    inst.state = super::instance::MachineState::Fatal;
+    inst.logger.log(
+        fmi2Status::Fatal,
+        &format!("{function}: internal error: {}", panic_text(&*payload)),
+    );
+    fmi2Status::Fatal
 }
 
 /// A slice from a C array; NULL is accepted only for an empty array.
@@ -98,6 +114,8 @@ unsafe fn text(s: fmi2String) -> Option<String> {
     (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned())
 }
 
+#[cold]
+#[inline(never)]
 pub(super) fn null_argument(inst: &Instance, function: &str, argument: &str) -> fmi2Status {
     inst.error(&format!("{function}: {argument} must not be NULL"))
 }

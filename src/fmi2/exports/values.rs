@@ -31,7 +31,15 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    unsafe { set_values(c, "fmi2SetReal", vr, nvr, value) }
+    const F: &str = "fmi2SetReal";
+    unsafe {
+        guarded(c, F, |inst| {
+            let (Some(vrs), Some(values)) = (slice(vr, nvr), slice(value, nvr)) else {
+                return null_argument(inst, F, "vr and value");
+            };
+            inst.set_reals(vrs, values)
+        })
+    }
 }
 
 #[no_mangle]

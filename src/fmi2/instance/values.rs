@@ -152,13 +152,19 @@ fn settable_in(var: &Variable, state: MachineState) -> bool {
 /// (a mask of [`MachineState::bit`]) and its bounds (infinite where none is declared).
 pub struct SetRule {
     var: &'static Variable,
-    states: u32,
+    pub(super) states: u32,
     min: f64,
     max: f64,
-    parameter: bool,
+    pub(super) parameter: bool,
 }
 
 impl SetRule {
+    /// Whether a Real passes this variable's range check (finite, within its bounds).
+    #[inline(always)]
+    pub fn accepts(&self, x: f64) -> bool {
+        x.within(self.min, self.max)
+    }
+
     pub fn new(var: &'static Variable) -> Self {
         Self {
             var,
@@ -194,6 +200,18 @@ impl Instance {
             "{function}: {vr} is not the value reference of a {kind:?} variable of {}",
             self.info.name
         ))
+    }
+
+    /// [`Instance::set`] out of line: what the per-step path ([`super::HotPath`]) falls back to.
+    #[cold]
+    #[inline(never)]
+    pub(super) fn set_general(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+        values: &[f64],
+    ) -> fmi2Status {
+        self.set(function, vrs, values)
     }
 
     /// Sets all values or, if any is refused, none (the old values are kept).
@@ -317,10 +335,26 @@ impl Instance {
         status
     }
 
-    /// `fmi2GetReal`: as [`Instance::get`], with the value references checked first and one call
-    /// into the runtime for all values (this is on every step's path).
+    /// `fmi2GetReal` on this instance's model: [`Instance::get_reals_general`] after a fast path
+    /// for current outputs ([`super::HotPath`]).
     #[inline]
     pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
+        // SAFETY: `hot` and `runtime` come from the same factory (Instance::new).
+        unsafe { (self.hot.get_reals)(self, vrs, out) }
+    }
+
+    /// `fmi2SetReal` on this instance's model: [`Instance::set`] after a fast path for inputs
+    /// within their range ([`super::HotPath`]).
+    #[inline]
+    pub fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> fmi2Status {
+        // SAFETY: as in get_reals.
+        unsafe { (self.hot.set_reals)(self, vrs, values) }
+    }
+
+    /// `fmi2GetReal`: as [`Instance::get`], with the value references checked first and one call
+    /// into the runtime for all values.
+    #[inline(never)]
+    pub(super) fn get_reals_general(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
         const F: &str = "fmi2GetReal";
         if !self.allowed(F, allowed::GET) {
             return fmi2Status::Error;
