@@ -1,7 +1,7 @@
 //! The bridge between the C ABI and any [`Model`]: one instance's typed variable values and
 //! model, behind a trait object so that the exported functions are written once for every model.
 
-use super::instance::HotPath;
+use super::exports::HotPath;
 use super::registry::Bindings;
 use crate::models::{EventUpdate, Model, Report};
 use crate::variables::{ContinuousStates, Interface, ModelInfo};

@@ -20,6 +20,7 @@ use std::path::PathBuf;
 /// # Safety
 /// `c` must be NULL or a pointer returned by `fmi2Instantiate` (freed ones are caught by the magic
 /// number as long as the memory was not reused).
+#[inline(always)]
 unsafe fn instance<'a>(c: fmi2Component) -> Option<&'a mut Instance> {
     let ptr = c as *mut Instance;
     // SAFETY: non-null and aligned; the caller promises it came from fmi2Instantiate.
@@ -38,9 +39,7 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Runs `body` on the instance `c`; a panic is logged, the instance becomes fatal. Inlined into
-/// every export: on the per-step path only the instance check and the body run here, the panic
-/// arm is out of line.
+/// Runs `body` on the instance `c`; a panic is logged, the instance becomes fatal.
 ///
 /// # Safety
 /// As [`instance`]: `c` must be NULL or a pointer returned by `fmi2Instantiate`.
@@ -54,7 +53,21 @@ pub(super) unsafe fn guarded(
     let Some(inst) = (unsafe { instance(c) }) else {
         return fmi2Status::Error;
     };
-    let ptr: *mut Instance = inst;
+    // SAFETY: checked just now.
+    unsafe { run_guarded(inst, function, body) }
+}
+
+/// [`guarded`] on an instance already checked. Inlined into every export: on the per-step path
+/// only the body runs here, the panic arm is out of line.
+///
+/// # Safety
+/// `ptr` is a live instance of ours that nothing else borrows.
+#[inline(always)]
+pub(super) unsafe fn run_guarded(
+    ptr: *mut Instance,
+    function: &str,
+    body: impl FnOnce(&mut Instance) -> fmi2Status,
+) -> fmi2Status {
     // SAFETY: `ptr` is live for the whole call; the closure's borrow ends before the panic arm.
     match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *ptr }))) {
         Ok(status) => status,
@@ -319,9 +332,12 @@ pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
 }
 
 mod fmu_state;
+mod hot;
 #[cfg(test)]
 mod tests;
 mod values;
+
+pub use hot::HotPath;
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
@@ -391,12 +407,19 @@ pub unsafe extern "C" fn fmi2DoStep(
     c: fmi2Component,
     current_communication_point: fmi2Real,
     communication_step_size: fmi2Real,
-    _no_set_fmu_state_prior_to_current_point: fmi2Boolean,
+    no_set_fmu_state_prior_to_current_point: fmi2Boolean,
 ) -> fmi2Status {
-    unsafe {
-        guarded(c, "fmi2DoStep", |inst| {
-            inst.do_step(current_communication_point, communication_step_size)
-        })
+    // SAFETY: see `instance`; then a tail call to the model's own entry point (exports/hot.rs).
+    match unsafe { instance(c) } {
+        Some(inst) => unsafe {
+            (inst.hot_path().do_step)(
+                c,
+                current_communication_point,
+                communication_step_size,
+                no_set_fmu_state_prior_to_current_point,
+            )
+        },
+        None => fmi2Status::Error,
     }
 }
 

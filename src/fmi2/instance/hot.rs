@@ -4,9 +4,9 @@
 //! per-step path that costs a dynamic call per FMI call and, worse, hides the model from the
 //! optimizer: the step could not inline the model's `step`, so it built, passed and inspected a
 //! `Report` even for models that never write one. Here each function is generic over the concrete
-//! runtime, and the instance holds the three instantiations of its own model ([`HotPath`]): one
-//! indirect call reaches code in which the bindings' `match`, the model's step and the report's
-//! bookkeeping are all inlined.
+//! runtime, and the instance holds the three instantiations of its own model (their C entry points
+//! are [`HotPath`]'s): one indirect call, a tail call from the exported function, reaches code in
+//! which the bindings' `match`, the model's step and the report's bookkeeping are all inlined.
 //!
 //! Each function takes the fast path only for a call the FMI standard accepts without a word: state
 //! allowed, debug logging off, known value references, values within their declared range, no
@@ -14,38 +14,24 @@
 //! which checks again and refuses, logs or rebuilds exactly as before.
 
 use super::{allowed, quiet, to_fmi, Instance, MachineState};
+pub use crate::fmi2::exports::HotPath;
 use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::fmi2Status;
 use crate::models::Report;
 
-/// The per-step functions of one model, for the runtime type its factory creates.
-///
-/// # Safety
-/// Each function may only be called on an instance whose `runtime` is that type: [`Instance::new`]
-/// takes the runtime and this table from the same factory, and nothing replaces the runtime.
-#[derive(Clone, Copy)]
-pub struct HotPath {
-    pub(in crate::fmi2) set_reals: unsafe fn(&mut Instance, &[u32], &[f64]) -> fmi2Status,
-    pub(in crate::fmi2) do_step: unsafe fn(&mut Instance, f64, f64) -> fmi2Status,
-    pub(in crate::fmi2) get_reals: unsafe fn(&mut Instance, &[u32], &mut [f64]) -> fmi2Status,
-}
-
-impl HotPath {
-    /// The table for runtimes of type `R`.
-    pub fn of<R: Runtime + 'static>() -> Self {
-        Self {
-            set_reals: set_reals::<R>,
-            do_step: do_step::<R>,
-            get_reals: get_reals::<R>,
-        }
-    }
-}
-
 impl Instance {
+    /// The per-step entry points of this instance's model.
+    #[inline(always)]
+    pub(in crate::fmi2) fn hot_path(&self) -> &HotPath {
+        &self.hot
+    }
+
     /// The runtime as its concrete type.
     ///
     /// # Safety
-    /// `R` must be the type of `self.runtime` (see [`HotPath`]).
+    /// `R` must be the type of `self.runtime`: [`Instance::new`] takes the runtime and the
+    /// [`HotPath`] (whose functions call this) from the same factory, and nothing replaces the
+    /// runtime.
     #[inline(always)]
     unsafe fn runtime_as<R: Runtime + 'static>(&mut self) -> &mut R {
         debug_assert!(self.runtime.as_any().is::<R>());
@@ -63,26 +49,25 @@ impl Instance {
 /// `fmi2SetReal`. The fast path stores inputs (and tunable locals) within their range.
 ///
 /// # Safety
-/// See [`HotPath`].
-unsafe fn set_reals<R: Runtime + 'static>(
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+pub(in crate::fmi2) unsafe fn set_reals<R: Runtime + 'static>(
     inst: &mut Instance,
     vrs: &[u32],
     values: &[f64],
 ) -> fmi2Status {
-    if !inst.quietly_allowed(allowed::SET) {
+    // A rule's fast states are a subset of those that allow a set: no separate state check.
+    let state = inst.state.bit();
+    let rules = &inst.set_rules[0];
+    let fast = !inst.logger.debug
+        && vrs.iter().zip(values).all(|(&vr, &value)| {
+            rules
+                .get(vr as usize)
+                .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
+        });
+    if !fast {
         return inst.set_general("fmi2SetReal", vrs, values);
     }
-    let rules = &inst.set_rules[0];
-    let state = inst.state.bit();
-    for (&vr, &value) in vrs.iter().zip(values) {
-        let fast = rules
-            .get(vr as usize)
-            .is_some_and(|rule| rule.states & state != 0 && !rule.parameter && rule.accepts(value));
-        if !fast {
-            return inst.set_general("fmi2SetReal", vrs, values);
-        }
-    }
-    // SAFETY: see HotPath.
+    // SAFETY: the caller promises that R is the runtime's type.
     unsafe { inst.runtime_as::<R>() }.set_reals(vrs, values, false);
     fmi2Status::OK
 }
@@ -90,8 +75,12 @@ unsafe fn set_reals<R: Runtime + 'static>(
 /// `fmi2DoStep`, all of it: the checks refuse out of line.
 ///
 /// # Safety
-/// See [`HotPath`].
-unsafe fn do_step<R: Runtime + 'static>(inst: &mut Instance, time: f64, step: f64) -> fmi2Status {
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+pub(in crate::fmi2) unsafe fn do_step<R: Runtime + 'static>(
+    inst: &mut Instance,
+    time: f64,
+    step: f64,
+) -> fmi2Status {
     const F: &str = "fmi2DoStep";
     if !inst.quietly_allowed(allowed::DO_STEP) && !inst.allowed(F, allowed::DO_STEP) {
         return fmi2Status::Error;
@@ -101,7 +90,7 @@ unsafe fn do_step<R: Runtime + 'static>(inst: &mut Instance, time: f64, step: f6
     }
     let mut report = Report::default();
     let flag = inst.out_of_range.flag();
-    // SAFETY: see HotPath.
+    // SAFETY: the caller promises that R is the runtime's type.
     unsafe { inst.runtime_as::<R>() }.step(time, step, &mut report, flag);
     // The flag is written: only a report with something to say needs more.
     let status = if quiet(&report) {
@@ -126,8 +115,8 @@ unsafe fn do_step<R: Runtime + 'static>(inst: &mut Instance, time: f64, step: f6
 /// set since) and finite.
 ///
 /// # Safety
-/// See [`HotPath`].
-unsafe fn get_reals<R: Runtime + 'static>(
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
     inst: &mut Instance,
     vrs: &[u32],
     out: &mut [f64],
@@ -136,7 +125,7 @@ unsafe fn get_reals<R: Runtime + 'static>(
     // it refreshes only stale ones.
     if inst.quietly_allowed(allowed::GET) {
         let count = inst.set_rules[0].len();
-        // SAFETY: see HotPath.
+        // SAFETY: the caller promises that R is the runtime's type.
         let runtime = unsafe { inst.runtime_as::<R>() };
         if runtime.outputs_current() {
             let mut fast = true;

@@ -191,11 +191,11 @@ impl Instance {
         fmi2Status::OK
     }
 
-    /// `fmi2DoStep` on this instance's model ([`super::HotPath`]).
-    #[inline]
+    /// `fmi2DoStep` on this instance's model, through its C entry point (`exports/hot.rs`).
+    #[cfg(test)]
     pub fn do_step(&mut self, time: f64, step: f64) -> fmi2Status {
-        // SAFETY: `hot` and `runtime` come from the same factory (Instance::new).
-        unsafe { (self.hot.do_step)(self, time, step) }
+        // SAFETY: the instance is live.
+        unsafe { (self.hot.do_step)(self as *mut Self as _, time, step, 0) }
     }
 
     /// The refusal of a step of `step` from `time`, if any (the caller checked the state). The

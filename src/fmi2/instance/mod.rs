@@ -5,7 +5,7 @@
 //! `fmu_state`, on the state pointers this instance handed out itself.
 
 mod fmu_state;
-mod hot;
+pub(super) mod hot;
 mod machine;
 #[cfg(test)]
 mod tests;

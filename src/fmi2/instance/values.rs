@@ -152,29 +152,42 @@ fn settable_in(var: &Variable, state: MachineState) -> bool {
 /// (a mask of [`MachineState::bit`]) and its bounds (infinite where none is declared).
 pub struct SetRule {
     var: &'static Variable,
-    pub(super) states: u32,
+    states: u32,
     min: f64,
     max: f64,
-    pub(super) parameter: bool,
+    parameter: bool,
+    /// The per-step path's checks in two compares: `states` of a variable that is not a
+    /// parameter (a parameter's change rebuilds the model), and the bounds clamped to the finite
+    /// range, so that `fast_min <= x <= fast_max` also refuses NaN and the infinities.
+    pub(super) fast_states: u32,
+    fast_min: f64,
+    fast_max: f64,
 }
 
 impl SetRule {
     /// Whether a Real passes this variable's range check (finite, within its bounds).
     #[inline(always)]
     pub fn accepts(&self, x: f64) -> bool {
-        x.within(self.min, self.max)
+        x >= self.fast_min && x <= self.fast_max
     }
 
     pub fn new(var: &'static Variable) -> Self {
+        let states = MachineState::ALL
+            .iter()
+            .filter(|&&s| settable_in(var, s))
+            .fold(0, |mask, s| mask | s.bit());
+        let min = var.min.unwrap_or(f64::NEG_INFINITY);
+        let max = var.max.unwrap_or(f64::INFINITY);
+        let parameter = var.causality == Causality::Parameter;
         Self {
             var,
-            states: MachineState::ALL
-                .iter()
-                .filter(|&&s| settable_in(var, s))
-                .fold(0, |mask, s| mask | s.bit()),
-            min: var.min.unwrap_or(f64::NEG_INFINITY),
-            max: var.max.unwrap_or(f64::INFINITY),
-            parameter: var.causality == Causality::Parameter,
+            states,
+            min,
+            max,
+            parameter,
+            fast_states: if parameter { 0 } else { states },
+            fast_min: min.max(f64::MIN),
+            fast_max: max.min(f64::MAX),
         }
     }
 }
@@ -202,7 +215,7 @@ impl Instance {
         ))
     }
 
-    /// [`Instance::set`] out of line: what the per-step path ([`super::HotPath`]) falls back to.
+    /// [`Instance::set`] out of line: what the per-step path (`hot.rs`) falls back to.
     #[cold]
     #[inline(never)]
     pub(super) fn set_general(
@@ -335,24 +348,8 @@ impl Instance {
         status
     }
 
-    /// `fmi2GetReal` on this instance's model: [`Instance::get_reals_general`] after a fast path
-    /// for current outputs ([`super::HotPath`]).
-    #[inline]
-    pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
-        // SAFETY: `hot` and `runtime` come from the same factory (Instance::new).
-        unsafe { (self.hot.get_reals)(self, vrs, out) }
-    }
-
-    /// `fmi2SetReal` on this instance's model: [`Instance::set`] after a fast path for inputs
-    /// within their range ([`super::HotPath`]).
-    #[inline]
-    pub fn set_reals(&mut self, vrs: &[u32], values: &[f64]) -> fmi2Status {
-        // SAFETY: as in get_reals.
-        unsafe { (self.hot.set_reals)(self, vrs, values) }
-    }
-
     /// `fmi2GetReal`: as [`Instance::get`], with the value references checked first and one call
-    /// into the runtime for all values.
+    /// into the runtime for all values. What the per-step path (`hot.rs`) falls back to.
     #[inline(never)]
     pub(super) fn get_reals_general(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
         const F: &str = "fmi2GetReal";
