@@ -17,7 +17,8 @@
 //!
 //! Writes `target/parity/parity.json` for `benches/report.py`. `PARITY_ROUNDS` sets the rounds;
 //! `PARITY_ONLY=<text>` keeps the C fixture and the cases whose name contains the text;
-//! `PARITY_INSTRUCTIONS=0` skips the instruction counts.
+//! `PARITY_INSTRUCTIONS=0` skips the instruction counts; `PARITY_AB=<path to another build of
+//! libactuator_fmus.so>` adds its PassThrough and ideal McKibben cases to the same rounds.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -204,6 +205,29 @@ fn cases(keep: &dyn Fn(&str) -> bool) -> Vec<Case> {
     cases.push(case(IDEAL_CASE, mck_api, ideal, io, 1e-3, |k| {
         0.09 + 1e-6 * (k % 1000) as f64
     }));
+    // Another build of the library (`PARITY_AB=path/to/libactuator_fmus.so`) beside this one, in
+    // the same rounds: how a change to the FMI layer measures without the load in between.
+    if let Some(other) = std::env::var_os("PARITY_AB").filter(|_| keep("walls and motor")) {
+        let api = leak(common::Api::load(Path::new(&other)));
+        let inst = instance(api, pt.guid, Some(pt), &[]);
+        cases.push(case(
+            "PassThrough, PARITY_AB",
+            api,
+            inst,
+            (vr(pt, "u"), vr(pt, "y")),
+            1e-3,
+            |k| 0.5 + 1e-6 * (k % 1000) as f64,
+        ));
+        let ideal = instance(api, mck.guid, Some(mck), &[("pressure", 4e5)]);
+        cases.push(case(
+            "McKibbenMuscle, ideal, PARITY_AB",
+            api,
+            ideal,
+            io,
+            1e-3,
+            |k| 0.09 + 1e-6 * (k % 1000) as f64,
+        ));
+    }
     if !keep("walls and motor") {
         return cases;
     }
