@@ -16,7 +16,7 @@
 //! virtual machines expose no hardware counters.)
 //!
 //! Writes `target/parity/parity.json` for `benches/report.py`. `PARITY_ROUNDS` sets the rounds;
-//! `PARITY_ONLY=<text>` keeps the C fixture and the cases whose name contains the text;
+//! `PARITY_ONLY=<text>[,<text>...]` keeps the C fixture and the cases whose name contains a text;
 //! `PARITY_INSTRUCTIONS=0` skips the instruction counts; `PARITY_AB=<path to another build of
 //! libactuator_fmus.so>` adds its PassThrough and ideal McKibben cases to the same rounds.
 
@@ -389,7 +389,7 @@ fn main() {
         let mut i = 0;
         cases.retain(|c| {
             i += 1;
-            i == 1 || c.name.contains(only.as_str())
+            i == 1 || only.split(',').any(|part| c.name.contains(part))
         });
     }
     // Batches of about 0.5 ms: long enough for the clock, short enough that on a loaded machine
