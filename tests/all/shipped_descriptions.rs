@@ -694,7 +694,13 @@ mod continuous_states {
             .skip(1)
             .take_while(|l| !l.starts_with("];"))
             .collect();
-        let field = |vr: usize| offsets[vr].trim().trim_end_matches("),").rsplit(", ").next();
+        let field = |vr: usize| {
+            offsets[vr]
+                .trim()
+                .trim_end_matches("),")
+                .rsplit(", ")
+                .next()
+        };
         assert_eq!(field(7), Some("states.joint_velocity"));
         assert_eq!(field(6), Some("outputs.joint_angle"));
         assert_eq!(field(29), Some("derivatives.joint_angle"));

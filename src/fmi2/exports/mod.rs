@@ -23,8 +23,13 @@ use std::path::PathBuf;
 #[inline(always)]
 unsafe fn instance<'a>(c: fmi2Component) -> Option<&'a mut Instance> {
     let ptr = c as *mut Instance;
-    // SAFETY: non-null and aligned; the caller promises it came from fmi2Instantiate.
-    if ptr.is_null() || !ptr.is_aligned() || unsafe { (*ptr).magic } != MAGIC {
+    if ptr.is_null() {
+        return None;
+    }
+    // SAFETY: non-null; the caller promises it came from fmi2Instantiate. Read unaligned, so that
+    // the alignment and the magic number are tested by one branch.
+    let magic = unsafe { std::ptr::addr_of!((*ptr).magic).read_unaligned() };
+    if (magic ^ MAGIC) | (ptr as u64 % std::mem::align_of::<Instance>() as u64) != 0 {
         return None;
     }
     // SAFETY: a live instance of ours (the magic number matches).
