@@ -391,8 +391,14 @@ def fmt_time(s):
 
 
 def main():
-    times = criterion_times()
     parity = parity_figures()
+    if "--parity" in sys.argv:
+        # `make parity`: only the README's FMI-layer table, from benches/parity.rs's last run.
+        if parity is None:
+            sys.exit("no target/parity/parity.json: run `cargo bench --bench parity` first")
+        write_readme_block("fmi-parity", parity_table(parity))
+        return
+    times = criterion_times()
     if not times:
         sys.exit("no criterion results: run `cargo bench --bench accuracy_cost` first (make report does)")
     PLOTS.mkdir(parents=True, exist_ok=True)
