@@ -157,9 +157,11 @@ bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench parity
 
 .PHONY: parity
-## benches/parity.rs alone: the FMI layer against C, the walls, the motor and the knitted table.
-parity: deps fmus $(C_PASSTHROUGH)
+## benches/parity.rs alone: the FMI layer against C, the walls, the motor and the knitted table;
+## then the README's FMI-layer table from that run.
+parity: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	cargo bench --bench parity
+	$(PY) benches/report.py --parity
 
 ## The motor's Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step.
 .PHONY: bench-motor

@@ -9,8 +9,16 @@
 //! Feedthrough semantics, compiled by `make bench` (`cc -O2 -shared`; this bench compiles it itself
 //! when run alone).
 //!
+//! Time on a shared machine moves with the load; instructions do not. When `valgrind` is on the
+//! PATH, the bench also runs itself under callgrind once per FMI-layer case (`PARITY_COUNT=<case>`:
+//! that case alone, its steps inside `counted_steps`, the only function callgrind counts) and
+//! reports instructions per step beside the times. (`perf stat` would count them too, but these
+//! virtual machines expose no hardware counters.)
+//!
 //! Writes `target/parity/parity.json` for `benches/report.py`. `PARITY_ROUNDS` sets the rounds;
-//! `PARITY_ONLY=<text>` keeps the C fixture and the cases whose name contains the text.
+//! `PARITY_ONLY=<text>[,<text>...]` keeps the C fixture and the cases whose name contains a text;
+//! `PARITY_INSTRUCTIONS=0` skips the instruction counts; `PARITY_AB=<path to another build of
+//! libactuator_fmus.so>` adds its PassThrough and ideal McKibben cases to the same rounds.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -23,6 +31,10 @@ use std::time::{Duration, Instant};
 
 const C_SOURCE: &str = "benches/c_passthrough/passthrough.c";
 const C_GUID: &str = "{c-passthrough-bench-fixture}";
+const C_CASE: &str = "C pass-through";
+const IDEAL_CASE: &str = "McKibbenMuscle, ideal";
+/// The cases of the FMI-layer goals, whose instructions per step are counted.
+const COUNTED: [&str; 3] = [C_CASE, "PassThrough", IDEAL_CASE];
 
 /// The C fixture's binary: `make bench` builds it; built here if it is missing or older.
 fn c_fixture() -> PathBuf {
@@ -159,12 +171,16 @@ fn leak(api: common::Api) -> &'static common::Api {
     Box::leak(Box::new(api))
 }
 
-fn cases() -> Vec<Case> {
+/// The cases whose name `keep` accepts (the C fixture is always first).
+fn cases(keep: &dyn Fn(&str) -> bool) -> Vec<Case> {
     let c_api = leak(common::Api::load(&c_fixture()));
     let c_inst = instance(c_api, C_GUID, None, &[]);
-    let mut cases = vec![case("C pass-through", c_api, c_inst, (0, 1), 1e-3, |k| {
+    let mut cases = vec![case(C_CASE, c_api, c_inst, (0, 1), 1e-3, |k| {
         0.5 + 1e-6 * (k % 1000) as f64
     })];
+    if !keep("PassThrough") {
+        return cases;
+    }
 
     let pt = info("PassThrough");
     let pt_api = leak(common::Api::load(&common::extract_binary("PassThrough")));
@@ -178,19 +194,43 @@ fn cases() -> Vec<Case> {
         |k| 0.5 + 1e-6 * (k % 1000) as f64,
     ));
 
+    if !keep(IDEAL_CASE) {
+        return cases;
+    }
     let mck = info("McKibbenMuscle");
     let mck_api = leak(common::Api::load(&common::extract_binary("McKibbenMuscle")));
     let io = (vr(mck, "length"), vr(mck, "force"));
     // The ideal sleeve (eq. 2.3) at 400 kPa, the length sweeping 90-91 mm of muscle A.
     let ideal = instance(mck_api, mck.guid, Some(mck), &[("pressure", 4e5)]);
-    cases.push(case(
-        "McKibbenMuscle, ideal",
-        mck_api,
-        ideal,
-        io,
-        1e-3,
-        |k| 0.09 + 1e-6 * (k % 1000) as f64,
-    ));
+    cases.push(case(IDEAL_CASE, mck_api, ideal, io, 1e-3, |k| {
+        0.09 + 1e-6 * (k % 1000) as f64
+    }));
+    // Another build of the library (`PARITY_AB=path/to/libactuator_fmus.so`) beside this one, in
+    // the same rounds: how a change to the FMI layer measures without the load in between.
+    if let Some(other) = std::env::var_os("PARITY_AB").filter(|_| keep("walls and motor")) {
+        let api = leak(common::Api::load(Path::new(&other)));
+        let inst = instance(api, pt.guid, Some(pt), &[]);
+        cases.push(case(
+            "PassThrough, PARITY_AB",
+            api,
+            inst,
+            (vr(pt, "u"), vr(pt, "y")),
+            1e-3,
+            |k| 0.5 + 1e-6 * (k % 1000) as f64,
+        ));
+        let ideal = instance(api, mck.guid, Some(mck), &[("pressure", 4e5)]);
+        cases.push(case(
+            "McKibbenMuscle, ideal, PARITY_AB",
+            api,
+            ideal,
+            io,
+            1e-3,
+            |k| 0.09 + 1e-6 * (k % 1000) as f64,
+        ));
+    }
+    if !keep("walls and motor") {
+        return cases;
+    }
     // The walls of issue 15's continuum goal: muscle A at 690 kPa over 0.75-0.93 of its length (on
     // the sleeve), the scenario of docs/accuracy-cost.md.
     let walls = [
@@ -269,6 +309,68 @@ fn median(mut v: Vec<f64>) -> f64 {
     v[v.len() / 2]
 }
 
+/// Steps counted under callgrind: `--toggle-collect` names this function.
+#[inline(never)]
+fn counted_steps(case: &mut Case, n: u64) {
+    (case.run)(n, &mut []);
+}
+
+/// Steps each `PARITY_COUNT` run counts; the loop's entry and exit are amortized over them.
+const COUNTED_STEPS: u64 = 20_000;
+
+/// `PARITY_COUNT=<case>`: that case alone, warmed up (lazy binding, first-call work), then
+/// [`COUNTED_STEPS`] steps inside [`counted_steps`].
+fn count_mode(name: &str) {
+    // `cases` builds its cases in the order of COUNTED: up to this one.
+    let last = COUNTED
+        .iter()
+        .position(|c| *c == name)
+        .unwrap_or_else(|| panic!("{name} is not one of {COUNTED:?}"));
+    let mut cases = cases(&|case| COUNTED[..=last].contains(&case));
+    let case = cases
+        .iter_mut()
+        .find(|c| c.name == name)
+        .unwrap_or_else(|| panic!("no case {name}"));
+    (case.run)(1000, &mut []);
+    counted_steps(case, COUNTED_STEPS);
+}
+
+/// Instructions per step of each case in [`COUNTED`], by callgrind (this binary run again in
+/// `PARITY_COUNT` mode); `None` when valgrind is missing or `PARITY_INSTRUCTIONS=0`.
+fn instructions_per_step() -> Option<Vec<(&'static str, f64)>> {
+    if std::env::var("PARITY_INSTRUCTIONS").is_ok_and(|v| v == "0") {
+        return None;
+    }
+    let exe = std::env::current_exe().ok()?;
+    let mut counts = Vec::new();
+    for name in COUNTED {
+        let output = std::process::Command::new("valgrind")
+            .args([
+                "--tool=callgrind",
+                "--callgrind-out-file=/dev/null",
+                "--toggle-collect=*counted_steps*",
+            ])
+            .arg(&exe)
+            .env("PARITY_COUNT", name)
+            .output()
+            .ok()?;
+        let log = String::from_utf8_lossy(&output.stderr);
+        // "==pid== Collected : 1234567"
+        let collected = log
+            .lines()
+            .find_map(|l| l.split("Collected :").nth(1))
+            .and_then(|n| n.trim().parse::<f64>().ok());
+        match (output.status.success(), collected) {
+            (true, Some(n)) => counts.push((name, n / COUNTED_STEPS as f64)),
+            _ => {
+                eprintln!("callgrind on {name} failed:\n{log}");
+                return None;
+            }
+        }
+    }
+    Some(counts)
+}
+
 fn main() {
     // `cargo bench` passes `--bench`; a filter or `--list` from the harness protocol is ignored.
     if std::env::args().any(|a| a == "--list") {
@@ -278,13 +380,16 @@ fn main() {
         .ok()
         .and_then(|r| r.parse().ok())
         .unwrap_or(201);
-    let mut cases = cases();
+    if let Ok(name) = std::env::var("PARITY_COUNT") {
+        return count_mode(&name);
+    }
+    let mut cases = cases(&|_| true);
     // For profiling one case (`PARITY_ONLY=PassThrough perf record ...`): the yardstick stays first.
     if let Ok(only) = std::env::var("PARITY_ONLY") {
         let mut i = 0;
         cases.retain(|c| {
             i += 1;
-            i == 1 || c.name.contains(only.as_str())
+            i == 1 || only.split(',').any(|part| c.name.contains(part))
         });
     }
     // Batches of about 0.5 ms: long enough for the clock, short enough that on a loaded machine
@@ -395,7 +500,7 @@ fn main() {
     );
     goal(
         "ideal McKibben <= 1.3x the C pass-through (min)",
-        ratio("McKibbenMuscle, ideal"),
+        ratio(IDEAL_CASE),
         1.3,
         &x,
     );
@@ -442,10 +547,31 @@ fn main() {
         &ms,
     );
 
+    let instructions = instructions_per_step();
+    match &instructions {
+        Some(counts) => {
+            println!("\nInstructions per step (callgrind, {COUNTED_STEPS} steps; independent of the load):");
+            let c = counts[0].1;
+            for (name, n) in counts {
+                println!("{name:<42} {n:>10.1} {:>8.2}x", n / c);
+            }
+        }
+        None => {
+            println!("\nInstructions per step: not counted (no valgrind, or PARITY_INSTRUCTIONS=0)")
+        }
+    }
+    let instructions_json = instructions.map_or("[]".to_string(), |counts| {
+        let rows: Vec<String> = counts
+            .iter()
+            .map(|(name, n)| format!("  {{\"case\": \"{name}\", \"per_step\": {n}}}"))
+            .collect();
+        format!("[\n{}\n]", rows.join(",\n"))
+    });
+
     let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("target/parity");
     std::fs::create_dir_all(&dir).unwrap();
     let body = format!(
-        "{{\"rounds\": {rounds}, \"walls_round_ratio\": {}, \"cases\": [\n{}\n], \"cold\": [\n{}\n], \"knitted_initialization\": [\n{}\n]}}\n",
+        "{{\"rounds\": {rounds}, \"walls_round_ratio\": {}, \"cases\": [\n{}\n], \"cold\": [\n{}\n], \"knitted_initialization\": [\n{}\n], \"instructions\": {instructions_json}}}\n",
         walls.map_or("null".to_string(), |r| format!("{r:e}")),
         json.join(",\n"),
         cold.join(",\n"),

@@ -363,9 +363,17 @@ fn place(model: &Model, i: usize) -> Result<(&'static str, String), String> {
 }
 
 /// Appends the export layer's access by value reference to the typed values of `model`
-/// (`model_bindings.rs`): per type, one `match` from value reference to field.
+/// (`model_bindings.rs`): per type, one `match` from value reference to field; for more than a
+/// few Reals with value references 0..n, a table of field offsets instead.
 pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
     let module = module_name(&model.name);
+    let real_arms = arms_of(model, 0)?;
+    // A few arms compile to a compare or two, cheaper than the table's two dependent loads
+    // (PassThrough: 254 against 265 instructions per set + step + get, benches/parity.rs).
+    let by_offset = real_arms.len() > 4 && dense(&real_arms);
+    if by_offset {
+        real_offsets(&module, &real_arms, code);
+    }
     let _ = writeln!(
         code,
         "#[allow(unused_variables, clippy::single_match, clippy::match_single_binding)]"
@@ -380,12 +388,10 @@ pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
             3 => ("&str", "\"\"", "&str"),
             _ => (rust, "Default::default()", rust),
         };
-        let mut arms = Vec::new();
-        for (i, v) in model.variables.iter().enumerate() {
-            if v.type_index == t {
-                let (g, f) = place(model, i)?;
-                arms.push((v.value_reference, g, f));
-            }
+        let arms = arms_of(model, t)?;
+        if t == 0 && by_offset {
+            real_by_offset(&module, code);
+            continue;
         }
         let _ = writeln!(code, "    #[inline]");
         let _ = writeln!(
@@ -424,6 +430,93 @@ pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
     }
     let _ = writeln!(code, "}}\n");
     Ok(())
+}
+
+/// The variables of type `t` (an index of ARRAYS): value reference, group and field.
+fn arms_of(model: &Model, t: usize) -> Result<Vec<(u32, &'static str, String)>, String> {
+    let mut arms = Vec::new();
+    for (i, v) in model.variables.iter().enumerate() {
+        if v.type_index == t {
+            let (g, f) = place(model, i)?;
+            arms.push((v.value_reference, g, f));
+        }
+    }
+    arms.sort_by_key(|a| a.0);
+    Ok(arms)
+}
+
+/// Whether the value references of `arms` (sorted) are exactly 0..n.
+fn dense(arms: &[(u32, &'static str, String)]) -> bool {
+    arms.iter().enumerate().all(|(i, a)| a.0 as usize == i)
+}
+
+/// The offset of each Real variable's field in `Values`, indexed by value reference, for
+/// [`real_by_offset`]; and a never-called function that fails to compile unless every one of
+/// those fields is an `f64`, which the reads and writes through the offsets rely on.
+fn real_offsets(module: &str, arms: &[(u32, &'static str, String)], code: &mut String) {
+    let values = format!("Values<crate::variables::{module}::Variables>");
+    let upper = module.to_uppercase();
+    let n = arms.len();
+    let _ = writeln!(
+        code,
+        "/// {module}: the offset in `Values` of each Real variable's field, by value reference."
+    );
+    let _ = writeln!(code, "const REAL_OFFSETS_{upper}: [usize; {n}] = [");
+    for (_, g, f) in arms {
+        let _ = writeln!(code, "    core::mem::offset_of!({values}, {g}.{f}),");
+    }
+    let _ = writeln!(code, "];\n");
+    let _ = writeln!(
+        code,
+        "/// Compiles only if every field behind REAL_OFFSETS_{upper} is an f64."
+    );
+    let _ = writeln!(code, "#[allow(dead_code)]");
+    let _ = writeln!(
+        code,
+        "fn real_fields_of_{module}_are_f64(values: &{values}) -> [&f64; {n}] {{"
+    );
+    let fields: Vec<String> = arms
+        .iter()
+        .map(|(_, g, f)| format!("&values.{g}.{f}"))
+        .collect();
+    let _ = writeln!(code, "    [{}]", fields.join(", "));
+    let _ = writeln!(code, "}}\n");
+}
+
+/// `real`/`set_real` through the offsets of [`real_offsets`]: a load of the offset and one of the
+/// value, where a `match` over dozens of variables compiles to a jump table that the per-step path
+/// cannot inline.
+fn real_by_offset(module: &str, code: &mut String) {
+    let table = format!("REAL_OFFSETS_{}", module.to_uppercase());
+    let safety = "// SAFETY: the offset of an f64 field of Values<Self> (offset_of!; the fields' \
+                  type is checked by real_fields_of_*_are_f64).";
+    let _ = writeln!(code, "    #[inline]");
+    let _ = writeln!(
+        code,
+        "    fn real(values: &Values<Self>, vr: usize) -> f64 {{"
+    );
+    let _ = writeln!(code, "        match {table}.get(vr) {{");
+    let _ = writeln!(code, "            {safety}");
+    let _ = writeln!(
+        code,
+        "            Some(&offset) => unsafe {{ (values as *const Values<Self>).cast::<u8>().add(offset).cast::<f64>().read() }},"
+    );
+    let _ = writeln!(code, "            None => 0.0,");
+    let _ = writeln!(code, "        }}");
+    let _ = writeln!(code, "    }}");
+    let _ = writeln!(code, "    #[inline]");
+    let _ = writeln!(
+        code,
+        "    fn set_real(values: &mut Values<Self>, vr: usize, value: f64) {{"
+    );
+    let _ = writeln!(code, "        if let Some(&offset) = {table}.get(vr) {{");
+    let _ = writeln!(code, "            {safety}");
+    let _ = writeln!(
+        code,
+        "            unsafe {{ (values as *mut Values<Self>).cast::<u8>().add(offset).cast::<f64>().write(value) }}"
+    );
+    let _ = writeln!(code, "        }}");
+    let _ = writeln!(code, "    }}");
 }
 
 /// The registry: one factory per model, the model type named after the description.

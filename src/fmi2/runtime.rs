@@ -1,6 +1,7 @@
 //! The bridge between the C ABI and any [`Model`]: one instance's typed variable values and
 //! model, behind a trait object so that the exported functions are written once for every model.
 
+use super::exports::HotPath;
 use super::registry::Bindings;
 use crate::models::{EventUpdate, Model, Report};
 use crate::variables::{ContinuousStates, Interface, ModelInfo};
@@ -62,6 +63,8 @@ pub trait Factory: Sync {
     fn create(&self) -> Box<dyn Runtime>;
     /// Whether the model serves Model Exchange ([`Model::MODEL_EXCHANGE`]).
     fn model_exchange(&self) -> bool;
+    /// The per-step calls compiled for the runtime type that [`Factory::create`] returns.
+    fn hot_path(&self) -> HotPath;
 }
 
 pub struct ModelFactory<M>(PhantomData<fn() -> M>);
@@ -82,6 +85,9 @@ where
     }
     fn model_exchange(&self) -> bool {
         M::MODEL_EXCHANGE
+    }
+    fn hot_path(&self) -> HotPath {
+        HotPath::of::<RuntimeOf<M>>()
     }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
@@ -242,9 +248,11 @@ impl<M: Model> Runtime for RuntimeOf<M>
 where
     M::Variables: Bindings,
 {
+    #[inline]
     fn real(&self, vr: usize) -> f64 {
         M::Variables::real(&self.values, vr)
     }
+    #[inline]
     fn set_real(&mut self, vr: usize, value: f64) {
         M::Variables::set_real(&mut self.values, vr, value)
     }
@@ -263,11 +271,13 @@ where
     fn string(&self, vr: usize) -> &str {
         M::Variables::string(&self.values, vr)
     }
+    #[inline]
     fn reals(&self, vrs: &[u32], out: &mut [f64]) {
         for (&vr, slot) in vrs.iter().zip(out) {
             *slot = M::Variables::real(&self.values, vr as usize);
         }
     }
+    #[inline]
     fn current_reals(&self, vrs: &[u32], out: &mut [f64]) -> bool {
         if !self.outputs_current() {
             return false;
@@ -275,6 +285,7 @@ where
         self.reals(vrs, out);
         true
     }
+    #[inline]
     fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool) {
         for (&vr, &value) in vrs.iter().zip(values) {
             M::Variables::set_real(&mut self.values, vr as usize, value);
@@ -284,6 +295,7 @@ where
     fn set_string(&mut self, vr: usize, value: &str) {
         M::Variables::set_string(&mut self.values, vr, value)
     }
+    #[inline]
     fn changed(&mut self, parameters: bool) {
         self.outputs_stale = true;
         self.rejected = None;
@@ -294,6 +306,7 @@ where
     fn is_built(&self) -> bool {
         self.model.is_some()
     }
+    #[inline]
     fn outputs_current(&self) -> bool {
         !self.outputs_stale && self.model.is_some()
     }
@@ -323,6 +336,7 @@ where
             self.mirror_states();
         }
     }
+    #[inline]
     fn step(&mut self, time: f64, step: f64, report: &mut Report, clamp_flag: Option<usize>) {
         if let Some(model) = self.model.as_mut() {
             let v = &mut self.values;

@@ -687,10 +687,24 @@ mod continuous_states {
         assert!(tables.contains("const COUNT: usize = 2;"));
         assert!(tables.contains(r#"const DERIVATIVE_NAMES: &'static [&'static str] = &["der(joint_angle)", "der(joint_velocity)"];"#));
         assert!(tables.contains("pub const DER_JOINT_VELOCITY: usize = 30;"));
-        assert!(bindings.contains("7 => values.states.joint_velocity,"));
-        assert!(bindings.contains("6 => values.outputs.joint_angle,"));
-        assert!(bindings.contains("29 => values.derivatives.joint_angle,"));
-        assert!(bindings.contains("30 => values.derivatives.joint_velocity,"));
+        // Reals by value reference: the rows of the table of field offsets.
+        let offsets: Vec<&str> = bindings
+            .lines()
+            .skip_while(|l| !l.starts_with("const REAL_OFFSETS_PULLEY_JOINT"))
+            .skip(1)
+            .take_while(|l| !l.starts_with("];"))
+            .collect();
+        let field = |vr: usize| {
+            offsets[vr]
+                .trim()
+                .trim_end_matches("),")
+                .rsplit(", ")
+                .next()
+        };
+        assert_eq!(field(7), Some("states.joint_velocity"));
+        assert_eq!(field(6), Some("outputs.joint_angle"));
+        assert_eq!(field(29), Some("derivatives.joint_angle"));
+        assert_eq!(field(30), Some("derivatives.joint_velocity"));
     }
 
     #[test]

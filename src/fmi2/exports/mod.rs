@@ -20,10 +20,16 @@ use std::path::PathBuf;
 /// # Safety
 /// `c` must be NULL or a pointer returned by `fmi2Instantiate` (freed ones are caught by the magic
 /// number as long as the memory was not reused).
+#[inline(always)]
 unsafe fn instance<'a>(c: fmi2Component) -> Option<&'a mut Instance> {
     let ptr = c as *mut Instance;
-    // SAFETY: non-null and aligned; the caller promises it came from fmi2Instantiate.
-    if ptr.is_null() || !ptr.is_aligned() || unsafe { (*ptr).magic } != MAGIC {
+    if ptr.is_null() {
+        return None;
+    }
+    // SAFETY: non-null; the caller promises it came from fmi2Instantiate. Read unaligned, so that
+    // the alignment and the magic number are tested by one branch.
+    let magic = unsafe { std::ptr::addr_of!((*ptr).magic).read_unaligned() };
+    if (magic ^ MAGIC) | (ptr as u64 % std::mem::align_of::<Instance>() as u64) != 0 {
         return None;
     }
     // SAFETY: a live instance of ours (the magic number matches).
@@ -42,6 +48,7 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 ///
 /// # Safety
 /// As [`instance`]: `c` must be NULL or a pointer returned by `fmi2Instantiate`.
+#[inline(always)]
 pub(super) unsafe fn guarded(
     c: fmi2Component,
     function: &str,
@@ -51,20 +58,47 @@ pub(super) unsafe fn guarded(
     let Some(inst) = (unsafe { instance(c) }) else {
         return fmi2Status::Error;
     };
-    let ptr: *mut Instance = inst;
+    // SAFETY: checked just now.
+    unsafe { run_guarded(inst, function, body) }
+}
+
+/// [`guarded`] on an instance already checked. Inlined into every export: on the per-step path
+/// only the body runs here, the panic arm is out of line.
+///
+/// # Safety
+/// `ptr` is a live instance of ours that nothing else borrows.
+#[inline(always)]
+pub(super) unsafe fn run_guarded(
+    ptr: *mut Instance,
+    function: &str,
+    body: impl FnOnce(&mut Instance) -> fmi2Status,
+) -> fmi2Status {
     // SAFETY: `ptr` is live for the whole call; the closure's borrow ends before the panic arm.
     match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *ptr }))) {
         Ok(status) => status,
-        Err(payload) => {
-            let inst = unsafe { &mut *ptr };
-            inst.state = super::instance::MachineState::Fatal;
-            inst.logger.log(
-                fmi2Status::Fatal,
-                &format!("{function}: internal error: {}", panic_text(&*payload)),
-            );
-            fmi2Status::Fatal
-        }
+        Err(payload) => unsafe { panicked(ptr, function, payload) },
     }
+}
+
+/// A panic in `function`: logged, the instance becomes fatal.
+///
+/// # Safety
+/// `ptr` is a live instance (checked by [`guarded`]) that nothing else borrows.
+#[cold]
+#[inline(never)]
+unsafe fn panicked(
+    ptr: *mut Instance,
+    function: &str,
+    payload: Box<dyn std::any::Any + Send>,
+) -> fmi2Status {
+    // SAFETY: the caller's promise.
+    let inst = unsafe { &mut *ptr };
+    inst.state = super::instance::MachineState::Fatal;
+    inst.logger.log(
+        fmi2Status::Fatal,
+        &format!("{function}: internal error: {}", panic_text(&*payload)),
+    );
+    fmi2Status::Fatal
 }
 
 /// A slice from a C array; NULL is accepted only for an empty array.
@@ -98,6 +132,8 @@ unsafe fn text(s: fmi2String) -> Option<String> {
     (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned())
 }
 
+#[cold]
+#[inline(never)]
 pub(super) fn null_argument(inst: &Instance, function: &str, argument: &str) -> fmi2Status {
     inst.error(&format!("{function}: {argument} must not be NULL"))
 }
@@ -301,9 +337,12 @@ pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
 }
 
 mod fmu_state;
+mod hot;
 #[cfg(test)]
 mod tests;
 mod values;
+
+pub use hot::HotPath;
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
@@ -373,12 +412,19 @@ pub unsafe extern "C" fn fmi2DoStep(
     c: fmi2Component,
     current_communication_point: fmi2Real,
     communication_step_size: fmi2Real,
-    _no_set_fmu_state_prior_to_current_point: fmi2Boolean,
+    no_set_fmu_state_prior_to_current_point: fmi2Boolean,
 ) -> fmi2Status {
-    unsafe {
-        guarded(c, "fmi2DoStep", |inst| {
-            inst.do_step(current_communication_point, communication_step_size)
-        })
+    // SAFETY: see `instance`; then a tail call to the model's own entry point (exports/hot.rs).
+    match unsafe { instance(c) } {
+        Some(inst) => unsafe {
+            (inst.hot_path().do_step)(
+                c,
+                current_communication_point,
+                communication_step_size,
+                no_set_fmu_state_prior_to_current_point,
+            )
+        },
+        None => fmi2Status::Error,
     }
 }
 

@@ -3,7 +3,6 @@
 
 use super::Instance;
 use crate::fmi2::types::fmi2Status;
-use crate::models::Report;
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -192,50 +191,43 @@ impl Instance {
         fmi2Status::OK
     }
 
-    /// The per-step path: the refusals below are tested inline, their messages built out of line.
-    #[inline]
+    /// `fmi2DoStep` on this instance's model, through its C entry point (`exports/hot.rs`).
+    #[cfg(test)]
     pub fn do_step(&mut self, time: f64, step: f64) -> fmi2Status {
-        const F: &str = "fmi2DoStep";
-        if !self.allowed(F, allowed::DO_STEP) {
-            return fmi2Status::Error;
-        }
-        if !(step > 0.0 && step.is_finite()) {
-            return self.refuse_step(step);
+        // SAFETY: the instance is live.
+        unsafe { (self.hot.do_step)(self as *mut Self as _, time, step, 0) }
+    }
+
+    /// The refusal of a step of `step` from `time`, if any (the caller checked the state). The
+    /// tests are inline, their messages built out of line.
+    #[inline(always)]
+    pub(super) fn step_refused(&self, time: f64, step: f64) -> Option<fmi2Status> {
+        // Positive and finite; two comparisons (NaN fails both).
+        if !(step > 0.0 && step < f64::INFINITY) {
+            return Some(self.refuse_step(step));
         }
         // The importer's clock and ours may differ by rounding only; adopt the importer's. The
         // allowance scales with the clocks, not the step: a long step must not excuse a wrong
-        // communication point.
-        let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs());
-        if !time.is_finite() || (time - self.time).abs() > tolerance {
-            return self.refuse_communication_point(time);
+        // communication point. Most masters pass our own time back: then no allowance is needed.
+        let exact = time == self.time;
+        if !time.is_finite() || !(exact || self.within_rounding(time)) {
+            return Some(self.refuse_communication_point(time));
         }
         if let Some(stop) = self.stop_time {
             // A step computed as stop - time may overshoot by rounding of either.
             let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
             if time + step > stop + tolerance {
-                return self.refuse_past_stop(time + step, stop);
+                return Some(self.refuse_past_stop(time + step, stop));
             }
         }
-        let mut report = Report::default();
-        let flag = self.out_of_range.flag();
-        self.runtime.step(time, step, &mut report, flag);
-        // The flag is written: only a report with something to say needs more.
-        let status = if super::quiet(&report) {
-            let status = super::to_fmi(report.status);
-            if report.messages.capacity() == 0 && report.clamp_messages.capacity() == 0 {
-                // Nothing to free: skip the out-of-line drop of the empty report.
-                std::mem::forget(report);
-            }
-            status
-        } else {
-            self.forward_messages(F, report, true)
-        };
-        match status {
-            fmi2Status::OK | fmi2Status::Warning => self.time = time + step,
-            fmi2Status::Discard => self.state = MachineState::StepFailed,
-            _ => self.state = MachineState::Error,
-        }
-        status
+        None
+    }
+
+    /// Whether `time` differs from the instance's time by rounding only.
+    #[inline(never)]
+    fn within_rounding(&self, time: f64) -> bool {
+        let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs());
+        (time - self.time).abs() <= tolerance
     }
 
     #[cold]

@@ -5,12 +5,14 @@
 //! `fmu_state`, on the state pointers this instance handed out itself.
 
 mod fmu_state;
+pub(super) mod hot;
 mod machine;
 #[cfg(test)]
 mod tests;
 mod values;
 
 pub use fmu_state::FmuState;
+pub use hot::HotPath;
 pub use machine::{allowed, MachineState};
 pub use values::{CBoolean, Value};
 
@@ -40,7 +42,10 @@ pub struct Instance {
     pub(super) time: f64,
     start_time: f64,
     stop_time: Option<f64>,
+    /// Never replaced once created: [`HotPath`]'s functions rely on its concrete type.
     pub(super) runtime: Box<dyn Runtime>,
+    /// The per-step calls compiled for this instance's model (the same factory as `runtime`).
+    hot: HotPath,
     /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
@@ -102,6 +107,7 @@ impl Instance {
             start_time: 0.0,
             stop_time: None,
             runtime: factory.create(),
+            hot: factory.hot_path(),
             string_values: Vec::new(),
             fmu_states: HashSet::new(),
             out_of_range: OutOfRange::new(info),

@@ -1,0 +1,143 @@
+//! The per-step calls (`fmi2SetReal`, `fmi2DoStep`, `fmi2GetReal`), compiled once per model.
+//!
+//! One binary serves every model, so the instance reaches its model through `dyn Runtime`. On the
+//! per-step path that costs a dynamic call per FMI call and, worse, hides the model from the
+//! optimizer: the step could not inline the model's `step`, so it built, passed and inspected a
+//! `Report` even for models that never write one. Here each function is generic over the concrete
+//! runtime, and the instance holds the three instantiations of its own model (their C entry points
+//! are [`HotPath`]'s): one indirect call, a tail call from the exported function, reaches code in
+//! which the bindings' `match`, the model's step and the report's bookkeeping are all inlined.
+//!
+//! Each function takes the fast path only for a call the FMI standard accepts without a word: state
+//! allowed, debug logging off, known value references, values within their declared range, no
+//! parameter among them. Anything else goes to the general code in `values.rs` and `machine.rs`,
+//! which checks again and refuses, logs or rebuilds exactly as before.
+
+use super::{allowed, quiet, to_fmi, Instance, MachineState};
+pub use crate::fmi2::exports::HotPath;
+use crate::fmi2::runtime::Runtime;
+use crate::fmi2::types::fmi2Status;
+use crate::models::Report;
+
+impl Instance {
+    /// The per-step entry points of this instance's model.
+    #[inline(always)]
+    pub(in crate::fmi2) fn hot_path(&self) -> &HotPath {
+        &self.hot
+    }
+
+    /// The runtime as its concrete type.
+    ///
+    /// # Safety
+    /// `R` must be the type of `self.runtime`: [`Instance::new`] takes the runtime and the
+    /// [`HotPath`] (whose functions call this) from the same factory, and nothing replaces the
+    /// runtime.
+    #[inline(always)]
+    unsafe fn runtime_as<R: Runtime + 'static>(&mut self) -> &mut R {
+        debug_assert!(self.runtime.as_any().is::<R>());
+        // SAFETY: the caller promises that the box holds an `R`; the cast drops the vtable only.
+        unsafe { &mut *(self.runtime.as_mut() as *mut dyn Runtime as *mut R) }
+    }
+
+    /// Whether a call allowed in `mask` takes the fast path: allowed now, and no call tracing.
+    #[inline(always)]
+    fn quietly_allowed(&self, mask: u32) -> bool {
+        mask & self.state.bit() != 0 && !self.logger.debug
+    }
+}
+
+/// `fmi2SetReal`. The fast path stores inputs (and tunable locals) within their range.
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+pub(in crate::fmi2) unsafe fn set_reals<R: Runtime + 'static>(
+    inst: &mut Instance,
+    vrs: &[u32],
+    values: &[f64],
+) -> fmi2Status {
+    // A rule's fast states are a subset of those that allow a set: no separate state check.
+    let state = inst.state.bit();
+    let rules = &inst.set_rules[0];
+    let fast = !inst.logger.debug
+        && vrs.iter().zip(values).all(|(&vr, &value)| {
+            rules
+                .get(vr as usize)
+                .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
+        });
+    if !fast {
+        return inst.set_general("fmi2SetReal", vrs, values);
+    }
+    // SAFETY: the caller promises that R is the runtime's type.
+    unsafe { inst.runtime_as::<R>() }.set_reals(vrs, values, false);
+    fmi2Status::OK
+}
+
+/// `fmi2DoStep`, all of it: the checks refuse out of line.
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+pub(in crate::fmi2) unsafe fn do_step<R: Runtime + 'static>(
+    inst: &mut Instance,
+    time: f64,
+    step: f64,
+) -> fmi2Status {
+    const F: &str = "fmi2DoStep";
+    if !inst.quietly_allowed(allowed::DO_STEP) && !inst.allowed(F, allowed::DO_STEP) {
+        return fmi2Status::Error;
+    }
+    if let Some(refused) = inst.step_refused(time, step) {
+        return refused;
+    }
+    let mut report = Report::default();
+    let flag = inst.out_of_range.flag();
+    // SAFETY: the caller promises that R is the runtime's type.
+    unsafe { inst.runtime_as::<R>() }.step(time, step, &mut report, flag);
+    // The flag is written: only a report with something to say needs more.
+    let status = if quiet(&report) {
+        let status = to_fmi(report.status);
+        if report.messages.capacity() == 0 && report.clamp_messages.capacity() == 0 {
+            // Nothing to free: skip the out-of-line drop of the empty report.
+            std::mem::forget(report);
+        }
+        status
+    } else {
+        inst.forward_messages(F, report, true)
+    };
+    match status {
+        fmi2Status::OK | fmi2Status::Warning => inst.time = time + step,
+        fmi2Status::Discard => inst.state = MachineState::StepFailed,
+        _ => inst.state = MachineState::Error,
+    }
+    status
+}
+
+/// `fmi2GetReal`. The fast path reads outputs that are current (after a step, or a get with no
+/// set since) and finite.
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
+    inst: &mut Instance,
+    vrs: &[u32],
+    out: &mut [f64],
+) -> fmi2Status {
+    // Current outputs are what the general path hands out in every state that allows a get:
+    // it refreshes only stale ones.
+    if inst.quietly_allowed(allowed::GET) {
+        let count = inst.set_rules[0].len();
+        // SAFETY: the caller promises that R is the runtime's type.
+        let runtime = unsafe { inst.runtime_as::<R>() };
+        if runtime.outputs_current() {
+            let mut fast = true;
+            for (&vr, slot) in vrs.iter().zip(out.iter_mut()) {
+                let x = runtime.real(vr as usize);
+                fast &= (vr as usize) < count && x.is_finite();
+                *slot = x;
+            }
+            if fast {
+                return fmi2Status::OK;
+            }
+        }
+    }
+    inst.get_reals_general(vrs, out)
+}
