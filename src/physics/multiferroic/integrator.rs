@@ -18,8 +18,7 @@ impl Motor {
         let mut f = [0.0; 4];
         let mut j = [[0.0; 4]; 4];
         let beta = y[2] - y[0];
-        let tau = self.ring_bar.torque(beta);
-        let k_bar = self.ring_bar.stiffness(beta);
+        let (tau, k_bar) = self.ring_bar.torque_stiffness(beta);
         let e = self.magnetoelastic_per_stress * d.stress;
         let (s2, c2) = (2.0 * (y[2] - d.direction)).sin_cos();
         let k_me = 2.0 * e * c2;

@@ -9,12 +9,12 @@ impl Motor {
     /// bounded near a fold as in [`Self::rhs_jacobian`]).
     pub(super) fn rotor_force(&self, phi: f64, psi: f64, d: &Drive) -> (f64, f64) {
         let beta = psi - phi;
-        let k_bar = self.ring_bar.stiffness(beta);
+        let (tau, k_bar) = self.ring_bar.torque_stiffness(beta);
         let k_me =
             2.0 * self.magnetoelastic_per_stress * d.stress * (2.0 * (psi - d.direction)).cos();
         let sum = (k_bar + k_me).max(0.05 * (k_bar.abs() + k_me.abs()));
         let k = if sum > 0.0 { k_bar * k_me / sum } else { 0.0 };
-        (self.ring_bar.torque(beta) + d.load, k)
+        (tau + d.load, k)
     }
 
     /// The rotor after `available` seconds at constant drive, in the overdamped limit, when by
