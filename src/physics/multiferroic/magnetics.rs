@@ -85,6 +85,14 @@ impl RingBar {
         self.coupling * (1.0 / b - 1.0 / a)
     }
 
+    /// [`Self::energy`] from the cosine of the offset.
+    pub fn energy_of_cos(&self, cos_offset: f64) -> f64 {
+        let (a, r) = (self.bar_charge_radius, self.wall_radius);
+        let sum = a * a + r * r;
+        let cross = 2.0 * a * r * cos_offset;
+        self.coupling * (1.0 / (sum + cross).sqrt() - 1.0 / (sum - cross).sqrt())
+    }
+
     /// Section 3.2.2: torque on the bar (N m), `tau_bar = dU_m/d beta = K a r sin(beta)(1/A^3 + 1/B^3)`.
     /// Positive when the onion state leads the bar: it pulls the bar forward.
     pub fn torque(&self, offset: f64) -> f64 {

@@ -19,6 +19,7 @@
 //! Either way no minimum is ever stepped over, and near a simple minimum `s_safe` is the Newton
 //! step to second order, so the march costs one or two evaluations in the usual case.
 
+use super::angles::Angles;
 use super::magnetics::RingBar;
 
 /// Cap on the downhill march (a full turn far from any minimum takes a few dozen strides).
@@ -75,12 +76,24 @@ impl Landscape<'_> {
     /// [`Self::gradient`] and [`Self::curvature`] together, from one `sin_cos` of each angle.
     #[inline]
     pub fn gradient_curvature(&self, onion: f64) -> (f64, f64) {
-        let (tau, k) = self.ring_bar.torque_stiffness(onion - self.bar_angle);
-        let (s2, c2) = (2.0 * (onion - self.strain_direction)).sin_cos();
+        self.gradient_curvature_of(&self.angles(onion))
+    }
+
+    /// [`Self::gradient_curvature`] from the angles' sines and cosines (no trigonometry).
+    #[inline]
+    pub fn gradient_curvature_of(&self, a: &Angles) -> (f64, f64) {
+        let (tau, k) = self
+            .ring_bar
+            .torque_stiffness_of(a.sin_offset, a.cos_offset);
         (
-            tau + self.magnetoelastic * s2,
-            k + 2.0 * self.magnetoelastic * c2,
+            tau + self.magnetoelastic * a.sin_double,
+            k + 2.0 * self.magnetoelastic * a.cos_double,
         )
+    }
+
+    /// The angles of this landscape at `onion`, fresh from libm.
+    pub fn angles(&self, onion: f64) -> Angles {
+        Angles::exact(onion, self.bar_angle, self.strain_direction)
     }
 
     /// Energy relative to an arbitrary constant (J): eq. 3.3 plus eq. 3.4's wall term.
@@ -108,18 +121,25 @@ impl Landscape<'_> {
     /// edge is safe, so the march takes the Newton step there: each evaluation is then a Newton
     /// iteration, and the usual settle (the rotor moved a little) costs two or three evaluations.
     pub fn settle(&self, previous: f64) -> f64 {
-        let (g0, c0) = self.gradient_curvature(previous);
+        self.settle_from(self.angles(previous)).onion
+    }
+
+    /// [`Self::settle`] from `start`, the angles at the previous onion angle for this landscape,
+    /// returning the angles at the minimum: each evaluation turns the last one's angles (see
+    /// [`Angles::moved`]) instead of calling libm.
+    pub fn settle_from(&self, start: Angles) -> Angles {
+        let (g0, c0) = self.gradient_curvature_of(&start);
         let tiny = self.gradient_tolerance();
         if g0.abs() <= tiny && c0 > 0.0 {
-            return previous;
+            return start;
         }
         // Downhill direction; from a maximum (zero gradient, negative curvature) go forward.
         let dir = if g0 > tiny { -1.0 } else { 1.0 };
         let m = self.third_derivative_bound();
         if !(m.is_finite() && m > 0.0) {
-            return previous;
+            return start;
         }
-        let (mut x, mut g, mut c) = (previous, g0, c0);
+        let (mut x, mut g, mut c) = (start, g0, c0);
         for _ in 0..MAX_MARCH_STEPS {
             // h(0) = dir g = -a <= 0 (downhill), h'(0) = c.
             let a = (-dir * g).max(0.0);
@@ -127,8 +147,8 @@ impl Landscape<'_> {
             let stride = if c > 0.0 && newton < 0.99 * c / m {
                 // Newton's next error is at most M s^2 / (2 c') with c' >= c / 100 in the window:
                 // below the root finder's tolerance, the step lands on the minimum.
-                if m * newton * newton <= 0.02 * c * refine_tolerance(x) {
-                    return x + dir * newton;
+                if m * newton * newton <= 0.02 * c * refine_tolerance(x.onion) {
+                    return x.at_onion(x.onion + dir * newton);
                 }
                 newton
             } else {
@@ -137,13 +157,17 @@ impl Landscape<'_> {
             if !(stride.is_finite() && stride > 0.0) {
                 break;
             }
-            let end = x + dir * stride;
-            if end == x {
+            let end = x.at_onion(x.onion + dir * stride);
+            if end.onion == x.onion {
                 break;
             }
-            let (g_end, c_end) = self.gradient_curvature(end);
+            let (g_end, c_end) = self.gradient_curvature_of(&end);
             if dir * g_end >= 0.0 {
-                let (lo, hi) = if dir > 0.0 { (x, end) } else { (end, x) };
+                let (lo, hi) = if dir > 0.0 {
+                    (x.onion, end.onion)
+                } else {
+                    (end.onion, x.onion)
+                };
                 return self.refine(lo, hi, end, g_end, c_end);
             }
             (x, g, c) = (end, g_end, c_end);
@@ -154,38 +178,38 @@ impl Landscape<'_> {
 
     /// The minimum between `a` and `b`, where the gradient changes sign from downhill to uphill.
     pub(super) fn refine_minimum(&self, a: f64, b: f64) -> f64 {
-        let x = 0.5 * (a + b);
-        let (g, c) = self.gradient_curvature(x);
-        self.refine(a.min(b), a.max(b), x, g, c)
+        let x = self.angles(0.5 * (a + b));
+        let (g, c) = self.gradient_curvature_of(&x);
+        self.refine(a.min(b), a.max(b), x, g, c).onion
     }
 
     /// Safeguarded Newton-bisection for the minimum in `[lo, hi]` (the gradient rises through
     /// zero there) from `x` in it, where the gradient is `g` and the curvature `c`. A Newton step
     /// whose successor's error (`M s^2 / (2 c)`) is below the tolerance is taken without a
     /// further evaluation.
-    fn refine(&self, mut lo: f64, mut hi: f64, mut x: f64, mut g: f64, mut c: f64) -> f64 {
+    fn refine(&self, mut lo: f64, mut hi: f64, mut x: Angles, mut g: f64, mut c: f64) -> Angles {
         let m = self.third_derivative_bound();
         for _ in 0..MAX_REFINE_ITERATIONS {
             if g == 0.0 {
                 return x;
             }
             if g < 0.0 {
-                lo = x;
+                lo = x.onion;
             } else {
-                hi = x;
+                hi = x.onion;
             }
-            let tolerance = refine_tolerance(x);
+            let tolerance = refine_tolerance(x.onion);
             let step = -g / c;
-            let next = x + step;
+            let next = x.onion + step;
             let newton_ok = c > 0.0 && next > lo && next < hi;
             if newton_ok && (step.abs() <= tolerance || m * step * step <= c * tolerance) {
-                return next;
+                return x.at_onion(next);
             }
             if hi - lo <= tolerance {
-                return 0.5 * (lo + hi);
+                return x.at_onion(0.5 * (lo + hi));
             }
-            x = if newton_ok { next } else { 0.5 * (lo + hi) };
-            (g, c) = self.gradient_curvature(x);
+            x = x.at_onion(if newton_ok { next } else { 0.5 * (lo + hi) });
+            (g, c) = self.gradient_curvature_of(&x);
         }
         x
     }
