@@ -612,6 +612,9 @@ impl Motor {
                 None => run.t_end,
             };
             run.enter_segment(segment_end, d.direction);
+            if self.advance_load_dominated(&mut run, &d, segment_end) {
+                continue;
+            }
             if run.settle_tried_for != segment_end && segment_end - run.t > long_segment {
                 run.settle_tried_for = segment_end;
                 if self.advance_overdamped(&mut run, &d, segment_end) {
