@@ -347,7 +347,7 @@ impl Motor {
         let load = d.load;
         if d.locked
             || !self.quasi_static()
-            || !(load.abs() * LOAD_DOMINATED * self.params.tolerance >= self.torque_bound())
+            || load.abs() * LOAD_DOMINATED * self.params.tolerance < self.torque_bound()
             || run.y[1] * load < 0.0
         {
             return false;
