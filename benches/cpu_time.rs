@@ -21,27 +21,9 @@ use actuator_fmus::physics::multiferroic::{
 };
 use std::hint::black_box;
 
-#[repr(C)]
-struct Timespec {
-    sec: i64,
-    nsec: i64,
-}
-
-extern "C" {
-    fn clock_gettime(clock: i32, ts: *mut Timespec) -> i32;
-}
-
-/// CLOCK_THREAD_CPUTIME_ID on Linux.
-const THREAD_CPU: i32 = 3;
-
-/// CPU seconds this thread has used.
-fn thread_cpu() -> f64 {
-    let mut ts = Timespec { sec: 0, nsec: 0 };
-    // SAFETY: a valid pointer to a timespec; clock_gettime only writes it.
-    let rc = unsafe { clock_gettime(THREAD_CPU, &mut ts) };
-    assert_eq!(rc, 0, "clock_gettime");
-    ts.sec as f64 + 1e-9 * ts.nsec as f64
-}
+#[path = "cpu_clock.rs"]
+mod cpu_clock;
+use cpu_clock::thread_cpu;
 
 struct Scenario {
     name: &'static str,
