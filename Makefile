@@ -154,6 +154,7 @@ bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench knitted_shape
 	cargo bench --bench directional_derivative
 	cargo bench --bench model_exchange
+	cargo bench --bench cpu_time
 	cargo bench --bench parity
 
 .PHONY: parity
@@ -163,9 +164,11 @@ parity: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	cargo bench --bench parity
 	$(PY) benches/report.py --parity
 
-## The motor's Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step.
+## The motor's step in CPU time (stepping scene, large load torques; benches/cpu_time.rs), its
+## Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step.
 .PHONY: bench-motor
 bench-motor: deps fmus $(VENV)/.installed
+	cargo bench --bench cpu_time
 	cargo bench --bench motor_model_exchange
 	$(PY) benches/motor_me_fmpy.py
 
@@ -173,6 +176,7 @@ bench-motor: deps fmus $(VENV)/.installed
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
 report: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	cargo bench --bench accuracy_cost
+	cargo bench --bench cpu_time
 	cargo bench --bench parity
 	$(PY) benches/report.py
 

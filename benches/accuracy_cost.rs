@@ -3,10 +3,13 @@
 //! configuration's error against a converged reference and writes docs/accuracy-cost.md.
 //!
 //! Each configuration is named `<FMU>/<knob>/<value>`; its inputs follow the same scenario as the
-//! report's accuracy runs, so time and error describe the same work.
+//! report's accuracy runs, so time and error describe the same work. Times are the benchmark
+//! thread's CPU time (`cpu_clock.rs`), so that they reproduce on a loaded machine.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
+#[path = "cpu_clock.rs"]
+mod cpu_clock;
 
 use actuator_fmus::fmi2::REGISTRY;
 use actuator_fmus::variables::VarType;
@@ -146,7 +149,7 @@ fn configurations() -> Vec<Config> {
     c
 }
 
-fn accuracy_cost(c: &mut Criterion) {
+fn accuracy_cost(c: &mut Criterion<cpu_clock::ThreadCpuTime>) {
     let mut apis = std::collections::BTreeMap::new();
     let mut group = c.benchmark_group("accuracy_cost");
     for cfg in configurations() {
@@ -224,6 +227,7 @@ fn accuracy_cost(c: &mut Criterion) {
 criterion_group! {
     name = benches;
     config = Criterion::default()
+        .with_measurement(cpu_clock::ThreadCpuTime)
         .measurement_time(Duration::from_secs(2))
         .warm_up_time(Duration::from_millis(500))
         .sample_size(30);

@@ -21,6 +21,9 @@ use super::hyper_dual::KernelScalar;
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
 use std::f64::consts::PI;
 
+/// Nodes whose positions are computed ahead of their algebra, at a time (stack buffer).
+const NODE_CHUNK: usize = 16;
+
 /// One Gauss-Legendre node on `[0, 1]`: where it sits between the inner and the outer wall in
 /// the logarithm of the deformed diameter, and its weight (the weights sum to 1).
 #[derive(Clone, Copy, Debug, serde::Serialize, serde::Deserialize)]
@@ -121,25 +124,66 @@ impl<S: SleeveGeometry> Bladder<S> {
         // nearer singular point: each integrand is then smooth on the scale of the interval.
         let u_s = x_sq - lambda1.recip() * (d_ro * d_ro);
         let u_0 = if u_s.value() > 0.0 { u_s } else { zero };
-        let ln_in = (d_in_sq - u_0).ln();
-        let span = (x_sq - u_0).ln() - ln_in;
-        let (mut h_sum, mut hoop_sum, mut axial_sum) = (zero, zero, zero);
-        for node in &self.nodes {
-            let e = (ln_in + span * node.at).exp();
-            let u = u_0 + e;
-            // Two divisions per node: 1/sqrt(u) gives 1/d^3 and 1/u, and 1/s^2.
-            let inv_d = u.rsqrt();
-            let inv_u = inv_d * inv_d;
-            // s^2 = D_RO^2 - lambda_1 (x^2 - u) (eq. 2.20 solved for the unstretched diameter).
-            let s_sq = (u - x_sq) * lambda1 + d_ro * d_ro;
-            let (hoop, axial) = mooney(u * s_sq.recip(), s_sq * inv_u)?;
-            let jacobian = e * (node.weight * 0.5);
-            let hoop_term = hoop * jacobian;
-            h_sum = h_sum + hoop_term * (inv_u * inv_d);
-            // h (x^3 - d^3) / (2 d^3) = x^3 h / (2 d^3) - h / 2: the first part is x^3 h_sum.
-            hoop_sum = hoop_sum + hoop_term;
-            axial_sum = axial_sum + axial * jacobian;
+        let (inner_gap, outer_gap) = (d_in_sq - u_0, x_sq - u_0);
+        let ln_in = inner_gap.ln();
+        let span = outer_gap.ln() - ln_in;
+        // With l3^2 = 1/(lambda_1^2 l2^2), eq. 2.9b's hoop difference is l2^2 A - B / l2^2 and the
+        // node-dependent part of the axial one l2^2 A' - B' / l2^2, with A, B, A', B' fixed per
+        // call: so the nodes only add up l2^2 and 1/l2^2 with two weights each.
+        let c2_lambda = lambda1_sq * c2x2;
+        let c1_over_lambda = inv_lambda1_sq * c1x2;
+        let (mut jac_sum, mut l2_sum, mut inv_l2_sum) = (zero, zero, zero);
+        let (mut l2_h_sum, mut inv_l2_h_sum) = (zero, zero);
+        // The node positions first, then the nodes' algebra: with the libm `exp` calls out of
+        // the second loop, the nodes' square roots and divisions (independent from node to node)
+        // overlap in the pipeline instead of waiting on each other behind every call; the
+        // kernel was latency-bound.
+        let mut positions = [zero; NODE_CHUNK];
+        let n = self.nodes.len();
+        for chunk in self.nodes.chunks(NODE_CHUNK) {
+            if n == chunk.len() {
+                // The nodes are symmetric (`at` and `1 - at`), so a node's `u - u_0` times its
+                // mirror's is `(d_in^2 - u_0)(x^2 - u_0)`: half the `exp` calls.
+                let product = inner_gap * outer_gap;
+                for i in 0..n.div_ceil(2) {
+                    let e = (ln_in + span * chunk[i].at).exp();
+                    positions[i] = e;
+                    positions[n - 1 - i] = product * e.recip();
+                }
+            } else {
+                for (slot, node) in positions.iter_mut().zip(chunk) {
+                    *slot = (ln_in + span * node.at).exp();
+                }
+            }
+            for (&e, node) in positions.iter().zip(chunk) {
+                let u = u_0 + e;
+                // Two divisions per node: 1/sqrt(u) gives 1/d^3 and 1/u, and 1/s^2.
+                let inv_d = u.rsqrt();
+                let inv_u = inv_d * inv_d;
+                // s^2 = D_RO^2 - lambda_1 (x^2 - u) (eq. 2.20 solved for the unstretched diameter).
+                let s_sq = (u - x_sq) * lambda1 + d_ro * d_ro;
+                let l2_sq = u * s_sq.recip();
+                let inv_l2_sq = s_sq * inv_u;
+                if !(l2_sq.value() > 0.0 && l2_sq.value().is_finite() && inv_l2_sq.value().is_finite()) {
+                    return None;
+                }
+                let jacobian = e * (node.weight * 0.5);
+                let (l2_term, inv_l2_term) = (l2_sq * jacobian, inv_l2_sq * jacobian);
+                let per_d3 = inv_u * inv_d;
+                jac_sum = jac_sum + jacobian;
+                l2_sum = l2_sum + l2_term;
+                inv_l2_sum = inv_l2_sum + inv_l2_term;
+                l2_h_sum = l2_h_sum + l2_term * per_d3;
+                inv_l2_h_sum = inv_l2_h_sum + inv_l2_term * per_d3;
+            }
         }
+        let (hoop_a, hoop_b) = (c2_lambda + c1x2, c1_over_lambda + c2x2);
+        // int h / (2 d^3) du, int h du / 2 and int sigma_axial du / 2 over the nodes.
+        let h_sum = l2_h_sum * hoop_a - inv_l2_h_sum * hoop_b;
+        // h (x^3 - d^3) / (2 d^3) = x^3 h / (2 d^3) - h / 2: the first part is x^3 h_sum.
+        let hoop_sum = l2_sum * hoop_a - inv_l2_sum * hoop_b;
+        let axial_sum = jac_sum * (lambda1_sq * c1x2 - inv_lambda1_sq * c2x2) + l2_sum * c2_lambda
+            - inv_l2_sum * c1_over_lambda;
         let h_phi_sum = x_cu * h_sum - hoop_sum;
         let a = x * inv_d_in;
         let c = x * h_sum * span;

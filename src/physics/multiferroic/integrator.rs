@@ -1,7 +1,7 @@
 //! Exponential Rosenbrock substeps with an embedded error estimate (quasi-static onion) or step
 //! doubling (Gilbert onion); see [`Motor::step`].
 
-use super::{expm, phi, Drive, Motor, StepRun, Vector, MAX_ANGLE};
+use super::{expm, phi, Angles, Drive, Motor, StepRun, Vector, MAX_ANGLE};
 
 impl Motor {
     /// Right-hand side and Jacobian of the ODE in `(phi, omega, psi, theta)`, for a substep `dt`.
@@ -15,13 +15,37 @@ impl Motor {
     /// amplify. Such substeps are only ever taken when budget-forced (the error control rejects
     /// them otherwise: their half steps keep the stiffness and disagree), and they are flagged.
     pub(super) fn rhs_jacobian(&self, y: &Vector, d: &Drive, dt: f64) -> (Vector, [[f64; 4]; 4]) {
+        self.rhs_jacobian_at(y, d, dt, &Angles::exact(y[2], y[0], d.direction))
+    }
+
+    /// [`Self::rhs_jacobian`] from the angles at `y`.
+    pub(super) fn rhs_jacobian_at(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        dt: f64,
+        angles: &Angles,
+    ) -> (Vector, [[f64; 4]; 4]) {
+        let (tau, k_bar) = self
+            .ring_bar
+            .torque_stiffness_of(angles.sin_offset, angles.cos_offset);
+        self.rhs_jacobian_of(y, d, dt, angles, tau, k_bar)
+    }
+
+    /// [`Self::rhs_jacobian_at`] given the ring-bar torque and stiffness there.
+    fn rhs_jacobian_of(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        dt: f64,
+        angles: &Angles,
+        tau: f64,
+        k_bar: f64,
+    ) -> (Vector, [[f64; 4]; 4]) {
         let mut f = [0.0; 4];
         let mut j = [[0.0; 4]; 4];
-        let beta = y[2] - y[0];
-        let tau = self.ring_bar.torque(beta);
-        let k_bar = self.ring_bar.stiffness(beta);
         let e = self.magnetoelastic_per_stress * d.stress;
-        let (s2, c2) = (2.0 * (y[2] - d.direction)).sin_cos();
+        let (s2, c2) = (angles.sin_double, angles.cos_double);
         let k_me = 2.0 * e * c2;
         let quasi = self.quasi_static();
         if !d.locked {
@@ -129,22 +153,28 @@ impl Motor {
     /// time it advances (`dt`, or less when the quasi-static onion snaps inside it, see
     /// [`Self::step_to_onion_snap`]). The quasi-static rotor uses the embedded pair
     /// ([`Self::embedded_step`]); the Gilbert onion (a 4x4 system) keeps step doubling.
+    /// `angles` are those at `y`; the result carries those at the new state when known.
     pub(super) fn controlled_step(
         &self,
         y: &Vector,
         dt: f64,
         d: &Drive,
-    ) -> Option<(Vector, f64, f64)> {
+        angles: &Angles,
+    ) -> Option<(Vector, f64, f64, Option<Angles>)> {
         if self.quasi_static() && !d.locked {
-            match self.embedded_step(y, dt, d) {
-                Some(Some((u, err))) if self.onion_snapped(y, &u) => {
-                    return self.step_to_onion_snap(y, dt, d).or(Some((u, err, dt)));
+            match self.embedded_step(y, dt, d, angles) {
+                Some(Some((u, err, _))) if self.onion_snapped(y, &u) => {
+                    return self
+                        .step_to_onion_snap(y, dt, d, angles)
+                        .map(|(u, err, taken)| (u, err, taken, None))
+                        .or(Some((u, err, dt, None)));
                 }
-                Some(result) => return result.map(|(u, err)| (u, err, dt)),
+                Some(result) => return result.map(|(u, err, a)| (u, err, dt, Some(a))),
                 None => {}
             }
         }
-        self.doubled_step(y, dt, d).map(|(u, err)| (u, err, dt))
+        self.doubled_step(y, dt, d)
+            .map(|(u, err)| (u, err, dt, None))
     }
 
     /// Whether the quasi-static onion left its branch between `y` and `u`: its minimum of eq. 3.3
@@ -164,7 +194,13 @@ impl Motor {
     /// length, the rotor advanced on the old branch to just before it (error-controlled as
     /// usual), and the onion put on its new branch; the substep after it starts from the new
     /// torque. `None` if no snap-free prefix is found.
-    fn step_to_onion_snap(&self, y: &Vector, dt: f64, d: &Drive) -> Option<(Vector, f64, f64)> {
+    fn step_to_onion_snap(
+        &self,
+        y: &Vector,
+        dt: f64,
+        d: &Drive,
+        angles: &Angles,
+    ) -> Option<(Vector, f64, f64)> {
         let (mut before, mut after) = (0.0, dt);
         let mut last_before: Option<(Vector, f64)> = None;
         let mut snapped = None;
@@ -176,12 +212,12 @@ impl Motor {
                 break;
             }
             let mid = 0.5 * (before + after);
-            match self.embedded_step(y, mid, d) {
-                Some(Some((u, err))) if !self.onion_snapped(y, &u) => {
+            match self.embedded_step(y, mid, d, angles) {
+                Some(Some((u, err, _))) if !self.onion_snapped(y, &u) => {
                     before = mid;
                     last_before = Some((u, err));
                 }
-                Some(Some((u, _))) => {
+                Some(Some((u, _, _))) => {
                     after = mid;
                     snapped = Some(u);
                 }
@@ -191,7 +227,7 @@ impl Motor {
         let (mut u, err) = last_before?;
         let snapped = match snapped {
             Some(v) => v,
-            None => self.embedded_step(y, dt, d)??.0,
+            None => self.embedded_step(y, dt, d, angles)??.0,
         };
         // The rotor state at the snap, the onion on the branch it fell into there.
         u[2] = self
@@ -208,20 +244,49 @@ impl Motor {
     /// ([`phi::Phi2x2`]). One right-hand side and two onion settles per substep, where step
     /// doubling took three 3x3 matrix exponentials and three settles. `None` (use step doubling)
     /// when the block's eigenvalues are complex or nearly equal; `Some(None)` if the step fails.
-    fn embedded_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<Option<(Vector, f64)>> {
-        let (f0, j) = self.rhs_jacobian(y, d, dt);
+    ///
+    /// `angles` are those at `y`; every later evaluation turns them (see [`Angles::moved`]), and
+    /// the result carries the angles at `u3`.
+    fn embedded_step(
+        &self,
+        y: &Vector,
+        dt: f64,
+        d: &Drive,
+        angles: &Angles,
+    ) -> Option<Option<(Vector, f64, Angles)>> {
+        let (tau, k_bar) = self
+            .ring_bar
+            .torque_stiffness_of(angles.sin_offset, angles.cos_offset);
+        let (f0, j) = self.rhs_jacobian_of(y, d, dt, angles, tau, k_bar);
+        // The onion's turn per rotor turn along its branch, k_bar / (k_bar + k_me) (implicit
+        // function theorem on dU/dpsi = 0), and how far that prediction may be trusted.
+        let curvature = k_bar + 2.0 * self.magnetoelastic_per_stress * d.stress * angles.cos_double;
+        let bound =
+            self.ring_bar_slope_bound + 4.0 * (self.magnetoelastic_per_stress * d.stress).abs();
+        let predict = |from: &Angles, rotor: f64| -> Angles {
+            let turn = k_bar / curvature * (rotor - from.bar);
+            let onion = if curvature > 0.0 && turn.abs() <= PREDICTION_WINDOW * curvature / bound {
+                from.onion + turn
+            } else {
+                from.onion
+            };
+            from.moved(onion, rotor, d.direction)
+        };
         let a = [[dt * j[0][0], dt * j[0][1]], [dt * j[1][0], dt * j[1][1]]];
         let phi = phi::Phi2x2::new(&a)?;
         let step = phi.apply(1, &a, [dt * f0[0], dt * f0[1]]);
         let mut u1 = *y;
         u1[0] += step[0];
         u1[1] += step[1];
-        u1[2] = self.settle(&u1, d);
+        let a1 = self
+            .landscape(u1[0], d.direction, d.stress)
+            .settle_from(predict(angles, u1[0]));
+        u1[2] = a1.onion;
         u1[3] = 0.0;
         if !self.sane(&u1) {
             return Some(None);
         }
-        let (f1, _) = self.rhs_jacobian(&u1, d, dt);
+        let (f1, _) = self.rhs_jacobian_at(&u1, d, dt, &a1);
         let defect = [
             f1[0] - f0[0] - (j[0][0] * step[0] + j[0][1] * step[1]),
             f1[1] - f0[1] - (j[1][0] * step[0] + j[1][1] * step[1]),
@@ -230,13 +295,16 @@ impl Motor {
         let mut u3 = u1;
         u3[0] += correction[0];
         u3[1] += correction[1];
-        u3[2] = self.settle(&u3, d);
+        let a3 = self
+            .landscape(u3[0], d.direction, d.stress)
+            .settle_from(predict(&a1, u3[0]));
+        u3[2] = a3.onion;
         if !self.sane(&u3) {
             return Some(None);
         }
         let tol = self.params.tolerance;
         let err = (correction[0].abs() / tol).max(correction[1].abs() / (tol * self.speed_scale));
-        Some(Some((u3, err)))
+        Some(Some((u3, err, a3)))
     }
 
     fn sane(&self, y: &Vector) -> bool {
@@ -281,12 +349,19 @@ impl Motor {
             return;
         }
         let forced = dt_try <= dt_min * (1.0 + 1e-12);
-        match self.controlled_step(&run.y, dt_try, d) {
-            Some((y_new, err, taken)) if err <= 1.0 || forced => {
+        let angles = Self::angles_at(&run.y, d, run.angles.as_ref());
+        run.angles = Some(angles);
+        match self.controlled_step(&run.y, dt_try, d, &angles) {
+            Some((y_new, err, taken, new_angles)) if err <= 1.0 || forced => {
                 if err > 1.0 {
                     run.limited = true;
                 }
                 run.y = y_new;
+                // The embedded pair's state is settled, with its angles; the others are not.
+                run.settled = new_angles.is_some();
+                if new_angles.is_some() {
+                    run.angles = new_angles;
+                }
                 let end = t + taken;
                 run.t = if end >= segment_end || segment_end - end < 1e-15 * run.t_end {
                     segment_end.max(end).min(run.t_end)
@@ -295,11 +370,12 @@ impl Motor {
                 };
                 run.dt = taken * step_factor(err);
             }
-            Some((_, err, _)) => run.dt = (dt_try * step_factor(err)).max(dt_min),
+            Some((_, err, _, _)) => run.dt = (dt_try * step_factor(err)).max(dt_min),
             None if forced => {
                 // The linearization overflowed even at the smallest allowed substep: hold the
                 // state over it rather than produce garbage.
                 run.limited = true;
+                run.settled = false;
                 run.y[1] = 0.0;
                 run.t = (t + dt_try).min(run.t_end);
                 run.dt = dt_try;
@@ -309,13 +385,32 @@ impl Motor {
     }
 }
 
+/// The onion's predicted turn along its branch is used as the settle's start only when it stays
+/// within this fraction of the monotone window `curvature / M` of the last minimum (see the onion
+/// module): the start then lies in the same basin, so the memory rule holds, and far from a fold.
+const PREDICTION_WINDOW: f64 = 0.1;
+
 /// Next-substep factor for a second-order method (local error ~ dt^3), bounded to [0.2, 5].
 pub(super) fn step_factor(err: f64) -> f64 {
-    if err <= 0.0 {
+    // 0.9 err^(-1/3) reaches the bounds at err = (0.9/5)^3 and (0.9/0.2)^3.
+    if err.is_nan() || err >= 91.125 {
+        0.2
+    } else if err <= 0.005_832 {
         5.0
     } else {
-        (0.9 * err.powf(-1.0 / 3.0)).clamp(0.2, 5.0)
+        0.9 / cube_root(err)
     }
+}
+
+/// `x^(1/3)` for `x` in [0.005, 92] to about 1e-7 relative (a step-size factor needs no more):
+/// the exponent divided by 3 in the bits, then two Newton steps. libm's `cbrt` was 4% of a
+/// motor step.
+fn cube_root(x: f64) -> f64 {
+    let mut y = f64::from_bits(x.to_bits() / 3 + 0x2A9F_7893_782D_A1CE);
+    for _ in 0..3 {
+        y = (2.0 * y + x / (y * y)) * (1.0 / 3.0);
+    }
+    y
 }
 
 /// A turn of the quasi-static onion beyond its branch's (rad) that marks a snap to the other
@@ -327,3 +422,18 @@ const SNAP_RESOLUTION: f64 = 1e-4;
 
 /// A segment of constant drive may use at most 1/this of the substeps left (see [`Motor::step`]).
 const SEGMENT_BUDGET_SHARE: u32 = 16;
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn cube_root_and_step_factor() {
+        for x in [0.005, 0.01, 0.3, 1.0, 2.0, 27.0, 92.0] {
+            let y = super::cube_root(x);
+            assert!((y - f64::cbrt(x)).abs() <= 1e-7 * f64::cbrt(x), "{x}: {y}");
+        }
+        assert_eq!(super::step_factor(0.0), 5.0);
+        assert_eq!(super::step_factor(f64::NAN), 0.2);
+        assert_eq!(super::step_factor(1e6), 0.2);
+        assert!((super::step_factor(1.0) - 0.9).abs() < 1e-7);
+    }
+}

@@ -9,12 +9,12 @@ impl Motor {
     /// bounded near a fold as in [`Self::rhs_jacobian`]).
     pub(super) fn rotor_force(&self, phi: f64, psi: f64, d: &Drive) -> (f64, f64) {
         let beta = psi - phi;
-        let k_bar = self.ring_bar.stiffness(beta);
+        let (tau, k_bar) = self.ring_bar.torque_stiffness(beta);
         let k_me =
             2.0 * self.magnetoelastic_per_stress * d.stress * (2.0 * (psi - d.direction)).cos();
         let sum = (k_bar + k_me).max(0.05 * (k_bar.abs() + k_me.abs()));
         let k = if sum > 0.0 { k_bar * k_me / sum } else { 0.0 };
-        (self.ring_bar.torque(beta) + d.load, k)
+        (tau + d.load, k)
     }
 
     /// The rotor after `available` seconds at constant drive, in the overdamped limit, when by
@@ -310,6 +310,167 @@ impl Motor {
         false
     }
 }
+
+/// The quasi-static onion's hysteresis cycle as the rotor turns without end in one direction.
+struct OnionCycle {
+    /// A rotor angle on the cycle and the onion angle there (rad).
+    rotor: f64,
+    onion: f64,
+    /// Onion turns per rotor turn (0 when the onion swings back and forth, +-1 when it follows).
+    winding: f64,
+    /// `int tau dphi` over one turn (J): the energy the onion's snaps dissipate, `<= 0`.
+    work: f64,
+}
+
+impl Motor {
+    /// A rotor driven by a load torque far beyond anything the ring can exert:
+    /// `tau_max / |load| <= LOAD_DOMINATED * tolerance`, with `tau_max` a bound of eq. 3.3's
+    /// torque. It then turns so fast that the ring's torque, periodic in the rotor angle,
+    /// averages out within each turn: the rotor moves as `I phi'' = load + <tau> - c phi'`, solved
+    /// exactly over the segment, where `<tau>` is the ring's mean torque over the onion's
+    /// hysteresis cycle (the energy its snaps dissipate per turn over 2 pi, found by marching
+    /// one turn, see [`Self::onion_cycle`]). The onion ends on its cycle at the end angle.
+    ///
+    /// Error bound (tolerance `tol`): the periodic part of the torque moves the rotor by at most
+    /// `tau_max / (I omega^2)` at speed `omega`, and while the rotor speeds up from rest by at most
+    /// `10 (tau_max / load)^2 / tol` (the angle turned before that amplitude falls below
+    /// `tol / 20`, times `tau_max / load`): both below `tol / 20`. The phase-resolved integration
+    /// took the whole substep budget here (about 20,000 substeps, 30-80 ms per 1 us step) and
+    /// was flagged. Returns `false` when the regime does not apply.
+    pub(super) fn advance_load_dominated(
+        &self,
+        run: &mut StepRun,
+        d: &Drive,
+        segment_end: f64,
+    ) -> bool {
+        let (i, c) = (self.inertia, self.drag);
+        let load = d.load;
+        if d.locked
+            || !self.quasi_static()
+            || load.abs() * LOAD_DOMINATED * self.params.tolerance < self.torque_bound()
+            || run.y[1] * load < 0.0
+        {
+            return false;
+        }
+        let dir = load.signum();
+        // The landscape depends on psi - phi and psi - gamma (mod pi): turn rotor and onion back
+        // by whole turns so that the march works near zero.
+        let turns = (run.y[0] / (2.0 * PI)).round() * 2.0 * PI;
+        let Some(cycle) = self.onion_cycle(run.y[0] - turns, run.y[2] - turns, d, dir) else {
+            return false;
+        };
+        let force = load + dir * cycle.work / (2.0 * PI);
+        let h = segment_end - run.t;
+        let omega0 = run.y[1];
+        let (advance, omega) = if c > 0.0 {
+            let rate = c / i;
+            let terminal = force / c;
+            // 1 - exp(-h c / I) without cancellation.
+            let approach = -(-h * rate).exp_m1();
+            (
+                terminal * h + (omega0 - terminal) * approach / rate,
+                terminal + (omega0 - terminal) * (1.0 - approach),
+            )
+        } else {
+            (omega0 * h + 0.5 * force / i * h * h, omega0 + force / i * h)
+        };
+        let phi = run.y[0] + advance;
+        if !(phi.is_finite() && phi.abs() <= super::MAX_ANGLE && omega.is_finite()) {
+            return false;
+        }
+        // The onion on its cycle at the end angle: whole turns shift it by the winding, the rest
+        // is marched.
+        let from_cycle = phi - turns - cycle.rotor;
+        let whole = (dir * from_cycle / (2.0 * PI)).floor();
+        let rest = from_cycle - dir * whole * 2.0 * PI;
+        let Some(onion) = self.march_onion(cycle.rotor, cycle.onion, cycle.rotor + rest, d) else {
+            return false;
+        };
+        let psi = onion.0 + turns + cycle.winding * dir * whole * 2.0 * PI;
+        if !(psi.is_finite() && psi.abs() <= super::MAX_ANGLE) {
+            return false;
+        }
+        run.y = [phi, omega, psi, 0.0];
+        run.t = segment_end;
+        run.settled = false;
+        run.attempts = run.attempts.saturating_add(1);
+        true
+    }
+
+    /// An upper bound of eq. 3.3's torque on the bar (N m): `K a r (1/(r - a)^3 + 1/(r + a)^3)`.
+    fn torque_bound(&self) -> f64 {
+        let rb = &self.ring_bar;
+        let (a, r) = (rb.bar_charge_radius, rb.wall_radius);
+        (rb.coupling * a * r * ((r - a).powi(-3) + (r + a).powi(-3))).abs()
+    }
+
+    /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
+    /// `psi0`: one turn to land on it, one to measure it. `None` if it does not close.
+    fn onion_cycle(&self, phi0: f64, psi0: f64, d: &Drive, dir: f64) -> Option<OnionCycle> {
+        let psi0 = self.landscape(phi0, d.direction, d.stress).settle(psi0);
+        let start = phi0 + dir * 2.0 * PI;
+        let (psi1, _) = self.march_onion(phi0, psi0, start, d)?;
+        let (psi2, work) = self.march_onion(start, psi1, start + dir * 2.0 * PI, d)?;
+        let winding = ((psi2 - psi1) / (2.0 * PI)).round();
+        if (psi2 - psi1 - winding * 2.0 * PI).abs() > 1e-6 {
+            return None;
+        }
+        Some(OnionCycle {
+            rotor: start,
+            onion: psi1,
+            winding: winding * dir,
+            work,
+        })
+    }
+
+    /// The quasi-static onion while the rotor turns from `from` to `to` (its memory rule, snaps
+    /// included), and the energy the snaps changed `U` by on the way (J). Strides of at most
+    /// [`CYCLE_STRIDE`]; a snap is placed by bisection within [`SNAP_PLACEMENT`] rad, where its
+    /// energy change is taken.
+    fn march_onion(&self, from: f64, psi: f64, to: f64, d: &Drive) -> Option<(f64, f64)> {
+        let settle = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).settle(onion);
+        let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
+        let strides = ((to - from).abs() / CYCLE_STRIDE).ceil().max(1.0);
+        if strides > 1e6 {
+            return None;
+        }
+        let (mut phi, mut psi, mut work) = (from, psi, 0.0);
+        for k in 1..=strides as usize {
+            let next = from + (to - from) * k as f64 / strides;
+            let psi_next = settle(next, psi);
+            if (psi_next - psi).abs() <= ONION_JUMP + 4.0 * (next - phi).abs() {
+                (phi, psi) = (next, psi_next);
+                continue;
+            }
+            // A snap inside the stride: bisect for it on the rotor angle.
+            let (mut lo, mut psi_lo, mut hi, mut psi_hi) = (phi, psi, next, psi_next);
+            for _ in 0..64 {
+                if (hi - lo).abs() <= SNAP_PLACEMENT {
+                    break;
+                }
+                let mid = 0.5 * (lo + hi);
+                let psi_mid = settle(mid, psi_lo);
+                if (psi_mid - psi_lo).abs() <= ONION_JUMP + 4.0 * (mid - lo).abs() {
+                    (lo, psi_lo) = (mid, psi_mid);
+                } else {
+                    (hi, psi_hi) = (mid, psi_mid);
+                }
+            }
+            work += energy(hi, psi_hi) - energy(lo, psi_lo);
+            (phi, psi) = (next, settle(next, psi_hi));
+        }
+        (psi.is_finite() && work.is_finite()).then_some((psi, work))
+    }
+}
+
+/// The load-dominated regime of [`Motor::advance_load_dominated`]: `tau_max / |load|` at most this
+/// times the tolerance.
+const LOAD_DOMINATED: f64 = 0.05;
+/// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
+const CYCLE_STRIDE: f64 = 0.05;
+const SNAP_PLACEMENT: f64 = 1e-10;
+/// An onion turn beyond its branch's that marks a snap (rad), as in the integrator.
+const ONION_JUMP: f64 = 0.05;
 
 /// Largest stride of the rotor march in [`Motor::settle_rotor`] (rad), as the onion's.
 const MAX_ROTOR_STRIDE: f64 = 0.05;

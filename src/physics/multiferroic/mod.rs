@@ -32,6 +32,7 @@
 //! turns; what is left is integrated, and a forced substep drops the negative stiffness so it
 //! cannot amplify. See [`Motor::step`].
 
+pub mod angles;
 pub mod branch;
 pub mod drive;
 pub mod expm;
@@ -50,6 +51,7 @@ pub mod schedule;
 #[cfg(test)]
 mod tests;
 
+use angles::Angles;
 use magnetics::{RingBar, GYROMAGNETIC_RATIO, MU0};
 use onion::Landscape;
 pub use params::*;
@@ -206,6 +208,12 @@ struct StepRun {
     /// onion, speed) and how far it was from the one before (rad).
     period_end: Option<[f64; 3]>,
     period_mismatch: f64,
+    /// The eq. 3.3-3.4 angles' sines and cosines at the last evaluated state, the starting point
+    /// of the next evaluation's (see [`angles`]).
+    angles: Option<Angles>,
+    /// Whether `angles` are those of a quasi-static onion settled at `y` for the present drive
+    /// (then the next [`Motor::constrain`] has nothing to do).
+    settled: bool,
 }
 
 impl StepRun {
@@ -232,6 +240,18 @@ impl StepRun {
             whole_period: false,
             period_end: None,
             period_mismatch: f64::INFINITY,
+            angles: None,
+            settled: false,
+        }
+    }
+
+    /// Whether the state is the settled one whose angles are kept, for the drive `d`.
+    fn is_settled(&self, d: &Drive) -> bool {
+        match (&self.angles, self.settled) {
+            (Some(a), true) => {
+                !d.locked && a.onion == self.y[2] && a.bar == self.y[0] && a.strain == d.direction
+            }
+            _ => false,
         }
     }
 
@@ -460,6 +480,21 @@ impl Motor {
         self.landscape(y[0], d.direction, d.stress).settle(y[2])
     }
 
+    /// The angles at `y` for the drive `d`, turned from `hint` (any earlier state) when close.
+    fn angles_at(y: &Vector, d: &Drive, hint: Option<&Angles>) -> Angles {
+        match hint {
+            Some(a) => a.moved(y[2], y[0], d.direction),
+            None => Angles::exact(y[2], y[0], d.direction),
+        }
+    }
+
+    /// [`Self::settle`] starting from the angles at `y` (turned from `hint`), returning the
+    /// angles at the settled onion.
+    fn settle_angles(&self, y: &Vector, d: &Drive, hint: Option<&Angles>) -> Angles {
+        self.landscape(y[0], d.direction, d.stress)
+            .settle_from(Self::angles_at(y, d, hint))
+    }
+
     /// Outputs for the current state and inputs without advancing (in the quasi-static model the
     /// onion state is settled for the present inputs, starting from its stored orientation).
     pub fn outputs(
@@ -483,16 +518,25 @@ impl Motor {
     }
 
     fn outputs_at(&self, y: &Vector, d: &Drive) -> MotorOutputs {
+        self.outputs_with(y, d, &Angles::exact(y[2], y[0], d.direction))
+    }
+
+    /// [`Self::outputs_at`] from the angles at `y` (no trigonometry but the wrap).
+    fn outputs_with(&self, y: &Vector, d: &Drive, a: &Angles) -> MotorOutputs {
         let beta = y[2] - y[0];
-        let s = (y[2] - d.direction).sin();
+        // sin^2(psi - gamma) = (1 - cos 2(psi - gamma)) / 2.
+        let sin_squared = 0.5 * (1.0 - a.cos_double);
+        let (torque, _) = self
+            .ring_bar
+            .torque_stiffness_of(a.sin_offset, a.cos_offset);
         MotorOutputs {
-            torque: self.ring_bar.torque(beta),
+            torque,
             rotor_angle: y[0],
             rotor_speed: y[1],
             onion_angle: y[2],
             offset_angle: wrap_angle(beta),
-            magnetostatic_energy: self.ring_bar.energy(beta),
-            magnetoelastic_energy: self.magnetoelastic_per_stress * d.stress * s * s,
+            magnetostatic_energy: self.ring_bar.energy_of_cos(a.cos_offset),
+            magnetoelastic_energy: self.magnetoelastic_per_stress * d.stress * sin_squared,
             applied_strain_direction: d.direction,
             applied_stress: d.stress,
         }
@@ -559,12 +603,18 @@ impl Motor {
                 }
             }
             let d = self.drive_at(inputs, run.t);
-            self.constrain(&mut run.y, &d);
+            if !run.is_settled(&d) {
+                run.angles = Some(self.constrain(&mut run.y, &d, run.angles.as_ref()));
+                run.settled = self.quasi_static();
+            }
             let segment_end = match inputs.schedule.get() {
                 Some(s) => s.next_switch_after(run.t).min(run.t_end),
                 None => run.t_end,
             };
             run.enter_segment(segment_end, d.direction);
+            if self.advance_load_dominated(&mut run, &d, segment_end) {
+                continue;
+            }
             if run.settle_tried_for != segment_end && segment_end - run.t > long_segment {
                 run.settle_tried_for = segment_end;
                 if self.advance_overdamped(&mut run, &d, segment_end) {
@@ -582,7 +632,10 @@ impl Motor {
             ));
         }
         let d = self.drive_at(inputs, run.t_end);
-        self.constrain(&mut run.y, &d);
+        let angles = match run.angles {
+            Some(a) if run.is_settled(&d) => a,
+            _ => self.constrain(&mut run.y, &d, run.angles.as_ref()),
+        };
         let y = run.y;
         *state = MotorState {
             time: run.t_end,
@@ -593,7 +646,7 @@ impl Motor {
             substep_hint: run.dt.clamp(1e-300, MAX_STEP),
         };
         Ok(StepReport {
-            outputs: self.outputs_at(&y, &d),
+            outputs: self.outputs_with(&y, &d, &angles),
             substeps: run.attempts,
             accuracy_limited: run.limited,
         })
@@ -601,12 +654,17 @@ impl Motor {
 
     /// The constraints that hold at every instant: a locked rotor does not turn, and the
     /// quasi-static onion sits settled for the present drive.
-    fn constrain(&self, y: &mut Vector, d: &Drive) {
+    /// Returns the angles at the constrained state (turned from `hint` when close).
+    fn constrain(&self, y: &mut Vector, d: &Drive, hint: Option<&Angles>) -> Angles {
         if d.locked {
             y[1] = 0.0;
         }
         if self.quasi_static() {
-            y[2] = self.settle(y, d);
+            let a = self.settle_angles(y, d, hint);
+            y[2] = a.onion;
+            a
+        } else {
+            Self::angles_at(y, d, hint)
         }
     }
 }

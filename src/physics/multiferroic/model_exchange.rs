@@ -211,7 +211,7 @@ impl Motor {
             state.onion_angle,
             state.onion_tilt,
         ];
-        self.constrain(&mut y, &d);
+        self.constrain(&mut y, &d, None);
         let changed = y[1] != state.rotor_speed;
         state.rotor_speed = y[1];
         state.onion_angle = y[2];

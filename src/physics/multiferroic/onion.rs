@@ -19,16 +19,13 @@
 //! Either way no minimum is ever stepped over, and near a simple minimum `s_safe` is the Newton
 //! step to second order, so the march costs one or two evaluations in the usual case.
 
+use super::angles::Angles;
 use super::magnetics::RingBar;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
 
 /// Cap on the downhill march (a full turn far from any minimum takes a few dozen strides).
 const MAX_MARCH_STEPS: usize = 2000;
-const REFINE: RootOptions = RootOptions {
-    absolute: 1e-15,
-    relative: 1e-15,
-    max_iterations: 100,
-};
+/// Cap on the Newton-bisection refinement of a bracketed minimum.
+const MAX_REFINE_ITERATIONS: usize = 100;
 /// Samples per turn for [`curvature_slope_bound`].
 const BOUND_SAMPLES: usize = 7200;
 
@@ -76,6 +73,29 @@ impl Landscape<'_> {
             + 2.0 * self.magnetoelastic * (2.0 * (onion - self.strain_direction)).cos()
     }
 
+    /// [`Self::gradient`] and [`Self::curvature`] together, from one `sin_cos` of each angle.
+    #[inline]
+    pub fn gradient_curvature(&self, onion: f64) -> (f64, f64) {
+        self.gradient_curvature_of(&self.angles(onion))
+    }
+
+    /// [`Self::gradient_curvature`] from the angles' sines and cosines (no trigonometry).
+    #[inline]
+    pub fn gradient_curvature_of(&self, a: &Angles) -> (f64, f64) {
+        let (tau, k) = self
+            .ring_bar
+            .torque_stiffness_of(a.sin_offset, a.cos_offset);
+        (
+            tau + self.magnetoelastic * a.sin_double,
+            k + 2.0 * self.magnetoelastic * a.cos_double,
+        )
+    }
+
+    /// The angles of this landscape at `onion`, fresh from libm.
+    pub fn angles(&self, onion: f64) -> Angles {
+        Angles::exact(onion, self.bar_angle, self.strain_direction)
+    }
+
     /// Energy relative to an arbitrary constant (J): eq. 3.3 plus eq. 3.4's wall term.
     pub fn energy(&self, onion: f64) -> f64 {
         let s = (onion - self.strain_direction).sin();
@@ -96,36 +116,61 @@ impl Landscape<'_> {
     /// The minimum reached downhill from `previous` (rad, unwrapped: the result stays on the same
     /// branch, so the onion angle is continuous). Never steps over a minimum (see the module
     /// documentation), so the onion settles in the basin it is in, however narrow.
+    ///
+    /// Inside the monotone window (positive curvature, `h` increasing) a stride up to the window's
+    /// edge is safe, so the march takes the Newton step there: each evaluation is then a Newton
+    /// iteration, and the usual settle (the rotor moved a little) costs two or three evaluations.
     pub fn settle(&self, previous: f64) -> f64 {
-        let g0 = self.gradient(previous);
-        let c0 = self.curvature(previous);
+        self.settle_from(self.angles(previous)).onion
+    }
+
+    /// [`Self::settle`] from `start`, the angles at the previous onion angle for this landscape,
+    /// returning the angles at the minimum: each evaluation turns the last one's angles (see
+    /// [`Angles::moved`]) instead of calling libm.
+    pub fn settle_from(&self, start: Angles) -> Angles {
+        let (g0, c0) = self.gradient_curvature_of(&start);
         let tiny = self.gradient_tolerance();
         if g0.abs() <= tiny && c0 > 0.0 {
-            return previous;
+            return start;
         }
         // Downhill direction; from a maximum (zero gradient, negative curvature) go forward.
         let dir = if g0 > tiny { -1.0 } else { 1.0 };
         let m = self.third_derivative_bound();
         if !(m.is_finite() && m > 0.0) {
-            return previous;
+            return start;
         }
-        let (mut x, mut g, mut c) = (previous, g0, c0);
+        let (mut x, mut g, mut c) = (start, g0, c0);
         for _ in 0..MAX_MARCH_STEPS {
             // h(0) = dir g = -a <= 0 (downhill), h'(0) = c.
             let a = (-dir * g).max(0.0);
-            let (stride, _) = downhill_stride(a, c, m);
+            let newton = a / c;
+            let stride = if c > 0.0 && newton < 0.99 * c / m {
+                // Newton's next error is at most M s^2 / (2 c') with c' >= c / 100 in the window:
+                // below the root finder's tolerance, the step lands on the minimum.
+                if m * newton * newton <= 0.02 * c * refine_tolerance(x.onion) {
+                    return x.at_onion(x.onion + dir * newton);
+                }
+                newton
+            } else {
+                downhill_stride(a, c, m).0
+            };
             if !(stride.is_finite() && stride > 0.0) {
                 break;
             }
-            let end = x + dir * stride;
-            if end == x {
+            let end = x.at_onion(x.onion + dir * stride);
+            if end.onion == x.onion {
                 break;
             }
-            let g_end = self.gradient(end);
+            let (g_end, c_end) = self.gradient_curvature_of(&end);
             if dir * g_end >= 0.0 {
-                return self.refine_minimum(x, end);
+                let (lo, hi) = if dir > 0.0 {
+                    (x.onion, end.onion)
+                } else {
+                    (end.onion, x.onion)
+                };
+                return self.refine(lo, hi, end, g_end, c_end);
             }
-            (x, g, c) = (end, g_end, self.curvature(end));
+            (x, g, c) = (end, g_end, c_end);
         }
         // A landscape flat to rounding, or a degenerate fold: stay where the march stopped.
         x
@@ -133,16 +178,47 @@ impl Landscape<'_> {
 
     /// The minimum between `a` and `b`, where the gradient changes sign from downhill to uphill.
     pub(super) fn refine_minimum(&self, a: f64, b: f64) -> f64 {
-        // Left of a minimum the gradient is negative, right of it positive: rising.
-        let root = newton_bisection(a, b, 0.5 * (a + b), true, REFINE, |x| {
-            Ok::<_, ()>(Some(Sample {
-                value: self.gradient(x),
-                slope: self.curvature(x),
-                payload: (),
-            }))
-        });
-        root.map_or(0.5 * (a + b), |r| r.x)
+        let x = self.angles(0.5 * (a + b));
+        let (g, c) = self.gradient_curvature_of(&x);
+        self.refine(a.min(b), a.max(b), x, g, c).onion
     }
+
+    /// Safeguarded Newton-bisection for the minimum in `[lo, hi]` (the gradient rises through
+    /// zero there) from `x` in it, where the gradient is `g` and the curvature `c`. A Newton step
+    /// whose successor's error (`M s^2 / (2 c)`) is below the tolerance is taken without a
+    /// further evaluation.
+    fn refine(&self, mut lo: f64, mut hi: f64, mut x: Angles, mut g: f64, mut c: f64) -> Angles {
+        let m = self.third_derivative_bound();
+        for _ in 0..MAX_REFINE_ITERATIONS {
+            if g == 0.0 {
+                return x;
+            }
+            if g < 0.0 {
+                lo = x.onion;
+            } else {
+                hi = x.onion;
+            }
+            let tolerance = refine_tolerance(x.onion);
+            let step = -g / c;
+            let next = x.onion + step;
+            let newton_ok = c > 0.0 && next > lo && next < hi;
+            if newton_ok && (step.abs() <= tolerance || m * step * step <= c * tolerance) {
+                return x.at_onion(next);
+            }
+            if hi - lo <= tolerance {
+                return x.at_onion(0.5 * (lo + hi));
+            }
+            x = x.at_onion(if newton_ok { next } else { 0.5 * (lo + hi) });
+            (g, c) = self.gradient_curvature_of(&x);
+        }
+        x
+    }
+}
+
+/// The onion angle's root tolerance (rad): 1e-15 absolute plus relative.
+#[inline]
+fn refine_tolerance(x: f64) -> f64 {
+    1e-15 * (1.0 + x.abs())
 }
 
 /// The stride a downhill march may take from a point where the gradient along the march is `-a`

@@ -9,6 +9,36 @@
 //! plain arrays it needs no allocation and no generic matrix machinery (nalgebra's fixed-size
 //! matrices would add nothing to two scalars and a 2-vector).
 
+/// `[phi_1(z), phi_2(z), phi_3(z)]` together: one `expm1` and the downward recurrence away from 0;
+/// near 0 the series of `phi_3` (reciprocal constants, no division) and the upward recurrence
+/// `phi_k = 1/k! + z phi_{k+1}`, which is stable there.
+#[inline]
+pub fn phis(z: f64) -> [f64; 3] {
+    if z.abs() < 0.5 {
+        // phi_3(z) = sum_n z^n / (n + 3)!, 16 terms: the remainder is below 0.5^16 / 19! ~ 1e-22.
+        let mut sum = 0.0;
+        for n in (0..16).rev() {
+            sum = sum * z + INV_FACTORIAL[n + 3];
+        }
+        let phi2 = 0.5 + z * sum;
+        return [1.0 + z * phi2, phi2, sum];
+    }
+    let phi1 = z.exp_m1() / z;
+    let phi2 = (phi1 - 1.0) / z;
+    [phi1, phi2, (phi2 - 0.5) / z]
+}
+
+/// `1 / n!` for n = 0..=18.
+const INV_FACTORIAL: [f64; 19] = {
+    let mut t = [1.0; 19];
+    let mut n = 1;
+    while n < 19 {
+        t[n] = t[n - 1] / n as f64;
+        n += 1;
+    }
+    t
+};
+
 /// `phi_k(z)` for `k` in 1..=3, by its series near 0 and the recurrence from `expm1` elsewhere.
 pub fn phi(k: u32, z: f64) -> f64 {
     if z.abs() < 0.5 {
@@ -36,6 +66,8 @@ pub fn phi(k: u32, z: f64) -> f64 {
 /// caller then uses the general matrix exponential).
 pub struct Phi2x2 {
     mu: (f64, f64),
+    /// `phi_1..3` at each eigenvalue.
+    at_mu: ([f64; 3], [f64; 3]),
 }
 
 impl Phi2x2 {
@@ -57,13 +89,17 @@ impl Phi2x2 {
             return None;
         }
         let mu2 = det / mu1;
-        ((mu1 - mu2).abs() > 1e-6 * (mu1.abs() + mu2.abs())).then_some(Self { mu: (mu1, mu2) })
+        ((mu1 - mu2).abs() > 1e-6 * (mu1.abs() + mu2.abs())).then(|| Self {
+            mu: (mu1, mu2),
+            at_mu: (phis(mu1), phis(mu2)),
+        })
     }
 
-    /// `phi_k(A) v` for the matrix `a` given to [`Self::new`].
+    /// `phi_k(A) v` (`k` in 1..=3) for the matrix `a` given to [`Self::new`].
     pub fn apply(&self, k: u32, a: &[[f64; 2]; 2], v: [f64; 2]) -> [f64; 2] {
         let (mu1, mu2) = self.mu;
-        let (f1, f2) = (phi(k, mu1), phi(k, mu2));
+        let i = (k.clamp(1, 3) - 1) as usize;
+        let (f1, f2) = (self.at_mu.0[i], self.at_mu.1[i]);
         let gap = mu1 - mu2;
         let c1 = (f1 - f2) / gap;
         let c0 = (mu1 * f2 - mu2 * f1) / gap;
@@ -119,6 +155,19 @@ mod tests {
                 (p1[i] - e[i][2]).abs() <= 1e-12 * e[i][2].abs(),
                 "{p1:?} {e:?}"
             );
+        }
+        // The joint evaluation agrees with the single one.
+        for z in [
+            -700.0f64, -30.0, -0.6, -0.49, -1e-3, 0.0, 0.2, 0.49, 0.51, 3.0,
+        ] {
+            let p = phis(z);
+            for k in 1..=3u32 {
+                let single = phi(k, z);
+                assert!(
+                    (p[k as usize - 1] - single).abs() <= 4e-16 * single.abs(),
+                    "{k} {z}"
+                );
+            }
         }
         // A complex pair is refused.
         assert!(Phi2x2::new(&[[0.0, 1.0], [-1.0, 0.0]]).is_none());

@@ -863,3 +863,72 @@ fn rotating_drive_steps_within_tolerance() {
     eprintln!("worst rotor angle error against the reference: {worst:e} rad");
     assert!(worst < 1e-6, "{worst:e}");
 }
+
+/// The `motor_stepping` scene (the FMU's defaults: 60 degree steps every 100 us at 200 MPa) at
+/// 1 us communication steps over 12 periods, against a converged reference (tolerance 1e-10):
+/// within the 1e-6 rad tolerance (measured 2.3e-7), at about two substeps per step. Guards the
+/// step's shortcuts (angles by rotation, the onion's predicted start, skipped re-settles).
+#[test]
+fn stepping_scene_at_microsecond_steps_within_tolerance() {
+    let m = motor();
+    let reference = motor_with(|p| {
+        p.tolerance = 1e-10;
+        p.max_substeps = 1_000_000;
+    });
+    let s = SteppingSchedule::new(0.0, 60f64.to_radians(), 1e-4, CALIBRATION_STRESS).unwrap();
+    let inputs = MotorInputs {
+        schedule: ScheduleSwitch::on(s),
+        ..MotorInputs::fixed(0.0, 0.0)
+    };
+    let (mut st, mut rs) = (MotorState::aligned(0.0), MotorState::aligned(0.0));
+    let (mut substeps, mut worst) = (0, 0.0f64);
+    for _ in 0..1200 {
+        let r = m.step(&mut st, &inputs, 1e-6).unwrap();
+        reference.step(&mut rs, &inputs, 1e-6).unwrap();
+        assert!(!r.accuracy_limited);
+        substeps += r.substeps;
+        worst = worst.max((st.rotor_angle - rs.rotor_angle).abs());
+        assert!((st.onion_angle - rs.onion_angle).abs() < 4e-6);
+    }
+    eprintln!("substeps {substeps}, worst rotor angle error {worst:e} rad");
+    assert!(worst < 1e-6, "{worst:e}");
+    // It followed the schedule: 570 degrees by the end of the 12th period.
+    assert!((rs.rotor_angle.to_degrees() - 570.0).abs() < 0.01);
+    assert!(substeps < 2600, "{substeps}");
+}
+
+/// A load far beyond the ring's peak torque (2.16e-18 N m) spins the rotor so fast that the
+/// ring's torque averages out within each turn (see `Motor::advance_load_dominated`): a step is
+/// then one closed-form segment plus one march around the onion's cycle, where the resolved
+/// integration took the whole substep budget. Against the resolved reference (tolerance 1e-10,
+/// which never takes the shortcut) over steps short enough to resolve: 1e-8 N m over 0.1 ns
+/// steps (about 115 turns each) and -1e-6 N m over 1 ps steps, from rest.
+#[test]
+fn load_dominated_rotor_agrees_with_resolved_steps() {
+    let m = motor();
+    let reference = motor_with(|p| {
+        p.tolerance = 1e-10;
+        p.max_substeps = 10_000_000;
+    });
+    for (load, h, steps) in [(1e-8, 1e-10, 3), (-1e-6, 1e-12, 5)] {
+        let inputs = MotorInputs {
+            load_torque: load,
+            ..MotorInputs::fixed(0.3, CALIBRATION_STRESS)
+        };
+        let (mut s, mut r_s) = (MotorState::aligned(0.0), MotorState::aligned(0.0));
+        for k in 0..steps {
+            let r = m.step(&mut s, &inputs, h).unwrap();
+            let rr = reference.step(&mut r_s, &inputs, h).unwrap();
+            eprintln!(
+                "{load:e} step {k}: {} substeps (reference {}), rotor {} against {}, onion {} against {}",
+                r.substeps, rr.substeps, s.rotor_angle, r_s.rotor_angle, s.onion_angle, r_s.onion_angle
+            );
+            assert!(!r.accuracy_limited && r.substeps <= 2, "{r:?}");
+            assert!(!rr.accuracy_limited);
+            assert!((s.rotor_angle - r_s.rotor_angle).abs() < 1e-6);
+            assert!((s.onion_angle - r_s.onion_angle).abs() < 1e-6);
+            assert!((s.rotor_speed - r_s.rotor_speed).abs() < 1e-6 * r_s.rotor_speed.abs());
+        }
+        assert!(s.rotor_angle.abs() > 100.0, "{}", s.rotor_angle);
+    }
+}
