@@ -232,6 +232,9 @@ load: fmus
 	cargo test --release --test load -- --include-ignored --nocapture
 
 FUZZ_SECONDS ?= 120
+## Stop after this many sequences instead (libFuzzer's -runs), whichever limit comes first; e.g.
+## `make fuzz SANITIZER=none FUZZ_RUNS=10000000 FUZZ_SECONDS=36000` for issue 19's 10 million.
+FUZZ_RUNS ?=
 ## address (the default: AddressSanitizer, ~15x slower) or none (the plain build, for volume).
 SANITIZER ?= address
 ## Per-sequence limit in wall-clock seconds: the longest sequences take ~0.3 s of CPU, but a
@@ -253,7 +256,7 @@ fuzz:
 	mkdir -p fuzz/corpus-run/call_sequences fuzz/logs
 	cargo +nightly fuzz run -s $(SANITIZER) $(FUZZ_TARGET_DIR) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
 	  $(CURDIR)/fuzz/corpus/call_sequences $(CURDIR)/fuzz/regressions/call_sequences \
-	  -- -max_total_time=$(FUZZ_SECONDS) -timeout=$(FUZZ_TIMEOUT) \
+	  -- -max_total_time=$(FUZZ_SECONDS) $(if $(FUZZ_RUNS),-runs=$(FUZZ_RUNS)) -timeout=$(FUZZ_TIMEOUT) \
 	  -rss_limit_mb=2048 -print_final_stats=1 \
 	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; test $${PIPESTATUS[0]} = 0
 	@grep -h 'stat::number_of_executed_units' fuzz/logs/$(SANITIZER).log \
