@@ -164,7 +164,10 @@ impl<S: SleeveGeometry> Bladder<S> {
                 let s_sq = (u - x_sq) * lambda1 + d_ro * d_ro;
                 let l2_sq = u * s_sq.recip();
                 let inv_l2_sq = s_sq * inv_u;
-                if !(l2_sq.value() > 0.0 && l2_sq.value().is_finite() && inv_l2_sq.value().is_finite()) {
+                if !(l2_sq.value() > 0.0
+                    && l2_sq.value().is_finite()
+                    && inv_l2_sq.value().is_finite())
+                {
                     return None;
                 }
                 let jacobian = e * (node.weight * 0.5);

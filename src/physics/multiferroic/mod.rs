@@ -175,10 +175,23 @@ pub struct StepReport {
     pub accuracy_limited: bool,
 }
 
+/// Eq. 3.4 depends on the strain direction only modulo pi (through `2 (psi - gamma)`), and the
+/// onion follows the rotor, which the long-step paths turn back near zero: a direction of many
+/// turns would hand libm's sine and cosine arguments beyond 1e8, where they take the slow
+/// Payne-Hanek reduction (about ten times a normal call; the fuzzer's sequences with a
+/// `strain_direction` of 1e12 rad ran at a tenth of the usual rate). Above this size the
+/// direction is reduced modulo pi, which costs no accuracy that the difference `psi - gamma` had
+/// (the rounding of pi times the number of turns stays below the direction's own spacing).
+const REDUCED_DIRECTION_ABOVE: f64 = 1e3;
+
 /// Strain, stress and load held over one substep.
 #[derive(Clone, Copy, Debug)]
 struct Drive {
+    /// The strain direction the physics uses: the applied one, brought into `[0, pi)` when far
+    /// beyond a few turns (see [`REDUCED_DIRECTION_ABOVE`]).
     direction: f64,
+    /// The strain direction as applied, for the `applied_strain_direction` output.
+    applied_direction: f64,
     stress: f64,
     load: f64,
     locked: bool,
@@ -460,12 +473,18 @@ impl Motor {
     }
 
     fn drive_at(&self, inputs: &MotorInputs, time: f64) -> Drive {
-        let (direction, stress) = match inputs.schedule.get() {
+        let (applied_direction, stress) = match inputs.schedule.get() {
             Some(s) => (s.direction(time), s.stress_amplitude),
             None => (inputs.strain_direction, inputs.stress),
         };
+        let direction = if applied_direction.abs() > REDUCED_DIRECTION_ABOVE {
+            applied_direction.rem_euclid(PI)
+        } else {
+            applied_direction
+        };
         Drive {
             direction,
+            applied_direction,
             stress,
             load: inputs.load_torque,
             locked: inputs.rotor_locked,
@@ -537,7 +556,7 @@ impl Motor {
             offset_angle: wrap_angle(beta),
             magnetostatic_energy: self.ring_bar.energy_of_cos(a.cos_offset),
             magnetoelastic_energy: self.magnetoelastic_per_stress * d.stress * sin_squared,
-            applied_strain_direction: d.direction,
+            applied_strain_direction: d.applied_direction,
             applied_stress: d.stress,
         }
     }

@@ -932,3 +932,43 @@ fn load_dominated_rotor_agrees_with_resolved_steps() {
         assert!(s.rotor_angle.abs() > 100.0, "{}", s.rotor_angle);
     }
 }
+
+#[test]
+fn strain_direction_whole_half_turns_away_gives_the_same_motor() {
+    // Eq. 3.4 depends on 2 (psi - gamma): gamma and gamma + N pi are the same drive. Far beyond a
+    // few turns the physics reduces gamma modulo pi (REDUCED_DIRECTION_ABOVE); the output keeps
+    // the direction as applied.
+    let m = motor();
+    for load in [0.0, 1e-8] {
+        let near = MotorInputs {
+            load_torque: load,
+            ..MotorInputs::fixed(0.3, CALIBRATION_STRESS)
+        };
+        let far_direction = 0.3 + 1e6 * PI;
+        let far = MotorInputs {
+            strain_direction: far_direction,
+            ..near
+        };
+        let (mut s_near, mut s_far) = (MotorState::aligned(0.0), MotorState::aligned(0.0));
+        for _ in 0..5 {
+            let a = m.step(&mut s_near, &near, 1e-7).unwrap();
+            let b = m.step(&mut s_far, &far, 1e-7).unwrap();
+            assert_eq!(b.outputs.applied_strain_direction, far_direction);
+            assert!(
+                (a.outputs.rotor_angle - b.outputs.rotor_angle).abs() < 1e-6,
+                "{a:?} {b:?}"
+            );
+            assert!(
+                (a.outputs.onion_angle - b.outputs.onion_angle).abs() < 1e-6,
+                "{a:?} {b:?}"
+            );
+            assert_relative_eq!(
+                a.outputs.torque,
+                b.outputs.torque,
+                max_relative = 1e-5,
+                epsilon = 1e-24
+            );
+        }
+        assert!(s_near.rotor_angle.abs() > 1e-3 || load == 0.0);
+    }
+}
