@@ -1,5 +1,6 @@
 //! Long steps in the overdamped limit: settling a rotor and whole slipping turns (issue 5).
 
+use super::angles::turned_back;
 use super::{Drive, Motor, StepRun, SteppingSchedule, Vector};
 use std::f64::consts::PI;
 
@@ -10,8 +11,10 @@ impl Motor {
     pub(super) fn rotor_force(&self, phi: f64, psi: f64, d: &Drive) -> (f64, f64) {
         let beta = psi - phi;
         let (tau, k_bar) = self.ring_bar.torque_stiffness(beta);
-        let k_me =
-            2.0 * self.magnetoelastic_per_stress * d.stress * (2.0 * (psi - d.direction)).cos();
+        let k_me = 2.0
+            * self.magnetoelastic_per_stress
+            * d.stress
+            * turned_back(2.0 * (psi - d.direction)).cos();
         let sum = (k_bar + k_me).max(0.05 * (k_bar.abs() + k_me.abs()));
         let k = if sum > 0.0 { k_bar * k_me / sum } else { 0.0 };
         (tau + d.load, k)

@@ -4,6 +4,7 @@
 //! Angles: `offset` (beta) is the onion state's angle minus the bar's. At beta = 0 the bar's
 //! positive end faces the ring's negative domain wall (flux closure, the minimum of eq. 3.3).
 
+use super::angles::turned_back;
 use std::f64::consts::PI;
 
 /// Vacuum permeability (T m / A), CODATA 2018.
@@ -74,7 +75,7 @@ impl RingBar {
     fn distances(&self, offset: f64) -> (f64, f64, f64) {
         let (a, r) = (self.bar_charge_radius, self.wall_radius);
         let sum = a * a + r * r;
-        let cross = 2.0 * a * r * offset.cos();
+        let cross = 2.0 * a * r * turned_back(offset).cos();
         // a < r (checked), so both are positive.
         ((sum - cross).sqrt(), (sum + cross).sqrt(), a * r)
     }
@@ -97,7 +98,7 @@ impl RingBar {
     /// Positive when the onion state leads the bar: it pulls the bar forward.
     pub fn torque(&self, offset: f64) -> f64 {
         let (a, b, ar) = self.distances(offset);
-        self.coupling * ar * offset.sin() * (1.0 / (a * a * a) + 1.0 / (b * b * b))
+        self.coupling * ar * turned_back(offset).sin() * (1.0 / (a * a * a) + 1.0 / (b * b * b))
     }
 
     /// [`Self::torque`] and [`Self::stiffness`] together from one `sin_cos` of the offset and one
@@ -105,7 +106,7 @@ impl RingBar {
     /// both at every evaluation (trigonometry was 40% of a motor step with them apart).
     #[inline]
     pub fn torque_stiffness(&self, offset: f64) -> (f64, f64) {
-        let (s, c) = offset.sin_cos();
+        let (s, c) = turned_back(offset).sin_cos();
         self.torque_stiffness_of(s, c)
     }
 
@@ -129,7 +130,7 @@ impl RingBar {
     /// `d^2 U_m / d beta^2` (N m / rad): the ring-bar spring stiffness.
     pub fn stiffness(&self, offset: f64) -> f64 {
         let (a, b, ar) = self.distances(offset);
-        let (s, c) = offset.sin_cos();
+        let (s, c) = turned_back(offset).sin_cos();
         let (a2, b2) = (a * a, b * b);
         self.coupling
             * ar
@@ -141,7 +142,7 @@ impl RingBar {
     /// onion's fold (where its minimum vanishes, the inflection's motion depends on it).
     pub fn stiffness_slope(&self, offset: f64) -> f64 {
         let (a, b, ar) = self.distances(offset);
-        let (s, c) = offset.sin_cos();
+        let (s, c) = turned_back(offset).sin_cos();
         let (ia, ib) = (1.0 / a, 1.0 / b);
         let (ia3, ib3) = (ia * ia * ia, ib * ib * ib);
         let (ia5, ib5) = (ia3 * ia * ia, ib3 * ib * ib);

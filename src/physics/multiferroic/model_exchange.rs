@@ -16,6 +16,7 @@
 //! ([`Landscape::settle`](super::onion::Landscape::settle)). The schedule's direction is a discrete state too: it is read at the
 //! time of the last event, so it changes only at its switches, which are time events.
 
+use super::angles::turned_back;
 use super::branch::Branch;
 use super::{Drive, Motor, MotorInputs, MotorOutputs, MotorState, OnionModel};
 
@@ -155,7 +156,8 @@ impl Motor {
                 self.tilt_stiffness,
             );
             let e = self.magnetoelastic_per_stress * d.stress;
-            let grad = self.ring_bar.torque(beta) + e * (2.0 * (y[2] - d.direction)).sin();
+            let grad =
+                self.ring_bar.torque(beta) + e * turned_back(2.0 * (y[2] - d.direction)).sin();
             derivatives[2] = g * (-t * y[3] - a * grad);
             derivatives[3] = g * (grad - a * t * y[3]);
         }
@@ -253,7 +255,7 @@ impl Motor {
         let psi_now = y[2];
         let beta = psi_now - y[0];
         let k_bar = self.ring_bar.stiffness(beta);
-        let (s2, c2) = (2.0 * (psi_now - d.direction)).sin_cos();
+        let (s2, c2) = turned_back(2.0 * (psi_now - d.direction)).sin_cos();
         let k_me = 2.0 * e * c2;
         let floor = 1e-9 * self.alignment_stiffness.abs();
         let psi = match branch {
@@ -308,7 +310,7 @@ impl Motor {
             derivatives[3] = std::array::from_fn(|j| g * (grad[j] - a * t * tilt[j]));
         }
         let tau = self.ring_bar.torque(beta);
-        let sin2 = (psi_now - d.direction).sin().powi(2);
+        let sin2 = turned_back(psi_now - d.direction).sin().powi(2);
         Ok(MePartials {
             derivatives,
             torque,

@@ -19,6 +19,7 @@
 //! Either way no minimum is ever stepped over, and near a simple minimum `s_safe` is the Newton
 //! step to second order, so the march costs one or two evaluations in the usual case.
 
+use super::angles::turned_back;
 use super::angles::Angles;
 use super::magnetics::RingBar;
 
@@ -63,14 +64,14 @@ impl Landscape<'_> {
     #[inline]
     pub fn gradient(&self, onion: f64) -> f64 {
         self.ring_bar.torque(onion - self.bar_angle)
-            + self.magnetoelastic * (2.0 * (onion - self.strain_direction)).sin()
+            + self.magnetoelastic * turned_back(2.0 * (onion - self.strain_direction)).sin()
     }
 
     /// `d^2U/dpsi^2` (J/rad^2).
     #[inline]
     pub fn curvature(&self, onion: f64) -> f64 {
         self.ring_bar.stiffness(onion - self.bar_angle)
-            + 2.0 * self.magnetoelastic * (2.0 * (onion - self.strain_direction)).cos()
+            + 2.0 * self.magnetoelastic * turned_back(2.0 * (onion - self.strain_direction)).cos()
     }
 
     /// [`Self::gradient`] and [`Self::curvature`] together, from one `sin_cos` of each angle.
@@ -98,7 +99,7 @@ impl Landscape<'_> {
 
     /// Energy relative to an arbitrary constant (J): eq. 3.3 plus eq. 3.4's wall term.
     pub fn energy(&self, onion: f64) -> f64 {
-        let s = (onion - self.strain_direction).sin();
+        let s = turned_back(onion - self.strain_direction).sin();
         self.ring_bar.energy(onion - self.bar_angle) + self.magnetoelastic * s * s
     }
 
