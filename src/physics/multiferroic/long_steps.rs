@@ -348,7 +348,8 @@ impl Motor {
     ) -> bool {
         let (i, c) = (self.inertia, self.drag);
         let load = d.load;
-        if d.locked
+        if run.load_dominated_failed
+            || d.locked
             || !self.quasi_static()
             || load.abs() * LOAD_DOMINATED * self.params.tolerance < self.torque_bound()
             || run.y[1] * load < 0.0
@@ -357,9 +358,14 @@ impl Motor {
         }
         let dir = load.signum();
         // The landscape depends on psi - phi and psi - gamma (mod pi): turn rotor and onion back
-        // by whole turns so that the march works near zero.
+        // by whole turns so that the march works near zero (the onion by its own turns too, for
+        // a state whose onion is far from its rotor).
         let turns = (run.y[0] / (2.0 * PI)).round() * 2.0 * PI;
-        let Some(cycle) = self.onion_cycle(run.y[0] - turns, run.y[2] - turns, d, dir) else {
+        let onion_turns = ((run.y[2] - run.y[0]) / (2.0 * PI)).round() * 2.0 * PI;
+        let Some(cycle) =
+            self.onion_cycle(run.y[0] - turns, run.y[2] - turns - onion_turns, d, dir)
+        else {
+            run.load_dominated_failed = true;
             return false;
         };
         let force = load + dir * cycle.work / (2.0 * PI);
@@ -379,6 +385,7 @@ impl Motor {
         };
         let phi = run.y[0] + advance;
         if !(phi.is_finite() && phi.abs() <= super::MAX_ANGLE && omega.is_finite()) {
+            run.load_dominated_failed = true;
             return false;
         }
         // The onion on its cycle at the end angle: whole turns shift it by the winding, the rest
@@ -387,10 +394,12 @@ impl Motor {
         let whole = (dir * from_cycle / (2.0 * PI)).floor();
         let rest = from_cycle - dir * whole * 2.0 * PI;
         let Some(onion) = self.march_onion(cycle.rotor, cycle.onion, cycle.rotor + rest, d) else {
+            run.load_dominated_failed = true;
             return false;
         };
-        let psi = onion.0 + turns + cycle.winding * dir * whole * 2.0 * PI;
+        let psi = onion.0 + turns + onion_turns + cycle.winding * dir * whole * 2.0 * PI;
         if !(psi.is_finite() && psi.abs() <= super::MAX_ANGLE) {
+            run.load_dominated_failed = true;
             return false;
         }
         run.y = [phi, omega, psi, 0.0];

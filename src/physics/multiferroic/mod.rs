@@ -212,6 +212,9 @@ struct StepRun {
     dt: f64,
     /// The segment whose settle was tried.
     settle_tried_for: f64,
+    /// The load-dominated closed form ([`Motor::advance_load_dominated`]) was tried in this call
+    /// and did not apply: its onion cycle (two turns of strides) is not tried again on every pass.
+    load_dominated_failed: bool,
     /// The segment in progress: its end, strain direction, and whether it began at a switch (a
     /// whole period of the schedule).
     segment_end: f64,
@@ -248,6 +251,7 @@ impl StepRun {
                 1e-10
             },
             settle_tried_for: f64::NAN,
+            load_dominated_failed: false,
             segment_end: f64::NAN,
             segment_direction: 0.0,
             whole_period: false,
