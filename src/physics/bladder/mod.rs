@@ -323,14 +323,7 @@ impl<S: SleeveGeometry> Bladder<S> {
     /// the rubber does not fit), for a vacuum so deep that the free bladder would collapse, or if
     /// the numbers overflow right at the limits.
     pub fn evaluate(&self, pressure: f64, length: f64) -> Result<BladderState, String> {
-        if !pressure.is_finite() {
-            return Err(format!("pressure must be finite, got {pressure} Pa"));
-        }
-        self.check_length(length)?;
-        let (l, x) = self.contact_seed(length);
-        let contact = self
-            .kernel(pressure, l, x)
-            .ok_or_else(|| self.domain_error(length))?;
+        let (x, contact) = self.contact_point(pressure, length)?;
         if contact.p_eff.v >= 0.0 {
             let state = self.contact_state(pressure, length, &contact);
             return check_state(state, length);
@@ -378,6 +371,21 @@ impl<S: SleeveGeometry> Bladder<S> {
              (eq. 2.7's inner diameter is positive only there): no solution",
             self.min_length, self.max_length
         )
+    }
+
+    /// The checked inputs' contact point: the sleeve's diameter `D(L)` as seeded by
+    /// [`Self::contact_seed`] and the wall's kernel there (what every evaluation starts from).
+    #[inline]
+    fn contact_point(&self, pressure: f64, length: f64) -> Result<(Dual, Kernel<Dual>), String> {
+        if !pressure.is_finite() {
+            return Err(format!("pressure must be finite, got {pressure} Pa"));
+        }
+        self.check_length(length)?;
+        let (l, x) = self.contact_seed(length);
+        let contact = self
+            .kernel(pressure, l, x)
+            .ok_or_else(|| self.domain_error(length))?;
+        Ok((x, contact))
     }
 
     /// Length seeded with d/dL = 1, and the sleeve diameter `D(L)` seeded with its total slope

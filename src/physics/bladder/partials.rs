@@ -54,14 +54,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         pressure: f64,
         length: f64,
     ) -> Result<(BladderState, BladderPartials), String> {
-        if !pressure.is_finite() {
-            return Err(format!("pressure must be finite, got {pressure} Pa"));
-        }
-        self.check_length(length)?;
-        let (l, x) = self.contact_seed(length);
-        let contact = self
-            .kernel(pressure, l, x)
-            .ok_or_else(|| self.domain_error(length))?;
+        let (x, contact) = self.contact_point(pressure, length)?;
         if contact.p_eff.v >= 0.0 {
             // The dual numbers seeded by `contact_seed` carry the contact branch's total d/dL in `dl`.
             let (g, g_slope) = self.sleeve.strand_area(length);

@@ -40,14 +40,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         pressure: f64,
         length: f64,
     ) -> Result<BladderCurvature, String> {
-        if !pressure.is_finite() {
-            return Err(format!("pressure must be finite, got {pressure} Pa"));
-        }
-        self.check_length(length)?;
-        let (l, x) = self.contact_seed(length);
-        let contact = self
-            .kernel(pressure, l, x)
-            .ok_or_else(|| self.domain_error(length))?;
+        let (x, contact) = self.contact_point(pressure, length)?;
         let l2 = HyperDual::seed(length, [1.0, 0.0], [0.0; 3]);
         let curvature = if contact.p_eff.v >= 0.0 {
             let (d, d1) = self.sleeve.diameter_and_slope(length);
