@@ -175,13 +175,12 @@ pub struct StepReport {
     pub accuracy_limited: bool,
 }
 
-/// Eq. 3.4 depends on the strain direction only modulo pi (through `2 (psi - gamma)`), and the
-/// onion follows the rotor, which the long-step paths turn back near zero: a direction of many
-/// turns would hand libm's sine and cosine arguments beyond 1e8, where they take the slow
-/// Payne-Hanek reduction (about ten times a normal call; the fuzzer's sequences with a
-/// `strain_direction` of 1e12 rad ran at a tenth of the usual rate). Above this size the
-/// direction is reduced modulo pi, which costs no accuracy that the difference `psi - gamma` had
-/// (the rounding of pi times the number of turns stays below the direction's own spacing).
+/// Eq. 3.4 depends on the strain direction only modulo pi (through `2 (psi - gamma)`). A direction
+/// of many turns is reduced modulo pi above this size: the onion's angle, which follows the rotor,
+/// then meets a direction of its own size, so `psi - gamma` keeps the onion's precision instead of
+/// the direction's (beside 1e12 rad it is 1e-4 rad), and the long-step paths, which turn the
+/// rotor back near zero, hand libm small arguments ([`angles::turned_back`] guards the rest). The
+/// rounding of pi times the turns stays below the direction's own spacing.
 const REDUCED_DIRECTION_ABOVE: f64 = 1e3;
 
 /// Strain, stress and load held over one substep.
