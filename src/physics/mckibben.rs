@@ -5,7 +5,7 @@
 //! Effects that are off are `None` and cost nothing: with no bladder, no friction and a rigid
 //! connector, [`McKibben::evaluate`] is eq. 2.3 and nothing else.
 
-use crate::physics::bladder::{Bladder, BladderState, BladderTube, Wall, MOONEY_C1, MOONEY_C2};
+use crate::physics::bladder::{Bladder, BladderState, BladderTube, Wall};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
 use crate::physics::root::{newton_bisection, RootOptions, Sample};
@@ -130,13 +130,11 @@ impl MuscleGeometry {
 
     /// The bladder tube with the chapter's latex constants (Fig. 2.9).
     pub fn tube(&self) -> BladderTube {
-        BladderTube {
-            inner_diameter: self.bladder_inner_diameter,
-            thickness: self.bladder_thickness,
-            unstretched_length: self.bladder_length,
-            mooney_c1: MOONEY_C1,
-            mooney_c2: MOONEY_C2,
-        }
+        BladderTube::latex(
+            self.bladder_inner_diameter,
+            self.bladder_thickness,
+            self.bladder_length,
+        )
     }
 }
 

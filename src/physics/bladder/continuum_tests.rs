@@ -10,13 +10,7 @@ const MUSCLE_D: (f64, f64, f64, f64, f64, f64) = (0.1358, 0.1336, 3.8e-3, 0.25e-
 
 fn bladder(m: (f64, f64, f64, f64, f64, f64), wall: Wall) -> Bladder {
     let (_, lr0, d_ri, t, b, n) = m;
-    let tube = BladderTube {
-        inner_diameter: d_ri,
-        thickness: t,
-        unstretched_length: lr0,
-        mooney_c1: MOONEY_C1,
-        mooney_c2: MOONEY_C2,
-    };
+    let tube = BladderTube::latex(d_ri, t, lr0);
     Bladder::with_wall(Sleeve::new(b, n).unwrap(), tube, wall).unwrap()
 }
 

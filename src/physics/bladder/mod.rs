@@ -68,6 +68,19 @@ pub struct BladderTube {
     pub mooney_c2: f64,
 }
 
+impl BladderTube {
+    /// A tube of the chapter's latex (Fig. 2.9's Mooney-Rivlin constants).
+    pub fn latex(inner_diameter: f64, thickness: f64, unstretched_length: f64) -> Self {
+        Self {
+            inner_diameter,
+            thickness,
+            unstretched_length,
+            mooney_c1: MOONEY_C1,
+            mooney_c2: MOONEY_C2,
+        }
+    }
+}
+
 /// How the wall is integrated through its thickness.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Wall {

@@ -114,7 +114,7 @@ impl<S: SleeveGeometry> Bladder<S> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{BladderTube, KnittedCylinder, Wall, MOONEY_C1, MOONEY_C2};
+    use super::super::{BladderTube, KnittedCylinder, Wall};
     use super::*;
     use crate::physics::gaylord::Sleeve;
     use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
@@ -181,13 +181,7 @@ mod tests {
         ];
         let (mut points, mut free, mut worst) = (0, 0, 0.0f64);
         for (i, (lr0, d_ri, t, strand, turns)) in table.into_iter().enumerate() {
-            let tube = BladderTube {
-                inner_diameter: d_ri,
-                thickness: t,
-                unstretched_length: lr0,
-                mooney_c1: MOONEY_C1,
-                mooney_c2: MOONEY_C2,
-            };
+            let tube = BladderTube::latex(d_ri, t, lr0);
             for wall in walls() {
                 let sleeve = Sleeve::new(strand, turns).unwrap();
                 let b = Bladder::with_wall(sleeve, tube, wall).unwrap();
@@ -217,13 +211,7 @@ mod tests {
         let (mut points, mut free, mut worst) = (0, 0, 0.0f64);
         for kind in [ShapeKind::Ideal, ShapeKind::Tubular] {
             let sleeve = KnittedSleeve::new(KnittedParams::fig_1_16(2e-4), kind).unwrap();
-            let tube = BladderTube {
-                inner_diameter: 6.4e-3,
-                thickness: 0.8e-3,
-                unstretched_length: 0.110,
-                mooney_c1: MOONEY_C1,
-                mooney_c2: MOONEY_C2,
-            };
+            let tube = BladderTube::latex(6.4e-3, 0.8e-3, 0.110);
             for wall in walls() {
                 let b = Bladder::<KnittedCylinder>::knitted_wall(&sleeve, tube, wall).unwrap();
                 let (lo, hi) = (b.min_length(), b.max_length());

@@ -29,13 +29,7 @@ const D: usize = 3;
 
 fn muscle(which: usize, layers: usize) -> Bladder {
     let (_, lr0, d_ri, t, b, n) = TABLE_2_1[which];
-    let tube = BladderTube {
-        inner_diameter: d_ri,
-        thickness: t,
-        unstretched_length: lr0,
-        mooney_c1: MOONEY_C1,
-        mooney_c2: MOONEY_C2,
-    };
+    let tube = BladderTube::latex(d_ri, t, lr0);
     Bladder::new(Sleeve::new(b, n).unwrap(), tube, layers).unwrap()
 }
 
@@ -397,13 +391,7 @@ fn contact_onset_length_at_400_kpa() {
 #[test]
 fn rejects_bad_parameters() {
     let s = Sleeve::new(0.1113, 3.74).unwrap();
-    let good = BladderTube {
-        inner_diameter: 1.6e-3,
-        thickness: 1.6e-3,
-        unstretched_length: 0.1,
-        mooney_c1: MOONEY_C1,
-        mooney_c2: MOONEY_C2,
-    };
+    let good = BladderTube::latex(1.6e-3, 1.6e-3, 0.1);
     assert!(Bladder::new(s, good, 1).is_ok());
     assert!(Bladder::new(s, good, 0).is_err());
     assert!(Bladder::new(s, good, MAX_LAYERS + 1).is_err());
@@ -448,13 +436,7 @@ fn knitted_sleeve(kind: ShapeKind, strand_thickness: f64) -> KnittedSleeve {
 
 /// 1/4" latex tube (6.4 mm bore, 0.8 mm wall), unstretched at the 110 mm muscle length.
 fn latex_tube() -> BladderTube {
-    BladderTube {
-        inner_diameter: 6.4e-3,
-        thickness: 0.8e-3,
-        unstretched_length: 0.110,
-        mooney_c1: MOONEY_C1,
-        mooney_c2: MOONEY_C2,
-    }
+    BladderTube::latex(6.4e-3, 0.8e-3, 0.110)
 }
 
 #[test]
@@ -645,8 +627,7 @@ proptest! {
     fn free_equilibrium_is_stable(d_ri in 0.5e-3f64..20e-3, wall in 0.01f64..1.5,
                                   prestrain in 0.3f64..1.2, layers in 1usize..40, frac in 0.0f64..1.0) {
         let sleeve = Sleeve::new(0.15, 3.5).unwrap();
-        let tube = BladderTube { inner_diameter: d_ri, thickness: wall * d_ri,
-            unstretched_length: prestrain * 0.12, mooney_c1: MOONEY_C1, mooney_c2: MOONEY_C2 };
+        let tube = BladderTube::latex(d_ri, wall * d_ri, prestrain * 0.12);
         if let Ok(bl) = Bladder::new(sleeve, tube, layers) {
             let l = bl.min_length() + frac * (bl.max_length() - bl.min_length());
             if let Ok(stable) = bl.free_contact_is_stable(l) {
@@ -661,8 +642,7 @@ proptest! {
                              p in -1e5f64..1e6, frac in -0.1f64..1.2) {
         let kind = if tubular { ShapeKind::Tubular } else { ShapeKind::Ideal };
         let ks = knitted_sleeve(kind, t);
-        let tube = BladderTube { inner_diameter: d_ri, thickness: wall, unstretched_length: lr0,
-            mooney_c1: MOONEY_C1, mooney_c2: MOONEY_C2 };
+        let tube = BladderTube::latex(d_ri, wall, lr0);
         if let Ok(bl) = Bladder::knitted(&ks, tube, layers) {
             prop_assert!(bl.min_length() >= ks.min_length() && bl.max_length() <= ks.max_length());
             let l = frac * ks.max_length();
