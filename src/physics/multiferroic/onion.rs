@@ -114,6 +114,20 @@ impl Landscape<'_> {
             + 1e-12 * self.magnetoelastic.abs()
     }
 
+    /// The onion angle's root tolerance (rad): 1e-15 absolute plus relative to the largest of the
+    /// angles. The gradient sees the onion only through `psi - phi` and `psi - gamma`, whose
+    /// spacing is that of the larger angle: with a rotor 1e12 rad out (a restored or fuzzed state)
+    /// the gradient is a staircase of 1e-4 rad treads, where a tolerance relative to `psi` alone
+    /// sent every refinement through 35 bisections.
+    #[inline]
+    fn root_tolerance(&self, onion: f64) -> f64 {
+        let largest = onion
+            .abs()
+            .max(self.bar_angle.abs())
+            .max(self.strain_direction.abs());
+        1e-15 * (1.0 + largest)
+    }
+
     /// The minimum reached downhill from `previous` (rad, unwrapped: the result stays on the same
     /// branch, so the onion angle is continuous). Never steps over a minimum (see the module
     /// documentation), so the onion settles in the basin it is in, however narrow.
@@ -148,7 +162,7 @@ impl Landscape<'_> {
             let stride = if c > 0.0 && newton < 0.99 * c / m {
                 // Newton's next error is at most M s^2 / (2 c') with c' >= c / 100 in the window:
                 // below the root finder's tolerance, the step lands on the minimum.
-                if m * newton * newton <= 0.02 * c * refine_tolerance(x.onion) {
+                if m * newton * newton <= 0.02 * c * self.root_tolerance(x.onion) {
                     return x.at_onion(x.onion + dir * newton);
                 }
                 newton
@@ -199,7 +213,7 @@ impl Landscape<'_> {
             } else {
                 hi = x.onion;
             }
-            let tolerance = refine_tolerance(x.onion);
+            let tolerance = self.root_tolerance(x.onion);
             let step = -g / c;
             let next = x.onion + step;
             let newton_ok = c > 0.0 && next > lo && next < hi;
@@ -214,12 +228,6 @@ impl Landscape<'_> {
         }
         x
     }
-}
-
-/// The onion angle's root tolerance (rad): 1e-15 absolute plus relative.
-#[inline]
-fn refine_tolerance(x: f64) -> f64 {
-    1e-15 * (1.0 + x.abs())
 }
 
 /// The stride a downhill march may take from a point where the gradient along the march is `-a`
