@@ -72,6 +72,43 @@ pub fn expm<const N: usize>(m: &Mat<N>) -> Option<Mat<N>> {
     }
 }
 
+/// `exp(m)` of an augmented matrix `[[J, f], [0, 0]]` (last row zero), balanced first: the
+/// forcing column is divided by a power of two `s` until it is no larger than the norm of `J`,
+/// and the result's column multiplied back (`exp(D^-1 m D) = D^-1 exp(m) D`, exact in binary).
+/// Scaling and squaring then needs the squarings of `J` alone: a forcing of 1e23 (a fuzzed load
+/// torque over the Gilbert rotor's inertia) had taken 79 squarings where `J` needed 24, and
+/// each extra squaring doubles the rounding error of the `J` block.
+pub fn expm_augmented<const N: usize>(m: &Mat<N>) -> Option<Mat<N>> {
+    let last = N - 1;
+    let block = m[..last]
+        .iter()
+        .map(|row| row[..last].iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    let forcing = m[..last]
+        .iter()
+        .map(|row| row[last].abs())
+        .fold(0.0, f64::max);
+    let target = block.max(0.25);
+    if !(forcing.is_finite() && forcing > target) {
+        return expm(m);
+    }
+    // s = 2^k with forcing / s <= target; at most 2^1000 (the forcing is finite).
+    let k = (forcing / target).log2().ceil().clamp(0.0, 1000.0) as i32;
+    let (down, up) = (0.5f64.powi(k), 2.0f64.powi(k));
+    let mut balanced = *m;
+    for row in balanced[..last].iter_mut() {
+        row[last] *= down;
+    }
+    let mut e = expm(&balanced)?;
+    for row in e[..last].iter_mut() {
+        row[last] *= up;
+    }
+    e[..last]
+        .iter()
+        .all(|row| row[last].is_finite())
+        .then_some(e)
+}
+
 pub fn identity<const N: usize>() -> Mat<N> {
     let mut e = [[0.0; N]; N];
     for (i, row) in e.iter_mut().enumerate() {
@@ -100,7 +137,58 @@ mod tests {
         assert!((small[0][1] - e[0][1]).abs() < 1e-15 && small[2][2] == 1.0);
         m[3][3] = 1e300;
         assert!(expm(&m).is_none());
+        assert!(expm_augmented(&m).is_none());
         m[3][3] = f64::NAN;
         assert!(expm(&m).is_none());
+    }
+
+    /// The balanced exponential of an augmented matrix matches the closed form where the forcing
+    /// dominates. The plain one loses accuracy there to its extra squarings: its `exp(J)` is off
+    /// by 9e-12 at a forcing of 1e6, 9e-9 at 1e12 and 0.9 at 1e22.
+    #[test]
+    fn balanced_augmented_exponential_matches_the_closed_form() {
+        // A damped rotor block with eigenvalues -1 and -4: exp(J) = a I + b J.
+        let j = [[0.0, 1.0], [-4.0, -5.0]];
+        let (l1, l2) = (-1.0f64, -4.0f64);
+        let b = (l1.exp() - l2.exp()) / (l1 - l2);
+        let a = l1.exp() - b * l1;
+        let exp_j = [
+            [a + b * j[0][0], b * j[0][1]],
+            [b * j[1][0], a + b * j[1][1]],
+        ];
+        // J^-1 = [[-5, -1], [4, 0]] / 4.
+        let inv = [[-1.25, -0.25], [1.0, 0.0]];
+        for forcing in [1e-3, 1.0, 1e6, 1e12, 1e22] {
+            let f = [0.5 * forcing, forcing];
+            let m = [
+                [j[0][0], j[0][1], f[0]],
+                [j[1][0], j[1][1], f[1]],
+                [0.0, 0.0, 0.0],
+            ];
+            let e = expm_augmented(&m).unwrap();
+            // (exp(J) - I) f, then J^-1 of it.
+            let g = [
+                (exp_j[0][0] - 1.0) * f[0] + exp_j[0][1] * f[1],
+                exp_j[1][0] * f[0] + (exp_j[1][1] - 1.0) * f[1],
+            ];
+            for i in 0..2 {
+                let column = inv[i][0] * g[0] + inv[i][1] * g[1];
+                assert!(
+                    (e[i][2] - column).abs() <= 1e-14 * forcing,
+                    "{forcing}: {i}: {} against {column}",
+                    e[i][2]
+                );
+                for k in 0..2 {
+                    assert!(
+                        (e[i][k] - exp_j[i][k]).abs() <= 1e-14,
+                        "{forcing}: [{i}][{k}]"
+                    );
+                }
+            }
+            assert_eq!(e[2], [0.0, 0.0, 1.0]);
+        }
+        // An overflowing forcing column is refused, never returned as infinity.
+        let huge = [[0.0, 1.0, 1e308], [-4.0, -3.0, 1e308], [0.0, 0.0, 0.0]];
+        assert!(expm_augmented(&huge).is_none_or(|e| e.iter().flatten().all(|x| x.is_finite())));
     }
 }

@@ -122,7 +122,7 @@ impl Motor {
                 m[i][1] = dt * j[i][1];
                 m[i][2] = dt * f[i];
             }
-            let e = expm::expm(&m)?;
+            let e = expm::expm_augmented(&m)?;
             out[0] += e[0][2];
             out[1] += e[1][2];
         } else {
@@ -133,7 +133,7 @@ impl Motor {
                 }
                 m[i][4] = dt * f[i];
             }
-            let e = expm::expm(&m)?;
+            let e = expm::expm_augmented(&m)?;
             for (i, x) in out.iter_mut().enumerate() {
                 *x += e[i][4];
             }
