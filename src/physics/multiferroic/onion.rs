@@ -120,7 +120,7 @@ impl Landscape<'_> {
     /// the gradient is a staircase of 1e-4 rad treads, where a tolerance relative to `psi` alone
     /// sent every refinement through 35 bisections.
     #[inline]
-    fn root_tolerance(&self, onion: f64) -> f64 {
+    pub(super) fn root_tolerance(&self, onion: f64) -> f64 {
         let largest = onion
             .abs()
             .max(self.bar_angle.abs())

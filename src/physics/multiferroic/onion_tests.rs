@@ -119,3 +119,33 @@ proptest! {
             "jump {} deg, slow ramp {} deg", jumped.to_degrees(), slow.to_degrees());
     }
 }
+
+#[test]
+fn a_rotor_far_out_settles_to_the_resolution_its_angles_have() {
+    // A restored or fuzzed state: the rotor 1.094e12 rad out, the onion near 5 rad. The gradient
+    // sees psi only through psi - phi, spaced 1.2e-4 rad there; a root tolerance finer than that
+    // (relative to psi alone) made every refinement bisect some 35 times.
+    let m = Motor::new(MotorParams::table_3_1()).unwrap();
+    let bar = 1.0940563349461193e12f64;
+    let spacing = bar - f64::from_bits(bar.to_bits() - 1);
+    for stress in [0.0, 50e6, 148e6] {
+        let landscape = m.landscape(bar, 0.3, stress);
+        assert!(landscape.root_tolerance(5.0) >= 4.0 * spacing);
+        assert!(landscape.root_tolerance(5.0) <= 16.0 * spacing);
+        let psi = landscape.settle(5.0);
+        // A minimum to that resolution: the energy rises a few spacings either side.
+        let step = 64.0 * spacing;
+        let (e, left, right) = (
+            landscape.energy(psi),
+            landscape.energy(psi - step),
+            landscape.energy(psi + step),
+        );
+        assert!(
+            psi.is_finite() && left >= e && right >= e,
+            "{stress}: {psi}"
+        );
+    }
+    // Where the angles are small, the tolerance stays 1e-15 relative.
+    let near = m.landscape(0.1, 0.3, 50e6);
+    assert!((near.root_tolerance(2.0) - 3e-15).abs() < 1e-29);
+}
