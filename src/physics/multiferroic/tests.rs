@@ -972,3 +972,38 @@ fn strain_direction_whole_half_turns_away_gives_the_same_motor() {
         assert!(s_near.rotor_angle.abs() > 1e-3 || load == 0.0);
     }
 }
+
+/// Fuzzing regression: the largest load with no stress drives a Table 3.1 rotor to
+/// `MAX_ANGLE` (1e12 rad) within about 0.1 ms, where no substep can be accepted. Each failed
+/// attempt settled the onion at an unrepresentable rotor angle (a flat landscape: a march of
+/// 2,000 strides), and the minimum-substep holds spent the whole default budget of 20,000
+/// attempts per step: 3-4 s per 0.1 s step. The rotor now holds at its limit, flagged, and the
+/// following steps cost a few substeps.
+#[test]
+fn a_rotor_driven_past_max_angle_holds_there_cheaply() {
+    let m = motor();
+    let inputs = MotorInputs {
+        load_torque: -MAX_LOAD_TORQUE,
+        ..MotorInputs::fixed(0.0, 0.0)
+    };
+    let mut s = MotorState::aligned(1.0);
+    let mut substeps = Vec::new();
+    for _ in 0..4 {
+        let r = m.step(&mut s, &inputs, 0.1).unwrap();
+        assert!(r.accuracy_limited);
+        substeps.push(r.substeps);
+        for x in [
+            s.rotor_angle,
+            s.rotor_speed,
+            s.onion_angle,
+            r.outputs.torque,
+        ] {
+            assert!(x.is_finite(), "{s:?}");
+        }
+        assert!(s.rotor_angle.abs() <= MAX_ANGLE && s.onion_angle.abs() <= MAX_ANGLE);
+    }
+    // The rotor ran far towards the limit (at 7e15 rad/s); it stops where a minimum substep
+    // would carry it past.
+    assert!(s.rotor_angle < -0.1 * MAX_ANGLE, "{s:?}");
+    assert!(substeps[1..].iter().all(|&n| n <= 16), "{substeps:?}");
+}
