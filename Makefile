@@ -235,6 +235,11 @@ FUZZ_SECONDS ?= 120
 ## Stop after this many sequences instead (libFuzzer's -runs), whichever limit comes first; e.g.
 ## `make fuzz SANITIZER=none FUZZ_RUNS=10000000 FUZZ_SECONDS=36000` for issue 19's 10 million.
 FUZZ_RUNS ?=
+## Fuzzing processes side by side (libFuzzer's -jobs and -workers), one per core for volume, e.g.
+## `make fuzz SANITIZER=none FUZZ_JOBS=2 FUZZ_RUNS=5000000 FUZZ_SECONDS=36000` for 10 million on
+## 2 cores. They share fuzz/corpus-run/; FUZZ_RUNS and FUZZ_SECONDS hold for each; each keeps its
+## log as fuzz/logs/$(SANITIZER)-job-N.log, and the summary line adds up all of them.
+FUZZ_JOBS ?= 1
 ## address (the default: AddressSanitizer, ~15x slower) or none (the plain build, for volume).
 SANITIZER ?= address
 ## Per-sequence limit in wall-clock seconds: the longest sequences take ~0.3 s of CPU, but a
@@ -254,12 +259,16 @@ fuzz:
 	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
 	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
 	mkdir -p fuzz/corpus-run/call_sequences fuzz/logs
+	rm -f fuzz/logs/$(SANITIZER)-job-*.log
 	cargo +nightly fuzz run -s $(SANITIZER) $(FUZZ_TARGET_DIR) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
 	  $(CURDIR)/fuzz/corpus/call_sequences $(CURDIR)/fuzz/regressions/call_sequences \
 	  -- -max_total_time=$(FUZZ_SECONDS) $(if $(FUZZ_RUNS),-runs=$(FUZZ_RUNS)) -timeout=$(FUZZ_TIMEOUT) \
-	  -rss_limit_mb=2048 -print_final_stats=1 \
-	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; test $${PIPESTATUS[0]} = 0
-	@grep -h 'stat::number_of_executed_units' fuzz/logs/$(SANITIZER).log \
+	  -rss_limit_mb=2048 -print_final_stats=1 $(if $(filter-out 1,$(FUZZ_JOBS)),-jobs=$(FUZZ_JOBS) -workers=$(FUZZ_JOBS)) \
+	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; status=$${PIPESTATUS[0]}; \
+	  for log in fuzz-[0-9]*.log; do [ ! -e "$$log" ] || mv "$$log" "fuzz/logs/$(SANITIZER)-job-$${log#fuzz-}"; done; \
+	  test $$status = 0
+	@grep -h 'stat::number_of_executed_units' \
+	  $(if $(filter-out 1,$(FUZZ_JOBS)),fuzz/logs/$(SANITIZER)-job-*.log,fuzz/logs/$(SANITIZER).log) \
 	  | awk '{n += $$2} END {print "make fuzz SANITIZER=$(SANITIZER): " n " sequences without a finding"}'
 	@git diff --exit-code --stat -- fuzz/Cargo.lock
 
