@@ -232,8 +232,7 @@ load: fmus
 	cargo test --release --test load -- --include-ignored --nocapture
 
 FUZZ_SECONDS ?= 120
-## Stop after this many sequences instead (libFuzzer's -runs), whichever limit comes first; e.g.
-## `make fuzz SANITIZER=none FUZZ_RUNS=10000000 FUZZ_SECONDS=36000` for issue 19's 10 million.
+## Stop after this many sequences instead (libFuzzer's -runs), whichever limit comes first.
 FUZZ_RUNS ?=
 ## Fuzzing processes side by side (libFuzzer's -jobs and -workers), one per core for volume, e.g.
 ## `make fuzz SANITIZER=none FUZZ_JOBS=2 FUZZ_RUNS=5000000 FUZZ_SECONDS=36000` for 10 million on
