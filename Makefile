@@ -239,6 +239,8 @@ FUZZ_RUNS ?=
 ## 2 cores. They share fuzz/corpus-run/; FUZZ_RUNS and FUZZ_SECONDS hold for each; each keeps its
 ## log as fuzz/logs/$(SANITIZER)-job-N.log, and the summary line adds up all of them.
 FUZZ_JOBS ?= 1
+# Non-empty when several jobs run; libFuzzer then writes each job's output to ./fuzz-N.log.
+FUZZ_PARALLEL = $(filter-out 1,$(FUZZ_JOBS))
 ## address (the default: AddressSanitizer, ~15x slower) or none (the plain build, for volume).
 SANITIZER ?= address
 ## Per-sequence limit in wall-clock seconds: the longest sequences take ~0.3 s of CPU, but a
@@ -262,12 +264,12 @@ fuzz:
 	cargo +nightly fuzz run -s $(SANITIZER) $(FUZZ_TARGET_DIR) call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
 	  $(CURDIR)/fuzz/corpus/call_sequences $(CURDIR)/fuzz/regressions/call_sequences \
 	  -- -max_total_time=$(FUZZ_SECONDS) $(if $(FUZZ_RUNS),-runs=$(FUZZ_RUNS)) -timeout=$(FUZZ_TIMEOUT) \
-	  -rss_limit_mb=2048 -print_final_stats=1 $(if $(filter-out 1,$(FUZZ_JOBS)),-jobs=$(FUZZ_JOBS) -workers=$(FUZZ_JOBS)) \
+	  -rss_limit_mb=2048 -print_final_stats=1 $(if $(FUZZ_PARALLEL),-jobs=$(FUZZ_JOBS) -workers=$(FUZZ_JOBS)) \
 	  2>&1 | tee fuzz/logs/$(SANITIZER).log | grep -v '^#[0-9]' ; status=$${PIPESTATUS[0]}; \
 	  for log in fuzz-[0-9]*.log; do [ ! -e "$$log" ] || mv "$$log" "fuzz/logs/$(SANITIZER)-job-$${log#fuzz-}"; done; \
 	  test $$status = 0
 	@grep -h 'stat::number_of_executed_units' \
-	  $(if $(filter-out 1,$(FUZZ_JOBS)),fuzz/logs/$(SANITIZER)-job-*.log,fuzz/logs/$(SANITIZER).log) \
+	  $(if $(FUZZ_PARALLEL),fuzz/logs/$(SANITIZER)-job-*.log,fuzz/logs/$(SANITIZER).log) \
 	  | awk '{n += $$2} END {print "make fuzz SANITIZER=$(SANITIZER): " n " sequences without a finding"}'
 	@git diff --exit-code --stat -- fuzz/Cargo.lock
 
