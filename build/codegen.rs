@@ -428,6 +428,19 @@ pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
         let _ = writeln!(code, "        }}");
         let _ = writeln!(code, "    }}");
     }
+    // The out-of-range flag (`src/fmi2/out_of_range.rs`, FLAG) written by its field, so that
+    // the per-step path does not look its value reference up in the Booleans' `match`.
+    let flag = arms_of(model, 2)?
+        .into_iter()
+        .find(|(_, g, f)| *g == "outputs" && f == "input_clamped")
+        .map_or(String::new(), |(_, g, f)| {
+            format!("values.{g}.{f} = value;")
+        });
+    let _ = writeln!(code, "    #[inline(always)]");
+    let _ = writeln!(
+        code,
+        "    fn set_input_clamped(values: &mut Values<Self>, value: bool) {{ {flag} }}"
+    );
     let _ = writeln!(code, "}}\n");
     Ok(())
 }

@@ -46,12 +46,6 @@ impl OutOfRange {
         }
     }
 
-    /// The value reference of the `input_clamped` output, if the model has one.
-    #[inline]
-    pub fn flag(&self) -> Option<usize> {
-        self.flag
-    }
-
     /// A report with nothing clamped: the flag says so (what [`OutOfRange::apply`] does then).
     #[inline]
     pub fn clear_flag(&self, runtime: &mut dyn Runtime) {

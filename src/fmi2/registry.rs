@@ -17,6 +17,8 @@ pub trait Bindings: Interface + Sized {
     fn set_boolean(values: &mut Values<Self>, vr: usize, value: bool);
     fn string(values: &Values<Self>, vr: usize) -> &str;
     fn set_string(values: &mut Values<Self>, vr: usize, value: &str);
+    /// Writes the `input_clamped` output, if the model has one (else nothing).
+    fn set_input_clamped(values: &mut Values<Self>, value: bool);
 }
 
 include!(concat!(env!("OUT_DIR"), "/model_bindings.rs"));

@@ -127,10 +127,9 @@ pub trait Runtime: Send {
     fn build(&mut self) -> Result<(), String>;
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
-    /// Steps the model; with `clamp_flag` (the `input_clamped` output's value reference) also
-    /// writes that flag from the report, as [`super::out_of_range::OutOfRange::apply`] would,
-    /// within this one dynamic call.
-    fn step(&mut self, time: f64, step: f64, report: &mut Report, clamp_flag: Option<usize>);
+    /// Steps the model and writes its `input_clamped` output (if it has one) from the report, as
+    /// [`super::out_of_range::OutOfRange::apply`] would, within this one dynamic call.
+    fn step(&mut self, time: f64, step: f64, report: &mut Report);
     /// Model Exchange, event mode: commits the history at the current inputs and writes the
     /// outputs ([`Model::update_discrete_states`]).
     fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate;
@@ -336,16 +335,14 @@ where
             self.mirror_states();
         }
     }
-    #[inline]
-    fn step(&mut self, time: f64, step: f64, report: &mut Report, clamp_flag: Option<usize>) {
+    #[inline(always)]
+    fn step(&mut self, time: f64, step: f64, report: &mut Report) {
         if let Some(model) = self.model.as_mut() {
             let v = &mut self.values;
             model.step(&v.inputs, &mut v.outputs, time, step, report);
             report.evaluated = true;
             self.outputs_stale = false;
-            if let Some(flag) = clamp_flag {
-                M::Variables::set_boolean(v, flag, report.clamped);
-            }
+            M::Variables::set_input_clamped(v, report.clamped);
         }
     }
     fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate {

@@ -181,7 +181,18 @@ fn out_of_range(
     *logged = true;
 }
 
+/// A length beyond the bare sleeve's reach `b`: evaluated at `b`. Out of line, so that the
+/// per-step path of the ideal muscle stays small enough to inline.
+#[cold]
+#[inline(never)]
+fn beyond_sleeve(logged: &mut bool, report: &mut Report, pressure: f64, requested: f64, b: f64) {
+    let reason =
+        format!("length {requested} m is outside [0, b = {b}] m, the ideal sleeve's range");
+    out_of_range(logged, report, &reason, (0.0, b), Some((pressure, b)));
+}
+
 /// Eq. 2.3 for the bare sleeve; the outputs of the absent effects keep their neutral values.
+#[inline(always)]
 fn sleeve_outputs(
     sleeve: &Sleeve,
     inputs: &Inputs,
@@ -192,9 +203,7 @@ fn sleeve_outputs(
     let (pressure, requested) = (inputs.pressure, inputs.length);
     let b = sleeve.max_length();
     let length = if requested > b {
-        let reason =
-            format!("length {requested} m is outside [0, b = {b}] m, the ideal sleeve's range");
-        out_of_range(logged, report, &reason, (0.0, b), Some((pressure, b)));
+        beyond_sleeve(logged, report, pressure, requested, b);
         b
     } else {
         *logged = false;
@@ -219,7 +228,27 @@ fn sleeve_outputs(
 
 impl McKibbenMuscle {
     /// Writes the outputs of the selected pipeline; `commit` advances the friction history.
+    /// The bare sleeve's path (eq. 2.3 alone) is inline; the rest is out of line.
+    #[inline(always)]
     fn outputs(
+        &mut self,
+        inputs: &Inputs,
+        outputs: &mut Outputs,
+        report: &mut Report,
+        commit: bool,
+    ) {
+        if let (Pipeline::Sleeve(sleeve), None, None) = (&self.pipeline, &self.notice, &self.solver)
+        {
+            outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
+            sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report);
+        } else {
+            self.all_outputs(inputs, outputs, report, commit);
+        }
+    }
+
+    /// [`McKibbenMuscle::outputs`] of any pipeline, with the notice and the pressure solver.
+    #[inline(never)]
+    fn all_outputs(
         &mut self,
         inputs: &Inputs,
         outputs: &mut Outputs,
@@ -542,6 +571,7 @@ impl Model for McKibbenMuscle {
         self.outputs(inputs, outputs, report, false)
     }
 
+    #[inline]
     fn step(
         &mut self,
         inputs: &Inputs,

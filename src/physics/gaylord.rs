@@ -10,6 +10,8 @@ use std::f64::consts::PI;
 pub struct Sleeve {
     pub strand_length: f64,
     pub turns: f64,
+    /// [`Sleeve::scale`], computed once: a division per evaluation otherwise.
+    scale: f64,
 }
 
 impl Sleeve {
@@ -26,13 +28,14 @@ impl Sleeve {
         Ok(Self {
             strand_length,
             turns,
+            scale: 1.0 / (4.0 * PI * turns * turns),
         })
     }
 
-    /// `b^2 / (4 pi n^2)`, the common factor of eq. 2.2 and 2.3 in units of b.
+    /// `1 / (4 pi n^2)`, the common factor of eq. 2.2 and 2.3.
     #[inline]
     fn scale(&self) -> f64 {
-        1.0 / (4.0 * PI * self.turns * self.turns)
+        self.scale
     }
 
     /// Cylinder diameter at length `L`: `D = b sin(theta) / (n pi)` with `cos(theta) = L / b`.

@@ -58,17 +58,32 @@ pub(in crate::fmi2) unsafe fn set_reals<R: Runtime + 'static>(
     // A rule's fast states are a subset of those that allow a set: no separate state check.
     let state = inst.state.bit();
     let rules = &inst.set_rules[0];
+    let accepts = |vr: u32, value: f64| {
+        rules
+            .get(vr as usize)
+            .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
+    };
+    // Most masters set one value per call: checked and stored without a loop.
     let fast = !inst.logger.debug
-        && vrs.iter().zip(values).all(|(&vr, &value)| {
-            rules
-                .get(vr as usize)
-                .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
-        });
+        && match (vrs, values) {
+            ([vr], [value]) => accepts(*vr, *value),
+            _ => vrs
+                .iter()
+                .zip(values)
+                .all(|(&vr, &value)| accepts(vr, value)),
+        };
     if !fast {
         return inst.set_general("fmi2SetReal", vrs, values);
     }
     // SAFETY: the caller promises that R is the runtime's type.
-    unsafe { inst.runtime_as::<R>() }.set_reals(vrs, values, false);
+    let runtime = unsafe { inst.runtime_as::<R>() };
+    match (vrs, values) {
+        ([vr], [value]) => {
+            runtime.set_real(*vr as usize, *value);
+            runtime.changed(false);
+        }
+        _ => runtime.set_reals(vrs, values, false),
+    }
     fmi2Status::OK
 }
 
@@ -81,17 +96,52 @@ pub(in crate::fmi2) unsafe fn do_step<R: Runtime + 'static>(
     time: f64,
     step: f64,
 ) -> fmi2Status {
-    const F: &str = "fmi2DoStep";
-    if !inst.quietly_allowed(allowed::DO_STEP) && !inst.allowed(F, allowed::DO_STEP) {
+    // The checks of a step that the standard accepts without a word, none of which calls out:
+    // anything else takes the general checks, out of line, which refuse or log as before.
+    if !(inst.quietly_allowed(allowed::DO_STEP) && inst.step_accepted(time, step)) {
+        // SAFETY: the caller's promise.
+        return unsafe { step_checked::<R>(inst, time, step) };
+    }
+    // SAFETY: the caller's promise.
+    unsafe { step_unchecked::<R>(inst, time, step) }
+}
+
+/// `fmi2DoStep` after a state or step check that did not pass at once: refused with the reason,
+/// or (a logged call, a communication point off by rounding) stepped after all.
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+#[cold]
+#[inline(never)]
+unsafe fn step_checked<R: Runtime + 'static>(
+    inst: &mut Instance,
+    time: f64,
+    step: f64,
+) -> fmi2Status {
+    if !inst.quietly_allowed(allowed::DO_STEP) && !inst.allowed("fmi2DoStep", allowed::DO_STEP) {
         return fmi2Status::Error;
     }
     if let Some(refused) = inst.step_refused(time, step) {
         return refused;
     }
+    // SAFETY: the caller's promise.
+    unsafe { step_unchecked::<R>(inst, time, step) }
+}
+
+/// The step itself, its checks passed.
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+#[inline(always)]
+unsafe fn step_unchecked<R: Runtime + 'static>(
+    inst: &mut Instance,
+    time: f64,
+    step: f64,
+) -> fmi2Status {
+    const F: &str = "fmi2DoStep";
     let mut report = Report::default();
-    let flag = inst.out_of_range.flag();
     // SAFETY: the caller promises that R is the runtime's type.
-    unsafe { inst.runtime_as::<R>() }.step(time, step, &mut report, flag);
+    unsafe { inst.runtime_as::<R>() }.step(time, step, &mut report);
     // The flag is written: only a report with something to say needs more.
     let status = if quiet(&report) {
         let status = to_fmi(report.status);
@@ -121,8 +171,38 @@ pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
     vrs: &[u32],
     out: &mut [f64],
 ) -> fmi2Status {
+    // Most masters get one value per call: read without a loop, the loop out of line.
+    let ([vr], [slot]) = (vrs, &mut *out) else {
+        // SAFETY: the caller's promise.
+        return unsafe { get_many_reals::<R>(inst, vrs, out) };
+    };
     // Current outputs are what the general path hands out in every state that allows a get:
     // it refreshes only stale ones.
+    let known = (*vr as usize) < inst.set_rules[0].len();
+    if known && inst.quietly_allowed(allowed::GET) {
+        // SAFETY: the caller promises that R is the runtime's type.
+        let runtime = unsafe { inst.runtime_as::<R>() };
+        if runtime.outputs_current() {
+            let x = runtime.real(*vr as usize);
+            if finite(x) {
+                *slot = x;
+                return fmi2Status::OK;
+            }
+        }
+    }
+    inst.get_reals_general(vrs, out)
+}
+
+/// [`get_reals`] of any number of values.
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+#[inline(never)]
+unsafe fn get_many_reals<R: Runtime + 'static>(
+    inst: &mut Instance,
+    vrs: &[u32],
+    out: &mut [f64],
+) -> fmi2Status {
     if inst.quietly_allowed(allowed::GET) {
         let count = inst.set_rules[0].len();
         // SAFETY: the caller promises that R is the runtime's type.
@@ -131,7 +211,7 @@ pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
             let mut fast = true;
             for (&vr, slot) in vrs.iter().zip(out.iter_mut()) {
                 let x = runtime.real(vr as usize);
-                fast &= (vr as usize) < count && x.is_finite();
+                fast &= (vr as usize) < count && finite(x);
                 *slot = x;
             }
             if fast {
@@ -140,4 +220,10 @@ pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
         }
     }
     inst.get_reals_general(vrs, out)
+}
+
+/// `x.is_finite()` in one subtraction and one compare: `x - x` is NaN for NaN and the infinities.
+#[inline(always)]
+fn finite(x: f64) -> bool {
+    x - x == 0.0
 }

@@ -198,6 +198,19 @@ impl Instance {
         unsafe { (self.hot.do_step)(self as *mut Self as _, time, step, 0) }
     }
 
+    /// Whether [`Instance::step_refused`] accepts this step without the rounding allowance: a
+    /// positive finite step from our own time that ends by the stop time. No call out, so that the
+    /// per-step path keeps its arguments in registers.
+    #[inline(always)]
+    pub(super) fn step_accepted(&self, time: f64, step: f64) -> bool {
+        // Positive finite doubles are the bit patterns 1 ..= INFINITY - 1 (NaN's are above).
+        let positive_finite = step.to_bits().wrapping_sub(1) < f64::INFINITY.to_bits() - 1;
+        // Zero only for equal finite times: an infinite clock (a step that overflowed) differs.
+        positive_finite
+            && time - self.time == 0.0
+            && self.stop_time.is_none_or(|stop| time + step <= stop)
+    }
+
     /// The refusal of a step of `step` from `time`, if any (the caller checked the state). The
     /// tests are inline, their messages built out of line.
     #[inline(always)]
@@ -213,7 +226,7 @@ impl Instance {
         if !time.is_finite() || !(exact || self.within_rounding(time)) {
             return Some(self.refuse_communication_point(time));
         }
-        if let Some(stop) = self.stop_time {
+        if let Some(stop) = self.stop_time.filter(|&stop| time + step > stop) {
             // A step computed as stop - time may overshoot by rounding of either.
             let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
             if time + step > stop + tolerance {

@@ -125,6 +125,7 @@ impl Bindings for GainVariables {
         ""
     }
     fn set_string(_: &mut Values<Self>, _: usize, _: &str) {}
+    fn set_input_clamped(_: &mut Values<Self>, _: bool) {}
 }
 
 impl Model for Gain {
