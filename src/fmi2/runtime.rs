@@ -297,7 +297,10 @@ where
     #[inline]
     fn changed(&mut self, parameters: bool) {
         self.outputs_stale = true;
-        self.rejected = None;
+        // Tested first: the per-step path then only reads it.
+        if self.rejected.is_some() {
+            self.rejected = None;
+        }
         if parameters {
             self.model = None;
         }

@@ -13,7 +13,7 @@
 //! parameter among them. Anything else goes to the general code in `values.rs` and `machine.rs`,
 //! which checks again and refuses, logs or rebuilds exactly as before.
 
-use super::{allowed, quiet, to_fmi, Instance, MachineState};
+use super::{allowed, to_fmi, Instance, MachineState};
 pub use crate::fmi2::exports::HotPath;
 use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::fmi2Status;
@@ -55,35 +55,57 @@ pub(in crate::fmi2) unsafe fn set_reals<R: Runtime + 'static>(
     vrs: &[u32],
     values: &[f64],
 ) -> fmi2Status {
-    // A rule's fast states are a subset of those that allow a set: no separate state check.
-    let state = inst.state.bit();
-    let rules = &inst.set_rules[0];
-    let accepts = |vr: u32, value: f64| {
-        rules
-            .get(vr as usize)
-            .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
+    // Most masters set one value per call: checked and stored without a loop, the loop and the
+    // general path out of line.
+    let ([vr], [value]) = (vrs, values) else {
+        // SAFETY: the caller's promise.
+        return unsafe { set_many_reals::<R>(inst, vrs, values) };
     };
-    // Most masters set one value per call: checked and stored without a loop.
+    if inst.logger.debug || !accepts(inst, *vr, *value) {
+        return set_general(inst, vrs, values);
+    }
+    // SAFETY: the caller promises that R is the runtime's type.
+    let runtime = unsafe { inst.runtime_as::<R>() };
+    runtime.set_real(*vr as usize, *value);
+    runtime.changed(false);
+    fmi2Status::OK
+}
+
+/// Whether the per-step path may store `value` at `vr` now: a rule's fast states are a subset of
+/// those that allow a set, so no separate state check.
+#[inline(always)]
+fn accepts(inst: &Instance, vr: u32, value: f64) -> bool {
+    let state = inst.state.bit();
+    inst.set_rules[0]
+        .get(vr as usize)
+        .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
+}
+
+#[inline(never)]
+fn set_general(inst: &mut Instance, vrs: &[u32], values: &[f64]) -> fmi2Status {
+    inst.set_general("fmi2SetReal", vrs, values)
+}
+
+/// [`set_reals`] of any number of values.
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+#[inline(never)]
+unsafe fn set_many_reals<R: Runtime + 'static>(
+    inst: &mut Instance,
+    vrs: &[u32],
+    values: &[f64],
+) -> fmi2Status {
     let fast = !inst.logger.debug
-        && match (vrs, values) {
-            ([vr], [value]) => accepts(*vr, *value),
-            _ => vrs
-                .iter()
-                .zip(values)
-                .all(|(&vr, &value)| accepts(vr, value)),
-        };
+        && vrs
+            .iter()
+            .zip(values)
+            .all(|(&vr, &value)| accepts(inst, vr, value));
     if !fast {
         return inst.set_general("fmi2SetReal", vrs, values);
     }
     // SAFETY: the caller promises that R is the runtime's type.
-    let runtime = unsafe { inst.runtime_as::<R>() };
-    match (vrs, values) {
-        ([vr], [value]) => {
-            runtime.set_real(*vr as usize, *value);
-            runtime.changed(false);
-        }
-        _ => runtime.set_reals(vrs, values, false),
-    }
+    unsafe { inst.runtime_as::<R>() }.set_reals(vrs, values, false);
     fmi2Status::OK
 }
 
@@ -142,21 +164,23 @@ unsafe fn step_unchecked<R: Runtime + 'static>(
     let mut report = Report::default();
     // SAFETY: the caller promises that R is the runtime's type.
     unsafe { inst.runtime_as::<R>() }.step(time, step, &mut report);
-    // The flag is written: only a report with something to say needs more.
-    let status = if quiet(&report) {
-        let status = to_fmi(report.status);
-        if report.messages.capacity() == 0 && report.clamp_messages.capacity() == 0 {
-            // Nothing to free: skip the out-of-line drop of the empty report.
+    // The flag is written: only a report with something to say needs more. A report that never
+    // allocated holds no message: nothing to log, nothing to free (the drop is out of line).
+    let status =
+        if !report.clamped && report.messages.capacity() | report.clamp_messages.capacity() == 0 {
+            let status = to_fmi(report.status);
             std::mem::forget(report);
-        }
-        status
+            status
+        } else {
+            inst.forward_messages(F, report, true)
+        };
+    // Compares, not a `match`: that compiled to a jump table, an indirect jump per step.
+    if status <= fmi2Status::Warning {
+        inst.time = time + step;
+    } else if status == fmi2Status::Discard {
+        inst.state = MachineState::StepFailed;
     } else {
-        inst.forward_messages(F, report, true)
-    };
-    match status {
-        fmi2Status::OK | fmi2Status::Warning => inst.time = time + step,
-        fmi2Status::Discard => inst.state = MachineState::StepFailed,
-        _ => inst.state = MachineState::Error,
+        inst.state = MachineState::Error;
     }
     status
 }
@@ -224,6 +248,7 @@ unsafe fn get_many_reals<R: Runtime + 'static>(
 
 /// `x.is_finite()` in one subtraction and one compare: `x - x` is NaN for NaN and the infinities.
 #[inline(always)]
+#[allow(clippy::eq_op)]
 fn finite(x: f64) -> bool {
     x - x == 0.0
 }
