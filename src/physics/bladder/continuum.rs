@@ -83,8 +83,8 @@ pub(super) fn wall_nodes(nodes: usize) -> Vec<WallNode> {
         .collect()
 }
 
-#[derive(Clone, Copy)]
 /// What the node sums depend on at one call (functions of the muscle length and outer diameter).
+#[derive(Clone, Copy)]
 pub(super) struct WallCall<T> {
     lambda1: T,
     x_sq: T,
