@@ -17,12 +17,20 @@
 //! unstretched wall, and an `n`-point Gauss-Legendre rule converges like `rho^-2n` where the
 //! layered sum (a left Riemann sum) converges like `1/n`.
 
+use super::dual::Dual;
 use super::hyper_dual::KernelScalar;
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
-use std::f64::consts::PI;
+use std::f64::consts::{LOG2_E, PI};
 
 /// Nodes whose positions are computed ahead of their algebra, at a time (stack buffer).
 const NODE_CHUNK: usize = 16;
+/// Mirror pairs of nodes per block of the [`Dual`] path: its 8 nodes are 8 independent lanes.
+const PAIRS: usize = 4;
+const LANES: usize = 2 * PAIRS;
+/// Largest `ln(outer gap / inner gap)` of the [`Dual`] path: keeps `|span t| <= 700`, so that
+/// [`exp_pairs`]'s powers of two stay normal. (A ratio of e^1400 is not met in practice; beyond
+/// it the generic path takes over.)
+const MAX_SPAN: f64 = 1400.0;
 
 /// One Gauss-Legendre node on `[0, 1]`: where it sits between the inner and the outer wall in
 /// the logarithm of the deformed diameter, and its weight (the weights sum to 1).
@@ -75,6 +83,31 @@ pub(super) fn wall_nodes(nodes: usize) -> Vec<WallNode> {
         .collect()
 }
 
+/// What the node sums depend on at one call (functions of the muscle length and outer diameter).
+#[derive(Clone, Copy)]
+pub(super) struct WallCall<T> {
+    lambda1: T,
+    x_sq: T,
+    d_ro_sq: f64,
+    /// The singular point the nodes are placed from (see [`Bladder::continuum_kernel`]).
+    u_0: T,
+    /// `d_in^2 - u_0` and `x^2 - u_0`.
+    inner_gap: T,
+    outer_gap: T,
+}
+
+/// `span = ln(outer_gap / inner_gap)` and the node sums (each still to be multiplied by `span`):
+/// the jacobian `e w / 2` (`e = u - u_0`, `w` the weight) alone and times `l2^2`, `1/l2^2`,
+/// `l2^2 / d^3` and `1/(l2^2 d^3)`.
+pub(super) struct WallSums<T> {
+    span: T,
+    jac: T,
+    l2: T,
+    inv_l2: T,
+    l2_h: T,
+    inv_l2_h: T,
+}
+
 impl<S: SleeveGeometry> Bladder<S> {
     /// The continuum wall at muscle length `l` and outer diameter `x`: the same [`Kernel`] as the
     /// layer recursion, from the closed form above. `None` where a squared hoop stretch is not
@@ -111,10 +144,10 @@ impl<S: SleeveGeometry> Bladder<S> {
         // The inner wall, exactly (eq. 2.20 at s = D_RI).
         let d_in_sq = x_sq - inv_lambda1 * (d_ro * d_ro - d_ri * d_ri);
         let l2_in = d_in_sq * (1.0 / (d_ri * d_ri));
-        let (hoop_in, axial_in) = mooney(l2_in, l2_in.recip())?;
+        // One division for 1/d_in and 1/l2_in.
         let d_in = d_in_sq.sqrt();
         let inv_d_in = d_in.recip();
-        let zero = T::constant(0.0);
+        let (hoop_in, axial_in) = mooney(l2_in, inv_d_in * inv_d_in * (d_ri * d_ri))?;
         // Through the wall in the squared deformed diameter u = d^2 (du = 2 s ds / lambda_1):
         // int g ds = int h / (2 d^3) du, int g Phi ds = pi/6 int h (x^3 - d^3) / (2 d^3) du and
         // int sigma_axial w ds = pi/4 int sigma_axial du. The integrands are singular where d = 0
@@ -122,71 +155,35 @@ impl<S: SleeveGeometry> Bladder<S> {
         // approaches the inner wall as it collapses (d_in -> 0, near the fill limit) or as the
         // wall's own bore dominates. So the nodes are placed evenly in ln(u - u_0) with u_0 the
         // nearer singular point: each integrand is then smooth on the scale of the interval.
-        let u_s = x_sq - lambda1.recip() * (d_ro * d_ro);
-        let u_0 = if u_s.value() > 0.0 { u_s } else { zero };
-        let (inner_gap, outer_gap) = (d_in_sq - u_0, x_sq - u_0);
-        let ln_in = inner_gap.ln();
-        let span = outer_gap.ln() - ln_in;
+        let u_s = x_sq - inv_lambda1 * (d_ro * d_ro);
+        let u_0 = if u_s.value() > 0.0 {
+            u_s
+        } else {
+            T::constant(0.0)
+        };
+        let call = WallCall {
+            lambda1,
+            x_sq,
+            d_ro_sq: d_ro * d_ro,
+            u_0,
+            inner_gap: d_in_sq - u_0,
+            outer_gap: x_sq - u_0,
+        };
+        let sums = T::wall_sums(&self.nodes, &call)?;
+        let span = sums.span;
         // With l3^2 = 1/(lambda_1^2 l2^2), eq. 2.9b's hoop difference is l2^2 A - B / l2^2 and the
         // node-dependent part of the axial one l2^2 A' - B' / l2^2, with A, B, A', B' fixed per
         // call: so the nodes only add up l2^2 and 1/l2^2 with two weights each.
         let c2_lambda = lambda1_sq * c2x2;
         let c1_over_lambda = inv_lambda1_sq * c1x2;
-        let (mut jac_sum, mut l2_sum, mut inv_l2_sum) = (zero, zero, zero);
-        let (mut l2_h_sum, mut inv_l2_h_sum) = (zero, zero);
-        // The node positions first, then the nodes' algebra: with the libm `exp` calls out of
-        // the second loop, the nodes' square roots and divisions (independent from node to node)
-        // overlap in the pipeline instead of waiting on each other behind every call; the
-        // kernel was latency-bound.
-        let mut positions = [zero; NODE_CHUNK];
-        let n = self.nodes.len();
-        for chunk in self.nodes.chunks(NODE_CHUNK) {
-            if n == chunk.len() {
-                // The nodes are symmetric (`at` and `1 - at`), so a node's `u - u_0` times its
-                // mirror's is `(d_in^2 - u_0)(x^2 - u_0)`: half the `exp` calls.
-                let product = inner_gap * outer_gap;
-                for i in 0..n.div_ceil(2) {
-                    let e = (ln_in + span * chunk[i].at).exp();
-                    positions[i] = e;
-                    positions[n - 1 - i] = product * e.recip();
-                }
-            } else {
-                for (slot, node) in positions.iter_mut().zip(chunk) {
-                    *slot = (ln_in + span * node.at).exp();
-                }
-            }
-            for (&e, node) in positions.iter().zip(chunk) {
-                let u = u_0 + e;
-                // Two divisions per node: 1/sqrt(u) gives 1/d^3 and 1/u, and 1/s^2.
-                let inv_d = u.rsqrt();
-                let inv_u = inv_d * inv_d;
-                // s^2 = D_RO^2 - lambda_1 (x^2 - u) (eq. 2.20 solved for the unstretched diameter).
-                let s_sq = (u - x_sq) * lambda1 + d_ro * d_ro;
-                let l2_sq = u * s_sq.recip();
-                let inv_l2_sq = s_sq * inv_u;
-                if !(l2_sq.value() > 0.0
-                    && l2_sq.value().is_finite()
-                    && inv_l2_sq.value().is_finite())
-                {
-                    return None;
-                }
-                let jacobian = e * (node.weight * 0.5);
-                let (l2_term, inv_l2_term) = (l2_sq * jacobian, inv_l2_sq * jacobian);
-                let per_d3 = inv_u * inv_d;
-                jac_sum = jac_sum + jacobian;
-                l2_sum = l2_sum + l2_term;
-                inv_l2_sum = inv_l2_sum + inv_l2_term;
-                l2_h_sum = l2_h_sum + l2_term * per_d3;
-                inv_l2_h_sum = inv_l2_h_sum + inv_l2_term * per_d3;
-            }
-        }
         let (hoop_a, hoop_b) = (c2_lambda + c1x2, c1_over_lambda + c2x2);
         // int h / (2 d^3) du, int h du / 2 and int sigma_axial du / 2 over the nodes.
-        let h_sum = l2_h_sum * hoop_a - inv_l2_h_sum * hoop_b;
+        let h_sum = sums.l2_h * hoop_a - sums.inv_l2_h * hoop_b;
         // h (x^3 - d^3) / (2 d^3) = x^3 h / (2 d^3) - h / 2: the first part is x^3 h_sum.
-        let hoop_sum = l2_sum * hoop_a - inv_l2_sum * hoop_b;
-        let axial_sum = jac_sum * (lambda1_sq * c1x2 - inv_lambda1_sq * c2x2) + l2_sum * c2_lambda
-            - inv_l2_sum * c1_over_lambda;
+        let hoop_sum = sums.l2 * hoop_a - sums.inv_l2 * hoop_b;
+        let axial_sum = sums.jac * (lambda1_sq * c1x2 - inv_lambda1_sq * c2x2)
+            + sums.l2 * c2_lambda
+            - sums.inv_l2 * c1_over_lambda;
         let h_phi_sum = x_cu * h_sum - hoop_sum;
         let a = x * inv_d_in;
         let c = x * h_sum * span;
@@ -210,4 +207,269 @@ impl<S: SleeveGeometry> Bladder<S> {
             },
         })
     }
+}
+
+/// The node sums for any [`KernelScalar`] (the second order, and the [`Dual`] path's fallback):
+/// node by node, with libm's `exp`.
+pub(super) fn node_sums<T: KernelScalar>(
+    nodes: &[WallNode],
+    call: &WallCall<T>,
+) -> Option<WallSums<T>> {
+    let WallCall {
+        lambda1,
+        x_sq,
+        d_ro_sq,
+        u_0,
+        inner_gap,
+        outer_gap,
+    } = *call;
+    let zero = T::constant(0.0);
+    let ln_in = inner_gap.ln();
+    let span = outer_gap.ln() - ln_in;
+    let (mut jac_sum, mut l2_sum, mut inv_l2_sum) = (zero, zero, zero);
+    let (mut l2_h_sum, mut inv_l2_h_sum) = (zero, zero);
+    // The node positions first, then the nodes' algebra: with the libm `exp` calls out of
+    // the second loop, the nodes' square roots and divisions (independent from node to node)
+    // overlap in the pipeline instead of waiting on each other behind every call.
+    let mut positions = [zero; NODE_CHUNK];
+    let n = nodes.len();
+    for chunk in nodes.chunks(NODE_CHUNK) {
+        if n == chunk.len() {
+            // The nodes are symmetric (`at` and `1 - at`), so a node's `u - u_0` times its
+            // mirror's is `(d_in^2 - u_0)(x^2 - u_0)`: half the `exp` calls.
+            let product = inner_gap * outer_gap;
+            for i in 0..n.div_ceil(2) {
+                let e = (ln_in + span * chunk[i].at).exp();
+                positions[i] = e;
+                positions[n - 1 - i] = product * e.recip();
+            }
+        } else {
+            for (slot, node) in positions.iter_mut().zip(chunk) {
+                *slot = (ln_in + span * node.at).exp();
+            }
+        }
+        for (&e, node) in positions.iter().zip(chunk) {
+            let u = u_0 + e;
+            // Two divisions per node: 1/sqrt(u) gives 1/d^3 and 1/u, and 1/s^2.
+            let inv_d = u.rsqrt();
+            let inv_u = inv_d * inv_d;
+            // s^2 = D_RO^2 - lambda_1 (x^2 - u) (eq. 2.20 solved for the unstretched diameter).
+            let s_sq = (u - x_sq) * lambda1 + d_ro_sq;
+            let l2_sq = u * s_sq.recip();
+            let inv_l2_sq = s_sq * inv_u;
+            if !(l2_sq.value() > 0.0 && l2_sq.value().is_finite() && inv_l2_sq.value().is_finite())
+            {
+                return None;
+            }
+            let jacobian = e * (node.weight * 0.5);
+            let (l2_term, inv_l2_term) = (l2_sq * jacobian, inv_l2_sq * jacobian);
+            let per_d3 = inv_u * inv_d;
+            jac_sum = jac_sum + jacobian;
+            l2_sum = l2_sum + l2_term;
+            inv_l2_sum = inv_l2_sum + inv_l2_term;
+            l2_h_sum = l2_h_sum + l2_term * per_d3;
+            inv_l2_h_sum = inv_l2_h_sum + inv_l2_term * per_d3;
+        }
+    }
+    Some(WallSums {
+        span,
+        jac: jac_sum,
+        l2: l2_sum,
+        inv_l2: inv_l2_sum,
+        l2_h: l2_h_sum,
+        inv_l2_h: inv_l2_h_sum,
+    })
+}
+
+/// `(exp(y), exp(-y))` lane by lane for `|y| <= 700`, within 1e-15 relative (tested; 2 ulp seen).
+///
+/// Hand-written instead of libm's `exp` because the four lanes then run in lock-step in vector
+/// registers (libm calls do not vectorize) and one polynomial gives both signs: `y = k ln 2 + r`
+/// with `|r| <= ln 2 / 2`, `exp(+-y) = 2^(+-k) (C(r) +- S(r))` with `C` and `S` the even and odd
+/// parts of the Taylor series, cut where the next term is below 3e-16 of `exp(r)`.
+#[inline(always)]
+pub(super) fn exp_pairs(y: [f64; PAIRS]) -> ([f64; PAIRS], [f64; PAIRS]) {
+    // 1.5 * 2^52: adding it rounds to an integer held in the low bits of the sum.
+    const SHIFT: f64 = 6755399441055744.0;
+    // ln 2 in two parts, the first with enough trailing zeros that k ln2_hi is exact.
+    const LN2_HI: f64 = f64::from_bits(0x3fe6_2e42_fee0_0000);
+    const LN2_LO: f64 = 1.908_214_929_270_587_7e-10;
+    let (mut plus, mut minus) = ([0.0; PAIRS], [0.0; PAIRS]);
+    for j in 0..PAIRS {
+        let shifted = y[j] * LOG2_E + SHIFT;
+        let k = shifted - SHIFT;
+        let r = (y[j] - k * LN2_HI) - k * LN2_LO;
+        let z = r * r;
+        // Estrin's scheme (in z, z^2, z^4): a shorter dependency chain than Horner's.
+        let (z2, z4) = (z * z, z * z * (z * z));
+        let even = (1.0 + z * (1.0 / 2.0) + z2 * (1.0 / 24.0 + z * (1.0 / 720.0)))
+            + z4 * ((1.0 / 40320.0 + z * (1.0 / 3628800.0)) + z2 * (1.0 / 479001600.0));
+        let odd = r
+            * ((1.0 + z * (1.0 / 6.0) + z2 * (1.0 / 120.0 + z * (1.0 / 5040.0)))
+                + z4 * (1.0 / 362880.0 + z * (1.0 / 39916800.0)));
+        // k itself is the low bits of `shifted`'s representation, less SHIFT's.
+        let k_bits = shifted.to_bits().wrapping_sub(SHIFT.to_bits());
+        let up = f64::from_bits(k_bits.wrapping_add(1023) << 52);
+        let down = f64::from_bits(1023u64.wrapping_sub(k_bits) << 52);
+        plus[j] = (even + odd) * up;
+        minus[j] = (even - odd) * down;
+    }
+    (plus, minus)
+}
+
+/// The node sums on [`Dual`] numbers (every step and first-order partial): the same sums as
+/// [`node_sums`], but 8 nodes at a time as 8 independent lanes (value and both derivatives as
+/// separate arrays), so that the compiler keeps them in vector registers, and with
+/// [`exp_pairs`] for the positions.
+pub(super) fn dual_node_sums(nodes: &[WallNode], call: &WallCall<Dual>) -> Option<WallSums<Dual>> {
+    let WallCall {
+        lambda1: lam,
+        x_sq,
+        d_ro_sq,
+        u_0,
+        inner_gap: inner,
+        outer_gap: outer,
+    } = *call;
+    // The nodes sit at e = u - u_0 = g exp(+-span t), g = sqrt(inner outer), t = at - 1/2, so
+    // d ln e = d ln g +- t d span.
+    let (inv_in, inv_out) = (1.0 / inner.v, 1.0 / outer.v);
+    let span = (outer.v * inv_in).ln();
+    let g = (inner.v * outer.v).sqrt();
+    if !(span.abs() <= MAX_SPAN && g > 0.0 && g.is_finite()) {
+        return node_sums(nodes, call);
+    }
+    let (ln_in_dl, ln_in_dx) = (inner.dl * inv_in, inner.dx * inv_in);
+    let (ln_out_dl, ln_out_dx) = (outer.dl * inv_out, outer.dx * inv_out);
+    let span = Dual {
+        v: span,
+        dl: ln_out_dl - ln_in_dl,
+        dx: ln_out_dx - ln_in_dx,
+    };
+    let (mid_dl, mid_dx) = (0.5 * (ln_in_dl + ln_out_dl), 0.5 * (ln_in_dx + ln_out_dx));
+    // u - x^2 = e + (u_0 - x^2).
+    let base = u_0 - x_sq;
+    let n = nodes.len();
+    let pairs = n.div_ceil(2);
+    // Lane sums: [jac, l2, inv_l2, l2_h, inv_l2_h] x [value, d/dl, d/dx].
+    let mut acc = [[[0.0; LANES]; 3]; 5];
+    let mut least = [f64::INFINITY; LANES];
+    for first in (0..pairs).step_by(PAIRS) {
+        // Lanes j and j + PAIRS are node i and its mirror n - 1 - i; unused lanes weigh 0 (and
+        // the middle node of an odd count has no mirror).
+        let (mut t, mut weight) = ([0.0; LANES], [0.0; LANES]);
+        if first + PAIRS <= n / 2 {
+            // A full block of pairs (the usual case): fixed indices, no branches.
+            let low = &nodes[first..first + PAIRS];
+            let high = &nodes[n - first - PAIRS..n - first];
+            for j in 0..PAIRS {
+                t[j] = low[j].at - 0.5;
+                t[j + PAIRS] = 0.5 - low[j].at;
+                weight[j] = 0.5 * low[j].weight;
+                weight[j + PAIRS] = 0.5 * high[PAIRS - 1 - j].weight;
+            }
+        } else {
+            for j in 0..PAIRS.min(pairs - first) {
+                let i = first + j;
+                t[j] = nodes[i].at - 0.5;
+                t[j + PAIRS] = -t[j];
+                weight[j] = 0.5 * nodes[i].weight;
+                if n - 1 - i != i {
+                    weight[j + PAIRS] = 0.5 * nodes[n - 1 - i].weight;
+                }
+            }
+        }
+        let mut y = [0.0; PAIRS];
+        for j in 0..PAIRS {
+            y[j] = span.v * t[j];
+        }
+        let (plus, minus) = exp_pairs(y);
+        let mut e = [0.0; LANES];
+        for j in 0..PAIRS {
+            e[j] = g * plus[j];
+            e[j + PAIRS] = g * minus[j];
+        }
+        for j in 0..LANES {
+            let e = e[j];
+            // d ln e, which is also d ln(jacobian).
+            let (le_dl, le_dx) = (mid_dl + t[j] * span.dl, mid_dx + t[j] * span.dx);
+            let u = u_0.v + e;
+            let (u_dl, u_dx) = (u_0.dl + e * le_dl, u_0.dx + e * le_dx);
+            // s^2 = D_RO^2 - lambda_1 (x^2 - u) (eq. 2.20 solved for the unstretched diameter).
+            let diff = base.v + e;
+            let (diff_dl, diff_dx) = (base.dl + e * le_dl, base.dx + e * le_dx);
+            let s = diff * lam.v + d_ro_sq;
+            let (s_dl, s_dx) = (
+                diff_dl * lam.v + diff * lam.dl,
+                diff_dx * lam.v + diff * lam.dx,
+            );
+            // One division for 1/sqrt(u) and 1/s^2.
+            let root = u.sqrt();
+            let w = 1.0 / (s * root);
+            let (inv_d, inv_s) = (s * w, root * w);
+            let inv_u = inv_d * inv_d;
+            let l2 = u * inv_s;
+            let inv_l2 = s * inv_u;
+            // (Compared as floats, not bits, to stay in vector registers; a non-finite l2 or
+            // 1/l2 makes a sum non-finite, which is checked at the end.)
+            least[j] = if l2 < least[j] { l2 } else { least[j] };
+            // The terms are powers of u and s times the jacobian, so their logarithmic
+            // derivatives are sums of d ln e, d ln u and d ln s.
+            let jac = e * weight[j];
+            let l2_term = jac * l2;
+            let inv_l2_term = jac * inv_l2;
+            let per_d3 = inv_u * inv_d;
+            let terms = [
+                jac,
+                l2_term,
+                inv_l2_term,
+                l2_term * per_d3,
+                inv_l2_term * per_d3,
+            ];
+            for (dir, (le, du, ds)) in [(le_dl, u_dl, s_dl), (le_dx, u_dx, s_dx)]
+                .into_iter()
+                .enumerate()
+            {
+                let (lu, ls) = (du * inv_u, ds * inv_s);
+                let l2_log = le + lu - ls;
+                let inv_l2_log = le + ls - lu;
+                let logs = [
+                    le,
+                    l2_log,
+                    inv_l2_log,
+                    l2_log - 1.5 * lu,
+                    inv_l2_log - 1.5 * lu,
+                ];
+                for k in 0..5 {
+                    acc[k][dir + 1][j] += terms[k] * logs[k];
+                }
+            }
+            for k in 0..5 {
+                acc[k][0][j] += terms[k];
+            }
+        }
+    }
+    let sum = |k: usize| {
+        let lanes = |c: usize| {
+            let a = &acc[k][c];
+            ((a[0] + a[4]) + (a[1] + a[5])) + ((a[2] + a[6]) + (a[3] + a[7]))
+        };
+        Dual {
+            v: lanes(0),
+            dl: lanes(1),
+            dx: lanes(2),
+        }
+    };
+    let sums = WallSums {
+        span,
+        jac: sum(0),
+        l2: sum(1),
+        inv_l2: sum(2),
+        l2_h: sum(3),
+        inv_l2_h: sum(4),
+    };
+    // Every node's l2^2 positive, and (so) finite: [`node_sums`]' test.
+    let finite = [sums.jac, sums.l2, sums.inv_l2, sums.l2_h, sums.inv_l2_h]
+        .iter()
+        .all(|s| s.v.is_finite());
+    (finite && least.iter().all(|&l| l > 0.0)).then_some(sums)
 }

@@ -194,3 +194,64 @@ fn continuum_pressure_partial_is_the_slope_in_pressure() {
         }
     }
 }
+
+#[test]
+fn exp_pairs_is_exp_to_rounding_over_its_range() {
+    // The Dual path's hand-written exp, against libm over |y| <= 700 (where it is used): dense
+    // near 0 (the usual spans) and across the whole range (every power of two it builds).
+    use super::continuum::exp_pairs;
+    let mut worst = 0.0f64;
+    for i in 0..=200_000 {
+        let f = i as f64 / 200_000.0;
+        for y in [700.0 * (2.0 * f - 1.0), 8.0 * (2.0 * f - 1.0), 1e-3 * f] {
+            let (plus, minus) = exp_pairs([y, -y, 0.5 * y, 0.0]);
+            for (got, arg) in plus.iter().zip([y, -y, 0.5 * y, 0.0]) {
+                worst = worst.max((got / arg.exp() - 1.0).abs());
+            }
+            for (got, arg) in minus.iter().zip([-y, y, -0.5 * y, 0.0]) {
+                worst = worst.max((got / arg.exp() - 1.0).abs());
+            }
+        }
+    }
+    // A few ulp (an error in a coefficient or in the reduction shows as 1e-13 or worse).
+    assert!(worst < 1e-15, "{worst:e}");
+}
+
+#[test]
+fn dual_node_sums_agree_with_the_generic_path() {
+    // The kernel on Dual numbers (vectorized node sums) against the same kernel on hyper-dual
+    // numbers (the generic node by node sums), value and first derivatives, over both muscles,
+    // node counts with and without a middle node and past one block, in contact and below it.
+    use super::hyper_dual::HyperDual;
+    for m in [MUSCLE_C, MUSCLE_D] {
+        for nodes in [1, 2, 3, 7, 8, 9, 16, 17, 23] {
+            let bl = bladder(m, Wall::Continuum(nodes));
+            for &l in &stroke(&bl, 13) {
+                for shrink in [1.0, 0.97, 0.9] {
+                    let x = bl.sleeve.diameter_sq(l).sqrt() * shrink;
+                    let one = bl.kernel(450e3, Dual::var_l(l), Dual::var_x(x));
+                    let two = bl.kernel(
+                        450e3,
+                        HyperDual::seed(l, [1.0, 0.0], [0.0; 3]),
+                        HyperDual::seed(x, [0.0, 1.0], [0.0; 3]),
+                    );
+                    assert_eq!(one.is_some(), two.is_some(), "{nodes} nodes l {l} x {x}");
+                    let (Some(one), Some(two)) = (one, two) else {
+                        continue;
+                    };
+                    let close = |a: Dual, b: HyperDual, what: &str| {
+                        for (p, q) in [(a.v, b.v), (a.dl, b.d[0]), (a.dx, b.d[1])] {
+                            assert!(
+                                (p - q).abs() <= 1e-11 * q.abs().max(1e-300),
+                                "{what}, {nodes} nodes, l {l}, x {x}: {p:e} vs {q:e}"
+                            );
+                        }
+                    };
+                    close(one.c, two.c, "c");
+                    close(one.a, two.a, "a");
+                    close(one.elastic, two.elastic, "elastic");
+                }
+            }
+        }
+    }
+}

@@ -4,6 +4,7 @@
 //! diameter `x`. The kernel runs on [`Dual`] for every step and first-order partial; it runs on
 //! [`HyperDual`] only when the partials of `stiffness` (itself `dF/dL`) are asked for.
 
+use super::continuum::{dual_node_sums, node_sums, WallCall, WallNode, WallSums};
 use super::dual::Dual;
 use std::ops::{Add, Mul, Sub};
 
@@ -23,6 +24,10 @@ pub(super) trait KernelScalar:
     fn exp(self) -> Self;
     fn rsqrt(self) -> Self;
     fn sqrt(self) -> Self;
+    /// The continuum wall's sums over its quadrature nodes (`continuum.rs`).
+    fn wall_sums(nodes: &[WallNode], call: &WallCall<Self>) -> Option<WallSums<Self>> {
+        node_sums(nodes, call)
+    }
 }
 
 impl KernelScalar for Dual {
@@ -53,6 +58,11 @@ impl KernelScalar for Dual {
     #[inline]
     fn sqrt(self) -> Self {
         Dual::sqrt(self)
+    }
+    /// Vectorized across the nodes: the hot path.
+    #[inline]
+    fn wall_sums(nodes: &[WallNode], call: &WallCall<Self>) -> Option<WallSums<Self>> {
+        dual_node_sums(nodes, call)
     }
 }
 
