@@ -81,6 +81,7 @@ fn accepts(inst: &Instance, vr: u32, value: f64) -> bool {
         .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
 }
 
+#[cold]
 #[inline(never)]
 fn set_general(inst: &mut Instance, vrs: &[u32], values: &[f64]) -> fmi2Status {
     inst.set_general("fmi2SetReal", vrs, values)
@@ -214,6 +215,12 @@ pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
             }
         }
     }
+    get_general(inst, vrs, out)
+}
+
+#[cold]
+#[inline(never)]
+fn get_general(inst: &mut Instance, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
     inst.get_reals_general(vrs, out)
 }
 
