@@ -1,3 +1,4 @@
+use super::values::{fmi2GetReal, fmi2SetReal};
 use super::*;
 use std::sync::Mutex;
 
@@ -50,6 +51,38 @@ fn a_panic_is_logged_and_becomes_fatal() {
         assert!(line(&log, 1).1.contains("illegal call in state Fatal"));
         fmi2FreeInstance(c);
     }
+}
+
+#[test]
+fn the_magic_number_has_no_period() {
+    // What lets `instance` refuse a misaligned pointer by the magic number alone.
+    let bytes = MAGIC.to_le_bytes();
+    for shift in 1..8 {
+        assert_ne!(bytes[..8 - shift], bytes[shift..], "period {shift}");
+    }
+}
+
+#[test]
+fn a_pointer_off_a_live_instance_by_1_to_7_bytes_is_refused() {
+    let instance = Instance::new(REGISTRY[0], Logger::new(None, std::ptr::null_mut(), "t"));
+    let c = Box::into_raw(Box::new(instance)) as fmi2Component;
+    let (vr, mut value) = (0u32, 0.0);
+    for off in (1..8isize).flat_map(|k| [k, -k]) {
+        let bad = c.wrapping_byte_offset(off);
+        // SAFETY: `bad` lies within the live instance, so the magic number's read stays in it;
+        // the calls must refuse it before anything else is read.
+        unsafe {
+            assert_eq!(fmi2SetReal(bad, &vr, 1, &value), fmi2Status::Error, "{off}");
+            assert_eq!(fmi2DoStep(bad, 0.0, 1e-3, 0), fmi2Status::Error, "{off}");
+            assert_eq!(
+                fmi2GetReal(bad, &vr, 1, &mut value),
+                fmi2Status::Error,
+                "{off}"
+            );
+        }
+    }
+    // SAFETY: the live instance, freed once.
+    unsafe { fmi2FreeInstance(c) };
 }
 
 #[test]
