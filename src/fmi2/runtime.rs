@@ -340,13 +340,16 @@ where
     }
     #[inline(always)]
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
-        if let Some(model) = self.model.as_mut() {
-            let v = &mut self.values;
-            model.step(&v.inputs, &mut v.outputs, time, step, report);
-            report.evaluated = true;
-            self.outputs_stale = false;
-            M::Variables::set_input_clamped(v, report.clamped);
-        }
+        let Some(model) = self.model.as_mut() else {
+            // Not built (no step reaches here before initialization): laid out of the way.
+            std::hint::cold_path();
+            return;
+        };
+        let v = &mut self.values;
+        model.step(&v.inputs, &mut v.outputs, time, step, report);
+        report.evaluated = true;
+        self.outputs_stale = false;
+        M::Variables::set_input_clamped(v, report.clamped);
     }
     fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate {
         let Some(model) = self.model.as_mut() else {
