@@ -353,6 +353,7 @@ impl Motor {
         let per_segment = (left / SEGMENT_BUDGET_SHARE).max(1);
         let dt_min = (remaining / left as f64).min((segment_end - t) / per_segment as f64);
         let mut dt_try = run.dt.max(dt_min).min(segment_end - t);
+        let clipped = dt_try < run.dt;
         if dt_try < 1e-300 {
             dt_try = segment_end - t;
         }
@@ -382,7 +383,15 @@ impl Motor {
                 } else {
                     end
                 };
-                run.dt = taken * step_factor(err);
+                // A substep cut short at the segment's end says little about the size the
+                // error allows: keep the uncut proposal, or every communication step shorter
+                // than two substeps would take two (its stub's small size seeding the next).
+                let proposal = taken * step_factor(err);
+                run.dt = if clipped && err <= 1.0 {
+                    proposal.max(run.dt)
+                } else {
+                    proposal
+                };
             }
             Some((_, err, _, _)) => run.dt = (dt_try * step_factor(err)).max(dt_min),
             None if forced => {
