@@ -281,14 +281,20 @@ impl StepRun {
     }
 }
 
+/// Inline with the message out of line: every step checks a dozen values.
+#[inline]
 fn check_finite(name: &str, value: f64, limit: f64, unit: &str) -> Result<(), String> {
     if value.is_finite() && value.abs() <= limit {
         Ok(())
     } else {
-        Err(format!(
-            "{name} must be finite and within {limit:e} {unit}, got {value}"
-        ))
+        Err(not_finite(name, value, limit, unit))
     }
+}
+
+#[cold]
+#[inline(never)]
+fn not_finite(name: &str, value: f64, limit: f64, unit: &str) -> String {
+    format!("{name} must be finite and within {limit:e} {unit}, got {value}")
 }
 
 /// Wraps an angle to (-pi, pi].
