@@ -117,8 +117,11 @@ impl RingBar {
         let ar = a * r;
         let sum = a * a + r * r;
         let cross = 2.0 * ar * c;
-        // a < r (checked), so both are positive.
-        let (ia, ib) = (1.0 / (sum - cross).sqrt(), 1.0 / (sum + cross).sqrt());
+        // a < r (checked), so both are positive. One division for both reciprocals
+        // (1/A = B/(AB)): this runs at every evaluation of the onion's Newton iteration.
+        let (dist_a, dist_b) = ((sum - cross).sqrt(), (sum + cross).sqrt());
+        let inv = 1.0 / (dist_a * dist_b);
+        let (ia, ib) = (dist_b * inv, dist_a * inv);
         let (ia3, ib3) = (ia * ia * ia, ib * ib * ib);
         let k_ar = self.coupling * ar;
         let torque = k_ar * s * (ia3 + ib3);

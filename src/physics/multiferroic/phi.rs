@@ -23,7 +23,9 @@ pub fn phis(z: f64) -> [f64; 3] {
         let phi2 = 0.5 + z * sum;
         return [1.0 + z * phi2, phi2, sum];
     }
-    let phi1 = z.exp_m1() / z;
+    // Below -40, exp(z) < 5e-18 is under half an ulp of 1 and expm1 is -1 exactly: skip the call
+    // (the stiff rotor's inertial eigenvalue, -h c/I, is about -500 at 1 us substeps).
+    let phi1 = if z < -40.0 { -1.0 } else { z.exp_m1() } / z;
     let phi2 = (phi1 - 1.0) / z;
     [phi1, phi2, (phi2 - 0.5) / z]
 }
