@@ -49,22 +49,23 @@ impl Motor {
         let k_me = 2.0 * e * c2;
         let quasi = self.quasi_static();
         if !d.locked {
-            let (i, c) = (self.inertia, self.drag);
+            // One division by the inertia for the whole row.
+            let (inv_i, c) = (1.0 / self.inertia, self.drag);
             f[0] = y[1];
-            f[1] = (tau + d.load - c * y[1]) / i;
+            f[1] = (tau + d.load - c * y[1]) * inv_i;
             j[0][1] = 1.0;
-            j[1][1] = -c / i;
+            j[1][1] = -c * inv_i;
             if quasi {
                 // Onion in equilibrium: bar spring in series with the magnetoelastic spring,
                 // k = k_bar k_me / (k_bar + k_me) (implicit function theorem on dU/dpsi = 0).
                 // Near a fold the sum vanishes; bound it so the linearization stays finite.
                 let sum = (k_bar + k_me).max(0.05 * (k_bar.abs() + k_me.abs()));
                 let k_eff = if sum > 0.0 { k_bar * k_me / sum } else { 0.0 };
-                j[1][0] = -self.bounded_stiffness(k_eff, dt) / i;
+                j[1][0] = -self.bounded_stiffness(k_eff, dt) * inv_i;
             } else {
                 let k = self.bounded_stiffness(k_bar, dt);
-                j[1][0] = -k / i;
-                j[1][2] = k / i;
+                j[1][0] = -k * inv_i;
+                j[1][2] = k * inv_i;
             }
         }
         if !quasi {
@@ -311,8 +312,9 @@ impl Motor {
         if !Self::onion_sane(&u3) {
             return Some(None);
         }
-        let tol = self.params.tolerance;
-        let err = (correction[0].abs() / tol).max(correction[1].abs() / (tol * self.speed_scale));
+        let inv_tol = 1.0 / self.params.tolerance;
+        let err = (correction[0].abs() * inv_tol)
+            .max(correction[1].abs() * inv_tol / self.speed_scale);
         Some(Some((u3, err, a3)))
     }
 

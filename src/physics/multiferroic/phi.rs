@@ -68,6 +68,8 @@ pub fn phi(k: u32, z: f64) -> f64 {
 /// caller then uses the general matrix exponential).
 pub struct Phi2x2 {
     mu: (f64, f64),
+    /// `1 / (mu_1 - mu_2)`, shared by every [`Self::apply`].
+    inv_gap: f64,
     /// `phi_1..3` at each eigenvalue.
     at_mu: ([f64; 3], [f64; 3]),
 }
@@ -93,6 +95,7 @@ impl Phi2x2 {
         let mu2 = det / mu1;
         ((mu1 - mu2).abs() > 1e-6 * (mu1.abs() + mu2.abs())).then(|| Self {
             mu: (mu1, mu2),
+            inv_gap: 1.0 / (mu1 - mu2),
             at_mu: (phis(mu1), phis(mu2)),
         })
     }
@@ -102,9 +105,8 @@ impl Phi2x2 {
         let (mu1, mu2) = self.mu;
         let i = (k.clamp(1, 3) - 1) as usize;
         let (f1, f2) = (self.at_mu.0[i], self.at_mu.1[i]);
-        let gap = mu1 - mu2;
-        let c1 = (f1 - f2) / gap;
-        let c0 = (mu1 * f2 - mu2 * f1) / gap;
+        let c1 = (f1 - f2) * self.inv_gap;
+        let c0 = (mu1 * f2 - mu2 * f1) * self.inv_gap;
         [
             c0 * v[0] + c1 * (a[0][0] * v[0] + a[0][1] * v[1]),
             c0 * v[1] + c1 * (a[1][0] * v[0] + a[1][1] * v[1]),
