@@ -153,9 +153,19 @@ mod tests {
         assert!(worst < 2e-15, "{worst:e}");
         // A far move, and the series at its limit against libm.
         assert_eq!(a.moved(3.0, 0.0, 1.2), Angles::exact(3.0, 0.0, 1.2));
-        for d in [MAX_TURN, -MAX_TURN, SHORT_TURN, 0.99 * SHORT_TURN, -3e-4, 1e-9] {
+        for d in [
+            MAX_TURN,
+            -MAX_TURN,
+            SHORT_TURN,
+            0.99 * SHORT_TURN,
+            -3e-4,
+            1e-9,
+        ] {
             let (s, c) = small_sin_cos(d);
-            assert!((s - d.sin()).abs() < 1e-17 && (c - d.cos()).abs() < 1e-16, "{d}");
+            assert!(
+                (s - d.sin()).abs() < 1e-17 && (c - d.cos()).abs() < 1e-16,
+                "{d}"
+            );
         }
     }
 

@@ -313,8 +313,8 @@ impl Motor {
             return Some(None);
         }
         let inv_tol = 1.0 / self.params.tolerance;
-        let err = (correction[0].abs() * inv_tol)
-            .max(correction[1].abs() * inv_tol / self.speed_scale);
+        let err =
+            (correction[0].abs() * inv_tol).max(correction[1].abs() * inv_tol / self.speed_scale);
         Some(Some((u3, err, a3)))
     }
 
