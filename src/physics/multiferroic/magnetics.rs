@@ -130,6 +130,21 @@ impl RingBar {
         (torque, stiffness)
     }
 
+    /// The torque ([`Self::torque_stiffness_of`]) and the energy ([`Self::energy_of_cos`]) from
+    /// one pair of distances, for a step's outputs.
+    #[inline]
+    pub fn torque_energy_of(&self, s: f64, c: f64) -> (f64, f64) {
+        let (a, r) = (self.bar_charge_radius, self.wall_radius);
+        let ar = a * r;
+        let sum = a * a + r * r;
+        let cross = 2.0 * ar * c;
+        let (dist_a, dist_b) = ((sum - cross).sqrt(), (sum + cross).sqrt());
+        let inv = 1.0 / (dist_a * dist_b);
+        let (ia, ib) = (dist_b * inv, dist_a * inv);
+        let torque = self.coupling * ar * s * (ia * ia * ia + ib * ib * ib);
+        (torque, self.coupling * (ib - ia))
+    }
+
     /// `d^2 U_m / d beta^2` (N m / rad): the ring-bar spring stiffness.
     pub fn stiffness(&self, offset: f64) -> f64 {
         let (a, b, ar) = self.distances(offset);

@@ -573,16 +573,15 @@ impl Motor {
         let beta = y[2] - y[0];
         // sin^2(psi - gamma) = (1 - cos 2(psi - gamma)) / 2.
         let sin_squared = 0.5 * (1.0 - a.cos_double);
-        let (torque, _) = self
-            .ring_bar
-            .torque_stiffness_of(a.sin_offset, a.cos_offset);
+        let (torque, magnetostatic_energy) =
+            self.ring_bar.torque_energy_of(a.sin_offset, a.cos_offset);
         MotorOutputs {
             torque,
             rotor_angle: y[0],
             rotor_speed: y[1],
             onion_angle: y[2],
             offset_angle: wrap_angle(beta),
-            magnetostatic_energy: self.ring_bar.energy_of_cos(a.cos_offset),
+            magnetostatic_energy,
             magnetoelastic_energy: self.magnetoelastic_per_stress * d.stress * sin_squared,
             applied_strain_direction: d.applied_direction,
             applied_stress: d.stress,
