@@ -19,6 +19,7 @@ impl Motor {
     }
 
     /// [`Self::rhs_jacobian`] from the angles at `y`.
+    #[inline]
     pub(super) fn rhs_jacobian_at(
         &self,
         y: &Vector,
@@ -32,7 +33,9 @@ impl Motor {
         self.rhs_jacobian_of(y, d, dt, angles, tau, k_bar)
     }
 
-    /// [`Self::rhs_jacobian_at`] given the ring-bar torque and stiffness there.
+    /// [`Self::rhs_jacobian_at`] given the ring-bar torque and stiffness there. Inlined: the
+    /// 160-byte result went through memory, where the embedded pair uses four of its entries.
+    #[inline(always)]
     fn rhs_jacobian_of(
         &self,
         y: &Vector,

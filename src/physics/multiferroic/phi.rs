@@ -75,6 +75,8 @@ pub struct Phi2x2 {
 }
 
 impl Phi2x2 {
+    /// Inlined, as [`Self::apply`]: a returned struct goes through memory.
+    #[inline(always)]
     pub fn new(a: &[[f64; 2]; 2]) -> Option<Self> {
         let half_trace = 0.5 * (a[0][0] + a[1][1]);
         let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
@@ -101,6 +103,7 @@ impl Phi2x2 {
     }
 
     /// `phi_k(A) v` (`k` in 1..=3) for the matrix `a` given to [`Self::new`].
+    #[inline(always)]
     pub fn apply(&self, k: u32, a: &[[f64; 2]; 2], v: [f64; 2]) -> [f64; 2] {
         let (mu1, mu2) = self.mu;
         let i = (k.clamp(1, 3) - 1) as usize;
