@@ -19,6 +19,7 @@ impl Motor {
     }
 
     /// [`Self::rhs_jacobian`] from the angles at `y`.
+    #[inline]
     pub(super) fn rhs_jacobian_at(
         &self,
         y: &Vector,
@@ -32,7 +33,9 @@ impl Motor {
         self.rhs_jacobian_of(y, d, dt, angles, tau, k_bar)
     }
 
-    /// [`Self::rhs_jacobian_at`] given the ring-bar torque and stiffness there.
+    /// [`Self::rhs_jacobian_at`] given the ring-bar torque and stiffness there. Inlined: the
+    /// 160-byte result went through memory, where the embedded pair uses four of its entries.
+    #[inline(always)]
     fn rhs_jacobian_of(
         &self,
         y: &Vector,
@@ -49,22 +52,23 @@ impl Motor {
         let k_me = 2.0 * e * c2;
         let quasi = self.quasi_static();
         if !d.locked {
-            let (i, c) = (self.inertia, self.drag);
+            // One division by the inertia for the whole row.
+            let (inv_i, c) = (1.0 / self.inertia, self.drag);
             f[0] = y[1];
-            f[1] = (tau + d.load - c * y[1]) / i;
+            f[1] = (tau + d.load - c * y[1]) * inv_i;
             j[0][1] = 1.0;
-            j[1][1] = -c / i;
+            j[1][1] = -c * inv_i;
             if quasi {
                 // Onion in equilibrium: bar spring in series with the magnetoelastic spring,
                 // k = k_bar k_me / (k_bar + k_me) (implicit function theorem on dU/dpsi = 0).
                 // Near a fold the sum vanishes; bound it so the linearization stays finite.
                 let sum = (k_bar + k_me).max(0.05 * (k_bar.abs() + k_me.abs()));
                 let k_eff = if sum > 0.0 { k_bar * k_me / sum } else { 0.0 };
-                j[1][0] = -self.bounded_stiffness(k_eff, dt) / i;
+                j[1][0] = -self.bounded_stiffness(k_eff, dt) * inv_i;
             } else {
                 let k = self.bounded_stiffness(k_bar, dt);
-                j[1][0] = -k / i;
-                j[1][2] = k / i;
+                j[1][0] = -k * inv_i;
+                j[1][2] = k * inv_i;
             }
         }
         if !quasi {
@@ -149,7 +153,7 @@ impl Motor {
             out[2] = self.settle(&out, d);
             out[3] = 0.0;
         }
-        self.sane(&out).then_some(out)
+        Self::onion_sane(&out).then_some(out)
     }
 
     /// One error-controlled substep: the new state, its error relative to the tolerance and the
@@ -289,7 +293,7 @@ impl Motor {
             .settle_from(predict(angles, u1[0]));
         u1[2] = a1.onion;
         u1[3] = 0.0;
-        if !self.sane(&u1) {
+        if !Self::onion_sane(&u1) {
             return Some(None);
         }
         let (f1, _) = self.rhs_jacobian_at(&u1, d, dt, &a1);
@@ -308,16 +312,23 @@ impl Motor {
             .landscape(u3[0], d.direction, d.stress)
             .settle_from(predict(&a1, u3[0]));
         u3[2] = a3.onion;
-        if !self.sane(&u3) {
+        if !Self::onion_sane(&u3) {
             return Some(None);
         }
-        let tol = self.params.tolerance;
-        let err = (correction[0].abs() / tol).max(correction[1].abs() / (tol * self.speed_scale));
+        let inv_tol = 1.0 / self.params.tolerance;
+        let err =
+            (correction[0].abs() * inv_tol).max(correction[1].abs() * inv_tol / self.speed_scale);
         Some(Some((u3, err, a3)))
     }
 
     fn sane(&self, y: &Vector) -> bool {
-        self.rotor_sane(y) && y[2].abs() <= MAX_ANGLE && y[3].abs() <= 10.0 && y[3].is_finite()
+        self.rotor_sane(y) && Self::onion_sane(y)
+    }
+
+    /// The onion half of [`Self::sane`], for a state whose rotor was checked before its settle
+    /// (the comparisons are false for NaN, so they also test finiteness).
+    fn onion_sane(y: &Vector) -> bool {
+        y[2].abs() <= MAX_ANGLE && y[3].abs() <= 10.0
     }
 
     /// The rotor half of [`Self::sane`], checked before the quasi-static onion is settled at a
@@ -353,6 +364,7 @@ impl Motor {
         let per_segment = (left / SEGMENT_BUDGET_SHARE).max(1);
         let dt_min = (remaining / left as f64).min((segment_end - t) / per_segment as f64);
         let mut dt_try = run.dt.max(dt_min).min(segment_end - t);
+        let clipped = dt_try < run.dt;
         if dt_try < 1e-300 {
             dt_try = segment_end - t;
         }
@@ -382,7 +394,15 @@ impl Motor {
                 } else {
                     end
                 };
-                run.dt = taken * step_factor(err);
+                // A substep cut short at the segment's end says little about the size the
+                // error allows: keep the uncut proposal, or every communication step shorter
+                // than two substeps would take two (its stub's small size seeding the next).
+                let proposal = taken * step_factor(err);
+                run.dt = if clipped && err <= 1.0 {
+                    proposal.max(run.dt)
+                } else {
+                    proposal
+                };
             }
             Some((_, err, _, _)) => run.dt = (dt_try * step_factor(err)).max(dt_min),
             None if forced => {

@@ -117,14 +117,32 @@ impl RingBar {
         let ar = a * r;
         let sum = a * a + r * r;
         let cross = 2.0 * ar * c;
-        // a < r (checked), so both are positive.
-        let (ia, ib) = (1.0 / (sum - cross).sqrt(), 1.0 / (sum + cross).sqrt());
+        // a < r (checked), so both are positive. One division for both reciprocals
+        // (1/A = B/(AB)): this runs at every evaluation of the onion's Newton iteration.
+        let (dist_a, dist_b) = ((sum - cross).sqrt(), (sum + cross).sqrt());
+        let inv = 1.0 / (dist_a * dist_b);
+        let (ia, ib) = (dist_b * inv, dist_a * inv);
         let (ia3, ib3) = (ia * ia * ia, ib * ib * ib);
         let k_ar = self.coupling * ar;
         let torque = k_ar * s * (ia3 + ib3);
         let stiffness =
             k_ar * (c * (ia3 + ib3) + 3.0 * ar * s * s * (ib3 * ib * ib - ia3 * ia * ia));
         (torque, stiffness)
+    }
+
+    /// The torque ([`Self::torque_stiffness_of`]) and the energy ([`Self::energy_of_cos`]) from
+    /// one pair of distances, for a step's outputs.
+    #[inline]
+    pub fn torque_energy_of(&self, s: f64, c: f64) -> (f64, f64) {
+        let (a, r) = (self.bar_charge_radius, self.wall_radius);
+        let ar = a * r;
+        let sum = a * a + r * r;
+        let cross = 2.0 * ar * c;
+        let (dist_a, dist_b) = ((sum - cross).sqrt(), (sum + cross).sqrt());
+        let inv = 1.0 / (dist_a * dist_b);
+        let (ia, ib) = (dist_b * inv, dist_a * inv);
+        let torque = self.coupling * ar * s * (ia * ia * ia + ib * ib * ib);
+        (torque, self.coupling * (ib - ia))
     }
 
     /// `d^2 U_m / d beta^2` (N m / rad): the ring-bar spring stiffness.

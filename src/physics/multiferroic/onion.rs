@@ -217,7 +217,11 @@ impl Landscape<'_> {
             let step = -g / c;
             let next = x.onion + step;
             let newton_ok = c > 0.0 && next > lo && next < hi;
-            if newton_ok && (step.abs() <= tolerance || m * step * step <= c * tolerance) {
+            // A converged step may end on the bracket's end: the march hands over its last point,
+            // often the root itself (its gradient rounding to either sign), as `hi` or `lo`.
+            // Testing it against the open bracket sent such calls through ~25 bisections.
+            let converged = step.abs() <= tolerance || m * step * step <= c * tolerance;
+            if converged && c > 0.0 && next >= lo && next <= hi {
                 return x.at_onion(next);
             }
             if hi - lo <= tolerance {

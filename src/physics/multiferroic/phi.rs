@@ -23,7 +23,9 @@ pub fn phis(z: f64) -> [f64; 3] {
         let phi2 = 0.5 + z * sum;
         return [1.0 + z * phi2, phi2, sum];
     }
-    let phi1 = z.exp_m1() / z;
+    // Below -40, exp(z) < 5e-18 is under half an ulp of 1 and expm1 is -1 exactly: skip the call
+    // (the stiff rotor's inertial eigenvalue, -h c/I, is about -500 at 1 us substeps).
+    let phi1 = if z < -40.0 { -1.0 } else { z.exp_m1() } / z;
     let phi2 = (phi1 - 1.0) / z;
     [phi1, phi2, (phi2 - 0.5) / z]
 }
@@ -66,11 +68,15 @@ pub fn phi(k: u32, z: f64) -> f64 {
 /// caller then uses the general matrix exponential).
 pub struct Phi2x2 {
     mu: (f64, f64),
+    /// `1 / (mu_1 - mu_2)`, shared by every [`Self::apply`].
+    inv_gap: f64,
     /// `phi_1..3` at each eigenvalue.
     at_mu: ([f64; 3], [f64; 3]),
 }
 
 impl Phi2x2 {
+    /// Inlined, as [`Self::apply`]: a returned struct goes through memory.
+    #[inline(always)]
     pub fn new(a: &[[f64; 2]; 2]) -> Option<Self> {
         let half_trace = 0.5 * (a[0][0] + a[1][1]);
         let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
@@ -91,18 +97,19 @@ impl Phi2x2 {
         let mu2 = det / mu1;
         ((mu1 - mu2).abs() > 1e-6 * (mu1.abs() + mu2.abs())).then(|| Self {
             mu: (mu1, mu2),
+            inv_gap: 1.0 / (mu1 - mu2),
             at_mu: (phis(mu1), phis(mu2)),
         })
     }
 
     /// `phi_k(A) v` (`k` in 1..=3) for the matrix `a` given to [`Self::new`].
+    #[inline(always)]
     pub fn apply(&self, k: u32, a: &[[f64; 2]; 2], v: [f64; 2]) -> [f64; 2] {
         let (mu1, mu2) = self.mu;
         let i = (k.clamp(1, 3) - 1) as usize;
         let (f1, f2) = (self.at_mu.0[i], self.at_mu.1[i]);
-        let gap = mu1 - mu2;
-        let c1 = (f1 - f2) / gap;
-        let c0 = (mu1 * f2 - mu2 * f1) / gap;
+        let c1 = (f1 - f2) * self.inv_gap;
+        let c0 = (mu1 * f2 - mu2 * f1) * self.inv_gap;
         [
             c0 * v[0] + c1 * (a[0][0] * v[0] + a[0][1] * v[1]),
             c0 * v[1] + c1 * (a[1][0] * v[0] + a[1][1] * v[1]),

@@ -1007,3 +1007,17 @@ fn a_rotor_driven_past_max_angle_holds_there_cheaply() {
     assert!(s.rotor_angle < -0.1 * MAX_ANGLE, "{s:?}");
     assert!(substeps[1..].iter().all(|&n| n <= 16), "{substeps:?}");
 }
+
+/// The outputs' joint torque and energy agree with the separate formulas (eq. 3.3 and its
+/// derivative).
+#[test]
+fn joint_torque_and_energy_agree_with_the_separate_ones() {
+    let rb = &motor().ring_bar;
+    for beta in [-3.0f64, -1.0, -1e-3, 0.0, 0.4, 1.5, 3.1] {
+        let (torque, energy) = rb.torque_energy_of(beta.sin(), beta.cos());
+        let (t, _) = rb.torque_stiffness_of(beta.sin(), beta.cos());
+        let e = rb.energy_of_cos(beta.cos());
+        assert_eq!(torque, t, "{beta}");
+        assert!((energy - e).abs() <= 1e-14 * e.abs().max(rb.energy_of_cos(1.0).abs()));
+    }
+}
