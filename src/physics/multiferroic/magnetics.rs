@@ -113,15 +113,7 @@ impl RingBar {
     /// [`Self::torque_stiffness`] from the sine and cosine of the offset.
     #[inline]
     pub fn torque_stiffness_of(&self, s: f64, c: f64) -> (f64, f64) {
-        let (a, r) = (self.bar_charge_radius, self.wall_radius);
-        let ar = a * r;
-        let sum = a * a + r * r;
-        let cross = 2.0 * ar * c;
-        // a < r (checked), so both are positive. One division for both reciprocals
-        // (1/A = B/(AB)): this runs at every evaluation of the onion's Newton iteration.
-        let (dist_a, dist_b) = ((sum - cross).sqrt(), (sum + cross).sqrt());
-        let inv = 1.0 / (dist_a * dist_b);
-        let (ia, ib) = (dist_b * inv, dist_a * inv);
+        let (ar, ia, ib) = self.inverse_distances(c);
         let (ia3, ib3) = (ia * ia * ia, ib * ib * ib);
         let k_ar = self.coupling * ar;
         let torque = k_ar * s * (ia3 + ib3);
@@ -134,15 +126,23 @@ impl RingBar {
     /// one pair of distances, for a step's outputs.
     #[inline]
     pub fn torque_energy_of(&self, s: f64, c: f64) -> (f64, f64) {
+        let (ar, ia, ib) = self.inverse_distances(c);
+        let torque = self.coupling * ar * s * (ia * ia * ia + ib * ib * ib);
+        (torque, self.coupling * (ib - ia))
+    }
+
+    /// `(a r, 1/A, 1/B)` at the offset's cosine `c`. `a < r` (checked), so both distances are
+    /// positive; one division gives both reciprocals (`1/A = B/(AB)`): this runs at every
+    /// evaluation of the onion's Newton iteration.
+    #[inline(always)]
+    fn inverse_distances(&self, c: f64) -> (f64, f64, f64) {
         let (a, r) = (self.bar_charge_radius, self.wall_radius);
         let ar = a * r;
         let sum = a * a + r * r;
         let cross = 2.0 * ar * c;
         let (dist_a, dist_b) = ((sum - cross).sqrt(), (sum + cross).sqrt());
         let inv = 1.0 / (dist_a * dist_b);
-        let (ia, ib) = (dist_b * inv, dist_a * inv);
-        let torque = self.coupling * ar * s * (ia * ia * ia + ib * ib * ib);
-        (torque, self.coupling * (ib - ia))
+        (ar, dist_b * inv, dist_a * inv)
     }
 
     /// `d^2 U_m / d beta^2` (N m / rad): the ring-bar spring stiffness.
