@@ -62,7 +62,7 @@ pub(in crate::fmi2) unsafe fn set_reals<R: Runtime + 'static>(
         return unsafe { set_many_reals::<R>(inst, vrs, values) };
     };
     if inst.logger.debug || !accepts(inst, *vr, *value) {
-        return set_general(inst, vrs, values);
+        return set_general_path(inst, vrs, values);
     }
     // SAFETY: the caller promises that R is the runtime's type.
     let runtime = unsafe { inst.runtime_as::<R>() };
@@ -81,9 +81,10 @@ fn accepts(inst: &Instance, vr: u32, value: f64) -> bool {
         .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
 }
 
+/// The general `fmi2SetReal` (it refuses, logs or stores as before), out of line and cold.
 #[cold]
 #[inline(never)]
-fn set_general(inst: &mut Instance, vrs: &[u32], values: &[f64]) -> fmi2Status {
+fn set_general_path(inst: &mut Instance, vrs: &[u32], values: &[f64]) -> fmi2Status {
     inst.set_general("fmi2SetReal", vrs, values)
 }
 
@@ -103,7 +104,7 @@ unsafe fn set_many_reals<R: Runtime + 'static>(
             .zip(values)
             .all(|(&vr, &value)| accepts(inst, vr, value));
     if !fast {
-        return inst.set_general("fmi2SetReal", vrs, values);
+        return set_general_path(inst, vrs, values);
     }
     // SAFETY: the caller promises that R is the runtime's type.
     unsafe { inst.runtime_as::<R>() }.set_reals(vrs, values, false);
@@ -209,18 +210,20 @@ pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
         let runtime = unsafe { inst.runtime_as::<R>() };
         if runtime.outputs_current() {
             let x = runtime.real(*vr as usize);
-            if finite(x) {
+            if x.is_finite() {
                 *slot = x;
                 return fmi2Status::OK;
             }
         }
     }
-    get_general(inst, vrs, out)
+    get_general_path(inst, vrs, out)
 }
 
+/// The general `fmi2GetReal` (it refreshes stale outputs and refuses as before), out of line and
+/// cold.
 #[cold]
 #[inline(never)]
-fn get_general(inst: &mut Instance, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
+fn get_general_path(inst: &mut Instance, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
     inst.get_reals_general(vrs, out)
 }
 
@@ -242,7 +245,7 @@ unsafe fn get_many_reals<R: Runtime + 'static>(
             let mut fast = true;
             for (&vr, slot) in vrs.iter().zip(out.iter_mut()) {
                 let x = runtime.real(vr as usize);
-                fast &= (vr as usize) < count && finite(x);
+                fast &= (vr as usize) < count && x.is_finite();
                 *slot = x;
             }
             if fast {
@@ -250,11 +253,5 @@ unsafe fn get_many_reals<R: Runtime + 'static>(
             }
         }
     }
-    inst.get_reals_general(vrs, out)
-}
-
-/// `x.is_finite()` as one mask and one compare (NaN compares false).
-#[inline(always)]
-fn finite(x: f64) -> bool {
-    x.abs() < f64::INFINITY
+    get_general_path(inst, vrs, out)
 }
