@@ -188,7 +188,7 @@ def parity_goal_rows(parity):
 # nanoseconds went"). Shown only beside a missed goal.
 FMI_LAYER_WHY = ("beside the checks kept on purpose (the instance's magic number on every call, the "
                  "range and NaN checks of every value set and got), most of what remains is the "
-                 "model's own step: eq. 2.2-2.3, the stroke clamp and 13 outputs (README, \"Where the "
+                 "model's own step: eq. 2.2-2.3, the stroke clamp and 14 outputs (README, \"Where the "
                  "nanoseconds went\")")
 
 
