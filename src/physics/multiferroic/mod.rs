@@ -291,6 +291,22 @@ fn check_finite(name: &str, value: f64, limit: f64, unit: &str) -> Result<(), St
     }
 }
 
+/// Each `(name, value, limit, unit)` finite and within its limit: on the usual path one test of
+/// all of them (`abs() <= limit` is false for NaN), then [`check_finite`] names the first that
+/// is not.
+#[inline]
+fn within_limits(checks: &[(&str, f64, f64, &str)]) -> Result<(), String> {
+    if checks
+        .iter()
+        .fold(true, |ok, &(_, v, limit, _)| ok & (v.abs() <= limit))
+    {
+        return Ok(());
+    }
+    checks
+        .iter()
+        .try_for_each(|&(name, v, limit, unit)| check_finite(name, v, limit, unit))
+}
+
 #[cold]
 #[inline(never)]
 fn not_finite(name: &str, value: f64, limit: f64, unit: &str) -> String {
@@ -452,52 +468,38 @@ impl Motor {
     }
 
     fn validate_inputs(&self, inputs: &MotorInputs) -> Result<(), String> {
-        // The usual case in one test (`abs() <= limit` is false for NaN and infinity, as in
-        // check_finite); the checks below only run to name what is wrong.
-        if (inputs.strain_direction.abs() <= MAX_ANGLE)
-            & (inputs.stress.abs() <= MAX_STRESS)
-            & (inputs.load_torque.abs() <= MAX_LOAD_TORQUE)
-            && inputs.schedule.get().is_none_or(SteppingSchedule::is_valid)
-        {
-            return Ok(());
-        }
-        check_finite(
-            "strain_direction",
-            inputs.strain_direction,
-            MAX_ANGLE,
-            "rad",
-        )?;
-        check_finite("stress", inputs.stress, MAX_STRESS, "Pa")?;
-        check_finite("load_torque", inputs.load_torque, MAX_LOAD_TORQUE, "N m")?;
-        if let Some(s) = inputs.schedule.get() {
-            SteppingSchedule::new(
+        within_limits(&[
+            (
+                "strain_direction",
+                inputs.strain_direction,
+                MAX_ANGLE,
+                "rad",
+            ),
+            ("stress", inputs.stress, MAX_STRESS, "Pa"),
+            ("load_torque", inputs.load_torque, MAX_LOAD_TORQUE, "N m"),
+        ])?;
+        match inputs.schedule.get() {
+            Some(s) if !s.is_valid() => SteppingSchedule::new(
                 s.initial_direction,
                 s.step_angle,
                 s.step_period,
                 s.stress_amplitude,
-            )?;
+            )
+            .map(|_| ()),
+            _ => Ok(()),
         }
-        Ok(())
     }
 
     /// Why `state` is not one [`Motor::step`] can start from (non-finite or beyond its bounds).
     pub fn validate_state(state: &MotorState) -> Result<(), String> {
-        // The usual case in one test, as in `validate_inputs`.
-        if (state.time.abs() <= 1e12)
-            & (state.rotor_angle.abs() <= MAX_ANGLE)
-            & (state.rotor_speed.abs() <= 1e30)
-            & (state.onion_angle.abs() <= MAX_ANGLE)
-            & (state.onion_tilt.abs() <= 10.0)
-            & (state.substep_hint.abs() <= MAX_STEP)
-        {
-            return Ok(());
-        }
-        check_finite("time", state.time, 1e12, "s")?;
-        check_finite("rotor_angle", state.rotor_angle, MAX_ANGLE, "rad")?;
-        check_finite("rotor_speed", state.rotor_speed, 1e30, "rad/s")?;
-        check_finite("onion_angle", state.onion_angle, MAX_ANGLE, "rad")?;
-        check_finite("onion_tilt", state.onion_tilt, 10.0, "rad")?;
-        check_finite("substep_hint", state.substep_hint, MAX_STEP, "s")
+        within_limits(&[
+            ("time", state.time, 1e12, "s"),
+            ("rotor_angle", state.rotor_angle, MAX_ANGLE, "rad"),
+            ("rotor_speed", state.rotor_speed, 1e30, "rad/s"),
+            ("onion_angle", state.onion_angle, MAX_ANGLE, "rad"),
+            ("onion_tilt", state.onion_tilt, 10.0, "rad"),
+            ("substep_hint", state.substep_hint, MAX_STEP, "s"),
+        ])
     }
 
     fn drive_at(&self, inputs: &MotorInputs, time: f64) -> Drive {
