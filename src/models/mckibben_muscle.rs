@@ -26,6 +26,9 @@ const LIMIT_MARGIN: f64 = 1e-3;
 
 /// The effects the parameters switch on, built once at initialization. The bare sleeve needs
 /// none of the bladder, friction and connector machinery, and none of their outputs change.
+// Built once per instance and never moved on the per-step path: its size does not matter, and a
+// box would add a load to every step of the full model.
+#[allow(clippy::large_enum_variant)]
 #[derive(Clone, Debug, Serialize, Deserialize)]
 enum Pipeline {
     /// Eq. 2.3 alone: no bladder, no friction, rigid connector.
@@ -42,6 +45,14 @@ pub struct McKibbenMuscle {
     out_of_range: bool,
     /// The parameters in use (the preset's or the user's), read back as `effective_*`.
     effective: MuscleParams,
+    /// `1 / effective.nominal_length`: `contraction` by a product, not a division, per step.
+    per_nominal_length: f64,
+    /// The bare sleeve, once its first evaluation has logged the notice and written the neutral
+    /// outputs of the absent effects (which never change) into the outputs this model is paired
+    /// with, and when no pressure solver runs: then a step is eq. 2.3 alone, behind one test. A
+    /// model built or deserialized afresh starts without it.
+    #[serde(skip)]
+    bare_sleeve: Option<Sleeve>,
     /// Which user-set parameters the preset replaced: a warning with the first outputs.
     notice: Option<String>,
     /// `pressure_solver` on: the muscle to invert and `max_pressure`.
@@ -191,7 +202,7 @@ fn beyond_sleeve(logged: &mut bool, report: &mut Report, pressure: f64, requeste
     out_of_range(logged, report, &reason, (0.0, b), Some((pressure, b)));
 }
 
-/// Eq. 2.3 for the bare sleeve; the outputs of the absent effects keep their neutral values.
+/// Eq. 2.3 for the bare sleeve.
 #[inline(always)]
 fn sleeve_outputs(
     sleeve: &Sleeve,
@@ -216,6 +227,11 @@ fn sleeve_outputs(
     out.effective_pressure = p_eff;
     out.stiffness = sleeve.stiffness(p_eff, length);
     out.bladder_contact = pressure > 0.0;
+}
+
+/// The outputs of the effects the bare sleeve lacks, at their neutral values: no bladder (no
+/// threshold, no stretch, no stress) and no friction.
+fn neutral_outputs(out: &mut Outputs) {
     out.threshold_pressure = 0.0;
     out.stretch_axial = 1.0;
     out.stretch_hoop = 1.0;
@@ -237,9 +253,8 @@ impl McKibbenMuscle {
         report: &mut Report,
         commit: bool,
     ) {
-        if let (Pipeline::Sleeve(sleeve), None, None) = (&self.pipeline, &self.notice, &self.solver)
-        {
-            outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
+        if let Some(sleeve) = &self.bare_sleeve {
+            outputs.contraction = 1.0 - inputs.length * self.per_nominal_length;
             sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report);
         } else {
             self.all_outputs(inputs, outputs, report, commit);
@@ -260,10 +275,14 @@ impl McKibbenMuscle {
             report.add(Status::Ok, notice);
         }
         let history = self.friction;
-        outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
+        outputs.contraction = 1.0 - inputs.length * self.per_nominal_length;
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
-                sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report)
+                neutral_outputs(outputs);
+                sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report);
+                if self.solver.is_none() {
+                    self.bare_sleeve = Some(*sleeve);
+                }
             }
             Pipeline::Full(muscle) => {
                 if let Some(out) = Self::compute(
@@ -537,6 +556,8 @@ impl Model for McKibbenMuscle {
             pipeline,
             friction,
             out_of_range: false,
+            per_nominal_length: 1.0 / params.nominal_length,
+            bare_sleeve: None,
             effective: params,
             notice,
             solver,
@@ -621,7 +642,7 @@ impl McKibbenMuscle {
             rows.row("stiffness", &[("pressure", dp), ("length", dl)]);
         }
         // contraction = 1 - length / nominal_length.
-        let per_length = -1.0 / self.effective.nominal_length;
+        let per_length = -self.per_nominal_length;
         rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
         let target = self.target_pressure_partials(inputs);
         rows.row(
@@ -724,5 +745,58 @@ mod tests {
         assert_eq!(with.get("force"), first.get("force"));
         // Served from the cache, stiffness included.
         assert_eq!(m.partials_for(&x, &["force"]).unwrap(), with);
+    }
+
+    /// The bare sleeve writes the neutral outputs of the absent effects once per model, and every
+    /// model built or deserialized afresh writes them again: outputs that came with an importer's
+    /// bytes (whatever they hold) are right after the first step.
+    #[test]
+    fn neutral_outputs_are_written_by_every_fresh_model() {
+        let p = Parameters::default();
+        let x = Inputs {
+            pressure: 3e5,
+            length: 0.1,
+            ..Default::default()
+        };
+        let garbage = Outputs {
+            threshold_pressure: 7.0,
+            stretch_axial: 7.0,
+            stretch_hoop: 7.0,
+            stretch_radial: 7.0,
+            stress_axial: 7.0,
+            stress_hoop: 7.0,
+            stress_radial: 7.0,
+            friction_force: 7.0,
+            ..Default::default()
+        };
+        let neutral = |o: &Outputs| {
+            [
+                o.threshold_pressure,
+                o.stress_axial,
+                o.stress_hoop,
+                o.stress_radial,
+            ]
+            .iter()
+            .all(|&v| v == 0.0)
+                && o.friction_force == 0.0
+                && [o.stretch_axial, o.stretch_hoop, o.stretch_radial] == [1.0; 3]
+        };
+        let mut m = McKibbenMuscle::new(&p, &x).unwrap();
+        assert!(matches!(m.pipeline, Pipeline::Sleeve(_)));
+        let mut out = garbage.clone();
+        for _ in 0..2 {
+            m.step(&x, &mut out, 0.0, 1e-3, &mut Report::default());
+            assert!(neutral(&out), "{out:?}");
+            assert!(m.bare_sleeve.is_some());
+        }
+        let bytes = postcard::to_allocvec(&m).unwrap();
+        let mut restored: McKibbenMuscle = postcard::from_bytes(&bytes).unwrap();
+        assert!(restored.bare_sleeve.is_none());
+        let mut out = garbage;
+        restored.step(&x, &mut out, 0.0, 1e-3, &mut Report::default());
+        assert!(neutral(&out), "{out:?}");
+        // Eq. 2.3 itself.
+        let sleeve = Sleeve::new(p.strand_length, p.turns).unwrap();
+        assert_eq!(out.force, sleeve.force(3e5, 0.1));
     }
 }
