@@ -384,7 +384,9 @@ pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
     );
     for (t, array) in ARRAYS.iter().enumerate() {
         let rust = RUST_TYPES[t];
+        // An unknown Real reads as NaN (see `Bindings::real`).
         let (get_type, default, set_type) = match t {
+            0 => (rust, "f64::NAN", rust),
             3 => ("&str", "\"\"", "&str"),
             _ => (rust, "Default::default()", rust),
         };
@@ -514,7 +516,7 @@ fn real_by_offset(module: &str, code: &mut String) {
         code,
         "            Some(&offset) => unsafe {{ (values as *const Values<Self>).cast::<u8>().add(offset).cast::<f64>().read() }},"
     );
-    let _ = writeln!(code, "            None => 0.0,");
+    let _ = writeln!(code, "            None => f64::NAN,");
     let _ = writeln!(code, "        }}");
     let _ = writeln!(code, "    }}");
     let _ = writeln!(code, "    #[inline]");

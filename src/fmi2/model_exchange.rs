@@ -76,7 +76,7 @@ impl Instance {
         if !self.me_allowed(F, allowed::EVENT_OR_CONTINUOUS_TIME_MODE) {
             return fmi2Status::Error;
         }
-        self.state = MachineState::EventMode;
+        self.set_state(MachineState::EventMode);
         fmi2Status::OK
     }
 
@@ -106,7 +106,7 @@ impl Instance {
         if !self.me_allowed(F, allowed::EVENT_MODE) {
             return fmi2Status::Error;
         }
-        self.state = MachineState::ContinuousTimeMode;
+        self.set_state(MachineState::ContinuousTimeMode);
         fmi2Status::OK
     }
 

@@ -70,20 +70,22 @@ impl OutOfRange {
         }
         let status = self.status(runtime, in_step);
         report.status = report.status.max(status);
-        let messages = std::mem::take(&mut report.clamp_messages);
+        let messages = report.take_clamp_messages();
         if status > Status::Ok {
             if messages.is_empty() {
                 // The model explains an excursion once, when it begins (perhaps in another
                 // call); a status other than OK still needs its reason in this call.
-                report.messages.push((
+                report.add(
                     status,
                     format!(
-                        "an input is still outside the model's valid range (explained when the                          excursion began); outputs are those of the nearest valid point                          (`{FLAG}` is true; `{POLICY}` asks for this status)"
+                        "an input is still outside the model's valid range (explained when the \
+                         excursion began); outputs are those of the nearest valid point \
+                         (`{FLAG}` is true; `{POLICY}` asks for this status)"
                     ),
-                ));
+                );
             }
             for m in messages {
-                report.messages.push((status, m));
+                report.add(status, m);
             }
             Vec::new()
         } else {

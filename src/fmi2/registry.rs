@@ -9,6 +9,8 @@ use crate::variables::Interface;
 /// `crate::variables::<model>::Variables` as one `match` per type. A value reference that is not
 /// the model's reads a default and writes nothing (the export layer refuses those before).
 pub trait Bindings: Interface + Sized {
+    /// The Real at `vr`; NaN for a value reference that is not the model's, so that the per-step
+    /// `fmi2GetReal`, which hands out only finite values, needs no separate test of the reference.
     fn real(values: &Values<Self>, vr: usize) -> f64;
     fn set_real(values: &mut Values<Self>, vr: usize, value: f64);
     fn integer(values: &Values<Self>, vr: usize) -> i32;

@@ -179,16 +179,44 @@ pub trait Runtime: Send {
 struct RuntimeOf<M: Model> {
     values: Values<M::Variables>,
     model: Option<M>,
+    /// The outputs are not those the built model wrote for the current values. True whenever
+    /// `model` is `None` (every change of `model` sets it; bytes from an importer are made to
+    /// agree), so that [`Runtime::outputs_current`] is one test on the per-step path.
     outputs_stale: bool,
     /// Model Exchange's time, given to the model when it is built (`None` for Co-Simulation).
     /// Not saved: the model keeps its own time, and the instance its.
     #[serde(skip)]
     time: Option<f64>,
-    /// Why the last build failed, until a value changes: a rejected KnittedMuscle builds its
-    /// whole shape table before a later check refuses it, and initialization mode retries the
-    /// build at every get.
+    /// Why the last build failed, with the values it failed on: a rejected KnittedMuscle builds
+    /// its whole shape table before a later check refuses it, and initialization mode retries
+    /// the build at every get. Compared when building, so that a set clears nothing.
     #[serde(skip)]
-    rejected: Option<String>,
+    rejected: Option<Rejected<M::Variables>>,
+}
+
+/// A failed build: the parameters and start inputs [`Model::new`] refused, and why.
+struct Rejected<V: Interface> {
+    parameters: V::Parameters,
+    inputs: V::Inputs,
+    why: String,
+}
+
+impl<V: Interface> Clone for Rejected<V> {
+    fn clone(&self) -> Self {
+        Self {
+            parameters: self.parameters.clone(),
+            inputs: self.inputs.clone(),
+            why: self.why.clone(),
+        }
+    }
+}
+
+impl<V: Interface> Rejected<V> {
+    /// Why, if `values` are those that were refused.
+    fn of(&self, values: &Values<V>) -> Option<&str> {
+        (self.parameters == values.parameters && self.inputs == values.inputs)
+            .then_some(self.why.as_str())
+    }
 }
 
 impl<M: Model> RuntimeOf<M>
@@ -297,10 +325,6 @@ where
     #[inline]
     fn changed(&mut self, parameters: bool) {
         self.outputs_stale = true;
-        // Tested first: the per-step path then only reads it.
-        if self.rejected.is_some() {
-            self.rejected = None;
-        }
         if parameters {
             self.model = None;
         }
@@ -310,16 +334,24 @@ where
     }
     #[inline]
     fn outputs_current(&self) -> bool {
-        !self.outputs_stale && self.model.is_some()
+        debug_assert!(self.outputs_stale || self.model.is_some());
+        !self.outputs_stale
     }
     fn build(&mut self) -> Result<(), String> {
-        if let Some(why) = &self.rejected {
-            return Err(why.clone());
+        if let Some(why) = self.rejected.as_ref().and_then(|r| r.of(&self.values)) {
+            return Err(why.to_string());
         }
         let v = &mut self.values;
         let mut model = match M::new(&v.parameters, &v.inputs) {
             Ok(model) => model,
-            Err(why) => return Err(self.rejected.insert(why.0).clone()),
+            Err(why) => {
+                let rejected = Rejected {
+                    parameters: v.parameters.clone(),
+                    inputs: v.inputs.clone(),
+                    why: why.0,
+                };
+                return Err(self.rejected.insert(rejected).why.clone());
+            }
         };
         v.calculated = model.calculated_parameters();
         if let Some(time) = self.time {
@@ -345,9 +377,10 @@ where
             std::hint::cold_path();
             return;
         };
+        // Before the step: written with the report's other flags.
+        report.evaluated = true;
         let v = &mut self.values;
         model.step(&v.inputs, &mut v.outputs, time, step, report);
-        report.evaluated = true;
         self.outputs_stale = false;
         M::Variables::set_input_clamped(v, report.clamped);
     }
@@ -473,14 +506,18 @@ where
     }
     fn rebuild_model(&mut self) -> Result<(), String> {
         if let Some(saved) = self.model.take() {
+            let stale = std::mem::replace(&mut self.outputs_stale, true);
             self.model = Some(rebuilt(&self.values, &saved)?);
+            self.outputs_stale = stale;
         }
         self.mirror_states();
         Ok(())
     }
     fn snapshot_from_bytes(&self, bytes: &[u8]) -> Result<Box<dyn Runtime>, String> {
-        let r: Self =
+        let mut r: Self =
             postcard::from_bytes(bytes).map_err(|e| format!("corrupt model state: {e}"))?;
+        // No model, no current outputs, whatever the bytes say.
+        r.outputs_stale |= r.model.is_none();
         Ok(Box::new(r))
     }
     fn as_any(&self) -> &dyn Any {
@@ -515,4 +552,47 @@ where
         .adopt_history(saved)
         .map_err(|e| format!("corrupt model state: {e}"))?;
     Ok(model)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::models::mckibben_muscle::McKibbenMuscle;
+
+    /// "Outputs current" is one flag on the per-step path, which holds only with a built model:
+    /// bytes that claim current outputs without a model, or whose model fails to rebuild, are
+    /// made to agree.
+    #[test]
+    fn no_model_means_stale_outputs_whatever_the_bytes_say() {
+        let mut runtime = ModelFactory::<McKibbenMuscle>::NEW.create();
+        let crafted = |runtime: &dyn Runtime| {
+            let mut r = runtime
+                .as_any()
+                .downcast_ref::<RuntimeOf<McKibbenMuscle>>()
+                .unwrap()
+                .clone();
+            r.outputs_stale = false;
+            r.to_bytes().unwrap()
+        };
+        let restored = runtime.snapshot_from_bytes(&crafted(&*runtime)).unwrap();
+        assert!(!restored.is_built());
+        assert!(!restored.outputs_current());
+
+        runtime.build().unwrap();
+        let mut report = Report::default();
+        runtime.step(0.0, 1e-3, &mut report);
+        assert!(runtime.outputs_current());
+        // A model whose parameters no longer build it: no model, stale outputs.
+        let mut r = runtime
+            .as_any()
+            .downcast_ref::<RuntimeOf<McKibbenMuscle>>()
+            .unwrap()
+            .clone();
+        r.values.parameters.turns = -1.0;
+        let mut broken = runtime.snapshot_from_bytes(&r.to_bytes().unwrap()).unwrap();
+        assert!(broken.outputs_current());
+        assert!(broken.rebuild_model().is_err());
+        assert!(!broken.is_built());
+        assert!(!broken.outputs_current());
+    }
 }

@@ -275,7 +275,7 @@ mod tests {
             m.step(&inputs, &mut o, 0.0, 0.01, &mut report);
             assert_eq!(report.clamped, !(-101_325.0..52_000.0).contains(&pressure));
             assert!(o.volume.is_finite() && o.volume > 0.0);
-            messages += report.clamp_messages.len();
+            messages += report.clamp_messages().len();
             volumes.push(o.volume);
         }
         // Two excursions (ballooning, vacuum), one message each; a clamped pressure gives the

@@ -690,7 +690,7 @@ mod tests {
             let mut report = Report::default();
             inputs.length = length;
             m.evaluate(&inputs, &mut out, &mut report);
-            warned += report.clamp_messages.len();
+            warned += report.clamp_messages().len();
             assert_eq!(report.status, Status::Ok);
             assert_eq!(report.clamped, !(lo..=hi).contains(&length));
             if length > hi {

@@ -30,24 +30,32 @@ pub enum Status {
     Error,
 }
 
-/// What a model call has to say: the worst status and the messages that explain it.
+/// What a model call has to say: the worst status and the messages that explain it. A report with
+/// nothing to say is three flags and a null pointer: the per-step path builds and tests one every
+/// step.
 #[derive(Debug, Default)]
 pub struct Report {
     pub status: Status,
-    pub messages: Vec<(Status, String)>,
     /// The model ran (evaluated or stepped): `clamped` describes the outputs it wrote.
     pub evaluated: bool,
     /// An input lay outside the model's solvable range and was evaluated at the nearest valid
     /// point. The export layer turns this into a status by the `out_of_range_policy` parameter.
     pub clamped: bool,
-    /// Why, logged once per excursion (the first call that leaves the range).
-    pub clamp_messages: Vec<String>,
+    /// The messages, allocated with the first.
+    notes: Option<Box<Notes>>,
+}
+
+#[derive(Debug, Default)]
+struct Notes {
+    messages: Vec<(Status, String)>,
+    /// Why an input was clamped, logged once per excursion (the first call that leaves the range).
+    clamp_messages: Vec<String>,
 }
 
 impl Report {
     pub fn add(&mut self, status: Status, message: impl Into<String>) {
         self.status = self.status.max(status);
-        self.messages.push((status, message.into()));
+        self.notes_mut().messages.push((status, message.into()));
     }
     pub fn warn(&mut self, message: impl Into<String>) {
         self.add(Status::Warning, message)
@@ -57,8 +65,31 @@ impl Report {
     pub fn clamp(&mut self, first: bool, message: impl FnOnce() -> String) {
         self.clamped = true;
         if first {
-            self.clamp_messages.push(message());
+            self.notes_mut().clamp_messages.push(message());
         }
+    }
+    /// The messages with their statuses, in order.
+    pub fn messages(&self) -> &[(Status, String)] {
+        self.notes.as_ref().map_or(&[], |n| &n.messages)
+    }
+    /// Why inputs were clamped, if this call began an excursion.
+    pub fn clamp_messages(&self) -> &[String] {
+        self.notes.as_ref().map_or(&[], |n| &n.clamp_messages)
+    }
+    /// Takes [`Report::clamp_messages`] out of the report.
+    pub fn take_clamp_messages(&mut self) -> Vec<String> {
+        self.notes
+            .as_mut()
+            .map(|n| std::mem::take(&mut n.clamp_messages))
+            .unwrap_or_default()
+    }
+    /// Nothing to say: fmi2OK, nothing clamped, no message. Such a report owns no memory.
+    #[inline(always)]
+    pub fn is_quiet(&self) -> bool {
+        self.status == Status::Ok && !self.clamped && self.notes.is_none()
+    }
+    fn notes_mut(&mut self) -> &mut Notes {
+        self.notes.get_or_insert_with(Default::default)
     }
 }
 

@@ -1,7 +1,8 @@
 //! The C entry points of the per-step calls, compiled once per model: `fmi2SetReal`, `fmi2DoStep`
 //! and `fmi2GetReal` check the instance pointer and jump (a tail call) to the entry point of the
 //! instance's model, which catches panics, checks the arrays and runs the monomorphized body
-//! (`instance/hot.rs`).
+//! (`instance/hot.rs`). A set or get of one value is first tried on a path that cannot panic,
+//! outside the guard: without a landing pad it needs no stack frame.
 
 use super::{null_argument, run_guarded, slice, slice_mut};
 use crate::fmi2::instance::{hot, Instance};
@@ -44,9 +45,39 @@ impl HotPath {
     }
 }
 
+/// Neither pointer is NULL: one test of the smaller address (two tests compiled to four flag
+/// operations).
+#[inline(always)]
+fn non_null<T, U>(a: *const T, b: *const U) -> bool {
+    (a as usize).min(b as usize) != 0
+}
+
 /// # Safety
 /// See [`HotPath`].
 unsafe extern "C" fn set_real<R: Runtime + 'static>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *const fmi2Real,
+) -> fmi2Status {
+    // SAFETY: see HotPath; one readable element at each non-null pointer.
+    if nvr == 1
+        && non_null(vr, value)
+        && unsafe { hot::try_set_real::<R>(&mut *(c as *mut Instance), *vr, *value) }
+    {
+        return fmi2Status::OK;
+    }
+    // SAFETY: the caller's promise.
+    unsafe { set_real_guarded::<R>(c, vr, nvr, value) }
+}
+
+/// `fmi2SetReal` under the panic guard. `extern "C"`, as it cannot unwind: the call to it is then a
+/// tail call (a call that may unwind out of an `extern "C"` function needs a landing pad).
+///
+/// # Safety
+/// See [`HotPath`].
+#[inline(never)]
+unsafe extern "C" fn set_real_guarded<R: Runtime + 'static>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,
@@ -83,6 +114,28 @@ unsafe extern "C" fn do_step<R: Runtime + 'static>(
 /// # Safety
 /// See [`HotPath`].
 unsafe extern "C" fn get_real<R: Runtime + 'static>(
+    c: fmi2Component,
+    vr: *const fmi2ValueReference,
+    nvr: usize,
+    value: *mut fmi2Real,
+) -> fmi2Status {
+    // SAFETY: see HotPath; one element at each non-null pointer, `value` writable.
+    if nvr == 1
+        && non_null(vr, value)
+        && unsafe { hot::try_get_real::<R>(&mut *(c as *mut Instance), *vr, &mut *value) }
+    {
+        return fmi2Status::OK;
+    }
+    // SAFETY: the caller's promise.
+    unsafe { get_real_guarded::<R>(c, vr, nvr, value) }
+}
+
+/// `fmi2GetReal` under the panic guard, `extern "C"` as [`set_real_guarded`].
+///
+/// # Safety
+/// See [`HotPath`].
+#[inline(never)]
+unsafe extern "C" fn get_real_guarded<R: Runtime + 'static>(
     c: fmi2Component,
     vr: *const fmi2ValueReference,
     nvr: usize,

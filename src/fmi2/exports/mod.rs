@@ -94,7 +94,7 @@ unsafe fn panicked(
 ) -> fmi2Status {
     // SAFETY: the caller's promise.
     let inst = unsafe { &mut *ptr };
-    inst.state = super::instance::MachineState::Fatal;
+    inst.set_state(super::instance::MachineState::Fatal);
     inst.logger.log(
         fmi2Status::Fatal,
         &format!("{function}: internal error: {}", panic_text(&*payload)),

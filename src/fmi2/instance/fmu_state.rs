@@ -45,7 +45,7 @@ impl Instance {
             time: self.time,
             start_time: self.start_time,
             stop_time: self.stop_time,
-            machine: self.state,
+            machine: self.state(),
             runtime: self.runtime.snapshot(),
         }
     }
@@ -117,7 +117,7 @@ impl Instance {
         self.time = saved.time;
         self.start_time = saved.start_time;
         self.stop_time = saved.stop_time;
-        self.state = saved.machine;
+        self.set_state(saved.machine);
         fmi2Status::OK
     }
 

@@ -13,7 +13,7 @@
 //! parameter among them. Anything else goes to the general code in `values.rs` and `machine.rs`,
 //! which checks again and refuses, logs or rebuilds exactly as before.
 
-use super::{allowed, to_fmi, Instance, MachineState};
+use super::{allowed, Instance, MachineState};
 pub use crate::fmi2::exports::HotPath;
 use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::fmi2Status;
@@ -42,11 +42,35 @@ impl Instance {
     /// Whether a call allowed in `mask` takes the fast path: allowed now, and no call tracing.
     #[inline(always)]
     fn quietly_allowed(&self, mask: u32) -> bool {
-        mask & self.state.bit() != 0 && !self.logger.debug
+        mask & self.gate.quiet() != 0
     }
 }
 
-/// `fmi2SetReal`. The fast path stores inputs (and tunable locals) within their range.
+/// `fmi2SetReal` of one value on the per-step path: stores an input (or tunable local) within its
+/// range, and says whether it did. Anything else is left to [`set_reals`].
+///
+/// Called outside the panic guard (`exports/hot.rs`): it must not panic, and cannot (compares,
+/// loads and two stores; `get` rather than indexing).
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+#[inline(always)]
+pub(in crate::fmi2) unsafe fn try_set_real<R: Runtime + 'static>(
+    inst: &mut Instance,
+    vr: u32,
+    value: f64,
+) -> bool {
+    if !accepts(inst, vr, value) {
+        return false;
+    }
+    // SAFETY: the caller promises that R is the runtime's type.
+    let runtime = unsafe { inst.runtime_as::<R>() };
+    runtime.set_real(vr as usize, value);
+    runtime.changed(false);
+    true
+}
+
+/// `fmi2SetReal`, any call: the per-step path for one value, else the loop or the general path.
 ///
 /// # Safety
 /// `R` is the runtime's type ([`Instance::runtime_as`]).
@@ -55,30 +79,25 @@ pub(in crate::fmi2) unsafe fn set_reals<R: Runtime + 'static>(
     vrs: &[u32],
     values: &[f64],
 ) -> fmi2Status {
-    // Most masters set one value per call: checked and stored without a loop, the loop and the
-    // general path out of line.
     let ([vr], [value]) = (vrs, values) else {
         // SAFETY: the caller's promise.
         return unsafe { set_many_reals::<R>(inst, vrs, values) };
     };
-    if inst.logger.debug || !accepts(inst, *vr, *value) {
-        return set_general_path(inst, vrs, values);
+    // SAFETY: the caller's promise.
+    if unsafe { try_set_real::<R>(inst, *vr, *value) } {
+        return fmi2Status::OK;
     }
-    // SAFETY: the caller promises that R is the runtime's type.
-    let runtime = unsafe { inst.runtime_as::<R>() };
-    runtime.set_real(*vr as usize, *value);
-    runtime.changed(false);
-    fmi2Status::OK
+    set_general_path(inst, vrs, values)
 }
 
 /// Whether the per-step path may store `value` at `vr` now: a rule's fast states are a subset of
-/// those that allow a set, so no separate state check.
+/// those that allow a set, so no separate state check; none while calls are logged.
 #[inline(always)]
 fn accepts(inst: &Instance, vr: u32, value: f64) -> bool {
-    let state = inst.state.bit();
+    let quiet = inst.gate.quiet();
     inst.set_rules[0]
         .get(vr as usize)
-        .is_some_and(|rule| rule.fast_states & state != 0 && rule.accepts(value))
+        .is_some_and(|rule| rule.fast_states & quiet != 0 && rule.accepts(value))
 }
 
 /// The general `fmi2SetReal` (it refuses, logs or stores as before), out of line and cold.
@@ -98,11 +117,10 @@ unsafe fn set_many_reals<R: Runtime + 'static>(
     vrs: &[u32],
     values: &[f64],
 ) -> fmi2Status {
-    let fast = !inst.logger.debug
-        && vrs
-            .iter()
-            .zip(values)
-            .all(|(&vr, &value)| accepts(inst, vr, value));
+    let fast = vrs
+        .iter()
+        .zip(values)
+        .all(|(&vr, &value)| accepts(inst, vr, value));
     if !fast {
         return set_general_path(inst, vrs, values);
     }
@@ -166,29 +184,61 @@ unsafe fn step_unchecked<R: Runtime + 'static>(
     let mut report = Report::default();
     // SAFETY: the caller promises that R is the runtime's type.
     unsafe { inst.runtime_as::<R>() }.step(time, step, &mut report);
-    // The flag is written: only a report with something to say needs more. A report that never
-    // allocated holds no message: nothing to log, nothing to free (the drop is out of line).
-    let status =
-        if !report.clamped && report.messages.capacity() | report.clamp_messages.capacity() == 0 {
-            let status = to_fmi(report.status);
-            std::mem::forget(report);
-            status
-        } else {
-            inst.forward_messages(F, report, true)
-        };
-    // Compares, not a `match`: that compiled to a jump table, an indirect jump per step.
+    // The flag is written: only a report with something to say needs more. A quiet report has
+    // nothing to log and nothing to free: its drop is skipped and the step returns at once,
+    // without a dispatch on the status.
+    if report.is_quiet() {
+        std::mem::forget(report);
+        inst.time = time + step;
+        return fmi2Status::OK;
+    }
+    let status = inst.forward_messages(F, report, true);
+    // Compares, not a `match`: that compiled to a jump table.
     if status <= fmi2Status::Warning {
         inst.time = time + step;
     } else if status == fmi2Status::Discard {
-        inst.state = MachineState::StepFailed;
+        inst.set_state(MachineState::StepFailed);
     } else {
-        inst.state = MachineState::Error;
+        inst.set_state(MachineState::Error);
     }
     status
 }
 
-/// `fmi2GetReal`. The fast path reads outputs that are current (after a step, or a get with no
-/// set since) and finite.
+/// `fmi2GetReal` of one value on the per-step path: reads an output that is current (after a
+/// step, or a get with no set since) and finite into `slot`, and says whether it did. Anything
+/// else is left to [`get_reals`].
+///
+/// Called outside the panic guard (`exports/hot.rs`): it must not panic, and cannot (compares,
+/// loads and a store; `get` rather than indexing).
+///
+/// # Safety
+/// `R` is the runtime's type ([`Instance::runtime_as`]).
+#[inline(always)]
+pub(in crate::fmi2) unsafe fn try_get_real<R: Runtime + 'static>(
+    inst: &mut Instance,
+    vr: u32,
+    slot: &mut f64,
+) -> bool {
+    // Current outputs are what the general path hands out in every state that allows a get:
+    // it refreshes only stale ones. An unknown value reference reads as NaN, so the finiteness
+    // test sends it to the general path too, which refuses it.
+    if !inst.quietly_allowed(allowed::GET) {
+        return false;
+    }
+    // SAFETY: the caller promises that R is the runtime's type.
+    let runtime = unsafe { inst.runtime_as::<R>() };
+    if !runtime.outputs_current() {
+        return false;
+    }
+    let x = runtime.real(vr as usize);
+    if !x.is_finite() {
+        return false;
+    }
+    *slot = x;
+    true
+}
+
+/// `fmi2GetReal`, any call: the per-step path for one value, else the loop or the general path.
 ///
 /// # Safety
 /// `R` is the runtime's type ([`Instance::runtime_as`]).
@@ -197,24 +247,13 @@ pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
     vrs: &[u32],
     out: &mut [f64],
 ) -> fmi2Status {
-    // Most masters get one value per call: read without a loop, the loop out of line.
     let ([vr], [slot]) = (vrs, &mut *out) else {
         // SAFETY: the caller's promise.
         return unsafe { get_many_reals::<R>(inst, vrs, out) };
     };
-    // Current outputs are what the general path hands out in every state that allows a get:
-    // it refreshes only stale ones.
-    let known = (*vr as usize) < inst.set_rules[0].len();
-    if known && inst.quietly_allowed(allowed::GET) {
-        // SAFETY: the caller promises that R is the runtime's type.
-        let runtime = unsafe { inst.runtime_as::<R>() };
-        if runtime.outputs_current() {
-            let x = runtime.real(*vr as usize);
-            if x.is_finite() {
-                *slot = x;
-                return fmi2Status::OK;
-            }
-        }
+    // SAFETY: the caller's promise.
+    if unsafe { try_get_real::<R>(inst, *vr, slot) } {
+        return fmi2Status::OK;
     }
     get_general_path(inst, vrs, out)
 }
@@ -238,19 +277,15 @@ unsafe fn get_many_reals<R: Runtime + 'static>(
     out: &mut [f64],
 ) -> fmi2Status {
     if inst.quietly_allowed(allowed::GET) {
-        let count = inst.set_rules[0].len();
         // SAFETY: the caller promises that R is the runtime's type.
         let runtime = unsafe { inst.runtime_as::<R>() };
-        if runtime.outputs_current() {
-            let mut fast = true;
-            for (&vr, slot) in vrs.iter().zip(out.iter_mut()) {
-                let x = runtime.real(vr as usize);
-                fast &= (vr as usize) < count && x.is_finite();
-                *slot = x;
-            }
-            if fast {
-                return fmi2Status::OK;
-            }
+        // Checked before anything is written: NaN (an unknown value reference reads as NaN) never
+        // reaches the importer's array.
+        let fast = runtime.outputs_current()
+            && vrs.iter().all(|&vr| runtime.real(vr as usize).is_finite());
+        if fast {
+            runtime.reals(vrs, out);
+            return fmi2Status::OK;
         }
     }
     get_general_path(inst, vrs, out)

@@ -20,6 +20,50 @@ pub enum MachineState {
     ContinuousTimeMode,
 }
 
+/// The machine state and the view of it that the per-step paths test with one instruction: the
+/// state's bit while calls are not logged, none while they are (a logged call takes the general
+/// path, which logs it). Its fields change only together, through its methods.
+#[derive(Clone, Copy, Debug)]
+pub struct Gate {
+    state: MachineState,
+    logging_calls: bool,
+    quiet: u32,
+}
+
+impl Gate {
+    pub(super) fn new(state: MachineState, logging_calls: bool) -> Self {
+        let mut gate = Self {
+            state,
+            logging_calls,
+            quiet: 0,
+        };
+        gate.set(state);
+        gate
+    }
+
+    #[inline(always)]
+    pub(super) fn state(&self) -> MachineState {
+        self.state
+    }
+
+    pub(super) fn set(&mut self, state: MachineState) {
+        self.state = state;
+        self.quiet = if self.logging_calls { 0 } else { state.bit() };
+    }
+
+    pub(super) fn set_logging_calls(&mut self, on: bool) {
+        self.logging_calls = on;
+        self.set(self.state);
+    }
+
+    /// The current state's bit, or none while calls are logged: a per-step path may serve a call
+    /// allowed in `mask` itself when `mask & quiet() != 0`.
+    #[inline(always)]
+    pub(super) fn quiet(&self) -> u32 {
+        self.quiet
+    }
+}
+
 impl MachineState {
     pub(super) const fn bit(self) -> u32 {
         1 << self as u32
@@ -112,7 +156,9 @@ impl Instance {
             ));
         }
         // Warnings and errors are always logged; the switch is about call tracing.
-        self.logger.debug = on && (categories.is_empty() || categories.contains(&"logCalls"));
+        let calls = on && (categories.is_empty() || categories.contains(&"logCalls"));
+        self.logger.debug = calls;
+        self.gate.set_logging_calls(calls);
         fmi2Status::OK
     }
 
@@ -148,7 +194,7 @@ impl Instance {
         if !self.allowed("fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION) {
             return fmi2Status::Error;
         }
-        self.state = MachineState::InitializationMode;
+        self.set_state(MachineState::InitializationMode);
         fmi2Status::OK
     }
 
@@ -159,14 +205,14 @@ impl Instance {
         let status = self.refresh_outputs("fmi2ExitInitializationMode");
         if status >= fmi2Status::Error {
             // Bad parameters: the instance can be reset (or freed).
-            self.state = MachineState::Error;
+            self.set_state(MachineState::Error);
             return status;
         }
-        self.state = if self.model_exchange {
+        self.set_state(if self.model_exchange {
             MachineState::EventMode
         } else {
             MachineState::StepComplete
-        };
+        });
         status
     }
 
@@ -174,7 +220,7 @@ impl Instance {
         if !self.allowed("fmi2Terminate", allowed::TERMINATE) {
             return fmi2Status::Error;
         }
-        self.state = MachineState::Terminated;
+        self.set_state(MachineState::Terminated);
         fmi2Status::OK
     }
 
@@ -184,7 +230,7 @@ impl Instance {
             return fmi2Status::Error;
         }
         self.runtime.reset();
-        self.state = MachineState::Instantiated;
+        self.set_state(MachineState::Instantiated);
         self.time = 0.0;
         self.start_time = 0.0;
         self.stop_time = None;

@@ -13,6 +13,7 @@ mod values;
 
 pub use fmu_state::FmuState;
 pub use hot::HotPath;
+use machine::Gate;
 pub use machine::{allowed, MachineState};
 pub use values::{CBoolean, Value};
 
@@ -36,7 +37,8 @@ pub struct Instance {
     by_type: [Vec<&'static Variable>; 4],
     /// What fmi2SetXXX checks, by type and value reference, flattened for the per-step path.
     set_rules: [Vec<values::SetRule>; 4],
-    pub state: MachineState,
+    /// The machine state, with the per-step paths' view of it ([`Gate`]).
+    gate: Gate,
     /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
     pub(super) model_exchange: bool,
     pub(super) time: f64,
@@ -65,7 +67,7 @@ fn type_index(kind: VarType) -> usize {
 /// A report with nothing to log and no clamp to apply the out-of-range policy to.
 #[inline]
 fn quiet(report: &Report) -> bool {
-    !report.clamped && report.messages.is_empty()
+    !report.clamped && report.messages().is_empty()
 }
 
 fn to_fmi(status: Status) -> fmi2Status {
@@ -95,13 +97,14 @@ impl Instance {
                 .map(|var: &&'static Variable| values::SetRule::new(var))
                 .collect()
         });
+        let gate = Gate::new(MachineState::Instantiated, logger.debug);
         Self {
             magic: MAGIC,
             logger,
             info,
             by_type,
             set_rules,
-            state: MachineState::Instantiated,
+            gate,
             model_exchange: false,
             time: 0.0,
             start_time: 0.0,
@@ -119,11 +122,21 @@ impl Instance {
         fmi2Status::Error
     }
 
+    /// The state of FMI's call sequence.
+    #[inline(always)]
+    pub fn state(&self) -> MachineState {
+        self.gate.state()
+    }
+
+    pub fn set_state(&mut self, state: MachineState) {
+        self.gate.set(state);
+    }
+
     /// Logs and refuses a call that the current state does not allow. Inlined: on the per-step
     /// path it is one mask test and one flag test; the logging is out of line.
     #[inline]
     pub fn allowed(&self, function: &str, mask: u32) -> bool {
-        if mask & self.state.bit() == 0 {
+        if mask & self.state().bit() == 0 {
             self.illegal_call(function);
             return false;
         }
@@ -138,7 +151,7 @@ impl Instance {
     fn illegal_call(&self, function: &str) {
         self.error(&format!(
             "{function}: illegal call in state {:?}",
-            self.state
+            self.state()
         ));
     }
 
@@ -147,7 +160,7 @@ impl Instance {
     fn trace_call(&self, function: &str) {
         self.logger.log(
             fmi2Status::OK,
-            &format!("{function} in state {:?}", self.state),
+            &format!("{function} in state {:?}", self.state()),
         );
     }
 
@@ -195,7 +208,7 @@ impl Instance {
         for note in notes {
             self.logger.notice(&format!("{function}: {note}"));
         }
-        for (status, message) in &report.messages {
+        for (status, message) in report.messages() {
             let message = format!("{function}: {message}");
             match status {
                 // A notice the user should read although nothing failed: always logged, at fmi2OK.
@@ -219,7 +232,7 @@ impl Instance {
     #[inline(never)]
     fn recompute_outputs(&mut self, function: &str) -> fmi2Status {
         if !self.runtime.is_built() {
-            if self.state != MachineState::InitializationMode {
+            if self.state() != MachineState::InitializationMode {
                 return fmi2Status::OK;
             }
             if let Err(reason) = self.runtime.build() {

@@ -233,7 +233,7 @@ impl Instance {
             return fmi2Status::Error;
         }
         let rules = &self.set_rules[type_index(T::KIND)];
-        let state = self.state.bit();
+        let state = self.state().bit();
         let mut parameters_changed = false;
         for (&vr, value) in vrs.iter().zip(values) {
             let Some(rule) = rules.get(vr as usize) else {
@@ -257,7 +257,10 @@ impl Instance {
     fn not_settable(&self, function: &str, var: &Variable) -> fmi2Status {
         self.error(&format!(
             "{function}: {} ({:?}, {:?}) cannot be set in state {:?}",
-            var.name, var.causality, var.variability, self.state
+            var.name,
+            var.causality,
+            var.variability,
+            self.state()
         ))
     }
 
@@ -275,7 +278,7 @@ impl Instance {
     fn before_retune(&self, parameters_changed: bool) -> Option<Box<dyn Runtime>> {
         (parameters_changed
             && matches!(
-                self.state,
+                self.state(),
                 MachineState::StepComplete | MachineState::EventMode
             ))
         .then(|| self.runtime.snapshot())
@@ -323,7 +326,7 @@ impl Instance {
         }
         let mut status = fmi2Status::OK;
         if matches!(
-            self.state,
+            self.state(),
             MachineState::InitializationMode
                 | MachineState::StepComplete
                 | MachineState::EventMode
@@ -361,7 +364,7 @@ impl Instance {
             return self.unknown_reference(F, VarType::Real, vr);
         }
         let refreshing = matches!(
-            self.state,
+            self.state(),
             MachineState::InitializationMode
                 | MachineState::StepComplete
                 | MachineState::EventMode
