@@ -63,13 +63,13 @@ impl OutOfRange {
         in_step: bool,
     ) -> Vec<String> {
         if let (true, Some(i)) = (report.evaluated, self.flag) {
-            runtime.set_boolean(i, report.clamped);
+            runtime.set_boolean(i, report.clamped());
         }
-        if !report.clamped {
+        if !report.clamped() {
             return Vec::new();
         }
         let status = self.status(runtime, in_step);
-        report.status = report.status.max(status);
+        report.raise(status);
         let messages = report.take_clamp_messages();
         if status > Status::Ok {
             if messages.is_empty() {

@@ -382,7 +382,7 @@ where
         let v = &mut self.values;
         model.step(&v.inputs, &mut v.outputs, time, step, report);
         self.outputs_stale = false;
-        M::Variables::set_input_clamped(v, report.clamped);
+        M::Variables::set_input_clamped(v, report.clamped());
     }
     fn update_discrete_states(&mut self, time: f64, report: &mut Report) -> EventUpdate {
         let Some(model) = self.model.as_mut() else {

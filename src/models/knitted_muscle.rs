@@ -673,7 +673,7 @@ mod tests {
         let (f, fr) = (out.force, out.friction_force);
         let tension = f + 14e3 * m.sleeve.mean_area(0.35);
         assert!((fr + SQRT_2 * 0.25 * tension).abs() < 1e-12 * f.abs());
-        assert_eq!(report.status, Status::Ok);
+        assert_eq!(report.status(), Status::Ok);
     }
 
     #[test]
@@ -691,8 +691,8 @@ mod tests {
             inputs.length = length;
             m.evaluate(&inputs, &mut out, &mut report);
             warned += report.clamp_messages().len();
-            assert_eq!(report.status, Status::Ok);
-            assert_eq!(report.clamped, !(lo..=hi).contains(&length));
+            assert_eq!(report.status(), Status::Ok);
+            assert_eq!(report.clamped(), !(lo..=hi).contains(&length));
             if length > hi {
                 assert_eq!(out.force, at_limit.force);
             }

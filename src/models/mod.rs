@@ -31,16 +31,16 @@ pub enum Status {
 }
 
 /// What a model call has to say: the worst status and the messages that explain it. A report with
-/// nothing to say is three flags and a null pointer: the per-step path builds and tests one every
-/// step.
+/// nothing to say is a few flags and a null pointer, told by one of them: the per-step path builds
+/// and tests one every step.
 #[derive(Debug, Default)]
 pub struct Report {
-    pub status: Status,
+    status: Status,
     /// The model ran (evaluated or stepped): `clamped` describes the outputs it wrote.
     pub evaluated: bool,
-    /// An input lay outside the model's solvable range and was evaluated at the nearest valid
-    /// point. The export layer turns this into a status by the `out_of_range_policy` parameter.
-    pub clamped: bool,
+    clamped: bool,
+    /// The status is worse than OK, an input was clamped, or there is a message.
+    loud: bool,
     /// The messages, allocated with the first.
     notes: Option<Box<Notes>>,
 }
@@ -53,8 +53,18 @@ struct Notes {
 }
 
 impl Report {
-    pub fn add(&mut self, status: Status, message: impl Into<String>) {
+    /// The worst status so far.
+    pub fn status(&self) -> Status {
+        self.status
+    }
+    /// Makes the status at least `status` (without a message: the caller logs why elsewhere).
+    pub fn raise(&mut self, status: Status) {
         self.status = self.status.max(status);
+        self.loud |= status > Status::Ok;
+    }
+    pub fn add(&mut self, status: Status, message: impl Into<String>) {
+        self.raise(status);
+        self.loud = true;
         self.notes_mut().messages.push((status, message.into()));
     }
     pub fn warn(&mut self, message: impl Into<String>) {
@@ -64,9 +74,15 @@ impl Report {
     /// first call of an excursion (`first`), so that the log gets one line per excursion.
     pub fn clamp(&mut self, first: bool, message: impl FnOnce() -> String) {
         self.clamped = true;
+        self.loud = true;
         if first {
             self.notes_mut().clamp_messages.push(message());
         }
+    }
+    /// An input lay outside the model's solvable range and was evaluated at the nearest valid
+    /// point. The export layer turns this into a status by the `out_of_range_policy` parameter.
+    pub fn clamped(&self) -> bool {
+        self.clamped
     }
     /// The messages with their statuses, in order.
     pub fn messages(&self) -> &[(Status, String)] {
@@ -86,7 +102,7 @@ impl Report {
     /// Nothing to say: fmi2OK, nothing clamped, no message. Such a report owns no memory.
     #[inline(always)]
     pub fn is_quiet(&self) -> bool {
-        self.status == Status::Ok && !self.clamped && self.notes.is_none()
+        !self.loud
     }
     fn notes_mut(&mut self) -> &mut Notes {
         self.notes.get_or_insert_with(Default::default)

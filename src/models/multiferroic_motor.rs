@@ -374,7 +374,7 @@ impl Model for MultiferroicMotor {
                 write_outputs(outputs, &r.outputs);
                 if r.accuracy_limited {
                     if self.accuracy_warned {
-                        report.status = report.status.max(Status::Warning);
+                        report.raise(Status::Warning);
                     } else {
                         report.warn(format!(
                             "the step from t = {time} s by {step} s was completed beyond tolerance \

@@ -423,6 +423,19 @@ fn steps_may_not_pass_the_stop_time() {
     assert_eq!(i.do_step(0.75, 0.25), OK);
 }
 
+/// The per-step path takes only our own clock, bit for bit, and only a step that ends on a
+/// finite clock; the general path still takes -0 for 0 and a step whose end overflows, after
+/// which every step is refused.
+#[test]
+fn the_clock_is_ours_to_the_bit_and_an_infinite_clock_stops_the_run() {
+    let i = ready();
+    assert_eq!(i.do_step(-0.0, 0.5), OK);
+    assert_eq!(i.do_step(0.5, f64::MAX), OK);
+    assert_eq!(i.do_step(f64::MAX, f64::MAX), OK, "{:?}", i.log.lines());
+    assert_eq!(i.do_step(f64::INFINITY, 1.0), ERROR);
+    assert!(i.log.contains("expected currentCommunicationPoint"));
+}
+
 #[test]
 fn unsupported_functions_say_why() {
     let i = ready();

@@ -116,7 +116,7 @@ impl Instance {
         }
         self.time = saved.time;
         self.start_time = saved.start_time;
-        self.stop_time = saved.stop_time;
+        self.set_stop_time(saved.stop_time);
         self.set_state(saved.machine);
         fmi2Status::OK
     }

@@ -186,7 +186,7 @@ impl Instance {
         }
         self.start_time = start;
         self.time = start;
-        self.stop_time = stop;
+        self.set_stop_time(stop);
         fmi2Status::OK
     }
 
@@ -233,7 +233,7 @@ impl Instance {
         self.set_state(MachineState::Instantiated);
         self.time = 0.0;
         self.start_time = 0.0;
-        self.stop_time = None;
+        self.set_stop_time(None);
         fmi2Status::OK
     }
 
@@ -244,6 +244,11 @@ impl Instance {
         unsafe { (self.hot.do_step)(self as *mut Self as _, time, step, 0) }
     }
 
+    pub(super) fn set_stop_time(&mut self, stop: Option<f64>) {
+        self.stop_time = stop;
+        self.step_end_limit = stop.unwrap_or(f64::MAX);
+    }
+
     /// Whether [`Instance::step_refused`] accepts this step without the rounding allowance: a
     /// positive finite step from our own time that ends by the stop time. No call out, so that the
     /// per-step path keeps its arguments in registers.
@@ -251,10 +256,11 @@ impl Instance {
     pub(super) fn step_accepted(&self, time: f64, step: f64) -> bool {
         // Positive finite doubles are the bit patterns 1 ..= INFINITY - 1 (NaN's are above).
         let positive_finite = step.to_bits().wrapping_sub(1) < f64::INFINITY.to_bits() - 1;
-        // Zero only for equal finite times: an infinite clock (a step that overflowed) differs.
+        // Our own time, bit for bit (-0 for 0 takes the general path, which accepts it). The end
+        // is finite and by the stop time: so is `time`, and an infinite or NaN clock is refused.
         positive_finite
-            && time - self.time == 0.0
-            && self.stop_time.is_none_or(|stop| time + step <= stop)
+            && time.to_bits() == self.time.to_bits()
+            && time + step <= self.step_end_limit
     }
 
     /// The refusal of a step of `step` from `time`, if any (the caller checked the state). The

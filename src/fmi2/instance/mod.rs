@@ -43,7 +43,11 @@ pub struct Instance {
     pub(super) model_exchange: bool,
     pub(super) time: f64,
     start_time: f64,
+    /// Set with [`Instance::set_stop_time`], which keeps `step_end_limit` with it.
     stop_time: Option<f64>,
+    /// The latest end of a step the per-step path accepts: the stop time, or the largest finite
+    /// double (a step whose end would overflow takes the general path, as a clock that did).
+    step_end_limit: f64,
     /// Never replaced once created: [`HotPath`]'s functions rely on its concrete type.
     pub(super) runtime: Box<dyn Runtime>,
     /// The per-step calls compiled for this instance's model (the same factory as `runtime`).
@@ -67,7 +71,7 @@ fn type_index(kind: VarType) -> usize {
 /// A report with nothing to log and no clamp to apply the out-of-range policy to.
 #[inline]
 fn quiet(report: &Report) -> bool {
-    !report.clamped && report.messages().is_empty()
+    !report.clamped() && report.messages().is_empty()
 }
 
 fn to_fmi(status: Status) -> fmi2Status {
@@ -109,6 +113,7 @@ impl Instance {
             time: 0.0,
             start_time: 0.0,
             stop_time: None,
+            step_end_limit: f64::MAX,
             runtime: factory.create(),
             hot: factory.hot_path(),
             string_values: Vec::new(),
@@ -189,7 +194,7 @@ impl Instance {
             if report.evaluated {
                 self.out_of_range.clear_flag(self.runtime.as_mut());
             }
-            return to_fmi(report.status);
+            return to_fmi(report.status());
         }
         self.forward_messages(function, std::mem::take(report), in_step)
     }
@@ -216,7 +221,7 @@ impl Instance {
                 _ => self.logger.log(to_fmi(*status), &message),
             }
         }
-        to_fmi(report.status)
+        to_fmi(report.status())
     }
 
     /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.

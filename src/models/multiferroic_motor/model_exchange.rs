@@ -273,7 +273,11 @@ mod tests {
                     let t = (k * steps + j) as f64 * 1e-6;
                     cs.step(&Inputs::default(), &mut out, t, 1e-6, &mut report);
                 }
-                assert!(report.status <= Status::Warning, "{:?}", report.messages());
+                assert!(
+                    report.status() <= Status::Warning,
+                    "{:?}",
+                    report.messages()
+                );
                 assert!(
                     (angle - out.rotor_angle).abs() < 1e-4,
                     "gilbert {gilbert}, period {k}: {angle} {}",
