@@ -188,8 +188,8 @@ def parity_goal_rows(parity):
 # nanoseconds went"). Shown only beside a missed goal.
 FMI_LAYER_WHY = ("beside the checks kept on purpose (the instance's magic number on every call, the "
                  "range and NaN checks of every value set and got), most of what remains is the "
-                 "model's own step: eq. 2.2-2.3, the stroke clamp and 14 outputs (README, \"Where the "
-                 "nanoseconds went\")")
+                 "model's own step: eq. 2.2-2.3, the stroke clamp and the 6 outputs it writes each step "
+                 "(README, \"Where the nanoseconds went\")")
 
 
 def progress(text):
