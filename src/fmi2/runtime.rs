@@ -377,7 +377,6 @@ where
             std::hint::cold_path();
             return;
         };
-        // Before the step: written with the report's other flags.
         report.evaluated = true;
         let v = &mut self.values;
         model.step(&v.inputs, &mut v.outputs, time, step, report);

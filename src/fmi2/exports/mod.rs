@@ -1,6 +1,8 @@
 //! Every common and Co-Simulation function of FMI 2.0 (FMPy resolves all of them when it loads a
 //! binary). Each body runs inside `catch_unwind`: a panic is logged and becomes `fmi2Fatal`, it
-//! never unwinds into the importer. Pointers are checked here and turned into slices.
+//! never unwinds into the importer. The one exception is the per-step set or get of one value
+//! (`hot.rs`), tried first on a path that cannot panic. Pointers are checked here and turned into
+//! slices.
 //!
 //! Every `unsafe` block below relies on the importer keeping the FMI 2.0 calling convention: a
 //! component from `fmi2Instantiate` (or NULL), arrays of the length it passes (or NULL), and
