@@ -45,8 +45,6 @@ pub struct McKibbenMuscle {
     out_of_range: bool,
     /// The parameters in use (the preset's or the user's), read back as `effective_*`.
     effective: MuscleParams,
-    /// `1 / effective.nominal_length`: `contraction` by a product, not a division, per step.
-    per_nominal_length: f64,
     /// The bare sleeve, once its first evaluation has logged the notice and written the neutral
     /// outputs of the absent effects (which never change) into the outputs this model is paired
     /// with, and when no pressure solver runs: then a step is eq. 2.3 alone, behind one test. A
@@ -254,7 +252,7 @@ impl McKibbenMuscle {
         commit: bool,
     ) {
         if let Some(sleeve) = &self.bare_sleeve {
-            outputs.contraction = 1.0 - inputs.length * self.per_nominal_length;
+            outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
             sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report);
         } else {
             self.all_outputs(inputs, outputs, report, commit);
@@ -275,7 +273,7 @@ impl McKibbenMuscle {
             report.add(Status::Ok, notice);
         }
         let history = self.friction;
-        outputs.contraction = 1.0 - inputs.length * self.per_nominal_length;
+        outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
                 neutral_outputs(outputs);
@@ -556,7 +554,6 @@ impl Model for McKibbenMuscle {
             pipeline,
             friction,
             out_of_range: false,
-            per_nominal_length: 1.0 / params.nominal_length,
             bare_sleeve: None,
             effective: params,
             notice,
@@ -642,7 +639,7 @@ impl McKibbenMuscle {
             rows.row("stiffness", &[("pressure", dp), ("length", dl)]);
         }
         // contraction = 1 - length / nominal_length.
-        let per_length = -self.per_nominal_length;
+        let per_length = -1.0 / self.effective.nominal_length;
         rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
         let target = self.target_pressure_partials(inputs);
         rows.row(

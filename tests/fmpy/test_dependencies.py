@@ -30,8 +30,12 @@ CONFIGS = {
          {"pressure": -5e4, "length": 0.12}],
     ),
     "McKibbenMuscle": (
+        # Presets from one that differs from the defaults in nothing (1, Table 2.1's muscle A) to
+        # one that does (2, muscle B; 5 to 6, the Festo DMSP-10 to the DMSP-40), with and without
+        # the bladder and the pressure solver.
         [{}, {"bladder_model": 1}, {"friction": True}, {"bladder_model": 1, "friction": True},
-         {"pressure_solver": True}],
+         {"pressure_solver": True}, {"preset": 1}, {"preset": 1, "bladder_model": 1},
+         {"preset": 1, "pressure_solver": True}, {"preset": 5}],
         [{"pressure": 2e5, "length": 0.09, "target_force": 50.0},
          {"pressure": 4e5, "length": 0.085, "target_force": 200.0},
          {"pressure": 0.0, "length": 0.095, "target_force": 0.0}],
@@ -42,7 +46,9 @@ CONFIGS = {
          {"pressure": 0.0, "length": 0.42}],
     ),
     "McKibbenJoint": (
-        [{}, {"friction": True}, {"bladder_model": 1}, {"command_mode": 1}],
+        # common_mode_pressure at max_pressure: the flexor's pressure saturates there.
+        [{}, {"friction": True}, {"bladder_model": 1}, {"command_mode": 1},
+         {"common_mode_pressure": 7e5}],
         [{"actuatorInput": 0.3, "jointPosition": 0.1, "jointVelocity": 0.2},
          {"actuatorInput": -0.5, "jointPosition": -0.2, "jointVelocity": -1.0},
          {"actuatorInput": 1.0, "jointPosition": 0.0, "jointVelocity": 0.0}],
