@@ -70,7 +70,9 @@ pub(in crate::fmi2) unsafe fn try_set_real<R: Runtime + 'static>(
     true
 }
 
-/// `fmi2SetReal`, any call: the per-step path for one value, else the loop or the general path.
+/// `fmi2SetReal` of what the entry point's one-value path ([`try_set_real`]) did not take: many
+/// values through the per-step loop, one value through the general path (which is right for any
+/// call, so nothing depends on the first try).
 ///
 /// # Safety
 /// `R` is the runtime's type ([`Instance::runtime_as`]).
@@ -79,15 +81,11 @@ pub(in crate::fmi2) unsafe fn set_reals<R: Runtime + 'static>(
     vrs: &[u32],
     values: &[f64],
 ) -> fmi2Status {
-    let ([vr], [value]) = (vrs, values) else {
-        // SAFETY: the caller's promise.
-        return unsafe { set_many_reals::<R>(inst, vrs, values) };
-    };
-    // SAFETY: the caller's promise.
-    if unsafe { try_set_real::<R>(inst, *vr, *value) } {
-        return fmi2Status::OK;
+    if vrs.len() == 1 {
+        return set_general_path(inst, vrs, values);
     }
-    set_general_path(inst, vrs, values)
+    // SAFETY: the caller's promise.
+    unsafe { set_many_reals::<R>(inst, vrs, values) }
 }
 
 /// Whether the per-step path may store `value` at `vr` now: a rule's fast states are a subset of
@@ -238,7 +236,8 @@ pub(in crate::fmi2) unsafe fn try_get_real<R: Runtime + 'static>(
     true
 }
 
-/// `fmi2GetReal`, any call: the per-step path for one value, else the loop or the general path.
+/// `fmi2GetReal` of what the entry point's one-value path ([`try_get_real`]) did not take, as
+/// [`set_reals`].
 ///
 /// # Safety
 /// `R` is the runtime's type ([`Instance::runtime_as`]).
@@ -247,15 +246,11 @@ pub(in crate::fmi2) unsafe fn get_reals<R: Runtime + 'static>(
     vrs: &[u32],
     out: &mut [f64],
 ) -> fmi2Status {
-    let ([vr], [slot]) = (vrs, &mut *out) else {
-        // SAFETY: the caller's promise.
-        return unsafe { get_many_reals::<R>(inst, vrs, out) };
-    };
-    // SAFETY: the caller's promise.
-    if unsafe { try_get_real::<R>(inst, *vr, slot) } {
-        return fmi2Status::OK;
+    if vrs.len() == 1 {
+        return get_general_path(inst, vrs, out);
     }
-    get_general_path(inst, vrs, out)
+    // SAFETY: the caller's promise.
+    unsafe { get_many_reals::<R>(inst, vrs, out) }
 }
 
 /// The general `fmi2GetReal` (it refreshes stale outputs and refuses as before), out of line and
