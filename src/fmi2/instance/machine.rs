@@ -20,7 +20,7 @@ pub enum MachineState {
     ContinuousTimeMode,
 }
 
-/// The machine state and the view of it that the per-step paths test with one instruction: the
+/// The machine state and the view of it that the per-step paths test in one compare: the
 /// state's bit while calls are not logged, none while they are (a logged call takes the general
 /// path, which logs it). Its fields change only together, through its methods.
 #[derive(Clone, Copy, Debug)]
