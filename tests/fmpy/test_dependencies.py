@@ -207,8 +207,8 @@ def measure_initial(model):
     seen = {u.name: set() for u in model.initial}
     candidates = [v for v in model.vars if v.causality in ("input", "parameter")]
     params, points = CONFIGS[model.name]
-    for config in params:
-        values = dict(config, **points[0])
+    for config, point in ((c, p) for c in params for p in points):
+        values = dict(config, **point)
         base = initial_values(model, values)
         assert base is not None, f"{model.name} {values}: initialization failed"
         for c in candidates:
