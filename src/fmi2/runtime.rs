@@ -558,40 +558,39 @@ mod tests {
     use super::*;
     use crate::models::mckibben_muscle::McKibbenMuscle;
 
+    /// A copy of `runtime` as its concrete type, to edit before serializing.
+    fn copy_of(runtime: &dyn Runtime) -> Result<RuntimeOf<McKibbenMuscle>, String> {
+        runtime
+            .as_any()
+            .downcast_ref::<RuntimeOf<McKibbenMuscle>>()
+            .cloned()
+            .ok_or_else(|| "not a McKibbenMuscle runtime".to_string())
+    }
+
     /// "Outputs current" is one flag on the per-step path, which holds only with a built model:
     /// bytes that claim current outputs without a model, or whose model fails to rebuild, are
     /// made to agree.
     #[test]
-    fn no_model_means_stale_outputs_whatever_the_bytes_say() {
+    fn no_model_means_stale_outputs_whatever_the_bytes_say() -> Result<(), String> {
         let mut runtime = ModelFactory::<McKibbenMuscle>::NEW.create();
-        let crafted = |runtime: &dyn Runtime| {
-            let mut r = runtime
-                .as_any()
-                .downcast_ref::<RuntimeOf<McKibbenMuscle>>()
-                .unwrap()
-                .clone();
-            r.outputs_stale = false;
-            r.to_bytes().unwrap()
-        };
-        let restored = runtime.snapshot_from_bytes(&crafted(&*runtime)).unwrap();
+        let mut crafted = copy_of(&*runtime)?;
+        crafted.outputs_stale = false;
+        let restored = runtime.snapshot_from_bytes(&crafted.to_bytes()?)?;
         assert!(!restored.is_built());
         assert!(!restored.outputs_current());
 
-        runtime.build().unwrap();
+        runtime.build()?;
         let mut report = Report::default();
         runtime.step(0.0, 1e-3, &mut report);
         assert!(runtime.outputs_current());
         // A model whose parameters no longer build it: no model, stale outputs.
-        let mut r = runtime
-            .as_any()
-            .downcast_ref::<RuntimeOf<McKibbenMuscle>>()
-            .unwrap()
-            .clone();
+        let mut r = copy_of(&*runtime)?;
         r.values.parameters.turns = -1.0;
-        let mut broken = runtime.snapshot_from_bytes(&r.to_bytes().unwrap()).unwrap();
+        let mut broken = runtime.snapshot_from_bytes(&r.to_bytes()?)?;
         assert!(broken.outputs_current());
         assert!(broken.rebuild_model().is_err());
         assert!(!broken.is_built());
         assert!(!broken.outputs_current());
+        Ok(())
     }
 }
