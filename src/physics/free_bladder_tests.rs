@@ -61,7 +61,8 @@ fn solves_eq_2_18_and_eq_2_11_as_written() {
 fn is_the_mckibben_bladders_free_branch() {
     // The same thin tube inside Table 2.1 muscle A's sleeve, off the sleeve (P below the threshold
     // pressure): the shared bladder code solves eq. 2.18 numerically, this one in closed form.
-    let sleeved = Bladder::new(Sleeve::new(0.1113, 3.74).unwrap(), tube(TUBE_A), 1).unwrap();
+    let sleeved =
+        Bladder::dissertation_layers(Sleeve::new(0.1113, 3.74).unwrap(), tube(TUBE_A), 1).unwrap();
     let b = free(TUBE_A);
     for (p, f) in [(345e3, 0.7), (1e5, 0.85), (0.0, 0.6), (-5e4, 0.8)] {
         let l = f * 0.10325;
