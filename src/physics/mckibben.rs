@@ -619,21 +619,25 @@ mod tests {
         assert_relative_eq!(d.bladder_thickness, 0.25e-3, max_relative = 1e-12);
         assert_relative_eq!(d.strand_length / d.turns, 0.0314, max_relative = 1e-2); // b/n ~ 30 mm
         assert!(MuscleGeometry::preset('E').is_none());
-        assert_eq!(
-            BladderModel::from_switch(2, 16).unwrap(),
-            BladderModel::DissertationLayers { layers: 16 }
-        );
+        for model in [
+            BladderModel::None,
+            BladderModel::ThinWall,
+            BladderModel::Layers { layers: 16 },
+            BladderModel::Exact { nodes: 16 },
+            BladderModel::DissertationThinWall,
+            BladderModel::DissertationLayers { layers: 16 },
+            BladderModel::DissertationContinuum { nodes: 16 },
+        ] {
+            assert_eq!(BladderModel::from_switch(model.switch(), 16), Ok(model));
+        }
         assert_eq!(
             BladderModel::from_switch(1, 0).unwrap(),
-            BladderModel::DissertationThinWall
+            BladderModel::ThinWall
         );
-        assert!(BladderModel::from_switch(2, 0).is_err());
-        assert_eq!(
-            BladderModel::from_switch(3, 8).unwrap(),
-            BladderModel::DissertationContinuum { nodes: 8 }
-        );
-        assert!(BladderModel::from_switch(3, 0).is_err());
-        assert!(BladderModel::from_switch(4, 1).is_err());
+        for counted in [2, 3, 5, 6] {
+            assert!(BladderModel::from_switch(counted, 0).is_err());
+        }
+        assert!(BladderModel::from_switch(7, 1).is_err());
     }
 
     #[test]
@@ -936,6 +940,25 @@ mod tests {
         // and so does the thick wall over the whole sweep (the text says it gains).
         assert!(sweep[0][..4].windows(2).all(|w| w[1] < w[0]), "{sweep:?}");
         assert!(sweep[1].windows(2).all(|w| w[1] < w[0]), "{sweep:?}");
+    }
+
+    #[test]
+    fn exact_wall_net_work_grows_with_prestrain() {
+        // Section 2.4's claim, which the dissertation's own walls do not reproduce (above): more
+        // pre-strain, more net work per cycle (A 3% < B 52% < C 82%) at 690 kPa, for every
+        // cut-off of the cycle's top below max_length.
+        let p = 690e3;
+        for cutoff in [0.99, 0.995, 0.999] {
+            let work: Vec<f64> = PRESETS[..3]
+                .iter()
+                .map(|g| {
+                    let m = muscle(g, BladderModel::Exact { nodes: 16 });
+                    net_work(&m, p, g.length.min(cutoff * m.max_length())).0
+                })
+                .collect();
+            println!("exact wall, top {cutoff} of max_length: net work A/B/C {work:?} J");
+            assert!(work[0] < work[1] && work[1] < work[2], "{cutoff}: {work:?}");
+        }
     }
 
     proptest! {
