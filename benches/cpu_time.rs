@@ -106,7 +106,10 @@ fn walls(rounds: usize) -> Vec<(&'static str, f64)> {
     let a = MuscleGeometry::muscle_a();
     let walls = [
         // The dissertation's walls (bladder_model 5 and 6), under their benchmark names.
-        ("McKibbenMuscle, layered wall, 16 layers", Wall::DissertationLayers(16)),
+        (
+            "McKibbenMuscle, layered wall, 16 layers",
+            Wall::DissertationLayers(16),
+        ),
         (
             "McKibbenMuscle, continuum wall, 8 nodes",
             Wall::DissertationContinuum(8),
