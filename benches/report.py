@@ -593,7 +593,7 @@ README_ROWS = [
     ("McKibbenMuscle/bladder_model/none", "McKibbenMuscle, ideal sleeve (eq. 2.3)"),
     ("McKibbenMuscle/bladder_model/thin", "McKibbenMuscle, thin-walled bladder (muscle A, 690 kPa, in contact)"),
     ("McKibbenMuscle/bladder_layers/16", "McKibbenMuscle, layered wall, 16 layers"),
-    ("McKibbenMuscle/bladder_continuum/8", "McKibbenMuscle, continuum wall, 8 nodes"),
+    ("McKibbenMuscle/bladder_exact/16", "McKibbenMuscle, exact wall, 16 nodes"),
     ("McKibbenMuscle/friction/on (thin)", "McKibbenMuscle, thin wall + friction"),
     ("KnittedMuscle/shape_model/ideal", "KnittedMuscle, ideal cylinder"),
     ("KnittedMuscle/shape_segments/49", "KnittedMuscle, non-cylindrical, 49 segments (tabulated)"),
@@ -606,20 +606,22 @@ def continuum_wall_table():
     error, relative to the peak force, of the continuum and layered walls against the layered
     wall's limit, found independently by Richardson extrapolation from 256-2048 layers."""
     progress("continuum wall against the extrapolated layered limit")
-    probe = Slave("McKibbenMuscle", preset=3, bladder_model=3, bladder_layers=8, length=0.08)
+    # The dissertation's layers (bladder_model 5) and their continuum limit (6).
+    probe = Slave("McKibbenMuscle", preset=3, bladder_model=6, bladder_layers=8, length=0.08)
     lo, hi = probe.get("min_length"), probe.get("max_length")
     probe.close()
     lengths = lo + (hi - lo) * np.linspace(0.005, 0.995, 41)
     curve = lambda model, n: forces("McKibbenMuscle", 4.5e5, lengths, preset=3, bladder_model=model, bladder_layers=n)
-    f = [curve(2, n) for n in (256, 512, 1024, 2048)]
+    f = [curve(5, n) for n in (256, 512, 1024, 2048)]
     r1 = [2 * f[i + 1] - f[i] for i in range(3)]
     r2 = [(4 * r1[i + 1] - r1[i]) / 3 for i in range(2)]
     limit = (8 * r2[1] - r2[0]) / 7
     peak = np.max(np.abs(limit))
     err = lambda model, n: np.max(np.abs(curve(model, n) - limit)) / peak
-    rows = ["| nodes or layers | continuum wall (`bladder_model` 3) | layered wall (`bladder_model` 2) |", "|---|---|---|"]
+    rows = ["| nodes or layers | dissertation's continuum (`bladder_model` 6) | dissertation's layers (`bladder_model` 5) |",
+            "|---|---|---|"]
     for n in (1, 2, 4, 8, 16, 64, 128):
-        rows.append(f"| {n} | {err(3, n):.1e} | {err(2, n):.1e} |")
+        rows.append(f"| {n} | {err(6, n):.1e} | {err(5, n):.1e} |")
     return rows
 
 
