@@ -62,6 +62,19 @@ pub struct KnittedMuscle {
     /// Jacobian's further seeds reuse them. Not part of the FMU state.
     #[serde(skip)]
     partials_cache: Option<([u64; 4], bool, Partials)>,
+    /// The dissertation's signed force (`signed_force`); else tension only (see [`tension_only`]).
+    signed_force: bool,
+}
+
+/// A knitted sleeve cannot push: past its free contraction (signed force < 0, eq. 1.8's
+/// `-P dV/dL` changing sign) its strands go slack and so does the muscle: no force, no
+/// stiffness. With `signed` the dissertation's force stands.
+fn tension_only(out: &mut Outputs, signed: bool) {
+    out.slack = !signed && out.force < 0.0;
+    if out.slack {
+        out.force = 0.0;
+        out.stiffness = 0.0;
+    }
 }
 
 /// Outputs at one input point, with the friction history after moving there.
@@ -325,7 +338,12 @@ impl KnittedMuscle {
     /// bladder's [`Bladder::evaluate_with_partials`], eq. 1.21 with the stop operator's slope;
     /// with a bladder, the stiffness's row only if `stiffness` (from
     /// [`Bladder::stiffness_partials`]).
-    fn partials_at(&self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
+    fn partials_at(
+        &self,
+        inputs: &Inputs,
+        stiffness: bool,
+        slack: bool,
+    ) -> Result<Partials, String> {
         let (pressure, length) = (inputs.pressure, inputs.length);
         if !(pressure.is_finite() && length.is_finite()) {
             return Err(format!(
@@ -345,6 +363,11 @@ impl KnittedMuscle {
             Some(b) => self.bladder_rows(b, pressure, l, direction, stiffness)?,
             None => self.sleeve_rows(pressure, l, direction),
         };
+        if slack {
+            // Tension only: the slack muscle's force and stiffness are 0 nearby.
+            r.force = [0.0; 2];
+            r.stiffness = r.stiffness.map(|_| [0.0; 2]);
+        }
         let mut table = Partials::default();
         let mut add = |name: &'static str, row: &mut [f64; 2]| {
             row[1] *= length_moves;
@@ -544,6 +567,7 @@ impl Model for KnittedMuscle {
             collapsed: false,
             length_range,
             partials_cache: None,
+            signed_force: p.signed_force,
         })
     }
 
@@ -558,6 +582,7 @@ impl Model for KnittedMuscle {
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
         if let Some(out) = self.compute(inputs, report) {
             Self::write(outputs, &out);
+            tension_only(outputs, self.signed_force);
         }
     }
 
@@ -573,6 +598,7 @@ impl Model for KnittedMuscle {
         // history follows the length path sampled at the communication points.
         if let Some(out) = self.compute(inputs, report) {
             Self::write(outputs, &out);
+            tension_only(outputs, self.signed_force);
             self.history = out.history;
         }
     }
@@ -591,6 +617,17 @@ impl Model for KnittedMuscle {
 }
 
 impl KnittedMuscle {
+    /// The signed force [`Self::compute`] gives at `inputs`, leaving the excursion flags (and
+    /// their log) as they were.
+    fn signed_force_at(&mut self, inputs: &Inputs) -> Option<f64> {
+        let flags = (self.out_of_range, self.collapsed);
+        let force = self
+            .compute(inputs, &mut Report::default())
+            .map(|o| o.force);
+        (self.out_of_range, self.collapsed) = flags;
+        force
+    }
+
     fn cached_partials(&mut self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
         let h = &self.history;
         let key = [inputs.pressure, inputs.length, h.z, h.position].map(f64::to_bits);
@@ -599,7 +636,8 @@ impl KnittedMuscle {
                 return Ok(rows.clone());
             }
         }
-        let rows = self.partials_at(inputs, stiffness)?;
+        let slack = !self.signed_force && self.signed_force_at(inputs).is_some_and(|f| f < 0.0);
+        let rows = self.partials_at(inputs, stiffness, slack)?;
         self.partials_cache = Some((key, stiffness, rows.clone()));
         Ok(rows)
     }

@@ -45,6 +45,8 @@ pub struct McKibbenJoint {
     position_range: (f64, f64),
     /// `actuatorInput` is a joint torque (N m) to meet, not a pressure difference (Pa).
     torque_command: bool,
+    /// The dissertation's signed muscle forces (`signed_force`); else tension only.
+    signed_force: bool,
 }
 
 /// Both muscles' operating point at the current inputs.
@@ -55,6 +57,8 @@ struct Pair {
     lengths: [f64; 2],
     /// Command mode 1: the commanded torque was out of reach.
     saturated: bool,
+    /// Whether each muscle (flexor, extensor) is slack: its signed force is negative.
+    slack: [bool; 2],
 }
 
 fn muscle(p: &Parameters) -> Result<McKibben, String> {
@@ -114,6 +118,21 @@ fn positive(name: &str, x: f64) -> Result<f64, Refusal> {
 }
 
 impl McKibbenJoint {
+    /// Whether a muscle with this signed force is slack: a braided muscle cannot push, so past
+    /// its free contraction it carries no force and has no stiffness (unless `signed_force`).
+    fn slack(&self, force: f64) -> bool {
+        !self.signed_force && force < 0.0
+    }
+
+    /// The muscle's output, tension only unless `signed_force`.
+    fn tension(&self, mut out: McKibbenOutput) -> McKibbenOutput {
+        if self.slack(out.force) {
+            out.force = 0.0;
+            out.stiffness = 0.0;
+        }
+        out
+    }
+
     /// One muscle at (pressure, length); out of range, the nearest valid length (flagged).
     fn evaluate_muscle(
         &self,
@@ -156,7 +175,13 @@ impl McKibbenJoint {
         [length, inside]
             .into_iter()
             .find_map(|l| self.muscle.partials(pressure, l, history).ok())
-            .map(|(out, d)| (out.force, d.force[0]))
+            .map(|(out, d)| {
+                if self.slack(out.force) {
+                    (0.0, 0.0)
+                } else {
+                    (out.force, d.force[0])
+                }
+            })
     }
 
     /// Torque of the pair at the pressures from `difference`, and its slope in the difference,
@@ -224,9 +249,11 @@ impl McKibbenJoint {
             }
             None => self.out_of_range = false,
         }
+        let (flexor, extensor) = (flexor?, extensor?);
         Some(Pair {
-            flexor: flexor?,
-            extensor: extensor?,
+            slack: [self.slack(flexor.force), self.slack(extensor.force)],
+            flexor: self.tension(flexor),
+            extensor: self.tension(extensor),
             pressures,
             lengths,
             saturated,
@@ -236,8 +263,12 @@ impl McKibbenJoint {
     /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: at a clamped length
     /// the length no longer moves the force.
     fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
-        if let Ok((_, d)) = self.muscle.partials(pressure, length, history) {
-            return d.force;
+        if let Ok((out, d)) = self.muscle.partials(pressure, length, history) {
+            return if self.slack(out.force) {
+                [0.0; 2]
+            } else {
+                d.force
+            };
         }
         let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
         let margin = if self.muscle.bladder().is_some() {
@@ -248,6 +279,8 @@ impl McKibbenJoint {
         let inside = length.max(lo + margin).min(hi - margin);
         self.muscle
             .partials(pressure, inside, history)
+            .ok()
+            .filter(|(out, _)| !self.slack(out.force))
             .map_or([0.0, 0.0], |(_, d)| [d.force[0], 0.0])
     }
 
@@ -260,6 +293,7 @@ impl McKibbenJoint {
         out.flexor_length = pair.lengths[0];
         out.extensor_length = pair.lengths[1];
         out.torque_saturated = pair.saturated;
+        [out.flexor_slack, out.extensor_slack] = pair.slack;
     }
 }
 
@@ -327,6 +361,7 @@ impl Model for McKibbenJoint {
             out_of_range: false,
             position_range: (min_position, max_position),
             torque_command,
+            signed_force: p.signed_force,
         })
     }
 

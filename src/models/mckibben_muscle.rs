@@ -60,6 +60,8 @@ pub struct McKibbenMuscle {
     /// the same point reuse them. Not part of the FMU state.
     #[serde(skip)]
     partials_cache: Option<(PartialsKey, bool, Partials)>,
+    /// The dissertation's signed force (`signed_force`); else tension only (see [`tension_only`]).
+    signed_force: bool,
 }
 
 /// Bit patterns of what the partials depend on: pressure, length, target_force, friction z and
@@ -227,6 +229,18 @@ fn sleeve_outputs(
     out.bladder_contact = pressure > 0.0;
 }
 
+/// A braided muscle cannot push: past its free contraction (signed force < 0, where eq. 2.3's
+/// `3 L^2 - b^2` changes sign for the bare sleeve) the strands buckle and the muscle is slack,
+/// carrying no force and having no stiffness. With `signed` the dissertation's force stands.
+#[inline(always)]
+fn tension_only(out: &mut Outputs, signed: bool) {
+    out.slack = !signed && out.force < 0.0;
+    if out.slack {
+        out.force = 0.0;
+        out.stiffness = 0.0;
+    }
+}
+
 /// The outputs of the effects the bare sleeve lacks, at their neutral values: no bladder (no
 /// threshold, no stretch, no stress) and no friction.
 fn neutral_outputs(out: &mut Outputs) {
@@ -257,6 +271,7 @@ impl McKibbenMuscle {
         } else {
             self.all_outputs(inputs, outputs, report, commit);
         }
+        tension_only(outputs, self.signed_force);
     }
 
     /// [`McKibbenMuscle::outputs`] of any pipeline, with the notice and the pressure solver.
@@ -439,6 +454,9 @@ impl McKibbenMuscle {
     /// [`McKibben::stiffness_partials`] (a second-order pass through the bladder).
     fn stiffness_row(&self, inputs: &Inputs) -> Result<[f64; 2], String> {
         let (pressure, length) = (inputs.pressure, inputs.length);
+        if self.slack_at(inputs)? {
+            return Ok([0.0; 2]);
+        }
         match &self.pipeline {
             Pipeline::Sleeve(s) => {
                 let on = if pressure > 0.0 { 1.0 } else { 0.0 };
@@ -465,6 +483,32 @@ impl McKibbenMuscle {
     /// length (and, under a vacuum it cannot hold, at zero pressure), which the input no longer
     /// moves, so those columns are zero.
     fn partials_at(&self, inputs: &Inputs) -> Result<McKibbenPartials, String> {
+        let mut d = self.signed_partials_at(inputs)?;
+        if self.slack_at(inputs)? {
+            d.force = [0.0; 2];
+        }
+        Ok(d)
+    }
+
+    /// Whether [`tension_only`] makes the muscle slack at `inputs`: its signed force, on the
+    /// branch [`Model::evaluate`] takes, is negative.
+    fn slack_at(&self, inputs: &Inputs) -> Result<bool, String> {
+        if self.signed_force {
+            return Ok(false);
+        }
+        let (pressure, length) = (inputs.pressure, inputs.length);
+        let force = match &self.pipeline {
+            Pipeline::Sleeve(s) => s.force(pressure.max(0.0), length.min(s.max_length())),
+            Pipeline::Full(m) => {
+                let at = |p: f64, l: f64| m.evaluate(p, l, &self.friction);
+                on_branch(m, pressure, length, at)?.0.force
+            }
+        };
+        Ok(force < 0.0)
+    }
+
+    /// [`Self::partials_at`] of the signed force.
+    fn signed_partials_at(&self, inputs: &Inputs) -> Result<McKibbenPartials, String> {
         let (pressure, length) = (inputs.pressure, inputs.length);
         match &self.pipeline {
             Pipeline::Sleeve(s) => {
@@ -559,6 +603,7 @@ impl Model for McKibbenMuscle {
             notice,
             solver,
             partials_cache: None,
+            signed_force: p.signed_force,
         })
     }
 
