@@ -842,3 +842,157 @@ mod tests {
         assert_eq!(out.force, sleeve.force(3e5, 0.1));
     }
 }
+
+#[cfg(test)]
+mod slack_tests {
+    use super::*;
+
+    fn at(m: &mut McKibbenMuscle, pressure: f64, length: f64) -> Outputs {
+        let x = Inputs {
+            pressure,
+            length,
+            ..Default::default()
+        };
+        let mut out = Outputs::default();
+        m.step(&x, &mut out, 0.0, 1e-3, &mut Report::default());
+        out
+    }
+
+    fn built(p: &Parameters, length: f64) -> McKibbenMuscle {
+        let x = Inputs {
+            length,
+            ..Default::default()
+        };
+        McKibbenMuscle::new(p, &x).unwrap()
+    }
+
+    /// Eq. 2.3, F = P (3 L^2 - b^2) / (4 pi n^2), crosses zero at L = b / sqrt(3): below it the
+    /// bare sleeve is slack (force and stiffness 0, `slack` set), above it eq. 2.3 stands, and
+    /// `signed_force` gives eq. 2.3 everywhere.
+    #[test]
+    fn bare_sleeve_is_slack_below_its_free_contraction() {
+        let p = Parameters::default();
+        let (b, n, pressure) = (p.strand_length, p.turns, 3e5);
+        let eq_2_3 =
+            |l: f64| pressure * (3.0 * l * l - b * b) / (4.0 * std::f64::consts::PI * n * n);
+        let free = b / 3f64.sqrt();
+        let mut m = built(&p, 0.09);
+        for l in [0.5 * free, 0.99 * free, free * (1.0 - 1e-9)] {
+            let out = at(&mut m, pressure, l);
+            assert!(
+                out.slack && out.force == 0.0 && out.stiffness == 0.0,
+                "{l}: {out:?}"
+            );
+        }
+        for l in [free * (1.0 + 1e-9), 1.01 * free, 0.9 * b] {
+            let out = at(&mut m, pressure, l);
+            assert!(!out.slack, "{l}");
+            assert!(
+                (out.force - eq_2_3(l)).abs() <= 1e-12 * eq_2_3(0.9 * b),
+                "{l}"
+            );
+            assert!(out.force >= 0.0);
+        }
+        // Continuous through the free contraction: the force there is 0 to rounding.
+        let near = at(&mut m, pressure, free * (1.0 + 1e-9)).force;
+        assert!(near.abs() < 1e-6 * eq_2_3(b), "{near}");
+        let mut signed = built(
+            &Parameters {
+                signed_force: true,
+                ..p
+            },
+            0.09,
+        );
+        let out = at(&mut signed, pressure, 0.8 * free);
+        assert!(!out.slack);
+        assert!((out.force - eq_2_3(0.8 * free)).abs() < 1e-9 * eq_2_3(b).abs());
+        assert!(out.force < 0.0);
+    }
+
+    /// The Festo DMSP-10 (preset 5) at nominal length 0.2 m and 300 kPa: the dissertation's
+    /// signed force, +25.5 N at 10 % contraction and -19.5 N at 15 %, is tension only by
+    /// default: positive at 10 %, 0 and slack at 15 %, and continuous through the zero crossing
+    /// found by bisection on the signed force.
+    #[test]
+    fn festo_dmsp_10_goes_slack_past_its_free_contraction() {
+        let p = Parameters {
+            preset: 5,
+            nominal_length: 0.2,
+            ..Default::default()
+        };
+        let signed_p = Parameters {
+            signed_force: true,
+            ..p.clone()
+        };
+        let (mut m, mut s) = (built(&p, 0.18), built(&signed_p, 0.18));
+        let pressure = 3e5;
+        let l = |contraction: f64| 0.2 * (1.0 - contraction);
+        let signed = |s: &mut McKibbenMuscle, c: f64| at(s, pressure, l(c)).force;
+        assert!((signed(&mut s, 0.10) - 25.5).abs() < 0.1);
+        assert!((signed(&mut s, 0.15) + 19.5).abs() < 0.1);
+        let tension = at(&mut m, pressure, l(0.10));
+        assert!(!tension.slack && (tension.force - signed(&mut s, 0.10)).abs() < 1e-12);
+        for c in [0.15, 0.2, 0.25] {
+            let out = at(&mut m, pressure, l(c));
+            assert!(
+                out.slack && out.force == 0.0 && out.stiffness == 0.0,
+                "{c}: {out:?}"
+            );
+        }
+        // The zero crossing of the signed force, between 10 % and 15 % contraction.
+        let (mut lo, mut hi) = (0.10, 0.15);
+        for _ in 0..60 {
+            let mid = 0.5 * (lo + hi);
+            if signed(&mut s, mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let before = at(&mut m, pressure, l(lo - 1e-7));
+        let after = at(&mut m, pressure, l(hi + 1e-7));
+        assert!(!before.slack && after.slack, "{before:?} {after:?}");
+        assert!(
+            before.force > 0.0 && before.force < 1e-3,
+            "{}",
+            before.force
+        );
+        assert_eq!(after.force, 0.0);
+    }
+
+    /// While slack the force's and the stiffness's partials are 0 (the force is 0 nearby); taut,
+    /// they are the signed model's.
+    #[test]
+    fn partials_vanish_while_slack() {
+        let p = Parameters {
+            preset: 5,
+            nominal_length: 0.2,
+            ..Default::default()
+        };
+        let mut m = built(&p, 0.18);
+        let mut s = built(
+            &Parameters {
+                signed_force: true,
+                ..p.clone()
+            },
+            0.18,
+        );
+        let x = |length: f64| Inputs {
+            pressure: 3e5,
+            length,
+            ..Default::default()
+        };
+        let slack = m.partials(&x(0.17)).unwrap();
+        for name in ["force", "stiffness"] {
+            assert!(
+                slack.get(name).unwrap().iter().all(|(_, d)| *d == 0.0),
+                "{name}"
+            );
+        }
+        assert_ne!(
+            s.partials(&x(0.17)).unwrap().get("force").unwrap()[0].1,
+            0.0
+        );
+        assert_eq!(m.partials(&x(0.19)).unwrap(), s.partials(&x(0.19)).unwrap());
+    }
+}
