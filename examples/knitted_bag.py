@@ -32,7 +32,9 @@ CASES = [
 
 
 def contraction(pressure, points=2001, **start):
-    """Force (N) against length (m) while contracting from full extension at `pressure` (Pa)."""
+    """Force (N) against length (m) while contracting from full extension at `pressure` (Pa):
+    the signed force, so that the stroke is where it crosses zero."""
+    start = {"signed_force": True, **start}
     probe = simulate_fmu(FMU, stop_time=1e-3, output_interval=1e-3, start_values=start,
                          output=["max_length", "min_length"])
     hi, lo = probe["max_length"][0], probe["min_length"][0]

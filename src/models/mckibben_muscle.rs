@@ -14,6 +14,7 @@ use crate::physics::gaylord::Sleeve;
 use crate::physics::inverse::pressure_for_force;
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, McKibbenPartials, MuscleGeometry,
+    StrandTransition, SURVIVABLE_STRAND_STRAIN,
 };
 use crate::variables::mckibben_muscle::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
@@ -62,6 +63,8 @@ pub struct McKibbenMuscle {
     partials_cache: Option<(PartialsKey, bool, Partials)>,
     /// The dissertation's signed force (`signed_force`); else tension only (see [`tension_only`]).
     signed_force: bool,
+    /// The straight strands' axial stiffness `k_s = E A / b`, N/m (from `strand_rigidity`).
+    strand_stiffness: f64,
 }
 
 /// Bit patterns of what the partials depend on: pressure, length, target_force, friction z and
@@ -172,6 +175,28 @@ fn geometry(p: &Parameters) -> Result<Resolved, String> {
     Ok(Resolved { params, overridden })
 }
 
+/// `E A` of all strands together, N: the user's `strand_rigidity`, or for the Festo presets
+/// (unless set) their aramid strands, sized by the datasheet's largest force: Kevlar 49's
+/// modulus (112 GPa) over a working stress of a tenth of its strength (0.3 GPa) times 630 N
+/// (DMSP-10) or 6000 N (DMSP-40).
+fn strand_rigidity(p: &Parameters) -> Result<f64, String> {
+    const ARAMID_MODULUS_PER_WORKING_STRESS: f64 = 112e9 / 0.3e9;
+    let rigidity = match p.preset {
+        5 | 6 if p.strand_rigidity == Parameters::default().strand_rigidity => {
+            let largest_force = if p.preset == 5 { 630.0 } else { 6000.0 };
+            ARAMID_MODULUS_PER_WORKING_STRESS * largest_force
+        }
+        _ => p.strand_rigidity,
+    };
+    if rigidity.is_finite() && rigidity > 0.0 {
+        Ok(rigidity)
+    } else {
+        Err(format!(
+            "strand_rigidity must be positive and finite, got {rigidity} N"
+        ))
+    }
+}
+
 /// An input without a solution: explained once per excursion, then only flagged.
 fn out_of_range(
     logged: &mut bool,
@@ -192,20 +217,16 @@ fn out_of_range(
     *logged = true;
 }
 
-/// A length beyond the bare sleeve's reach `b`: evaluated at `b`. Out of line, so that the
-/// per-step path of the ideal muscle stays small enough to inline.
+/// The bare sleeve past `reach`, where its strands stretch (see [`crate::physics::mckibben`]'s
+/// strands): `F = F(reach) + k_s (L - reach)`; past [`SURVIVABLE_STRAND_STRAIN`] of `b` beyond
+/// `b` no muscle survives: evaluated there (logged). Out of line, so that the per-step path of
+/// the ideal muscle stays small enough to inline.
 #[cold]
 #[inline(never)]
-fn beyond_sleeve(logged: &mut bool, report: &mut Report, pressure: f64, requested: f64, b: f64) {
-    let reason =
-        format!("length {requested} m is outside [0, b = {b}] m, the ideal sleeve's range");
-    out_of_range(logged, report, &reason, (0.0, b), Some((pressure, b)));
-}
-
-/// Eq. 2.3 for the bare sleeve.
-#[inline(always)]
-fn sleeve_outputs(
+fn on_sleeve_strands(
     sleeve: &Sleeve,
+    strand_stiffness: f64,
+    reach: f64,
     inputs: &Inputs,
     out: &mut Outputs,
     logged: &mut bool,
@@ -213,15 +234,60 @@ fn sleeve_outputs(
 ) {
     let (pressure, requested) = (inputs.pressure, inputs.length);
     let b = sleeve.max_length();
-    let length = if requested > b {
-        beyond_sleeve(logged, report, pressure, requested, b);
-        b
+    let breaking = b * (1.0 + SURVIVABLE_STRAND_STRAIN);
+    let length = if requested > breaking {
+        let reason = format!(
+            "length {requested} m stretches the strands more than {}% past b = {b} m, which no muscle survives",
+            100.0 * SURVIVABLE_STRAND_STRAIN
+        );
+        out_of_range(
+            logged,
+            report,
+            &reason,
+            (0.0, breaking),
+            Some((pressure, breaking)),
+        );
+        breaking
     } else {
         *logged = false;
         requested
     };
+    let p_eff = pressure.max(0.0);
+    out.force = sleeve.force(p_eff, reach) + strand_stiffness * (length - reach);
+    out.volume = sleeve.volume(reach);
+    out.effective_pressure = p_eff;
+    out.stiffness = strand_stiffness;
+    out.bladder_contact = pressure > 0.0;
+}
+
+/// Where the bare sleeve's strands take over at `p_eff`: at `b` (straight strands) or where eq.
+/// 2.3's stiffness `6 P L / (4 pi n^2)` reaches the strands' `k_s`, whichever comes first.
+#[inline(always)]
+fn sleeve_reach(sleeve: &Sleeve, strand_stiffness: f64, p_eff: f64) -> f64 {
+    sleeve
+        .max_length()
+        .min(strand_stiffness / sleeve.stiffness(p_eff, 1.0))
+}
+
+/// Eq. 2.3 for the bare sleeve.
+#[inline(always)]
+fn sleeve_outputs(
+    sleeve: &Sleeve,
+    strand_stiffness: f64,
+    inputs: &Inputs,
+    out: &mut Outputs,
+    logged: &mut bool,
+    report: &mut Report,
+) {
+    let (pressure, length) = (inputs.pressure, inputs.length);
     // The sleeve is only ever pushed outwards: under vacuum the bladder leaves it.
     let p_eff = pressure.max(0.0);
+    let reach = sleeve_reach(sleeve, strand_stiffness, p_eff);
+    if length > reach {
+        on_sleeve_strands(sleeve, strand_stiffness, reach, inputs, out, logged, report);
+        return;
+    }
+    *logged = false;
     out.force = sleeve.force(p_eff, length);
     out.volume = sleeve.volume(length);
     out.effective_pressure = p_eff;
@@ -267,7 +333,8 @@ impl McKibbenMuscle {
     ) {
         if let Some(sleeve) = &self.bare_sleeve {
             outputs.contraction = 1.0 - inputs.length / self.effective.nominal_length;
-            sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report);
+            let k_s = self.strand_stiffness;
+            sleeve_outputs(sleeve, k_s, inputs, outputs, &mut self.out_of_range, report);
         } else {
             self.all_outputs(inputs, outputs, report, commit);
         }
@@ -292,7 +359,8 @@ impl McKibbenMuscle {
         match &self.pipeline {
             Pipeline::Sleeve(sleeve) => {
                 neutral_outputs(outputs);
-                sleeve_outputs(sleeve, inputs, outputs, &mut self.out_of_range, report);
+                let k_s = self.strand_stiffness;
+                sleeve_outputs(sleeve, k_s, inputs, outputs, &mut self.out_of_range, report);
                 if self.solver.is_none() {
                     self.bare_sleeve = Some(*sleeve);
                 }
@@ -300,6 +368,7 @@ impl McKibbenMuscle {
             Pipeline::Full(muscle) => {
                 if let Some(out) = Self::compute(
                     muscle,
+                    self.strand_stiffness,
                     &self.friction,
                     &mut self.out_of_range,
                     inputs,
@@ -373,20 +442,51 @@ impl McKibbenMuscle {
     /// The full model at the current inputs; out of range, the nearest point inside it (logged).
     fn compute(
         muscle: &McKibben,
+        strand_stiffness: f64,
         friction: &HysteresisState,
         logged: &mut bool,
         inputs: &Inputs,
         report: &mut Report,
     ) -> Option<McKibbenOutput> {
         let (pressure, length) = (inputs.pressure, inputs.length);
-        let reason = match muscle.evaluate(pressure, length, friction) {
-            Ok(out) => {
+        let (reason, rigid) = match muscle.evaluate(pressure, length, friction) {
+            Ok(out) if !(out.force > 0.0 && out.stiffness > strand_stiffness) => {
                 *logged = false;
                 return Some(out);
             }
-            Err(reason) => reason,
+            Ok(out) => (String::new(), Some(out)),
+            Err(reason) => (reason, None),
         };
         let (lo, hi) = (muscle.min_length(), muscle.max_length());
+        // Out of the rigid braid's reach, or stiffer than its strands: the strands stretch.
+        let breaking = muscle.breaking_length();
+        let on_strands = length.min(breaking);
+        if let Some(t) = muscle.strand_transition(pressure, on_strands, strand_stiffness, friction)
+        {
+            if length > breaking {
+                let reason = format!(
+                    "length {length} m stretches the strands more than {}% of their length past max_length, which no muscle survives",
+                    100.0 * SURVIVABLE_STRAND_STRAIN
+                );
+                out_of_range(
+                    logged,
+                    report,
+                    &reason,
+                    (lo, breaking),
+                    Some((pressure, breaking)),
+                );
+            } else {
+                *logged = false;
+            }
+            let mut out = t.rigid;
+            out.force += strand_stiffness * (on_strands - t.length);
+            out.stiffness = strand_stiffness;
+            return Some(out);
+        }
+        if let Some(out) = rigid {
+            *logged = false;
+            return Some(out);
+        }
         let margin = if muscle.bladder().is_some() {
             LIMIT_MARGIN * (hi - lo)
         } else {
@@ -454,7 +554,8 @@ impl McKibbenMuscle {
     /// [`McKibben::stiffness_partials`] (a second-order pass through the bladder).
     fn stiffness_row(&self, inputs: &Inputs) -> Result<[f64; 2], String> {
         let (pressure, length) = (inputs.pressure, inputs.length);
-        if self.slack_at(inputs)? {
+        if self.slack_at(inputs)? || self.on_strands(inputs) {
+            // Slack: 0; on the strands: their constant k_s.
             return Ok([0.0; 2]);
         }
         match &self.pipeline {
@@ -507,8 +608,96 @@ impl McKibbenMuscle {
         Ok(force < 0.0)
     }
 
+    /// Whether [`Self::compute`] (or the bare sleeve) puts `inputs` on the stretching strands.
+    fn on_strands(&self, inputs: &Inputs) -> bool {
+        let (pressure, length) = (inputs.pressure, inputs.length);
+        match &self.pipeline {
+            Pipeline::Sleeve(s) => {
+                length > sleeve_reach(s, self.strand_stiffness, pressure.max(0.0))
+            }
+            Pipeline::Full(m) => self.strand_point(m, pressure, length).is_some(),
+        }
+    }
+
+    /// The transition [`Self::compute`] uses at these inputs, if on the strands.
+    fn strand_point(&self, m: &McKibben, pressure: f64, length: f64) -> Option<StrandTransition> {
+        let k_s = self.strand_stiffness;
+        match m.evaluate(pressure, length, &self.friction) {
+            Ok(out) if !(out.force > 0.0 && out.stiffness > k_s) => None,
+            _ => m.strand_transition(
+                pressure,
+                length.min(m.breaking_length()),
+                k_s,
+                &self.friction,
+            ),
+        }
+    }
+
+    /// On the strands `F = F(P, L_t(P)) + k_s (L - L_t(P))` and every other output is the
+    /// rigid muscle's at `L_t`: by the chain rule with `dL_t/dP = -K_P / K_L` at an interior
+    /// transition (where the rigid stiffness `K` equals `k_s`), 0 at the braid's reach. The
+    /// length moves only the force, by `k_s`, up to the breaking length.
+    fn strand_partials(&self, inputs: &Inputs) -> Result<Option<McKibbenPartials>, String> {
+        let (pressure, length) = (inputs.pressure, inputs.length);
+        let k_s = self.strand_stiffness;
+        match &self.pipeline {
+            Pipeline::Sleeve(s) => {
+                let p_eff = pressure.max(0.0);
+                let reach = sleeve_reach(s, k_s, p_eff);
+                if !(length > reach) {
+                    return Ok(None);
+                }
+                let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+                let moves = length <= s.max_length() * (1.0 + SURVIVABLE_STRAND_STRAIN);
+                // reach = k_s / (6 P / (4 pi n^2)) inside b: dreach/dP = -reach / P.
+                let dreach = if reach < s.max_length() && p_eff > 0.0 {
+                    -reach / p_eff
+                } else {
+                    0.0
+                };
+                let per_pa = s.force(1.0, reach);
+                Ok(Some(McKibbenPartials {
+                    force: [
+                        on * (per_pa + (s.stiffness(p_eff, reach) - k_s) * dreach),
+                        if moves { k_s } else { 0.0 },
+                    ],
+                    effective_pressure: [on, 0.0],
+                    friction_force: [0.0, 0.0],
+                    volume: [-on * per_pa * dreach, 0.0],
+                    ..Default::default()
+                }))
+            }
+            Pipeline::Full(m) => {
+                let Some(t) = self.strand_point(m, pressure, length) else {
+                    return Ok(None);
+                };
+                let (_, mut d) = m.partials(pressure, t.length, &self.friction)?;
+                let dlt = if t.interior {
+                    let [kp, kl] = m.stiffness_partials(pressure, t.length, &self.friction)?;
+                    if kl != 0.0 {
+                        -kp / kl
+                    } else {
+                        0.0
+                    }
+                } else {
+                    0.0
+                };
+                let [fp, fl] = d.force;
+                for y in d.rows_mut() {
+                    *y = [y[0] + y[1] * dlt, 0.0];
+                }
+                let moves = length <= m.breaking_length();
+                d.force = [fp + (fl - k_s) * dlt, if moves { k_s } else { 0.0 }];
+                Ok(Some(d))
+            }
+        }
+    }
+
     /// [`Self::partials_at`] of the signed force.
     fn signed_partials_at(&self, inputs: &Inputs) -> Result<McKibbenPartials, String> {
+        if let Some(d) = self.strand_partials(inputs)? {
+            return Ok(d);
+        }
         let (pressure, length) = (inputs.pressure, inputs.length);
         match &self.pipeline {
             Pipeline::Sleeve(s) => {
@@ -604,6 +793,7 @@ impl Model for McKibbenMuscle {
             solver,
             partials_cache: None,
             signed_force: p.signed_force,
+            strand_stiffness: strand_rigidity(p)? / params.strand_length,
         })
     }
 
@@ -994,5 +1184,130 @@ mod slack_tests {
             0.0
         );
         assert_eq!(m.partials(&x(0.19)).unwrap(), s.partials(&x(0.19)).unwrap());
+    }
+}
+
+#[cfg(test)]
+mod strand_tests {
+    use super::*;
+
+    fn step(m: &mut McKibbenMuscle, pressure: f64, length: f64) -> (Outputs, bool) {
+        let x = Inputs {
+            pressure,
+            length,
+            ..Default::default()
+        };
+        let mut out = Outputs::default();
+        let mut report = Report::default();
+        m.step(&x, &mut out, 0.0, 1e-3, &mut report);
+        (out, report.clamped())
+    }
+
+    /// Through `max_length` the force is finite and continuous: it rises, never by more than the
+    /// strands' `k_s = E A / b` times the length step (no jump), keeps rising past `max_length`
+    /// (no plateau) with slope `k_s`, and nothing is clamped before the breaking length.
+    fn continuous_through_max_length(p: Parameters, pressure: f64) {
+        let mut m = McKibbenMuscle::new(&p, &Inputs::default()).unwrap();
+        let c = m.calculated_parameters();
+        let k_s = p.strand_rigidity / m.effective.strand_length;
+        let (hi, b) = (c.max_length, m.effective.strand_length);
+        let (from, to) = (hi - 0.02 * (hi - c.min_length), hi + 0.04 * b);
+        let n = 4000;
+        let dl = (to - from) / n as f64;
+        let mut previous = step(&mut m, pressure, from).0.force;
+        for i in 1..=n {
+            let l = from + dl * i as f64;
+            let (out, clamped) = step(&mut m, pressure, l);
+            assert!(
+                out.force.is_finite() && !clamped && !out.slack,
+                "{l}: {out:?}"
+            );
+            let rise = out.force - previous;
+            assert!(
+                rise > 0.0 && rise <= k_s * dl * (1.0 + 1e-6),
+                "{l}: rise {rise} N"
+            );
+            if l - dl > hi {
+                assert_eq!(out.stiffness, k_s);
+                assert!(
+                    (rise - k_s * dl).abs() < 1e-6 * k_s * dl,
+                    "{l}: rise {rise} N"
+                );
+            }
+            previous = out.force;
+        }
+        // Past the breaking length the policy holds the force there, and says so.
+        let (out, clamped) = step(&mut m, pressure, hi + 0.1 * b);
+        let (at_break, _) = step(&mut m, pressure, hi + 0.05 * b);
+        assert!(clamped && out.force == at_break.force);
+    }
+
+    #[test]
+    fn bare_sleeve_is_continuous_through_b() {
+        continuous_through_max_length(Parameters::default(), 3e5);
+        // Eq. 2.3 at b, then the strands: F(b) + k_s (L - b).
+        let p = Parameters::default();
+        let mut m = McKibbenMuscle::new(&p, &Inputs::default()).unwrap();
+        let b = p.strand_length;
+        let eq_2_3_at_b = 3e5 * 2.0 * b * b / (4.0 * std::f64::consts::PI * p.turns * p.turns);
+        let (out, _) = step(&mut m, 3e5, 1.01 * b);
+        let expected = eq_2_3_at_b + p.strand_rigidity / b * 0.01 * b;
+        assert!((out.force - expected).abs() < 1e-9 * expected, "{out:?}");
+    }
+
+    #[test]
+    fn bladder_muscles_are_continuous_through_max_length() {
+        for (preset, model) in [(1, 1), (1, 3), (4, 3), (2, 4)] {
+            let p = Parameters {
+                preset,
+                bladder_model: model,
+                ..Default::default()
+            };
+            continuous_through_max_length(p, 4e5);
+        }
+    }
+
+    /// On the strands the partials are central differences of the outputs.
+    #[test]
+    fn partials_on_the_strands_are_the_slopes() {
+        for (p, length) in [
+            (Parameters::default(), 0.113),
+            (
+                Parameters {
+                    preset: 1,
+                    bladder_model: 3,
+                    ..Default::default()
+                },
+                0.0985,
+            ),
+        ] {
+            let mut m = McKibbenMuscle::new(&p, &Inputs::default()).unwrap();
+            let x = Inputs {
+                pressure: 4e5,
+                length,
+                ..Default::default()
+            };
+            assert!(m.on_strands(&x));
+            let d = m.partials(&x).unwrap();
+            let value = |m: &mut McKibbenMuscle, pressure: f64, length: f64| {
+                let (o, _) = step(m, pressure, length);
+                [o.force, o.volume, o.effective_pressure, o.stiffness]
+            };
+            let names = ["force", "volume", "effective_pressure", "stiffness"];
+            for (column, h) in [(0, 1.0), (1, 1e-7)] {
+                let (dp, dl) = if column == 0 { (h, 0.0) } else { (0.0, h) };
+                let up = value(&mut m, x.pressure + dp, x.length + dl);
+                let down = value(&mut m, x.pressure - dp, x.length - dl);
+                for (k, name) in names.iter().enumerate() {
+                    let fd = (up[k] - down[k]) / (2.0 * h);
+                    let exact = d.get(name).unwrap()[column].1;
+                    let scale = fd.abs().max(exact.abs()).max(1e-12);
+                    assert!(
+                        (fd - exact).abs() < 1e-4 * scale,
+                        "{name}[{column}]: {exact} vs {fd}"
+                    );
+                }
+            }
+        }
     }
 }

@@ -12,7 +12,9 @@ use crate::physics::gaylord::Sleeve;
 use crate::physics::root::{newton_bisection, RootOptions, Sample};
 
 mod partials;
+mod strands;
 pub use partials::McKibbenPartials;
+pub use strands::{StrandTransition, SURVIVABLE_STRAND_STRAIN};
 
 /// Iteration caps of the connector solve (bracket search doubles its step; root is Newton-bisection).
 const BRACKET_STEPS: usize = 64;

@@ -38,20 +38,32 @@ CONFIGS = {
          {"preset": 1, "pressure_solver": True}, {"preset": 5}],
         [{"pressure": 2e5, "length": 0.09, "target_force": 50.0},
          {"pressure": 4e5, "length": 0.085, "target_force": 200.0},
-         {"pressure": 0.0, "length": 0.095, "target_force": 0.0}],
+         {"pressure": 0.0, "length": 0.095, "target_force": 0.0},
+         # Past the free contraction: slack unless signed_force.
+         {"pressure": 2e5, "length": 0.06, "target_force": 0.0},
+         # Taut with muscle A's bladder (max_length 97.3 mm), on the stretching strands beyond
+         # it and beyond the bare sleeve's b, taut for the DMSP-10 (preset 5).
+         {"pressure": 3e5, "length": 0.096, "target_force": 20.0},
+         {"pressure": 2e5, "length": 0.1, "target_force": 20.0},
+         {"pressure": 2e5, "length": 0.115, "target_force": 20.0},
+         {"pressure": 3e5, "length": 0.26, "target_force": 20.0}],
     ),
     "KnittedMuscle": (
         [{}, {"bladder_model": 1}, {"friction": True}, {"shape_model": 1}],
         [{"pressure": 2e4, "length": 0.4}, {"pressure": 5e4, "length": 0.35},
-         {"pressure": 0.0, "length": 0.42}],
+         {"pressure": 0.0, "length": 0.42}, {"pressure": 2e4, "length": 0.15}],
     ),
     "McKibbenJoint": (
         # common_mode_pressure at max_pressure: the flexor's pressure saturates there.
         [{}, {"friction": True}, {"bladder_model": 1}, {"command_mode": 1},
-         {"common_mode_pressure": 7e5}],
+         {"common_mode_pressure": 7e5},
+         # Short muscles: past +-0.45 rad one goes slack (unless signed_force).
+         {"flexor_rest_length": 0.07, "extensor_rest_length": 0.07}],
         [{"actuatorInput": 0.3, "jointPosition": 0.1, "jointVelocity": 0.2},
          {"actuatorInput": -0.5, "jointPosition": -0.2, "jointVelocity": -1.0},
-         {"actuatorInput": 1.0, "jointPosition": 0.0, "jointVelocity": 0.0}],
+         {"actuatorInput": 1.0, "jointPosition": 0.0, "jointVelocity": 0.0},
+         {"actuatorInput": 2e4, "jointPosition": 0.6, "jointVelocity": 0.0},
+         {"actuatorInput": -2e4, "jointPosition": -0.6, "jointVelocity": 0.0}],
     ),
     "PulleyJoint": (
         [{}, {"external_pressures": True}],
