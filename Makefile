@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs slack-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
 
@@ -202,6 +202,11 @@ motor-docs: fmus $(VENV)/.installed
 ## and its stroke against the measured 42% and 51% (issue 16).
 knitted-bag-docs: fmus $(VENV)/.installed
 	$(PY) examples/knitted_bag.py
+
+## docs/img/slack_and_max_length.png: force against length of the DMSP-10 through its free
+## contraction (slack) and through max_length (the stretching strands).
+slack-docs: fmus $(VENV)/.installed
+	$(PY) examples/slack_and_max_length.py
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).

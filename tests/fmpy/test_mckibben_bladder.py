@@ -16,8 +16,13 @@ THIN, THICK, CONTINUUM = 4, 5, 6
 EXACT, CONSISTENT_THIN = 3, 1
 
 
+# The dissertation's muscle: signed force (negative past the free contraction) and inextensible
+# strands (a rigidity of 1e12 N: the strands take over only within 1e-9 of max_length).
+DISSERTATION = {"signed_force": True, "strand_rigidity": 1e12}
+
+
 def muscle(log=None, **parameters):
-    return Slave(MODEL, log=log, **parameters)
+    return Slave(MODEL, log=log, **{**DISSERTATION, **parameters})
 
 
 def forces(m, pressure, lengths):
