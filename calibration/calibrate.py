@@ -37,7 +37,9 @@ def fmu_forces(params, points, fmu=FMU):
     try:
         p0, l0 = points[0]
         setters = {"Real": slave.setReal, "Integer": slave.setInteger, "Boolean": slave.setBoolean}
-        for name, value in {**params, "pressure": p0, "length": l0}.items():
+        # The fitter's muscle: the signed force of the datasheets, inextensible strands.
+        model = {"signed_force": True, "strand_rigidity": 1e12, **params}
+        for name, value in {**model, "pressure": p0, "length": l0}.items():
             setters[vr[name].type]([vr[name].valueReference], [value])
         slave.setupExperiment(startTime=0.0)
         slave.enterInitializationMode()
