@@ -57,6 +57,9 @@ def net_work(fmu, vr, prestrain, thickness, layers, n_lengths):
     fmu.setReal([vr[k] for k in reals], list(reals.values()))
     # The dissertation's layers as written (bladder_model 5), as in the README's work table.
     fmu.setInteger([vr["bladder_model"], vr["bladder_layers"]], [5, layers])
+    # ... with its signed force and inextensible strands.
+    fmu.setBoolean([vr["signed_force"]], [True])
+    fmu.setReal([vr["strand_rigidity"]], [1e12])
     try:
         fmu.exitInitializationMode()
     except Exception:

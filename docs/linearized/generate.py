@@ -43,6 +43,9 @@ class Muscle:
         self.fmu.setupExperiment(startTime=0.0)
         self.fmu.enterInitializationMode()
         self.fmu.setInteger([self.vr["preset"], self.vr["bladder_model"]], [preset, 5])
+        # The dissertation's muscle: signed force, inextensible strands.
+        self.fmu.setBoolean([self.vr["signed_force"]], [True])
+        self.fmu.setReal([self.vr["strand_rigidity"]], [1e12])
         self.fmu.exitInitializationMode()
         self.min_length, self.max_length = self.fmu.getReal([self.vr["min_length"], self.vr["max_length"]])
 

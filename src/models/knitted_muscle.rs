@@ -942,6 +942,8 @@ mod tests {
         let mut p = parameters_with(0, false);
         p.preset = 1;
         p.bag_diameter = 0.085;
+        // The bag pushes the clamps apart below the binding length: the signed force.
+        p.signed_force = true;
         let (mut m, _, _, _) = built(&p);
         let pressure = 14e3;
         let l = m.bag.unwrap().binding_length(&m.sleeve, pressure);

@@ -211,7 +211,7 @@ fn out_of_range(
             None => "holding the previous outputs".into(),
         };
         format!(
-            "{reason} (valid lengths {lo} .. {hi} m, max_length {hi} m); {what} until the inputs return"
+            "{reason} (lengths the model evaluates: {lo} .. {hi} m); {what} until the inputs return"
         )
     });
     *logged = true;

@@ -17,6 +17,9 @@ T = (S - 0.514 * 2 * M / N) / (4 * M)
 
 def knitted(log=None, **parameters):
     parameters.setdefault("length", 0.4)
+    # The dissertation's signed force: the tests check its equations, negative below the free
+    # contraction.
+    parameters.setdefault("signed_force", True)
     return Slave(MODEL, log=log, **parameters)
 
 
@@ -214,7 +217,7 @@ def test_knitted_against_mckibben_section_1_3_6():
     # McKibben with zero initial braid angle: L_max = strand length b; free contraction at
     # b / sqrt(3) with D = b sqrt(2/3) / (turns pi) = 14.6 mm gives the turns.
     turns = b * math.sqrt(2 / 3) / (math.pi * d)
-    mk = Slave("McKibbenMuscle", preset=0, bladder_model=0, strand_length=b, turns=turns, length=0.08)
+    mk = Slave("McKibbenMuscle", signed_force=True, strand_rigidity=1e12, preset=0, bladder_model=0, strand_length=b, turns=turns, length=0.08)
     free_mk = b / math.sqrt(3)
     assert abs(mk.at("force", pressure=p, length=free_mk)) < 1e-9
     stroke_mk = 1 - free_mk / b
@@ -384,7 +387,7 @@ def test_knitted_against_mckibben_with_bladder_section_1_3_6():
     rows = []
     # Ideal (the geometry of test_knitted_against_mckibben_section_1_3_6).
     k = knitted(preset=2, strand_thickness=0.0, length=0.08)
-    mk = Slave("McKibbenMuscle", preset=0, bladder_model=0, strand_length=b, turns=turns, length=0.08)
+    mk = Slave("McKibbenMuscle", signed_force=True, strand_rigidity=1e12, preset=0, bladder_model=0, strand_length=b, turns=turns, length=0.08)
     top_k, free_k = k.get("max_length", "free_contraction_length")
     free_mk = b / math.sqrt(3)
     ideal = {
@@ -397,7 +400,7 @@ def test_knitted_against_mckibben_with_bladder_section_1_3_6():
     mk.close()
     # With the same bladder in both.
     kb = knitted(preset=2, strand_thickness=0.2e-3, length=0.08, **BLADDER)
-    mkb = Slave("McKibbenMuscle", preset=0, strand_length=b, turns=turns, length=0.08, **BLADDER)
+    mkb = Slave("McKibbenMuscle", signed_force=True, strand_rigidity=1e12, preset=0, strand_length=b, turns=turns, length=0.08, **BLADDER)
     bladder = {"knitted": stroke_with_bladder(kb, p), "McKibben": stroke_with_bladder(mkb, p)}
     reach = {"knitted": kb.get("max_length"), "McKibben": mkb.get("max_length")}
     kb.close()
@@ -443,7 +446,7 @@ def test_knitted_against_mckibben_with_bladder_section_1_3_6():
     for wall, bore in ((0.4e-3, 6.4e-3), (0.2e-3, 3.2e-3)):
         tube = dict(BLADDER, bladder_thickness=wall, bladder_inner_diameter=bore)
         kb = knitted(preset=2, strand_thickness=0.2e-3, length=0.08, **tube)
-        mkb = Slave("McKibbenMuscle", preset=0, strand_length=b, turns=turns, length=0.08, **tube)
+        mkb = Slave("McKibbenMuscle", signed_force=True, strand_rigidity=1e12, preset=0, strand_length=b, turns=turns, length=0.08, **tube)
         wk, wm = stroke_with_bladder(kb, p)[3], stroke_with_bladder(mkb, p)[3]
         print(f"  {bore * 1e3:.1f} mm bore, {wall * 1e3:.1f} mm wall: {wk:.3f} J vs {wm:.3f} J")
         assert bladder["knitted"][3] < wk < wm

@@ -65,7 +65,8 @@ def test_crosscheck_input_under_a_strict_master(model, strict):
                       output_interval=opt["StepSize"], input=inputs)
 
 
-# The case: the thin-walled bladder at a length past where it fills the sleeve.
+# The case: the thin-walled bladder at a length past where it fills the sleeve (97.3 mm)
+# and past 5% strand strain beyond it (102.9 mm), which no muscle survives.
 PAST_THE_SLEEVE = dict(bladder_model=1)
 
 
@@ -75,7 +76,7 @@ def test_clamped_input_is_ok_flagged_and_logged_once_per_excursion(recording_log
     m.fmu.fmiCallLogger = calls
     assert not m.at("input_clamped", pressure=2e5, length=0.09)
     flags = []
-    for length in [0.1, 0.11, 0.09, 0.1, 0.1]:
+    for length in [0.11, 0.12, 0.09, 0.11, 0.11]:
         m.step(pressure=2e5, length=length)
         clamped, force = m.get("input_clamped", "force")
         flags.append(bool(clamped))
@@ -105,7 +106,7 @@ def test_policy_restores_the_warning_or_asks_for_discard(policy, status):
     fmu.setInteger([vr["bladder_model"], vr["out_of_range_policy"]], [1, policy])
     fmu.enterInitializationMode()
     fmu.exitInitializationMode()
-    fmu.setReal([vr["pressure"], vr["length"]], [2e5, 0.1])
+    fmu.setReal([vr["pressure"], vr["length"]], [2e5, 0.11])
     if status == 2:
         from fmpy.fmi1 import FMICallException
 
