@@ -32,7 +32,7 @@ PATTERNS = [
                                r"(?![0-9]+(?:e[0-9]+)?f(?:32|64))(?=[0-9a-f]*[a-f])"
                                r"(?=[0-9a-f]*[0-9])[0-9a-f]{7,40}(?![0-9A-Za-z_-])")),
     ("issue number", re.compile(r"\b(?:issues?|PRs?|pull requests?)\s*#?\d+", re.I)),
-    ("issue number", re.compile(r"\bissue_\d+|\bthe issue\b", re.I)),
+    ("issue number", re.compile(r"(?<![A-Za-z])issue_\d+|\bthe issue\b", re.I)),
     ("date", re.compile(rf"\b\d{{1,2}} {MONTH}\b|\b{MONTH} \d{{4}}\b|\b20\d\d-[01]\d-[0-3]\d\b")),
     ("narrative", re.compile(rf"\b{ORDINAL} (?:rounds?|sessions?)\b|\bround \d+\b|\bsessions?\b",
                              re.I)),

@@ -1,0 +1,153 @@
+"""The documentation site: `mkdocs build --strict` (a broken link or anchor fails), then every built
+page opened in headless Chromium from a local HTTP server. A page passes when the browser asked
+the server for nothing it lacks (no missing image, script, stylesheet or font), every image on the
+page decoded, no script raised an error, and the page's title heading is in the rendered DOM.
+A screenshot of one page goes to out/docs_site/ for a person to look at."""
+import functools
+import html
+import http.server
+import os
+import re
+import shutil
+import subprocess
+import threading
+from concurrent.futures import ThreadPoolExecutor
+from pathlib import Path
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[2]
+MKDOCS = ROOT / ".venv" / "bin" / "mkdocs"
+CHROMIUM = shutil.which("chromium") or shutil.which("chromium-browser")
+FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
+         "--disable-background-networking", "--disable-component-update", "--disable-sync",
+         "--hide-scrollbars"]
+# Served at the end of every HTML page: once the page has loaded, writes onto <body> the images
+# that did not decode and the script errors, for --dump-dom to return.
+PROBE = b"""<script>
+window.__errors = [];
+window.addEventListener('error', e => window.__errors.push(String(e.message || e.type)), true);
+window.addEventListener('load', () => setTimeout(() => {
+  const broken = [...document.images].filter(i => !i.complete || i.naturalWidth === 0)
+    .map(i => i.getAttribute('src'));
+  document.body.setAttribute('data-probe', JSON.stringify({broken, errors: window.__errors}));
+}, 300));
+</script></body>"""
+
+
+def test_mkdocs_strict_build_has_no_warning(site):
+    built, log = site
+    assert built.joinpath("index.html").is_file(), log
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    out = tmp_path_factory.mktemp("site")
+    env = dict(os.environ, NO_MKDOCS_2_WARNING="1")
+    run = subprocess.run([str(MKDOCS), "build", "--strict", "--site-dir", str(out)], cwd=ROOT,
+                         capture_output=True, text=True, env=env, timeout=300)
+    assert run.returncode == 0, f"mkdocs build --strict failed:\n{run.stdout}\n{run.stderr}"
+    return out, run.stderr
+
+
+class Recorder(http.server.SimpleHTTPRequestHandler):
+    """Serves the built site; records every request's path and status (200, or 304 when the
+    browser's cache holds it), and adds PROBE to HTML."""
+    log = []
+
+    def send_head(self):
+        path = Path(self.translate_path(self.path))
+        if path.is_file() and path.suffix == ".html":
+            body = path.read_bytes().replace(b"</body>", PROBE, 1)
+            self.send_response(200)
+            self.send_header("Content-Type", "text/html; charset=utf-8")
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            return _Bytes(body)
+        return super().send_head()
+
+    def log_request(self, code="-", size="-"):
+        Recorder.log.append((self.path, int(getattr(code, "value", code))))
+
+    def log_message(self, *args):
+        pass
+
+
+class _Bytes:
+    def __init__(self, data):
+        self.data = data
+
+    def read(self, *args):
+        data, self.data = self.data, b""
+        return data
+
+    def close(self):
+        pass
+
+
+@pytest.fixture(scope="module")
+def server(site):
+    built, _ = site
+    handler = functools.partial(Recorder, directory=str(built))
+    httpd = http.server.ThreadingHTTPServer(("127.0.0.1", 0), handler)
+    thread = threading.Thread(target=httpd.serve_forever, daemon=True)
+    thread.start()
+    yield f"http://127.0.0.1:{httpd.server_address[1]}"
+    httpd.shutdown()
+
+
+def pages(built):
+    # 404.html is served by a web server for any missing path; it links its assets from the site root.
+    return sorted(str(p.relative_to(built)) for p in built.rglob("*.html") if p.name != "404.html")
+
+
+def chromium(profile, *args):
+    return subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", "--window-size=1280,1600",
+                           "--virtual-time-budget=4000", *args], capture_output=True, text=True, timeout=120)
+
+
+def heading(page_html):
+    found = re.search(r"<h1[^>]*>(.*?)</h1>", page_html, re.S)
+    # Without the permalink sign that the toc extension appends.
+    return html.unescape(re.sub(r"<[^>]+>", "", found.group(1))).replace("¶", "").strip() if found else None
+
+
+@pytest.mark.skipif(CHROMIUM is None, reason="chromium not installed (make test installs it)")
+def test_every_page_renders_with_every_image_and_script(site, server, tmp_path):
+    built, _ = site
+    names = pages(built)
+    assert len(names) >= 30, names  # 23 Markdown pages, 2 calibration reports and 7 FMU pages at least
+
+    def visit(index_name):
+        index, name = index_name
+        dom = chromium(tmp_path / f"profile{index % 2}", "--dump-dom", f"{server}/{name}")
+        return name, dom
+
+    with ThreadPoolExecutor(max_workers=2) as pool:
+        visits = list(pool.map(visit, enumerate(names)))
+
+    problems = []
+    for name, dom in visits:
+        probe = re.search(r'data-probe="([^"]*)"', dom.stdout)
+        if not probe:
+            problems.append(f"{name}: the page never finished loading ({dom.stderr[-300:]})")
+            continue
+        found = html.unescape(probe.group(1))
+        if found != '{"broken":[],"errors":[]}':
+            problems.append(f"{name}: {found}")
+        title, shown = heading((built / name).read_text()), heading(dom.stdout)
+        if title != shown:
+            problems.append(f"{name}: heading {title!r} rendered as {shown!r}")
+    # The browser asks for /favicon.ico by itself when a page names no icon (the FMU pages).
+    missing = sorted({path for path, status in Recorder.log
+                      if status not in (200, 304) and path != "/favicon.ico"})
+    assert not missing, f"requested but not in the site: {missing}"
+    assert not problems, "\n".join(problems)
+    requested = {path.split("?")[0].lstrip("/") for path, _ in Recorder.log}
+    assert set(names) <= requested
+
+    out = ROOT / "out" / "docs_site"
+    out.mkdir(parents=True, exist_ok=True)
+    shot = out / "McKibbenMuscle.png"
+    run = chromium(tmp_path / "shot", f"--screenshot={shot}", f"{server}/fmus/McKibbenMuscle.html")
+    assert shot.is_file() and shot.stat().st_size > 20_000, run.stderr[-2000:]
