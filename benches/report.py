@@ -89,8 +89,7 @@ def cpu_goal_rows():
     if MOTOR_LOADED in by:
         m = by[MOTOR_LOADED]
         rows.append(f"| motor with a load torque of 1e-6 N m (legal, far beyond the 2.16e-18 N m peak): 1 us step "
-                    f"stays cheap, CPU time | {fmt_time(m['cpu_s'])} | was 30-80 ms (the whole substep "
-                    f"budget); now one closed-form segment and one march around the onion's cycle |")
+                    f"stays cheap, CPU time | {fmt_time(m['cpu_s'])} | one closed-form segment and one march around the onion's cycle |")
     if MOTOR_FAST_SLIP in by:
         m = by[MOTOR_FAST_SLIP]
         rows.append(f"| motor with a load torque of 1e-13 N m (thousands of turns per 1 us step, ring torque not "
