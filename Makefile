@@ -331,7 +331,7 @@ compliance: fmus
 ## `mkdocs build --strict`: a broken link or anchor fails. tests/fmpy/test_docs_site.py builds it the
 ## same way in `make test` and opens every page in headless Chromium.
 docs: fmus $(VENV)/.installed
-	$(VENV)/bin/mkdocs build --strict --quiet
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
 	@echo "site/index.html: $$(find site -name '*.html' | wc -l) pages"
 
 ## The user targets, one line each. The README points here instead of listing them, and

@@ -24,9 +24,15 @@ FLAGS = ["--headless", "--no-sandbox", "--disable-gpu", "--no-first-run",
          "--hide-scrollbars"]
 # Served at the end of every HTML page: once the page has loaded, writes onto <body> the images
 # that did not decode and the script errors, for --dump-dom to return.
-PROBE = b"""<script>
+# Served at the top of every HTML page's <head>: records script errors and failed resources.
+LISTEN = b"""<head><script>
 window.__errors = [];
-window.addEventListener('error', e => window.__errors.push(String(e.message || e.type)), true);
+window.addEventListener('error', e => window.__errors.push(
+  e.message || ('failed to load ' + (e.target && (e.target.src || e.target.href)))), true);
+</script>"""
+# Served at the end of every HTML page: once the page has loaded, writes onto <body> the images
+# that did not decode and the errors, for --dump-dom to return.
+PROBE = b"""<script>
 window.addEventListener('load', () => setTimeout(() => {
   const broken = [...document.images].filter(i => !i.complete || i.naturalWidth === 0)
     .map(i => i.getAttribute('src'));
@@ -58,7 +64,7 @@ class Recorder(http.server.SimpleHTTPRequestHandler):
     def send_head(self):
         path = Path(self.translate_path(self.path))
         if path.is_file() and path.suffix == ".html":
-            body = path.read_bytes().replace(b"</body>", PROBE, 1)
+            body = path.read_bytes().replace(b"<head>", LISTEN, 1).replace(b"</body>", PROBE, 1)
             self.send_response(200)
             self.send_header("Content-Type", "text/html; charset=utf-8")
             self.send_header("Content-Length", str(len(body)))
@@ -103,7 +109,7 @@ def pages(built):
 
 def chromium(profile, *args):
     return subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={profile}", "--window-size=1280,1600",
-                           "--virtual-time-budget=4000", *args], capture_output=True, text=True, timeout=120)
+                           "--virtual-time-budget=3000", *args], capture_output=True, text=True, timeout=120)
 
 
 def heading(page_html):
