@@ -320,7 +320,7 @@ struct Rows {
 }
 
 impl KnittedMuscle {
-    /// Exact partials on the branch [`Self::compute`] takes (see the module's README section for
+    /// Exact partials on the branch [`Self::compute`] takes (see docs/model-exchange.md for
     /// the one-sided choices): eq. 1.6-1.14 or the table's interpolant differentiated, the
     /// bladder's [`Bladder::evaluate_with_partials`], eq. 1.21 with the stop operator's slope;
     /// with a bladder, the stiffness's row only if `stiffness` (from
