@@ -157,3 +157,17 @@ def test_every_page_renders_with_every_image_and_script(site, server, tmp_path):
     shot = out / "McKibbenMuscle.png"
     run = chromium(tmp_path / "shot", f"--screenshot={shot}", f"{server}/fmus/McKibbenMuscle.html")
     assert shot.is_file() and shot.stat().st_size > 20_000, run.stderr[-2000:]
+
+
+def test_every_generated_table_has_one_place_in_the_docs_and_none_in_the_readme():
+    """benches/report.py (`make report`, `make parity`) writes its tables between
+    `<!-- report:NAME -->` markers of the documentation pages; each must exist exactly once, and the
+    README holds none, so no script rewrites it."""
+    sources = (ROOT / "benches" / "report.py").read_text() + (ROOT / "benches" / "knitted_shape_init.py").read_text()
+    names = set(re.findall(r'write_docs_block\("([^"]+)"', sources))
+    assert names >= {"cost-per-step", "continuum-wall", "knitted-shape-init", "fmi-parity"}
+    pages = {p: p.read_text() for p in (ROOT / "docs").rglob("*.md")}
+    for name in names:
+        holders = [p for p, text in pages.items() if f"<!-- report:{name} -->" in text]
+        assert len(holders) == 1, (name, holders)
+    assert "<!-- report:" not in (ROOT / "README.md").read_text()
