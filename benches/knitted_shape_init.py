@@ -1,6 +1,6 @@
 """Time of `fmi2ExitInitializationMode` of KnittedMuscle with the non-cylindrical shape (the
 table is built there), through FMPy, for the section 1.4 prototype at 49 and 1,568 segments
-(issue 15's goals: 3 ms and 100 ms). Each figure is the best of `repeats` fresh instances, in
+(the goals: 3 ms and 100 ms). Each figure is the best of `repeats` fresh instances, in
 CPU time of this process (the FMU runs in it) and in wall time.
 
     .venv/bin/python benches/knitted_shape_init.py [--docs] [OTHER.fmu]

@@ -1,6 +1,7 @@
 #!/usr/bin/env python3
 """History stays out of the product: what changed lives in CHANGELOG.md and in git, not in the
-README, the documentation, the code, the tests, the Makefile or Cargo.toml.
+README, the documentation, the code (src, build, tools, benches), the tests, the Makefile or
+Cargo.toml.
 
 Fails, naming file and line, on:
 - a commit hash (7 to 40 hex digits with at least one digit and one letter, not a `0x` literal);
@@ -17,7 +18,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 FILES = ["README.md", "CONTRIBUTING.md", "Makefile", "Cargo.toml", "mkdocs.yml"]
-FOLDERS = ["docs", "src", "build", "tests"]
+FOLDERS = ["docs", "src", "build", "tests", "benches", "tools"]
 TEXT = {".md", ".rs", ".py", ".toml", ".json", ".txt", ".c", ".h", ".sh", ".yml", ".yaml", ".html",
         ".supp", ".ssd", ".xml", ".cfg", ".ini"}
 # The checker and its test name the patterns they look for.
@@ -72,7 +73,7 @@ def main():
     if found:
         print(f"{len(found)} traces of history (they belong in CHANGELOG.md or git)", file=sys.stderr)
         return 1
-    print("no history in README, docs, src, build, tests, Makefile, Cargo.toml")
+    print("no history in README, docs, src, build, tools, benches, tests, Makefile, Cargo.toml")
     return 0
 
 
