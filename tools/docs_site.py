@@ -1,6 +1,8 @@
 """MkDocs hook (mkdocs.yml `hooks:`): each FMU's own page, the `documentation/` folder that
 `package_fmus` writes into target/fmu/<Model>.fmu, joins the site as fmu/<Model>/, so the site
-shows exactly what an importer's user sees and the strict build checks links into it."""
+shows exactly what an importer's user sees and the strict build checks links into it. A link to a
+repository file outside docs/ is checked to exist and shown as its path."""
+import re
 import zipfile
 from pathlib import Path
 
@@ -26,3 +28,29 @@ def on_files(files, config):
                     uri = f"fmu/{model}/{name.removeprefix('documentation/')}"
                     files.append(File.generated(config, uri, content=archive.read(name)))
     return files
+
+
+LINK = re.compile(r"(?<!!)\[([^\]]+)\]\(([^)\s]+)\)")
+
+
+def on_page_markdown(markdown, page, config, files):
+    """A link from a page to a file of the repository outside docs/ (a script, a scene, the
+    README) must name a file that exists; the site does not host the sources, so it is shown as
+    the file's path in code. A link to a missing file fails the build, as a broken link does."""
+    docs = Path(config["docs_dir"]).resolve()
+    here = (docs / page.file.src_path).parent
+    parts = re.split(r"(^```.*?^```)", markdown, flags=re.M | re.S)
+
+    def outside(match):
+        label, target = match.group(1), match.group(2)
+        if re.match(r"[a-z]+:", target) or target.startswith("#"):
+            return match.group(0)
+        path = (here / target.split("#", 1)[0]).resolve()
+        if path.is_relative_to(docs):
+            return match.group(0)
+        if not path.is_relative_to(ROOT) or not path.exists():
+            raise PluginError(f"{page.file.src_path}: the link {target!r} names no file of the repository")
+        shown = path.relative_to(ROOT).as_posix()
+        return label if label.strip("`") == shown else f"{label} (`{shown}`)"
+
+    return "".join(part if part.startswith("```") else LINK.sub(outside, part) for part in parts)

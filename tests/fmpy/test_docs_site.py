@@ -171,3 +171,22 @@ def test_every_generated_table_has_one_place_in_the_docs_and_none_in_the_readme(
         holders = [p for p, text in pages.items() if f"<!-- report:{name} -->" in text]
         assert len(holders) == 1, (name, holders)
     assert "<!-- report:" not in (ROOT / "README.md").read_text()
+
+
+def test_a_link_to_a_repository_file_must_name_one_that_exists():
+    """tools/docs_site.py shows a link to a source file as the file's path, and fails the build on
+    a link to a file that is not in the repository."""
+    import importlib.util
+    from types import SimpleNamespace
+
+    from mkdocs.exceptions import PluginError
+    spec = importlib.util.spec_from_file_location("docs_site", ROOT / "tools" / "docs_site.py")
+    hook = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(hook)
+    page = SimpleNamespace(file=SimpleNamespace(src_path="fmus/X.md"))
+    config = {"docs_dir": str(ROOT / "docs")}
+    text = "[the joint](../../examples/robot_joint.json), [`recipes/pressure_for_force.py`](../../recipes/pressure_for_force.py), [A](../calibration.md#x)"
+    assert hook.on_page_markdown(text, page, config, None) == (
+        "the joint (`examples/robot_joint.json`), `recipes/pressure_for_force.py`, [A](../calibration.md#x)")
+    with pytest.raises(PluginError, match="no file of the repository"):
+        hook.on_page_markdown("[gone](../../examples/gone.py)", page, config, None)
