@@ -11,6 +11,9 @@ from mkdocs.structure.files import File
 
 ROOT = Path(__file__).resolve().parents[1]
 FMU_DIR = ROOT / "target" / "fmu"
+# The site's copy of an FMU page links back to the site (the page inside the .fmu stays as shipped).
+BACK = (b'<body>\n<p><a href="../../index.html">actuator-fmus documentation</a> &rsaquo; '
+        b'<a href="../../fmus/MODEL.html">MODEL</a> &rsaquo; variables</p>')
 
 
 def models():
@@ -26,7 +29,10 @@ def on_files(files, config):
             for name in archive.namelist():
                 if name.startswith("documentation/") and not name.endswith("/"):
                     uri = f"fmu/{model}/{name.removeprefix('documentation/')}"
-                    files.append(File.generated(config, uri, content=archive.read(name)))
+                    content = archive.read(name)
+                    if uri.endswith("/index.html"):
+                        content = content.replace(b"<body>", BACK.replace(b"MODEL", model.encode()), 1)
+                    files.append(File.generated(config, uri, content=content))
     return files
 
 
