@@ -1,17 +1,18 @@
 """The documentation site: `mkdocs build --strict` (a broken link or anchor fails), then every built
-page opened in headless Chromium from a local HTTP server. A page passes when the browser asked
+page opened in headless Chromium from a local HTTP server (one browser, each page in turn in an
+iframe). A page passes when the browser asked
 the server for nothing it lacks (no missing image, script, stylesheet or font), every image on the
 page decoded, no script raised an error, and the page's title heading is in the rendered DOM.
 A screenshot of one page goes to out/docs_site/ for a person to look at."""
 import functools
 import html
+import json
 import http.server
 import os
 import re
 import shutil
 import subprocess
 import threading
-from concurrent.futures import ThreadPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -60,11 +61,13 @@ class Recorder(http.server.SimpleHTTPRequestHandler):
     """Serves the built site; records every request's path and status (200, or 304 when the
     browser's cache holds it), and adds PROBE to HTML."""
     log = []
+    harness = b""
 
     def send_head(self):
         path = Path(self.translate_path(self.path))
-        if path.is_file() and path.suffix == ".html":
-            body = path.read_bytes().replace(b"<head>", LISTEN, 1).replace(b"</body>", PROBE, 1)
+        if self.path == "/__harness__.html" or (path.is_file() and path.suffix == ".html"):
+            body = Recorder.harness if self.path == "/__harness__.html" else (
+                path.read_bytes().replace(b"<head>", LISTEN, 1).replace(b"</body>", PROBE, 1))
             self.send_response(200)
             self.send_header("Content-Type", "text/html; charset=utf-8")
             self.send_header("Content-Length", str(len(body)))
@@ -112,6 +115,30 @@ def chromium(profile, *args):
                            "--virtual-time-budget=3000", *args], capture_output=True, text=True, timeout=120)
 
 
+# Opens each page in turn in an iframe of one browser and collects, once it has loaded, what PROBE
+# wrote and the rendered title heading; then writes them all onto its own <body>.
+HARNESS = """<!doctype html><html><body><script>
+const pages = PAGES;
+const results = {};
+(async () => {
+  for (const name of pages) {
+    const frame = document.createElement('iframe');
+    frame.width = 1280; frame.height = 1600;
+    const loaded = new Promise(done => frame.addEventListener('load', done, {once: true}));
+    frame.src = name;
+    document.body.appendChild(frame);
+    await loaded;
+    await new Promise(done => setTimeout(done, 800));
+    const doc = frame.contentDocument;
+    const h1 = doc.querySelector('h1');
+    results[name] = {probe: doc.body.getAttribute('data-probe'), h1: h1 ? h1.textContent : null};
+    frame.remove();
+  }
+  document.body.setAttribute('data-results', JSON.stringify(results));
+})();
+</script></body></html>"""
+
+
 def heading(page_html):
     found = re.search(r"<h1[^>]*>(.*?)</h1>", page_html, re.S)
     # Without the permalink sign that the toc extension appends.
@@ -124,24 +151,24 @@ def test_every_page_renders_with_every_image_and_script(site, server, tmp_path):
     names = pages(built)
     assert len(names) >= 30, names  # 23 Markdown pages, 2 calibration reports and 7 FMU pages at least
 
-    def visit(index_name):
-        index, name = index_name
-        dom = chromium(tmp_path / f"profile{index % 2}", "--dump-dom", f"{server}/{name}")
-        return name, dom
-
-    with ThreadPoolExecutor(max_workers=2) as pool:
-        visits = list(pool.map(visit, enumerate(names)))
+    Recorder.harness = HARNESS.replace("PAGES", json.dumps(names)).encode()
+    run = subprocess.run([CHROMIUM, *FLAGS, f"--user-data-dir={tmp_path / 'profile'}", "--window-size=1400,1700",
+                          "--virtual-time-budget=300000", "--dump-dom", f"{server}/__harness__.html"],
+                         capture_output=True, text=True, timeout=600)
+    found = re.search(r'data-results="([^"]*)"', run.stdout)
+    assert found, f"the harness never finished: {run.stderr[-2000:]}"
+    results = json.loads(html.unescape(found.group(1)))
 
     problems = []
-    for name, dom in visits:
-        probe = re.search(r'data-probe="([^"]*)"', dom.stdout)
-        if not probe:
-            problems.append(f"{name}: the page never finished loading ({dom.stderr[-300:]})")
+    for name in names:
+        result = results.get(name, {})
+        if result.get("probe") is None:
+            problems.append(f"{name}: the page never finished loading")
             continue
-        found = html.unescape(probe.group(1))
-        if found != '{"broken":[],"errors":[]}':
-            problems.append(f"{name}: {found}")
-        title, shown = heading((built / name).read_text()), heading(dom.stdout)
+        if json.loads(result["probe"]) != {"broken": [], "errors": []}:
+            problems.append(f"{name}: {result['probe']}")
+        title = heading((built / name).read_text())
+        shown = (result.get("h1") or "").replace("¶", "").strip() or None
         if title != shown:
             problems.append(f"{name}: heading {title!r} rendered as {shown!r}")
     # The browser asks for /favicon.ico by itself when a page names no icon (the FMU pages).
