@@ -217,3 +217,25 @@ def test_a_link_to_a_repository_file_must_name_one_that_exists():
         "the joint (`examples/robot_joint.json`), `recipes/pressure_for_force.py`, [A](../calibration.md#x)")
     with pytest.raises(PluginError, match="no file of the repository"):
         hook.on_page_markdown("[gone](../../examples/gone.py)", page, config, None)
+
+
+# Top-level folders of the repository whose paths the README and the docs name in code spans.
+REPO_FOLDERS = ("src", "tests", "tools", "benches", "examples", "recipes", "scenes", "build", "calibration",
+                "crosscheck", "systems", "data", "fuzz", "docs", "python", "modelDescription")
+# Named in the docs, made by the commands they describe, ignored by git.
+MADE_BY_RUNS = {"fuzz/artifacts", "fuzz/corpus-run"}
+
+
+def test_every_repository_path_the_docs_name_exists():
+    """A file or folder named in a code span of README.md, CONTRIBUTING.md or docs/ (`src/...`,
+    `examples/...`) exists, so a moved or renamed file cannot leave the documentation behind.
+    Placeholders (`<Model>`, `*`, `{a,b}`) are skipped."""
+    texts = [ROOT / "README.md", ROOT / "CONTRIBUTING.md", *sorted((ROOT / "docs").rglob("*.md"))]
+    stale = []
+    for path in texts:
+        for name in re.findall(r"`([A-Za-z0-9_./-]+)`", path.read_text()):
+            name = name.rstrip("/")
+            if name.split("/")[0] in REPO_FOLDERS and "/" in name and name not in MADE_BY_RUNS:
+                if not (ROOT / name).exists():
+                    stale.append(f"{path.relative_to(ROOT)}: {name}")
+    assert not stale, "\n".join(stale)
