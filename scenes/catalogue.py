@@ -19,9 +19,9 @@ def main():
         "",
         "Each scene in `scenes/` reproduces the model side of one of the figures of E. Ball, *Novel Methods in",
         "Meso-Scale and Nano-Scale Actuation*, M.S. thesis, Cornell University, 2014 (\"the dissertation\"; the",
-        "site's [home page](index.md#the-source) says how to obtain it). Regenerate this page with",
+        "README's [The source](../README.md#the-source) says how to obtain it). Regenerate this page with",
         "`make figures`; run one scene with `.venv/bin/python scenes/run.py scenes/<scene>.json`. The scene",
-        "format is `scenes/schema/scene.schema.json`.",
+        "format is [`scenes/schema/scene.schema.json`](../scenes/schema/scene.schema.json).",
         "",
     ]
     def figure_order(path):
