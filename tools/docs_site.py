@@ -57,6 +57,6 @@ def on_page_markdown(markdown, page, config, files):
         if not path.is_relative_to(ROOT) or not path.exists():
             raise PluginError(f"{page.file.src_path}: the link {target!r} names no file of the repository")
         shown = path.relative_to(ROOT).as_posix()
-        return label if label.strip("`") == shown else f"{label} (`{shown}`)"
+        return f"`{shown}`" if label.strip("`") == shown else f"{label} (`{shown}`)"
 
     return "".join(part if part.startswith("```") else LINK.sub(outside, part) for part in parts)

@@ -212,9 +212,11 @@ def test_a_link_to_a_repository_file_must_name_one_that_exists():
     spec.loader.exec_module(hook)
     page = SimpleNamespace(file=SimpleNamespace(src_path="fmus/X.md"))
     config = {"docs_dir": str(ROOT / "docs")}
-    text = "[the joint](../../examples/robot_joint.json), [`recipes/pressure_for_force.py`](../../recipes/pressure_for_force.py), [A](../calibration.md#x)"
+    text = ("[the joint](../../examples/robot_joint.json), [`recipes/pressure_for_force.py`](../../recipes/pressure_for_force.py), "
+            "[recipes/calibrate_datasheet.py](../../recipes/calibrate_datasheet.py), [A](../calibration.md#x)")
     assert hook.on_page_markdown(text, page, config, None) == (
-        "the joint (`examples/robot_joint.json`), `recipes/pressure_for_force.py`, [A](../calibration.md#x)")
+        "the joint (`examples/robot_joint.json`), `recipes/pressure_for_force.py`, `recipes/calibrate_datasheet.py`, "
+        "[A](../calibration.md#x)")
     with pytest.raises(PluginError, match="no file of the repository"):
         hook.on_page_markdown("[gone](../../examples/gone.py)", page, config, None)
 
