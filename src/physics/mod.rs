@@ -1,9 +1,7 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no pointers.
-
 #![forbid(unsafe_code)]
 
 pub mod bladder;
-pub mod bounds;
 pub mod calibration;
 pub mod festo;
 pub mod free_bladder;
@@ -12,8 +10,9 @@ pub mod gaylord;
 pub mod inverse;
 pub mod knitted;
 pub mod knitted_bag;
+pub mod knitted_muscle;
 pub mod knitted_partials;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
-pub mod root;
+pub mod numerics;
