@@ -1,8 +1,8 @@
 //! Pure physics: functions and small structs, SI units throughout. No FMI, no I/O, no pointers.
+
 #![forbid(unsafe_code)]
 
 pub mod bladder;
-pub mod calibration;
 pub mod festo;
 pub mod free_bladder;
 pub mod friction;
@@ -15,4 +15,5 @@ pub mod knitted_partials;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
+pub mod muscle_params;
 pub mod numerics;
