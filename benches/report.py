@@ -186,10 +186,7 @@ def parity_goal_rows(parity):
 
 # Where the FMI layer's remaining nanoseconds go (callgrind, benches/parity.rs; README, "Where the
 # nanoseconds went"). Shown only beside a missed goal.
-FMI_LAYER_WHY = ("beside the checks kept on purpose (the instance's magic number on every call, the "
-                 "range and NaN checks of every value set and got), most of what remains is the "
-                 "model's own step: eq. 2.2-2.3, the stroke clamp and the 6 outputs it writes each step "
-                 "(README, \"Where the nanoseconds went\")")
+FMI_LAYER_WHY = ('the one path\'s checks (the instance\'s magic number, the call\'s state, the range and NaN checks of every value set and got) and one dynamic call into the model per FMI call, which the C fixture does not make (see "Where the time goes" below)')
 
 
 def progress(text):
