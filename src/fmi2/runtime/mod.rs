@@ -178,7 +178,7 @@ struct RuntimeOf<M: Model> {
     model: Option<M>,
     /// The outputs are not those the built model wrote for the current values. True whenever
     /// `model` is `None` (every change of `model` sets it; bytes from an importer are made to
-    /// agree), so that [`Runtime::outputs_current`] is one test on the per-step path.
+    /// agree), so that [`Runtime::outputs_current`] is one test.
     outputs_stale: bool,
     /// Model Exchange's time, given to the model when it is built (`None` for Co-Simulation).
     /// Not saved: the model keeps its own time, and the instance its.
@@ -367,7 +367,6 @@ where
             self.mirror_states();
         }
     }
-    #[inline(always)]
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
         let Some(model) = self.model.as_mut() else {
             // Not built (no step reaches here before initialization): laid out of the way.
@@ -564,7 +563,7 @@ mod tests {
             .ok_or_else(|| "not a McKibbenMuscle runtime".to_string())
     }
 
-    /// "Outputs current" is one flag on the per-step path, which holds only with a built model:
+    /// "Outputs current" is one flag, which holds only with a built model:
     /// bytes that claim current outputs without a model, or whose model fails to rebuild, are
     /// made to agree.
     #[test]
