@@ -65,8 +65,8 @@ def test_crosscheck_input_under_a_strict_master(model, strict):
                       output_interval=opt["StepSize"], input=inputs)
 
 
-# The case: the thin-walled bladder at a length past where it fills the sleeve (97.3 mm)
-# and past 5% strand strain beyond it (102.9 mm), which no muscle survives.
+# The case: the thin-walled bladder at a length past where it fills the sleeve (97.3 mm) and past
+# 5% strand strain beyond it (102.9 mm), which no muscle survives.
 PAST_THE_SLEEVE = dict(bladder_model=1)
 
 

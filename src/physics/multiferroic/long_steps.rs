@@ -1,4 +1,4 @@
-//! Long steps in the overdamped limit: settling a rotor and whole slipping turns (issue 5).
+//! Long steps in the overdamped limit: settling a rotor and whole slipping turns.
 
 use super::angles::turned_back;
 use super::{Drive, Motor, StepRun, SteppingSchedule, Vector};
@@ -66,7 +66,11 @@ impl Motor {
                 // Near the root: aim past it to bracket it.
                 (1.5 * force.abs() / k).max(eps)
             } else if k != 0.0 {
-                crate::physics::bounds::limit(0.25 * force.abs() / k.abs(), eps, MAX_ROTOR_STRIDE)
+                crate::physics::numerics::bounds::limit(
+                    0.25 * force.abs() / k.abs(),
+                    eps,
+                    MAX_ROTOR_STRIDE,
+                )
             } else {
                 MAX_ROTOR_STRIDE
             };
