@@ -134,14 +134,14 @@ fn model_structure_indices_are_generated() {
     // Every output in order (FMI 2.0 section 2.2.8)...
     assert_eq!(
         indices(&m.outputs),
-        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 33, 47, 48, 50]
+        [3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 33, 47, 48, 50, 53]
     );
     // ...and the outputs with initial calculated plus the calculated parameters, ascending.
     assert_eq!(
         indices(&m.initial_unknowns),
         [
             3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 30, 31, 33, 34, 35, 36, 37, 38, 39, 40,
-            41, 42, 43, 47, 48, 50
+            41, 42, 43, 47, 48, 50, 53
         ]
     );
     assert!(m.outputs.iter().all(|u| u.dependencies.is_some()));
