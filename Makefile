@@ -3,10 +3,11 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
-LIB := target/release/libactuator_fmus.so
+## The linux64 binary the FMUs ship (see "Linux binaries for every maintained distribution" below).
+LIB := target/glibc/x86_64-unknown-linux-gnu/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized py-deps scene-schema
+.PHONY: all fmus zig-tools demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized py-deps scene-schema
 
 all: fmus
 
@@ -40,9 +41,35 @@ py-deps:
 
 ## One recipe for the three files (`&:`): under `make -j` it must run once, not once per file.
 ## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
-$(LIB) target/release/package_fmus target/release/calibrate &: $(SOURCES)
-	+cargo build --release --lib -p actuator-fmus
+target/release/package_fmus target/release/calibrate &: $(SOURCES)
 	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
+
+## Linux binaries for every maintained distribution: linked against glibc 2.17 (the manylinux2014
+## baseline: RHEL/Rocky 7-9, Ubuntu 18.04+, Debian 10+) by cargo-zigbuild with zig as the linker,
+## whatever glibc this machine has. Both tools are pinned and installed here, under target/tools/,
+## when missing (zig from PyPI's `ziglang` wheel, in its own venv). tests/all/glibc_versions.rs
+## fails if a shipped .so needs a newer symbol version.
+GLIBC := 2.17
+ZIGLANG_VERSION := 0.17.1
+ZIGBUILD_VERSION := 0.24.1
+TOOLS := target/tools
+ZIGBUILD := $(TOOLS)/bin/cargo-zigbuild
+ZIG_VENV := $(TOOLS)/zig
+# cargo-zigbuild finds zig as `python3 -m ziglang` first: the tool venv's python3 leads the PATH.
+ZIG_ENV := PATH=$(CURDIR)/$(ZIG_VENV)/bin:$(CURDIR)/$(TOOLS)/bin:$$PATH
+$(ZIG_VENV)/.installed:
+	$(PYTHON) -m venv $(ZIG_VENV)
+	$(ZIG_VENV)/bin/pip install --quiet ziglang==$(ZIGLANG_VERSION)
+	touch $@
+$(ZIGBUILD):
+	cargo install cargo-zigbuild --locked --version $(ZIGBUILD_VERSION) --root $(TOOLS)
+zig-tools: $(ZIG_VENV)/.installed $(ZIGBUILD)
+
+## Its own target directory, so that it runs beside the host build under `make -j`.
+GLIBC_TARGET_DIR := target/glibc
+$(LIB): $(SOURCES) | zig-tools
+	+$(ZIG_ENV) cargo zigbuild --release --lib -p actuator-fmus --target-dir $(GLIBC_TARGET_DIR) \
+	  --target x86_64-unknown-linux-gnu.$(GLIBC)
 
 ## Cross toolchains for the win64 and aarch64-linux binaries, and the emulators the tests run them
 ## under (wine, qemu-user); each installed only when missing.
@@ -64,11 +91,16 @@ cross-deps:
 ## host dependencies once more.
 CROSS_TARGET_DIR := target/cross
 WIN_DLL := $(CROSS_TARGET_DIR)/x86_64-pc-windows-gnu/release/actuator_fmus.dll
-ARM_SO := $(CROSS_TARGET_DIR)/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
+ARM_SO := $(GLIBC_TARGET_DIR)/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
 
-$(WIN_DLL) $(ARM_SO) &: $(SOURCES) | cross-deps
-	+cargo build --release --lib --target-dir $(CROSS_TARGET_DIR) \
-	  --target x86_64-pc-windows-gnu --target aarch64-unknown-linux-gnu
+$(WIN_DLL): $(SOURCES) | cross-deps
+	+cargo build --release --lib --target-dir $(CROSS_TARGET_DIR) --target x86_64-pc-windows-gnu
+
+## aarch64-linux as linux64: zig links it against glibc 2.17 (no cross gcc needed for the build;
+## the tests' C harness still uses it).
+$(ARM_SO): $(SOURCES) $(LIB) | zig-tools cross-deps
+	+$(ZIG_ENV) cargo zigbuild --release --lib -p actuator-fmus --target-dir $(GLIBC_TARGET_DIR) \
+	  --target aarch64-unknown-linux-gnu.$(GLIBC)
 
 ## target/fmu/<Model>.fmu for every model in modelDescription/, with binaries for linux64, win64 and
 ## aarch64-linux (`make fmus CROSS=0`: linux64 only, no cross toolchains needed).
