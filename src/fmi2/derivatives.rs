@@ -3,8 +3,9 @@
 //! outputs (and state derivatives): Model Exchange's Jacobian. No finite differences: a model
 //! that has no partials says so and the call is refused.
 
-use super::instance::{allowed, Instance};
+use super::instance::{allowed, Instance, MachineState};
 use super::registry::Bindings;
+use super::runtime::Runtime;
 use super::types::fmi2Status;
 use crate::models::{Inputs, Model};
 use crate::variables::{Causality, ContinuousStates, Interface, VarType};
@@ -115,6 +116,14 @@ impl Instance {
         if status >= fmi2Status::Error {
             return status;
         }
+        if self.state() == MachineState::InitializationMode
+            && self.initialization_partials_needed(unknown, known)
+        {
+            return match self.initialization_derivative(unknown, known, dv_known, dv_unknown) {
+                Ok(()) => status,
+                Err(why) => self.error(&format!("{F}: {why}")),
+            };
+        }
         match self
             .runtime
             .directional_derivative(unknown, known, dv_known, dv_unknown)
@@ -122,6 +131,131 @@ impl Instance {
             Ok(()) => status,
             Err(why) => self.error(&format!("{F}: {why}")),
         }
+    }
+}
+
+/// The relative step of the central differences in Initialization Mode: the cube root of the
+/// machine epsilon balances truncation (h^2) against rounding (eps / h).
+const CENTRAL_STEP: f64 = 6.055_454_452_393_343e-6;
+
+impl Instance {
+    /// Whether a call in Initialization Mode involves a parameter (a known) or a calculated
+    /// parameter (an unknown): the initial unknowns' dependencies FMI 2.0 lets a master ask for
+    /// there, which the models' exact partials (inputs and states only) do not cover.
+    fn initialization_partials_needed(&self, unknown: &[u32], known: &[u32]) -> bool {
+        let info = self.info();
+        let is = |vr: u32, causality: Causality| {
+            info.variable(VarType::Real, vr)
+                .is_some_and(|v| v.causality == causality)
+        };
+        known.iter().any(|&vr| is(vr, Causality::Parameter))
+            || unknown
+                .iter()
+                .any(|&vr| is(vr, Causality::CalculatedParameter))
+    }
+
+    /// Initialization Mode with parameters among the knowns: the parameters shape the model
+    /// itself (geometry, tables, presets), so the derivative along `dv_known` is the central
+    /// difference of the initial unknowns of the model rebuilt at the knowns moved by `+-h dv_known`,
+    /// with `h` relative to the knowns' magnitudes ([`CENTRAL_STEP`]); one-sided where a central
+    /// point would leave a declared range. The instance's own values are not touched.
+    fn initialization_derivative(
+        &mut self,
+        unknown: &[u32],
+        known: &[u32],
+        dv_known: &[f64],
+        dv_unknown: &mut [f64],
+    ) -> Result<(), String> {
+        let info = self.info();
+        let real = |vr: u32| {
+            info.variable(VarType::Real, vr)
+                .ok_or_else(|| format!("{vr} is not the value reference of a Real variable"))
+        };
+        let mut knowns = Vec::with_capacity(known.len());
+        for &vr in known {
+            let var = real(vr)?;
+            if !matches!(var.causality, Causality::Parameter | Causality::Input) {
+                return Err(format!(
+                    "{} (value reference {vr}) is not a parameter or an input of {}: in \
+                     Initialization Mode the knowns are those the initial unknowns depend on",
+                    var.name, info.name
+                ));
+            }
+            knowns.push(var);
+        }
+        for &vr in unknown {
+            let var = real(vr)?;
+            if !matches!(
+                var.causality,
+                Causality::Output | Causality::CalculatedParameter
+            ) {
+                return Err(format!(
+                    "{} (value reference {vr}) is not an output or a calculated parameter of {}: \
+                     in Initialization Mode the unknowns are the initial unknowns",
+                    var.name, info.name
+                ));
+            }
+        }
+        if let Some(bad) = dv_known.iter().find(|v| !v.is_finite()) {
+            return Err(format!("dvKnown must be finite, got {bad}"));
+        }
+        let x: Vec<f64> = known
+            .iter()
+            .map(|&vr| self.runtime.real(vr as usize))
+            .collect();
+        // The largest step that moves no known by more than CENTRAL_STEP of its magnitude (of 1
+        // in its unit at zero).
+        let Some(h) = x
+            .iter()
+            .zip(dv_known)
+            .filter(|(_, d)| **d != 0.0)
+            .map(|(x, d)| CENTRAL_STEP * if *x == 0.0 { 1.0 } else { x.abs() } / d.abs())
+            .reduce(f64::min)
+        else {
+            dv_unknown.fill(0.0);
+            return Ok(());
+        };
+        let inside = |s: f64| {
+            knowns.iter().zip(&x).zip(dv_known).all(|((v, x), d)| {
+                let y = x + s * d;
+                v.min.is_none_or(|m| y >= m) && v.max.is_none_or(|m| y <= m)
+            })
+        };
+        let (plus, minus) = match (inside(h), inside(-h)) {
+            (true, true) => (h, -h),
+            (true, false) => (h, 0.0),
+            (false, true) => (0.0, -h),
+            (false, false) => {
+                return Err(format!(
+                    "the knowns cannot move by {h:e} times dvKnown within their declared ranges"
+                ))
+            }
+        };
+        let at = |runtime: &dyn Runtime, s: f64| -> Result<Vec<f64>, String> {
+            let mut probe = runtime.snapshot();
+            let moved: Vec<f64> = x.iter().zip(dv_known).map(|(x, d)| x + s * d).collect();
+            probe.set_reals(known, &moved, true);
+            probe
+                .build()
+                .map_err(|why| format!("the model moved by {s:e} dvKnown is refused: {why}"))?;
+            let mut report = crate::models::Report::default();
+            probe.refresh_outputs(&mut report);
+            let mut out = vec![0.0; unknown.len()];
+            probe.reals(unknown, &mut out);
+            Ok(out)
+        };
+        let (high, low) = (at(&*self.runtime, plus)?, at(&*self.runtime, minus)?);
+        for (k, slot) in dv_unknown.iter_mut().enumerate() {
+            let value = (high[k] - low[k]) / (plus - minus);
+            if !value.is_finite() {
+                return Err(format!(
+                    "the derivative of {} is not finite",
+                    real(unknown[k]).map_or("?", |v| v.name)
+                ));
+            }
+            *slot = value;
+        }
+        Ok(())
     }
 }
 

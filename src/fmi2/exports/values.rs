@@ -1,6 +1,6 @@
 //! fmi2SetXXX and fmi2GetXXX: the importer's arrays as slices, handed to the instance.
 
-use super::{guarded, instance, null_argument, slice, slice_mut, text};
+use super::{entry, guarded, instance, null_argument, slice, slice_mut, text};
 use crate::fmi2::instance::{CBoolean, Value};
 use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::*;
@@ -33,7 +33,7 @@ pub unsafe extern "C" fn fmi2SetReal(
 ) -> fmi2Status {
     // SAFETY: see `instance`; then a tail call to the model's own entry point (exports/hot.rs).
     match unsafe { instance(c) } {
-        Some(inst) => unsafe { (inst.hot_path().set_real)(c, vr, nvr, value) },
+        Some(inst) => unsafe { (inst.hot_path().set_real)(entry(inst), vr, nvr, value) },
         None => fmi2Status::Error,
     }
 }
@@ -111,7 +111,7 @@ pub unsafe extern "C" fn fmi2GetReal(
 ) -> fmi2Status {
     // SAFETY: see `instance`; then a tail call to the model's own entry point (exports/hot.rs).
     match unsafe { instance(c) } {
-        Some(inst) => unsafe { (inst.hot_path().get_real)(c, vr, nvr, value) },
+        Some(inst) => unsafe { (inst.hot_path().get_real)(entry(inst), vr, nvr, value) },
         None => fmi2Status::Error,
     }
 }
