@@ -189,6 +189,13 @@ bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench cpu_time
 	cargo bench --bench parity
 
+.PHONY: worst-case
+## The cost of a step and of initialization anywhere in each FMU's declared space: every bound
+## alone, every option combination and 10,000 log-uniform random points per FMU (median, p99,
+## max; benches/worst_case.rs). WORST_CASE_POINTS and WORST_CASE_MODELS narrow it.
+worst-case: fmus
+	cargo bench --bench worst_case
+
 .PHONY: parity
 ## benches/parity.rs alone: the FMI layer against C, the walls, the motor and the knitted table;
 ## then the README's FMI-layer table from that run.

@@ -185,14 +185,19 @@ impl Instance {
         }
         for &vr in unknown {
             let var = real(vr)?;
-            if !matches!(
-                var.causality,
-                Causality::Output | Causality::CalculatedParameter
-            ) {
+            // Outputs, calculated parameters, continuous states and their derivatives.
+            if matches!(var.causality, Causality::Parameter | Causality::Input) {
                 return Err(format!(
-                    "{} (value reference {vr}) is not an output or a calculated parameter of {}: \
-                     in Initialization Mode the unknowns are the initial unknowns",
-                    var.name, info.name
+                    "{} (value reference {vr}) is a {} of {}: in Initialization Mode the \
+                     unknowns are the initial unknowns (outputs, calculated parameters, states \
+                     and their derivatives)",
+                    var.name,
+                    if var.causality == Causality::Input {
+                        "input"
+                    } else {
+                        "parameter"
+                    },
+                    info.name
                 ));
             }
         }

@@ -65,8 +65,9 @@ impl RingBar {
         let corner = 0.5 * bar_length.hypot(bar_width);
         if corner >= 0.5 * ring_inner_diameter {
             return Err(format!(
-                "the bar ({bar_length} x {bar_width} m) does not fit inside the ring's hole \
-                 (inner diameter {ring_inner_diameter} m): its corners reach {corner} m"
+                "the bar (bar_length {bar_length} m x bar_width {bar_width} m) does not fit \
+                 inside the ring's hole (ring_inner_diameter {ring_inner_diameter} m): its \
+                 corners reach {corner} m from the centre"
             ));
         }
         let ring_width = 0.5 * (ring_outer_diameter - ring_inner_diameter);
