@@ -8,7 +8,7 @@ use super::registry::Bindings;
 use super::runtime::Runtime;
 use super::types::fmi2Status;
 use crate::models::{Inputs, Model};
-use crate::variables::{Causality, ContinuousStates, Interface, VarType};
+use crate::variables::{Causality, ContinuousStates, Interface, VarType, Variable};
 
 /// `dv_unknown[i] = sum_j d(unknown_i)/d(known_j) dv_known[j]` for model `M` at the current inputs.
 pub(super) fn directional_derivative<M: Model>(
@@ -139,19 +139,20 @@ impl Instance {
 const CENTRAL_STEP: f64 = 6.055_454_452_393_343e-6;
 
 impl Instance {
-    /// Whether a call in Initialization Mode involves a parameter (a known) or a calculated
-    /// parameter (an unknown): the initial unknowns' dependencies FMI 2.0 lets a master ask for
-    /// there, which the models' exact partials (inputs and states only) do not cover.
+    /// Whether a call in Initialization Mode involves a parameter (a known) or an initial unknown
+    /// that is not an output (a calculated parameter, a state, a derivative): dependencies FMI
+    /// 2.0 lets a master ask for there, which the models' exact partials (outputs by inputs and
+    /// states) do not cover.
     fn initialization_partials_needed(&self, unknown: &[u32], known: &[u32]) -> bool {
         let info = self.info();
         let is = |vr: u32, causality: Causality| {
             info.variable(VarType::Real, vr)
                 .is_some_and(|v| v.causality == causality)
         };
+        // Exact partials cover outputs by inputs; states and derivatives among the initial
+        // unknowns depend on the start values the model is built from.
         known.iter().any(|&vr| is(vr, Causality::Parameter))
-            || unknown
-                .iter()
-                .any(|&vr| is(vr, Causality::CalculatedParameter))
+            || unknown.iter().any(|&vr| !is(vr, Causality::Output))
     }
 
     /// Initialization Mode with parameters among the knowns: the parameters shape the model
@@ -208,13 +209,19 @@ impl Instance {
             .iter()
             .map(|&vr| self.runtime.real(vr as usize))
             .collect();
-        // The largest step that moves no known by more than CENTRAL_STEP of its magnitude (of 1
-        // in its unit at zero).
-        let Some(h) = x
+        // The largest step that moves no known by more than CENTRAL_STEP of its magnitude (at
+        // zero, of half its declared range, at most 1 in its unit).
+        let scale = |var: &Variable, x: f64| match (x, var.min, var.max) {
+            (0.0, Some(lo), Some(hi)) => (0.5 * (hi - lo)).min(1.0),
+            (0.0, _, _) => 1.0,
+            _ => x.abs(),
+        };
+        let Some(h) = knowns
             .iter()
+            .zip(&x)
             .zip(dv_known)
             .filter(|(_, d)| **d != 0.0)
-            .map(|(x, d)| CENTRAL_STEP * if *x == 0.0 { 1.0 } else { x.abs() } / d.abs())
+            .map(|((var, x), d)| CENTRAL_STEP * scale(var, *x) / d.abs())
             .reduce(f64::min)
         else {
             dv_unknown.fill(0.0);

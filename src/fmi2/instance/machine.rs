@@ -203,10 +203,11 @@ impl Instance {
             return fmi2Status::Error;
         }
         let status = self.refresh_outputs("fmi2ExitInitializationMode");
-        if status >= fmi2Status::Error {
-            // Bad parameters: the instance can be reset (or freed).
+        if status >= fmi2Status::Discard {
+            // Bad parameters, or start values the model cannot evaluate (a Discard, which has no
+            // smaller step to retry here): the instance can be reset (or freed).
             self.set_state(MachineState::Error);
-            return status;
+            return status.max(fmi2Status::Error);
         }
         self.set_state(if self.model_exchange {
             MachineState::EventMode

@@ -9,6 +9,9 @@ use std::f64::consts::PI;
 /// but finer sleeves reach the eq. 1.17 limit at the clamps before free contraction.
 pub const MAX_SEGMENTS: usize = 1600;
 
+/// Most rows per axial segment accepted (see [`ShapeGeometry::new`]).
+pub const MAX_ROWS_PER_SEGMENT: f64 = 4.0;
+
 /// Geometry of the discretized sleeve. All lengths in metres.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ShapeGeometry {
@@ -66,6 +69,18 @@ impl ShapeGeometry {
                  segments per row, the segments at the clamps turn radial (eq. 1.17 slant \
                  length all radius step) before free contraction and the table would end \
                  short of zero force"
+            ));
+        }
+        // The table's solver resolves the contraction pocket ring by ring: with many rows per
+        // segment its cost grows with the square of the rows (7 ms at 4 rows per segment, 2.3 s
+        // at 32), so coarser discretizations are refused rather than left to run.
+        if rows > MAX_ROWS_PER_SEGMENT * segments as f64 {
+            return Err(format!(
+                "rows = {rows} on shape_segments = {segments} is {} rows per segment; the \
+                 non-cylindrical shape needs at most {MAX_ROWS_PER_SEGMENT}: set shape_segments \
+                 to at least {} (at most {MAX_SEGMENTS}), or use shape_model 1",
+                rows / segments as f64,
+                (rows / MAX_ROWS_PER_SEGMENT).ceil()
             ));
         }
         Ok(Self {
