@@ -10,7 +10,7 @@ use std::f64::consts::PI;
 pub const MAX_SEGMENTS: usize = 1600;
 
 /// Most rows per axial segment accepted (see [`ShapeGeometry::new`]).
-pub const MAX_ROWS_PER_SEGMENT: f64 = 4.0;
+pub const MAX_ROWS_PER_SEGMENT: f64 = 8.0;
 
 /// Geometry of the discretized sleeve. All lengths in metres.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]

@@ -367,9 +367,9 @@ impl Motor {
                 p.tolerance
             ));
         }
-        if p.max_substeps == 0 || p.max_substeps > 100_000_000 {
+        if p.max_substeps == 0 || p.max_substeps > 100_000 {
             return Err(format!(
-                "max_substeps must be within [1, 1e8], got {}",
+                "max_substeps must be within [1, 1e5], got {}",
                 p.max_substeps
             ));
         }
