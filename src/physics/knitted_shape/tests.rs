@@ -152,10 +152,12 @@ fn rejects_bad_geometry() {
     let why = ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS + 1).unwrap_err();
     assert!(why.contains("1600") && why.contains("radial"), "{why}");
     // More rows per segment than the table resolves in bounded time: refused, naming the fix.
-    let rows = MAX_ROWS_PER_SEGMENT * 49.0;
-    assert!(ShapeGeometry::new(22.0, rows, 0.48, 0.003, 49).is_ok());
-    let why = ShapeGeometry::new(22.0, rows + 1.0, 0.48, 0.003, 49).unwrap_err();
-    assert!(why.contains("shape_segments to at least 50"), "{why}");
+    let rows = MAX_ROWS_PER_SEGMENT * 20.0;
+    assert!(ShapeGeometry::new(22.0, rows, 0.48, 0.003, 20).is_ok());
+    let why = ShapeGeometry::new(22.0, rows + 1.0, 0.48, 0.003, 20).unwrap_err();
+    assert!(why.contains("shape_segments to at least 21"), "{why}");
+    let why = ShapeGeometry::new(22.0, 201.0, 0.48, 0.003, 49).unwrap_err();
+    assert!(why.contains("at most 200 rows"), "{why}");
 }
 
 proptest::proptest! {
