@@ -1,11 +1,10 @@
 """The win64 DLL (under wine) and the aarch64-linux .so (under qemu-user) of every FMU give the
 linux64 outputs bit for bit (the motor under wine to 1e-12: wine's libm): Real, Integer and
 Boolean outputs, directional derivatives every tenth step, and an FMU state saved and restored
-mid-run. One small C master
-(tests/cross/harness.c), built natively, with mingw-w64 and with the aarch64 cross gcc, runs the
-same script on each binary: every scene (fast
-variant, parameters and inputs included) whose FMU it is, then the FMU's cross-check input.
-`make fmus` builds the binaries and `make cross-deps` installs the toolchains and emulators."""
+mid-run. One small C master (tests/cross/harness.c), built natively, with mingw-w64 and with the
+aarch64 cross gcc, runs the same script on each binary: every scene (fast variant, parameters and
+inputs included) whose FMU it is, then the FMU's cross-check input. `make fmus` builds the
+binaries and `make cross-deps` installs the toolchains and emulators."""
 
 import os
 import pathlib
