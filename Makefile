@@ -7,7 +7,7 @@ PY := $(VENV)/bin/python
 LIB := target/glibc/x86_64-unknown-linux-gnu/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus zig-tools demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized py-deps scene-schema
+.PHONY: all fmus zig-tools demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
 
@@ -39,7 +39,7 @@ py-deps:
 	    --no-install-recommends $$missing; \
 	fi
 
-## One recipe for the three files (`&:`): under `make -j` it must run once, not once per file.
+## One recipe for both tools (`&:`): under `make -j` it must run once, not once per file.
 ## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
 target/release/package_fmus target/release/calibrate &: $(SOURCES)
 	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
@@ -223,6 +223,10 @@ report: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 ## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
 linearized: fmus $(VENV)/.installed
 	$(PY) docs/linearized/generate.py > /dev/null
+
+## Chapter 2's claims re-run with the dissertation's walls and the exact wall: docs/chapter2-claims.md.
+chapter2-claims: fmus $(VENV)/.installed
+	$(PY) docs/chapter2/generate.py
 
 clean:
 	cargo clean
