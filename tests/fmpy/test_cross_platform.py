@@ -1,5 +1,5 @@
 """The win64 DLL (under wine) and the aarch64-linux .so (under qemu-user) of every FMU give the
-linux64 outputs bit for bit (the motor under wine to 1e-12: wine's libm): Real, Integer and
+linux64 outputs bit for bit (the motor and FreeBladder under wine to 1e-12: wine's libm): Real, Integer and
 Boolean outputs, directional derivatives every tenth step, and an FMU state saved and restored
 mid-run. One small C master (tests/cross/harness.c), built natively, with mingw-w64 and with the
 aarch64 cross gcc, runs the same script on each binary: every scene (fast variant, parameters and
@@ -26,10 +26,11 @@ HARNESS = ROOT / "tests" / "cross" / "harness.c"
 STUB = ROOT / "tests" / "cross" / "bcryptprimitives.c"
 FMUS = sorted(p.stem for p in FMU_DIR.glob("*.fmu"))
 RTOL = 1e-12
-# Under wine the DLL calls wine's msvcrt libm, whose sin/cos/exp may differ from glibc's in the last
-# bit: MultiferroicMotor differs by 1.6e-13 relative there. Every other FMU is asserted
-# bit-identical under wine, and all seven under qemu, which runs glibc's code.
-LIBM_HEAVY = {"MultiferroicMotor"}
+# Under wine the DLL calls wine's msvcrt libm, whose sin/cos/exp/log may differ from glibc's in the
+# last bit: MultiferroicMotor differs by 1.6e-13 relative there, FreeBladder (the exact tube's
+# logarithm) by 4.2e-15. Every other FMU is asserted bit-identical under wine, and all seven under
+# qemu, which runs glibc's code.
+LIBM_HEAVY = {"MultiferroicMotor", "FreeBladder"}
 CROSS_STEPS = 200
 
 
