@@ -1,0 +1,322 @@
+"""The actuator_fmus.fmu MuJoCo plugin (mujoco_plugin/) with our muscle FMUs inside MuJoCo.
+
+Independent truths: the same FMU stepped by FMPy with the inputs MuJoCo gave the plugin (the
+coupling), torque balance and stiffness of the arm solved here from the FMU's own force-length
+curves and `stiffness` output with the arm's geometry written out by hand (the physics), and
+MuJoCo's state functions (history carried in plugin_state)."""
+
+import copy
+import math
+import pathlib
+import sys
+
+import mujoco
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+from conftest import Slave, fmu_path
+
+ROOT = pathlib.Path(__file__).resolve().parents[2]
+sys.path.insert(0, str(ROOT / "examples"))
+import mujoco_arm as arm  # noqa: E402
+
+R = arm.PULLEY_RADIUS
+H = arm.HANG
+# m g l of the forearm, from arm.xml's masses by hand: 0.3 kg rod from 0.02 to 0.3 m (centre
+# 0.16 m), 0.2 kg hand at 0.3 m, pulley on the axis; MuJoCo's default gravity 9.81 m/s^2.
+MGL = 9.81 * (0.3 * 0.16 + 0.2 * 0.3)
+
+
+def muscle_lengths(q):
+    """(flexor, extensor) lengths at elbow angle q (arm.xml's geometry: moment arm r)."""
+    return H - R * q, H + R * q
+
+
+# ---------------------------------------------------------------- the coupling, every variant
+
+SLIDER = """
+<mujoco>
+  <option timestep="{h}"/>
+  <extension><plugin plugin="actuator_fmus.fmu"/></extension>
+  <worldbody>
+    <site name="anchor" pos="0 0 0"/>
+    <body name="end">
+      <joint name="slide" type="slide" axis="0 0 -1"/>
+      <geom type="sphere" size="0.01" mass="0.1"/>
+      <site name="hook" pos="0 0 0"/>
+    </body>
+  </worldbody>
+  <tendon><spatial name="muscle"><site site="anchor"/><site site="hook"/></spatial></tendon>
+  <actuator>
+    <plugin name="muscle" plugin="actuator_fmus.fmu" tendon="muscle">
+      <config key="fmu" value="{fmu}"/>
+      <config key="parameters" value="{parameters}"/>
+      <config key="length_input" value="length"/>
+      <config key="ctrl_input" value="pressure"/>
+    </plugin>
+  </actuator>
+</mujoco>"""
+
+# (model, FMU parameters, rest length m, stroke amplitude m): both muscles, friction and bladder
+# off and on.
+VARIANTS = [
+    ("McKibbenMuscle", {}, 0.09, 0.004),
+    ("McKibbenMuscle", {"friction": "true"}, 0.09, 0.004),
+    ("McKibbenMuscle", {"bladder_model": 1}, 0.09, 0.004),
+    ("McKibbenMuscle", {"bladder_model": 1, "friction": "true"}, 0.09, 0.004),
+    ("McKibbenMuscle", {"preset": "DMSP-10", "nominal_length": 0.25, "friction": "true"}, 0.235,
+     0.006),
+    ("KnittedMuscle", {}, 0.4, 0.02),
+    ("KnittedMuscle", {"friction": "true"}, 0.4, 0.02),
+    ("KnittedMuscle", {"bladder_model": 1, "friction": "true"}, 0.4, 0.02),
+]
+
+
+def slider(model, parameters, h=1e-3):
+    arm.load_plugin()
+    text = " ".join(f"{k}={v}" for k, v in parameters.items())
+    return mujoco.MjModel.from_xml_string(SLIDER.format(h=h, fmu=fmu_path(model),
+                                                        parameters=text))
+
+
+def fmpy_parameters(parameters):
+    out = {}
+    for key, value in parameters.items():
+        if value in ("true", "false"):
+            value = value == "true"
+        elif key == "preset":
+            value = {"DMSP-10": 5, "DMSP-40": 6}[value]
+        out[key] = value
+    return out
+
+
+@pytest.mark.parametrize("model_name,parameters,rest,stroke", VARIANTS,
+                         ids=[f"{m}-{'-'.join(f'{k}={v}' for k, v in p.items()) or 'default'}"
+                              for m, p, _, _ in VARIANTS])
+def test_plugin_force_is_the_fmu_stepped_with_mujocos_inputs(model_name, parameters, rest, stroke):
+    """A prescribed stroke and pressure cycle through MuJoCo; FMPy steps the same FMU with the
+    lengths and pressures MuJoCo handed the plugin and must read the same force every step."""
+    h = 1e-3
+    model = slider(model_name, parameters, h)
+    data = mujoco.MjData(model)
+    record = []
+    for k in range(600):
+        t = k * h
+        data.qpos[0] = rest + stroke * math.sin(2 * math.pi * 2.5 * t)  # tendon length = qpos
+        data.qvel[0] = 0.0
+        data.ctrl[0] = 3e5 + 2e5 * math.sin(2 * math.pi * 1.5 * t)
+        mujoco.mj_step(model, data)
+        # After mj_step: the force and length of the step's start, the control it used.
+        record.append((data.actuator_length[0], data.ctrl[0], -data.actuator_force[0]))
+    reference = Slave(model_name, **fmpy_parameters(parameters), length=record[0][0],
+                      pressure=record[0][1])
+    forces = []
+    for length, pressure, _ in record:
+        forces.append(reference.at("force", length=length, pressure=pressure))
+        reference.step(h)
+    plugin = np.array([r[2] for r in record])
+    assert np.abs(plugin).max() > 1.0, "the stroke produced no force"
+    np.testing.assert_allclose(plugin, forces, rtol=1e-12, atol=1e-9)
+
+
+# ---------------------------------------------------------------- the arm: statics
+
+def settle(parameters=arm.DMSP10, pressures=(4e5, 3e5), torque=0.0, seconds=3.0, q0=0.0):
+    model = arm.arm_model(parameters)
+    data = mujoco.MjData(model)
+    data.qpos[0] = q0
+    data.ctrl[:] = pressures
+    data.qfrc_applied[0] = torque
+    for _ in range(int(seconds / model.opt.timestep)):
+        mujoco.mj_step(model, data)
+    return data
+
+
+class Curves:
+    """The DMSP-10 FMU's own force-length curves (FMPy), friction off."""
+
+    def __init__(self):
+        self.fmu = Slave("McKibbenMuscle", preset=5, nominal_length=0.25)
+
+    def force(self, length, pressure):
+        return self.fmu.at("force", length=length, pressure=pressure)
+
+    def stiffness(self, length, pressure):
+        return self.fmu.at("stiffness", length=length, pressure=pressure)
+
+    def torque(self, q, pf, pe, applied=0.0):
+        """Net elbow torque (N m) at angle q: cables pull only, gravity -m g l cos q."""
+        lf, le = muscle_lengths(q)
+        return (R * (max(self.force(lf, pf), 0.0) - max(self.force(le, pe), 0.0))
+                - MGL * math.cos(q) + applied)
+
+    def equilibrium(self, pf, pe, applied=0.0):
+        return brentq(lambda q: self.torque(q, pf, pe, applied), -1.0, 1.0, xtol=1e-13)
+
+
+@pytest.fixture(scope="module")
+def curves():
+    return Curves()
+
+
+@pytest.mark.parametrize("pressures", [(4e5, 3e5), (5.5e5, 4.5e5), (3e5, 3e5)])
+def test_arm_rests_where_the_muscle_moments_balance_gravity(curves, pressures):
+    data = settle(pressures=pressures)
+    expected = curves.equilibrium(*pressures)
+    assert abs(data.qvel[0]) < 1e-6, "not at rest"
+    assert data.qpos[0] == pytest.approx(expected, abs=1e-6)
+    # MuJoCo's lengths are the hand-written geometry.
+    np.testing.assert_allclose(data.actuator_length + arm.LENGTH_OFFSET,
+                               muscle_lengths(data.qpos[0]), atol=1e-12)
+
+
+def test_joint_stiffness_grows_with_co_contraction_and_matches_the_muscles(curves):
+    """Small torque perturbations (+-0.02 N m) about the equilibrium, at the same angle-holding
+    pressure difference and two common modes: measured stiffness against
+    k = r^2 (k_flexor + k_extensor) - m g l sin q from the FMU's `stiffness` outputs."""
+    measured, predicted = [], []
+    for pressures in [(3.5e5, 2.5e5), (5.5e5, 4.5e5)]:
+        dtau = 0.02
+        q_plus = settle(pressures=pressures, torque=dtau).qpos[0]
+        q_minus = settle(pressures=pressures, torque=-dtau).qpos[0]
+        k = 2 * dtau / (q_plus - q_minus)
+        q = curves.equilibrium(*pressures)
+        lf, le = muscle_lengths(q)
+        k_muscles = curves.stiffness(lf, pressures[0]) + curves.stiffness(le, pressures[1])
+        measured.append(k)
+        predicted.append(R * R * k_muscles - MGL * math.sin(q))
+    np.testing.assert_allclose(measured, predicted, rtol=2e-3)
+    assert measured[1] > 1.2 * measured[0], f"co-contraction did not stiffen: {measured}"
+
+
+# ---------------------------------------------------------------- the arm: history
+
+def pressure_cycle(parameters, seconds=32.0):
+    """Flexor pressure 250 -> 500 -> 250 kPa (triangle), extensor 350 kPa: (p_flexor, q)."""
+    model = arm.arm_model(parameters)
+    data = mujoco.MjData(model)
+    out = []
+    steps = int(seconds / model.opt.timestep)
+    for k in range(steps):
+        s = k / steps
+        pf = 2.5e5 + 2.5e5 * (1 - abs(2 * s - 1))
+        data.ctrl[:] = (pf, 3.5e5)
+        mujoco.mj_step(model, data)
+        out.append((pf, data.qpos[0], s < 0.5))
+    return np.array(out)
+
+
+def loop_width(cycle, pressure=3.75e5):
+    """Angle difference between the rising and falling branches at one flexor pressure (rad)."""
+    rising = cycle[cycle[:, 2] == 1]
+    falling = cycle[cycle[:, 2] == 0][::-1]
+    return (np.interp(pressure, rising[:, 0], rising[:, 1])
+            - np.interp(pressure, falling[:, 0], falling[:, 1]))
+
+
+def test_friction_gives_hysteresis_in_a_slow_pressure_cycle():
+    """32 s per cycle: without friction the loop is only the viscous lag of the joint damping."""
+    smooth = loop_width(pressure_cycle(arm.DMSP10))
+    rough = loop_width(pressure_cycle(arm.DMSP10 + " friction=true"))
+    # Rising pressure lifts the hand against friction: it lags below the falling branch.
+    assert rough < -0.02, rough
+    assert abs(smooth) < 0.1 * abs(rough), (smooth, rough)
+
+
+def run_arm(model, data, seconds):
+    controller = arm.Controller()
+    out = []
+    for _ in range(int(round(seconds / model.opt.timestep))):
+        _, pressures, torque = controller(data.time, data.qpos[0], data.qvel[0],
+                                          model.opt.timestep)
+        data.ctrl[:] = pressures
+        data.qfrc_applied[0] = torque
+        mujoco.mj_step(model, data)
+        out.append((data.qpos[0], data.qvel[0], *data.actuator_force))
+    return np.array(out)
+
+
+def test_runs_are_deterministic():
+    model = arm.arm_model(arm.DMSP10 + " friction=true")
+    first = run_arm(model, mujoco.MjData(model), 1.0)
+    second = run_arm(model, mujoco.MjData(model), 1.0)
+    other_model = arm.arm_model(arm.DMSP10 + " friction=true")
+    third = run_arm(other_model, mujoco.MjData(other_model), 1.0)
+    assert np.array_equal(first, second) and np.array_equal(first, third)
+
+
+def test_friction_history_is_carried_in_plugin_state():
+    """mj_getState/mj_setState, a copied mjData and mj_resetData continue exactly as the
+    uninterrupted run; a state from another moment gives another continuation."""
+    model = arm.arm_model(arm.DMSP10 + " friction=true")
+    data = mujoco.MjData(model)
+    data.ctrl[:] = (4.5e5, 2.5e5)
+    for _ in range(300):
+        mujoco.mj_step(model, data)
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    saved = np.empty(mujoco.mj_stateSize(model, spec))
+    mujoco.mj_getState(model, data, saved, spec)
+    twin = copy.copy(data)
+
+    def cycle(d):
+        out = []
+        for k in range(400):
+            d.ctrl[:] = (4.5e5 - 2e5 * math.sin(math.pi * k / 400), 2.5e5)
+            mujoco.mj_step(model, d)
+            out.append(-d.actuator_force[0])
+        return np.array(out)
+
+    reference = cycle(data)
+    later = cycle(data)  # friction state now differs from `saved`
+    mujoco.mj_setState(model, data, saved, spec)
+    assert np.array_equal(cycle(data), reference)
+    assert np.array_equal(cycle(twin), reference)
+    assert not np.array_equal(later, reference)
+
+    fresh = mujoco.MjData(model)
+    mujoco.mj_resetData(model, data)
+    for d in (fresh, data):
+        d.ctrl[:] = (4.5e5, 2.5e5)
+    assert np.array_equal(cycle(fresh), cycle(data))
+
+
+# ---------------------------------------------------------------- errors name their cause
+
+ERRORS = [
+    ({"fmu": "/nonexistent/Muscle.fmu"}, "cannot read FMU '/nonexistent/Muscle.fmu'"),
+    ({"length_input": "lenght"}, "has no variable 'lenght'"),
+    ({"force_output": "pressure"}, "'pressure' must be a Real output"),
+    ({"parameters": "preset=99"}, "preset refused"),
+    ({"parameters": "preset=DMSP-99"}, "preset name (none, A, B, C, D, DMSP-10, DMSP-40)"),
+    ({"parameters": "turnz=3"}, "parameter 'turnz': McKibbenMuscle has no such variable"),
+    ({"parameters": "force=3"}, "'force' is an output, not a parameter or input"),
+    ({"parameters": "friction=maybe"}, "'friction' = 'maybe' is not true or false"),
+    ({"force_scale": "fast"}, "'force_scale' = 'fast' is not a finite number"),
+]
+
+
+@pytest.mark.parametrize("config,message", ERRORS, ids=[m for _, m in ERRORS])
+def test_configuration_errors_name_the_cause(config, message):
+    arm.load_plugin()
+    xml = arm.arm_xml()
+    for key, value in config.items():
+        xml = arm._set_config(xml, "flexor", key, value)
+    with pytest.raises(Exception) as error:
+        mujoco.MjModel.from_xml_string(xml)
+    assert "actuator_fmus.fmu" in str(error.value)
+    assert message in str(error.value)
+
+
+def test_an_fmu_error_during_a_step_is_a_mujoco_error():
+    """out_of_range_policy=2: the FMU discards a step at a length beyond the muscle's range."""
+    arm.load_plugin()
+    xml = arm._set_config(arm.arm_xml(arm.DMSP10 + " out_of_range_policy=2"), "flexor",
+                          "length_offset", "0.5")
+    with pytest.raises(Exception) as error:
+        # MuJoCo's compiler already steps the model once, so the error may come from there.
+        model = mujoco.MjModel.from_xml_string(xml)
+        mujoco.mj_step(model, mujoco.MjData(model))
+    text = str(error.value)
+    assert "actuator 'flexor'" in text and "fmi2DoStep returned fmi2Discard" in text
+    assert "valid lengths" in text  # the FMU's own log line
