@@ -47,6 +47,9 @@ impl Actuator {
     /// The FMU state's size after initialization with the configured parameters, plus room for
     /// it to grow: how much `plugin_state` the instance asks MuJoCo for.
     pub fn probe_state_words(config: &Config) -> Result<usize, String> {
+        if !config.carry_history {
+            return Ok(HEADER);
+        }
         let mut instance = Instance::new(config.fmu.clone(), "probe")?;
         let values: Vec<_> = config
             .parameters
@@ -119,6 +122,26 @@ impl Actuator {
         })
     }
 
+    /// For a copied mjData whose history is not in plugin_state: continues from `source`'s FMU
+    /// state, handed over as bytes (once per copy, not per step).
+    pub unsafe fn adopt(
+        &mut self,
+        m: *const MjModel,
+        d: *mut MjData,
+        source: &mut Actuator,
+    ) -> Result<(), String> {
+        if self.config.carry_history {
+            return Ok(());
+        }
+        let mut bytes = vec![0u8; 1 << 24];
+        let count = source.instance.save(&mut bytes)?;
+        self.instance.restore(&bytes[..count])?;
+        self.time = source.time;
+        let state = self.state(m, d);
+        self.shadow.copy_from_slice(state);
+        Ok(())
+    }
+
     /// Forgets what this instance last wrote: the next callback continues from plugin_state (a
     /// copied mjData's state, for one).
     pub fn resync(&mut self) {
@@ -174,10 +197,18 @@ impl Actuator {
         if unchanged {
             return Ok(());
         }
-        let count = state[2];
-        if state[0] == 0.0 || count == 0.0 {
+        if state[0] == 0.0 {
             return self.start(m, d);
         }
+        if !self.config.carry_history {
+            return Err(
+                "plugin_state was set to another moment (mj_setState?), but with \
+                        history=\"fmu\" the FMU's history is not in plugin_state: use \
+                        history=\"plugin_state\""
+                    .into(),
+            );
+        }
+        let count = state[2];
         let time = state[1];
         let valid = count.fract() == 0.0 && count > 0.0 && (count as usize) <= self.bytes.len();
         if !valid || !time.is_finite() {
@@ -226,6 +257,13 @@ impl Actuator {
 
     /// Writes the FMU's state into plugin_state (and the shadow copy).
     unsafe fn capture(&mut self, m: *const MjModel, d: *mut MjData) -> Result<(), String> {
+        if !self.config.carry_history {
+            let state = self.state(m, d);
+            state[0] = 1.0;
+            state[1] = self.time;
+            self.shadow.copy_from_slice(state);
+            return Ok(());
+        }
         let count = self.instance.save(&mut self.bytes)?;
         let state = self.state(m, d);
         state[0] = 1.0;

@@ -5,7 +5,7 @@ use std::ffi::CString;
 use std::sync::Arc;
 
 /// The `<config key=...>` names the plugin accepts (MuJoCo refuses any other key at compile time).
-pub const ATTRIBUTES: [&str; 9] = [
+pub const ATTRIBUTES: [&str; 10] = [
     "fmu",
     "parameters",
     "length_input",
@@ -15,6 +15,7 @@ pub const ATTRIBUTES: [&str; 9] = [
     "force_scale",
     "length_offset",
     "state_bytes",
+    "history",
 ];
 
 /// Preset names for the `preset` parameter of this project's FMUs (model, names by value).
@@ -60,6 +61,10 @@ pub struct Config {
     pub force_scale: f64,
     pub length_offset: f64,
     pub state_bytes: Option<usize>,
+    /// Whether the FMU's history is written to plugin_state after every step (`history`
+    /// "plugin_state", the default) or stays inside the FMU instance ("fmu": faster, but
+    /// mj_setState cannot move it).
+    pub carry_history: bool,
 }
 
 fn number(key: &str, text: &str, default: f64) -> Result<f64, String> {
@@ -197,7 +202,17 @@ impl Config {
                     })?,
             )
         };
+        let carry_history = match attribute("history").trim() {
+            "" | "plugin_state" => true,
+            "fmu" => false,
+            other => {
+                return Err(format!(
+                    "attribute 'history' = '{other}' is neither plugin_state nor fmu"
+                ))
+            }
+        };
         Ok(Self {
+            carry_history,
             parameters: parameters(&fmu, &attribute("parameters"))?,
             length: mapped(&fmu, "length_input", &attribute("length_input"), "input")?,
             velocity: mapped(

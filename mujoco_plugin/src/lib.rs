@@ -128,16 +128,22 @@ unsafe extern "C-unwind" fn destroy(d: *mut MjData, instance: i32) {
 unsafe extern "C-unwind" fn copy(
     dest: *mut MjData,
     m: *const MjModel,
-    _src: *const MjData,
+    src: *const MjData,
     instance: i32,
 ) {
     let done = guarded(&instance_label(instance), || {
         let slot = mj::plugin_data(dest).add(instance as usize);
-        if let Some(actuator) = (*slot as *mut Actuator).as_mut() {
-            actuator.resync();
-        } else {
+        if (*slot as *mut Actuator).is_null() {
             let actuator = Actuator::new(m, instance, read_config(m, instance)?)?;
             *slot = Box::into_raw(Box::new(actuator)) as usize;
+        }
+        let copy = &mut *(*slot as *mut Actuator);
+        // MuJoCo copied plugin_state; the copy continues from it, or from the source's FMU when
+        // the history stays in the FMU (history="fmu").
+        copy.resync();
+        let source = *mj::plugin_data(src).add(instance as usize) as *mut Actuator;
+        if let Some(source) = source.as_mut().filter(|s| !std::ptr::eq(*s, copy)) {
+            copy.adopt(m, dest, source)?;
         }
         Ok(())
     });
