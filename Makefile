@@ -218,11 +218,13 @@ mujoco-plugin: $(MUJOCO_PLUGIN)
 mujoco-arm: fmus $(MUJOCO_PLUGIN)
 	$(PY) examples/mujoco_arm.py --out out/mujoco
 
-## docs/mujoco.md's figures: the arm, the plugin against MuJoCo's <muscle> fitted at one pressure,
-## and the real-time factors (docs/img/mujoco_*.png, docs/mujoco/results.md).
+## docs/mujoco.md's figures (the arm, rendered if EGL or OSMesa works) and docs/mujoco-comparison.md:
+## the plugin against MuJoCo's <muscle> fitted at one pressure, and the cost per step.
 mujoco-docs: fmus $(MUJOCO_PLUGIN)
-	$(PY) examples/mujoco_arm.py --out docs/img --prefix mujoco_ --gif
-	$(PY) examples/mujoco_vs_native_muscle.py --out docs/img --report docs/mujoco/results.md
+	$(PY) examples/mujoco_arm.py --out out/mujoco --gif
+	cp out/mujoco/arm.png docs/img/mujoco_arm.png
+	if [ -f out/mujoco/arm.gif ]; then cp out/mujoco/arm.gif docs/img/mujoco_arm.gif; fi
+	$(PY) examples/mujoco_vs_native_muscle.py --out docs/img --report docs/mujoco-comparison.md
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).

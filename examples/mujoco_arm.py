@@ -4,8 +4,8 @@ angle, with external torque pulses that show the stiffness. The model is example
 
     .venv/bin/python examples/mujoco_arm.py --out out/mujoco      (make mujoco-arm)
 
-Writes <out>/<prefix>arm.csv (time, angle, muscle lengths, forces, pressures, external torque),
-<prefix>arm.png, and with --gif a rendered <prefix>arm.gif when offscreen rendering works
+Writes <out>/arm.csv (time, angle, muscle lengths, forces, pressures, external torque),
+arm.png, and with --gif a rendered arm.gif when offscreen rendering works
 (MUJOCO_GL=egl, else osmesa). Importable: tests/fmpy/test_mujoco.py and
 examples/mujoco_vs_native_muscle.py build their models with `arm_model`.
 
@@ -147,7 +147,7 @@ COLUMNS = ["time_s", "angle_rad", "angle_ref_rad", "flexor_length_m", "extensor_
            "external_torque_Nm"]
 
 
-def run_task(model, duration=6.5, record_every=10, frames=None, fps=25):
+def run_task(model, duration=6.5, record_every=10, frames=None, fps=12.5):
     """The arm task; rows of COLUMNS every `record_every` steps, and rendered frames if asked."""
     import mujoco
 
@@ -184,8 +184,8 @@ def _camera():
     import mujoco
 
     cam = mujoco.MjvCamera()
-    cam.lookat[:] = (0.08, 0.0, 0.05)
-    cam.distance, cam.azimuth, cam.elevation = 0.9, 90.0, -5.0
+    cam.lookat[:] = (0.1, 0.0, 0.06)
+    cam.distance, cam.azimuth, cam.elevation = 0.75, 90.0, -5.0
     return cam
 
 
@@ -194,7 +194,7 @@ def _renderer(model):
     import mujoco
 
     try:
-        return mujoco.Renderer(model, 360, 480)
+        return mujoco.Renderer(model, 240, 320)
     except Exception as error:  # no EGL/OSMesa context: render nothing
         print(f"offscreen rendering unavailable ({error}); no GIF")
         return None
@@ -258,7 +258,6 @@ def pulse_stiffness(rows):
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default="out/mujoco")
-    parser.add_argument("--prefix", default="")
     parser.add_argument("--gif", action="store_true", help="render a GIF (needs EGL or OSMesa)")
     args = parser.parse_args()
     out = pathlib.Path(args.out)
@@ -270,8 +269,8 @@ def main():
     start = time.perf_counter()
     rows = run_task(model, frames=frames)
     wall = time.perf_counter() - start
-    write_csv(rows, out / f"{args.prefix}arm.csv")
-    plot(rows, out / f"{args.prefix}arm.png")
+    write_csv(rows, out / f"arm.csv")
+    plot(rows, out / f"arm.png")
     soft, stiff = pulse_stiffness(rows)
     print(f"simulated {rows[-1, 0]:.2f} s in {wall:.2f} s wall (recording included)")
     print(f"angle at 3.4 s: {rows[np.searchsorted(rows[:, 0], 3.4), 1]:.4f} rad (reference {Q_TARGET})")
@@ -281,10 +280,10 @@ def main():
         from PIL import Image
 
         images = [Image.fromarray(f) for f in frames]
-        images[0].save(out / f"{args.prefix}arm.gif", save_all=True, append_images=images[1:],
-                       duration=40, loop=0)
-        print(f"wrote {out / (args.prefix + 'arm.gif')} ({len(images)} frames)")
-    print(f"wrote {out / (args.prefix + 'arm.csv')} and {out / (args.prefix + 'arm.png')}")
+        images[0].save(out / f"arm.gif", save_all=True, append_images=images[1:],
+                       duration=round(1000 / 12.5), loop=0)
+        print(f"wrote {out / 'arm.gif'} ({len(images)} frames)")
+    print(f"wrote {out / 'arm.csv'} and {out / 'arm.png'}")
 
 
 if __name__ == "__main__":

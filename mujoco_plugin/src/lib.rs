@@ -37,23 +37,24 @@ use std::panic::{catch_unwind, AssertUnwindSafe};
 /// The name MJCF uses: `<plugin plugin="actuator_fmus.fmu" .../>`.
 pub const PLUGIN_NAME: &str = "actuator_fmus.fmu";
 
-/// Runs `body`; a returned error or a panic becomes a message for MuJoCo. The result holds
-/// nothing to drop, so the caller can raise it from a frame MuJoCo's handler may leave abruptly.
+/// Runs `body` for plugin instance `instance`; a returned error or a panic becomes a message for
+/// MuJoCo. The result holds nothing to drop, so the caller can raise it from a frame MuJoCo's
+/// handler may leave abruptly. Nothing is allocated unless something failed.
 fn guarded<T>(
-    what: &str,
+    instance: i32,
     body: impl FnOnce() -> Result<T, String>,
 ) -> Result<T, [u8; mj::MESSAGE_BYTES]> {
     let outcome = catch_unwind(AssertUnwindSafe(body));
     let text = match outcome {
         Ok(Ok(value)) => return Ok(value),
-        Ok(Err(reason)) => format!("{PLUGIN_NAME}: {what}: {reason}"),
+        Ok(Err(reason)) => format!("{PLUGIN_NAME}: plugin instance {instance}: {reason}"),
         Err(panic) => {
             let detail = panic
                 .downcast_ref::<&str>()
                 .map(|s| s.to_string())
                 .or_else(|| panic.downcast_ref::<String>().cloned())
                 .unwrap_or_default();
-            format!("{PLUGIN_NAME}: {what}: internal error (panic: {detail})")
+            format!("{PLUGIN_NAME}: plugin instance {instance}: internal error (panic: {detail})")
         }
     };
     Err(mj::message(&text))
@@ -67,11 +68,6 @@ unsafe fn read_config(m: *const MjModel, instance: i32) -> Result<Config, String
     })
 }
 
-/// Describes plugin instance `instance` for messages before its actuator is known.
-fn instance_label(instance: i32) -> String {
-    format!("plugin instance {instance}")
-}
-
 unsafe fn actuator<'a>(d: *mut MjData, instance: i32) -> Result<&'a mut Actuator, String> {
     let ptr = *mj::plugin_data(d).add(instance as usize) as *mut Actuator;
     ptr.as_mut()
@@ -79,7 +75,7 @@ unsafe fn actuator<'a>(d: *mut MjData, instance: i32) -> Result<&'a mut Actuator
 }
 
 unsafe extern "C-unwind" fn nstate(m: *const MjModel, instance: i32) -> i32 {
-    let words = guarded(&instance_label(instance), || {
+    let words = guarded(instance, || {
         let config = read_config(m, instance)?;
         let words = Actuator::probe_state_words(&config)?;
         i32::try_from(words).map_err(|_| "state too large".to_string())
@@ -94,7 +90,7 @@ unsafe extern "C-unwind" fn nstate(m: *const MjModel, instance: i32) -> i32 {
 }
 
 unsafe extern "C-unwind" fn init(m: *const MjModel, d: *mut MjData, instance: i32) -> i32 {
-    let made = guarded(&instance_label(instance), || {
+    let made = guarded(instance, || {
         let config = read_config(m, instance)?;
         let actuator = Actuator::new(m, instance, config)?;
         let (adr, words) = mj::state_span(m, instance);
@@ -131,7 +127,7 @@ unsafe extern "C-unwind" fn copy(
     src: *const MjData,
     instance: i32,
 ) {
-    let done = guarded(&instance_label(instance), || {
+    let done = guarded(instance, || {
         let slot = mj::plugin_data(dest).add(instance as usize);
         if (*slot as *mut Actuator).is_null() {
             let actuator = Actuator::new(m, instance, read_config(m, instance)?)?;
@@ -176,7 +172,7 @@ enum Phase {
 }
 
 unsafe fn run(m: *const MjModel, d: *mut MjData, instance: i32, phase: Phase) {
-    let done = guarded(&instance_label(instance), || {
+    let done = guarded(instance, || {
         let actuator = actuator(d, instance)?;
         let result = match phase {
             Phase::Compute => actuator.compute(m, d),

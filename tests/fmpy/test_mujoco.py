@@ -7,7 +7,9 @@ MuJoCo's state functions (history carried in plugin_state)."""
 
 import copy
 import math
+import os
 import pathlib
+import subprocess
 import sys
 
 import mujoco
@@ -318,6 +320,65 @@ def test_a_copy_continues_the_source_when_the_history_stays_in_the_fmu():
             out.append(d.actuator_force.copy())
         forces.append(np.array(out))
     assert np.array_equal(forces[0], forces[1])
+
+
+# ---------------------------------------------------------------- no allocation per step
+
+COUNTING_MALLOC = r"""
+#include <stddef.h>
+extern void* __libc_malloc(size_t);
+extern void* __libc_calloc(size_t, size_t);
+extern void* __libc_realloc(void*, size_t);
+extern void* __libc_memalign(size_t, size_t);
+static unsigned long n;
+unsigned long counted_allocations(void) { return n; }
+#define COUNT __atomic_add_fetch(&n, 1, __ATOMIC_RELAXED)
+void* malloc(size_t s) { COUNT; return __libc_malloc(s); }
+void* calloc(size_t a, size_t b) { COUNT; return __libc_calloc(a, b); }
+void* realloc(void* p, size_t s) { COUNT; return __libc_realloc(p, s); }
+void* memalign(size_t a, size_t s) { COUNT; return __libc_memalign(a, s); }
+void* aligned_alloc(size_t a, size_t s) { COUNT; return __libc_memalign(a, s); }
+int posix_memalign(void** p, size_t a, size_t s) { COUNT; *p = __libc_memalign(a, s); return *p ? 0 : 12; }
+"""
+
+ALLOCATIONS_PER_STEP = r"""
+import ctypes, math, sys
+sys.path.insert(0, sys.argv[1])
+import mujoco, mujoco_arm as arm
+count = ctypes.CDLL(None).counted_allocations
+count.restype = ctypes.c_ulong
+model = arm.arm_model(arm.DMSP10 + " friction=true", extra={"history": sys.argv[2]})
+data = mujoco.MjData(model)
+def run(steps):
+    for k in range(steps):
+        data.ctrl[0] = 3.5e5 + 1e5 * math.sin(k / 100)
+        data.ctrl[1] = 3.5e5 - 1e5 * math.sin(k / 100)
+        mujoco.mj_step(model, data)
+run(200)
+before = count()
+run(1000)
+print((count() - before) / 1000)
+"""
+
+
+@pytest.mark.parametrize("history", ["fmu", "plugin_state"])
+def test_a_step_allocates_nothing_in_the_plugin(tmp_path, history):
+    """malloc counted under LD_PRELOAD over 1000 steps of the moving arm. With history="fmu"
+    nothing allocates (plugin and FMU); with the history in plugin_state only the FMU's
+    fmi2GetFMUstate/fmi2SerializeFMUstate do (the plugin's part is the same code as above)."""
+    library = tmp_path / "libcount.so"
+    (tmp_path / "count.c").write_text(COUNTING_MALLOC)
+    subprocess.run(["cc", "-O2", "-shared", "-fPIC", "-o", str(library), str(tmp_path / "count.c")],
+                   check=True)
+    run = subprocess.run([sys.executable, "-c", ALLOCATIONS_PER_STEP, str(ROOT / "examples"),
+                          history], env={**os.environ, "LD_PRELOAD": str(library)},
+                         capture_output=True, text=True, cwd=ROOT, timeout=300)
+    assert run.returncode == 0, run.stderr
+    per_step = float(run.stdout.split()[-1])
+    if history == "fmu":
+        assert per_step == 0.0
+    else:
+        assert per_step > 0.0  # the counter works: the FMU's state saving allocates
 
 
 # ---------------------------------------------------------------- errors name their cause
