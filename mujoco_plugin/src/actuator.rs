@@ -57,8 +57,7 @@ impl Actuator {
             .map(|(v, x)| (v, x.clone()))
             .collect();
         instance.initialize(&values, false)?;
-        let mut scratch = vec![0u8; 1 << 24];
-        let size = instance.save(&mut scratch)?;
+        let size = instance.save_to_vec()?.len();
         let capacity = config.state_bytes.unwrap_or(size + size / 2 + 64);
         Ok(state_words(capacity))
     }
@@ -133,9 +132,8 @@ impl Actuator {
         if self.config.carry_history {
             return Ok(());
         }
-        let mut bytes = vec![0u8; 1 << 24];
-        let count = source.instance.save(&mut bytes)?;
-        self.instance.restore(&bytes[..count])?;
+        let bytes = source.instance.save_to_vec()?;
+        self.instance.restore(&bytes)?;
         self.time = source.time;
         let state = self.state(m, d);
         self.shadow.copy_from_slice(state);

@@ -443,10 +443,6 @@ impl Instance {
         })
     }
 
-    pub fn fmu(&self) -> &Fmu {
-        &self.fmu
-    }
-
     /// fmi2OK and fmi2Warning pass; anything else is an error naming the call and the FMU's log.
     fn check(&self, call: &str, status: c_int) -> Result<(), String> {
         if status == OK || status == WARNING {
@@ -559,6 +555,25 @@ impl Instance {
             )?;
         }
         Ok(size)
+    }
+
+    /// The instance's state serialized into a new buffer of exactly its size (not per step).
+    pub fn save_to_vec(&mut self) -> Result<Vec<u8>, String> {
+        let f = &self.fmu.functions;
+        let mut size = 0usize;
+        // SAFETY: as in `save`.
+        unsafe {
+            let status = (f.get_fmu_state)(self.component, &mut self.state);
+            self.check("fmi2GetFMUstate", status)?;
+            self.check(
+                "fmi2SerializedFMUstateSize",
+                (f.serialized_size)(self.component, self.state, &mut size),
+            )?;
+        }
+        let mut bytes = vec![0u8; size];
+        let count = self.save(&mut bytes)?;
+        bytes.truncate(count);
+        Ok(bytes)
     }
 
     /// Continues from serialized `bytes` (fmi2DeSerializeFMUstate, then fmi2SetFMUstate).

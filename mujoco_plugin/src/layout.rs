@@ -28,6 +28,7 @@ pub mod data {
 }
 
 /// `(struct, field, offset)` for each constant above, as build.rs checks them.
+#[allow(dead_code)] // read by build.rs
 pub const CHECKED_OFFSETS: &[(&str, &str, usize)] = &[
     ("mjModel", "nu", model::NU),
     ("mjModel", "opt.timestep", model::OPT_TIMESTEP),
@@ -80,6 +81,7 @@ pub struct MjpPlugin {
 }
 
 /// `(field, offset)` of MjpPlugin checked against `offsetof(mjpPlugin, field)`.
+#[allow(dead_code)] // read by build.rs
 pub fn plugin_offsets() -> [(&'static str, usize); 6] {
     [
         ("nstate", core::mem::offset_of!(MjpPlugin, nstate)),

@@ -21,10 +21,10 @@
 //! FMU state into `plugin_state` (src/actuator.rs). Every failure is a MuJoCo error naming the
 //! actuator and the cause; no panic crosses into MuJoCo.
 
-pub mod actuator;
-pub mod config;
-pub mod fmu;
-pub mod layout;
+mod actuator;
+mod config;
+mod fmu;
+mod layout;
 mod mujoco;
 
 use actuator::Actuator;
@@ -39,7 +39,9 @@ pub const PLUGIN_NAME: &str = "actuator_fmus.fmu";
 
 /// Runs `body` for plugin instance `instance`; a returned error or a panic becomes a message for
 /// MuJoCo. The result holds nothing to drop, so the caller can raise it from a frame MuJoCo's
-/// handler may leave abruptly. Nothing is allocated unless something failed.
+/// handler may leave abruptly (hence the fixed-size error). Nothing is allocated unless something
+/// failed.
+#[allow(clippy::result_large_err)]
 fn guarded<T>(
     instance: i32,
     body: impl FnOnce() -> Result<T, String>,

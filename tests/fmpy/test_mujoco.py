@@ -9,6 +9,7 @@ import copy
 import math
 import os
 import pathlib
+import re
 import subprocess
 import sys
 
@@ -407,6 +408,26 @@ def test_configuration_errors_name_the_cause(config, message):
         mujoco.MjModel.from_xml_string(xml)
     assert "actuator_fmus.fmu" in str(error.value)
     assert message in str(error.value)
+
+
+def test_one_plugin_instance_for_two_actuators_is_refused():
+    """Each actuator needs its own FMU instance: a shared <instance> is an error, not two
+    actuators writing one FMU's force."""
+    arm.load_plugin()
+    xml = arm.arm_xml()
+    actuators = re.search(r"<actuator>.*</actuator>", xml, re.S).group(0)
+    shared = f"""<extension><plugin plugin="actuator_fmus.fmu"><instance name="shared">
+      <config key="fmu" value="{fmu_path('McKibbenMuscle')}"/>
+      <config key="parameters" value="{arm.DMSP10}"/>
+      <config key="length_input" value="length"/><config key="ctrl_input" value="pressure"/>
+    </instance></plugin></extension>"""
+    xml = re.sub(r"<extension>.*?</extension>", shared, xml, flags=re.S)
+    xml = xml.replace(actuators, """<actuator>
+      <plugin name="flexor" instance="shared" tendon="flexor"/>
+      <plugin name="extensor" instance="shared" tendon="extensor"/></actuator>""")
+    with pytest.raises(Exception, match="2 actuators share one plugin instance"):
+        model = mujoco.MjModel.from_xml_string(xml)
+        mujoco.MjData(model)
 
 
 def test_an_fmu_error_during_a_step_is_a_mujoco_error():
