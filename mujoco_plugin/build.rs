@@ -119,6 +119,8 @@ fn main() {
     println!("cargo:rustc-link-search=native={}", dir.display());
     println!("cargo:rustc-link-lib=dylib:+verbatim={lib}");
     // rust-lang/rust#91979: a cdylib unloaded while thread-local destructors are registered
-    // crashes at thread exit; never unload.
-    println!("cargo:rustc-cdylib-link-arg=-Wl,-z,nodelete");
+    // crashes at thread exit; never unload (an ELF linker flag).
+    if std::env::var("CARGO_CFG_TARGET_OS").as_deref() == Ok("linux") {
+        println!("cargo:rustc-cdylib-link-arg=-Wl,-z,nodelete");
+    }
 }
