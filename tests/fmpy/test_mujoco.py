@@ -123,6 +123,32 @@ def test_plugin_force_is_the_fmu_stepped_with_mujocos_inputs(model_name, paramet
     np.testing.assert_allclose(plugin, forces, rtol=1e-12, atol=1e-9)
 
 
+def test_any_fmu_that_fits_the_mapping_pass_through_as_a_damper():
+    """PassThrough (y = u) with u <- actuator velocity and force = -3 y on a free 2 kg slider: a
+    viscous damper, so Euler's velocity follows v_k = v_0 (1 - h c / m)^k exactly."""
+    arm.load_plugin()
+    xml = f"""<mujoco><option timestep="0.001" gravity="0 0 0"/>
+      <extension><plugin plugin="actuator_fmus.fmu"/></extension>
+      <worldbody><body><joint name="x" type="slide" axis="1 0 0"/>
+        <geom type="sphere" size="0.05" mass="2"/></body></worldbody>
+      <actuator><plugin name="damper" plugin="actuator_fmus.fmu" joint="x">
+        <config key="fmu" value="{fmu_path('PassThrough')}"/>
+        <config key="velocity_input" value="u"/><config key="force_output" value="y"/>
+        <config key="force_scale" value="-3"/>
+      </plugin></actuator></mujoco>"""
+    model = mujoco.MjModel.from_xml_string(xml)
+    data = mujoco.MjData(model)
+    data.qvel[0] = 1.5
+    velocities = []
+    for _ in range(1000):
+        mujoco.mj_step(model, data)
+        velocities.append(data.qvel[0])
+    k = np.arange(1, 1001)
+    np.testing.assert_allclose(velocities, 1.5 * (1 - 1e-3 * 3 / 2) ** k, rtol=1e-12)
+    # The continuous law, within Euler's first-order error (N h^2 a^2 / 2 = 1.1e-3).
+    assert velocities[-1] == pytest.approx(1.5 * math.exp(-1.5), rel=2e-3)
+
+
 # ---------------------------------------------------------------- the arm: statics
 
 def settle(parameters=arm.DMSP10, pressures=(4e5, 3e5), torque=0.0, seconds=3.0, q0=0.0):
