@@ -349,6 +349,24 @@ def test_a_copy_continues_the_source_when_the_history_stays_in_the_fmu():
     assert np.array_equal(forces[0], forces[1])
 
 
+@pytest.mark.parametrize("damage", ["flip a byte", "NaN count", "huge count"])
+def test_a_corrupted_plugin_state_is_an_error_not_a_crash(damage):
+    model = arm.arm_model(arm.DMSP10 + " friction=true")
+    data = mujoco.MjData(model)
+    data.ctrl[:] = (4e5, 3e5)
+    for _ in range(10):
+        mujoco.mj_step(model, data)
+    start = model.plugin_stateadr[0]
+    if damage == "flip a byte":
+        data.plugin_state[start + 20] += 1.0  # the FMU's checksum catches it
+    elif damage == "NaN count":
+        data.plugin_state[start + 2] = float("nan")
+    else:
+        data.plugin_state[start + 2] = 1e12
+    with pytest.raises(Exception, match="actuator 'flexor'.*plugin_state"):
+        mujoco.mj_step(model, data)
+
+
 # ---------------------------------------------------------------- no allocation per step
 
 COUNTING_MALLOC = r"""
