@@ -25,6 +25,7 @@ mod actuator;
 mod config;
 mod fmu;
 mod layout;
+mod model_description;
 mod mujoco;
 
 use actuator::Actuator;
