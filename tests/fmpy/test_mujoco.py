@@ -310,6 +310,35 @@ def test_friction_history_is_carried_in_plugin_state():
     assert np.array_equal(cycle(fresh), cycle(data))
 
 
+def test_threaded_rollout_equals_stepping_one_by_one():
+    """mujoco.rollout on two threads (two mjData, FMU instances each) from four initial states:
+    the same full-physics states, plugin_state included, as mj_setState + mj_step here."""
+    from mujoco import rollout
+
+    model = arm.arm_model(arm.DMSP10 + " friction=true")
+    spec = mujoco.mjtState.mjSTATE_FULLPHYSICS
+    size = mujoco.mj_stateSize(model, spec)
+    data = mujoco.MjData(model)
+    initial = []
+    for q in (0.0, 0.1, -0.1, 0.2):
+        mujoco.mj_resetData(model, data)
+        data.qpos[0] = q
+        initial.append(np.empty(size))
+        mujoco.mj_getState(model, data, initial[-1], spec)
+    initial = np.array(initial)
+    control = np.tile([4e5, 3e5], (4, 300, 1))
+    threaded, _ = rollout.rollout(model, [mujoco.MjData(model) for _ in range(2)], initial,
+                                  control)
+    for i in range(4):
+        mujoco.mj_setState(model, data, initial[i], spec)
+        for k in range(300):
+            data.ctrl[:] = control[i, k]
+            mujoco.mj_step(model, data)
+            state = np.empty(size)
+            mujoco.mj_getState(model, data, state, spec)
+            assert np.array_equal(state, threaded[i, k]), (i, k)
+
+
 def test_history_kept_in_the_fmu_is_the_same_physics_and_refuses_foreign_states():
     """history="fmu": nothing serialized per step; same trajectory, copies and resets work, and
     mj_setState to another moment is an error that names the option (never a silent restart)."""
