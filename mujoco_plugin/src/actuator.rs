@@ -136,7 +136,11 @@ impl Actuator {
         self.instance.restore(&bytes)?;
         self.time = source.time;
         let state = self.state(m, d);
-        self.shadow.copy_from_slice(state);
+        if state[0] != 0.0 {
+            // Started: continue from the source's FMU. Not started: start at the first
+            // evaluation, as the source will.
+            self.shadow.copy_from_slice(state);
+        }
         Ok(())
     }
 
