@@ -35,6 +35,7 @@ HANG = 0.2375  # m, muscle length at q = 0
 NOMINAL_LENGTH = 0.25  # m, DMSP-10
 MAX_PRESSURE = 600e3  # Pa, ctrlrange
 DMSP10 = "preset=DMSP-10 nominal_length=0.25"
+LENGTH_OFFSET = -0.04695523289953723  # m, arm.xml's length_offset: muscle = tendon + offset
 
 _loaded = False
 
@@ -84,13 +85,6 @@ def arm_model(*args, **kwargs):
 
     load_plugin()
     return mujoco.MjModel.from_xml_string(arm_xml(*args, **kwargs))
-
-
-def gravity_moment(model):
-    """m g l of the forearm about the elbow (N m): gravity's torque is -m g l cos q."""
-    forearm = model.body("forearm").id
-    # Every forearm geom lies on the body's x axis: its centre of mass is at x = l when q = 0.
-    return -model.opt.gravity[2] * model.body_mass[forearm] * model.body_ipos[forearm][0]
 
 
 def minimum_jerk(t, t0, t1, q0, q1):
@@ -154,7 +148,7 @@ def run_task(model, duration=6.5, record_every=10, frames=None, fps=12.5):
     data = mujoco.MjData(model)
     controller = Controller()
     dt = model.opt.timestep
-    offset = float(LENGTH_OFFSET)
+    offset = LENGTH_OFFSET
     rows = []
     renderer = frames is not None and _renderer(model)
     next_frame = 0.0
@@ -175,9 +169,6 @@ def run_task(model, duration=6.5, record_every=10, frames=None, fps=12.5):
             next_frame += 1.0 / fps
         mujoco.mj_step(model, data)
     return np.array(rows)
-
-
-LENGTH_OFFSET = -0.04695523289953723  # arm.xml's length_offset (m)
 
 
 def _camera():
