@@ -221,8 +221,9 @@ mujoco-arm: fmus $(MUJOCO_PLUGIN)
 ## docs/mujoco.md's figures (the arm, rendered if EGL or OSMesa works) and docs/mujoco-comparison.md:
 ## the plugin against MuJoCo's <muscle> fitted at one pressure, and the cost per step.
 mujoco-docs: fmus $(MUJOCO_PLUGIN)
-	$(PY) examples/mujoco_arm.py --out out/mujoco --gif
+	$(PY) examples/mujoco_arm.py --out out/mujoco --gif --stiffness
 	cp out/mujoco/arm.png docs/img/mujoco_arm.png
+	cp out/mujoco/arm_stiffness.png docs/img/mujoco_stiffness.png
 	if [ -f out/mujoco/arm.gif ]; then cp out/mujoco/arm.gif docs/img/mujoco_arm.gif; fi
 	$(PY) examples/mujoco_vs_native_muscle.py --out docs/img --report docs/mujoco-comparison.md
 

@@ -246,10 +246,69 @@ def pulse_stiffness(rows):
     return result
 
 
+def stiffness_sweep(commons=np.linspace(250e3, 550e3, 7), difference=100e3, dtau=0.02):
+    """Joint stiffness over co-contraction at a fixed pressure difference: measured in MuJoCo by
+    +-dtau torque perturbations about the equilibrium, and predicted from the FMU's own
+    `stiffness` output, k = r^2 (k_flexor + k_extensor) - m g l sin q.
+    Rows: (common-mode Pa, angle rad, measured N m/rad, predicted N m/rad)."""
+    import mujoco
+    import sys
+
+    sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
+    from conftest import Slave
+
+    fmu = Slave("McKibbenMuscle", preset=5, nominal_length=0.25)
+    model = arm_model()
+    forearm = model.body("forearm").id
+    mgl = -model.opt.gravity[2] * model.body_mass[forearm] * model.body_ipos[forearm][0]
+
+    def rest(pressures, torque):
+        data = mujoco.MjData(model)
+        data.ctrl[:] = pressures
+        data.qfrc_applied[0] = torque
+        for _ in range(3000):
+            mujoco.mj_step(model, data)
+        return data.qpos[0]
+
+    rows = []
+    for common in commons:
+        pressures = (common + difference / 2, common - difference / 2)
+        q = rest(pressures, 0.0)
+        measured = 2 * dtau / (rest(pressures, dtau) - rest(pressures, -dtau))
+        lf, le = HANG - PULLEY_RADIUS * q, HANG + PULLEY_RADIUS * q
+        k = (fmu.at("stiffness", length=lf, pressure=pressures[0])
+             + fmu.at("stiffness", length=le, pressure=pressures[1]))
+        rows.append((common, q, measured, PULLEY_RADIUS ** 2 * k - mgl * math.sin(q)))
+        print(f"  common mode {common / 1e3:.0f} kPa: q = {q:.4f} rad, k = {measured:.4f} "
+              f"(predicted {rows[-1][3]:.4f}) N m/rad")
+    return np.array(rows)
+
+
+def plot_stiffness(rows, path):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    ax.plot(rows[:, 0] / 1e3, rows[:, 3], "k-", label="from the FMU's stiffness outputs (N m/rad)")
+    ax.plot(rows[:, 0] / 1e3, rows[:, 2], "o", label="measured in MuJoCo, +-0.02 N m (N m/rad)")
+    ax.set_xlabel("common-mode pressure (kPa), flexor - extensor = 100 kPa")
+    ax.set_ylabel("joint stiffness (N m/rad)")
+    ax.set_title("Elbow stiffness over co-contraction: r^2 (k_flexor + k_extensor) - m g l sin q")
+    ax.grid(alpha=0.3)
+    ax.legend()
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+
+
 def main():
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--out", default="out/mujoco")
     parser.add_argument("--gif", action="store_true", help="render a GIF (needs EGL or OSMesa)")
+    parser.add_argument("--stiffness", action="store_true",
+                        help="also sweep the co-contraction: arm_stiffness.png")
     args = parser.parse_args()
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
@@ -275,6 +334,12 @@ def main():
                        duration=round(1000 / 12.5), loop=0)
         print(f"wrote {out / 'arm.gif'} ({len(images)} frames)")
     print(f"wrote {out / 'arm.csv'} and {out / 'arm.png'}")
+    if args.stiffness:
+        print("joint stiffness over co-contraction ...")
+        rows = stiffness_sweep()
+        plot_stiffness(rows, out / "arm_stiffness.png")
+        worst = np.max(np.abs(rows[:, 2] / rows[:, 3] - 1))
+        print(f"largest relative difference {worst:.1e}; wrote {out / 'arm_stiffness.png'}")
 
 
 if __name__ == "__main__":
