@@ -244,13 +244,25 @@ def loop_width(cycle, pressure=3.75e5):
             - np.interp(pressure, falling[:, 0], falling[:, 1]))
 
 
-def test_friction_gives_hysteresis_in_a_slow_pressure_cycle():
-    """32 s per cycle: without friction the loop is only the viscous lag of the joint damping."""
+def test_friction_gives_hysteresis_in_a_slow_pressure_cycle(curves):
+    """32 s per cycle: without friction the loop is only the viscous lag of the joint damping.
+    With it, each muscle's friction Cf P_eff (eq. 2.4, z = +-1 while sliding) opposes the motion
+    on both branches, so the loop is 2 r Cf (P_eff,flexor + P_eff,extensor) / k wide, with P_eff
+    (`effective_pressure`) and k (`stiffness`) from the FMU at the loop's middle."""
     smooth = loop_width(pressure_cycle(arm.DMSP10))
     rough = loop_width(pressure_cycle(arm.DMSP10 + " friction=true"))
     # Rising pressure lifts the hand against friction: it lags below the falling branch.
     assert rough < -0.02, rough
     assert abs(smooth) < 0.1 * abs(rough), (smooth, rough)
+    pf, pe = 3.75e5, 3.5e5
+    q = curves.equilibrium(pf, pe)
+    lf, le = muscle_lengths(q)
+    effective = (curves.fmu.at("effective_pressure", length=lf, pressure=pf)
+                 + curves.fmu.at("effective_pressure", length=le, pressure=pe))
+    k = R * R * (curves.stiffness(lf, pf) + curves.stiffness(le, pe)) - MGL * math.sin(q)
+    friction_coefficient = float(curves.fmu.vars["friction_coefficient"].start)  # the default
+    predicted = 2 * R * friction_coefficient * effective / k
+    assert -(rough - smooth) == pytest.approx(predicted, rel=0.05)
 
 
 def run_arm(model, data, seconds):
