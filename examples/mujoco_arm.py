@@ -164,6 +164,10 @@ def run_task(model, duration=6.5, record_every=10, frames=None, fps=12.5):
                          data.actuator_length[1] + offset, -data.actuator_force[0],
                          -data.actuator_force[1], pf, pe, torque])
         if renderer and data.time >= next_frame - 1e-9:
+            # Each muscle's colour brightens with its pressure (drawing only; physics unchanged).
+            for i, pressure in enumerate((pf, pe)):
+                level = 0.25 + 0.75 * pressure / MAX_PRESSURE
+                model.tendon_rgba[i] = (level, 0.15, 0.15, 1) if i == 0 else (0.15, 0.2, level, 1)
             renderer.update_scene(data, camera=_camera())
             frames.append(renderer.render().copy())
             next_frame += 1.0 / fps
