@@ -60,7 +60,17 @@ pub struct Log {
 impl Log {
     fn take(&self) -> String {
         let mut messages = self.messages.lock().unwrap_or_else(|e| e.into_inner());
-        let text = messages.join("; ");
+        // The newest message (the failing call's) first, then the earlier ones from the oldest,
+        // which tends to explain the cause (an excursion is explained once, when it begins).
+        let mut parts: Vec<String> = messages.last().cloned().into_iter().collect();
+        for earlier in messages.iter().take(messages.len().saturating_sub(1)) {
+            let cut = earlier
+                .char_indices()
+                .nth(400)
+                .map_or(earlier.as_str(), |(i, _)| &earlier[..i]);
+            parts.push(cut.to_string());
+        }
+        let text = parts.join("; earlier: ");
         messages.clear();
         text
     }
@@ -323,7 +333,8 @@ impl Instance {
         })
     }
 
-    /// fmi2OK and fmi2Warning pass; anything else is an error naming the call and the FMU's log.
+    /// fmi2OK and fmi2Warning pass; anything else is an error naming the call and the FMU's
+    /// log ([`Log::take`]).
     fn check(&self, call: &str, status: c_int) -> Result<(), String> {
         if status == OK || status == WARNING {
             return Ok(());
