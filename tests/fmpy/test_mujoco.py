@@ -73,6 +73,7 @@ VARIANTS = [
     ("KnittedMuscle", {}, 0.4, 0.02),
     ("KnittedMuscle", {"friction": "true"}, 0.4, 0.02),
     ("KnittedMuscle", {"bladder_model": 1, "friction": "true"}, 0.4, 0.02),
+    ("KnittedMuscle", {"preset": "fig1.16", "friction": "true"}, 0.08, 0.005),
 ]
 
 
@@ -89,7 +90,7 @@ def fmpy_parameters(parameters):
         if value in ("true", "false"):
             value = value == "true"
         elif key == "preset":
-            value = {"DMSP-10": 5, "DMSP-40": 6}[value]
+            value = {"DMSP-10": 5, "DMSP-40": 6, "fig1.16": 2}[value]
         out[key] = value
     return out
 
