@@ -5,10 +5,10 @@ static curves over pressure, the same arm task, a slow pressure cycle, and the c
     .venv/bin/python examples/mujoco_vs_native_muscle.py --out docs/img \
         --report docs/mujoco-comparison.md                                   (make mujoco-docs)
 
-The <muscle> gets activation = pressure / 600 kPa (its activation is capped at 1), no passive
-force to speak of (fpmax = 1e-9, as MuJoCo wants it positive: a McKibben muscle's cable goes
-slack instead) and MuJoCo's default force-velocity curve. Its force-length curve (range, force, lmin; lmax fixed) is fitted by least
-squares to the FMU's tension at 600 kPa over the arm's stroke."""
+The <muscle> gets activation = pressure / 600 kPa (its activation is capped at 1), no passive force
+to speak of (fpmax = 1e-9, as MuJoCo wants it positive: a McKibben muscle's cable goes slack
+instead) and MuJoCo's default force-velocity curve. Its force-length curve (range, force, lmin;
+lmax fixed) is fitted by least squares to the FMU's tension at 600 kPa over the arm's stroke."""
 
 import argparse
 import pathlib
