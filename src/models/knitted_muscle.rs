@@ -4,7 +4,7 @@
 //! is built once from the parameters; the non-cylindrical volume-length table exists only when
 //! that shape is selected. Strand friction (eq. 1.21, `friction`) is the shared stop-operator
 //! hysteresis; its state is part of the FMU state and advances only in `step`. The Mooney-Rivlin
-//! bladder of the McKibben muscle (`bladder_model` 1 thin, 2 thick, 3 continuum wall; section 1.3.6) is the
+//! bladder of the McKibben muscle (`bladder_model` 1-6 as McKibbenMuscle's; section 1.3.6) is the
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 

@@ -1,8 +1,8 @@
 //! McKibbenMuscle FMU: gauge pressure and length in, tension force out.
 //!
-//! Effects, each built only when switched on: the Mooney-Rivlin bladder (`bladder_model` 1 thin
-//! wall, 2 thick wall of `bladder_layers` layers, 3 continuum wall of `bladder_layers` quadrature
-//! nodes), friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
+//! Effects, each built only when switched on: the Mooney-Rivlin bladder (`bladder_model` 1-6, see
+//! [`BladderModel::from_switch`]; 3 is the exact wall of `bladder_layers` quadrature nodes),
+//! friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
 use super::{Model, Partials, Refusal, Report, Status};

@@ -31,7 +31,7 @@ pub struct MuscleParams {
     pub strand_length: f64,
     /// `turns` n.
     pub turns: f64,
-    /// `bladder_model`: 1 thin wall, 2 thick wall.
+    /// `bladder_model`: 4 the dissertation's thin wall, 5 its layers (the presets' fits).
     pub bladder_model: i32,
     /// `bladder_layers` (thick wall).
     pub bladder_layers: i32,
@@ -148,7 +148,7 @@ pub struct FitConfig {
     pub nominal_length: f64,
     /// Nominal inner diameter of the muscle, m: the scale of the starting diameters.
     pub diameter: f64,
-    /// `bladder_layers`: 1 = thin wall (`bladder_model` 1), more = thick wall (`bladder_model` 2).
+    /// `bladder_layers`: 1 = thin wall (`bladder_model` 4), more = layers (`bladder_model` 5).
     pub layers: i32,
     /// Number of starting points of the Levenberg-Marquardt search.
     pub starts: usize,
@@ -237,7 +237,7 @@ fn decode(x: &SVector<f64, DIM>, cfg: &FitConfig) -> MuscleParams {
         nominal_length: l_n,
         strand_length: b,
         turns: n,
-        bladder_model: if cfg.layers > 1 { 2 } else { 1 },
+        bladder_model: if cfg.layers > 1 { 5 } else { 4 },
         bladder_layers: cfg.layers.max(1),
         bladder_length: l_n * x[4].exp(),
         bladder_inner_diameter: cfg.diameter * x[2].exp(),
@@ -412,7 +412,7 @@ mod tests {
             nominal_length: 0.25,
             strand_length: 0.25 / 25f64.to_radians().cos(),
             turns: 0.25 * 25f64.to_radians().tan() / (std::f64::consts::PI * 0.011),
-            bladder_model: 1,
+            bladder_model: 4,
             bladder_layers: 1,
             bladder_length: 0.24,
             bladder_inner_diameter: 0.009,

@@ -144,8 +144,8 @@ mod tests {
         let rest = HysteresisState::at_rest(0.09);
         for model in [
             BladderModel::None,
-            BladderModel::ThinWall,
-            BladderModel::ThickWall { layers: 16 },
+            BladderModel::DissertationThinWall,
+            BladderModel::DissertationLayers { layers: 16 },
         ] {
             let m = McKibben::from_geometry(&g, model, None, 0.0).unwrap();
             for length in [0.085, 0.09, 0.095] {
