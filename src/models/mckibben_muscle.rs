@@ -7,7 +7,6 @@
 
 use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
-use crate::physics::calibration::MuscleParams;
 use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
@@ -15,6 +14,7 @@ use crate::physics::inverse::pressure_for_force;
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, McKibbenPartials, MuscleGeometry,
 };
+use crate::physics::muscle_params::MuscleParams;
 use crate::variables::mckibben_muscle::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
 };

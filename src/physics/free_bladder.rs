@@ -28,7 +28,7 @@
 //! follows from its slope.
 
 use crate::physics::bladder::BladderTube;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 use std::f64::consts::PI;
 
 /// Iteration cap of the volume-ratio root (Newton-bisection on a monotone smooth function).

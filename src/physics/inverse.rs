@@ -6,7 +6,7 @@
 
 use crate::physics::friction::HysteresisState;
 use crate::physics::mckibben::McKibben;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 
 /// Stopping rule of the inversions: the Newton correction of the argument (Pa) below 1e-13 of
 /// it plus 1e-9 Pa, or 200 evaluations (bisection alone would halve any bracket that often).

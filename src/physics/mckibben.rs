@@ -9,7 +9,7 @@
 use crate::physics::bladder::{Bladder, BladderState, BladderTube, Wall};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 
 mod partials;
 pub use partials::McKibbenPartials;
@@ -485,7 +485,7 @@ impl McKibben {
             let core = self.at_actual_length(pressure, l, history)?;
             Ok((l + c * core.out.force - reported, core))
         };
-        let x0 = super::bounds::limit(reported, lo_edge, hi_edge);
+        let x0 = super::numerics::bounds::limit(reported, lo_edge, hi_edge);
         let (h0, core0) = eval(x0)?;
         if h0 == 0.0 {
             return Ok(core0);

@@ -17,9 +17,9 @@
 //! unstretched wall, and an `n`-point Gauss-Legendre rule converges like `rho^-2n` where the
 //! layered sum (a left Riemann sum) converges like `1/n`.
 
-use super::dual::Dual;
 use super::hyper_dual::KernelScalar;
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
+use crate::physics::numerics::dual::Dual;
 use std::f64::consts::{LOG2_E, PI};
 
 /// Nodes whose positions are computed ahead of their algebra, at a time (stack buffer).

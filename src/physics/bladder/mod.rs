@@ -31,7 +31,6 @@
 mod continuum;
 #[cfg(test)]
 mod continuum_tests;
-mod dual;
 mod exact;
 #[cfg(test)]
 mod exact_tests;
@@ -45,9 +44,9 @@ mod tests;
 
 use crate::physics::gaylord::Sleeve;
 use crate::physics::knitted::KnittedSleeve;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use crate::physics::numerics::dual::Dual;
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 use continuum::WallNode;
-use dual::Dual;
 pub use geometry::SleeveGeometry;
 use hyper_dual::KernelScalar;
 pub use knitted_cylinder::KnittedCylinder;
