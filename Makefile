@@ -5,8 +5,11 @@ VENV := .venv
 PY := $(VENV)/bin/python
 ## The linux64 binary the FMUs ship (see "Linux binaries for every maintained distribution" below).
 LIB := target/glibc/x86_64-unknown-linux-gnu/release/libactuator_fmus.so
+# The MuJoCo actuator plugin (see "MuJoCo" below).
+MUJOCO_PLUGIN := target/mujoco-plugin/release/libactuator_fmus_mujoco.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
+.PHONY: mujoco-plugin mujoco-arm mujoco-docs
 .PHONY: all fmus zig-tools demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
@@ -162,12 +165,12 @@ interop-deps:
 ## that its module fixtures are built once and files that share a scratch directory (wine's
 ## prefix) never run beside themselves. PYTEST_WORKERS=0: one process.
 PYTEST_WORKERS ?= 2
-test-fmpy: fmus $(VENV)/.installed interop-deps py-deps
+test-fmpy: fmus $(VENV)/.installed interop-deps py-deps $(MUJOCO_PLUGIN)
 	$(PY) -m pytest tests/fmpy -q $(if $(filter-out 0,$(PYTEST_WORKERS)),-n $(PYTEST_WORKERS) --dist loadfile)
 
 ## All Rust tests and the FMPy suite. The apt checks run first, one at a time (dpkg has one lock);
 ## then everything else runs TEST_JOBS wide: the host build beside the cross builds and the venv,
-## then the Rust tests beside the FMPy suite (docs: README "Tests (`make test`)").
+## then the Rust tests beside the FMPy suite (CONTRIBUTING.md, "Tests").
 TEST_JOBS ?= 3
 test:
 	@$(MAKE) --no-print-directory deps cross-deps interop-deps py-deps
@@ -180,7 +183,7 @@ $(C_PASSTHROUGH): benches/c_passthrough/passthrough.c
 	cc -O2 -shared -fPIC -o $@ $< -lm
 
 ## Native cost per FMI step (criterion), through the packaged FMU's C ABI; then the FMI layer
-## against a C pass-through FMU and issue 15's goals, interleaved in one run (benches/parity.rs).
+## against a C pass-through FMU and the performance goals, interleaved in one run (benches/parity.rs).
 bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
@@ -198,7 +201,7 @@ worst-case: fmus
 
 .PHONY: parity
 ## benches/parity.rs alone: the FMI layer against C, the walls, the motor and the knitted table;
-## then the README's FMI-layer table from that run.
+## then docs/performance.md's FMI-layer table from that run.
 parity: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	cargo bench --bench parity
 	$(PY) benches/report.py --parity
@@ -233,14 +236,39 @@ clean:
 	rm -rf out $(VENV)
 
 ## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
-## densities, strain drive and onion reorientation of the MultiferroicMotor FMU (issue 16).
+## densities, strain drive and onion reorientation of the MultiferroicMotor FMU.
 motor-docs: fmus $(VENV)/.installed
 	$(PY) examples/motor_characteristics.py
 
 ## docs/knitted-bag.md and docs/img/knitted_bag.png: the section 1.4 prototype's polyethylene bag
-## and its stroke against the measured 42% and 51% (issue 16).
+## and its stroke against the measured 42% and 51%.
 knitted-bag-docs: fmus $(VENV)/.installed
 	$(PY) examples/knitted_bag.py
+
+## ---- MuJoCo (docs/mujoco.md) ----
+## The actuator plugin that runs an FMU inside MuJoCo (mujoco_plugin/, its own crate and target
+## directory so that it builds beside the Rust tests). It compiles against the headers and links the
+## libmujoco.so of the pinned `mujoco` wheel in the venv.
+MUJOCO_PLUGIN_SOURCES := $(shell find mujoco_plugin/src -type f) mujoco_plugin/Cargo.toml mujoco_plugin/build.rs
+$(MUJOCO_PLUGIN): $(MUJOCO_PLUGIN_SOURCES) $(VENV)/.installed
+	+cargo build --release --manifest-path mujoco_plugin/Cargo.toml --target-dir target/mujoco-plugin
+	@touch $@
+mujoco-plugin: $(MUJOCO_PLUGIN)
+
+## The antagonistic arm in MuJoCo (examples/mujoco/arm.xml): position control, then co-contraction
+## at a fixed angle, with torque pulses that show the stiffness; out/mujoco/arm.{csv,png} and, when
+## offscreen rendering works, out/mujoco/arm.gif.
+mujoco-arm: fmus $(MUJOCO_PLUGIN)
+	$(PY) examples/mujoco_arm.py --out out/mujoco
+
+## docs/mujoco.md's figures (the arm, rendered if EGL or OSMesa works) and docs/mujoco-comparison.md:
+## the plugin against MuJoCo's <muscle> fitted at one pressure, and the cost per step.
+mujoco-docs: fmus $(MUJOCO_PLUGIN)
+	$(PY) examples/mujoco_arm.py --out out/mujoco --gif --stiffness
+	cp out/mujoco/arm.png docs/img/mujoco_arm.png
+	cp out/mujoco/arm_stiffness.png docs/img/mujoco_stiffness.png
+	if [ -f out/mujoco/arm.gif ]; then cp out/mujoco/arm.gif docs/img/mujoco_arm.gif; fi
+	$(PY) examples/mujoco_vs_native_muscle.py --out docs/img --report docs/mujoco-comparison.md
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
@@ -266,7 +294,7 @@ systems: fmus $(VENV)/.installed
 sweep: fmus $(VENV)/.installed
 	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
 
-## ---- Reliability jobs (issue 8): longer runs, not part of `make test`. ----
+## ---- Reliability jobs: longer runs, not part of `make test`. ----
 .PHONY: fuzz memcheck load
 
 ## tests/load.rs with its 10,000-cycle heap test of every FMU in both interfaces (ignored by
@@ -362,7 +390,55 @@ memcheck: fmus $(VENV)/.installed
 .PHONY: compliance
 ## The FMU Compliance Checker (modelica-tools/FMUComplianceChecker) on every FMU, XML and both
 ## interfaces, driven by crosscheck/<Model>/ inputs: `make compliance FMUCHECKER=path/to/fmuCheck.linux64`.
-## Not on crates.io, PyPI or Debian: build it once from its repository (README, "FMU Compliance Checker").
+## Not on crates.io, PyPI or Debian: build it once from its repository (docs/compatibility.md, "FMU Compliance Checker").
 compliance: fmus
-	@test -n "$(FMUCHECKER)" || { echo "set FMUCHECKER=path/to/fmuCheck.linux64 (README: FMU Compliance Checker)"; exit 2; }
+	@test -n "$(FMUCHECKER)" || { echo "set FMUCHECKER=path/to/fmuCheck.linux64 (docs/compatibility.md: FMU Compliance Checker)"; exit 2; }
 	FMUCHECKER="$(FMUCHECKER)" tools/compliance.sh
+
+## ---- The documentation site and `make help` ----
+.PHONY: docs help
+
+## The documentation site (mkdocs.yml, docs/, each FMU's own page from target/fmu/) into site/, with
+## `mkdocs build --strict`: a broken link or anchor fails. tests/fmpy/test_docs_site.py builds it the
+## same way in `make test` and opens every page in headless Chromium.
+docs: fmus $(VENV)/.installed
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+	@echo "site/index.html: $$(find site -name '*.html' | wc -l) pages"
+
+## The user targets, one line each. The README points here instead of listing them, and
+## tests/fmpy/test_make_help.py checks that each name is a target of this Makefile. Internal
+## targets (deps, py-deps, cross-deps, interop-deps, test-rust, test-fmpy, scene-schema) stay out.
+define HELP_TEXT
+Start here
+  demo              build the FMUs and run the default scene under FMPy: out/fig2_3_ideal_mckibben.{csv,png}
+  test              all Rust tests, the FMPy suite and the documentation site's checks
+  help              this list
+Build
+  fmus              target/fmu/<Model>.fmu for every model (CROSS=0: linux64 binaries only)
+  docs              the documentation site into site/ (mkdocs build --strict)
+Run the models
+  scene             one scene under FMPy: make scene SCENE=scenes/<name>.json
+  figures           every scene of the catalogue, and docs/figures.md
+  calibrate         fit McKibbenMuscle to a datasheet: DATA= LENGTH= DIAMETER= FIT= OUT= STARTS=
+  calibrate-festo   refit the Festo presets and rewrite docs/calibration/dmsp{10,40}/
+  robot-joint       an antagonistic muscle pair on a pulley, co-simulated: out/robot_joint.{csv,png}
+  systems           the robot joint as an SSP and as a container FMU: out/systems/
+  crosscheck        FMI cross-check files crosscheck/<Model>/ and the FMU pages' plots
+  sweep             a design sweep on Dask: out/sweep.{csv,png} (SCHEDULER=tcp://host:port)
+  motor-docs        docs/motor.md: the motor's holding, pull-in and pull-out torque
+  knitted-bag-docs  docs/knitted-bag.md: the knitted prototype's bag against its measured stroke
+  linearized        docs/linearized-muscle.md: stiffness and pressure gain over the stroke
+Measure and check (not part of make test)
+  bench             native cost per step, derivatives, Model Exchange, the FMI layer against C
+  bench-motor       the motor's step and its Model Exchange calls
+  parity            the FMI layer against a C pass-through FMU: docs/performance.md's table
+  report            docs/accuracy-cost.md and the tables of docs/performance.md
+  compliance        the FMU Compliance Checker on every FMU: FMUCHECKER=path/to/fmuCheck.linux64
+  fuzz              random FMI call sequences (cargo-fuzz): FUZZ_SECONDS= FUZZ_JOBS= SANITIZER=
+  memcheck          every FMU under valgrind, natively and through FMPy
+  load              10,000 instantiate-run-free cycles per FMU with the heap counted
+  clean             remove build output, out/ and the .venv
+endef
+export HELP_TEXT
+help:
+	@echo "$$HELP_TEXT"

@@ -6,7 +6,7 @@
 //! finite outputs). Every value inside the declared range must be accepted by the setters, and
 //! each declared bound alone (every other value at its start) must initialize and step, or be
 //! refused for its combination with another variable, which the reason names.
-//! Prints how many cases ran (the README quotes the count).
+//! Prints how many cases ran (docs/compatibility.md quotes the count).
 
 use crate::common;
 
