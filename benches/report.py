@@ -22,8 +22,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
-from conftest import FMU_DIR, Slave  # noqa: E402
+from actuator_fmus import FMU_DIR, Slave  # noqa: E402
 import knitted_shape_init  # noqa: E402
 from knitted_shape_init import GOALS  # noqa: E402
 

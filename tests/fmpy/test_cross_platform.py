@@ -8,7 +8,6 @@ import os
 import pathlib
 import shutil
 import subprocess
-import sys
 import zipfile
 
 import numpy as np
@@ -17,8 +16,7 @@ from fmpy import read_model_description
 
 from conftest import FMU_DIR, ROOT
 
-sys.path.insert(0, str(ROOT / "scenes"))
-import run as scenes  # noqa: E402
+from actuator_fmus import scene as scenes  # noqa: E402
 
 HARNESS = ROOT / "tests" / "cross" / "harness.c"
 STUB = ROOT / "tests" / "cross" / "bcryptprimitives.c"

@@ -3,12 +3,11 @@
 fmi2GetDirectionalDerivative, and a test of chapter 2's proposal to treat a finished muscle as a
 spring whose stiffness is proportional to the applied pressure minus the threshold pressure.
 
-    .venv/bin/python docs/linearized/generate.py     (or: make linearized)
+    actuator-fmus linearized     (or: make linearized)
 
 Writes docs/linearized-muscle.md and docs/linearized/*.png; exits 1 if its own checks fail.
 """
 
-import pathlib
 import sys
 
 import matplotlib
@@ -19,8 +18,9 @@ import numpy as np  # noqa: E402
 from fmpy import extract, read_model_description  # noqa: E402
 from fmpy.fmi2 import FMU2Slave  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-FMU = ROOT / "target" / "fmu" / "McKibbenMuscle.fmu"
+from .paths import FMU_DIR, ROOT, fmu_path
+
+FMU = FMU_DIR / "McKibbenMuscle.fmu"
 OUT = ROOT / "docs" / "linearized"
 PAGE = ROOT / "docs" / "linearized-muscle.md"
 MUSCLES = {"A": 1, "B": 2, "C": 3, "D": 4}
@@ -134,9 +134,9 @@ def plot(s, a):
     return path
 
 
-def main():
-    if not FMU.exists():
-        sys.exit(f"{FMU} is missing: run `make fmus` first")
+def main(args=None):
+    """Writes docs/linearized-muscle.md and its plots; returns 1 if its own checks fail, else 0."""
+    fmu_path("McKibbenMuscle")
     rows, images, failures = [], [], []
     for name, preset in MUSCLES.items():
         s = sweep(name, preset)
@@ -203,8 +203,5 @@ the whole stroke, use `K1(L)` and `P0(L)` from the FMU's directional derivatives
     print(text)
     if failures:
         print("\n".join(failures), file=sys.stderr)
-        sys.exit(1)
-
-
-if __name__ == "__main__":
-    main()
+        return 1
+    return 0

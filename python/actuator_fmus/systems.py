@@ -6,17 +6,14 @@
   systems/RobotJoint.container.json (two McKibbenMuscle instances and PulleyJoint, 1 ms step).
 
 With --run both are simulated for 4 s and out/systems/robot_joint_systems.png compares them with
-the two-FMU co-simulation of examples/robot_joint.py. Usage: python systems/build.py [--run]"""
+the two-FMU co-simulation of `actuator-fmus robot-joint`. Usage: actuator-fmus systems [--run]"""
 
-import argparse
 import logging
-import pathlib
 import shutil
-import sys
 import zipfile
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-FMU_DIR = ROOT / "target" / "fmu"
+from .paths import FMU_DIR, ROOT
+
 OUT = ROOT / "out" / "systems"
 HERE = ROOT / "systems"
 STEP = 1e-3
@@ -126,23 +123,23 @@ class _UnconnectedOutputs(logging.Filter):
         return True
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--run", action="store_true")
-    args = parser.parse_args()
+def add_arguments(parser):
+    parser.add_argument("--run", action="store_true", help="simulate both for 4 s and plot them against the two-FMU run")
+
+
+def main(args):
     ssp = build_ssp()
     container = build_container()
     print(f"wrote {ssp} and {container}")
     if not args.run:
-        return
+        return 0
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
 
-    sys.path.insert(0, str(ROOT / "examples"))
-    import robot_joint
+    from . import robot_joint
 
     reference = np.array(robot_joint.read_csv(ROOT / "tests" / "data" / "robot_joint_ref.csv")[1])
     s = run_ssp(ssp)
@@ -161,7 +158,5 @@ def main():
     fig.tight_layout()
     fig.savefig(OUT / "robot_joint_systems.png", dpi=100)
     print(f"wrote {OUT}/robot_joint_systems.png")
+    return 0
 
-
-if __name__ == "__main__":
-    main()

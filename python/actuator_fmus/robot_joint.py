@@ -16,15 +16,11 @@ Each communication step h (fixed-step semi-implicit Euler for the joint):
 
 Writes out/robot_joint.csv and out/robot_joint.png."""
 
-import argparse
 import json
 import math
 import pathlib
-import sys
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
-from conftest import fmu_path  # noqa: E402
+from .paths import ROOT, fmu_path
 
 PARAMETERS = ROOT / "examples" / "robot_joint.json"
 COLUMNS = ["time", "q", "dq", "q_ref", "p_flexor", "p_extensor", "f_flexor", "f_extensor", "torque"]
@@ -164,12 +160,13 @@ def plot(rows, path):
     fig.savefig(path, dpi=100)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", default="out")
-    parser.add_argument("--stop-time", type=float, default=None)
-    parser.add_argument("--no-plot", action="store_true")
-    args = parser.parse_args()
+def add_arguments(parser):
+    parser.add_argument("--out", default="out", help="output directory (default: out)")
+    parser.add_argument("--stop-time", type=float, default=None, help="s (default: the parameters file's)")
+    parser.add_argument("--no-plot", action="store_true", help="write only the CSV")
+
+
+def main(args):
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     p = load_parameters()
@@ -180,7 +177,5 @@ def main():
     if not args.no_plot:
         plot(rows, out / "robot_joint.png")
         print(f"wrote {out}/robot_joint.png")
+    return 0
 
-
-if __name__ == "__main__":
-    main()

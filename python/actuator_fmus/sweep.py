@@ -13,10 +13,9 @@ each), or any running scheduler given by --scheduler tcp://host:8786. The FMU tr
 workers as bytes (scattered once), so remote workers need no shared file system, only this
 script's Python packages. Writes out/sweep.csv and out/sweep.png and prints runs per second.
 
-    python examples/sweep_dask.py                    # 60 x 40 = 2400 runs on a local cluster
-    python examples/sweep_dask.py --scheduler tcp://10.0.0.5:8786 --prestrains 200 --thicknesses 100"""
+    actuator-fmus sweep                    # 60 x 40 = 2400 runs on a local cluster
+    actuator-fmus sweep --scheduler tcp://10.0.0.5:8786 --prestrains 200 --thicknesses 100"""
 
-import argparse
 import hashlib
 import math
 import os
@@ -25,7 +24,7 @@ import sys
 import tempfile
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from .paths import fmu_path
 LISTED_LENGTH = 0.10325  # Table 2.1, muscle A
 PRESSURE = 6.9e5  # 690 kPa, the dissertation's work figure
 MUSCLE_A = {"strand_length": 0.1113, "turns": 3.74, "bladder_inner_diameter": 0.0016}
@@ -126,7 +125,7 @@ def sweep(prestrains, thicknesses, scheduler=None, workers=2, batch=20, layers=8
     def task(fmu, cases, layers, n_lengths):
         return run_batch(fmu, cases, layers, n_lengths)
 
-    fmu_bytes = (ROOT / "target" / "fmu" / "McKibbenMuscle.fmu").read_bytes()
+    fmu_bytes = pathlib.Path(fmu_path("McKibbenMuscle")).read_bytes()
     cases = [(p, t) for p in prestrains for t in thicknesses]
     batches = [cases[i:i + batch] for i in range(0, len(cases), batch)]
     cluster = None
@@ -191,8 +190,7 @@ def plot(rows, prestrains, thicknesses, path):
     fig.savefig(path, dpi=100)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_arguments(parser):
     parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (default: local cluster)")
     parser.add_argument("--workers", type=int, default=2, help="local cluster worker processes")
     parser.add_argument("--prestrains", type=int, default=60, help="pre-strain points, 0 .. 90%%")
@@ -200,8 +198,10 @@ def main():
     parser.add_argument("--layers", type=int, default=8, help="bladder_layers of the thick wall")
     parser.add_argument("--lengths", type=int, default=200, help="length samples per stroke")
     parser.add_argument("--batch", type=int, default=20, help="runs per Dask task")
-    parser.add_argument("--out", default="out")
-    args = parser.parse_args()
+    parser.add_argument("--out", default="out", help="output directory (default: out)")
+
+
+def main(args):
     prestrains = linspace(0.0, 0.9, args.prestrains)
     thicknesses = linspace(0.4e-3, 2.4e-3, args.thicknesses)
     rows, seconds = sweep(prestrains, thicknesses, args.scheduler, args.workers, args.batch, args.layers,
@@ -217,7 +217,5 @@ def main():
     print(f"{len(rows)} runs in {seconds:.1f} s: {len(rows) / seconds:.1f} runs/s "
           f"({args.lengths} lengths x 2 pressures each, {args.layers} layers); {failed} without a stroke")
     print(f"wrote {out}/sweep.csv and {out}/sweep.png")
+    return 0
 
-
-if __name__ == "__main__":
-    main()
