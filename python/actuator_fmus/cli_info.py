@@ -34,6 +34,7 @@ def main(args):
                 span = "" if lo is None and hi is None else \
                     f" {'' if lo is None else f'{lo:g}'} .. {'' if hi is None else f'{hi:g}'}"
                 what = f"{v.type}{span} {unit}".rstrip()
-            start = f", start {v.start}" if v.start is not None else ""
+            start = "" if v.start is None else f", start {v.start}" + "".join(
+                f" ({n})" for n, k in items.items() if str(k) == str(v.start))
             print(f"  {v.name}: {what}{start}")
     return 0

@@ -175,17 +175,26 @@ def plot(rows, prestrains, thicknesses, path):
     fig, ax = plt.subplots(figsize=(7, 4.8))
     # Near the corner where the bladder barely fits the work shoots up (the stroke's top nears
     # max_length); a robust colour range keeps the rest of the map readable.
+    # The contours are drawn at levels inside that range only, so that every label can be read off
+    # the colour bar; the bar's arrow stands for the work above it.
+    from matplotlib.ticker import MaxNLocator
+
     lo, hi = np.nanpercentile(z, 1), np.nanpercentile(z, 97)
     mesh = ax.pcolormesh(np.array(prestrains) * 100, np.array(thicknesses) * 1e3, z, shading="auto",
                          vmin=lo, vmax=hi)
-    fig.colorbar(mesh, ax=ax, label="net work per stroke (J)")
-    cs = ax.contour(np.array(prestrains) * 100, np.array(thicknesses) * 1e3, z, colors="w", linewidths=0.6)
-    ax.clabel(cs, fontsize=7, fmt="%.2f")
+    bar = fig.colorbar(mesh, ax=ax, extend="both", label="net work per stroke (J)")
+    levels = [x for x in MaxNLocator(5).tick_values(lo, hi) if lo < x < hi]
+    cs = ax.contour(np.array(prestrains) * 100, np.array(thicknesses) * 1e3, z, levels=levels, colors="w",
+                    linewidths=0.6)
+    ax.clabel(cs, fontsize=7, fmt="%.2f J")
+    for level in levels:
+        bar.ax.axhline(level, color="w", linewidth=0.8)
     ax.set_xlabel("bladder pre-strain (%)")
     ax.set_ylabel("bladder wall thickness (mm)")
-    ax.set_title("McKibbenMuscle, muscle A sleeve, thick wall: net work at 690 kPa\n"
-                 "(white: the bladder does not fit the sleeve; stroke top = min(listed, 0.99 max_length))",
-                 fontsize=9)
+    ax.set_title("McKibbenMuscle, Table 2.1 muscle A sleeve, thick-walled bladder: net work per stroke at 690 kPa\n"
+                 "(blank: the bladder does not fit the sleeve; stroke top = min(listed length, 0.99 max_length);\n"
+                 "colours saturate beyond the 1st and 97th percentiles, white lines: contours in J)",
+                 fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
 

@@ -1,6 +1,7 @@
 //! Tools around the FMU crate that the FMU binary does not need: packaging `target/fmu/<Model>.fmu`
 //! (`package_fmus`) and the scene files (`scenes/*.json`) that the examples and tests run.
 
+pub mod choices;
 pub mod package;
 pub mod scene;
 
