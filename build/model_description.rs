@@ -367,7 +367,10 @@ fn check_enumerations(types: &TypeDefinitions) -> Result<BTreeMap<String, (i32, 
                 ));
             }
             if !item_names.insert(item.name.as_str()) {
-                return Err(format!("type '{}': item '{}' appears twice", t.name, item.name));
+                return Err(format!(
+                    "type '{}': item '{}' appears twice",
+                    t.name, item.name
+                ));
             }
         }
         let last = first + e.items.len() as i32 - 1;

@@ -41,7 +41,7 @@ class Motor:
     def set(self, **values):
         for name, value in values.items():
             ref, kind = self.vr[name]
-            {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger,
+            {"Real": self.fmu.setReal, "Integer": self.fmu.setInteger, "Enumeration": self.fmu.setInteger,
              "Boolean": self.fmu.setBoolean}[kind]([ref], [value])
 
     def get(self, name):

@@ -70,7 +70,7 @@ class Muscle:
             vr, kind = self.vr[key]
             if kind == "Real":
                 self.fmu.setReal([vr], [float(value)])
-            elif kind == "Integer":
+            elif kind in ("Integer", "Enumeration"):
                 self.fmu.setInteger([vr], [int(value)])
             else:
                 self.fmu.setBoolean([vr], [bool(value)])

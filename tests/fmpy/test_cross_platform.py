@@ -39,7 +39,7 @@ def script_for(model):
 
     def set_line(name, value):
         v = by_name[name]
-        code = {"Real": "R", "Integer": "I", "Boolean": "B"}[v.type]
+        code = {"Real": "R", "Integer": "I", "Enumeration": "I", "Boolean": "B"}[v.type]
         value = float(value) if v.type == "Real" else int(value)
         return f"{code} {v.valueReference} {value!r}\n"
 

@@ -18,25 +18,36 @@ fn attribute(tag: &str, key: &str) -> Option<String> {
 }
 
 /// Start tags `<element ...>` in `text`, in order.
-fn tags<'a>(text: &'a str, element: &'a str) -> impl Iterator<Item = &'a str> + 'a {
+fn tags<'a>(text: &'a str, element: &str) -> std::vec::IntoIter<&'a str> {
     let open = format!("<{element} ");
     text.match_indices(&open)
-        .filter_map(move |(at, _)| text[at..].find('>').map(|end| &text[at..at + end]))
+        .filter_map(|(at, _)| text[at..].find('>').map(|end| &text[at..at + end]))
+        .collect::<Vec<_>>()
+        .into_iter()
 }
 
 /// The Enumeration types of a model description, in order.
 pub fn enumerations(xml: &str) -> Vec<Enumeration> {
     let mut out = Vec::new();
     for (at, _) in xml.match_indices("<SimpleType ") {
-        let end = xml[at..].find("</SimpleType>").map_or(xml.len(), |e| at + e);
+        let end = xml[at..]
+            .find("</SimpleType>")
+            .map_or(xml.len(), |e| at + e);
         let block = &xml[at..end];
-        let Some(name) = tags(block, "SimpleType").next().and_then(|t| attribute(t, "name")) else {
+        let Some(name) = tags(block, "SimpleType")
+            .next()
+            .and_then(|t| attribute(t, "name"))
+        else {
             continue;
         };
         let items = tags(block, "Item")
             .filter_map(|t| {
                 let value = attribute(t, "value")?.parse().ok()?;
-                Some((value, attribute(t, "name")?, attribute(t, "description").unwrap_or_default()))
+                Some((
+                    value,
+                    attribute(t, "name")?,
+                    attribute(t, "description").unwrap_or_default(),
+                ))
             })
             .collect();
         out.push(Enumeration { name, items });
@@ -48,10 +59,16 @@ pub fn enumerations(xml: &str) -> Vec<Enumeration> {
 pub fn enumeration_variables(xml: &str) -> Vec<(String, String)> {
     let mut out = Vec::new();
     for (at, _) in xml.match_indices("<ScalarVariable ") {
-        let end = xml[at..].find("</ScalarVariable>").map_or(xml.len(), |e| at + e);
+        let end = xml[at..]
+            .find("</ScalarVariable>")
+            .map_or(xml.len(), |e| at + e);
         let block = &xml[at..end];
-        let name = tags(block, "ScalarVariable").next().and_then(|t| attribute(t, "name"));
-        let declared = tags(block, "Enumeration").next().and_then(|t| attribute(t, "declaredType"));
+        let name = tags(block, "ScalarVariable")
+            .next()
+            .and_then(|t| attribute(t, "name"));
+        let declared = tags(block, "Enumeration")
+            .next()
+            .and_then(|t| attribute(t, "declaredType"));
         if let (Some(name), Some(declared)) = (name, declared) {
             out.push((name, declared));
         }
@@ -66,14 +83,19 @@ pub fn enumeration_variables(xml: &str) -> Vec<(String, String)> {
 pub fn preset_values(
     factory: &dyn Factory,
     info: &ModelInfo,
-) -> Option<(Vec<(&'static str, &'static str)>, Vec<(String, Vec<String>)>)> {
+) -> Option<(
+    Vec<(&'static str, &'static str)>,
+    Vec<(String, Vec<String>)>,
+)> {
     let preset = info.variables.iter().find(|v| v.name == "preset")?;
     let xml = info.model_description_xml;
     let type_name = enumeration_variables(xml)
         .into_iter()
         .find(|(name, _)| name == "preset")?
         .1;
-    let presets = enumerations(xml).into_iter().find(|e| e.name == type_name)?;
+    let presets = enumerations(xml)
+        .into_iter()
+        .find(|e| e.name == type_name)?;
     let calculated: Vec<_> = info
         .variables
         .iter()

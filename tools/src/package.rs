@@ -187,24 +187,25 @@ fn choices_html(factory: &dyn Factory, info: &ModelInfo) -> String {
         }
         html.push_str("</table>\n");
     }
-    if let Some((columns, rows)) = crate::choices::preset_values(factory, info) {
+    if let Some((parameters, presets)) = crate::choices::preset_values(factory, info) {
+        // One column per preset, one row per calculated parameter: the table stays narrow.
         html.push_str(
             "<h2>Presets</h2>\n<p>The calculated parameters with each <code>preset</code> and every \
-             other parameter at its start value, read from the model (SI units).</p>\n<table><tr><th>preset</th>",
+             other parameter at its start value, read from the model (SI units).</p>\n\
+             <table><tr><th>calculated parameter</th><th>unit</th>",
         );
-        for (name, unit) in &columns {
-            let unit = if unit.is_empty() || *unit == "1" {
-                String::new()
-            } else {
-                format!(" ({})", unit_text(unit))
-            };
-            html.push_str(&format!("<th><code>{name}</code>{unit}</th>"));
+        for (preset, _) in &presets {
+            html.push_str(&format!("<th><code>{preset}</code></th>"));
         }
         html.push_str("</tr>\n");
-        for (preset, values) in rows {
-            html.push_str(&format!("<tr><td><code>{preset}</code></td>"));
-            for value in values {
-                html.push_str(&format!("<td class=\"n\">{}</td>", escape(&value)));
+        for (k, (name, unit)) in parameters.iter().enumerate() {
+            html.push_str(&format!(
+                "<tr><td><code>{name}</code></td><td>{}</td>",
+                unit_text(unit)
+            ));
+            for (_, values) in &presets {
+                let value = values.get(k).or(values.first()).map_or("", String::as_str);
+                html.push_str(&format!("<td class=\"n\">{}</td>", escape(value)));
             }
             html.push_str("</tr>\n");
         }
@@ -222,7 +223,9 @@ pub fn documentation(info: &ModelInfo, model_exchange: bool, equations: &str) ->
         let kind = enumeration_of
             .iter()
             .find(|(name, _)| name == v.name)
-            .map_or(format!("{:?}", v.kind), |(_, t)| format!("Enumeration ({t})"));
+            .map_or(format!("{:?}", v.kind), |(_, t)| {
+                format!("Enumeration ({t})")
+            });
         let range = match (v.min, v.max) {
             (None, None) => String::new(),
             (min, max) => format!(
