@@ -136,14 +136,19 @@ def check_input_names(model, names):
         check_name(model, name, ("input",), "input")
 
 
-def check_input_values(model, name, values):
+def check_input_values(model, name, values, times=None):
     """Every sample of input `name` (in its SI unit) lies in the declared range, else UsageError
-    giving the first sample outside it."""
+    giving the first sample outside it and its time (`times`, s)."""
     variable = check_name(model, name, ("input",), "input")
     lo, hi = declared_range(variable)
-    for value in values:
+    for k, value in enumerate(values):
         if (lo is not None and value < lo) or (hi is not None and value > hi) or value != value:
-            check_value(model, variable, value)
+            try:
+                check_value(model, variable, value)
+            except UsageError as e:
+                if times is None:
+                    raise
+                raise UsageError(f"{e} (input signal at t = {times[k]:g} s)") from None
 
 
 def check_output_names(model, names):

@@ -118,7 +118,7 @@ def check_scene(scene):
         for _, _, parameters, inputs in sweep_runs(scene):
             checks.check_start_values(model, parameters)
             for name, signal in inputs.items():
-                checks.check_input_values(model, name, signal_values(signal, t, stop, scene["_dir"]))
+                checks.check_input_values(model, name, signal_values(signal, t, stop, scene["_dir"]), t)
     except UsageError as e:
         raise SceneError(f"{where}: {e}") from None
 

@@ -19,7 +19,7 @@ def simulate(model, start_values=None, input=None, output=None, **options):
     start_values = checks.check_start_values(model, start_values)
     if input is not None:
         for name in input.dtype.names[1:]:
-            checks.check_input_values(model, name, input[name])
+            checks.check_input_values(model, name, input[name], input["time"])
         input = _with_held_inputs(model, input)
     if output is not None:
         checks.check_output_names(model, output)
