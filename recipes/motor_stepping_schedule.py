@@ -30,10 +30,10 @@ def ends_of_periods(result):
 
 
 built_in = simulate(FMU, start_values={"schedule": "stepping_schedule", "step_period": PERIOD,
-                                           "step_angle": STEP, "stress_amplitude": STRESS,
-                                           "schedule_initial_direction": FIRST},
-                        stop_time=STEPS * PERIOD, output_interval=PERIOD / 50,
-                        output=["rotor_angle", "applied_strain_direction"])
+                                       "step_angle": STEP, "stress_amplitude": STRESS,
+                                       "schedule_initial_direction": FIRST},
+                    stop_time=STEPS * PERIOD, output_interval=PERIOD / 50,
+                    output=["rotor_angle", "applied_strain_direction"])
 
 # FMPy interpolates continuous inputs linearly between rows; a repeated time stamp is a jump.
 switches = np.arange(1, STEPS) * PERIOD
@@ -46,7 +46,7 @@ signal["strain_direction"] = FIRST + STEP * level
 signal["stress"] = STRESS
 # Inputs without a column (here `strain`) are held at their start values.
 own = simulate(FMU, start_values={"schedule": "inputs"}, input=signal, stop_time=STEPS * PERIOD,
-                   output_interval=PERIOD / 50, output=["rotor_angle", "applied_strain_direction"])
+               output_interval=PERIOD / 50, output=["rotor_angle", "applied_strain_direction"])
 
 a, b = ends_of_periods(built_in), ends_of_periods(own)
 print(f"MultiferroicMotor, {STEPS} steps of 60 degrees every {PERIOD * 1e6:g} us at {STRESS / 1e6:g} MPa")
