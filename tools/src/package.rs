@@ -53,7 +53,7 @@ fn package(
         .map_err(|e| format!("cannot create {}: {e}", partial.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    // A plot of the model's cross-check run (crosscheck/generate.py), shipped when present.
+    // A plot of the model's cross-check run (python/actuator_fmus/crosscheck.py), shipped when present.
     let plot_path = crate::repository_root()
         .join("docs/fmu")
         .join(format!("{}.png", info.name));
