@@ -154,6 +154,8 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus calibrate` (lengths in m, pressures in kPa as datasheets give
+    them)."""
     parser.add_argument("data", help="datasheet CSV with columns pressure_kpa,contraction,force_n")
     parser.add_argument("--length", type=float, required=True, help="nominal length of the muscle, m")
     parser.add_argument("--diameter", type=float, required=True, help="nominal inner diameter, m")

@@ -29,6 +29,7 @@ COMMANDS = [
 
 
 def parser():
+    """The argparse parser of `actuator-fmus` with one subcommand per entry of COMMANDS."""
     p = argparse.ArgumentParser(prog="actuator-fmus", description=__doc__,
                                 formatter_class=argparse.RawDescriptionHelpFormatter)
     sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
@@ -42,6 +43,7 @@ def parser():
 
 
 def main(argv=None):
+    """Runs `actuator-fmus` with `argv`; returns the exit status (2 and one line on a UsageError)."""
     args = parser().parse_args(argv)
     try:
         return args.run(args) or 0

@@ -5,6 +5,7 @@ from .paths import FMU_DIR, UsageError, models
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus info`."""
     parser.add_argument("model", nargs="?", help="FMU name (none: list the packaged FMUs)")
 
 

@@ -7,6 +7,7 @@ from .paths import UsageError
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus pressure-for-force` (force in N, length in m, pressure in Pa)."""
     parser.add_argument("force", type=float, help="tension force, N")
     parser.add_argument("length", type=float, help="muscle length, m")
     parser.add_argument("--set", action="append", default=[], metavar="NAME=VALUE",

@@ -76,6 +76,7 @@ SPEC = {
 
 
 def experiment(md):
+    """(start, stop, step) of the model description's default experiment, in s."""
     de = md.defaultExperiment
     start = float(de.startTime or 0.0) if de else 0.0
     stop = float(de.stopTime or 1.0) if de else 1.0
@@ -84,6 +85,7 @@ def experiment(md):
 
 
 def write_csv(path, names, columns):
+    """Writes `columns` (SI units, time in s first) under the header `names` to `path`."""
     with open(path, "w") as f:
         f.write(",".join(names) + "\n")
         for row in zip(*columns):
@@ -91,6 +93,8 @@ def write_csv(path, names, columns):
 
 
 def generate(model):
+    """Writes crosscheck/<model>/ (inputs, reference outputs in SI units, options) and
+    docs/fmu/<model>.png."""
     fmu = str(FMU_DIR / f"{model}.fmu")
     md = read_model_description(fmu)
     start, stop, step = experiment(md)
@@ -181,6 +185,7 @@ def plot(model, md, signals, result, outputs):
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus crosscheck`."""
     parser.add_argument("model", nargs="*", help="FMU names (default: every packaged FMU)")
 
 

@@ -61,6 +61,8 @@ class Muscle:
 
 
 def sweep(name, preset):
+    """Stiffness dF/dL (N/m), pressure gain dF/dP (m2) and threshold pressure (Pa) of Table 2.1
+    muscle `name` (`preset`) over its stroke (lengths in m) and PRESSURES (Pa)."""
     m = Muscle(preset)
     lo, hi = m.min_length, m.max_length
     # The stroke: from where the muscle at the highest pressure pulls nothing (F = 0) up to 2% of
@@ -107,6 +109,8 @@ def analyse(s):
 
 
 def plot(s, a):
+    """Writes docs/linearized/muscle_<name>.png from `sweep`'s and `analyse`'s results (plotted in
+    kN/m, N/MPa, kPa, mm); returns its path."""
     from matplotlib.lines import Line2D
 
     L = s["lengths"] * 1e3

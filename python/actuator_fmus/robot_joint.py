@@ -27,6 +27,7 @@ COLUMNS = ["time", "q", "dq", "q_ref", "p_flexor", "p_extensor", "f_flexor", "f_
 
 
 def load_parameters(path=PARAMETERS):
+    """The joint's parameters from examples/robot_joint.json (SI units: m, kg, kg m2, N m s, Pa, s)."""
     with open(path) as f:
         return json.load(f)
 
@@ -116,6 +117,7 @@ def simulate(p, stop_time=None):
 
 
 def write_csv(rows, path):
+    """Writes the trajectory rows (COLUMNS: s, rad, rad/s, rad, Pa, Pa, N, N, N m) to `path`."""
     with open(path, "w") as f:
         f.write(",".join(COLUMNS) + "\n")
         for row in rows:
@@ -123,6 +125,7 @@ def write_csv(rows, path):
 
 
 def read_csv(path):
+    """(header, rows) of a trajectory CSV written by `write_csv` (SI units)."""
     with open(path) as f:
         header = f.readline().strip().split(",")
         rows = [[float(x) for x in line.split(",")] for line in f if line.strip()]
@@ -130,6 +133,8 @@ def read_csv(path):
 
 
 def plot(rows, path):
+    """Writes the trajectory's plot to `path`: angle in deg, pressures in kPa, forces in N, torque in
+    N m."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -160,12 +165,14 @@ def plot(rows, path):
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus robot-joint` (stop time in s)."""
     parser.add_argument("--out", default="out", help="output directory (default: out)")
     parser.add_argument("--stop-time", type=float, default=None, help="s (default: the parameters file's)")
     parser.add_argument("--no-plot", action="store_true", help="write only the CSV")
 
 
 def main(args):
+    """Simulates the joint and writes <out>/robot_joint.csv (SI units) and .png; returns 0."""
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     p = load_parameters()

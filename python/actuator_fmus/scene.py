@@ -71,6 +71,8 @@ def schema_errors(scene):
 
 
 def load_scene(path, fast=False):
+    """The scene file at `path`, checked against the schema (SceneError otherwise); `fast`: its short
+    variant. Numbers in SI units."""
     path = pathlib.Path(path)
     scene = json.loads(path.read_text())
     errors = schema_errors(scene)
@@ -124,6 +126,7 @@ def check_scene(scene):
 
 
 def signal_values(signal, t, stop_time, directory):
+    """The input `signal` of a scene sampled at times `t` (s), in its variable's SI unit."""
     kind = signal["type"]
     if kind == "constant":
         return np.full_like(t, signal["value"])
@@ -229,6 +232,7 @@ def run_scene(scene, progress=True):
 
 
 def zero_crossing(x, y):
+    """The x where y first crosses zero, linearly interpolated (units of x); NaN if it never does."""
     sign = np.sign(y)
     idx = np.nonzero(sign[:-1] * sign[1:] <= 0)[0]
     if idx.size == 0:
@@ -266,6 +270,7 @@ def quantity(value, unit):
 
 
 def run_label(scene, value, unit_of):
+    """"<swept variable> = <value in display units>" for a sweep run, "" without a sweep."""
     if value is None:
         return ""
     variable = scene["sweep"]["variable"]
@@ -326,6 +331,7 @@ def branches(x):
 
 
 def write_outputs(scene, runs, out):
+    """Writes <out>/<scene>.csv (SI units) and, if the scene has a plot, <out>/<scene>.png."""
     out.mkdir(parents=True, exist_ok=True)
     sweep = scene.get("sweep")
     names = list(runs[0][1].dtype.names)
@@ -382,6 +388,7 @@ def write_outputs(scene, runs, out):
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus scene`."""
     parser.add_argument("scene", nargs="+", help="scene files (scenes/*.json)")
     parser.add_argument("--fast", action="store_true", help="the scene's short variant (as in make test)")
     parser.add_argument("--out", default="out", help="output directory (default: out)")

@@ -160,10 +160,13 @@ def sweep(prestrains, thicknesses, scheduler=None, workers=2, batch=20, layers=8
 
 
 def linspace(a, b, n):
+    """`n` evenly spaced values from `a` to `b` (their unit), as a list."""
     return [a + (b - a) * i / (n - 1) for i in range(n)] if n > 1 else [a]
 
 
 def plot(rows, prestrains, thicknesses, path):
+    """Writes the map of net work per stroke (J) over pre-strain (%) and wall thickness (mm) to
+    `path`."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -200,6 +203,7 @@ def plot(rows, prestrains, thicknesses, path):
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus sweep`."""
     parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (default: local cluster)")
     parser.add_argument("--workers", type=int, default=2, help="local cluster worker processes")
     parser.add_argument("--prestrains", type=int, default=60, help="pre-strain points, 0 .. 90%%")
@@ -211,6 +215,8 @@ def add_arguments(parser):
 
 
 def main(args):
+    """Runs the sweep and writes <out>/sweep.csv (pre-strain 1, thickness m, net work J) and
+    sweep.png; returns 0."""
     prestrains = linspace(0.0, 0.9, args.prestrains)
     thicknesses = linspace(0.4e-3, 2.4e-3, args.thicknesses)
     rows, seconds = sweep(prestrains, thicknesses, args.scheduler, args.workers, args.batch, args.layers,

@@ -20,6 +20,7 @@ STEP = 1e-3
 
 
 def build_ssp(out=OUT):
+    """Writes <out>/RobotJoint.ssp (systems/RobotJoint.ssd and the two FMUs); returns its path."""
     out.mkdir(parents=True, exist_ok=True)
     path = out / "RobotJoint.ssp"
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
@@ -51,6 +52,8 @@ def build_container(out=OUT):
 
 
 def run_ssp(path, stop_time=4.0):
+    """Simulates the SSP for `stop_time` s with FMPy's simulate_ssp at 1 ms steps; returns its result
+    (SI units)."""
     from fmpy.ssp.simulation import simulate_ssp
 
     return simulate_ssp(str(path), stop_time=stop_time, step_size=STEP)
@@ -90,6 +93,7 @@ def _callbacks(logger):
 
 
 def run_container(path, stop_time=4.0):
+    """Simulates the container FMU for `stop_time` s; returns the result (SI units)."""
     from fmpy import extract, read_model_description, simulate_fmu
     from fmpy.fmi2 import FMU2Slave, printLogMessage
 
@@ -124,10 +128,12 @@ class _UnconnectedOutputs(logging.Filter):
 
 
 def add_arguments(parser):
+    """The options of `actuator-fmus systems`."""
     parser.add_argument("--run", action="store_true", help="simulate both for 4 s and plot them against the two-FMU run")
 
 
 def main(args):
+    """Builds the SSP and the container FMU and, with --run, simulates and plots both; returns 0."""
     ssp = build_ssp()
     container = build_container()
     print(f"wrote {ssp} and {container}")
