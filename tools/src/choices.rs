@@ -111,7 +111,9 @@ pub fn preset_values(
             Ok(()) => calculated
                 .iter()
                 .map(|v| match v.kind {
-                    VarType::Real => crate::package::number(runtime.real(v.vr as usize)),
+                    VarType::Real => {
+                        crate::package::number(significant(runtime.real(v.vr as usize), 5))
+                    }
                     VarType::Integer => {
                         let x = runtime.integer(v.vr as usize);
                         enumeration_variables(xml)
@@ -130,4 +132,14 @@ pub fn preset_values(
         rows.push((name.clone(), values));
     }
     Some((columns, rows))
+}
+
+/// `x` rounded to `digits` significant digits: a table read at a glance (the model description
+/// and the FMU keep full precision).
+fn significant(x: f64, digits: i32) -> f64 {
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let scale = 10f64.powi(digits - 1 - x.abs().log10().floor() as i32);
+    (x * scale).round() / scale
 }
