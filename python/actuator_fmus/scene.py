@@ -199,8 +199,10 @@ def run_scene(scene, progress=True):
         signals = None
         if inputs:
             # FMPy warns for every input without a column: the scene's other inputs are held at
-            # their declared start values, as they would be without any input signal.
-            held = {name: float(v.start) for name, v in checks.variables(scene["fmu"]).items()
+            # their start values (the scene's parameters, else the declared ones), as they would
+            # be without any input signal.
+            held = {name: float(parameters.get(name, v.start))
+                    for name, v in checks.variables(scene["fmu"]).items()
                     if v.causality == "input" and name not in inputs and v.type == "Real"}
             signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in [*inputs, *held]])
             signals["time"] = t

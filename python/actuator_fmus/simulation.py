@@ -20,18 +20,19 @@ def simulate(model, start_values=None, input=None, output=None, **options):
     if input is not None:
         for name in input.dtype.names[1:]:
             checks.check_input_values(model, name, input[name], input["time"])
-        input = _with_held_inputs(model, input)
+        input = _with_held_inputs(model, input, start_values)
     if output is not None:
         checks.check_output_names(model, output)
     return simulate_fmu(path, start_values=start_values, input=input, output=output, **options)
 
 
-def _with_held_inputs(model, signals):
-    """`signals` with a constant column at its declared start value for every Real input it lacks,
-    so that FMPy does not warn about them (they are held at that value either way)."""
+def _with_held_inputs(model, signals, start_values):
+    """`signals` with a constant column for every Real input it lacks, at the start value given
+    in `start_values` or else the declared one, so that FMPy does not warn about them (they are
+    held at that value either way)."""
     import numpy as np
 
-    held = {name: float(v.start) for name, v in checks.variables(model).items()
+    held = {name: float(start_values.get(name, v.start)) for name, v in checks.variables(model).items()
             if v.causality == "input" and v.type == "Real" and name not in signals.dtype.names}
     if not held:
         return signals

@@ -179,3 +179,17 @@ def test_the_presets_table_gives_each_presets_values():
     # Table 2.1's listed lengths (mm) and the Festo fits' nominal lengths, in m.
     assert re.findall(r'<td class="n">([^<]*)</td>', row) == ["0.10325", "0.10325", "0.1088", "0.0989",
                                                                "0.1358", "0.25", "0.4"]
+
+
+def test_inputs_without_a_column_keep_their_start_values_and_nothing_warns(capfd):
+    # The signal gives only the length; the pressure is a start value the run must keep (FMPy
+    # would warn about its missing column; the package holds it instead).
+    t = np.linspace(0.0, 0.01, 11)
+    signals = np.array(list(zip(t, np.full_like(t, 0.09))), dtype=[("time", float), ("length", float)])
+    r = simulate("McKibbenMuscle", start_values={"pressure": 3e5}, input=signals, output=["force"],
+                 stop_time=0.01, output_interval=1e-3)
+    muscle = Slave("McKibbenMuscle", length=0.09)
+    assert r["force"][-1] == pytest.approx(muscle.at("force", pressure=3e5), rel=1e-12)
+    muscle.close()
+    out, err = capfd.readouterr()
+    assert "arning" not in out + err
