@@ -1,7 +1,8 @@
 """Writes docs/accuracy-cost.md: for every fidelity knob, the error against a converged reference
 (computed here under FMPy) beside the native time per step (criterion, benches/accuracy_cost.rs,
 read from target/criterion), log-log work-precision plots, the cost under FMPy beside the
-PassThrough FMU, and the targets of issues 7 and 15. Run by `make report` after the benchmarks.
+PassThrough FMU, and the targets of issues 7 and 15. Run by `make report` after the benchmarks;
+`benches/report.py --replot` redraws only the work-precision plots from docs/accuracy-cost.md.
 
 Timings are CPU time of the measuring thread wherever the machine's load would dominate wall
 time: the criterion bench measures thread CPU time (benches/cpu_clock.rs), benches/cpu_time.rs
@@ -484,6 +485,27 @@ def fmt_time(s):
     return f"{s * 1e9:.0f} ns" if s < 1e-6 else (f"{s * 1e6:.2f} us" if s < 1e-3 else f"{s * 1e3:.2f} ms")
 
 
+def replot_from_page():
+    """docs/accuracy/<FMU>.png again from the tables of docs/accuracy-cost.md (error, 1 or rad;
+    native time per step, ns, us or ms)."""
+    import re
+
+    text = (DOCS / "accuracy-cost.md").read_text()
+    per_second = {"ns": 1e-9, "us": 1e-6, "µs": 1e-6, "ms": 1e-3, "s": 1.0}
+    for fmu in ("McKibbenMuscle", "KnittedMuscle", "MultiferroicMotor"):
+        if f"## {fmu}\n" not in text:
+            continue
+        section = text.split(f"## {fmu}\n", 1)[1].split("\n## ", 1)[0]
+        scenario = re.search(r"Scenario: (.*)\.\n", section).group(1)
+        points = []
+        for knob, value, err, t in re.findall(r"\| `(\w+)` \| ([^|]+) \| ([^|]+) \| ([^|]+) \|", section):
+            number, unit = t.split()
+            if unit in per_second and float(err) > 0:
+                points.append((float(number) * per_second[unit], float(err), knob, value.strip()))
+        plot_work_precision(fmu, scenario, points, None, None)
+        print(f"wrote {PLOTS / fmu}.png")
+
+
 def main():
     global CPU
     parity = parity_figures()
@@ -492,6 +514,11 @@ def main():
         if parity is None:
             sys.exit("no target/parity/parity.json: run `cargo bench --bench parity` first")
         write_readme_block("fmi-parity", parity_table(parity))
+        return
+    if "--replot" in sys.argv:
+        # Only the work-precision plots, from the numbers docs/accuracy-cost.md holds (its last
+        # `make report`): a change to the plots needs no benchmark run.
+        replot_from_page()
         return
     times = criterion_times()
     CPU = cpu_figures()
