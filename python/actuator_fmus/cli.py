@@ -25,6 +25,7 @@ COMMANDS = [
     ("knitted-bag", "knitted_bag", "docs/knitted-bag.md: the section 1.4 prototype's bag and its stroke"),
     ("motor", "motor", "docs/motor.md: the MultiferroicMotor's stepper characteristics"),
     ("linearized", "linearized", "docs/linearized-muscle.md: stiffness and pressure gain over the stroke"),
+    ("chapter2-claims", "chapter2", "docs/chapter2-claims.md: chapter 2's claims with the dissertation's walls and the exact wall"),
 ]
 
 

@@ -57,6 +57,19 @@ def stroke(pressure, resistance=0.0, **start):
     return 1.0 - at / hi
 
 
+def bag_for(target, pressure=14e3, points=2001):
+    """The inextensible bag diameter (m) that stops the ideal cylinder at the stroke `target`
+    (bisection through the FMU; the stroke grows with the bag)."""
+    lo, hi = 0.02, 0.15
+    for _ in range(30):
+        mid = 0.5 * (lo + hi)
+        if stroke(pressure, points=points, bag_diameter=mid) < target:
+            lo = mid
+        else:
+            hi = mid
+    return 0.5 * (lo + hi)
+
+
 Y_RANGE = (-2.5, 6.5)  # N/kPa, the plot's
 
 
@@ -76,6 +89,11 @@ def main(args=None):
     resistance = float(np.interp(1.0 - MEASURED[14e3], (length / hi)[::-1], force[::-1]))
     # What the sleeve pulls at 2% contraction, past the presliding transition.
     pulling = float(np.interp(0.98, (length / hi)[::-1], force[::-1]))
+    # The bags that would stop the ideal cylinder at each measured stroke, and the naive guess
+    # (0.42 of the sleeve's 153 mm).
+    bag_42, bag_51 = bag_for(MEASURED[14e3]), bag_for(MEASURED[100e3])
+    naive = 0.42 * 0.153
+    naive_stroke = stroke(14e3, bag_diameter=naive)
 
     fig, ax = plt.subplots(figsize=(7.5, 4.8))
     # Per unit pressure several runs give the same curve: each distinct curve is drawn once, with
@@ -156,8 +174,10 @@ Free contraction (tension zero while contracting from full extension; friction z
   and `F = -P dV/dL` are both proportional to P), so neither, nor both together, makes the stroke
   depend on pressure.
 - Both measured strokes are shorter than the bag's limit. Stretching the bag only lengthens the
-  stroke where the bag binds, so it cannot bring it down to 42%. For the bag to stop the muscle at
-  42% its diameter would have to be about 0.42 x 153 mm = 64 mm, not 85 mm. The dissertation's own
+  stroke where the bag binds, so it cannot bring it down to 42%. For an inextensible bag to stop the
+  muscle at 42% its diameter would have to be {bag_42 * 1e3:.1f} mm, and at 51% {bag_51 * 1e3:.1f} mm, not
+  85 mm (the stroke is not proportional to the bag's diameter: a {naive * 1e3:.1f} mm bag, 0.42 of the
+  sleeve's 153 mm, stops it at {naive_stroke:.1%}). The dissertation's own
   explanation of the 51% (bag stretching) does not follow from this model; its other explanation
   (friction overcome by more energy at higher pressure) needs friction that does not scale with P.
 - A pressure-independent resistance (the folding bag, the clamps) would make the stroke grow with

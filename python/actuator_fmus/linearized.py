@@ -42,7 +42,7 @@ class Muscle:
         self.fmu.instantiate()
         self.fmu.setupExperiment(startTime=0.0)
         self.fmu.enterInitializationMode()
-        self.fmu.setInteger([self.vr["preset"], self.vr["bladder_model"]], [preset, 2])
+        self.fmu.setInteger([self.vr["preset"], self.vr["bladder_model"]], [preset, 5])
         self.fmu.exitInitializationMode()
         self.min_length, self.max_length = self.fmu.getReal([self.vr["min_length"], self.vr["max_length"]])
 
@@ -193,7 +193,7 @@ edit by hand.
 Chapter 2's introduction proposes that, once a muscle is designed, a controls engineer can treat it
 as a spring whose stiffness is proportional to the applied pressure minus the threshold pressure.
 This page checks that against the full model. For Table 2.1's muscles A-D with the thick-walled
-bladder (`bladder_model` 2, 16 layers, the chapter's latex), the stiffness `dF/dL` and the pressure
+bladder (`bladder_model` 5, the dissertation's 16 layers as written, the chapter's latex), the stiffness `dF/dL` and the pressure
 gain `dF/dP` are read through `fmi2GetDirectionalDerivative` (exact partials, no finite differences)
 on a grid of {LENGTHS} lengths over the stroke (from the length where the muscle at 700 kPa pulls
 nothing, to 2% of the length range short of the fill limit where the stiffness diverges) and

@@ -54,7 +54,8 @@ def net_work(fmu, vr, prestrain, thickness, layers, n_lengths):
     fmu.enterInitializationMode()
     reals = dict(MUSCLE_A, bladder_length=LISTED_LENGTH / (1 + prestrain), bladder_thickness=thickness, length=0.08)
     fmu.setReal([vr[k] for k in reals], list(reals.values()))
-    fmu.setInteger([vr["bladder_model"], vr["bladder_layers"]], [2, layers])
+    # The dissertation's layers as written (bladder_model 5), as in the README's work table.
+    fmu.setInteger([vr["bladder_model"], vr["bladder_layers"]], [5, layers])
     try:
         fmu.exitInitializationMode()
     except Exception:

@@ -1,19 +1,22 @@
-//! The FMI 2.0 export layer (Co-Simulation, and Model Exchange in `model_exchange`): the only
-//! `unsafe` code of the crate.
+//! The FMI 2.0 export layer (Co-Simulation and Model Exchange): the only `unsafe` code of the
+//! crate.
 //!
-//! `exports` holds the C functions; `instance` the call-sequence state machine and the variable
-//! rules; `runtime` the bridge to any [`crate::models::Model`]; `registry` the generated list of
-//! models and the bindings between value references and each model's typed variables. A model
-//! needs no code here.
+//! Imports point one way, each module only at those after it:
+//! - `exports`: the C functions, Co-Simulation and Model Exchange; each checks the pointers and
+//!   runs one `Instance` method under the panic guard;
+//! - `instance`: the call-sequence state machine, the variable rules, FMU states, the
+//!   out-of-range policy;
+//! - `registry`: the generated list of models and their [`runtime::Bindings`];
+//! - `runtime`: the bridge to any [`crate::models::Model`] behind `dyn Runtime`;
+//! - `logger`, `types`: the importer's callbacks and the C types.
+//!
+//! A model needs no code here.
 
 #![deny(unsafe_op_in_unsafe_fn)]
 
-mod derivatives;
 mod exports;
 mod instance;
 mod logger;
-mod model_exchange;
-mod out_of_range;
 pub mod registry;
 pub mod runtime;
 pub mod types;

@@ -56,3 +56,15 @@ pub struct fmi2CallbackFunctions {
     pub step_finished: Option<fmi2StepFinished>,
     pub component_environment: fmi2ComponentEnvironment,
 }
+
+/// `fmi2EventInfo` (fmi2FunctionTypes.h).
+#[repr(C)]
+#[derive(Clone, Copy, Debug)]
+pub struct fmi2EventInfo {
+    pub new_discrete_states_needed: fmi2Boolean,
+    pub terminate_simulation: fmi2Boolean,
+    pub nominals_of_continuous_states_changed: fmi2Boolean,
+    pub values_of_continuous_states_changed: fmi2Boolean,
+    pub next_event_time_defined: fmi2Boolean,
+    pub next_event_time: fmi2Real,
+}

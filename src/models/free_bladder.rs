@@ -1,6 +1,7 @@
 //! FreeBladder FMU: the McKibben muscle's latex tube without its sleeve, gauge pressure and clamp
 //! length in, diameter, volume, compliance, stretches, stresses and clamp force out (dissertation
-//! section 2.2.2, eq. 2.6-2.12, 2.17, 2.18; physics in [`crate::physics::free_bladder`]).
+//! section 2.2.2, eq. 2.6-2.9, 2.17, the thick wall solved exactly; physics in
+//! [`crate::physics::free_bladder`]).
 //!
 //! It has no history: evaluate and step are the same algebraic map, so it also serves Model
 //! Exchange. Inputs outside the solvable range are evaluated at the nearest valid point and
@@ -255,8 +256,8 @@ mod tests {
             (o.inner_diameter, o.stretch_hoop, o.force),
             (0.0038, 1.0, 0.0)
         );
-        // 2 (C1 + C2) 2t / D_RI (eq. 2.18 as the diameter grows without bound).
-        assert!((o.ballooning_pressure - 52_631.58).abs() < 0.01);
+        // 2 (C1 + C2) ln(D_RO / D_RI): the exact tube as its diameter grows without bound.
+        assert!((o.ballooning_pressure - 49_445.58).abs() < 0.01);
     }
 
     #[test]
@@ -286,7 +287,7 @@ mod tests {
         assert_eq!(messages, 2);
         assert_eq!(volumes[0], volumes[1]);
         assert_eq!(volumes[3], volumes[4]);
-        assert!(volumes[0] > 50.0 * volumes[2] && volumes[3] < volumes[5]);
+        assert!(volumes[0] > 20.0 * volumes[2] && volumes[3] < volumes[5]);
     }
 
     /// The Real outputs by name.
@@ -357,7 +358,10 @@ mod tests {
                             .map(|(_, d)| *d)
                             .unwrap_or_else(|| panic!("no partial of {name} by {input}"));
                         let size = hi.abs().max(lo.abs()).max(1e-30);
-                        let scale = exact.abs().max(central.abs()) + 1e-8 * size / h.max(1e-30);
+                        // Near the ballooning pressure the volume ratio is ill-conditioned (the
+                        // pressure is flat in it), so its rounding is larger there.
+                        let noise = if fraction > 0.98 { 1e-5 } else { 1e-8 };
+                        let scale = exact.abs().max(central.abs()) + noise * size / h.max(1e-30);
                         assert!(
                             (exact - central).abs() <= 1e-6 * scale,
                             "lambda {lambda}, P {pressure}: d{name}/d{input} exact {exact}, \

@@ -1,13 +1,12 @@
 //! McKibbenMuscle FMU: gauge pressure and length in, tension force out.
 //!
-//! Effects, each built only when switched on: the Mooney-Rivlin bladder (`bladder_model` 1 thin
-//! wall, 2 thick wall of `bladder_layers` layers, 3 continuum wall of `bladder_layers` quadrature
-//! nodes), friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
+//! Effects, each built only when switched on: the Mooney-Rivlin bladder (`bladder_model` 1-6, see
+//! [`BladderModel::from_switch`]; 3 is the exact wall of `bladder_layers` quadrature nodes),
+//! friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
 use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
-use crate::physics::calibration::MuscleParams;
 use crate::physics::festo::{DMSP_10, DMSP_40};
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
@@ -15,6 +14,7 @@ use crate::physics::inverse::pressure_for_force;
 use crate::physics::mckibben::{
     BladderModel, FrictionParams, McKibben, McKibbenOutput, McKibbenPartials, MuscleGeometry,
 };
+use crate::physics::muscle_params::MuscleParams;
 use crate::variables::mckibben_muscle::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
 };

@@ -1,13 +1,9 @@
 //! Exact partial derivatives of the free bladder's outputs with respect to its gauge pressure and
-//! clamp length, by the implicit function theorem on eq. 2.18 (dissertation section 2.2.2).
-//!
-//! In `w = lambda_1 lambda_2^2`, eq. 2.18 is `G(w, P, A) = (A - P r) w^2 - P w - A = 0` with
-//! `A = 2 (C1/lambda_1 + C2 lambda_1)`. At the positive root `dG/dw = 2 (A - P r) w - P` equals
-//! the quadratic's square root `sqrt(P^2 + 4 A (A - P r))` > 0, so
-//! `dw = ((r w^2 + w) dP - (w^2 - 1) dA) / sqrt(...)` everywhere below the ballooning pressure.
-//! The stretches (eq. 2.8), stresses (eq. 2.9), volume, diameters and clamp force (eq. 2.5, 2.17)
-//! are explicit in `w` and `lambda_1`; the compliance `V_0 dw/dP` is differentiated in the form
-//! [`FreeBladder::evaluate`] computes it, `V_0 (r w^2 + w)^2 / (A (w^2 + 2 r w + 1))`.
+//! clamp length, by the implicit function theorem on the tube's pressure equation
+//! `P = (A/2) f(w)` (see the module comment of `free_bladder.rs`): `dw = (dP - f dA / 2) / (A f' / 2)`
+//! with `f' > 0` everywhere below the ballooning pressure. The stretches (eq. 2.8), stresses
+//! (eq. 2.9), volume, diameters and clamp force are explicit in `w` and `lambda_1`; the compliance
+//! `V_0 / (A f' / 2)` is differentiated through `f''`.
 
 use super::{FreeBladder, FreeBladderState};
 use std::f64::consts::PI;
@@ -54,8 +50,8 @@ impl FreeBladder {
         let state = self.evaluate(pressure, length)?;
         let (a, w) = self.volume_ratio(pressure, length)?;
         let partials = FreeBladderPartials {
-            by_pressure: self.tangent(&state, pressure, length, a, w, 1.0, 0.0),
-            by_length: self.tangent(&state, pressure, length, a, w, 0.0, 1.0),
+            by_pressure: self.tangent(&state, length, a, w, 1.0, 0.0),
+            by_length: self.tangent(&state, length, a, w, 0.0, 1.0),
         };
         let finite = [partials.by_pressure, partials.by_length].iter().all(|t| {
             [
@@ -82,13 +78,12 @@ impl FreeBladder {
         }
     }
 
-    /// Forward-mode tangent of `state` (at `pressure`, `length`, with eq. 2.18's `A` and root `w`)
-    /// along `(dp, dl)`.
+    /// Forward-mode tangent of `state` (at `length`, with the modulus `A` and the
+    /// volume ratio `w`) along `(dp, dl)`.
     #[allow(clippy::too_many_arguments)]
     fn tangent(
         &self,
         state: &FreeBladderState,
-        pressure: f64,
         length: f64,
         a: f64,
         w: f64,
@@ -96,19 +91,17 @@ impl FreeBladder {
         dl: f64,
     ) -> FreeBladderState {
         let t = &self.tube;
-        let (c1, c2, r) = (t.mooney_c1, t.mooney_c2, self.slenderness);
+        let (c1, c2) = (t.mooney_c1, t.mooney_c2);
         let (l1, l2, l3) = (
             state.stretch_axial,
             state.stretch_hoop,
             state.stretch_radial,
         );
         let dl1 = dl / t.unstretched_length;
-        let da = r * self.ballooning_pressure_slope(length) * dl;
-        // Implicit function theorem on eq. 2.18 (module comment).
-        let lead = a - pressure * r;
-        let root = (pressure * pressure + 4.0 * a * lead).sqrt();
-        let n = r * w * w + w;
-        let dw = (n * dp - (w * w - 1.0) * da) / root;
+        let da = 2.0 * (c2 - c1 / (l1 * l1)) * dl1;
+        // Implicit function theorem on P = (A/2) f(w) (module comment).
+        let (f, slope, curvature) = self.shape(w);
+        let dw = (dp - 0.5 * f * da) / (0.5 * a * slope);
         // Eq. 2.8: lambda_2 = sqrt(w / lambda_1), lambda_3 = 1 / (lambda_1 lambda_2).
         let dl2 = 0.5 * l2 * (dw / w - dl1 / l1);
         let dl3 = -l3 * (dl1 / l1 + dl2 / l2);
@@ -120,26 +113,32 @@ impl FreeBladder {
         let d_inner = dl2 * t.inner_diameter;
         let d_in = state.inner_diameter;
         let rubber = self.rubber_volume;
-        // Compliance V_0 n^2 / (A q): d ln C = 2 dn/n - dA/A - dq/q.
-        let q = w * w + 2.0 * r * w + 1.0;
-        let dn = (2.0 * r * w + 1.0) * dw;
-        let dq = 2.0 * (w + r) * dw;
+        // Clamp force pi/(2 l1) ((G + 2 alpha) ring + alpha (w - 1) inner ln(w/u_o)).
+        let (_, alpha) = Self::force_constants(c1, c2, l1);
+        let dg0 = (8.0 * c1 * l1 + 8.0 * c2 / (l1 * l1 * l1)) * dl1;
+        let dalpha = (2.0 * c2 + 2.0 * c1 / (l1 * l1)) * dl1;
+        let (ring, inner) = self.radii_sq;
+        let log = self.log_volume_ratio(w);
+        let u_o = 1.0 + (w - 1.0) * self.rho;
+        let dlog = (1.0 - self.rho) / (w * u_o) * dw;
+        let d_force = -state.force * dl1 / l1
+            + PI / (2.0 * l1)
+                * ((dg0 + 2.0 * dalpha) * ring
+                    + dalpha * (w - 1.0) * inner * log
+                    + alpha * inner * (dw * log + (w - 1.0) * dlog));
         FreeBladderState {
             inner_diameter: d_inner,
             outer_diameter: (d_in * d_inner - 2.0 * rubber / (PI * length * length) * dl)
                 / state.outer_diameter,
             fluid_volume: self.relaxed_volume * dw,
-            compliance: state.compliance * (2.0 * dn / n - da / a - dq / q),
+            compliance: state.compliance * (-da / a - curvature * dw / slope),
             stretch_axial: dl1,
             stretch_hoop: dl2,
             stretch_radial: dl3,
             stress_axial: d_stress_axial,
             stress_hoop: dmooney(l2, dl2) - dp,
-            force: d_stress_axial * rubber / length
-                - state.stress_axial * rubber / (length * length) * dl
-                - dp * PI / 4.0 * d_in * d_in
-                - pressure * PI / 2.0 * d_in * d_inner,
-            ballooning_pressure: da / r,
+            force: d_force,
+            ballooning_pressure: da * self.log_ratio,
         }
     }
 }

@@ -6,7 +6,7 @@
 
 use crate::physics::friction::HysteresisState;
 use crate::physics::mckibben::McKibben;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 
 /// Stopping rule of the inversions: the Newton correction of the argument (Pa) below 1e-13 of
 /// it plus 1e-9 Pa, or 200 evaluations (bisection alone would halve any bracket that often).
@@ -144,8 +144,8 @@ mod tests {
         let rest = HysteresisState::at_rest(0.09);
         for model in [
             BladderModel::None,
-            BladderModel::ThinWall,
-            BladderModel::ThickWall { layers: 16 },
+            BladderModel::DissertationThinWall,
+            BladderModel::DissertationLayers { layers: 16 },
         ] {
             let m = McKibben::from_geometry(&g, model, None, 0.0).unwrap();
             for length in [0.085, 0.09, 0.095] {

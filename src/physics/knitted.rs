@@ -10,7 +10,6 @@
 // `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 use super::knitted_shape::{ShapeGeometry, ShapeTable, DEFAULT_TABLE_NODES};
-use crate::physics::knitted_bag::Bag;
 use std::f64::consts::{PI, SQRT_2};
 
 /// Sleeve parameters, SI units.
@@ -231,7 +230,7 @@ impl KnittedSleeve {
         if length.is_nan() {
             return self.max_length;
         }
-        super::bounds::limit(length, self.min_length, self.max_length)
+        super::numerics::bounds::limit(length, self.min_length, self.max_length)
     }
 
     /// `(V, dV/dL, d2V/dL2)` at a (clamped) length.
@@ -307,17 +306,17 @@ impl KnittedSleeve {
         length: f64,
         friction: Option<(&StrandFriction, f64)>,
     ) -> Result<SleeveState, String> {
-        self.evaluate_in_bag(pressure, length, friction, None)
+        self.evaluate_contained(pressure, length, friction, None)
     }
 
-    /// [`Self::evaluate`] with the fluid held inside `bag` (section 1.4's polyethylene bag; see
+    /// [`Self::evaluate`] with the fluid held inside `container` (section 1.4's polyethylene bag,
     /// [`crate::physics::knitted_bag`]): `F = -P dV/dL` of the capped volume.
-    pub fn evaluate_in_bag(
+    pub fn evaluate_contained(
         &self,
         pressure: f64,
         length: f64,
         friction: Option<(&StrandFriction, f64)>,
-        bag: Option<&Bag>,
+        container: Option<&dyn FluidContainer>,
     ) -> Result<SleeveState, String> {
         if !pressure.is_finite() || !length.is_finite() {
             return Err(format!(
@@ -326,8 +325,8 @@ impl KnittedSleeve {
         }
         let l = self.clamp_length(length);
         let sleeve_volume = self.volume_derivatives(l);
-        let (volume, dv, ddv) = match bag {
-            Some(b) => b.volume_derivatives(self, pressure, l),
+        let (volume, dv, ddv) = match container {
+            Some(c) => c.volume_derivatives(self, pressure, l),
             None => sleeve_volume,
         };
         let bag_binds = (volume, dv, ddv) != sleeve_volume;
@@ -336,8 +335,8 @@ impl KnittedSleeve {
         } else {
             (self.force(pressure, l), self.stiffness(pressure, l))
         };
-        let max_radius = match bag {
-            Some(b) => self.max_radius(l).min(b.radius_at(pressure)),
+        let max_radius = match container {
+            Some(c) => self.max_radius(l).min(c.radius_at(pressure)),
             None => self.max_radius(l),
         };
         let mut state = SleeveState {
@@ -448,6 +447,16 @@ impl KnittedSleeve {
             }
         }
     }
+}
+
+/// A flexible container inside the sleeve that may hold the fluid in less than the sleeve's
+/// volume (section 1.4's bag): it carries no axial load, it only caps the volume.
+pub trait FluidContainer {
+    /// `(V, dV/dL, d2V/dL2)` of the fluid at gauge pressure `pressure` and length `l`: the
+    /// sleeve's own where the container is wider.
+    fn volume_derivatives(&self, sleeve: &KnittedSleeve, pressure: f64, l: f64) -> (f64, f64, f64);
+    /// The container's radius at gauge pressure `pressure` (m).
+    fn radius_at(&self, pressure: f64) -> f64;
 }
 
 /// What the sleeve without a bladder reports at one point (see [`KnittedSleeve::evaluate`]).

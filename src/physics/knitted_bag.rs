@@ -11,7 +11,7 @@
 //! `R = R0 (1 + P R0 / (E t))` (thin-wall hoop strain `P R / (E t)` at small strain). It is the
 //! explanation section 1.4.2 offers for the stroke's growth with pressure.
 
-use crate::physics::knitted::KnittedSleeve;
+use crate::physics::knitted::{FluidContainer, KnittedSleeve};
 use std::f64::consts::PI;
 
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -99,6 +99,15 @@ impl Bag {
             }
         }
         hi
+    }
+}
+
+impl FluidContainer for Bag {
+    fn volume_derivatives(&self, sleeve: &KnittedSleeve, pressure: f64, l: f64) -> (f64, f64, f64) {
+        Bag::volume_derivatives(self, sleeve, pressure, l)
+    }
+    fn radius_at(&self, pressure: f64) -> f64 {
+        Bag::radius_at(self, pressure)
     }
 }
 

@@ -1,5 +1,6 @@
 //! The McKibben muscle of chapter 2: ideal sleeve (eq. 2.1-2.3) with an optional Mooney-Rivlin
-//! bladder (thin wall eq. 2.6-2.18, thick wall eq. 2.19-2.20), optional friction hysteresis
+//! bladder (the exact thick wall, its thin-wall limit, or the dissertation's walls of eq. 2.6-2.20
+//! as written; see [`crate::physics::bladder`]), optional friction hysteresis
 //! (eq. 2.4) and an optional series connector spring (section 2.4).
 //!
 //! Effects that are off are `None` and cost nothing: with no bladder, no friction and a rigid
@@ -8,7 +9,7 @@
 use crate::physics::bladder::{Bladder, BladderState, BladderTube, Wall};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 
 mod partials;
 pub use partials::McKibbenPartials;
@@ -17,18 +18,26 @@ pub use partials::McKibbenPartials;
 const BRACKET_STEPS: usize = 64;
 const ROOT_ITERATIONS: usize = 100;
 
-/// The bladder model switch (the FMU's `bladder_model` 0/1/2/3 with `bladder_layers`).
+/// The bladder model switch (the FMU's `bladder_model` 0-6 with `bladder_layers`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum BladderModel {
     /// Ideal sleeve, eq. 2.3.
     None,
-    /// Thin-walled tube, eq. 2.6-2.18.
+    /// The exact wall's consistent thin-wall limit: eq. 2.6-2.18 with the wall balanced by its
+    /// stress difference ([`Wall::Layers`] with one layer).
     ThinWall,
-    /// `layers` nested thin tubes, eq. 2.19-2.20 (1 layer = thin wall).
-    ThickWall { layers: usize },
-    /// The limit of infinitely many layers, by a `nodes`-point quadrature through the wall
-    /// ([`crate::physics::bladder::Wall::Continuum`]).
-    Continuum { nodes: usize },
+    /// `layers` nested thin tubes, each balanced by its stress difference ([`Wall::Layers`]);
+    /// converges to the exact wall at first order.
+    Layers { layers: usize },
+    /// The exact thick-walled tube by a `nodes`-point quadrature ([`Wall::Exact`]).
+    Exact { nodes: usize },
+    /// The dissertation's thin wall as written, eq. 2.6-2.18 (`sigma_33 = -P`).
+    DissertationThinWall,
+    /// `layers` nested thin tubes, eq. 2.19-2.20 as written ([`Wall::DissertationLayers`]).
+    DissertationLayers { layers: usize },
+    /// The limit of eq. 2.19-2.20 for infinitely many layers, by a `nodes`-point quadrature
+    /// ([`Wall::DissertationContinuum`]).
+    DissertationContinuum { nodes: usize },
 }
 
 impl BladderModel {
@@ -37,27 +46,50 @@ impl BladderModel {
         match self {
             Self::None => None,
             Self::ThinWall => Some(Wall::Layers(1)),
-            Self::ThickWall { layers } => Some(Wall::Layers(layers)),
-            Self::Continuum { nodes } => Some(Wall::Continuum(nodes)),
+            Self::Layers { layers } => Some(Wall::Layers(layers)),
+            Self::Exact { nodes } => Some(Wall::Exact(nodes)),
+            Self::DissertationThinWall => Some(Wall::DissertationLayers(1)),
+            Self::DissertationLayers { layers } => Some(Wall::DissertationLayers(layers)),
+            Self::DissertationContinuum { nodes } => Some(Wall::DissertationContinuum(nodes)),
         }
     }
 
-    /// From the FMU's integer switch (0 none, 1 thin wall, 2 thick wall, 3 continuum wall) and
-    /// layer (or node) count.
+    /// The FMU's integer switch of this model (see [`Self::from_switch`]).
+    pub fn switch(self) -> i32 {
+        match self {
+            Self::None => 0,
+            Self::ThinWall => 1,
+            Self::Layers { .. } => 2,
+            Self::Exact { .. } => 3,
+            Self::DissertationThinWall => 4,
+            Self::DissertationLayers { .. } => 5,
+            Self::DissertationContinuum { .. } => 6,
+        }
+    }
+
+    /// From the FMU's integer switch and layer (or node) count: 0 none, 1 thin wall, 2 layers,
+    /// 3 exact wall, 4 the dissertation's thin wall, 5 the dissertation's layers, 6 the
+    /// dissertation's continuum.
     pub fn from_switch(model: i32, layers: i32) -> Result<Self, String> {
+        let count = || {
+            if layers >= 1 {
+                Ok(layers as usize)
+            } else {
+                Err(format!("bladder_layers must be >= 1, got {layers}"))
+            }
+        };
         match model {
             0 => Ok(Self::None),
             1 => Ok(Self::ThinWall),
-            2 if layers >= 1 => Ok(Self::ThickWall {
-                layers: layers as usize,
-            }),
-            3 if layers >= 1 => Ok(Self::Continuum {
-                nodes: layers as usize,
-            }),
-            2 | 3 => Err(format!("bladder_layers must be >= 1, got {layers}")),
+            2 => Ok(Self::Layers { layers: count()? }),
+            3 => Ok(Self::Exact { nodes: count()? }),
+            4 => Ok(Self::DissertationThinWall),
+            5 => Ok(Self::DissertationLayers { layers: count()? }),
+            6 => Ok(Self::DissertationContinuum { nodes: count()? }),
             _ => Err(format!(
-                "bladder_model must be 0 (none), 1 (thin wall), 2 (thick wall) or 3 (continuum \
-                 wall), got {model}"
+                "bladder_model must be 0 (none), 1 (thin wall), 2 (layers), 3 (exact wall), \
+                 4 (dissertation's thin wall), 5 (dissertation's layers) or 6 (dissertation's \
+                 continuum), got {model}"
             )),
         }
     }
@@ -453,7 +485,7 @@ impl McKibben {
             let core = self.at_actual_length(pressure, l, history)?;
             Ok((l + c * core.out.force - reported, core))
         };
-        let x0 = super::bounds::limit(reported, lo_edge, hi_edge);
+        let x0 = super::numerics::bounds::limit(reported, lo_edge, hi_edge);
         let (h0, core0) = eval(x0)?;
         if h0 == 0.0 {
             return Ok(core0);
@@ -587,28 +619,32 @@ mod tests {
         assert_relative_eq!(d.bladder_thickness, 0.25e-3, max_relative = 1e-12);
         assert_relative_eq!(d.strand_length / d.turns, 0.0314, max_relative = 1e-2); // b/n ~ 30 mm
         assert!(MuscleGeometry::preset('E').is_none());
-        assert_eq!(
-            BladderModel::from_switch(2, 16).unwrap(),
-            BladderModel::ThickWall { layers: 16 }
-        );
+        for model in [
+            BladderModel::None,
+            BladderModel::ThinWall,
+            BladderModel::Layers { layers: 16 },
+            BladderModel::Exact { nodes: 16 },
+            BladderModel::DissertationThinWall,
+            BladderModel::DissertationLayers { layers: 16 },
+            BladderModel::DissertationContinuum { nodes: 16 },
+        ] {
+            assert_eq!(BladderModel::from_switch(model.switch(), 16), Ok(model));
+        }
         assert_eq!(
             BladderModel::from_switch(1, 0).unwrap(),
             BladderModel::ThinWall
         );
-        assert!(BladderModel::from_switch(2, 0).is_err());
-        assert_eq!(
-            BladderModel::from_switch(3, 8).unwrap(),
-            BladderModel::Continuum { nodes: 8 }
-        );
-        assert!(BladderModel::from_switch(3, 0).is_err());
-        assert!(BladderModel::from_switch(4, 1).is_err());
+        for counted in [2, 3, 5, 6] {
+            assert!(BladderModel::from_switch(counted, 0).is_err());
+        }
+        assert!(BladderModel::from_switch(7, 1).is_err());
     }
 
     #[test]
     fn switched_off_effects_change_nothing() {
         let g = MuscleGeometry::muscle_a();
-        let m = muscle(&g, BladderModel::ThickWall { layers: 16 });
-        let bl = Bladder::new(g.sleeve().unwrap(), g.tube(), 16).unwrap();
+        let m = muscle(&g, BladderModel::DissertationLayers { layers: 16 });
+        let bl = Bladder::dissertation_layers(g.sleeve().unwrap(), g.tube(), 16).unwrap();
         let l = 0.09;
         let o = m.evaluate(5e5, l, &rest()).unwrap();
         let s = bl.evaluate(5e5, l).unwrap();
@@ -618,7 +654,7 @@ mod tests {
         // Zero friction coefficient and a rigid connector give the same numbers as none.
         let f = McKibben::from_geometry(
             &g,
-            BladderModel::ThickWall { layers: 16 },
+            BladderModel::DissertationLayers { layers: 16 },
             Some(FrictionParams {
                 coefficient: 0.0,
                 presliding_length: 1e-4,
@@ -648,7 +684,8 @@ mod tests {
             coefficient: 2e-5,
             presliding_length: 1e-4,
         };
-        let m = McKibben::from_geometry(&g, BladderModel::ThinWall, Some(fr), 0.0).unwrap();
+        let m =
+            McKibben::from_geometry(&g, BladderModel::DissertationThinWall, Some(fr), 0.0).unwrap();
         let (lo, hi) = (0.7 * g.length, 0.95 * g.length);
         let up: Vec<f64> = (0..=200)
             .map(|i| lo + (hi - lo) * i as f64 / 200.0)
@@ -694,8 +731,13 @@ mod tests {
             coefficient: 3e-5,
             presliding_length: 2e-4,
         };
-        let m = McKibben::from_geometry(&g, BladderModel::ThickWall { layers: 4 }, Some(fr), 0.0)
-            .unwrap();
+        let m = McKibben::from_geometry(
+            &g,
+            BladderModel::DissertationLayers { layers: 4 },
+            Some(fr),
+            0.0,
+        )
+        .unwrap();
         let (a, b) = (0.90 * g.length, 0.9001 * g.length); // inside the presliding zone
         let path =
             |n: usize| -> Vec<f64> { (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect() };
@@ -717,11 +759,20 @@ mod tests {
             presliding_length: 1e-4,
         };
         for friction in [None, Some(fr)] {
-            let m = McKibben::from_geometry(&g, BladderModel::ThickWall { layers: 8 }, friction, k)
-                .unwrap();
-            let rigid =
-                McKibben::from_geometry(&g, BladderModel::ThickWall { layers: 8 }, friction, 0.0)
-                    .unwrap();
+            let m = McKibben::from_geometry(
+                &g,
+                BladderModel::DissertationLayers { layers: 8 },
+                friction,
+                k,
+            )
+            .unwrap();
+            let rigid = McKibben::from_geometry(
+                &g,
+                BladderModel::DissertationLayers { layers: 8 },
+                friction,
+                0.0,
+            )
+            .unwrap();
             assert!(rigid.evaluate(0.0, g.length, &rest()).is_err());
             for p in [0.0, 2e5, 690e3] {
                 for f in [0.7, 0.85, 0.95, 1.0] {
@@ -831,7 +882,7 @@ mod tests {
                     .into_iter()
                     .enumerate()
                 {
-                    let m = muscle(&g, BladderModel::ThickWall { layers });
+                    let m = muscle(&g, BladderModel::DissertationLayers { layers });
                     let top = g.length.min(cutoff * m.max_length());
                     let (wn, w_out, zero) = net_work(&m, p, top);
                     println!(
@@ -851,7 +902,8 @@ mod tests {
             "A sleeve, bladder/muscle length: net work thin / thick (J); same top: thin / thick"
         );
         let mut sweep = [[0.0; 5]; 2];
-        let common_top = 0.99 * muscle(&PRESETS[0], BladderModel::ThinWall).max_length();
+        let common_top =
+            0.99 * muscle(&PRESETS[0], BladderModel::DissertationThinWall).max_length();
         for (j, ratio) in [1.0, 0.8, 0.66, 0.5, 0.33].into_iter().enumerate() {
             let g = MuscleGeometry {
                 bladder_length: ratio * PRESETS[0].length,
@@ -859,7 +911,7 @@ mod tests {
             };
             let mut same_top = [0.0; 2];
             for (w, layers) in [1, 16].into_iter().enumerate() {
-                let m = muscle(&g, BladderModel::ThickWall { layers });
+                let m = muscle(&g, BladderModel::DissertationLayers { layers });
                 let top = g.length.min(0.99 * m.max_length());
                 sweep[w][j] = net_work(&m, p, top).0;
                 same_top[w] = net_work(&m, p, common_top).0;
@@ -888,6 +940,25 @@ mod tests {
         // and so does the thick wall over the whole sweep (the text says it gains).
         assert!(sweep[0][..4].windows(2).all(|w| w[1] < w[0]), "{sweep:?}");
         assert!(sweep[1].windows(2).all(|w| w[1] < w[0]), "{sweep:?}");
+    }
+
+    #[test]
+    fn exact_wall_net_work_grows_with_prestrain() {
+        // Section 2.4's claim, which the dissertation's own walls do not reproduce (above): more
+        // pre-strain, more net work per cycle (A 3% < B 52% < C 82%) at 690 kPa, for every
+        // cut-off of the cycle's top below max_length.
+        let p = 690e3;
+        for cutoff in [0.99, 0.995, 0.999] {
+            let work: Vec<f64> = PRESETS[..3]
+                .iter()
+                .map(|g| {
+                    let m = muscle(g, BladderModel::Exact { nodes: 16 });
+                    net_work(&m, p, g.length.min(cutoff * m.max_length())).0
+                })
+                .collect();
+            println!("exact wall, top {cutoff} of max_length: net work A/B/C {work:?} J");
+            assert!(work[0] < work[1] && work[1] < work[2], "{cutoff}: {work:?}");
+        }
     }
 
     proptest! {

@@ -3,8 +3,6 @@
 #![forbid(unsafe_code)]
 
 pub mod bladder;
-pub mod bounds;
-pub mod calibration;
 pub mod festo;
 pub mod free_bladder;
 pub mod friction;
@@ -12,8 +10,10 @@ pub mod gaylord;
 pub mod inverse;
 pub mod knitted;
 pub mod knitted_bag;
+pub mod knitted_muscle;
 pub mod knitted_partials;
 pub mod knitted_shape;
 pub mod mckibben;
 pub mod multiferroic;
-pub mod root;
+pub mod muscle_params;
+pub mod numerics;

@@ -423,9 +423,8 @@ fn steps_may_not_pass_the_stop_time() {
     assert_eq!(i.do_step(0.75, 0.25), OK);
 }
 
-/// The per-step path takes only our own clock, bit for bit, and only a step that ends on a
-/// finite clock; the general path still takes -0 for 0 and a step whose end overflows, after
-/// which every step is refused.
+/// A step takes our own clock (-0 for 0 too); a step whose end overflows is taken, after which
+/// every step is refused.
 #[test]
 fn the_clock_is_ours_to_the_bit_and_an_infinite_clock_stops_the_run() {
     let i = ready();
@@ -538,7 +537,7 @@ fn debug_logging_traces_calls_and_checks_categories() {
         );
     }
     assert_eq!(i.do_step(0.0, 0.1), OK);
-    // One value per set and get: the calls the per-step paths serve when nothing is logged.
+    // One value per set and get, as a master calls them every step.
     assert_eq!(i.set_real(&[LENGTH], &[0.09]), OK);
     assert!(i.real(FORCE).is_finite());
     for call in ["fmi2DoStep", "fmi2SetReal", "fmi2GetReal"] {

@@ -500,8 +500,8 @@ mod rules {
             "start 16 is outside",
         );
         broken(
-            r#"<Enumeration declaredType="BladderModel" min="0" max="3" start="0"/>"#,
-            r#"<Enumeration declaredType="BladderModel" min="1" max="3" start="0"/>"#,
+            r#"<Enumeration declaredType="BladderModel" min="0" max="6" start="0"/>"#,
+            r#"<Enumeration declaredType="BladderModel" min="1" max="6" start="0"/>"#,
             "start 0 is outside",
         );
         broken(

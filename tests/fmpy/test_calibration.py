@@ -69,7 +69,7 @@ def test_presets_can_be_read_back_through_calculated_parameters(recording_log):
     eff = dict(zip(["L", "b", "n", "c1", "model"], m.get(
         "effective_nominal_length", "effective_strand_length", "effective_turns", "effective_mooney_c1",
         "effective_bladder_model")))
-    assert eff["L"] == 0.4 and eff["model"] == 1
+    assert eff["L"] == 0.4 and eff["model"] == 4  # the dissertation's thin wall, as fitted
     assert eff["b"] != 0.3 and eff["c1"] != 2e5
     # The braid angle read back is the one of the effective geometry: cos(theta) = L_N / b.
     assert m.get("effective_braid_angle") == pytest.approx(np.arccos(0.4 / eff["b"]), rel=1e-12)

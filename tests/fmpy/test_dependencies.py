@@ -25,7 +25,7 @@ CONFIGS = {
     # 0.999 of the ballooning pressure, so that the initial input_clamped shows each parameter.
     "FreeBladder": (
         [{}, {"mooney_c2": 38719.67}, {"mooney_c2": 38679.73}],
-        [{"pressure": 5.25e4, "length": 0.1336}, {"pressure": 3e4, "length": 0.16},
+        [{"pressure": 4.9322e4, "length": 0.1336}, {"pressure": 3e4, "length": 0.16},
          {"pressure": -5e4, "length": 0.12}],
     ),
     "McKibbenMuscle": (

@@ -20,9 +20,13 @@ CASES = {
     "ideal A": (dict(preset=1), [(3e5, 0.8), (-2e4, 0.7)]),
     "thin wall A (free, contact)": (dict(preset=1, bladder_model=1), [(5e4, 0.95), (4e5, 0.4)]),
     "thick wall A, 8 layers": (dict(preset=1, bladder_model=2, bladder_layers=8), [(4e5, 0.5), (1e5, 0.9)]),
-    "continuum wall A, 6 nodes (free, contact)": (
-        dict(preset=1, bladder_model=3, bladder_layers=6), [(5e4, 0.95), (4e5, 0.5)],
+    "exact wall A, 16 nodes (free, contact)": (
+        dict(preset=1, bladder_model=3, bladder_layers=16), [(5e4, 0.95), (4e5, 0.5)],
     ),
+    "dissertation's continuum A, 6 nodes (free, contact)": (
+        dict(preset=1, bladder_model=6, bladder_layers=6), [(5e4, 0.95), (4e5, 0.5)],
+    ),
+    "dissertation's thin wall A (free, contact)": (dict(preset=1, bladder_model=4), [(5e4, 0.95), (4e5, 0.4)]),
     "pre-strained C, thin wall": (dict(preset=3, bladder_model=1), [(2e5, 0.6), (6e5, 0.8)]),
     "B, thick wall, friction": (
         dict(preset=2, bladder_model=2, bladder_layers=4, friction=True),
@@ -36,9 +40,13 @@ CASES = {
         dict(preset=4, friction=True, connector_stiffness=2e4),
         [(4e5, 0.7)],
     ),
-    "B, continuum wall, friction": (
+    "B, exact wall, friction": (
         dict(preset=2, bladder_model=3, bladder_layers=6, friction=True),
         [(1e5, 0.6), (5e5, 0.8)],
+    ),
+    "C, exact wall, friction and connector": (
+        dict(preset=3, bladder_model=3, bladder_layers=16, friction=True, connector_stiffness=5e4),
+        [(2e5, 0.6), (6e5, 0.8)],
     ),
 }
 
@@ -192,8 +200,9 @@ JOINT_INPUTS = ["actuatorInput", "jointPosition", "jointVelocity"]
         dict(bladder_model=2, bladder_layers=8),
         dict(bladder_model=1, friction=True),
         dict(bladder_model=1, command_mode=1),
+        dict(bladder_model=3, bladder_layers=16, friction=True),
     ],
-    ids=["ideal", "thick wall", "thin wall + friction", "thin wall, torque command"],
+    ids=["ideal", "thick wall", "thin wall + friction", "thin wall, torque command", "exact wall + friction"],
 )
 def test_joint_partials_match_central_differences(parameters):
     s = Slave("McKibbenJoint", **parameters)
@@ -230,7 +239,7 @@ KNITTED_CASES = {
     "Fig. 1.16 ideal, thick wall, friction": (
         dict(preset=2, shape_model=0, bladder_model=2, bladder_layers=6, friction=True), [1.5e5, 5.5e5],
     ),
-    "Fig. 1.16 tubular, continuum wall": (
+    "Fig. 1.16 tubular, exact wall": (
         dict(preset=2, shape_model=1, bladder_model=3, bladder_layers=6), [2e4, 5.5e5],
     ),
     "prototype in its 85 mm bag, friction": (

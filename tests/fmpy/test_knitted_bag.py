@@ -28,6 +28,20 @@ def test_the_inextensible_bag_stops_the_stroke_where_the_sleeve_reaches_its_radi
     assert abs(a - 0.580) < 0.002 and abs(a - b) < 1e-3
 
 
+def test_the_bags_that_would_give_the_measured_strokes():
+    # The document's figures: an inextensible bag stops the ideal cylinder at 42% if it is 67.7 mm
+    # across, at 51% if 80.9 mm; a 64.3 mm bag (0.42 of the 153 mm sleeve) at 39.6%. Eq. 1.4 gives the
+    # same in closed form: stroke = 1 - n pi (0.153 - d) / (2 m L_max).
+    def closed_form(d):
+        return 1.0 - 49 * math.pi * (0.153 - d) / (2 * 22) / 0.514
+    for target, diameter in ((0.42, 0.0677), (0.51, 0.0809)):
+        d = kb.bag_for(target, points=1001)
+        assert abs(d - diameter) < 2e-4, (target, d)
+        assert abs(closed_form(d) - target) < 2e-3
+    s = kb.stroke(14e3, points=1001, bag_diameter=0.42 * 0.153)
+    assert abs(s - 0.396) < 0.002 and abs(s - closed_form(0.42 * 0.153)) < 0.002
+
+
 def test_a_stretching_bag_lengthens_the_stroke_with_pressure():
     start = {"bag_diameter": kb.BAG, "bag_membrane_stiffness": kb.POLYETHYLENE, "friction": True}
     low, high = (kb.stroke(p, points=1001, **start) for p in (14e3, 100e3))

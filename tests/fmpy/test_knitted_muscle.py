@@ -281,11 +281,11 @@ def test_bad_parameters_fail_initialization(parameters):
 # free contraction (14.6 mm), and must inflate to a hoop stretch of 14.6/6.4 = 2.3 there, within
 # the stretches for which chapter 2's Mooney-Rivlin latex is used; its 110 mm unstretched length is
 # the muscles' nominal length ("no pre-strain", as the dissertation's green curves). Rubber volume
-# 1.99 cm^3: 32% of the knitted sleeve's largest volume, 19% of the McKibben's. Thick-walled model,
-# 16 layers (Fig. 2.8). The dissertation's knitted curve also has a 0.2 mm strand. Caveat: the rubber fills
+# 1.99 cm^3: 32% of the knitted sleeve's largest volume, 19% of the McKibben's. The dissertation's
+# thick-walled model as written, 16 layers (Fig. 2.8; bladder_model 5). The dissertation's knitted curve also has a 0.2 mm strand. Caveat: the rubber fills
 # the knitted sleeve at 82 mm, so there the 110 mm tube is always axially compressed (lambda_1 <=
 # 0.75), which the model takes as Mooney-Rivlin compression without buckling.
-BLADDER = dict(bladder_model=2, bladder_layers=16, bladder_length=0.110,
+BLADDER = dict(bladder_model=5, bladder_layers=16, bladder_length=0.110,
                bladder_inner_diameter=6.4e-3, bladder_thickness=0.8e-3)
 
 
@@ -453,7 +453,7 @@ def test_knitted_against_mckibben_with_bladder_section_1_3_6():
 
 @pytest.mark.parametrize("shape", [IDEAL, TUBULAR])
 @pytest.mark.parametrize("friction", [False, True])
-@pytest.mark.parametrize("model", [1, 2])
+@pytest.mark.parametrize("model", [1, 2, 3, 5])
 def test_bladder_dense_grid_never_gives_nan(shape, friction, model, recording_log):
     m = knitted(log=recording_log, preset=2, strand_thickness=0.2e-3, shape_model=shape, friction=friction,
                 length=0.08, **dict(BLADDER, bladder_model=model))

@@ -10,7 +10,10 @@ from conftest import Slave
 
 MODEL = "McKibbenMuscle"
 LISTED = {1: 0.10325, 2: 0.1088, 3: 0.0989, 4: 0.1358}  # Table 2.1 muscle lengths, A-D
-THIN, THICK = 1, 2
+# The dissertation's walls as written (eq. 2.6-2.20), whose statements most tests here check; the
+# exact wall (Rivlin's integral) is the physics, its consistent thin-wall limit the thin wall.
+THIN, THICK, CONTINUUM = 4, 5, 6
+EXACT, CONSISTENT_THIN = 3, 1
 
 
 def muscle(log=None, **parameters):
@@ -93,7 +96,7 @@ def test_prestrained_muscles_pull_without_pressure():
         assert f[3] > f[2] > f[1]
 
 
-@pytest.mark.parametrize("model", [THIN, THICK])
+@pytest.mark.parametrize("model", [THIN, THICK, EXACT, CONSISTENT_THIN])
 def test_force_is_continuous_across_the_contact_threshold(model):
     # Eq. 2.18: below the threshold the bladder leaves the sleeve; the force must not jump.
     m = muscle(preset=1, bladder_model=model, length=0.08)
@@ -152,7 +155,8 @@ def test_friction_state_is_part_of_the_fmu_state():
     m.close()
 
 
-@pytest.mark.parametrize("model, friction, connector", [(0, False, 0.0), (1, True, 0.0), (2, True, 2000.0)])
+@pytest.mark.parametrize("model, friction, connector", [(0, False, 0.0), (1, True, 0.0), (2, True, 2000.0),
+                                                       (EXACT, True, 0.0), (EXACT, False, 2000.0), (THICK, True, 0.0)])
 def test_dense_grid_never_gives_nan(model, friction, connector, recording_log):
     # Pressures from -100 kPa to 1 MPa, lengths from 0 to far beyond the limit.
     m = muscle(log=recording_log, preset=1, bladder_model=model, bladder_layers=8, friction=friction,
@@ -168,7 +172,7 @@ def test_dense_grid_never_gives_nan(model, friction, connector, recording_log):
     m.close()
 
 
-@pytest.mark.parametrize("model", [0, 1, 2])
+@pytest.mark.parametrize("model", [0, 1, 2, EXACT, THIN])
 def test_length_reversals_at_every_point_of_the_stroke(model):
     # Issue 8's hard case: reverse the length at 25 points along the stroke with friction on. At each
     # reversal the force may change by at most the full friction swing 2 Cf P_eff plus the elastic
@@ -192,10 +196,9 @@ def test_length_reversals_at_every_point_of_the_stroke(model):
 
 
 def test_continuum_wall_is_the_layered_walls_limit():
-    # bladder_model 3: eq. 2.19-2.20 with infinitely many layers, by an 8-node quadrature through
+    # bladder_model 6: eq. 2.19-2.20 with infinitely many layers, by an 8-node quadrature through
     # the wall. Independently, Richardson extrapolation of the layered wall (first order in
     # 1/layers) from 512 and 1024 layers; muscle C at 450 kPa, the thickest, pre-strained wall.
-    CONTINUUM = 3
     probe = muscle(preset=3, bladder_model=CONTINUUM, bladder_layers=8, length=0.08)
     lo, hi = probe.get("min_length"), probe.get("max_length")
     lengths = lo + (hi - lo) * np.linspace(0.05, 0.95, 7)
@@ -208,3 +211,36 @@ def test_continuum_wall_is_the_layered_walls_limit():
     # ... where 1024 layers are still 1e-4 away.
     assert np.max(np.abs(layered[1024] - limit)) > 1e-4 * peak
     probe.close()
+
+
+@pytest.mark.parametrize("model", [EXACT, CONSISTENT_THIN, 2])
+def test_a_wall_without_stiffness_only_takes_up_volume(model):
+    # C1 = C2 = 0: the rubber is a liquid, so the force is eq. 2.3 and P_eff = P (muscles A and D).
+    for preset in (1, 4):
+        m = muscle(preset=preset, bladder_model=model, bladder_layers=16, mooney_c1=0.0, mooney_c2=0.0,
+                   length=0.08)
+        b, n = m.get("effective_strand_length", "effective_turns")
+        for p in (1e5, 6.9e5):
+            for fraction in (0.6, 0.8, 0.9):
+                L = fraction * LISTED[preset]
+                force, p_eff = m.at("force", "effective_pressure", pressure=p, length=L)
+                ideal = p * (3 * L * L - b * b) / (4 * math.pi * n * n)
+                assert force == pytest.approx(ideal, rel=1e-12, abs=1e-12)
+                assert p_eff == pytest.approx(p, rel=1e-14)
+        m.close()
+    # The dissertation's walls more than double the contact pressure there (muscle A, 690 kPa).
+    m = muscle(preset=1, bladder_model=THIN, mooney_c1=0.0, mooney_c2=0.0, length=0.0929)
+    force, p_eff = m.at("force", "effective_pressure", pressure=6.9e5, length=0.0929)
+    assert force == pytest.approx(127.2, abs=0.05) and p_eff == pytest.approx(1.445e6, abs=500)
+    m.close()
+
+
+def test_exact_wall_matches_the_energy_of_the_same_kinematics():
+    # Muscle A, 690 kPa, 0.9 of its length: 37.1549 N by the energy of the thick tube (eq. 2.8),
+    # where the dissertation's 16 layers give 102.6 N.
+    exact = muscle(preset=1, bladder_model=EXACT, bladder_layers=16, length=0.09)
+    assert exact.at("force", pressure=6.9e5, length=0.9 * LISTED[1]) == pytest.approx(37.1549, abs=5e-4)
+    literal = muscle(preset=1, bladder_model=THICK, bladder_layers=16, length=0.09)
+    assert literal.at("force", pressure=6.9e5, length=0.9 * LISTED[1]) == pytest.approx(102.6, abs=0.05)
+    exact.close()
+    literal.close()

@@ -87,6 +87,25 @@ def test_scene_model_exchange_matches_co_simulation(path):
         assert not bad, f"{path.stem} {value}: {bad}"
 
 
+def test_exact_wall_model_exchange_matches_co_simulation():
+    # The exact wall with friction and a connector, through contact and free inflation.
+    step, stop = 0.01, 2.0
+    t = np.arange(0.0, stop + step / 2, step)
+    signals = np.zeros(t.size, dtype=[("time", float), ("pressure", float), ("length", float)])
+    signals["time"] = t
+    signals["pressure"] = 3.5e5 + 3.4e5 * np.sin(2 * np.pi * t)
+    signals["length"] = 0.085 + 0.01 * np.sin(3 * np.pi * t)
+    worst = compare(
+        "McKibbenMuscle",
+        dict(preset=1, bladder_model=3, bladder_layers=16, friction=True, connector_stiffness=5e4),
+        signals,
+        ["force", "effective_pressure", "stress_hoop", "friction_force"],
+        step,
+        stop,
+    )
+    assert max(worst.values()) <= TOLERANCE, worst
+
+
 def test_joint_model_exchange_matches_co_simulation():
     step, stop = 0.01, 2.0
     t = np.arange(0.0, stop + step / 2, step)

@@ -21,19 +21,21 @@ from conftest import FMU_DIR, ROOT
 CLI = [sys.executable, "-m", "actuator_fmus.cli"]
 DEMO = ROOT / "scenes" / "fig2_3_ideal_mckibben.json"
 
+BLADDER = ["none", "thin_wall", "layers", "exact_wall", "dissertation_thin_wall", "dissertation_layers",
+           "dissertation_continuum"]
 # Every Integer that selects among named options, by model: (variable, type, item names in value order).
 ENUMERATIONS = {
     "McKibbenMuscle": {"preset": ["none", "A", "B", "C", "D", "DMSP_10", "DMSP_40"],
-                       "bladder_model": ["none", "thin_wall", "thick_wall", "continuum_wall"],
-                       "effective_bladder_model": ["none", "thin_wall", "thick_wall", "continuum_wall"],
+                       "bladder_model": BLADDER,
+                       "effective_bladder_model": BLADDER,
                        "out_of_range_policy": ["ok", "warning", "discard"]},
     "McKibbenJoint": {"preset": ["none", "A", "B", "C", "D", "DMSP_10", "DMSP_40"],
-                      "bladder_model": ["none", "thin_wall", "thick_wall", "continuum_wall"],
+                      "bladder_model": BLADDER,
                       "command_mode": ["pressure_difference", "joint_torque"],
                       "out_of_range_policy": ["ok", "warning", "discard"]},
     "KnittedMuscle": {"preset": ["none", "prototype", "fig_1_16"],
                       "shape_model": ["ideal_cylinder", "tubular_knit", "non_cylindrical"],
-                      "bladder_model": ["none", "thin_wall", "thick_wall", "continuum_wall"],
+                      "bladder_model": BLADDER,
                       "out_of_range_policy": ["ok", "warning", "discard"]},
     "FreeBladder": {"out_of_range_policy": ["ok", "warning", "discard"]},
     "MultiferroicMotor": {"onion_model": ["quasi_static", "gilbert_relaxation"],
@@ -107,7 +109,7 @@ def test_an_item_by_name_equals_its_value():
     by_name = Slave("McKibbenMuscle", preset="DMSP_40", length=0.36)
     by_value = Slave("McKibbenMuscle", preset=6, length=0.36)
     assert by_name.at("force", pressure=3e5) == by_value.at("force", pressure=3e5)
-    assert by_name.get("effective_bladder_model") == 1  # thin wall, as the Festo presets set it
+    assert by_name.get("effective_bladder_model") == 4  # the dissertation's thin wall, as the Festo presets fit
     by_name.close()
     by_value.close()
     with pytest.raises(UsageError, match=r"preset = 'DMSP40' is not one of its items; valid: DMSP_40, DMSP_10,"):

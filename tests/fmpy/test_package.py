@@ -14,7 +14,7 @@ from conftest import ROOT
 
 USER_FACING = ["python", "recipes", "examples", "benches", "scenes", "docs", "calibration", "crosscheck", "systems"]
 COMMANDS = ["scene", "figures", "info", "calibrate", "pressure-for-force", "crosscheck", "robot-joint", "systems",
-            "sweep", "knitted-bag", "motor", "linearized"]
+            "sweep", "knitted-bag", "motor", "linearized", "chapter2-claims"]
 
 
 def test_the_package_is_installed_and_imports_outside_the_repository(tmp_path):

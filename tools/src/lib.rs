@@ -1,6 +1,8 @@
 //! Tools around the FMU crate that the FMU binary does not need: packaging `target/fmu/<Model>.fmu`
-//! (`package_fmus`) and the scene files (`scenes/*.json`) that the examples and tests run.
+//! (`package_fmus`), the scene files (`scenes/*.json`) that the examples and tests run, and the
+//! offline calibration fit (`calibrate`).
 
+pub mod calibration;
 pub mod choices;
 pub mod package;
 pub mod scene;

@@ -1,8 +1,7 @@
 //! Every common and Co-Simulation function of FMI 2.0 (FMPy resolves all of them when it loads a
 //! binary). Each body runs inside `catch_unwind`: a panic is logged and becomes `fmi2Fatal`, it
-//! never unwinds into the importer. The one exception is the per-step set or get of one value
-//! (`hot.rs`), tried first on a path that cannot panic. Pointers are checked here and turned into
-//! slices.
+//! never unwinds into the importer. Pointers are checked here and turned into slices. The Model
+//! Exchange functions are in `model_exchange.rs`.
 //!
 //! Every `unsafe` block below relies on the importer keeping the FMI 2.0 calling convention: a
 //! component from `fmi2Instantiate` (or NULL), arrays of the length it passes (or NULL), and
@@ -22,7 +21,6 @@ use std::path::PathBuf;
 /// # Safety
 /// `c` must be NULL or a pointer returned by `fmi2Instantiate` (freed ones are caught by the magic
 /// number as long as the memory was not reused).
-#[inline(always)]
 unsafe fn instance<'a>(c: fmi2Component) -> Option<&'a mut Instance> {
     let ptr = c as *mut Instance;
     if ptr.is_null() {
@@ -47,11 +45,11 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
         .unwrap_or_else(|| "unknown panic".into())
 }
 
-/// Runs `body` on the instance `c`; a panic is logged, the instance becomes fatal.
+/// Every export's one path: checks the instance pointer, then runs `body` on it; a panic is
+/// logged and the instance becomes fatal, it never unwinds into the importer.
 ///
 /// # Safety
 /// As [`instance`]: `c` must be NULL or a pointer returned by `fmi2Instantiate`.
-#[inline(always)]
 pub(super) unsafe fn guarded(
     c: fmi2Component,
     function: &str,
@@ -61,47 +59,21 @@ pub(super) unsafe fn guarded(
     let Some(inst) = (unsafe { instance(c) }) else {
         return fmi2Status::Error;
     };
-    // SAFETY: checked just now.
-    unsafe { run_guarded(inst, function, body) }
-}
-
-/// [`guarded`] on an instance already checked. Inlined into every export: on the per-step path
-/// only the body runs here, the panic arm is out of line.
-///
-/// # Safety
-/// `ptr` is a live instance of ours that nothing else borrows.
-#[inline(always)]
-pub(super) unsafe fn run_guarded(
-    ptr: *mut Instance,
-    function: &str,
-    body: impl FnOnce(&mut Instance) -> fmi2Status,
-) -> fmi2Status {
+    let ptr: *mut Instance = inst;
     // SAFETY: `ptr` is live for the whole call; the closure's borrow ends before the panic arm.
     match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *ptr }))) {
         Ok(status) => status,
-        Err(payload) => unsafe { panicked(ptr, function, payload) },
+        Err(payload) => {
+            // SAFETY: as above; nothing else borrows the instance now.
+            let inst = unsafe { &mut *ptr };
+            inst.set_state(super::instance::MachineState::Fatal);
+            inst.logger.log(
+                fmi2Status::Fatal,
+                &format!("{function}: internal error: {}", panic_text(&*payload)),
+            );
+            fmi2Status::Fatal
+        }
     }
-}
-
-/// A panic in `function`: logged, the instance becomes fatal.
-///
-/// # Safety
-/// `ptr` is a live instance (checked by [`guarded`]) that nothing else borrows.
-#[cold]
-#[inline(never)]
-unsafe fn panicked(
-    ptr: *mut Instance,
-    function: &str,
-    payload: Box<dyn std::any::Any + Send>,
-) -> fmi2Status {
-    // SAFETY: the caller's promise.
-    let inst = unsafe { &mut *ptr };
-    inst.set_state(super::instance::MachineState::Fatal);
-    inst.logger.log(
-        fmi2Status::Fatal,
-        &format!("{function}: internal error: {}", panic_text(&*payload)),
-    );
-    fmi2Status::Fatal
 }
 
 /// A slice from a C array; NULL is accepted only for an empty array.
@@ -340,12 +312,10 @@ pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
 }
 
 mod fmu_state;
-mod hot;
+mod model_exchange;
 #[cfg(test)]
 mod tests;
 mod values;
-
-pub use hot::HotPath;
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
@@ -415,19 +385,12 @@ pub unsafe extern "C" fn fmi2DoStep(
     c: fmi2Component,
     current_communication_point: fmi2Real,
     communication_step_size: fmi2Real,
-    no_set_fmu_state_prior_to_current_point: fmi2Boolean,
+    _no_set_fmu_state_prior_to_current_point: fmi2Boolean,
 ) -> fmi2Status {
-    // SAFETY: see `instance`; then a tail call to the model's own entry point (exports/hot.rs).
-    match unsafe { instance(c) } {
-        Some(inst) => unsafe {
-            (inst.hot_path().do_step)(
-                c,
-                current_communication_point,
-                communication_step_size,
-                no_set_fmu_state_prior_to_current_point,
-            )
-        },
-        None => fmi2Status::Error,
+    unsafe {
+        guarded(c, "fmi2DoStep", |inst| {
+            inst.do_step(current_communication_point, communication_step_size)
+        })
     }
 }
 

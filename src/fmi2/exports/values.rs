@@ -1,6 +1,6 @@
 //! fmi2SetXXX and fmi2GetXXX: the importer's arrays as slices, handed to the instance.
 
-use super::{guarded, instance, null_argument, slice, slice_mut, text};
+use super::{guarded, null_argument, slice, slice_mut, text};
 use crate::fmi2::instance::{CBoolean, Value};
 use crate::fmi2::runtime::Runtime;
 use crate::fmi2::types::*;
@@ -31,11 +31,7 @@ pub unsafe extern "C" fn fmi2SetReal(
     nvr: usize,
     value: *const fmi2Real,
 ) -> fmi2Status {
-    // SAFETY: see `instance`; then a tail call to the model's own entry point (exports/hot.rs).
-    match unsafe { instance(c) } {
-        Some(inst) => unsafe { (inst.hot_path().set_real)(c, vr, nvr, value) },
-        None => fmi2Status::Error,
-    }
+    unsafe { set_values(c, "fmi2SetReal", vr, nvr, value) }
 }
 
 #[no_mangle]
@@ -109,10 +105,14 @@ pub unsafe extern "C" fn fmi2GetReal(
     nvr: usize,
     value: *mut fmi2Real,
 ) -> fmi2Status {
-    // SAFETY: see `instance`; then a tail call to the model's own entry point (exports/hot.rs).
-    match unsafe { instance(c) } {
-        Some(inst) => unsafe { (inst.hot_path().get_real)(c, vr, nvr, value) },
-        None => fmi2Status::Error,
+    const F: &str = "fmi2GetReal";
+    unsafe {
+        guarded(c, F, |inst| {
+            let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
+                return null_argument(inst, F, "vr and value");
+            };
+            inst.get_reals(vrs, out)
+        })
     }
 }
 

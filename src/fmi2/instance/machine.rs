@@ -3,6 +3,7 @@
 
 use super::Instance;
 use crate::fmi2::types::fmi2Status;
+use crate::models::Report;
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -14,54 +15,10 @@ pub enum MachineState {
     Terminated,
     Error,
     Fatal,
-    /// Model Exchange (`src/fmi2/model_exchange.rs`); after the others so that saved states keep
+    /// Model Exchange (`src/fmi2/instance/model_exchange.rs`); after the others so that saved states keep
     /// their encoding.
     EventMode,
     ContinuousTimeMode,
-}
-
-/// The machine state and the view of it that the per-step paths test in one compare: the
-/// state's bit while calls are not logged, none while they are (a logged call takes the general
-/// path, which logs it). Its fields change only together, through its methods.
-#[derive(Clone, Copy, Debug)]
-pub struct Gate {
-    state: MachineState,
-    logging_calls: bool,
-    quiet: u32,
-}
-
-impl Gate {
-    pub(super) fn new(state: MachineState, logging_calls: bool) -> Self {
-        let mut gate = Self {
-            state,
-            logging_calls,
-            quiet: 0,
-        };
-        gate.set(state);
-        gate
-    }
-
-    #[inline(always)]
-    pub(super) fn state(&self) -> MachineState {
-        self.state
-    }
-
-    pub(super) fn set(&mut self, state: MachineState) {
-        self.state = state;
-        self.quiet = if self.logging_calls { 0 } else { state.bit() };
-    }
-
-    pub(super) fn set_logging_calls(&mut self, on: bool) {
-        self.logging_calls = on;
-        self.set(self.state);
-    }
-
-    /// The current state's bit, or none while calls are logged: a per-step path may serve a call
-    /// allowed in `mask` itself when `mask & quiet() != 0`.
-    #[inline(always)]
-    pub(super) fn quiet(&self) -> u32 {
-        self.quiet
-    }
 }
 
 impl MachineState {
@@ -158,7 +115,6 @@ impl Instance {
         // Warnings and errors are always logged; the switch is about call tracing.
         let calls = on && (categories.is_empty() || categories.contains(&"logCalls"));
         self.logger.debug = calls;
-        self.gate.set_logging_calls(calls);
         fmi2Status::OK
     }
 
@@ -237,36 +193,37 @@ impl Instance {
         fmi2Status::OK
     }
 
-    /// `fmi2DoStep` on this instance's model, through its C entry point (`exports/hot.rs`).
-    #[cfg(test)]
+    /// `fmi2DoStep`: checks the state and the step, steps the model and forwards its report.
     pub fn do_step(&mut self, time: f64, step: f64) -> fmi2Status {
-        // SAFETY: the instance is live.
-        unsafe { (self.hot.do_step)(self as *mut Self as _, time, step, 0) }
+        const F: &str = "fmi2DoStep";
+        if !self.allowed(F, allowed::DO_STEP) {
+            return fmi2Status::Error;
+        }
+        if let Some(refused) = self.step_refused(time, step) {
+            return refused;
+        }
+        let mut report = Report::default();
+        // The runtime writes the `input_clamped` output itself: a quiet report needs nothing more.
+        self.runtime.step(time, step, &mut report);
+        let status = if report.is_quiet() {
+            fmi2Status::OK
+        } else {
+            self.forward_messages(F, report, true)
+        };
+        match status {
+            fmi2Status::OK | fmi2Status::Warning => self.time = time + step,
+            fmi2Status::Discard => self.set_state(MachineState::StepFailed),
+            _ => self.set_state(MachineState::Error),
+        }
+        status
     }
 
     pub(super) fn set_stop_time(&mut self, stop: Option<f64>) {
         self.stop_time = stop;
-        self.step_end_limit = stop.unwrap_or(f64::MAX);
     }
 
-    /// Whether [`Instance::step_refused`] accepts this step without the rounding allowance: a
-    /// positive finite step from our own time that ends by the stop time. No call out, so that the
-    /// per-step path keeps its arguments in registers.
-    #[inline(always)]
-    pub(super) fn step_accepted(&self, time: f64, step: f64) -> bool {
-        // Positive finite doubles are the bit patterns 1 ..= INFINITY - 1 (NaN's are above).
-        let positive_finite = step.to_bits().wrapping_sub(1) < f64::INFINITY.to_bits() - 1;
-        // Our own time, bit for bit (-0 for 0 takes the general path, which accepts it). The end
-        // is finite and by the stop time: so is `time`, and an infinite or NaN clock is refused.
-        positive_finite
-            && time.to_bits() == self.time.to_bits()
-            && time + step <= self.step_end_limit
-    }
-
-    /// The refusal of a step of `step` from `time`, if any (the caller checked the state). The
-    /// tests are inline, their messages built out of line.
-    #[inline(always)]
-    pub(super) fn step_refused(&self, time: f64, step: f64) -> Option<fmi2Status> {
+    /// The refusal of a step of `step` from `time`, if any (the caller checked the state).
+    fn step_refused(&self, time: f64, step: f64) -> Option<fmi2Status> {
         // Positive and finite; two comparisons (NaN fails both).
         if !(step > 0.0 && step < f64::INFINITY) {
             return Some(self.refuse_step(step));
@@ -289,7 +246,6 @@ impl Instance {
     }
 
     /// Whether `time` differs from the instance's time by rounding only.
-    #[inline(never)]
     fn within_rounding(&self, time: f64) -> bool {
         let tolerance = 1e3 * f64::EPSILON * time.abs().max(self.time.abs());
         (time - self.time).abs() <= tolerance

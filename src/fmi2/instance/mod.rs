@@ -1,28 +1,30 @@
 //! One FMU instance: its core (this file), the FMI 2.0.4 Co-Simulation call-sequence state
 //! machine (section 4.2.4, `machine`), the rules for which variables may be set when (section
-//! 2.2.7, `values`) and FMU states (`fmu_state`). The code here works on Rust slices and
-//! references; `exports.rs` turns the importer's C pointers into them. The only `unsafe` here is in
+//! 2.2.7, `values`), FMU states (`fmu_state`), Model Exchange's modes (`model_exchange`), the
+//! out-of-range policy (`out_of_range`) and directional derivatives. The code here works on Rust
+//! slices and references; `exports` turns the importer's C pointers into them. The only `unsafe` here is in
 //! `fmu_state`, on the state pointers this instance handed out itself.
 
+mod directional_derivative;
 mod fmu_state;
-pub(super) mod hot;
 mod machine;
+mod model_exchange;
+mod out_of_range;
 #[cfg(test)]
 mod tests;
 mod values;
 
 pub use fmu_state::FmuState;
-pub use hot::HotPath;
-use machine::Gate;
 pub use machine::{allowed, MachineState};
+pub use model_exchange::Vector;
 pub use values::{CBoolean, Value};
 
 use super::logger::Logger;
-use super::out_of_range::OutOfRange;
 use super::runtime::{Factory, Runtime};
 use super::types::fmi2Status;
 use crate::models::{Report, Status};
 use crate::variables::{ModelInfo, VarType, Variable};
+use out_of_range::OutOfRange;
 use std::collections::HashSet;
 use std::ffi::CString;
 
@@ -35,23 +37,16 @@ pub struct Instance {
     info: &'static ModelInfo,
     /// Variables by type and value reference (value references are dense per type).
     by_type: [Vec<&'static Variable>; 4],
-    /// What fmi2SetXXX checks, by type and value reference, flattened for the per-step path.
+    /// What fmi2SetXXX checks, by type and value reference.
     set_rules: [Vec<values::SetRule>; 4],
-    /// The machine state, with the per-step paths' view of it ([`Gate`]).
-    gate: Gate,
+    /// Where the instance is in FMI's call sequence.
+    state: MachineState,
     /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
     pub(super) model_exchange: bool,
     pub(super) time: f64,
     start_time: f64,
-    /// Set with [`Instance::set_stop_time`], which keeps `step_end_limit` with it.
     stop_time: Option<f64>,
-    /// The latest end of a step the per-step path accepts: the stop time, or the largest finite
-    /// double (a step whose end would overflow takes the general path, as a clock that did).
-    step_end_limit: f64,
-    /// Never replaced once created: [`HotPath`]'s functions rely on its concrete type.
     pub(super) runtime: Box<dyn Runtime>,
-    /// The per-step calls compiled for this instance's model (the same factory as `runtime`).
-    hot: HotPath,
     /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
@@ -101,21 +96,18 @@ impl Instance {
                 .map(|var: &&'static Variable| values::SetRule::new(var))
                 .collect()
         });
-        let gate = Gate::new(MachineState::Instantiated, logger.debug);
         Self {
             magic: MAGIC,
             logger,
             info,
             by_type,
             set_rules,
-            gate,
+            state: MachineState::Instantiated,
             model_exchange: false,
             time: 0.0,
             start_time: 0.0,
             stop_time: None,
-            step_end_limit: f64::MAX,
             runtime: factory.create(),
-            hot: factory.hot_path(),
             string_values: Vec::new(),
             fmu_states: HashSet::new(),
             out_of_range: OutOfRange::new(info),
@@ -128,18 +120,15 @@ impl Instance {
     }
 
     /// The state of FMI's call sequence.
-    #[inline(always)]
     pub fn state(&self) -> MachineState {
-        self.gate.state()
+        self.state
     }
 
     pub fn set_state(&mut self, state: MachineState) {
-        self.gate.set(state);
+        self.state = state;
     }
 
-    /// Logs and refuses a call that the current state does not allow. Inlined: on the per-step
-    /// path it is one mask test and one flag test; the logging is out of line.
-    #[inline]
+    /// Logs and refuses a call that the current state does not allow.
     pub fn allowed(&self, function: &str, mask: u32) -> bool {
         if mask & self.state().bit() == 0 {
             self.illegal_call(function);
@@ -180,10 +169,8 @@ impl Instance {
         self.settle(function, &mut report, in_step)
     }
 
-    /// [`Instance::forward`] on a report in place (no copy of it on the per-step path). Inlined
-    /// for the common case, a report with nothing to log: then the only work is clearing the
-    /// `input_clamped` flag.
-    #[inline]
+    /// [`Instance::forward`] on a report in place. A report with nothing to log needs only the
+    /// `input_clamped` flag cleared.
     pub(super) fn settle(
         &mut self,
         function: &str,

@@ -2,8 +2,7 @@
 //! parameter (FMI 2.0.4 section 2.2.7 lets it change between steps).
 use super::*;
 use crate::fmi2::logger::Logger;
-use crate::fmi2::registry::Bindings;
-use crate::fmi2::runtime::{ModelFactory, Values};
+use crate::fmi2::runtime::{Bindings, ModelFactory, Values};
 use crate::models::{Model, Refusal};
 use crate::variables::{Causality, Initial, Interface, Start, Variability};
 use serde::{Deserialize, Serialize};

@@ -156,21 +156,9 @@ pub struct SetRule {
     min: f64,
     max: f64,
     parameter: bool,
-    /// The per-step path's checks in two compares: `states` of a variable that is not a
-    /// parameter (a parameter's change rebuilds the model), and the bounds clamped to the finite
-    /// range, so that `fast_min <= x <= fast_max` also refuses NaN and the infinities.
-    pub(super) fast_states: u32,
-    fast_min: f64,
-    fast_max: f64,
 }
 
 impl SetRule {
-    /// Whether a Real passes this variable's range check (finite, within its bounds).
-    #[inline(always)]
-    pub fn accepts(&self, x: f64) -> bool {
-        x >= self.fast_min && x <= self.fast_max
-    }
-
     pub fn new(var: &'static Variable) -> Self {
         let states = MachineState::ALL
             .iter()
@@ -185,9 +173,6 @@ impl SetRule {
             min,
             max,
             parameter,
-            fast_states: if parameter { 0 } else { states },
-            fast_min: min.max(f64::MIN),
-            fast_max: max.min(f64::MAX),
         }
     }
 }
@@ -213,18 +198,6 @@ impl Instance {
             "{function}: {vr} is not the value reference of a {kind:?} variable of {}",
             self.info.name
         ))
-    }
-
-    /// [`Instance::set`] out of line: what the per-step path (`hot.rs`) falls back to.
-    #[cold]
-    #[inline(never)]
-    pub(super) fn set_general(
-        &mut self,
-        function: &str,
-        vrs: &[u32],
-        values: &[f64],
-    ) -> fmi2Status {
-        self.set(function, vrs, values)
     }
 
     /// Sets all values or, if any is refused, none (the old values are kept).
@@ -352,9 +325,8 @@ impl Instance {
     }
 
     /// `fmi2GetReal`: as [`Instance::get`], with the value references checked first and one call
-    /// into the runtime for all values. What the per-step path (`hot.rs`) falls back to.
-    #[inline(never)]
-    pub(super) fn get_reals_general(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
+    /// into the runtime for all values.
+    pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
         const F: &str = "fmi2GetReal";
         if !self.allowed(F, allowed::GET) {
             return fmi2Status::Error;

@@ -17,9 +17,9 @@
 //! unstretched wall, and an `n`-point Gauss-Legendre rule converges like `rho^-2n` where the
 //! layered sum (a left Riemann sum) converges like `1/n`.
 
-use super::dual::Dual;
 use super::hyper_dual::KernelScalar;
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
+use crate::physics::numerics::dual::Dual;
 use std::f64::consts::{LOG2_E, PI};
 
 /// Nodes whose positions are computed ahead of their algebra, at a time (stack buffer).
@@ -94,18 +94,65 @@ pub(super) struct WallCall<T> {
     /// `d_in^2 - u_0` and `x^2 - u_0`.
     inner_gap: T,
     outer_gap: T,
+    /// The power of `u` the weighted sums divide by: 3/2 for this wall's `1/d^3`, 1 for the
+    /// exact wall's `dr/r = du / (2u)` (see `exact.rs`).
+    pub(super) weight: WallWeight,
+}
+
+/// What the weighted node sums divide by.
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub(super) enum WallWeight {
+    /// `1/d^3 = u^(-3/2)`: this wall's closed form.
+    PerCube,
+    /// `1/u`: the exact wall's `dr/r`.
+    PerSquare,
+}
+
+impl WallWeight {
+    fn power(self) -> f64 {
+        match self {
+            Self::PerCube => 1.5,
+            Self::PerSquare => 1.0,
+        }
+    }
+}
+
+impl<T: KernelScalar> WallCall<T> {
+    /// The call at axial stretch `lambda1`, squared outer and inner diameters `x_sq`, `d_in_sq`,
+    /// for a tube of squared relaxed outer diameter `d_ro_sq`. The integrands are singular where
+    /// `d = 0` and where `s = 0` (`u_s = x^2 - D_RO^2 / lambda_1`), both below the wall; the nearer
+    /// one approaches the inner wall as it collapses (`d_in -> 0`, near the fill limit) or as the
+    /// wall's own bore dominates. So the nodes are placed evenly in `ln(u - u_0)` with `u_0` the
+    /// nearer singular point: each integrand is then smooth on the scale of the interval.
+    pub(super) fn new(lambda1: T, x_sq: T, d_in_sq: T, d_ro_sq: f64, weight: WallWeight) -> Self {
+        let u_s = x_sq - lambda1.recip() * d_ro_sq;
+        let u_0 = if u_s.value() > 0.0 {
+            u_s
+        } else {
+            T::constant(0.0)
+        };
+        Self {
+            lambda1,
+            x_sq,
+            d_ro_sq,
+            u_0,
+            inner_gap: d_in_sq - u_0,
+            outer_gap: x_sq - u_0,
+            weight,
+        }
+    }
 }
 
 /// `span = ln(outer_gap / inner_gap)` and the node sums (each still to be multiplied by `span`):
 /// the jacobian `e w / 2` (`e = u - u_0`, `w` the weight) alone and times `l2^2`, `1/l2^2`,
-/// `l2^2 / d^3` and `1/(l2^2 d^3)`.
+/// `l2^2 q` and `q / l2^2` with `q` the [`WallWeight`].
 pub(super) struct WallSums<T> {
-    span: T,
-    jac: T,
-    l2: T,
-    inv_l2: T,
-    l2_h: T,
-    inv_l2_h: T,
+    pub(super) span: T,
+    pub(super) jac: T,
+    pub(super) l2: T,
+    pub(super) inv_l2: T,
+    pub(super) l2_h: T,
+    pub(super) inv_l2_h: T,
 }
 
 impl<S: SleeveGeometry> Bladder<S> {
@@ -150,25 +197,8 @@ impl<S: SleeveGeometry> Bladder<S> {
         let (hoop_in, axial_in) = mooney(l2_in, inv_d_in * inv_d_in * (d_ri * d_ri))?;
         // Through the wall in the squared deformed diameter u = d^2 (du = 2 s ds / lambda_1):
         // int g ds = int h / (2 d^3) du, int g Phi ds = pi/6 int h (x^3 - d^3) / (2 d^3) du and
-        // int sigma_axial w ds = pi/4 int sigma_axial du. The integrands are singular where d = 0
-        // and where s = 0 (u_s = x^2 - D_RO^2 / lambda_1), both below the wall; the nearer one
-        // approaches the inner wall as it collapses (d_in -> 0, near the fill limit) or as the
-        // wall's own bore dominates. So the nodes are placed evenly in ln(u - u_0) with u_0 the
-        // nearer singular point: each integrand is then smooth on the scale of the interval.
-        let u_s = x_sq - inv_lambda1 * (d_ro * d_ro);
-        let u_0 = if u_s.value() > 0.0 {
-            u_s
-        } else {
-            T::constant(0.0)
-        };
-        let call = WallCall {
-            lambda1,
-            x_sq,
-            d_ro_sq: d_ro * d_ro,
-            u_0,
-            inner_gap: d_in_sq - u_0,
-            outer_gap: x_sq - u_0,
-        };
+        // int sigma_axial w ds = pi/4 int sigma_axial du.
+        let call = WallCall::new(lambda1, x_sq, d_in_sq, d_ro * d_ro, WallWeight::PerCube);
         let sums = T::wall_sums(&self.nodes, &call)?;
         let span = sums.span;
         // With l3^2 = 1/(lambda_1^2 l2^2), eq. 2.9b's hoop difference is l2^2 A - B / l2^2 and the
@@ -222,6 +252,7 @@ pub(super) fn node_sums<T: KernelScalar>(
         u_0,
         inner_gap,
         outer_gap,
+        weight,
     } = *call;
     let zero = T::constant(0.0);
     let ln_in = inner_gap.ln();
@@ -263,12 +294,15 @@ pub(super) fn node_sums<T: KernelScalar>(
             }
             let jacobian = e * (node.weight * 0.5);
             let (l2_term, inv_l2_term) = (l2_sq * jacobian, inv_l2_sq * jacobian);
-            let per_d3 = inv_u * inv_d;
+            let per = match weight {
+                WallWeight::PerCube => inv_u * inv_d,
+                WallWeight::PerSquare => inv_u,
+            };
             jac_sum = jac_sum + jacobian;
             l2_sum = l2_sum + l2_term;
             inv_l2_sum = inv_l2_sum + inv_l2_term;
-            l2_h_sum = l2_h_sum + l2_term * per_d3;
-            inv_l2_h_sum = inv_l2_h_sum + inv_l2_term * per_d3;
+            l2_h_sum = l2_h_sum + l2_term * per;
+            inv_l2_h_sum = inv_l2_h_sum + inv_l2_term * per;
         }
     }
     Some(WallSums {
@@ -329,7 +363,9 @@ pub(super) fn dual_node_sums(nodes: &[WallNode], call: &WallCall<Dual>) -> Optio
         u_0,
         inner_gap: inner,
         outer_gap: outer,
+        weight: wall_weight,
     } = *call;
+    let power = wall_weight.power();
     // The nodes sit at e = u - u_0 = g exp(+-span t), g = sqrt(inner outer), t = at - 1/2, so
     // d ln e = d ln g +- t d span.
     let (inv_in, inv_out) = (1.0 / inner.v, 1.0 / outer.v);
@@ -417,14 +453,11 @@ pub(super) fn dual_node_sums(nodes: &[WallNode], call: &WallCall<Dual>) -> Optio
             let jac = e * weight[j];
             let l2_term = jac * l2;
             let inv_l2_term = jac * inv_l2;
-            let per_d3 = inv_u * inv_d;
-            let terms = [
-                jac,
-                l2_term,
-                inv_l2_term,
-                l2_term * per_d3,
-                inv_l2_term * per_d3,
-            ];
+            let per = match wall_weight {
+                WallWeight::PerCube => inv_u * inv_d,
+                WallWeight::PerSquare => inv_u,
+            };
+            let terms = [jac, l2_term, inv_l2_term, l2_term * per, inv_l2_term * per];
             for (dir, (le, du, ds)) in [(le_dl, u_dl, s_dl), (le_dx, u_dx, s_dx)]
                 .into_iter()
                 .enumerate()
@@ -436,8 +469,8 @@ pub(super) fn dual_node_sums(nodes: &[WallNode], call: &WallCall<Dual>) -> Optio
                     le,
                     l2_log,
                     inv_l2_log,
-                    l2_log - 1.5 * lu,
-                    inv_l2_log - 1.5 * lu,
+                    l2_log - power * lu,
+                    inv_l2_log - power * lu,
                 ];
                 for k in 0..5 {
                     acc[k][dir + 1][j] += terms[k] * logs[k];

@@ -31,7 +31,7 @@ fn layered_limit(m: (f64, f64, f64, f64, f64, f64), p: f64, lengths: &[f64]) -> 
     let forces: Vec<Vec<f64>> = [256, 512, 1024, 2048]
         .iter()
         .map(|&n| {
-            let bl = bladder(m, Wall::Layers(n));
+            let bl = bladder(m, Wall::DissertationLayers(n));
             lengths
                 .iter()
                 .map(|&l| bl.evaluate(p, l).unwrap().force)
@@ -65,16 +65,21 @@ fn largest_error(bl: &Bladder, p: f64, lengths: &[f64], limit: &[f64]) -> f64 {
 fn eight_nodes_reach_the_layered_limit_within_1e_6_of_peak_force() {
     // Issue 15's case: muscle C at 450 kPa (the thickest wall for its bore, pre-strained).
     let p = 450e3;
-    let probe = bladder(MUSCLE_C, Wall::Continuum(8));
+    let probe = bladder(MUSCLE_C, Wall::DissertationContinuum(8));
     let lengths = stroke(&probe, 41);
     let limit = layered_limit(MUSCLE_C, p, &lengths);
     let err8 = largest_error(&probe, p, &lengths, &limit);
     assert!(err8 <= 1e-6, "8 nodes: {err8:e} of peak force");
     // The same measure separates the layered walls clearly (16 layers are ~17% off here).
-    let err16_layers = largest_error(&bladder(MUSCLE_C, Wall::Layers(16)), p, &lengths, &limit);
+    let err16_layers = largest_error(
+        &bladder(MUSCLE_C, Wall::DissertationLayers(16)),
+        p,
+        &lengths,
+        &limit,
+    );
     assert!(err16_layers > 0.1, "{err16_layers}");
     // And muscle D, whose thin wall nearly collapses towards its fill limit.
-    let probe = bladder(MUSCLE_D, Wall::Continuum(8));
+    let probe = bladder(MUSCLE_D, Wall::DissertationContinuum(8));
     let limit = layered_limit(MUSCLE_D, p, &lengths_of(&probe));
     let err = largest_error(&probe, p, &lengths_of(&probe), &limit);
     assert!(err <= 1e-6, "muscle D, 8 nodes: {err:e} of peak force");
@@ -83,7 +88,7 @@ fn eight_nodes_reach_the_layered_limit_within_1e_6_of_peak_force() {
 #[test]
 fn quadrature_converges_geometrically_where_layers_converge_at_first_order() {
     let p = 450e3;
-    let probe = bladder(MUSCLE_C, Wall::Continuum(32));
+    let probe = bladder(MUSCLE_C, Wall::DissertationContinuum(32));
     let lengths = stroke(&probe, 21);
     let reference: Vec<f64> = lengths
         .iter()
@@ -91,14 +96,17 @@ fn quadrature_converges_geometrically_where_layers_converge_at_first_order() {
         .collect();
     let err = |wall| largest_error(&bladder(MUSCLE_C, wall), p, &lengths, &reference);
     // Layers: doubling halves the error (first order).
-    let (l64, l128) = (err(Wall::Layers(64)), err(Wall::Layers(128)));
+    let (l64, l128) = (
+        err(Wall::DissertationLayers(64)),
+        err(Wall::DissertationLayers(128)),
+    );
     assert!((l64 / l128 - 2.0).abs() < 0.1, "layers {l64:e} {l128:e}");
     // Nodes: each doubling gains far more than a factor of 2 (at least 20x per doubling until
     // the rounding floor).
     let (n2, n4, n8) = (
-        err(Wall::Continuum(2)),
-        err(Wall::Continuum(4)),
-        err(Wall::Continuum(8)),
+        err(Wall::DissertationContinuum(2)),
+        err(Wall::DissertationContinuum(4)),
+        err(Wall::DissertationContinuum(8)),
     );
     assert!(
         n2 / n4 > 20.0 && n4 / n8 > 20.0,
@@ -114,8 +122,8 @@ fn one_node_meets_the_thin_wall_as_the_wall_thins() {
     let p = 400e3;
     let diff = |t: f64| {
         let m = (0.1358, 0.1336, 3.8e-3, t, 0.1423, 4.53);
-        let thin = bladder(m, Wall::Layers(1));
-        let one = bladder(m, Wall::Continuum(1));
+        let thin = bladder(m, Wall::DissertationLayers(1));
+        let one = bladder(m, Wall::DissertationContinuum(1));
         let l = 0.5 * (thin.min_length() + thin.max_length());
         let (a, b) = (thin.evaluate(p, l).unwrap(), one.evaluate(p, l).unwrap());
         (a.force - b.force).abs() / a.force.abs()
@@ -132,7 +140,7 @@ fn one_node_meets_the_thin_wall_as_the_wall_thins() {
 
 #[test]
 fn continuum_stiffness_is_the_slope_and_threshold_switches_contact() {
-    let bl = bladder(MUSCLE_C, Wall::Continuum(8));
+    let bl = bladder(MUSCLE_C, Wall::DissertationContinuum(8));
     for &p in &[0.0, 100e3, 450e3] {
         for &l in &stroke(&bl, 9)[1..8] {
             // (The finite difference needs the force smooth over 2e-7 m: away from the limits.)
@@ -158,8 +166,8 @@ proptest! {
     fn finite_wherever_the_layered_wall_is(which in 0usize..2, nodes in 1usize..24,
                                             p in -80e3f64..800e3, u in 0.0f64..1.0) {
         let m = [MUSCLE_C, MUSCLE_D][which];
-        let layered = bladder(m, Wall::Layers(64));
-        let cont = bladder(m, Wall::Continuum(nodes));
+        let layered = bladder(m, Wall::DissertationLayers(64));
+        let cont = bladder(m, Wall::DissertationContinuum(nodes));
         let l = layered.min_length() + u * (layered.max_length() - layered.min_length());
         if let Ok(ls) = layered.evaluate(p, l) {
             prop_assert!(ls.force.is_finite());
@@ -175,7 +183,7 @@ proptest! {
 fn continuum_pressure_partial_is_the_slope_in_pressure() {
     // The directional derivatives (Model Exchange) use d(elastic)/dP of the wall: check the
     // continuum's against central differences in pressure, in contact and free.
-    let bl = bladder(MUSCLE_C, Wall::Continuum(8));
+    let bl = bladder(MUSCLE_C, Wall::DissertationContinuum(8));
     for &p in &[20e3, 100e3, 450e3] {
         for &l in &stroke(&bl, 9)[1..8] {
             let dp = 1.0;
@@ -225,7 +233,7 @@ fn dual_node_sums_agree_with_the_generic_path() {
     use super::hyper_dual::HyperDual;
     for m in [MUSCLE_C, MUSCLE_D] {
         for nodes in [1, 2, 3, 7, 8, 9, 16, 17, 23] {
-            let bl = bladder(m, Wall::Continuum(nodes));
+            let bl = bladder(m, Wall::DissertationContinuum(nodes));
             for &l in &stroke(&bl, 13) {
                 for shrink in [1.0, 0.97, 0.9] {
                     let x = bl.sleeve.diameter_sq(l).sqrt() * shrink;

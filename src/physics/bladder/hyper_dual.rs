@@ -5,7 +5,7 @@
 //! [`HyperDual`] only when the partials of `stiffness` (itself `dF/dL`) are asked for.
 
 use super::continuum::{dual_node_sums, node_sums, WallCall, WallNode, WallSums};
-use super::dual::Dual;
+use crate::physics::numerics::dual::Dual;
 use std::ops::{Add, Mul, Sub};
 
 /// What the kernel needs of a number: arithmetic and the few elementary functions it calls.

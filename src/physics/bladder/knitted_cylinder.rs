@@ -68,7 +68,11 @@ impl KnittedCylinder {
             self.sleeve_max_length
         };
         if l.is_finite() {
-            crate::physics::bounds::limit(l, self.sleeve_min_length, self.sleeve_max_length)
+            crate::physics::numerics::bounds::limit(
+                l,
+                self.sleeve_min_length,
+                self.sleeve_max_length,
+            )
         } else {
             self.sleeve_max_length
         }

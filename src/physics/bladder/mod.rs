@@ -1,9 +1,20 @@
 //! Hyperelastic McKibben bladder, dissertation section 2.2.2 (eq. 2.6-2.20).
 //!
 //! The bladder is an incompressible Mooney-Rivlin tube (eq. 2.8) clamped inside the ideal sleeve of
-//! [`crate::physics::gaylord`]. It is modelled as `gamma` nested thin-walled layers (eq. 2.19-2.20);
-//! one layer is exactly the thin-walled tube of eq. 2.6-2.17. Each layer follows eq. 2.9-2.12 with
-//! the radial stress taken as minus the pressure inside that layer (for one layer, `sigma_33 = -P`).
+//! [`crate::physics::gaylord`]. Its wall is integrated through the thickness in one of four ways
+//! ([`Wall`]):
+//! - [`Wall::Exact`]: the exact thick tube (Rivlin's integral, `exact.rs`), the physics;
+//! - [`Wall::Layers`]: nested thin layers, each balanced by eq. 2.12 read with the stress
+//!   difference `sigma_22 - sigma_33` (the layer's own pressure drop); it converges to the exact
+//!   wall at first order, and one layer is the exact wall's consistent thin-wall limit;
+//! - [`Wall::DissertationLayers`]: eq. 2.19-2.20 as written (`sigma_33 = -P` inside each layer and
+//!   the inner diameter for both pressures of eq. 2.10); one layer is the thin wall of
+//!   eq. 2.6-2.17 as written. The neglected term `p_out (d_out - d_in)` is first order in each
+//!   layer's thickness, so more layers never remove it: with no rubber stiffness at all the wall
+//!   still more than doubles the contact pressure (muscle A, 690 kPa: `P_eff` 1,445 kPa thin,
+//!   1,588 kPa with 16 layers). Kept to reproduce the dissertation's figures;
+//! - [`Wall::DissertationContinuum`]: that recursion's limit of infinitely many layers
+//!   (`continuum.rs`).
 //!
 //! Every layer is described by its stretch in squared form, so the per-call work is a handful of
 //! multiplications per layer and one reciprocal; the partial derivatives with respect to the muscle
@@ -20,7 +31,9 @@
 mod continuum;
 #[cfg(test)]
 mod continuum_tests;
-mod dual;
+mod exact;
+#[cfg(test)]
+mod exact_tests;
 mod geometry;
 mod hyper_dual;
 mod knitted_cylinder;
@@ -31,9 +44,9 @@ mod tests;
 
 use crate::physics::gaylord::Sleeve;
 use crate::physics::knitted::KnittedSleeve;
-use crate::physics::root::{newton_bisection, RootOptions, Sample};
+use crate::physics::numerics::dual::Dual;
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 use continuum::WallNode;
-use dual::Dual;
 pub use geometry::SleeveGeometry;
 use hyper_dual::KernelScalar;
 pub use knitted_cylinder::KnittedCylinder;
@@ -84,12 +97,32 @@ impl BladderTube {
 /// How the wall is integrated through its thickness.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum Wall {
-    /// `n` nested thin layers, eq. 2.19-2.20 as written (1 = the thin wall of eq. 2.6-2.17);
-    /// first order in `1/n`.
+    /// The exact thick-walled tube (Rivlin's integral) by an `n`-point Gauss-Legendre quadrature
+    /// through the wall (see `exact.rs`); converges geometrically in `n`.
+    Exact(usize),
+    /// `n` nested thin layers, each balanced by its own stress difference (eq. 2.12 with
+    /// `sigma_33 = 0`); first order in `1/n` towards [`Wall::Exact`]. One layer is the exact
+    /// wall's consistent thin-wall limit.
     Layers(usize),
-    /// The limit of infinitely many layers by an `n`-point Gauss-Legendre quadrature through the
-    /// wall (see `continuum.rs`); converges geometrically in `n`.
-    Continuum(usize),
+    /// `n` nested thin layers, eq. 2.19-2.20 as the dissertation writes them (1 = its thin wall
+    /// of eq. 2.6-2.17, `sigma_33 = -P`); first order in `1/n` towards
+    /// [`Wall::DissertationContinuum`], not towards the exact wall.
+    DissertationLayers(usize),
+    /// The limit of [`Wall::DissertationLayers`] for infinitely many layers by an `n`-point
+    /// Gauss-Legendre quadrature through the wall (see `continuum.rs`).
+    DissertationContinuum(usize),
+}
+
+impl Wall {
+    /// Layers or quadrature nodes.
+    pub fn count(self) -> usize {
+        match self {
+            Self::Exact(n)
+            | Self::Layers(n)
+            | Self::DissertationLayers(n)
+            | Self::DissertationContinuum(n) => n,
+        }
+    }
 }
 
 /// Parameter-only constants of one nested layer (eq. 2.19-2.20), precomputed once.
@@ -113,9 +146,9 @@ pub struct Bladder<S = Sleeve> {
     sleeve: S,
     tube: BladderTube,
     wall: Wall,
-    /// The layers of [`Wall::Layers`] (empty for the continuum).
+    /// The layers of the layered walls (empty for the quadratures).
     layers: Vec<Layer>,
-    /// The quadrature nodes of [`Wall::Continuum`] (empty for the layers).
+    /// The quadrature nodes of [`Wall::Exact`] and [`Wall::DissertationContinuum`].
     nodes: Vec<WallNode>,
     outer_diameter: f64,
     rubber_volume: f64,
@@ -178,7 +211,7 @@ impl Bladder<KnittedCylinder> {
         tube: BladderTube,
         layers: usize,
     ) -> Result<Self, String> {
-        Self::new(KnittedCylinder::new(sleeve)?, tube, layers)
+        Self::dissertation_layers(KnittedCylinder::new(sleeve)?, tube, layers)
     }
 
     /// As [`Self::knitted`] with any [`Wall`].
@@ -192,10 +225,15 @@ impl Bladder<KnittedCylinder> {
 }
 
 impl<S: SleeveGeometry> Bladder<S> {
-    /// Builds a bladder of `layers` nested thin layers (1 = thin-walled model, eq. 2.6-2.17;
-    /// more = thick-walled model, eq. 2.19-2.20) inside `sleeve`.
-    pub fn new(sleeve: S, tube: BladderTube, layers: usize) -> Result<Self, String> {
-        Self::with_wall(sleeve, tube, Wall::Layers(layers))
+    /// Builds a bladder of `layers` nested thin layers as the dissertation writes them
+    /// ([`Wall::DissertationLayers`]: 1 = its thin wall, eq. 2.6-2.17; more = eq. 2.19-2.20)
+    /// inside `sleeve`.
+    pub fn dissertation_layers(
+        sleeve: S,
+        tube: BladderTube,
+        layers: usize,
+    ) -> Result<Self, String> {
+        Self::with_wall(sleeve, tube, Wall::DissertationLayers(layers))
     }
 
     /// Builds a bladder whose wall is integrated as `wall` says inside `sleeve`.
@@ -215,7 +253,7 @@ impl<S: SleeveGeometry> Bladder<S> {
                 return Err(format!("{name} must be finite and >= 0 Pa, got {c}"));
             }
         }
-        let (Wall::Layers(count) | Wall::Continuum(count)) = wall;
+        let count = wall.count();
         if !(1..=MAX_LAYERS).contains(&count) {
             return Err(format!(
                 "bladder layers (or quadrature nodes) must be 1..={MAX_LAYERS}, got {count}"
@@ -224,8 +262,8 @@ impl<S: SleeveGeometry> Bladder<S> {
         let d_ri = tube.inner_diameter;
         let d_ro = d_ri + 2.0 * tube.thickness;
         let (layers, nodes) = match wall {
-            Wall::Layers(n) => (n, Vec::new()),
-            Wall::Continuum(n) => (0, continuum::wall_nodes(n)),
+            Wall::Layers(n) | Wall::DissertationLayers(n) => (n, Vec::new()),
+            Wall::Exact(n) | Wall::DissertationContinuum(n) => (0, continuum::wall_nodes(n)),
         };
         let step = (d_ro - d_ri) / layers.max(1) as f64;
         let layer_list: Vec<Layer> = (0..layers)
@@ -273,7 +311,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         &self.tube
     }
 
-    /// Layers of [`Wall::Layers`], or quadrature nodes of [`Wall::Continuum`].
+    /// Layers of a layered wall, or quadrature nodes of a quadrature.
     pub fn layer_count(&self) -> usize {
         self.layers.len() + self.nodes.len()
     }
@@ -415,19 +453,29 @@ impl<S: SleeveGeometry> Bladder<S> {
         )
     }
 
-    /// The wall at muscle length `l` and bladder outer diameter `x`: layers or continuum.
+    /// The wall at muscle length `l` and bladder outer diameter `x`.
     #[inline]
     fn kernel<T: KernelScalar>(&self, pressure: f64, l: T, x: T) -> Option<Kernel<T>> {
         match self.wall {
-            Wall::Layers(_) => self.layered_kernel(pressure, l, x),
-            Wall::Continuum(_) => self.continuum_kernel(pressure, l, x),
+            Wall::Exact(_) => self.exact_kernel(pressure, l, x),
+            Wall::Layers(_) => self.layered_kernel(pressure, l, x, false),
+            Wall::DissertationLayers(_) => self.layered_kernel(pressure, l, x, true),
+            Wall::DissertationContinuum(_) => self.continuum_kernel(pressure, l, x),
         }
     }
 
-    /// The layer recursion of eq. 2.19-2.20 at muscle length `l` and bladder outer diameter `x`.
-    /// `None` if a layer's squared hoop stretch is not positive (outside the geometry) or not finite.
+    /// The layer recursion of eq. 2.19-2.20 at muscle length `l` and bladder outer diameter `x`:
+    /// as written (`as_written`, `sigma_33 = -p_in` in eq. 2.12) or with each layer balanced by
+    /// its stress difference (`sigma_33 = 0`). `None` if a layer's squared hoop stretch is not
+    /// positive (outside the geometry) or not finite.
     #[inline]
-    fn layered_kernel<T: KernelScalar>(&self, pressure: f64, l: T, x: T) -> Option<Kernel<T>> {
+    fn layered_kernel<T: KernelScalar>(
+        &self,
+        pressure: f64,
+        l: T,
+        x: T,
+        as_written: bool,
+    ) -> Option<Kernel<T>> {
         let c1x2 = 2.0 * self.tube.mooney_c1;
         let c2x2 = 2.0 * self.tube.mooney_c2;
         let lambda1 = l * (1.0 / self.tube.unstretched_length);
@@ -465,10 +513,16 @@ impl<S: SleeveGeometry> Bladder<S> {
             if inner.is_none() {
                 inner = Some(InnerLayer { l2_sq, axial, hoop });
             }
-            // Eq. 2.12 for the layer: p_out = p_in - sigma_22 k with sigma_22 = -p_in + hoop.
-            let one_k = k + 1.0;
-            c = c * one_k + hoop * k;
-            a = a * one_k;
+            if as_written {
+                // Eq. 2.12 for the layer: p_out = p_in - sigma_22 k with sigma_22 = -p_in + hoop.
+                let one_k = k + 1.0;
+                c = c * one_k + hoop * k;
+                a = a * one_k;
+            } else {
+                // The layer's balance with its stress difference: p_out = p_in - hoop k (the
+                // first-order term p_out (d_out - d_in) of eq. 2.10 no longer dropped).
+                c = c + hoop * k;
+            }
         }
         let inner = inner?;
         let p_eff = a * pressure - c;

@@ -161,12 +161,15 @@ mod tests {
         (worst, !b.evaluate(p, l).unwrap().contact)
     }
 
-    fn walls() -> [Wall; 4] {
+    fn walls() -> [Wall; 7] {
         [
-            Wall::Layers(1),
-            Wall::Layers(8),
-            Wall::Continuum(6),
-            Wall::Continuum(1),
+            Wall::Exact(8),
+            Wall::Exact(1),
+            Wall::Layers(4),
+            Wall::DissertationLayers(1),
+            Wall::DissertationLayers(8),
+            Wall::DissertationContinuum(6),
+            Wall::DissertationContinuum(1),
         ]
     }
 

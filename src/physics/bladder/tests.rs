@@ -30,7 +30,7 @@ const D: usize = 3;
 fn muscle(which: usize, layers: usize) -> Bladder {
     let (_, lr0, d_ri, t, b, n) = TABLE_2_1[which];
     let tube = BladderTube::latex(d_ri, t, lr0);
-    Bladder::new(Sleeve::new(b, n).unwrap(), tube, layers).unwrap()
+    Bladder::dissertation_layers(Sleeve::new(b, n).unwrap(), tube, layers).unwrap()
 }
 
 fn listed_length(which: usize) -> f64 {
@@ -135,7 +135,7 @@ fn vanishing_bladder_converges_to_eq_2_3() {
                 mooney_c1: MOONEY_C1 * eps,
                 mooney_c2: MOONEY_C2 * eps,
             };
-            let s = Bladder::new(sleeve, tube, layers)
+            let s = Bladder::dissertation_layers(sleeve, tube, layers)
                 .unwrap()
                 .evaluate(p, l)
                 .unwrap();
@@ -392,9 +392,9 @@ fn contact_onset_length_at_400_kpa() {
 fn rejects_bad_parameters() {
     let s = Sleeve::new(0.1113, 3.74).unwrap();
     let good = BladderTube::latex(1.6e-3, 1.6e-3, 0.1);
-    assert!(Bladder::new(s, good, 1).is_ok());
-    assert!(Bladder::new(s, good, 0).is_err());
-    assert!(Bladder::new(s, good, MAX_LAYERS + 1).is_err());
+    assert!(Bladder::dissertation_layers(s, good, 1).is_ok());
+    assert!(Bladder::dissertation_layers(s, good, 0).is_err());
+    assert!(Bladder::dissertation_layers(s, good, MAX_LAYERS + 1).is_err());
     for bad in [
         BladderTube {
             inner_diameter: 0.0,
@@ -422,7 +422,7 @@ fn rejects_bad_parameters() {
             ..good
         },
     ] {
-        let e = Bladder::new(s, bad, 1).unwrap_err();
+        let e = Bladder::dissertation_layers(s, bad, 1).unwrap_err();
         assert!(!e.is_empty());
     }
 }
@@ -628,7 +628,7 @@ proptest! {
                                   prestrain in 0.3f64..1.2, layers in 1usize..40, frac in 0.0f64..1.0) {
         let sleeve = Sleeve::new(0.15, 3.5).unwrap();
         let tube = BladderTube::latex(d_ri, wall * d_ri, prestrain * 0.12);
-        if let Ok(bl) = Bladder::new(sleeve, tube, layers) {
+        if let Ok(bl) = Bladder::dissertation_layers(sleeve, tube, layers) {
             let l = bl.min_length() + frac * (bl.max_length() - bl.min_length());
             if let Ok(stable) = bl.free_contact_is_stable(l) {
                 prop_assert!(stable, "{:?} layers {} at {}", tube, layers, l);

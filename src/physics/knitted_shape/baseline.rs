@@ -45,7 +45,7 @@ pub fn seed_gradient_volume_curve(
     let l_max = geom.max_length();
     let r_min = geom.min_radius;
     let r_ceiling = geom.radius_ceiling();
-    let end = crate::physics::bounds::limit(end_length, 0.0, l_max);
+    let end = crate::physics::numerics::bounds::limit(end_length, 0.0, l_max);
     let steps = options.length_steps.clamp(1, 100_000);
     let rings = geom.segments + 1;
     let r_ref = geom.row_strand_length / (2.0 * PI);
@@ -145,8 +145,11 @@ pub fn seed_gradient_volume_curve(
                     .map(|(a, b)| a.lb + b.la);
                 match dlw {
                     Some(g) if g < 0.0 => {
-                        trial[worst] =
-                            crate::physics::bounds::limit(trial[worst] - err / g, r_min, r_ceiling)
+                        trial[worst] = crate::physics::numerics::bounds::limit(
+                            trial[worst] - err / g,
+                            r_min,
+                            r_ceiling,
+                        )
                     }
                     _ => break,
                 }

@@ -183,7 +183,7 @@ impl Solver {
         for j in 0..self.radii.len() {
             if !self.held[j] {
                 let r = self.base[j] + alpha * self.x[j];
-                self.radii[j] = crate::physics::bounds::limit(r, r_min, r_ceiling);
+                self.radii[j] = crate::physics::numerics::bounds::limit(r, r_min, r_ceiling);
             }
         }
     }

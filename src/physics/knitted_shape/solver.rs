@@ -381,7 +381,11 @@ impl Solver {
                     self.radii[j] = if self.held[j] {
                         base[j]
                     } else {
-                        crate::physics::bounds::limit(base[j] + alpha * self.x[j], r_min, r_ceiling)
+                        crate::physics::numerics::bounds::limit(
+                            base[j] + alpha * self.x[j],
+                            r_min,
+                            r_ceiling,
+                        )
                     };
                 }
                 self.hold_touching(r_min);
@@ -454,7 +458,8 @@ impl Solver {
         } else {
             n
         };
-        let period = crate::physics::bounds::limit(period, 2.0 * geom.rows_per_segment(), n);
+        let period =
+            crate::physics::numerics::bounds::limit(period, 2.0 * geom.rows_per_segment(), n);
         let amplitude = deficit * m / (PI * period);
         let k = geom.rows_per_segment();
         let rings = self.radii.len();

@@ -76,7 +76,7 @@ impl ShapeTable {
         if last == 0 || !(self.spacing > 0.0) {
             return (0, 0.0);
         }
-        let u = crate::physics::bounds::limit(
+        let u = crate::physics::numerics::bounds::limit(
             (self.max_length - length) / self.spacing,
             0.0,
             last as f64,
@@ -153,7 +153,8 @@ impl ShapeTable {
         if !length.is_finite() {
             return Err(format!("length must be finite, got {length}"));
         }
-        let length = crate::physics::bounds::limit(length, self.min_length(), self.max_length);
+        let length =
+            crate::physics::numerics::bounds::limit(length, self.min_length(), self.max_length);
         let mut solver = Solver::new(&self.geometry);
         let nodes = self.volume.len().saturating_sub(1).max(1);
         follow_path(&self.geometry, &mut solver, length, nodes, Some(length))?;
@@ -191,7 +192,7 @@ fn follow_path(
     let l_max = geom.max_length();
     let r = geom.min_radius;
     let s = geom.row_strand_length;
-    let end = crate::physics::bounds::limit(end_length, 0.0, l_max);
+    let end = crate::physics::numerics::bounds::limit(end_length, 0.0, l_max);
     let nodes = nodes.clamp(2, 100_000);
     let step = (l_max - end) / nodes as f64;
     let mut pts = Vec::with_capacity(nodes + 1);

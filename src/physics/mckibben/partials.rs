@@ -335,9 +335,9 @@ mod tests {
     fn partials_match_central_differences_across_effects() {
         let models = [
             BladderModel::None,
-            BladderModel::ThinWall,
-            BladderModel::ThickWall { layers: 8 },
-            BladderModel::Continuum { nodes: 6 },
+            BladderModel::DissertationThinWall,
+            BladderModel::DissertationLayers { layers: 8 },
+            BladderModel::DissertationContinuum { nodes: 6 },
         ];
         let (mut worst, mut worst_stiffness) = (0.0f64, 0.0f64);
         let (mut free_points, mut points) = (0, 0);
@@ -398,7 +398,7 @@ mod tests {
         // At the threshold pressure P_eff = 0 but dP_eff/dP = a > 0: the contact branch.
         let m = muscle(
             &MuscleGeometry::muscle_a(),
-            BladderModel::ThinWall,
+            BladderModel::DissertationThinWall,
             false,
             0.0,
         );
@@ -418,7 +418,10 @@ mod tests {
     fn stiffness_partials_at_the_contact_kink_are_the_contact_branch() {
         // At the threshold pressure the stiffness's pressure slope jumps (free below, contact
         // above): the call returns the contact branch's, the one-sided difference from above.
-        for model in [BladderModel::ThinWall, BladderModel::Continuum { nodes: 6 }] {
+        for model in [
+            BladderModel::DissertationThinWall,
+            BladderModel::DissertationContinuum { nodes: 6 },
+        ] {
             let m = muscle(&MuscleGeometry::muscle_a(), model, false, 0.0);
             let l = 0.09;
             let s = HysteresisState::at_rest(l);

@@ -1,7 +1,11 @@
 //! Exponential Rosenbrock substeps with an embedded error estimate (quasi-static onion) or step
 //! doubling (Gilbert onion); see [`Motor::step`].
 
-use super::{expm, phi, Angles, Drive, Motor, StepRun, Vector, MAX_ANGLE};
+use super::{phi, Angles, Drive, Motor, StepRun, Vector, MAX_ANGLE};
+use crate::physics::numerics::expm;
+
+/// The size of the full augmented system: rotor angle and speed, onion angle and tilt, forcing.
+const AUGMENTED: usize = 5;
 
 impl Motor {
     /// Right-hand side and Jacobian of the ODE in `(phi, omega, psi, theta)`, for a substep `dt`.
@@ -130,7 +134,7 @@ impl Motor {
             out[0] += e[0][2];
             out[1] += e[1][2];
         } else {
-            let mut m = [[0.0; expm::N]; expm::N];
+            let mut m = [[0.0; AUGMENTED]; AUGMENTED];
             for i in 0..4 {
                 for k in 0..4 {
                     m[i][k] = dt * j[i][k];

@@ -66,7 +66,11 @@ impl Motor {
                 // Near the root: aim past it to bracket it.
                 (1.5 * force.abs() / k).max(eps)
             } else if k != 0.0 {
-                crate::physics::bounds::limit(0.25 * force.abs() / k.abs(), eps, MAX_ROTOR_STRIDE)
+                crate::physics::numerics::bounds::limit(
+                    0.25 * force.abs() / k.abs(),
+                    eps,
+                    MAX_ROTOR_STRIDE,
+                )
             } else {
                 MAX_ROTOR_STRIDE
             };

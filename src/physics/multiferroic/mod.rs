@@ -35,7 +35,6 @@
 pub mod angles;
 pub mod branch;
 pub mod drive;
-pub mod expm;
 mod integrator;
 mod long_steps;
 pub mod magnetics;

@@ -156,7 +156,7 @@ mod tests {
             m[i][1] = a[i][1];
             m[i][2] = v[i];
         }
-        let e = crate::physics::multiferroic::expm::expm(&m).unwrap();
+        let e = crate::physics::numerics::expm::expm(&m).unwrap();
         for i in 0..2 {
             assert!(
                 (p1[i] - e[i][2]).abs() <= 1e-12 * e[i][2].abs(),

@@ -1,5 +1,5 @@
 //! `calibrate`: fits McKibbenMuscle's physical parameters to a datasheet of force-contraction
-//! curves with the FMU's own physics (see `actuator_fmus::physics::calibration`).
+//! curves with the FMU's own physics (see `actuator_fmus_tools::calibration`).
 //!
 //! ```text
 //! calibrate --data festo_dmsp40.csv --length 0.4 --diameter 0.04 --fit 0,600 --out out/dmsp40
@@ -10,7 +10,7 @@
 //! values), `OUT/fit.csv` (every datum with the model's force) and `OUT/fit.json` (errors per
 //! pressure, fit time). `python/actuator_fmus/calibration.py` adds the report and its plot.
 
-use actuator_fmus::physics::calibration::{
+use actuator_fmus_tools::calibration::{
     curves, errors, fit, model_force, Curve, Datum, FitConfig, MuscleParams,
 };
 use std::fmt::Write as _;

@@ -5,15 +5,15 @@ use std::ops::{Add, Mul, Sub};
 /// Forward-mode dual number: value and partial derivatives with respect to the muscle length
 /// (`dl`) and the bladder's outer diameter (`dx`). Hand-written for speed on the hot path.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Dual {
-    pub(super) v: f64,
-    pub(super) dl: f64,
-    pub(super) dx: f64,
+pub struct Dual {
+    pub v: f64,
+    pub dl: f64,
+    pub dx: f64,
 }
 
 impl Dual {
     #[inline]
-    pub(super) fn constant(v: f64) -> Self {
+    pub fn constant(v: f64) -> Self {
         Self {
             v,
             dl: 0.0,
@@ -21,7 +21,7 @@ impl Dual {
         }
     }
     #[inline]
-    pub(super) fn var_l(v: f64) -> Self {
+    pub fn var_l(v: f64) -> Self {
         Self {
             v,
             dl: 1.0,
@@ -29,7 +29,7 @@ impl Dual {
         }
     }
     #[inline]
-    pub(super) fn var_x(v: f64) -> Self {
+    pub fn var_x(v: f64) -> Self {
         Self {
             v,
             dl: 0.0,
@@ -37,7 +37,7 @@ impl Dual {
         }
     }
     #[inline]
-    pub(super) fn ln(self) -> Self {
+    pub fn ln(self) -> Self {
         let d = 1.0 / self.v;
         Self {
             v: self.v.ln(),
@@ -46,7 +46,7 @@ impl Dual {
         }
     }
     #[inline]
-    pub(super) fn exp(self) -> Self {
+    pub fn exp(self) -> Self {
         let e = self.v.exp();
         Self {
             v: e,
@@ -55,7 +55,7 @@ impl Dual {
         }
     }
     #[inline]
-    pub(super) fn rsqrt(self) -> Self {
+    pub fn rsqrt(self) -> Self {
         let r = 1.0 / self.v.sqrt();
         let d = -0.5 * r * r * r;
         Self {
@@ -65,7 +65,7 @@ impl Dual {
         }
     }
     #[inline]
-    pub(super) fn sqrt(self) -> Self {
+    pub fn sqrt(self) -> Self {
         let r = self.v.sqrt();
         let d = 0.5 / r;
         Self {
@@ -75,7 +75,7 @@ impl Dual {
         }
     }
     #[inline]
-    pub(super) fn recip(self) -> Self {
+    pub fn recip(self) -> Self {
         let r = 1.0 / self.v;
         let d = -r * r;
         Self {

@@ -4,8 +4,6 @@
 //! and so that a hopeless argument returns `None` instead of panicking or producing NaN. Generic
 //! over the size: the quasi-static motor needs 3x3 (rotor and forcing), the Gilbert one 5x5.
 
-/// The size of the full augmented system: rotor angle and speed, onion angle and tilt, forcing.
-pub const N: usize = 5;
 pub type Mat<const N: usize> = [[f64; N]; N];
 
 /// Dense and branch-free, so that the rows vectorize (a test for zero entries cost more than
@@ -122,7 +120,7 @@ mod tests {
 
     #[test]
     fn exponential_of_a_rotation_generator_and_a_decay() {
-        let mut m = [[0.0; N]; N];
+        let mut m = [[0.0; 5]; 5];
         m[0][1] = 1.0;
         m[1][0] = -1.0;
         m[2][2] = -3.0;

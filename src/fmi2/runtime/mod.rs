@@ -1,10 +1,12 @@
 //! The bridge between the C ABI and any [`Model`]: one instance's typed variable values and
 //! model, behind a trait object so that the exported functions are written once for every model.
 
-use super::exports::HotPath;
-use super::registry::Bindings;
+mod bindings;
+mod directional_derivative;
+
 use crate::models::{EventUpdate, Model, Report};
 use crate::variables::{ContinuousStates, Interface, ModelInfo};
+pub use bindings::Bindings;
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::marker::PhantomData;
@@ -63,8 +65,6 @@ pub trait Factory: Sync {
     fn create(&self) -> Box<dyn Runtime>;
     /// Whether the model serves Model Exchange ([`Model::MODEL_EXCHANGE`]).
     fn model_exchange(&self) -> bool;
-    /// The per-step calls compiled for the runtime type that [`Factory::create`] returns.
-    fn hot_path(&self) -> HotPath;
 }
 
 pub struct ModelFactory<M>(PhantomData<fn() -> M>);
@@ -85,9 +85,6 @@ where
     }
     fn model_exchange(&self) -> bool {
         M::MODEL_EXCHANGE
-    }
-    fn hot_path(&self) -> HotPath {
-        HotPath::of::<RuntimeOf<M>>()
     }
     fn create(&self) -> Box<dyn Runtime> {
         Box::new(RuntimeOf::<M> {
@@ -128,7 +125,7 @@ pub trait Runtime: Send {
     /// Recomputes the outputs if an input changed since they were last written.
     fn refresh_outputs(&mut self, report: &mut Report);
     /// Steps the model and writes its `input_clamped` output (if it has one) from the report, as
-    /// [`super::out_of_range::OutOfRange::apply`] would, within this one dynamic call.
+    /// the instance's out-of-range policy would, within this one dynamic call.
     fn step(&mut self, time: f64, step: f64, report: &mut Report);
     /// Model Exchange, event mode: commits the history at the current inputs and writes the
     /// outputs ([`Model::update_discrete_states`]).
@@ -153,7 +150,7 @@ pub trait Runtime: Send {
     /// The next time event after `time`, if any.
     fn next_time_event(&self, time: f64) -> Option<f64>;
     /// `dv_unknown = d(unknown)/d(known) * dv_known` over Real value references
-    /// ([`super::derivatives`]).
+    /// ([`directional_derivative`]).
     fn directional_derivative(
         &mut self,
         unknown: &[u32],
@@ -181,7 +178,7 @@ struct RuntimeOf<M: Model> {
     model: Option<M>,
     /// The outputs are not those the built model wrote for the current values. True whenever
     /// `model` is `None` (every change of `model` sets it; bytes from an importer are made to
-    /// agree), so that [`Runtime::outputs_current`] is one test on the per-step path.
+    /// agree), so that [`Runtime::outputs_current`] is one test.
     outputs_stale: bool,
     /// Model Exchange's time, given to the model when it is built (`None` for Co-Simulation).
     /// Not saved: the model keeps its own time, and the instance its.
@@ -370,7 +367,6 @@ where
             self.mirror_states();
         }
     }
-    #[inline(always)]
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
         let Some(model) = self.model.as_mut() else {
             // Not built (no step reaches here before initialization): laid out of the way.
@@ -473,7 +469,7 @@ where
         dv_known: &[f64],
         dv_unknown: &mut [f64],
     ) -> Result<(), String> {
-        super::derivatives::directional_derivative(
+        directional_derivative::directional_derivative(
             self.model.as_mut(),
             &self.values.inputs,
             unknown,
@@ -567,7 +563,7 @@ mod tests {
             .ok_or_else(|| "not a McKibbenMuscle runtime".to_string())
     }
 
-    /// "Outputs current" is one flag on the per-step path, which holds only with a built model:
+    /// "Outputs current" is one flag, which holds only with a built model:
     /// bytes that claim current outputs without a model, or whose model fails to rebuild, are
     /// made to agree.
     #[test]

@@ -51,7 +51,7 @@ pub fn newton_bisection<T, E>(
 ) -> Result<Root<T>, E> {
     let (mut lo, mut hi) = if lo <= hi { (lo, hi) } else { (hi, lo) };
     let mut x = if start.is_finite() {
-        crate::physics::bounds::limit(start, lo, hi)
+        crate::physics::numerics::bounds::limit(start, lo, hi)
     } else {
         0.5 * (lo + hi)
     };

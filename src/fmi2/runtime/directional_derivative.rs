@@ -3,9 +3,7 @@
 //! outputs (and state derivatives): Model Exchange's Jacobian. No finite differences: a model
 //! that has no partials says so and the call is refused.
 
-use super::instance::{allowed, Instance};
-use super::registry::Bindings;
-use super::types::fmi2Status;
+use super::Bindings;
 use crate::models::{Inputs, Model};
 use crate::variables::{Causality, ContinuousStates, Interface, VarType};
 
@@ -91,58 +89,4 @@ where
         *slot = value;
     }
     Ok(())
-}
-
-impl Instance {
-    pub fn get_directional_derivative(
-        &mut self,
-        unknown: &[u32],
-        known: &[u32],
-        dv_known: &[f64],
-        dv_unknown: &mut [f64],
-    ) -> fmi2Status {
-        const F: &str = "fmi2GetDirectionalDerivative";
-        if !self.allowed(F, allowed::GET) {
-            return fmi2Status::Error;
-        }
-        // Builds the model in initialization mode (as fmi2GetReal does); the partials need no
-        // fresh outputs, so a built model skips that evaluation.
-        let status = if self.runtime.is_built() {
-            fmi2Status::OK
-        } else {
-            self.refresh_outputs(F)
-        };
-        if status >= fmi2Status::Error {
-            return status;
-        }
-        match self
-            .runtime
-            .directional_derivative(unknown, known, dv_known, dv_unknown)
-        {
-            Ok(()) => status,
-            Err(why) => self.error(&format!("{F}: {why}")),
-        }
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::super::REGISTRY;
-
-    #[test]
-    fn the_shipped_capabilities_match_the_models() {
-        for factory in REGISTRY {
-            let info = factory.info();
-            let mut runtime = factory.create();
-            let built = runtime.build();
-            assert!(built.is_ok(), "{}: {built:?}", info.name);
-            let provided = runtime.directional_derivative(&[], &[], &[], &mut []);
-            let flag = info
-                .model_description_xml
-                .contains(r#"providesDirectionalDerivative="true""#);
-            assert_eq!(provided.is_ok(), flag, "{}: {provided:?}", info.name);
-            let model_exchange = info.model_description_xml.contains("<ModelExchange");
-            assert_eq!(factory.model_exchange(), model_exchange, "{}", info.name);
-        }
-    }
 }

@@ -10,22 +10,9 @@
 //! steps fall on the communication points gives the Co-Simulation outputs, and the stop operator
 //! needs no event of its own: it is rate-independent and continuous in the length.
 
-use super::exports::{guarded, null_argument, slice, slice_mut};
-use super::instance::{allowed, Instance, MachineState};
-use super::types::*;
+use super::{allowed, Instance, MachineState};
+use crate::fmi2::types::{fmi2EventInfo, fmi2Status, FMI2_FALSE, FMI2_TRUE};
 use crate::models::{EventUpdate, Report};
-
-/// `fmi2EventInfo` (fmi2FunctionTypes.h).
-#[repr(C)]
-#[derive(Clone, Copy, Debug)]
-pub struct fmi2EventInfo {
-    pub new_discrete_states_needed: fmi2Boolean,
-    pub terminate_simulation: fmi2Boolean,
-    pub nominals_of_continuous_states_changed: fmi2Boolean,
-    pub values_of_continuous_states_changed: fmi2Boolean,
-    pub next_event_time_defined: fmi2Boolean,
-    pub next_event_time: fmi2Real,
-}
 
 impl Instance {
     /// Refuses Model Exchange calls on a Co-Simulation instance and in the wrong state.
@@ -224,169 +211,12 @@ pub enum Vector {
 }
 
 impl Vector {
-    fn name(self) -> &'static str {
+    pub(in crate::fmi2) fn name(self) -> &'static str {
         match self {
             Vector::States => "states",
             Vector::Derivatives => "derivatives",
             Vector::EventIndicators => "event indicators",
             Vector::Nominals => "nominals",
         }
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-    unsafe { guarded(c, "fmi2EnterEventMode", |inst| inst.enter_event_mode()) }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2NewDiscreteStates(
-    c: fmi2Component,
-    event_info: *mut fmi2EventInfo,
-) -> fmi2Status {
-    const F: &str = "fmi2NewDiscreteStates";
-    unsafe {
-        guarded(c, F, |inst| {
-            // SAFETY: a non-null pointer from the importer points to an fmi2EventInfo.
-            match event_info.as_mut() {
-                Some(info) => inst.new_discrete_states(info),
-                None => null_argument(inst, F, "fmi2eventInfo"),
-            }
-        })
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-    unsafe {
-        guarded(c, "fmi2EnterContinuousTimeMode", |inst| {
-            inst.enter_continuous_time_mode()
-        })
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
-    c: fmi2Component,
-    _no_set_fmu_state_prior_to_current_point: fmi2Boolean,
-    enter_event_mode: *mut fmi2Boolean,
-    terminate_simulation: *mut fmi2Boolean,
-) -> fmi2Status {
-    const F: &str = "fmi2CompletedIntegratorStep";
-    unsafe {
-        guarded(c, F, |inst| {
-            // SAFETY: non-null pointers from the importer point to fmi2Booleans.
-            let (Some(enter), Some(terminate)) =
-                (enter_event_mode.as_mut(), terminate_simulation.as_mut())
-            else {
-                return null_argument(inst, F, "enterEventMode or terminateSimulation");
-            };
-            let (status, event) = inst.completed_integrator_step();
-            *enter = if event { FMI2_TRUE } else { FMI2_FALSE };
-            *terminate = FMI2_FALSE;
-            status
-        })
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
-    unsafe { guarded(c, "fmi2SetTime", |inst| inst.set_time(time)) }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2SetContinuousStates(
-    c: fmi2Component,
-    x: *const fmi2Real,
-    nx: usize,
-) -> fmi2Status {
-    const F: &str = "fmi2SetContinuousStates";
-    unsafe {
-        guarded(c, F, |inst| {
-            // SAFETY: the importer passes nx readable values (or NULL, refused here).
-            match slice(x, nx) {
-                Some(x) => inst.set_continuous_states(x),
-                None => null_argument(inst, F, "x"),
-            }
-        })
-    }
-}
-
-/// The getters of state-sized vectors, on the importer's buffer of n values.
-unsafe fn get_vector(
-    c: fmi2Component,
-    function: &'static str,
-    what: Vector,
-    values: *mut fmi2Real,
-    n: usize,
-) -> fmi2Status {
-    unsafe {
-        guarded(c, function, |inst| {
-            // SAFETY: the importer passes n writable values (or NULL, refused here).
-            match slice_mut(values, n) {
-                Some(out) => inst.get_vector(function, what, out),
-                None => null_argument(inst, function, what.name()),
-            }
-        })
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2GetDerivatives(
-    c: fmi2Component,
-    derivatives: *mut fmi2Real,
-    nx: usize,
-) -> fmi2Status {
-    unsafe {
-        get_vector(
-            c,
-            "fmi2GetDerivatives",
-            Vector::Derivatives,
-            derivatives,
-            nx,
-        )
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2GetEventIndicators(
-    c: fmi2Component,
-    indicators: *mut fmi2Real,
-    ni: usize,
-) -> fmi2Status {
-    unsafe {
-        get_vector(
-            c,
-            "fmi2GetEventIndicators",
-            Vector::EventIndicators,
-            indicators,
-            ni,
-        )
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2GetContinuousStates(
-    c: fmi2Component,
-    x: *mut fmi2Real,
-    nx: usize,
-) -> fmi2Status {
-    unsafe { get_vector(c, "fmi2GetContinuousStates", Vector::States, x, nx) }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi2GetNominalsOfContinuousStates(
-    c: fmi2Component,
-    nominals: *mut fmi2Real,
-    nx: usize,
-) -> fmi2Status {
-    unsafe {
-        get_vector(
-            c,
-            "fmi2GetNominalsOfContinuousStates",
-            Vector::Nominals,
-            nominals,
-            nx,
-        )
     }
 }

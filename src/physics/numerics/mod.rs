@@ -1,0 +1,9 @@
+//! Generic numerics the physics is written with, each hand-written for the per-step cost or for
+//! its failure mode (no panic, no NaN, a bounded loop): a safeguarded Newton-bisection root finder,
+//! limiting to computed bounds, forward-mode dual numbers of two variables, and the matrix
+//! exponential of a small matrix. Nothing here knows an actuator; the domain code beside it does.
+
+pub mod bounds;
+pub mod dual;
+pub mod expm;
+pub mod root;
