@@ -83,10 +83,12 @@ class Muscle:
 
 
 def top_of(m, preset):
+    """Top of the stroke (m): the listed length of Table 2.1 muscle `preset`, or 0.99 of max_length if shorter."""
     return min(LISTED[preset], 0.99 * m.max_length)
 
 
 def net_works(model):
+    """Net work per cycle at 690 kPa (J) of muscles A-C (presets 1-3) with `bladder_model` `model`."""
     out = {}
     for preset in (1, 2, 3):
         m = Muscle(preset=preset, bladder_model=model)
@@ -96,10 +98,12 @@ def net_works(model):
 
 
 def ordered(values):
+    """Whether muscles A < B < C in `values` (any one unit)."""
     return values[1] < values[2] < values[3]
 
 
 def fmt_works(w):
+    """Net works of muscles A-C (J) as text."""
     return f"A {w[1]:.2f}, B {w[2]:.2f}, C {w[3]:.2f} J"
 
 
@@ -116,6 +120,8 @@ def prestrain_sweep(model, ratios):
 
 
 def thick_thin_deviation(preset, thick, thin):
+    """Largest force difference between bladder models `thick` and `thin` over 60-95% of the
+    listed length at 345 kPa, as a share (1) of the largest force with `thick`."""
     a, b = Muscle(preset=preset, bladder_model=thick), Muscle(preset=preset, bladder_model=thin)
     top = min(0.95 * LISTED[preset], 0.99 * a.max_length, 0.99 * b.max_length)
     lengths = [0.6 * LISTED[preset] + (top - 0.6 * LISTED[preset]) * k / 29 for k in range(30)]
@@ -127,6 +133,7 @@ def thick_thin_deviation(preset, thick, thin):
 
 
 def thresholds(model):
+    """Threshold pressure (Pa) of muscles A-C at 0.8 of their listed lengths (m) with `model`."""
     out = {}
     for preset in (1, 2, 3):
         m = Muscle(preset=preset, bladder_model=model)
@@ -136,6 +143,7 @@ def thresholds(model):
 
 
 def rows():
+    """The claims table: (claim, dissertation, its walls, exact wall), each a text cell."""
     table = []
     # Section 2.4 / Fig. 2.8, 2.11-2.13: more pre-strain, more net work.
     lit, exa = net_works(LITERAL), net_works(EXACT)
