@@ -298,7 +298,7 @@ fn enumerations_are_checked_and_travel_as_integers() {
         .unwrap();
     assert_eq!(
         (effective.min.as_deref(), effective.max.as_deref()),
-        (Some("0"), Some("3"))
+        (Some("0"), Some("6"))
     );
     let policy = r#"<Enumeration declaredType="OutOfRangePolicy" min="0" max="2" start="0"/>"#;
     refused(
