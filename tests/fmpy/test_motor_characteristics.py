@@ -1,4 +1,4 @@
-"""The figures docs/motor.md states (issue 16), measured again through FMPy with the functions of
+"""The figures docs/motor.md states, measured again through FMPy with the functions of
 actuator_fmus.motor that generate it."""
 
 import math
