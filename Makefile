@@ -3,6 +3,7 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
+AF := $(VENV)/bin/actuator-fmus
 ## The linux64 binary the FMUs ship (see "Linux binaries for every maintained distribution" below).
 LIB := target/glibc/x86_64-unknown-linux-gnu/release/libactuator_fmus.so
 # The MuJoCo actuator plugin (see "MuJoCo" below).
@@ -14,11 +15,13 @@ SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml
 
 all: fmus
 
-## The Python tools, pinned (FMPy is the importer the tests and the demo drive).
-$(VENV)/.installed: tests/fmpy/requirements.txt
+## The Python tools, pinned (FMPy is the importer the tests and the demo drive), and this project's
+## package (pyproject.toml, python/actuator_fmus/), editable, with its command `actuator-fmus`.
+$(VENV)/.installed: tests/fmpy/requirements.txt pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --upgrade pip
 	$(VENV)/bin/pip install --quiet -r tests/fmpy/requirements.txt
+	$(VENV)/bin/pip install --quiet --no-deps -e .
 	touch $@
 
 ## libclang for the `fmi` crate's bindgen (a dev-dependency: the Rust tests import our FMUs with it).
@@ -119,7 +122,7 @@ DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
 
 ## Builds the FMUs and runs the default scene under FMPy: out/fig2_3_ideal_mckibben.{csv,png}.
 demo: fmus $(VENV)/.installed
-	$(PY) scenes/run.py $(DEFAULT_SCENE) --out out
+	$(AF) scene $(DEFAULT_SCENE) --out out
 
 ## scenes/schema/scene.schema.json, the JSON Schema of scene files, from the Rust types in src/scene.rs.
 scene-schema:
@@ -127,11 +130,11 @@ scene-schema:
 
 ## Any scene: make scene SCENE=scenes/<name>.json
 scene: fmus $(VENV)/.installed
-	$(PY) scenes/run.py $(SCENE) --out out
+	$(AF) scene $(SCENE) --out out
 
 ## Every scene at full length, and docs/figures.md with the plots beside the dissertation's statements.
 figures: fmus $(VENV)/.installed
-	$(PY) scenes/catalogue.py
+	$(AF) figures
 
 ## Fits McKibbenMuscle to a datasheet (CSV pressure_kpa,contraction,force_n) with the FMU's own
 ## physics, checks the result through the FMU: OUT/{params.json,params.ssv,report.md,fit.png}.
@@ -143,12 +146,12 @@ FIT ?= 0,600
 OUT ?= out/calibrate
 STARTS ?= 24
 calibrate: fmus target/release/calibrate $(VENV)/.installed
-	$(PY) calibration/calibrate.py $(DATA) $(LENGTH) $(DIAMETER) $(FIT) $(OUT) $(STARTS)
+	$(AF) calibrate $(DATA) --length $(LENGTH) --diameter $(DIAMETER) --fit-kpa $(FIT) --out $(OUT) --starts $(STARTS)
 
 ## The Festo presets' fits (src/physics/festo.rs) and their reports: docs/calibration/dmsp{40,10}/.
 calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
-	$(PY) calibration/calibrate.py data/festo/festo_dmsp40.csv 0.4 0.04 0,600 docs/calibration/dmsp40
-	$(PY) calibration/calibrate.py data/festo/festo_dmsp10.csv 0.25 0.01 0,600 docs/calibration/dmsp10
+	$(AF) calibrate data/festo/festo_dmsp40.csv --length 0.4 --diameter 0.04 --fit-kpa 0,600 --out docs/calibration/dmsp40
+	$(AF) calibrate data/festo/festo_dmsp10.csv --length 0.25 --diameter 0.01 --fit-kpa 0,600 --out docs/calibration/dmsp10
 
 test-rust: deps fmus
 	+cargo test --release --workspace
@@ -225,11 +228,11 @@ report: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 ## docs/linearized-muscle.md: stiffness dF/dL and pressure gain dF/dP over the stroke of Table 2.1's
 ## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
 linearized: fmus $(VENV)/.installed
-	$(PY) docs/linearized/generate.py > /dev/null
+	$(AF) linearized > /dev/null
 
 ## Chapter 2's claims re-run with the dissertation's walls and the exact wall: docs/chapter2-claims.md.
 chapter2-claims: fmus $(VENV)/.installed
-	$(PY) docs/chapter2/generate.py
+	$(AF) chapter2-claims
 
 clean:
 	cargo clean
@@ -238,12 +241,12 @@ clean:
 ## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
 ## densities, strain drive and onion reorientation of the MultiferroicMotor FMU.
 motor-docs: fmus $(VENV)/.installed
-	$(PY) examples/motor_characteristics.py
+	$(AF) motor
 
 ## docs/knitted-bag.md and docs/img/knitted_bag.png: the section 1.4 prototype's polyethylene bag
 ## and its stroke against the measured 42% and 51%.
 knitted-bag-docs: fmus $(VENV)/.installed
-	$(PY) examples/knitted_bag.py
+	$(AF) knitted-bag
 
 ## ---- MuJoCo (docs/mujoco.md) ----
 ## The actuator plugin that runs an FMU inside MuJoCo (mujoco_plugin/, its own crate and target
@@ -273,26 +276,26 @@ mujoco-docs: fmus $(MUJOCO_PLUGIN)
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
 robot-joint: deps fmus $(VENV)/.installed
-	$(PY) examples/robot_joint.py --out out
+	$(AF) robot-joint --out out
 	cargo run --release -p actuator-fmus-tools --example robot_joint
 
 ## FMI cross-check files crosscheck/<Model>/<Model>_{in,ref}.csv, _ref.opt and the plots
 ## docs/fmu/<Model>.png, then the FMUs again so that each documentation/ carries its plot.
 crosscheck: fmus $(VENV)/.installed
-	$(PY) crosscheck/generate.py
+	$(AF) crosscheck
 	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
 
 ## The robot joint as a system: out/systems/RobotJoint.ssp (fmpy simulate_ssp) and the container
 ## FMU out/systems/RobotJoint.fmu (fmu-manipulation-toolbox), both run and plotted against the
 ## two-FMU co-simulation: out/systems/robot_joint_systems.png.
 systems: fmus $(VENV)/.installed
-	$(PY) systems/build.py --run
+	$(AF) systems --run
 
 ## Design sweep on Dask (not part of `make test`): bladder pre-strain x wall thickness -> net work per
 ## stroke of the McKibbenMuscle FMU, out/sweep.{csv,png}. Local cluster by default; any running
 ## scheduler with `make sweep SCHEDULER=tcp://host:8786`.
 sweep: fmus $(VENV)/.installed
-	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
+	$(AF) sweep --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
 
 ## ---- Reliability jobs: longer runs, not part of `make test`. ----
 .PHONY: fuzz memcheck load

@@ -79,14 +79,14 @@ fn parse(xml: &str) -> Description {
                     attr("causality").unwrap_or_else(|| "local".into()),
                 ))
             }
-            tag @ (b"Real" | b"Integer" | b"Boolean") => {
+            tag @ (b"Real" | b"Integer" | b"Enumeration" | b"Boolean") => {
                 if let Some((name, vr, causality)) = current.take() {
                     d.vars.push(Var {
                         name,
                         vr,
                         kind: match tag {
                             b"Real" => Kind::Real,
-                            b"Integer" => Kind::Integer,
+                            b"Integer" | b"Enumeration" => Kind::Integer,
                             _ => Kind::Boolean,
                         },
                         causality,

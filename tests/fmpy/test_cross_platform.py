@@ -10,7 +10,6 @@ import os
 import pathlib
 import shutil
 import subprocess
-import sys
 import zipfile
 
 import numpy as np
@@ -19,8 +18,7 @@ from fmpy import read_model_description
 
 from conftest import FMU_DIR, ROOT
 
-sys.path.insert(0, str(ROOT / "scenes"))
-import run as scenes  # noqa: E402
+from actuator_fmus import scene as scenes  # noqa: E402
 
 HARNESS = ROOT / "tests" / "cross" / "harness.c"
 STUB = ROOT / "tests" / "cross" / "bcryptprimitives.c"
@@ -54,7 +52,7 @@ def script_for(model, gilbert=False):
 
     def set_line(name, value):
         v = by_name[name]
-        code = {"Real": "R", "Integer": "I", "Boolean": "B"}[v.type]
+        code = {"Real": "R", "Integer": "I", "Enumeration": "I", "Boolean": "B"}[v.type]
         value = float(value) if v.type == "Real" else int(value)
         return f"{code} {v.valueReference} {value!r}\n"
 

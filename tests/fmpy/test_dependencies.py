@@ -16,7 +16,6 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-sys.path.insert(0, __import__("os").path.dirname(__file__))
 from conftest import ROOT, fmu_path  # noqa: E402
 
 # Operating points: parameter overrides (the effects on) x input points.

@@ -2,9 +2,6 @@
 Every scene (fast variant) and every FMU's cross-check input run through it under the default
 out-of-range policy; FMPy's call logger sees the status of every call."""
 
-import pathlib
-import sys
-
 import fmpy
 import numpy as np
 import pytest
@@ -13,8 +10,7 @@ from fmpy.util import read_ref_opt_file
 
 from conftest import FMU_DIR, ROOT, Slave
 
-sys.path.insert(0, str(ROOT / "scenes"))
-import run as scenes  # noqa: E402
+from actuator_fmus import scene as scenes  # noqa: E402
 
 SCENES = sorted((ROOT / "scenes").glob("*.json"))
 CROSSCHECK = ROOT / "crosscheck"
