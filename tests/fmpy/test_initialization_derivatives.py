@@ -6,10 +6,18 @@ model from the changed value at each get)."""
 import math
 
 import pytest
-from fmpy import read_model_description
+from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-from conftest import _extracted, fmu_path
+from conftest import fmu_path
+
+_EXTRACTED = {}
+
+
+def _extracted(path):
+    if path not in _EXTRACTED:
+        _EXTRACTED[path] = extract(path)
+    return _EXTRACTED[path]
 
 # (model, parameters set before the derivatives are taken).
 # Pressurized, and with a connector spring: away from the kinks at zero pressure and at the
@@ -44,7 +52,8 @@ def in_initialization(model, parameters):
     by_name = {v.name: v for v in md.modelVariables}
     for name, value in parameters.items():
         v = by_name[name]
-        {"Real": fmu.setReal, "Integer": fmu.setInteger, "Boolean": fmu.setBoolean}[v.type](
+        {"Real": fmu.setReal, "Integer": fmu.setInteger, "Enumeration": fmu.setInteger,
+         "Boolean": fmu.setBoolean}[v.type](
             [v.valueReference], [value])
     return md, fmu
 

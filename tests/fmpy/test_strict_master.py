@@ -143,7 +143,7 @@ def option_values():
                 continue
             if v.type == "Boolean":
                 values = [True, False]
-            elif v.type == "Integer" and v.min is not None and v.max is not None \
+            elif v.type in ("Integer", "Enumeration") and v.min is not None and v.max is not None \
                     and int(v.max) - int(v.min) < 8:
                 values = list(range(int(v.min), int(v.max) + 1))
             else:
