@@ -16,7 +16,6 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-sys.path.insert(0, __import__("os").path.dirname(__file__))
 from conftest import ROOT, fmu_path  # noqa: E402
 
 # Operating points: parameter overrides (the effects on) x input points.
@@ -35,7 +34,10 @@ CONFIGS = {
         # the bladder and the pressure solver.
         [{}, {"bladder_model": 1}, {"friction": True}, {"bladder_model": 1, "friction": True},
          {"pressure_solver": True}, {"preset": 1}, {"preset": 1, "bladder_model": 1},
-         {"preset": 1, "pressure_solver": True}, {"preset": 5}],
+         {"preset": 1, "pressure_solver": True}, {"preset": 5},
+         # Muscle D to the DMSP-10 (preset 4 to 5) switches the bladder model and its constants;
+         # the thick wall shows its layer count.
+         {"preset": 4}, {"bladder_model": 2, "bladder_layers": 8}, {"connector_stiffness": 5e4}],
         [{"pressure": 2e5, "length": 0.09, "target_force": 50.0},
          {"pressure": 4e5, "length": 0.085, "target_force": 200.0},
          {"pressure": 0.0, "length": 0.095, "target_force": 0.0},
