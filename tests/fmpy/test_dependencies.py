@@ -11,6 +11,7 @@ before initialization and the initial unknowns compared after fmi2ExitInitializa
 import shutil
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 
 import pytest
 from fmpy import extract, read_model_description
@@ -19,53 +20,27 @@ from fmpy.fmi2 import FMU2Slave
 sys.path.insert(0, __import__("os").path.dirname(__file__))
 from conftest import ROOT, fmu_path  # noqa: E402
 
-# Operating points: parameter overrides (the effects on) x input points.
-CONFIGS = {
-    "PassThrough": ([{}], [{}, {"u": 0.7}]),
-    # The first point lies just below (C2 38719.67 Pa) and just above (38679.73 Pa) the clamp at
-    # 0.999 of the ballooning pressure, so that the initial input_clamped shows each parameter.
-    "FreeBladder": (
-        [{}, {"mooney_c2": 38719.67}, {"mooney_c2": 38679.73}],
-        [{"pressure": 4.9322e4, "length": 0.1336}, {"pressure": 3e4, "length": 0.16},
-         {"pressure": -5e4, "length": 0.12}],
-    ),
-    "McKibbenMuscle": (
-        # Presets from one that differs from the defaults in nothing (1, Table 2.1's muscle A) to
-        # one that does (2, muscle B; 5 to 6, the Festo DMSP-10 to the DMSP-40), with and without
-        # the bladder and the pressure solver.
-        [{}, {"bladder_model": 1}, {"friction": True}, {"bladder_model": 1, "friction": True},
-         {"pressure_solver": True}, {"preset": 1}, {"preset": 1, "bladder_model": 1},
-         {"preset": 1, "pressure_solver": True}, {"preset": 5}],
-        [{"pressure": 2e5, "length": 0.09, "target_force": 50.0},
-         {"pressure": 4e5, "length": 0.085, "target_force": 200.0},
-         {"pressure": 0.0, "length": 0.095, "target_force": 0.0}],
-    ),
-    "KnittedMuscle": (
-        [{}, {"bladder_model": 1}, {"friction": True}, {"shape_model": 1}],
-        [{"pressure": 2e4, "length": 0.4}, {"pressure": 5e4, "length": 0.35},
-         {"pressure": 0.0, "length": 0.42}],
-    ),
-    "McKibbenJoint": (
-        # common_mode_pressure at max_pressure: the flexor's pressure saturates there.
-        [{}, {"friction": True}, {"bladder_model": 1}, {"command_mode": 1},
-         {"common_mode_pressure": 7e5}],
-        [{"actuatorInput": 0.3, "jointPosition": 0.1, "jointVelocity": 0.2},
-         {"actuatorInput": -0.5, "jointPosition": -0.2, "jointVelocity": -1.0},
-         {"actuatorInput": 1.0, "jointPosition": 0.0, "jointVelocity": 0.0}],
-    ),
-    "PulleyJoint": (
-        [{}, {"external_pressures": True}],
-        [{"flexor_force": 100.0, "extensor_force": 50.0, "flexor_pressure_command": 2e5,
-          "extensor_pressure_command": 1e5},
-         {"flexor_force": 0.0, "extensor_force": 0.0}],
-    ),
-    "MultiferroicMotor": (
-        [{}, {"strain_drive": True}, {"onion_model": 1}, {"schedule": 1}],
-        [{"strain_direction": 0.3, "stress": 5e7, "load_torque": 1e-9, "strain": 1e-4},
-         {"strain_direction": 1.2, "stress": 2e7, "load_torque": 0.0, "strain": 5e-4}],
-    ),
-}
-MODELS = list(CONFIGS)
+def parse_values(text):
+    """`name=value ...` from a model description's test data: {name: bool or float}."""
+    values = {}
+    for item in text.split():
+        name, value = item.split("=")
+        values[name] = value == "true" if value in ("true", "false") else float(value)
+    return values
+
+
+def operating_points(model):
+    """The operating points a model's description gives for its tests (VendorAnnotations): the
+    defaults and each Parameters set (the effects on), and the Inputs points (the start values if
+    none)."""
+    root = ET.parse(ROOT / "modelDescription" / f"{model}.xml").getroot()
+    tests = root.find("VendorAnnotations/Tool[@name='actuator-fmus']/Tests")
+    given = lambda tag: [parse_values(e.get("values")) for e in tests.iter(tag)] if tests is not None else []
+    return [{}] + given("Parameters"), given("Inputs") or [{}]
+
+
+MODELS = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
+CONFIGS = {m: operating_points(m) for m in MODELS}
 
 
 class Model:
