@@ -6,7 +6,7 @@ PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
-.PHONY: all fmus demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
+.PHONY: all fmus demo scene figures test test-rust test-new-model test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
 
@@ -117,6 +117,12 @@ calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
 
 test-rust: deps fmus
 	+cargo test --release --workspace
+
+## docs/adding-a-model.md's trivial model added to a scratch copy of the repository, built and put
+## through the Rust suites that cover every model (tests/all/new_model.rs; builds the crate again
+## in target/new-model, minutes).
+test-new-model: deps
+	+cargo test --release --test all new_model -- --ignored --nocapture
 
 ## ecos (ecospy, tests/fmpy/test_interop.py) needs Debian's libtbb12.
 interop-deps:

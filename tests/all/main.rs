@@ -19,6 +19,7 @@ mod declared_ranges;
 mod fmi_crate;
 mod fuzz_corpus;
 mod motor_c_abi;
+mod new_model;
 mod restore_validation;
 mod robot_joint_runs;
 mod shipped_descriptions;
