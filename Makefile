@@ -141,7 +141,7 @@ test-fmpy: fmus $(VENV)/.installed interop-deps py-deps
 
 ## All Rust tests and the FMPy suite. The apt checks run first, one at a time (dpkg has one lock);
 ## then everything else runs TEST_JOBS wide: the host build beside the cross builds and the venv,
-## then the Rust tests beside the FMPy suite (docs: README "Tests (`make test`)").
+## then the Rust tests beside the FMPy suite (CONTRIBUTING.md, "Tests").
 TEST_JOBS ?= 3
 test:
 	@$(MAKE) --no-print-directory deps cross-deps interop-deps py-deps
@@ -154,7 +154,7 @@ $(C_PASSTHROUGH): benches/c_passthrough/passthrough.c
 	cc -O2 -shared -fPIC -o $@ $< -lm
 
 ## Native cost per FMI step (criterion), through the packaged FMU's C ABI; then the FMI layer
-## against a C pass-through FMU and issue 15's goals, interleaved in one run (benches/parity.rs).
+## against a C pass-through FMU and the performance goals, interleaved in one run (benches/parity.rs).
 bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench fmi_step
 	cargo bench --bench knitted_shape
@@ -165,7 +165,7 @@ bench: deps fmus $(C_PASSTHROUGH)
 
 .PHONY: parity
 ## benches/parity.rs alone: the FMI layer against C, the walls, the motor and the knitted table;
-## then the README's FMI-layer table from that run.
+## then docs/performance.md's FMI-layer table from that run.
 parity: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	cargo bench --bench parity
 	$(PY) benches/report.py --parity
@@ -200,12 +200,12 @@ clean:
 	rm -rf out $(VENV)
 
 ## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
-## densities, strain drive and onion reorientation of the MultiferroicMotor FMU (issue 16).
+## densities, strain drive and onion reorientation of the MultiferroicMotor FMU.
 motor-docs: fmus $(VENV)/.installed
 	$(PY) examples/motor_characteristics.py
 
 ## docs/knitted-bag.md and docs/img/knitted_bag.png: the section 1.4 prototype's polyethylene bag
-## and its stroke against the measured 42% and 51% (issue 16).
+## and its stroke against the measured 42% and 51%.
 knitted-bag-docs: fmus $(VENV)/.installed
 	$(PY) examples/knitted_bag.py
 
@@ -233,7 +233,7 @@ systems: fmus $(VENV)/.installed
 sweep: fmus $(VENV)/.installed
 	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
 
-## ---- Reliability jobs (issue 8): longer runs, not part of `make test`. ----
+## ---- Reliability jobs: longer runs, not part of `make test`. ----
 .PHONY: fuzz memcheck load
 
 ## tests/load.rs with its 10,000-cycle heap test of every FMU in both interfaces (ignored by
@@ -329,7 +329,55 @@ memcheck: fmus $(VENV)/.installed
 .PHONY: compliance
 ## The FMU Compliance Checker (modelica-tools/FMUComplianceChecker) on every FMU, XML and both
 ## interfaces, driven by crosscheck/<Model>/ inputs: `make compliance FMUCHECKER=path/to/fmuCheck.linux64`.
-## Not on crates.io, PyPI or Debian: build it once from its repository (README, "FMU Compliance Checker").
+## Not on crates.io, PyPI or Debian: build it once from its repository (docs/compatibility.md, "FMU Compliance Checker").
 compliance: fmus
-	@test -n "$(FMUCHECKER)" || { echo "set FMUCHECKER=path/to/fmuCheck.linux64 (README: FMU Compliance Checker)"; exit 2; }
+	@test -n "$(FMUCHECKER)" || { echo "set FMUCHECKER=path/to/fmuCheck.linux64 (docs/compatibility.md: FMU Compliance Checker)"; exit 2; }
 	FMUCHECKER="$(FMUCHECKER)" tools/compliance.sh
+
+## ---- The documentation site and `make help` ----
+.PHONY: docs help
+
+## The documentation site (mkdocs.yml, docs/, each FMU's own page from target/fmu/) into site/, with
+## `mkdocs build --strict`: a broken link or anchor fails. tests/fmpy/test_docs_site.py builds it the
+## same way in `make test` and opens every page in headless Chromium.
+docs: fmus $(VENV)/.installed
+	NO_MKDOCS_2_WARNING=1 $(VENV)/bin/mkdocs build --strict --quiet
+	@echo "site/index.html: $$(find site -name '*.html' | wc -l) pages"
+
+## The user targets, one line each. The README points here instead of listing them, and
+## tests/fmpy/test_make_help.py checks that each name is a target of this Makefile. Internal
+## targets (deps, py-deps, cross-deps, interop-deps, test-rust, test-fmpy, scene-schema) stay out.
+define HELP_TEXT
+Start here
+  demo              build the FMUs and run the default scene under FMPy: out/fig2_3_ideal_mckibben.{csv,png}
+  test              all Rust tests, the FMPy suite and the documentation site's checks
+  help              this list
+Build
+  fmus              target/fmu/<Model>.fmu for every model (CROSS=0: linux64 binaries only)
+  docs              the documentation site into site/ (mkdocs build --strict)
+Run the models
+  scene             one scene under FMPy: make scene SCENE=scenes/<name>.json
+  figures           every scene of the catalogue, and docs/figures.md
+  calibrate         fit McKibbenMuscle to a datasheet: DATA= LENGTH= DIAMETER= FIT= OUT= STARTS=
+  calibrate-festo   refit the Festo presets and rewrite docs/calibration/dmsp{10,40}/
+  robot-joint       an antagonistic muscle pair on a pulley, co-simulated: out/robot_joint.{csv,png}
+  systems           the robot joint as an SSP and as a container FMU: out/systems/
+  crosscheck        FMI cross-check files crosscheck/<Model>/ and the FMU pages' plots
+  sweep             a design sweep on Dask: out/sweep.{csv,png} (SCHEDULER=tcp://host:port)
+  motor-docs        docs/motor.md: the motor's holding, pull-in and pull-out torque
+  knitted-bag-docs  docs/knitted-bag.md: the knitted prototype's bag against its measured stroke
+  linearized        docs/linearized-muscle.md: stiffness and pressure gain over the stroke
+Measure and check (not part of make test)
+  bench             native cost per step, derivatives, Model Exchange, the FMI layer against C
+  bench-motor       the motor's step and its Model Exchange calls
+  parity            the FMI layer against a C pass-through FMU: docs/performance.md's table
+  report            docs/accuracy-cost.md and the tables of docs/performance.md
+  compliance        the FMU Compliance Checker on every FMU: FMUCHECKER=path/to/fmuCheck.linux64
+  fuzz              random FMI call sequences (cargo-fuzz): FUZZ_SECONDS= FUZZ_JOBS= SANITIZER=
+  memcheck          every FMU under valgrind, natively and through FMPy
+  load              10,000 instantiate-run-free cycles per FMU with the heap counted
+  clean             remove build output, out/ and the .venv
+endef
+export HELP_TEXT
+help:
+	@echo "$$HELP_TEXT"

@@ -3,7 +3,7 @@
 //!
 //! - The motor's Co-Simulation step: each scenario from a fresh state, several rounds, the
 //!   minimum CPU time per communication step with the substeps per step.
-//! - The bladder walls of issue 15 (the continuum wall at 8 nodes against 16 layers), one
+//! - The bladder walls (the continuum wall at 8 nodes against 16 layers), one
 //!   `Bladder::evaluate` per call along the same stroke, interleaved round by round.
 //!
 //! Motor scenarios: the `motor_stepping` scene (section 3.2.2, 60 degree steps every 100 us at

@@ -110,7 +110,7 @@ fn motor(c: &mut Criterion) {
     );
 }
 
-/// Issue 6: the ideal McKibben step against eq. 2.3 hand-inlined behind the same FMI calls. Both
+/// The ideal McKibben step against eq. 2.3 hand-inlined behind the same FMI calls. Both
 /// FMUs get one fmi2SetReal of one value, one fmi2DoStep and one fmi2GetReal of one value; the
 /// PassThrough FMU's step is the FMI layer alone, and eq. 2.3 itself costs about 1 ns on top.
 fn ideal_against_inlined(c: &mut Criterion) {

@@ -1,4 +1,4 @@
-//! Issue 4's benchmark: the non-cylindrical volume-length table of the section 1.4 prototype
+//! The benchmark of the non-cylindrical volume-length table of the section 1.4 prototype
 //! (n = 49 rows) built by our solver, against the dissertation's row-by-row gradient algorithm
 //! (section 1.3.5), each with the volume error it reaches against a fine reference table.
 

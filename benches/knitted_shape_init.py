@@ -1,9 +1,9 @@
 """Time of `fmi2ExitInitializationMode` of KnittedMuscle with the non-cylindrical shape (the
 table is built there), through FMPy, for the section 1.4 prototype at 49 and 1,568 segments
-(issue 15's goals: 3 ms and 100 ms). Each figure is the best of `repeats` fresh instances, in
+(the goals: 3 ms and 100 ms). Each figure is the best of `repeats` fresh instances, in
 CPU time of this process (the FMU runs in it) and in wall time.
 
-    .venv/bin/python benches/knitted_shape_init.py [--readme] [OTHER.fmu]
+    .venv/bin/python benches/knitted_shape_init.py [--docs] [OTHER.fmu]
 
 With another KnittedMuscle.fmu (for example one packaged from an older commit), the two are
 timed interleaved, so that a loaded machine slows both alike, and their ratio is printed.
@@ -82,15 +82,15 @@ def rows(paths):
 
 
 def main():
-    """`--readme` writes the table into README.md's `knitted-shape-init` block (as `make report`
+    """`--docs` writes the table into the `knitted-shape-init` block of docs/performance.md (as `make report`
     does); a path is another KnittedMuscle.fmu to time interleaved."""
-    args = [a for a in sys.argv[1:] if a != "--readme"]
+    args = [a for a in sys.argv[1:] if a != "--docs"]
     paths = [FMU_DIR / "KnittedMuscle.fmu"] + [pathlib.Path(p) for p in args[:1]]
     table = rows(paths)[0]
     print("\n".join(table))
-    if "--readme" in sys.argv:
-        from report import write_readme_block
-        write_readme_block("knitted-shape-init", table)
+    if "--docs" in sys.argv:
+        from report import write_docs_block
+        write_docs_block("knitted-shape-init", table)
     print(f"load average during the run: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
 
 

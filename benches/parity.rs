@@ -1,4 +1,4 @@
-//! The FMI layer against C, and the goals of issue 15 that are ratios of two step costs, measured
+//! The FMI layer against C, and the performance goals that are ratios of two step costs, measured
 //! interleaved in one process: every round times each case once (in a rotating order), and each
 //! case's figure is the minimum and the median over the rounds. On a machine shared with other jobs
 //! a ratio of two figures taken minutes apart means little; taken round by round, it holds.
@@ -231,7 +231,7 @@ fn cases(keep: &dyn Fn(&str) -> bool) -> Vec<Case> {
     if !keep("walls and motor") {
         return cases;
     }
-    // The walls of issue 15's continuum goal: muscle A at 690 kPa over 0.75-0.93 of its length (on
+    // The walls of the continuum goal: muscle A at 690 kPa over 0.75-0.93 of its length (on
     // the sleeve), the scenario of docs/accuracy-cost.md.
     let walls = [
         // The dissertation's walls (bladder_model 5 and 6) and the exact wall (3).
@@ -297,7 +297,7 @@ fn knitted_initialization(api: &'static common::Api, segments: i32, repeats: usi
     best
 }
 
-/// A goal of issue 15 beside its measured figure.
+/// A performance goal beside its measured figure.
 fn verdict(measured: f64, goal: f64) -> String {
     if measured <= goal {
         "met".into()
@@ -484,7 +484,7 @@ fn main() {
     }
 
     println!(
-        "\nGoals of issue 15 (ratios within this run; the motor FMPy goal is in `make report`):"
+        "\nPerformance goals (ratios within this run; the motor FMPy goal is in `make report`):"
     );
     let goal = |text: &str, measured: Option<f64>, target: f64, shown: &dyn Fn(f64) -> String| {
         match measured {

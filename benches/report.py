@@ -1,7 +1,7 @@
 """Writes docs/accuracy-cost.md: for every fidelity knob, the error against a converged reference
 (computed here under FMPy) beside the native time per step (criterion, benches/accuracy_cost.rs,
 read from target/criterion), log-log work-precision plots, the cost under FMPy beside the
-PassThrough FMU, and the targets of issues 7 and 15. Run by `make report` after the benchmarks.
+PassThrough FMU, and the performance goals. Run by `make report` after the benchmarks.
 
 Timings are CPU time of the measuring thread wherever the machine's load would dominate wall
 time: the criterion bench measures thread CPU time (benches/cpu_clock.rs), benches/cpu_time.rs
@@ -71,7 +71,7 @@ WALL_CONTINUUM = "McKibbenMuscle, continuum wall, 8 nodes"
 
 
 def cpu_goal_rows():
-    """Issue 15's goals that benches/cpu_time.rs measures in CPU time, each beside its figure."""
+    """The goals that benches/cpu_time.rs measures in CPU time, each beside its figure."""
     if CPU is None:
         return []
     by = CPU["by_case"]
@@ -79,18 +79,17 @@ def cpu_goal_rows():
     if WALL_LAYERS in by and WALL_CONTINUUM in by:
         r = CPU["walls_ratio"]
         rows.append(f"| continuum wall, 8 nodes: cost <= 16 layers, `Bladder::evaluate` in CPU time, median of the "
-                    f"rounds' ratios (issue 15) | {r:.2f}x ({fmt_time(by[WALL_CONTINUUM]['cpu_s'])} against "
+                    f"rounds' ratios | {r:.2f}x ({fmt_time(by[WALL_CONTINUUM]['cpu_s'])} against "
                     f"{fmt_time(by[WALL_LAYERS]['cpu_s'])}, minima) | {goal_verdict(r, 1.0)} |")
     if MOTOR_STEPPING in by:
         m = by[MOTOR_STEPPING]
         rows.append(f"| motor, 1 us step of the stepping scene <= 2 us natively, `Motor::step` in CPU time, average over "
-                    f"12 periods (issues 7, 15) | {fmt_time(m['cpu_s'])} ({m['substeps']:.2f} substeps per step) | "
+                    f"12 periods | {fmt_time(m['cpu_s'])} ({m['substeps']:.2f} substeps per step) | "
                     f"{goal_verdict(m['cpu_s'], 2e-6)} |")
     if MOTOR_LOADED in by:
         m = by[MOTOR_LOADED]
         rows.append(f"| motor with a load torque of 1e-6 N m (legal, far beyond the 2.16e-18 N m peak): 1 us step "
-                    f"stays cheap, CPU time (issue 15) | {fmt_time(m['cpu_s'])} | was 30-80 ms (the whole substep "
-                    f"budget); now one closed-form segment and one march around the onion's cycle |")
+                    f"stays cheap, CPU time | {fmt_time(m['cpu_s'])} | one closed-form segment and one march around the onion's cycle |")
     if MOTOR_FAST_SLIP in by:
         m = by[MOTOR_FAST_SLIP]
         rows.append(f"| motor with a load torque of 1e-13 N m (thousands of turns per 1 us step, ring torque not "
@@ -144,9 +143,9 @@ def goal_verdict(measured, goal, why=""):
 
 
 def parity_goal_rows(parity):
-    """Issue 15's goals that benches/parity.rs measures, each beside its figure."""
+    """The goals that benches/parity.rs measures, each beside its figure."""
     if parity is None:
-        return ["| FMI layer, continuum wall cost, motor step, knitted table (issue 15) | not measured: "
+        return ["| FMI layer, continuum wall cost, motor step, knitted table | not measured: "
                 "run `cargo bench --bench parity` (make report does) | open |"]
     by = parity["by_case"]
     c = by[C_CASE]["min_s"]
@@ -156,7 +155,7 @@ def parity_goal_rows(parity):
             r = by[name]["min_s"] / c
             n, c_n = parity["instructions_by_case"].get(name), parity["instructions_by_case"].get(C_CASE)
             count = f"; {n:.0f} against {c_n:.0f} instructions, {n / c_n:.2f}x" if n and c_n else ""
-            rows.append(f"| {name} <= {goal}x the C pass-through FMU, interleaved minimum (issue 15) | "
+            rows.append(f"| {name} <= {goal}x the C pass-through FMU, interleaved minimum | "
                         f"{r:.2f}x ({by[name]['min_s'] * 1e9:.1f} ns against {c * 1e9:.1f} ns{count}) | "
                         f"{goal_verdict(r, goal, FMI_LAYER_WHY)} |")
     cont, lay = by.get("McKibbenMuscle, continuum wall, 8 nodes"), by.get("McKibbenMuscle, layered wall, 16 layers")
@@ -166,13 +165,13 @@ def parity_goal_rows(parity):
         motor_case = by.get("MultiferroicMotor, 1 us step")
     if cont and lay and parity.get("walls_round_ratio"):
         r = parity["walls_round_ratio"]
-        rows.append(f"| continuum wall, 8 nodes: cost <= 16 layers, median of the {parity['rounds']} rounds' ratios (issue 15) | "
+        rows.append(f"| continuum wall, 8 nodes: cost <= 16 layers, median of the {parity['rounds']} rounds' ratios | "
                     f"{r:.2f}x (medians {fmt_time(cont['median_s'])} against {fmt_time(lay['median_s'])}, minima "
                     f"{fmt_time(cont['min_s'])} against {fmt_time(lay['min_s'])}) | "
                     f"{goal_verdict(r, 1.0, 'a node costs an exponential, a square root and two divisions, a layer one division')} |")
     motor = motor_case
     if motor:
-        rows.append(f"| motor, per 1 us communication step <= 2 us natively, median (issues 7, 15) | "
+        rows.append(f"| motor, per 1 us communication step <= 2 us natively, median | "
                     f"{fmt_time(motor['median_s'])} | {goal_verdict(motor['median_s'], 2e-6, EXPLANATIONS['MultiferroicMotor/tolerance/1e-6'])} |")
     # The shape table's goals come from benches/knitted_shape_init.py (CPU time through FMPy) when
     # it ran; the parity run's wall-clock figure stands in otherwise.
@@ -180,11 +179,11 @@ def parity_goal_rows(parity):
         t = parity["init"].get(segments)
         if t is not None:
             rows.append(f"| knitted shape table, {label}: `fmi2ExitInitializationMode` <= {fmt_time(goal)} "
-                        f"through the FMU (issue 15) | {fmt_time(t)} | {goal_verdict(t, goal)} |")
+                        f"through the FMU | {fmt_time(t)} | {goal_verdict(t, goal)} |")
     return rows
 
 
-# Where the FMI layer's remaining nanoseconds go (callgrind, benches/parity.rs; README, "Where the
+# Where the FMI layer's remaining nanoseconds go (callgrind, benches/parity.rs; docs/accuracy-cost.md, "Where the
 # nanoseconds went"). Shown only beside a missed goal.
 FMI_LAYER_WHY = ('the one path\'s checks (the instance\'s magic number, the call\'s state, the range and NaN checks of every value set and got) and one dynamic call into the model per FMI call, which the C fixture does not make (see "Where the time goes" below)')
 
@@ -336,14 +335,14 @@ def fmpy_costs(models):
     return best
 
 
-# ---- targets of issue 7 ----
+# ---- per-step targets ----
 
 NATIVE_TARGETS = [
-    ("McKibbenMuscle/bladder_model/none", 50e-9, "ideal McKibben (issue 7)"),
-    ("McKibbenMuscle/bladder_model/thin", 300e-9, "thin wall (issue 7)"),
-    ("McKibbenMuscle/bladder_layers/16", 2e-6, "thick wall, 16 layers (issue 7)"),
-    ("KnittedMuscle/shape_segments/49", 300e-9, "knitted non-cylindrical (tabulated) (issue 7)"),
-    ("MultiferroicMotor/tolerance/1e-6", 2e-6, "motor, per 1 us communication step, criterion median (issue 7)"),
+    ("McKibbenMuscle/bladder_model/none", 50e-9, "ideal McKibben"),
+    ("McKibbenMuscle/bladder_model/thin", 300e-9, "thin wall"),
+    ("McKibbenMuscle/bladder_layers/16", 2e-6, "thick wall, 16 layers"),
+    ("KnittedMuscle/shape_segments/49", 300e-9, "knitted non-cylindrical (tabulated)"),
+    ("MultiferroicMotor/tolerance/1e-6", 2e-6, "motor, per 1 us communication step, criterion median"),
 ]
 
 # The native configuration each FMU runs in its FMPy measurement.
@@ -458,10 +457,10 @@ def main():
     global CPU
     parity = parity_figures()
     if "--parity" in sys.argv:
-        # `make parity`: only the README's FMI-layer table, from benches/parity.rs's last run.
+        # `make parity`: only the FMI-layer table of docs/accuracy-cost.md, from benches/parity.rs's last run.
         if parity is None:
             sys.exit("no target/parity/parity.json: run `cargo bench --bench parity` first")
-        write_readme_block("fmi-parity", parity_table(parity))
+        write_docs_block("fmi-parity", parity_table(parity))
         return
     times = criterion_times()
     CPU = cpu_figures()
@@ -471,7 +470,7 @@ def main():
     shape_init()
     lines = ["# What accuracy costs in time", "",
              "Generated by `make report` (benches/accuracy_cost.rs, benches/cpu_time.rs, benches/report.py) on",
-             "the 2-core development machine. Native times are criterion medians, in the benchmark thread's CPU",
+             "a 2-core machine. Native times are criterion medians, in the benchmark thread's CPU",
              "time (so that they reproduce on a loaded machine), of one set-inputs + `fmi2DoStep` + get-output",
              "through the packaged FMU's C ABI; errors are the largest deviation from a converged",
              "reference over the scenario, relative to the reference's largest force (muscles) or in rad (motor).",
@@ -530,7 +529,7 @@ def main():
         why = f": its own step costs {fmt_time(native)} natively" if native else ""
         verdict = "met" if ratio <= 1.2 else f"missed by {ratio / 1.2:.2f}x{why}"
         lines.append(f"| {model} | {fmt_time(t)} | {ratio:.2f} | {verdict} |")
-    lines += ["", "## Goals beside the measured figures (issues 7 and 15)", "",
+    lines += ["", "## Goals beside the measured figures", "",
               "| goal | measured | verdict |", "|---|---|---|"]
     # The exact wall within 1e-9 with 16 nodes.
     mck = dict(((k, v), e) for k, v, e in MCKIBBEN_ERRORS)
@@ -540,21 +539,21 @@ def main():
                      f"(reference: 64 nodes) | {'met' if err <= 1e-9 else 'missed'} |")
     if FMPY_RATIOS.get("MultiferroicMotor"):
         r = FMPY_RATIOS["MultiferroicMotor"]
-        lines.append(f"| motor under FMPy <= 1.2x PassThrough, interleaved minima (issue 15) | {r:.2f}x | "
+        lines.append(f"| motor under FMPy <= 1.2x PassThrough, interleaved minima | {r:.2f}x | "
                      f"{goal_verdict(r, 1.2, motor_fmpy_why(parity))} |")
     lines += cpu_goal_rows()
     lines += parity_goal_rows(parity)
-    # Issue 15: the shape table's build in fmi2ExitInitializationMode (benches/knitted_shape_init.py).
+    # Goal: the shape table's build in fmi2ExitInitializationMode (benches/knitted_shape_init.py).
     if SHAPE_INIT:
         for segments, goal in GOALS.items():
             t = SHAPE_INIT[segments]
             lines.append(f"| knitted shape table: `fmi2ExitInitializationMode` at {segments:,} segments <= "
-                         f"{fmt_time(goal)}, CPU time through FMPy (issue 15) | {fmt_time(t)} | {'met' if t <= goal else 'missed'} |")
+                         f"{fmt_time(goal)}, CPU time through FMPy | {fmt_time(t)} | {'met' if t <= goal else 'missed'} |")
     for key, target, label in NATIVE_TARGETS:
         t = times.get(key)
         if key == "McKibbenMuscle/bladder_model/none" and parity and "McKibbenMuscle, ideal" in parity["by_case"]:
             t = parity["by_case"]["McKibbenMuscle, ideal"]["median_s"]
-            label = "ideal McKibben, interleaved median (issue 7)"
+            label = "ideal McKibben, interleaved median"
         if t is None:
             lines.append(f"| {label} <= {fmt_time(target)} | not measured | FMU not built |")
             continue
@@ -583,19 +582,18 @@ def main():
                   'checks; the ideal McKibben adds eq. 2.3, a few multiplications (budget 2.5x). The walls and the',
                   "motor spend their time in their physics: the bladder's equilibrium, the rotor's integration.",
                   ""]
-        lines += parity_table(parity)
+        # `make parity` rewrites this block alone.
+        lines += ["<!-- report:fmi-parity -->", *parity_table(parity), "<!-- /report -->"]
         lines.append("")
     (DOCS / "accuracy-cost.md").write_text("\n".join(lines))
     print("wrote docs/accuracy-cost.md")
-    write_readme_block("cost-per-step", cost_per_step_table(times))
-    write_readme_block("continuum-wall", continuum_wall_table())
+    write_docs_block("cost-per-step", cost_per_step_table(times))
+    write_docs_block("continuum-wall", continuum_wall_table())
     if SHAPE_INIT_ROWS:
-        write_readme_block("knitted-shape-init", SHAPE_INIT_ROWS)
-    if parity:
-        write_readme_block("fmi-parity", parity_table(parity))
+        write_docs_block("knitted-shape-init", SHAPE_INIT_ROWS)
 
 
-README_ROWS = [
+COST_ROWS = [
     ("PassThrough/baseline/y = u", "PassThrough (y = u): the FMI layer alone"),
     ("McKibbenMuscle/bladder_model/none", "McKibbenMuscle, ideal sleeve (eq. 2.3)"),
     ("McKibbenMuscle/bladder_model/thin", "McKibbenMuscle, thin-walled bladder (muscle A, 690 kPa, in contact)"),
@@ -636,12 +634,12 @@ def cost_per_step_table(times):
     base = times.get("PassThrough/baseline/y = u")
     rows = ["| FMU and effects | time per step | against PassThrough in the same run |", "|---|---|---|"]
     rows += [f"| {label} | {fmt_time(times[key])} | {times[key] / base:.2f}x |" if base else
-             f"| {label} | {fmt_time(times[key])} | |" for key, label in README_ROWS if key in times]
+             f"| {label} | {fmt_time(times[key])} | |" for key, label in COST_ROWS if key in times]
     return rows
 
 
 def shape_init():
-    """Issue 15: fmi2ExitInitializationMode of the knitted shape table through FMPy."""
+    """fmi2ExitInitializationMode of the knitted shape table through FMPy."""
     global SHAPE_INIT_ROWS
     if (FMU_DIR / "KnittedMuscle.fmu").exists():
         progress("KnittedMuscle: shape table initialization")
@@ -652,17 +650,18 @@ def shape_init():
 SHAPE_INIT, SHAPE_INIT_ROWS = {}, []
 
 
-def write_readme_block(name, rows):
-    """Rewrites README.md between `<!-- report:NAME -->` and `<!-- /report -->`, if present."""
-    readme = ROOT / "README.md"
-    text = readme.read_text()
+def write_docs_block(name, rows):
+    """Rewrites the documentation page (docs/**/*.md) that holds `<!-- report:NAME -->`, between
+    that marker and `<!-- /report -->`. The README is never rewritten."""
     start, end = f"<!-- report:{name} -->", "<!-- /report -->"
-    i = text.find(start)
-    j = text.find(end, i)
-    if i < 0 or j < 0:
-        return
-    readme.write_text(text[:i + len(start)] + "\n" + "\n".join(rows) + "\n" + text[j:])
-    print(f"rewrote README.md block {name}")
+    for page in sorted((ROOT / "docs").rglob("*.md")):
+        text = page.read_text()
+        i = text.find(start)
+        j = text.find(end, i)
+        if i < 0 or j < 0:
+            continue
+        page.write_text(text[:i + len(start)] + "\n" + "\n".join(rows) + "\n" + text[j:])
+        print(f"rewrote {page.relative_to(ROOT)} block {name}")
 
 
 if __name__ == "__main__":

@@ -607,7 +607,7 @@ fn resolve_list(
             return Err(context(format!("'{name}' is listed twice")));
         }
     }
-    // Issue 12: every output and initial unknown declares its dependencies (an empty list where
+    // Every output and initial unknown declares its dependencies (an empty list where
     // it depends on none), so masters need not assume that everything depends on everything.
     expected
         .iter()

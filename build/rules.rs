@@ -9,7 +9,7 @@
 use quick_xml::events::{BytesStart, Event};
 use std::collections::{BTreeMap, BTreeSet};
 
-/// The rules, one line each: the README quotes this list.
+/// The rules, one line each: docs/compatibility.md quotes this list.
 #[allow(dead_code)]
 pub const RULES: &[&str] = &[
     "unit names in UnitDefinitions are unique (2.2.2)",
@@ -23,7 +23,7 @@ pub const RULES: &[&str] = &[
     "boolean attributes are 'true' or 'false' (2.2.1)",
     "variableNamingConvention 'structured' names follow the structured grammar (2.2.9)",
     "ModelStructure Unknown indices refer to existing variables, at most once per list (2.2.8)",
-    "every Outputs and InitialUnknowns entry declares its dependencies (issue 12)",
+    "every Outputs and InitialUnknowns entry declares its dependencies",
     "dependencies are ascending unique indices of knowns: inputs, continuous states (Outputs and \
      Derivatives) or the independent variable, dependenciesKind has one valid kind per \
      dependency (2.2.8)",
@@ -349,7 +349,7 @@ fn check_unknowns(
                     "{at}: Unknown {index} has dependenciesKind without dependencies"
                 ));
             }
-            // Issue 12: without a list a master must assume the unknown depends on everything.
+            // Without a list a master must assume the unknown depends on everything.
             if list != "Derivatives" {
                 return Err(format!("{at}: Unknown {index} declares no dependencies"));
             }

@@ -260,7 +260,7 @@ def main():
     ax.set_xlim(120, 160)
     ax.set_xlabel("stress sigma11 - sigma22 (MPa)")
     ax.set_ylabel("onion offset from the locked rotor (deg)")
-    ax.set_title("Onion state near the fold, tension at -15 degrees (issue 16): jumps end where a\n"
+    ax.set_title("Onion state near the fold, tension at -15 degrees: jumps end where a\n"
                  "slow ramp ends, in the narrow basin, until the fold", wrap=True, fontsize=10)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)

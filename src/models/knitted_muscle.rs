@@ -154,7 +154,7 @@ impl KnittedMuscle {
 }
 
 impl KnittedMuscle {
-    /// Exact partials on the branch [`Self::compute`] takes (see the module's README section for
+    /// Exact partials on the branch [`Self::compute`] takes (see docs/model-exchange.md for
     /// the one-sided choices), from [`KnittedAssembly::partial_rows`]; with a bladder, the
     /// stiffness's row only if `stiffness`.
     fn partials_at(&self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {

@@ -788,7 +788,7 @@ mod tests {
         let w_mk = integrate(&|l| mk.force(p, l), lf_mk, b);
         assert_relative_eq!(w_k, p * k.volume(lf), max_relative = 1e-9);
         assert_relative_eq!(w_mk, p * mk.volume(lf_mk), max_relative = 1e-9);
-        // Our numbers (DESIGN.md: 3.38 J vs 5.85 J; 69 N vs 276 N). The dissertation's "McKibben peak
+        // Our numbers (3.38 J vs 5.85 J; 69 N vs 276 N). The dissertation's "McKibben peak
         // about twice the knitted" and 2.6 J vs 2.3 J include bladder effects; ideal, the
         // McKibben peak is 4.0 times the knitted and does more work, as the dissertation also says.
         assert_relative_eq!(w_k, 3.376, max_relative = 1e-3);

@@ -195,7 +195,7 @@ pub struct McKibben {
     connector_compliance: Option<f64>,
 }
 
-/// The muscle's outputs at one pressure and length (the FMU outputs of issue 3).
+/// The muscle's outputs at one pressure and length (the FMU's outputs).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct McKibbenOutput {
     /// Tension, N, friction included (eq. 2.4).

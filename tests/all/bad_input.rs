@@ -1,11 +1,11 @@
 //! Bad input through the C ABI of EVERY packaged FMU in `target/fmu`, driven generically from each
-//! FMU's own modelDescription.xml (README, "Bad input policy"): non-finite and out-of-range values,
+//! FMU's own modelDescription.xml (docs/reliability.md, "Bad input policy"): non-finite and out-of-range values,
 //! wrong value references, variables that may not be set, NULL pointers for every pointer argument,
 //! wrong GUIDs, every illegal call order of FMI 2.0.4 section 4.2.4, bad step sizes and
 //! communication points. Each refusal must return the expected non-OK status AND log a reason, and
 //! the instance must then come back through `fmi2Reset`: a normal run afterwards gives exactly the
 //! outputs of a fresh instance. One test runs everything and lists every failing case at once;
-//! it prints how many cases were tried (the README quotes the count).
+//! it prints how many cases were tried (docs/reliability.md quotes the count).
 
 use crate::common;
 

@@ -4,7 +4,7 @@
 //! initialization with a logged reason, or give finite Real outputs and calculated parameters after
 //! initialization and after every step (a step may be discarded, with a logged reason, keeping
 //! finite outputs). Every value inside the declared range must be accepted by the setters.
-//! Prints how many cases ran (the README quotes the count).
+//! Prints how many cases ran (docs/compatibility.md quotes the count).
 
 use crate::common;
 

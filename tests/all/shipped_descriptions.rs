@@ -250,7 +250,7 @@ fn bad_model_structure_entries_fail() {
 
 #[test]
 fn every_output_and_initial_unknown_declares_its_dependencies() {
-    // Issue 12: an output left out, or listed without a dependency list, is refused...
+    // An output left out, or listed without a dependency list, is refused...
     refused(&edited(FORCE, ""), "'force' declares no dependencies");
     refused(&with_dependencies(""), "'force' declares no dependencies");
     // ...and so is an initial unknown (a calculated parameter here).

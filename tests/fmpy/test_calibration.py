@@ -1,4 +1,4 @@
-"""Calibration to measured curves (issue 14): `make calibrate`'s Python function, the Festo
+"""Calibration to measured curves: `make calibrate`'s Python function, the Festo
 presets, their read-back and the contraction output, all through McKibbenMuscle.fmu under FMPy."""
 
 import csv

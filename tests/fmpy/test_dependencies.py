@@ -1,4 +1,4 @@
-"""Declared `dependencies` against measured ones (issue 12). For every FMU, at several operating
+"""Declared `dependencies` against measured ones. For every FMU, at several operating
 points with the effects on, each input is perturbed alone (relative 1e-3, absolute where zero) and
 the outputs are re-read WITHOUT stepping (fmi2GetReal after fmi2SetReal recomputes the direct
 feedthrough): an output that changes must declare the input, and each declared input must change

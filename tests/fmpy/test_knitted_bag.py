@@ -1,4 +1,4 @@
-"""The figures docs/knitted-bag.md states (issue 16, section 1.4's polyethylene bag), measured again
+"""The figures docs/knitted-bag.md states (section 1.4's polyethylene bag), measured again
 through FMPy with the functions of examples/knitted_bag.py that generate it."""
 
 import math

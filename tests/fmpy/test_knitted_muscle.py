@@ -1,5 +1,5 @@
-"""KnittedMuscle under FMPy: the knitted-sleeve muscle of dissertation ch. 1 against the issue's
-"What it must show" list. Each test names the equation or figure it checks."""
+"""KnittedMuscle under FMPy: the knitted-sleeve muscle of dissertation ch. 1 against what the
+model must show. Each test names the equation or figure it checks."""
 
 import math
 

@@ -174,7 +174,7 @@ def test_dense_grid_never_gives_nan(model, friction, connector, recording_log):
 
 @pytest.mark.parametrize("model", [0, 1, 2, EXACT, THIN])
 def test_length_reversals_at_every_point_of_the_stroke(model):
-    # Issue 8's hard case: reverse the length at 25 points along the stroke with friction on. At each
+    # A hard case: reverse the length at 25 points along the stroke with friction on. At each
     # reversal the force may change by at most the full friction swing 2 Cf P_eff plus the elastic
     # change over the step; it never jumps beyond that, and nothing is NaN.
     m = muscle(preset=4, bladder_model=model, bladder_layers=8, friction=True, friction_coefficient=2e-5,

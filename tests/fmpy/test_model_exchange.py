@@ -318,7 +318,7 @@ def scene_load(scene, inputs):
 @pytest.mark.parametrize("path", PULLEY_SCENES, ids=lambda p: p.stem)
 @pytest.mark.parametrize("solver", ["CVode", "Euler"])
 def test_pulley_scene_model_exchange_matches_co_simulation(path, solver):
-    # Measured on pulley_lifting_load (fast variant, 2 s): see the README's "Continuous states".
+    # Measured on pulley_lifting_load (fast variant, 2 s): see docs/model-exchange.md, "Continuous states".
     scene = scenes.load_scene(path, fast=True)
     sweep = scene.get("sweep")
     for _, value, parameters, inputs in scenes.sweep_runs(scene, [0, len(sweep["values"]) - 1] if sweep else None):

@@ -1,4 +1,4 @@
-"""The figures docs/motor.md states (issue 16), measured again through FMPy with the functions of
+"""The figures docs/motor.md states, measured again through FMPy with the functions of
 examples/motor_characteristics.py that generate it."""
 
 import math

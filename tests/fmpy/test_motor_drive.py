@@ -1,4 +1,4 @@
-"""MultiferroicMotor under FMPy, issue 16: the onion state's initial offset and strain as the drive
+"""MultiferroicMotor under FMPy: the onion state's initial offset and strain as the drive
 (dissertation section 3.3 and abstract)."""
 
 import math
@@ -63,7 +63,7 @@ def test_a_ring_magnetised_parallel_to_the_bar_reorients_to_antiparallel():
 
 
 def test_a_jump_near_the_fold_keeps_the_narrow_basin():
-    # Issue 16: locked rotor, tension at -15 deg, stress ramped slowly to 146 MPa, then one step to
+    # Locked rotor, tension at -15 deg, stress ramped slowly to 146 MPa, then one step to
     # 148 MPa. A minimum still exists at 16.69 deg, where a slow ramp ends; the old settle strode
     # over its basin (< 1 deg wide) and left the onion at 58.97 deg.
     n = 1460

@@ -1,4 +1,4 @@
-"""MultiferroicMotor under FMPy: what issue 5 says the motor must show (dissertation chapter 3)."""
+"""MultiferroicMotor under FMPy: what the motor must show (dissertation chapter 3)."""
 
 import math
 

@@ -65,7 +65,7 @@ def test_crosscheck_input_under_a_strict_master(model, strict):
                       output_interval=opt["StepSize"], input=inputs)
 
 
-# The case: the thin-walled bladder at a length past where it fills the sleeve.
+# The case: the thin-walled bladder at a length past where it fills the sleeve.
 PAST_THE_SLEEVE = dict(bladder_model=1)
 
 

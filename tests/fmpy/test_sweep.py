@@ -20,7 +20,7 @@ def _sweep_module():
 
 
 def test_net_work_of_muscle_a_matches_the_work_table():
-    # README work table: muscle A (3% pre-strain), thick wall of 16 layers, 690 kPa: 1.313 J.
+    # Work table of docs/fmus/McKibbenMuscle.md: muscle A (3% pre-strain), thick wall of 16 layers, 690 kPa: 1.313 J.
     sd = _sweep_module()
     fmu = (FMU_DIR / "McKibbenMuscle.fmu").read_bytes()
     [(_, _, work)] = sd.run_batch(fmu, [(0.10325 / 0.1005 - 1, 1.6e-3)], layers=16, n_lengths=4000)

@@ -1,4 +1,4 @@
-"""Commands in the units a controller has (issue 14): McKibbenJoint's torque mode (command_mode 1),
+"""Commands in the units a controller has: McKibbenJoint's torque mode (command_mode 1),
 McKibbenMuscle's pressure for a force (pressure_solver), and PulleyJoint's external pressures.
 Every answer is checked against the forward model it inverts."""
 

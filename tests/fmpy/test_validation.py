@@ -27,7 +27,7 @@ def test_archive_layout(fmu):
     identifier = md.coSimulation.modelIdentifier
     assert f"binaries/linux64/{identifier}.so" in names
     # Windows 64-bit, and 64-bit ARM Linux in the FMI 3.0 platform tuple that FMI 2.0.4 section 2.3
-    # points to (README "Platforms").
+    # points to (docs/compatibility.md, "Platforms").
     assert f"binaries/win64/{identifier}.dll" in names
     assert f"binaries/aarch64-linux/{identifier}.so" in names
     assert "documentation/index.html" in names

@@ -1,4 +1,4 @@
-//! Model Exchange of the motor (issue 13): four continuous states, one event indicator (the
+//! Model Exchange of the motor: four continuous states, one event indicator (the
 //! quasi-static onion's fold), time events at the schedule's switches. The physics is
 //! [`crate::physics::multiferroic::model_exchange`].
 //!

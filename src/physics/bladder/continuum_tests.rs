@@ -63,7 +63,7 @@ fn largest_error(bl: &Bladder, p: f64, lengths: &[f64], limit: &[f64]) -> f64 {
 
 #[test]
 fn eight_nodes_reach_the_layered_limit_within_1e_6_of_peak_force() {
-    // Issue 15's case: muscle C at 450 kPa (the thickest wall for its bore, pre-strained).
+    // The hardest case: muscle C at 450 kPa (the thickest wall for its bore, pre-strained).
     let p = 450e3;
     let probe = bladder(MUSCLE_C, Wall::DissertationContinuum(8));
     let lengths = stroke(&probe, 41);

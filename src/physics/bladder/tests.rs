@@ -153,7 +153,7 @@ fn vanishing_bladder_converges_to_eq_2_3() {
 
 #[test]
 fn max_length_where_eq_2_7_inner_diameter_vanishes() {
-    // DESIGN.md / issue 3: A stops near 0.94 and B near 0.98 of their listed lengths; C and D
+    // A stops near 0.94 and B near 0.98 of their listed lengths; C and D
     // reach theirs. Computed: A 0.9424, B 0.9827, C 0.9993, D 1.0273.
     let expect = [(A, 0.9424), (B, 0.9827), (C, 0.9993), (D, 1.0273)];
     for (which, ratio) in expect {
@@ -214,7 +214,7 @@ fn stiffness_is_the_length_derivative_of_force() {
 
 #[test]
 fn force_is_continuous_in_pressure_at_the_threshold() {
-    // Issue 3: no jump above 1e-6 of the force scale where contact is lost. Force scale: the
+    // No jump above 1e-6 of the force scale where contact is lost. Force scale: the
     // ideal peak force at 690 kPa (eq. 2.3 at L = b).
     for which in [A, B, C, D] {
         for layers in [1, 16] {
@@ -350,7 +350,7 @@ fn unpressurized_free_bladder_is_uniaxial_mooney_rivlin() {
 
 #[test]
 fn contact_onset_length_at_400_kpa() {
-    // DESIGN.md: thin-walled A at 400 kPa stays off the sleeve below about 0.9 of its length;
+    // Thin-walled A at 400 kPa stays off the sleeve below about 0.9 of its length;
     // the thick-walled model (8+ layers) touches much earlier. Computed: thin 0.8815, 8 layers
     // 0.7652, 16 layers 0.7422 of the listed length (threshold falls monotonically with length
     // over this range, so bisection on contact finds the onset).
@@ -618,7 +618,7 @@ fn knitted_force_is_continuous_at_contact_and_stiffness_is_its_slope() {
 
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(300))]
-    /// Issue 3: any pressure in [-100 kPa, 1 MPa] and length up to beyond the limit gives
+    /// Any pressure in [-100 kPa, 1 MPa] and length up to beyond the limit gives
     /// finite values or an Err, never NaN or a panic.
     /// The free bladder's equilibrium pressure rises with its diameter for any tube, so losing
     /// contact is never a snap and the force is continuous at the threshold (proved for one

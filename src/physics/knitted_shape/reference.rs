@@ -1,5 +1,5 @@
-//! Reference tables from the one-ring-at-a-time solver (commit 2013c31), kept as fixtures so
-//! that the faster path is tested against the tables it replaced (issue 15).
+//! Reference tables from the one-ring-at-a-time solver, kept as fixtures so
+//! that the faster path is tested against the tables it replaced.
 //!
 //! Regenerate only deliberately: `cargo test --release --lib write_reference_tables --
 //! --ignored` overwrites `reference/*.csv` with the current solver's output.

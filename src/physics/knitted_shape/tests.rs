@@ -204,7 +204,7 @@ fn pocket_beats_cylinder_start_and_seed_baseline() {
 #[test]
 fn table_ends_at_the_first_node_past_zero_force() {
     // Past the free contraction the solves fail; the path stops at the first node with
-    // dV/dL >= 0 instead of spending its time on failed solves (issue 15), so the table still
+    // dV/dL >= 0 instead of spending its time on failed solves, so the table still
     // holds the zero-force point, in its last interval.
     for segments in [49, 98] {
         let g = prototype(segments);

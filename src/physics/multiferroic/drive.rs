@@ -1,4 +1,4 @@
-//! Strain as the motor's drive (issue 16). Eq. 3.1 is written in stress, `sigma11 - sigma22`;
+//! Strain as the motor's drive. Eq. 3.1 is written in stress, `sigma11 - sigma22`;
 //! a piezoelectric substrate imposes strain. For uniaxial stress in the ring's plane
 //! (`sigma22 = 0`) Hooke's law gives `sigma11 - sigma22 = E epsilon`.
 //!

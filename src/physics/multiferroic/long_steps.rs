@@ -1,4 +1,4 @@
-//! Long steps in the overdamped limit: settling a rotor and whole slipping turns (issue 5).
+//! Long steps in the overdamped limit: settling a rotor and whole slipping turns.
 
 use super::angles::turned_back;
 use super::{Drive, Motor, StepRun, SteppingSchedule, Vector};

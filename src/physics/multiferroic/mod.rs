@@ -24,7 +24,7 @@
 //! sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see [`MotorParams::max_substeps`]).
 //!
-//! Long steps (issue 5): a substep far longer than the relaxation time is never integrated
+//! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
 //! a constant-drive interval long enough for the rotor to settle is advanced in the overdamped
 //! limit to its equilibrium (the same downhill memory rule as the onion's), whole periods of the

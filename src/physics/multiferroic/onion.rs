@@ -8,7 +8,7 @@
 //! per-substep hot path, must respect the memory rule (a global minimizer would not), and every
 //! loop is capped.
 //!
-//! Why the march is safe (issue 16: a fixed 0.05 rad stride stepped over basins less than 1 degree
+//! Why the march is safe (a fixed 0.05 rad stride would step over basins less than 1 degree
 //! wide near a fold, leaving the onion at a far minimum). Write `h(s) = dir U'(psi0 + dir s)`,
 //! negative while going downhill, with `h'(s) = U''(psi0 + dir s)` and `|h''| <= M`, a bound on
 //! the third derivative of U. With `a = -h(0)` and `c = h'(0)`:

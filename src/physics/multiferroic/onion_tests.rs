@@ -1,4 +1,4 @@
-//! Issue 16: the onion state settles in the basin it is in after any input jump (section 3.2.2,
+//! The onion state settles in the basin it is in after any input jump (section 3.2.2,
 //! "the minimum closest to its orientation"), against a slow-ramp reference.
 
 use super::*;
@@ -16,7 +16,7 @@ fn ramp(m: &Motor, direction: f64, from: (f64, f64), to: f64, n: usize) -> f64 {
 }
 
 #[test]
-fn jump_near_a_fold_keeps_the_narrow_basin_of_issue_16() {
+fn jump_near_a_fold_keeps_the_narrow_basin() {
     // Locked rotor, tension at -15 degrees: ramp slowly to 146 MPa, then one step to 148 MPa.
     // A minimum still exists at 16.69 degrees, where a slow ramp ends; the old fixed stride
     // stepped over its basin (< 1 degree wide) and left the onion at 58.97 degrees.

@@ -365,7 +365,7 @@ fn one_second_step_stays_affordable_and_finite() {
     let r = m.step(&mut s, &inputs, 1.0).unwrap();
     assert!(r.substeps <= 2000 + 2, "{}", r.substeps);
     // Every 100 us period lets the rotor settle, so the step is exact per period and not limited
-    // (issue 5's long-step defect: it used to be limited and end at -1.35e9 rad).
+    // (a long step limited here would end at -1.35e9 rad).
     assert!(!r.accuracy_limited);
     assert!(
         (s.rotor_angle - 1e4 * PI / 3.0).abs() < 1e-5,
@@ -669,7 +669,7 @@ fn schedule_run(m: &Motor, h: f64, until: f64, every: f64) -> Vec<MotorState> {
 
 #[test]
 fn stepping_schedule_agrees_from_microsecond_to_long_steps() {
-    // Issue 5: communication steps from 1 us (every transient resolved by the error-controlled
+    // Communication steps from 1 us (every transient resolved by the error-controlled
     // integrator) to 10 ms (100 periods settled in one call) give the same rotor at the common
     // times. Tolerance 2e-6 rad: the integrator holds 1e-6 rad per substep, and the settled
     // periods end on the exponential tail (~9e-6 rad behind the minimum after 100 us, 8.4 us
@@ -699,7 +699,7 @@ fn stepping_schedule_agrees_from_microsecond_to_long_steps() {
 
 #[test]
 fn one_second_step_follows_the_schedule_period_by_period() {
-    // Issue 5's defect: one 1 s step over 10 000 switches ended at -1.35e9 rad. Each 100 us
+    // A 1 s step over 10 000 switches must not end at -1.35e9 rad. Each 100 us
     // period is ~12 relaxation times (c/k ~ 8.4 us at the schedule's minimum), so the rotor ends
     // every period settled one step on: +60 degrees per period, within the settle's 1e-4 rad.
     let m = motor();
