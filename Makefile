@@ -376,6 +376,7 @@ Measure and check (not part of make test)
   fuzz              random FMI call sequences (cargo-fuzz): FUZZ_SECONDS= FUZZ_JOBS= SANITIZER=
   memcheck          every FMU under valgrind, natively and through FMPy
   load              10,000 instantiate-run-free cycles per FMU with the heap counted
+  test-new-model    docs/adding-a-model.md's trivial model in a scratch copy, through the Rust suites
   clean             remove build output, out/ and the .venv
 endef
 export HELP_TEXT
