@@ -318,7 +318,8 @@ fn time_step(u: &mut Unstructured) -> Result<f64> {
 /// registry is in name order: FreeBladder's arrival once shifted every seed to another model).
 /// Never reorder or remove an entry. The reserved id (`None`) is a GUID that no model has, which
 /// must be refused, or, with the byte's high nibble set, a model added after this table (by name
-/// order, [`later_models`]): a new model needs no entry, and the seeds keep their models. Bit 3
+/// order, [`later_models`]): a new model needs no entry, and the seeds of the tabled models keep
+/// them (a seed on a later model may move to another later model when one is added). Bit 3
 /// of the byte asks `ready` for Model Exchange (the committed seeds from before Model Exchange
 /// was fuzzed have it clear).
 pub const MODEL_IDS: [Option<&str>; 8] = [
