@@ -4,8 +4,11 @@ PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
 LIB := target/release/libactuator_fmus.so
+# The MuJoCo actuator plugin (see "MuJoCo" below).
+MUJOCO_PLUGIN := target/mujoco-plugin/release/libactuator_fmus_mujoco.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
+.PHONY: mujoco-plugin mujoco-arm mujoco-docs
 .PHONY: all fmus demo scene figures test test-rust test-new-model test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
@@ -136,7 +139,7 @@ interop-deps:
 ## that its module fixtures are built once and files that share a scratch directory (wine's
 ## prefix) never run beside themselves. PYTEST_WORKERS=0: one process.
 PYTEST_WORKERS ?= 2
-test-fmpy: fmus $(VENV)/.installed interop-deps py-deps
+test-fmpy: fmus $(VENV)/.installed interop-deps py-deps $(MUJOCO_PLUGIN)
 	$(PY) -m pytest tests/fmpy -q $(if $(filter-out 0,$(PYTEST_WORKERS)),-n $(PYTEST_WORKERS) --dist loadfile)
 
 ## All Rust tests and the FMPy suite. The apt checks run first, one at a time (dpkg has one lock);
@@ -208,6 +211,31 @@ motor-docs: fmus $(VENV)/.installed
 ## and its stroke against the measured 42% and 51%.
 knitted-bag-docs: fmus $(VENV)/.installed
 	$(PY) examples/knitted_bag.py
+
+## ---- MuJoCo (docs/mujoco.md) ----
+## The actuator plugin that runs an FMU inside MuJoCo (mujoco_plugin/, its own crate and target
+## directory so that it builds beside the Rust tests). It compiles against the headers and links the
+## libmujoco.so of the pinned `mujoco` wheel in the venv.
+MUJOCO_PLUGIN_SOURCES := $(shell find mujoco_plugin/src -type f) mujoco_plugin/Cargo.toml mujoco_plugin/build.rs
+$(MUJOCO_PLUGIN): $(MUJOCO_PLUGIN_SOURCES) $(VENV)/.installed
+	+cargo build --release --manifest-path mujoco_plugin/Cargo.toml --target-dir target/mujoco-plugin
+	@touch $@
+mujoco-plugin: $(MUJOCO_PLUGIN)
+
+## The antagonistic arm in MuJoCo (examples/mujoco/arm.xml): position control, then co-contraction
+## at a fixed angle, with torque pulses that show the stiffness; out/mujoco/arm.{csv,png} and, when
+## offscreen rendering works, out/mujoco/arm.gif.
+mujoco-arm: fmus $(MUJOCO_PLUGIN)
+	$(PY) examples/mujoco_arm.py --out out/mujoco
+
+## docs/mujoco.md's figures (the arm, rendered if EGL or OSMesa works) and docs/mujoco-comparison.md:
+## the plugin against MuJoCo's <muscle> fitted at one pressure, and the cost per step.
+mujoco-docs: fmus $(MUJOCO_PLUGIN)
+	$(PY) examples/mujoco_arm.py --out out/mujoco --gif --stiffness
+	cp out/mujoco/arm.png docs/img/mujoco_arm.png
+	cp out/mujoco/arm_stiffness.png docs/img/mujoco_stiffness.png
+	if [ -f out/mujoco/arm.gif ]; then cp out/mujoco/arm.gif docs/img/mujoco_arm.gif; fi
+	$(PY) examples/mujoco_vs_native_muscle.py --out docs/img --report docs/mujoco-comparison.md
 
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
