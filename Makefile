@@ -3,21 +3,25 @@ SHELL := /bin/bash
 PYTHON ?= python3
 VENV := .venv
 PY := $(VENV)/bin/python
-LIB := target/release/libactuator_fmus.so
+AF := $(VENV)/bin/actuator-fmus
+## The linux64 binary the FMUs ship (see "Linux binaries for every maintained distribution" below).
+LIB := target/glibc/x86_64-unknown-linux-gnu/release/libactuator_fmus.so
 # The MuJoCo actuator plugin (see "MuJoCo" below).
 MUJOCO_PLUGIN := target/mujoco-plugin/release/libactuator_fmus_mujoco.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
 .PHONY: mujoco-plugin mujoco-arm mujoco-docs
-.PHONY: all fmus demo scene figures test test-rust test-new-model test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
+.PHONY: all fmus zig-tools demo scene figures test test-rust test-new-model test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
 
-## The Python tools, pinned (FMPy is the importer the tests and the demo drive).
-$(VENV)/.installed: tests/fmpy/requirements.txt
+## The Python tools, pinned (FMPy is the importer the tests and the demo drive), and this project's
+## package (pyproject.toml, python/actuator_fmus/), editable, with its command `actuator-fmus`.
+$(VENV)/.installed: tests/fmpy/requirements.txt pyproject.toml
 	$(PYTHON) -m venv $(VENV)
 	$(VENV)/bin/pip install --quiet --upgrade pip
 	$(VENV)/bin/pip install --quiet -r tests/fmpy/requirements.txt
+	$(VENV)/bin/pip install --quiet --no-deps -e .
 	touch $@
 
 ## libclang for the `fmi` crate's bindgen (a dev-dependency: the Rust tests import our FMUs with it).
@@ -41,11 +45,37 @@ py-deps:
 	    --no-install-recommends $$missing; \
 	fi
 
-## One recipe for the three files (`&:`): under `make -j` it must run once, not once per file.
+## One recipe for both tools (`&:`): under `make -j` it must run once, not once per file.
 ## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
-$(LIB) target/release/package_fmus target/release/calibrate &: $(SOURCES)
-	+cargo build --release --lib -p actuator-fmus
+target/release/package_fmus target/release/calibrate &: $(SOURCES)
 	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
+
+## Linux binaries for every maintained distribution: linked against glibc 2.17 (the manylinux2014
+## baseline: RHEL/Rocky 7-9, Ubuntu 18.04+, Debian 10+) by cargo-zigbuild with zig as the linker,
+## whatever glibc this machine has. Both tools are pinned and installed here, under target/tools/,
+## when missing (zig from PyPI's `ziglang` wheel, in its own venv). tests/all/glibc_versions.rs
+## fails if a shipped .so needs a newer symbol version.
+GLIBC := 2.17
+ZIGLANG_VERSION := 0.17.1
+ZIGBUILD_VERSION := 0.24.1
+TOOLS := target/tools
+ZIGBUILD := $(TOOLS)/bin/cargo-zigbuild
+ZIG_VENV := $(TOOLS)/zig
+# cargo-zigbuild finds zig as `python3 -m ziglang` first: the tool venv's python3 leads the PATH.
+ZIG_ENV := PATH=$(CURDIR)/$(ZIG_VENV)/bin:$(CURDIR)/$(TOOLS)/bin:$$PATH
+$(ZIG_VENV)/.installed:
+	$(PYTHON) -m venv $(ZIG_VENV)
+	$(ZIG_VENV)/bin/pip install --quiet ziglang==$(ZIGLANG_VERSION)
+	touch $@
+$(ZIGBUILD):
+	cargo install cargo-zigbuild --locked --version $(ZIGBUILD_VERSION) --root $(TOOLS)
+zig-tools: $(ZIG_VENV)/.installed $(ZIGBUILD)
+
+## Its own target directory, so that it runs beside the host build under `make -j`.
+GLIBC_TARGET_DIR := target/glibc
+$(LIB): $(SOURCES) | zig-tools
+	+$(ZIG_ENV) cargo zigbuild --release --lib -p actuator-fmus --target-dir $(GLIBC_TARGET_DIR) \
+	  --target x86_64-unknown-linux-gnu.$(GLIBC)
 
 ## Cross toolchains for the win64 and aarch64-linux binaries, and the emulators the tests run them
 ## under (wine, qemu-user); each installed only when missing.
@@ -67,11 +97,16 @@ cross-deps:
 ## host dependencies once more.
 CROSS_TARGET_DIR := target/cross
 WIN_DLL := $(CROSS_TARGET_DIR)/x86_64-pc-windows-gnu/release/actuator_fmus.dll
-ARM_SO := $(CROSS_TARGET_DIR)/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
+ARM_SO := $(GLIBC_TARGET_DIR)/aarch64-unknown-linux-gnu/release/libactuator_fmus.so
 
-$(WIN_DLL) $(ARM_SO) &: $(SOURCES) | cross-deps
-	+cargo build --release --lib --target-dir $(CROSS_TARGET_DIR) \
-	  --target x86_64-pc-windows-gnu --target aarch64-unknown-linux-gnu
+$(WIN_DLL): $(SOURCES) | cross-deps
+	+cargo build --release --lib --target-dir $(CROSS_TARGET_DIR) --target x86_64-pc-windows-gnu
+
+## aarch64-linux as linux64: zig links it against glibc 2.17 (no cross gcc needed for the build;
+## the tests' C harness still uses it).
+$(ARM_SO): $(SOURCES) $(LIB) | zig-tools cross-deps
+	+$(ZIG_ENV) cargo zigbuild --release --lib -p actuator-fmus --target-dir $(GLIBC_TARGET_DIR) \
+	  --target aarch64-unknown-linux-gnu.$(GLIBC)
 
 ## target/fmu/<Model>.fmu for every model in modelDescription/, with binaries for linux64, win64 and
 ## aarch64-linux (`make fmus CROSS=0`: linux64 only, no cross toolchains needed).
@@ -87,7 +122,7 @@ DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
 
 ## Builds the FMUs and runs the default scene under FMPy: out/fig2_3_ideal_mckibben.{csv,png}.
 demo: fmus $(VENV)/.installed
-	$(PY) scenes/run.py $(DEFAULT_SCENE) --out out
+	$(AF) scene $(DEFAULT_SCENE) --out out
 
 ## scenes/schema/scene.schema.json, the JSON Schema of scene files, from the Rust types in src/scene.rs.
 scene-schema:
@@ -95,11 +130,11 @@ scene-schema:
 
 ## Any scene: make scene SCENE=scenes/<name>.json
 scene: fmus $(VENV)/.installed
-	$(PY) scenes/run.py $(SCENE) --out out
+	$(AF) scene $(SCENE) --out out
 
 ## Every scene at full length, and docs/figures.md with the plots beside the dissertation's statements.
 figures: fmus $(VENV)/.installed
-	$(PY) scenes/catalogue.py
+	$(AF) figures
 
 ## Fits McKibbenMuscle to a datasheet (CSV pressure_kpa,contraction,force_n) with the FMU's own
 ## physics, checks the result through the FMU: OUT/{params.json,params.ssv,report.md,fit.png}.
@@ -111,12 +146,12 @@ FIT ?= 0,600
 OUT ?= out/calibrate
 STARTS ?= 24
 calibrate: fmus target/release/calibrate $(VENV)/.installed
-	$(PY) calibration/calibrate.py $(DATA) $(LENGTH) $(DIAMETER) $(FIT) $(OUT) $(STARTS)
+	$(AF) calibrate $(DATA) --length $(LENGTH) --diameter $(DIAMETER) --fit-kpa $(FIT) --out $(OUT) --starts $(STARTS)
 
 ## The Festo presets' fits (src/physics/festo.rs) and their reports: docs/calibration/dmsp{40,10}/.
 calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
-	$(PY) calibration/calibrate.py data/festo/festo_dmsp40.csv 0.4 0.04 0,600 docs/calibration/dmsp40
-	$(PY) calibration/calibrate.py data/festo/festo_dmsp10.csv 0.25 0.01 0,600 docs/calibration/dmsp10
+	$(AF) calibrate data/festo/festo_dmsp40.csv --length 0.4 --diameter 0.04 --fit-kpa 0,600 --out docs/calibration/dmsp40
+	$(AF) calibrate data/festo/festo_dmsp10.csv --length 0.25 --diameter 0.01 --fit-kpa 0,600 --out docs/calibration/dmsp10
 
 test-rust: deps fmus
 	+cargo test --release --workspace
@@ -166,6 +201,13 @@ bench: deps fmus $(C_PASSTHROUGH)
 	cargo bench --bench cpu_time
 	cargo bench --bench parity
 
+.PHONY: worst-case
+## The cost of a step and of initialization anywhere in each FMU's declared space: every bound
+## alone, every option combination and 10,000 log-uniform random points per FMU (median, p99,
+## max; benches/worst_case.rs). WORST_CASE_POINTS and WORST_CASE_MODELS narrow it.
+worst-case: fmus
+	cargo bench --bench worst_case
+
 .PHONY: parity
 ## benches/parity.rs alone: the FMI layer against C, the walls, the motor and the knitted table;
 ## then docs/performance.md's FMI-layer table from that run.
@@ -192,11 +234,11 @@ report: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 ## docs/linearized-muscle.md: stiffness dF/dL and pressure gain dF/dP over the stroke of Table 2.1's
 ## muscles through fmi2GetDirectionalDerivative, and chapter 2's linear-spring proposal tested.
 linearized: fmus $(VENV)/.installed
-	$(PY) docs/linearized/generate.py > /dev/null
+	$(AF) linearized > /dev/null
 
 ## Chapter 2's claims re-run with the dissertation's walls and the exact wall: docs/chapter2-claims.md.
 chapter2-claims: fmus $(VENV)/.installed
-	$(PY) docs/chapter2/generate.py
+	$(AF) chapter2-claims
 
 clean:
 	cargo clean
@@ -205,12 +247,12 @@ clean:
 ## docs/motor.md and docs/img/motor_*.png: holding, pull-in and pull-out torque, section 3.2.3's
 ## densities, strain drive and onion reorientation of the MultiferroicMotor FMU.
 motor-docs: fmus $(VENV)/.installed
-	$(PY) examples/motor_characteristics.py
+	$(AF) motor
 
 ## docs/knitted-bag.md and docs/img/knitted_bag.png: the section 1.4 prototype's polyethylene bag
 ## and its stroke against the measured 42% and 51%.
 knitted-bag-docs: fmus $(VENV)/.installed
-	$(PY) examples/knitted_bag.py
+	$(AF) knitted-bag
 
 ## ---- MuJoCo (docs/mujoco.md) ----
 ## The actuator plugin that runs an FMU inside MuJoCo (mujoco_plugin/, its own crate and target
@@ -240,26 +282,26 @@ mujoco-docs: fmus $(MUJOCO_PLUGIN)
 ## Robot joint: an antagonistic McKibbenMuscle pair on a pulley under PD pressure control,
 ## co-simulated with FMPy (out/robot_joint.{csv,png}) and with the fmi crate (out/robot_joint_fmi.csv).
 robot-joint: deps fmus $(VENV)/.installed
-	$(PY) examples/robot_joint.py --out out
+	$(AF) robot-joint --out out
 	cargo run --release -p actuator-fmus-tools --example robot_joint
 
 ## FMI cross-check files crosscheck/<Model>/<Model>_{in,ref}.csv, _ref.opt and the plots
 ## docs/fmu/<Model>.png, then the FMUs again so that each documentation/ carries its plot.
 crosscheck: fmus $(VENV)/.installed
-	$(PY) crosscheck/generate.py
+	$(AF) crosscheck
 	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
 
 ## The robot joint as a system: out/systems/RobotJoint.ssp (fmpy simulate_ssp) and the container
 ## FMU out/systems/RobotJoint.fmu (fmu-manipulation-toolbox), both run and plotted against the
 ## two-FMU co-simulation: out/systems/robot_joint_systems.png.
 systems: fmus $(VENV)/.installed
-	$(PY) systems/build.py --run
+	$(AF) systems --run
 
 ## Design sweep on Dask (not part of `make test`): bladder pre-strain x wall thickness -> net work per
 ## stroke of the McKibbenMuscle FMU, out/sweep.{csv,png}. Local cluster by default; any running
 ## scheduler with `make sweep SCHEDULER=tcp://host:8786`.
 sweep: fmus $(VENV)/.installed
-	$(PY) examples/sweep_dask.py --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
+	$(AF) sweep --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
 
 ## ---- Reliability jobs: longer runs, not part of `make test`. ----
 .PHONY: fuzz memcheck load

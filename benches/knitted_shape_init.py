@@ -15,8 +15,7 @@ import sys
 import time
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
-from conftest import FMU_DIR  # noqa: E402
+from actuator_fmus import FMU_DIR  # noqa: E402
 
 GOALS = {49: 3e-3, 1568: 100e-3}
 

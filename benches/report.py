@@ -1,7 +1,8 @@
 """Writes docs/accuracy-cost.md: for every fidelity knob, the error against a converged reference
 (computed here under FMPy) beside the native time per step (criterion, benches/accuracy_cost.rs,
 read from target/criterion), log-log work-precision plots, the cost under FMPy beside the
-PassThrough FMU, and the performance goals. Run by `make report` after the benchmarks.
+PassThrough FMU, and the performance goals. Run by `make report` after the benchmarks;
+`benches/report.py --replot` redraws only the work-precision plots from docs/accuracy-cost.md.
 
 Timings are CPU time of the measuring thread wherever the machine's load would dominate wall
 time: the criterion bench measures thread CPU time (benches/cpu_clock.rs), benches/cpu_time.rs
@@ -22,8 +23,7 @@ import matplotlib.pyplot as plt
 import numpy as np
 
 ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
-from conftest import FMU_DIR, Slave  # noqa: E402
+from actuator_fmus import FMU_DIR, Slave  # noqa: E402
 import knitted_shape_init  # noqa: E402
 from knitted_shape_init import GOALS  # noqa: E402
 
@@ -409,17 +409,44 @@ def is_number(text):
         return False
 
 
+def _place_labels(ax, labelled):
+    """Writes each (x, y, text) beside its point where it overlaps no label and no point already
+    there, trying offsets ever farther out; a label set off from its point gets a thin leader."""
+    fig = ax.figure
+    renderer = fig.canvas.get_renderer()
+    points = [ax.transData.transform((x, y)) for x, y, _ in labelled]
+    taken = []
+    rings = [(6, 4), (6, -12), (-8, 8), (-8, -14)]
+    candidates = [(dx * k, dy * k) for k in (1, 2, 3, 4) for dx, dy in rings]
+    for (x, y, text), own in zip(labelled, points):
+        for dx, dy in candidates:
+            ha = "left" if dx > 0 else "right"
+            note = ax.annotate(text, (x, y), fontsize=7, xytext=(dx, dy), textcoords="offset points", ha=ha,
+                               arrowprops=dict(arrowstyle="-", lw=0.4, color="0.4") if abs(dy) > 12 else None)
+            box = note.get_window_extent(renderer).expanded(1.05, 1.1)
+            near = box.padded(7)  # keeps a label off other markers, so that it names its own
+            clear = not any(box.overlaps(t) for t in taken) and not any(
+                near.contains(*p) for p in points if p is not own)
+            if clear or (dx, dy) == candidates[-1]:
+                taken.append(box)
+                break
+            note.remove()
+
+
 def plot_work_precision(fmu, scenario, points, rows, times):
     """Log-log error against native time, one labelled series per knob, values beside points."""
     import textwrap
-    fig, ax = plt.subplots(figsize=(8.0, 5.6))
+
+    from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
+
+    fig, ax = plt.subplots(figsize=(8.0, 5.8))
     markers = iter("osD^v<>ph*")
     knobs = []
     for _, _, knob, _ in points:
         if knob not in knobs:
             knobs.append(knob)
-    offsets = [(-14, 7), (5, -11), (6, 4), (6, 6), (-14, -12)]
-    for n, knob in enumerate(knobs):
+    labelled = []
+    for knob in knobs:
         series = [(t, e, v) for t, e, k, v in points if k == knob]
         numeric = all(is_number(v) for _, _, v in series)
         if numeric:
@@ -429,9 +456,11 @@ def plot_work_precision(fmu, scenario, points, rows, times):
         # A line joins the values of one numeric knob; categorical ones are points alone.
         ax.loglog(ts, es, linestyle="-" if numeric and len(series) > 1 else "none",
                   marker=next(markers), label=KNOB_LABELS.get(knob, knob))
-        dx, dy = offsets[n % len(offsets)]
-        for t, e, v in series:
-            ax.annotate(v, (t * 1e9, e), fontsize=7, xytext=(dx, dy), textcoords="offset points")
+        labelled += [(t * 1e9, e, str(v)) for t, e, v in series]
+    # Plain numbers at 1-2-5 steps: no minor-tick labels to collide on a short decade range.
+    ax.xaxis.set_major_locator(LogLocator(base=10, subs=(1.0, 2.0, 5.0)))
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:g}"))
+    ax.xaxis.set_minor_formatter(NullFormatter())
     unit = "rad" if fmu == "MultiferroicMotor" else "share of peak force, 1"
     ax.set_xlabel("native time per step (ns)")
     ax.set_ylabel(f"largest error against the reference ({unit})")
@@ -440,6 +469,7 @@ def plot_work_precision(fmu, scenario, points, rows, times):
     ax.grid(alpha=0.3, which="both")
     ax.legend(fontsize=7, loc="best")
     fig.tight_layout()
+    _place_labels(ax, labelled)
     fig.savefig(PLOTS / f"{fmu}.png", dpi=110)
     plt.close(fig)
 
@@ -453,6 +483,27 @@ def fmt_time(s):
     return f"{s * 1e9:.0f} ns" if s < 1e-6 else (f"{s * 1e6:.2f} us" if s < 1e-3 else f"{s * 1e3:.2f} ms")
 
 
+def replot_from_page():
+    """docs/accuracy/<FMU>.png again from the tables of docs/accuracy-cost.md (error, 1 or rad;
+    native time per step, ns, us or ms)."""
+    import re
+
+    text = (DOCS / "accuracy-cost.md").read_text()
+    per_second = {"ns": 1e-9, "us": 1e-6, "µs": 1e-6, "ms": 1e-3, "s": 1.0}
+    for fmu in ("McKibbenMuscle", "KnittedMuscle", "MultiferroicMotor"):
+        if f"## {fmu}\n" not in text:
+            continue
+        section = text.split(f"## {fmu}\n", 1)[1].split("\n## ", 1)[0]
+        scenario = re.search(r"Scenario: (.*)\.\n", section).group(1)
+        points = []
+        for knob, value, err, t in re.findall(r"\| `(\w+)` \| ([^|]+) \| ([^|]+) \| ([^|]+) \|", section):
+            number, unit = t.split()
+            if unit in per_second and float(err) > 0:
+                points.append((float(number) * per_second[unit], float(err), knob, value.strip()))
+        plot_work_precision(fmu, scenario, points, None, None)
+        print(f"wrote {PLOTS / fmu}.png")
+
+
 def main():
     global CPU
     parity = parity_figures()
@@ -461,6 +512,11 @@ def main():
         if parity is None:
             sys.exit("no target/parity/parity.json: run `cargo bench --bench parity` first")
         write_docs_block("fmi-parity", parity_table(parity))
+        return
+    if "--replot" in sys.argv:
+        # Only the work-precision plots, from the numbers docs/accuracy-cost.md holds (its last
+        # `make report`): a change to the plots needs no benchmark run.
+        replot_from_page()
         return
     times = criterion_times()
     CPU = cpu_figures()

@@ -40,6 +40,8 @@ struct ModelDescription {
     log_categories: Option<IgnoredAny>,
     #[serde(rename = "UnitDefinitions", default)]
     unit_definitions: UnitDefinitions,
+    #[serde(rename = "TypeDefinitions", default)]
+    type_definitions: TypeDefinitions,
     #[serde(rename = "ModelVariables")]
     model_variables: ModelVariables,
     #[serde(rename = "ModelStructure", default)]
@@ -50,6 +52,35 @@ struct ModelDescription {
 struct UnitDefinitions {
     #[serde(rename = "Unit", default)]
     units: Vec<Named>,
+}
+
+/// Only Enumeration types: a variable's unit is given directly (see `check_variable`).
+#[derive(Deserialize, Default)]
+struct TypeDefinitions {
+    #[serde(rename = "SimpleType", default)]
+    types: Vec<SimpleType>,
+}
+
+#[derive(Deserialize)]
+struct SimpleType {
+    #[serde(rename = "@name")]
+    name: String,
+    #[serde(rename = "Enumeration")]
+    enumeration: Option<EnumerationType>,
+}
+
+#[derive(Deserialize)]
+struct EnumerationType {
+    #[serde(rename = "Item", default)]
+    items: Vec<Item>,
+}
+
+#[derive(Deserialize)]
+struct Item {
+    #[serde(rename = "@name")]
+    name: String,
+    #[serde(rename = "@value")]
+    value: i32,
 }
 
 #[derive(Deserialize)]
@@ -86,6 +117,9 @@ struct ScalarVariable {
     boolean: Option<TypeAttributes>,
     #[serde(rename = "String")]
     string: Option<TypeAttributes>,
+    /// Travels as an Integer through fmi2Set/GetInteger (FMI 2.0 section 2.2.7).
+    #[serde(rename = "Enumeration")]
+    enumeration: Option<TypeAttributes>,
 }
 
 fn default_causality() -> String {
@@ -234,11 +268,13 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
         return Err("a unit is defined twice in UnitDefinitions".into());
     }
 
+    let enumerations = check_enumerations(&md.type_definitions)?;
     let mut variables = Vec::new();
     let mut names = BTreeSet::new();
     let mut field_names = BTreeSet::new();
     for v in &md.model_variables.variables {
-        let c = check_variable(v, &units).map_err(|e| format!("variable '{}': {e}", v.name))?;
+        let c = check_variable(v, &units, &enumerations)
+            .map_err(|e| format!("variable '{}': {e}", v.name))?;
         if !names.insert(v.name.as_str()) {
             return Err(format!("variable name '{}' is used twice", v.name));
         }
@@ -303,14 +339,78 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
     })
 }
 
+/// The (lowest, highest) item value of each Enumeration type by name. The items must be the
+/// consecutive integers from the lowest: the export layer checks an Integer against its min and
+/// max, which then admit exactly the items.
+fn check_enumerations(types: &TypeDefinitions) -> Result<BTreeMap<String, (i32, i32)>, String> {
+    let mut out = BTreeMap::new();
+    for t in &types.types {
+        let Some(e) = &t.enumeration else {
+            return Err(format!(
+                "type '{}': only Enumeration types are supported; give a Real's unit directly",
+                t.name
+            ));
+        };
+        let first = e.items.first().map(|i| i.value).ok_or(format!(
+            "type '{}': an Enumeration needs at least one Item",
+            t.name
+        ))?;
+        let mut item_names = BTreeSet::new();
+        for (k, item) in e.items.iter().enumerate() {
+            if item.value != first + k as i32 {
+                return Err(format!(
+                    "type '{}': item '{}' has value {}, expected {} (consecutive values in order)",
+                    t.name,
+                    item.name,
+                    item.value,
+                    first + k as i32
+                ));
+            }
+            if !item_names.insert(item.name.as_str()) {
+                return Err(format!(
+                    "type '{}': item '{}' appears twice",
+                    t.name, item.name
+                ));
+            }
+        }
+        let last = first + e.items.len() as i32 - 1;
+        if out.insert(t.name.clone(), (first, last)).is_some() {
+            return Err(format!("type '{}' is defined twice", t.name));
+        }
+    }
+    Ok(out)
+}
+
 /// FMI 2.0 section 2.2.7: which causality/variability pairs exist and which `initial` each allows.
-fn check_variable(v: &ScalarVariable, units: &BTreeSet<&str>) -> Result<Variable, String> {
-    let typed = [&v.real, &v.integer, &v.boolean, &v.string];
-    let present: Vec<usize> = (0..4).filter(|&t| typed[t].is_some()).collect();
-    let [type_index] = present[..] else {
-        return Err("needs exactly one of Real, Integer, Boolean, String".into());
+/// An Enumeration variable becomes an Integer (type index 1) whose min and max default to its
+/// type's items.
+fn check_variable(
+    v: &ScalarVariable,
+    units: &BTreeSet<&str>,
+    enumerations: &BTreeMap<String, (i32, i32)>,
+) -> Result<Variable, String> {
+    let typed = [&v.real, &v.integer, &v.boolean, &v.string, &v.enumeration];
+    let present: Vec<usize> = (0..5).filter(|&t| typed[t].is_some()).collect();
+    let [present_index] = present[..] else {
+        return Err("needs exactly one of Real, Integer, Boolean, String, Enumeration".into());
     };
-    let attrs = typed[type_index].as_ref().expect("checked present");
+    let attrs = typed[present_index].as_ref().expect("checked present");
+    let mut enumeration_range = None;
+    if present_index == 4 {
+        let declared = attrs
+            .declared_type
+            .as_deref()
+            .ok_or("an Enumeration needs a declaredType")?;
+        let range = enumerations.get(declared).ok_or(format!(
+            "declaredType '{declared}' is not an Enumeration in TypeDefinitions"
+        ))?;
+        enumeration_range = Some(*range);
+    } else if attrs.declared_type.is_some() {
+        return Err(
+            "declaredType is supported for Enumerations only; give the unit directly".into(),
+        );
+    }
+    let type_index = if present_index == 4 { 1 } else { present_index };
     let (causality, variability) = (v.causality.as_str(), v.variability.as_str());
     // Case letters of the spec's table: which initial values are legal, the first being the default.
     // Tunable parameters are accepted: the export layer rebuilds the model when one changes
@@ -347,10 +447,22 @@ fn check_variable(v: &ScalarVariable, units: &BTreeSet<&str>) -> Result<Variable
         }
         _ => {}
     }
-    if attrs.declared_type.is_some() {
-        return Err(
-            "declaredType is not supported by the generator; give the unit directly".into(),
-        );
+    let (mut min, mut max) = (attrs.min.clone(), attrs.max.clone());
+    if let Some((first, last)) = enumeration_range {
+        for (bound, value) in [("min", &min), ("max", &max), ("start", &attrs.start)] {
+            if let Some(text) = value {
+                match text.trim().parse::<i32>() {
+                    Ok(x) if (first..=last).contains(&x) => {}
+                    _ => {
+                        return Err(format!(
+                            "{bound} '{text}' is not an item value ({first} .. {last})"
+                        ))
+                    }
+                }
+            }
+        }
+        min.get_or_insert(first.to_string());
+        max.get_or_insert(last.to_string());
     }
     if type_index == 0 {
         let unit = attrs
@@ -373,8 +485,8 @@ fn check_variable(v: &ScalarVariable, units: &BTreeSet<&str>) -> Result<Variable
         variability: v.variability.clone(),
         initial,
         start: attrs.start.clone(),
-        min: attrs.min.clone(),
-        max: attrs.max.clone(),
+        min,
+        max,
         unit: attrs.unit.clone(),
         derivative_of: attrs.derivative.clone(),
         nominal: attrs.nominal.clone(),

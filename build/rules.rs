@@ -216,7 +216,10 @@ pub fn check(text: &str) -> Result<(), String> {
                     continuous_real: attrs.get("variability").is_none_or(|v| v == "continuous"),
                 });
             }
-            ("ScalarVariable", kind @ ("Real" | "Integer" | "Boolean" | "String")) => {
+            (
+                "ScalarVariable",
+                kind @ ("Real" | "Integer" | "Boolean" | "String" | "Enumeration"),
+            ) => {
                 let var = variables.last().map_or("?", |v| v.name.as_str());
                 let at = format!("variable '{var}'");
                 if kind != "Real" {

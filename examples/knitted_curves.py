@@ -10,7 +10,6 @@ import argparse
 import io
 import pathlib
 import subprocess
-import sys
 
 import matplotlib
 
@@ -18,9 +17,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
-from conftest import Slave  # noqa: E402
+from actuator_fmus import ROOT, Slave  # noqa: E402
 
 PRESSURE = 14e3
 SHAPES = {0: "ideal cylinder (eq. 1.8)", 1: "tubular knit (eq. 1.14)", 2: "non-cylindrical (eq. 1.17-1.20)"}

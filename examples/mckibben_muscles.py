@@ -14,8 +14,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests" / "fmpy"))
-from conftest import Slave  # noqa: E402
+from actuator_fmus import Slave  # noqa: E402
 
 MUSCLES = {1: ("A", 0.10325, "3% pre-strain"), 2: ("B", 0.1088, "52%"), 3: ("C", 0.0989, "82%"), 4: ("D", 0.1358, "2%, thin wide bladder")}
 PRESSURES_KPA = [0, 172, 345, 517, 690]

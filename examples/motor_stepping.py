@@ -19,17 +19,19 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 import numpy as np
-from fmpy import read_model_description, simulate_fmu
+from fmpy import read_model_description
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-FMU = str(ROOT / "target" / "fmu" / "MultiferroicMotor.fmu")
+from actuator_fmus import fmu_path, simulate  # simulate: inputs without a column keep their start values
+
+MODEL = "MultiferroicMotor"
+FMU = fmu_path(MODEL)
 OUTPUTS = ["torque", "rotor_angle", "rotor_speed", "onion_angle", "offset_angle", "applied_strain_direction"]
 
 
 def stepping(period, steps=12, samples_per_period=100):
-    return simulate_fmu(
-        FMU,
-        start_values={"schedule": 1, "step_period": period},
+    return simulate(
+        MODEL,
+        start_values={"schedule": "stepping_schedule", "step_period": period},
         output=OUTPUTS,
         stop_time=steps * period,
         output_interval=period / samples_per_period,
@@ -37,8 +39,8 @@ def stepping(period, steps=12, samples_per_period=100):
 
 
 def locked(signals, **start):
-    return simulate_fmu(
-        FMU,
+    return simulate(
+        MODEL,
         input=signals,
         start_values={"rotor_locked": True, **start},
         output=OUTPUTS,

@@ -256,10 +256,8 @@ def stiffness_sweep(commons=np.linspace(250e3, 550e3, 7), difference=100e3, dtau
     `stiffness` output, k = r^2 (k_flexor + k_extensor) - m g l sin q.
     Rows: (common-mode Pa, angle rad, measured N m/rad, predicted N m/rad)."""
     import mujoco
-    import sys
 
-    sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
-    from conftest import Slave
+    from actuator_fmus import Slave
 
     fmu = Slave("McKibbenMuscle", preset=5, nominal_length=0.25)
     model = arm_model()

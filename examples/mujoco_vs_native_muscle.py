@@ -13,13 +13,11 @@ lmax fixed) is fitted by least squares to the FMU's tension at 600 kPa over the 
 import argparse
 import pathlib
 import re
-import sys
 import time
 
 import numpy as np
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-import mujoco_arm as arm  # noqa: E402
+import mujoco_arm as arm  # noqa: E402  (beside this script: Python finds it there)
 
 P_FIT = 600e3  # Pa: the pressure the <muscle> is fitted at (activation 1)
 LMAX = 1.6  # the <muscle>'s lmax, fixed: the stroke lies on the ascending limb
@@ -94,8 +92,7 @@ def linear_xml(pressures):
     data.ctrl[:] = pressures
     for _ in range(3000):
         mujoco.mj_step(model, data)
-    sys.path.insert(0, str(arm.ROOT / "tests" / "fmpy"))
-    from conftest import Slave
+    from actuator_fmus import Slave
 
     fmu = Slave("McKibbenMuscle", preset=5, nominal_length=0.25)
     xml = arm.ARM_XML.read_text()

@@ -10,11 +10,8 @@
 """
 
 import math
-import pathlib
-import sys
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests" / "fmpy"))
-from conftest import Slave  # noqa: E402  (an initialized FMU addressed by variable names)
+from actuator_fmus import Slave  # an initialized FMU addressed by variable names
 
 H = 1e-3
 INERTIA, DAMPING, MGL = 0.004, 0.05, 0.25 * 9.81 * 0.12  # the PulleyJoint's pendulum

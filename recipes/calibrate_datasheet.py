@@ -7,14 +7,9 @@ FMU, and writes out/recipes/calibrate_dmsp40/{params.json,params.ssv,report.md,f
 """
 
 import json
-import pathlib
-import sys
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-from fmpy import simulate_fmu  # noqa: E402
-
-from calibration.calibrate import FMU, calibrate  # noqa: E402
+from actuator_fmus import ROOT, simulate
+from actuator_fmus.calibration import calibrate
 
 out = ROOT / "out" / "recipes" / "calibrate_dmsp40"
 summary = calibrate(ROOT / "data" / "festo" / "festo_dmsp40.csv", length=0.4, diameter=0.04,
@@ -28,8 +23,8 @@ assert summary["fmu_max_force_difference_n"] < 1e-9, "the FMU must reproduce the
 
 # The fitted parameters are FMPy start values as they are: the force at 300 kPa and 10% contraction.
 params = json.loads((out / "params.json").read_text())
-r = simulate_fmu(str(FMU), start_values={**params, "pressure": 3e5, "length": 0.4 * 0.9}, stop_time=0.001,
-                 output=["force", "contraction"])
+r = simulate("McKibbenMuscle", start_values={**params, "pressure": 3e5, "length": 0.4 * 0.9}, stop_time=0.001,
+             output=["force", "contraction"])
 print(f"McKibbenMuscle with params.json at 300 kPa, {100 * r['contraction'][-1]:.0f}% contraction: "
       f"{r['force'][-1]:.0f} N (datasheet, 300 kPa: 2084 N at 6%, 1000 N at 16%)")
 print(f"report: {out / 'report.md'}")

@@ -1,13 +1,12 @@
 """Recipe: a design sweep on a real Dask cluster, started as separate processes on loopback.
 
 It starts `dask scheduler` and two `dask worker` processes on 127.0.0.1 (as you would on a
-cluster, one command per machine), runs a small version of examples/sweep_dask.py's sweep
+cluster, one command per machine), runs a small version of `actuator-fmus sweep`
 (bladder pre-strain x wall thickness -> net work per stroke of Table 2.1's muscle A at 690 kPa,
 thick wall, eq. 2.19-2.20) through `--scheduler`, and stops the processes it started, also on
 failure. The FMU travels to the workers as bytes, so they need no shared file system.
 Run after `make fmus`: .venv/bin/python recipes/dask_sweep_real_scheduler.py
 """
-import importlib.util
 import math
 import socket
 import subprocess
@@ -34,10 +33,7 @@ def wait_for_workers(address, n, timeout=120.0):
 
 
 def main():
-    spec = importlib.util.spec_from_file_location("sweep_dask", ROOT / "examples" / "sweep_dask.py")
-    sweep_dask = importlib.util.module_from_spec(spec)
-    sys.modules["sweep_dask"] = sweep_dask
-    spec.loader.exec_module(sweep_dask)
+    from actuator_fmus import sweep as sweep_dask
 
     port = free_port()
     address = f"tcp://127.0.0.1:{port}"

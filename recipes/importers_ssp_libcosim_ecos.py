@@ -5,10 +5,9 @@ All three read the same .ssp file; the script prints the joint angle every 0.5 s
 checks that they agree at the times where each master stopped: libcosim keeps time in whole
 nanoseconds, ecos adds the steps up in floating point and may stop one step off. All three pass
 every output to the inputs at the same instant, so they lag a sequential co-simulation
-(examples/robot_joint.py) by one 1 ms step. Run after `make fmus`:
+(`actuator-fmus robot-joint`) by one 1 ms step. Run after `make fmus`:
 .venv/bin/python recipes/importers_ssp_libcosim_ecos.py
 """
-import importlib.util
 import sys
 import tempfile
 from pathlib import Path
@@ -20,9 +19,7 @@ STEP = 1e-3  # s
 STOP = 4.0  # s
 SAMPLES = np.arange(0.5, STOP + 1e-9, 0.5)
 
-spec = importlib.util.spec_from_file_location("systems_build", ROOT / "systems" / "build.py")
-systems = importlib.util.module_from_spec(spec)
-spec.loader.exec_module(systems)
+from actuator_fmus import systems  # noqa: E402
 
 
 def with_fmpy(ssp):

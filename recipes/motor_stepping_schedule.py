@@ -2,21 +2,20 @@
 
 Two ways, which must agree:
 
-1. the built-in schedule (`schedule` = 1): every `step_period` the strain direction turns by
+1. the built-in schedule (`schedule` = 1, `stepping_schedule`): every `step_period` the strain direction turns by
    `step_angle` at `stress_amplitude`, starting from `schedule_initial_direction` (-30 degrees);
-2. your own schedule through the inputs (`schedule` = 0): `strain_direction` and `stress` as a
+2. your own schedule through the inputs (`schedule` = 0, `inputs`): `strain_direction` and `stress` as a
    piecewise-constant input signal, here the same -30, 30, 90, ... degrees at 200 MPa.
 
 Uniaxial stress has 180-degree symmetry, so a 60-degree step makes the next energy minimum unique
 (+60, not -120): 12 steps turn the rotor two full turns. Run after `make fmus`:
 .venv/bin/python recipes/motor_stepping_schedule.py
 """
-from pathlib import Path
-
 import numpy as np
-from fmpy import simulate_fmu
 
-FMU = str(Path(__file__).resolve().parents[1] / "target" / "fmu" / "MultiferroicMotor.fmu")
+from actuator_fmus import simulate  # FMPy's simulate_fmu with names and ranges checked first
+
+FMU = "MultiferroicMotor"
 PERIOD = 100e-6  # s
 STEPS = 12
 STRESS = 200e6  # Pa
@@ -30,11 +29,11 @@ def ends_of_periods(result):
     return np.degrees(result["rotor_angle"][idx])
 
 
-built_in = simulate_fmu(FMU, start_values={"schedule": 1, "step_period": PERIOD,
-                                           "step_angle": STEP, "stress_amplitude": STRESS,
-                                           "schedule_initial_direction": FIRST},
-                        stop_time=STEPS * PERIOD, output_interval=PERIOD / 50,
-                        output=["rotor_angle", "applied_strain_direction"])
+built_in = simulate(FMU, start_values={"schedule": "stepping_schedule", "step_period": PERIOD,
+                                       "step_angle": STEP, "stress_amplitude": STRESS,
+                                       "schedule_initial_direction": FIRST},
+                    stop_time=STEPS * PERIOD, output_interval=PERIOD / 50,
+                    output=["rotor_angle", "applied_strain_direction"])
 
 # FMPy interpolates continuous inputs linearly between rows; a repeated time stamp is a jump.
 switches = np.arange(1, STEPS) * PERIOD
@@ -45,8 +44,9 @@ signal = np.zeros(len(times), dtype=[("time", float), ("strain_direction", float
 signal["time"] = times
 signal["strain_direction"] = FIRST + STEP * level
 signal["stress"] = STRESS
-own = simulate_fmu(FMU, start_values={"schedule": 0}, input=signal, stop_time=STEPS * PERIOD,
-                   output_interval=PERIOD / 50, output=["rotor_angle", "applied_strain_direction"])
+# Inputs without a column (here `strain`) are held at their start values.
+own = simulate(FMU, start_values={"schedule": "inputs"}, input=signal, stop_time=STEPS * PERIOD,
+               output_interval=PERIOD / 50, output=["rotor_angle", "applied_strain_direction"])
 
 a, b = ends_of_periods(built_in), ends_of_periods(own)
 print(f"MultiferroicMotor, {STEPS} steps of 60 degrees every {PERIOD * 1e6:g} us at {STRESS / 1e6:g} MPa")

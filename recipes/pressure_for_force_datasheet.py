@@ -3,24 +3,18 @@ simulating the muscle at that pressure.  Run after `make fmus`:
     .venv/bin/python recipes/pressure_for_force_datasheet.py
 """
 
-import pathlib
-import sys
+from actuator_fmus import pressure_for_force, simulate
 
-sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1]))
-from fmpy import simulate_fmu  # noqa: E402
-
-from calibration.inverse import FMU, pressure_for_force  # noqa: E402
-
-DMSP_40 = {"preset": 6}  # fitted to the datasheet, nominal length 0.4 m
-NOMINAL = 0.4
+DMSP_40 = {"preset": "DMSP_40"}  # fitted to the datasheet, nominal length 0.4 m
+NOMINAL = 0.4  # m
 
 length = NOMINAL * (1 - 0.10)
-p, saturated = pressure_for_force(2000.0, length, DMSP_40)
+p, saturated = pressure_for_force(2000.0, length, DMSP_40)  # Pa, and whether out of reach
 print(f"DMSP-40 at 10% contraction pulls 2000 N at {p / 1e3:.2f} kPa (out of reach: {saturated})")
 
 # Check: the forward model at that pressure.
-r = simulate_fmu(str(FMU), start_values={**DMSP_40, "pressure": p, "length": length}, stop_time=0.001,
-                 output=["force"])
+r = simulate("McKibbenMuscle", start_values={**DMSP_40, "pressure": p, "length": length}, stop_time=0.001,
+             output=["force"])
 print(f"forward check: force at {p / 1e3:.2f} kPa = {r['force'][-1]:.6f} N")
 assert not saturated and abs(r["force"][-1] - 2000.0) < 1e-6 * 2000.0
 

@@ -27,9 +27,6 @@ pub struct MultiferroicMotor {
     state: MotorState,
     /// Largest magnitude of the ring's torque on the bar (N m), for [`Self::implausible`].
     max_torque: f64,
-    /// Whether the accuracy warning was logged: it is logged once per run, later limited steps
-    /// only return `fmi2Warning` (a 1 s step over thousands of switches is limited every time).
-    accuracy_warned: bool,
     /// Model Exchange's discrete states (see [`model_exchange`]).
     me: model_exchange::Discrete,
 }
@@ -157,7 +154,6 @@ impl Model for MultiferroicMotor {
     fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
         Motor::validate_state(&saved.state).map_err(|e| format!("motor state: {e}"))?;
         self.state = saved.state;
-        self.accuracy_warned = saved.accuracy_warned;
         self.me = saved.me.validated()?;
         Ok(())
     }
@@ -220,7 +216,6 @@ impl Model for MultiferroicMotor {
             },
             max_torque: motor.ring_bar.max_torque().1.abs(),
             motor,
-            accuracy_warned: false,
             me: model_exchange::Discrete::default(),
         })
     }
@@ -372,20 +367,15 @@ impl Model for MultiferroicMotor {
             Ok(r) => {
                 self.state = next;
                 write_outputs(outputs, &r.outputs);
+                // Every warning is logged: a master that sees fmi2Warning can always say why.
                 if r.accuracy_limited {
-                    if self.accuracy_warned {
-                        report.raise(Status::Warning);
-                    } else {
-                        report.warn(format!(
-                            "the step from t = {time} s by {step} s was completed beyond tolerance \
-                             = {} rad (its substep budget max_substeps = {} ran out, or a slipping \
-                             rotor or the Gilbert onion model was advanced over many periods at \
-                             once); shorten the step or raise max_substeps where this matters \
-                             (logged once per run)",
-                            self.motor.params.tolerance, self.motor.params.max_substeps
-                        ));
-                        self.accuracy_warned = true;
-                    }
+                    report.warn(format!(
+                        "the step from t = {time} s by {step} s was completed beyond tolerance \
+                         = {} rad (its substep budget max_substeps = {} ran out, or a slipping \
+                         rotor or the Gilbert onion model was advanced over many periods at \
+                         once); shorten the step or raise max_substeps where this matters",
+                        self.motor.params.tolerance, self.motor.params.max_substeps
+                    ));
                 }
             }
             Err(e) => report.add(

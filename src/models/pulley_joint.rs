@@ -2,7 +2,7 @@
 //!
 //! Muscle forces in; the pendulum joint `I q'' = r (F_f - F_e) - c q' - m g l sin q`, stepped by
 //! semi-implicit Euler with the forces held over the communication step (the same update as
-//! `examples/robot_joint.py`); out come the muscle lengths `L0 -/+ r q` and the PD pressure
+//! `python/actuator_fmus/robot_joint.py`); out come the muscle lengths `L0 -/+ r q` and the PD pressure
 //! commands for the next step, so that two McKibbenMuscle FMUs wired to it by plain connections
 //! (SSP, container FMU) close the loop. Rigid-body mechanics and a controller, no dissertation
 //! physics: it lives here rather than in `src/physics/`. With `external_pressures` the controller is
@@ -60,7 +60,7 @@ impl Params {
             && (self.rest_length + self.moment_arm * q).is_finite()
     }
 
-    /// Quintic moves between the waypoints, as `reference` in examples/robot_joint.py.
+    /// Quintic moves between the waypoints, as `reference` in python/actuator_fmus/robot_joint.py.
     fn reference(&self, t: f64) -> (f64, f64) {
         let (w, period) = (&self.waypoints, self.segment_time);
         let k = if t.is_finite() && t > 0.0 {

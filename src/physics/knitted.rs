@@ -77,9 +77,9 @@ impl KnittedParams {
         if !(n.is_finite() && (1.0..=1e7).contains(&n)) {
             return Err(format!("rows must be in [1, 1e7], got {n}"));
         }
-        if !(s.is_finite() && s > 0.0 && s < 1e3) {
+        if !(s > 0.0 && s <= 1e3) {
             return Err(format!(
-                "row_strand_length must be positive and below 1 km, got {s} m"
+                "row_strand_length must be positive and at most 1 km, got {s} m"
             ));
         }
         if !(t.is_finite() && t >= 0.0) {
@@ -148,8 +148,9 @@ impl KnittedSleeve {
         let c_min = 2.0 * PI * r_min;
         if c_min >= s {
             return Err(format!(
-                "minimum circumference {c_min} m (strand thickness or bladder) is not shorter than \
-                 row_strand_length {s} m: the sleeve cannot extend"
+                "minimum circumference {c_min} m (4 stitches_per_row strand_thickness, or the \
+                 bladder's outer circumference) is not shorter than row_strand_length {s} m: the \
+                 sleeve cannot extend"
             ));
         }
         let l_min = params.min_length_thickness();

@@ -25,9 +25,9 @@ pub struct Bag {
 impl Bag {
     /// `diameter` (m) > 0; `membrane_stiffness` (N/m) > 0, or 0 for inextensible.
     pub fn new(diameter: f64, membrane_stiffness: f64) -> Result<Self, String> {
-        if !(diameter.is_finite() && diameter > 0.0 && diameter < 1e3) {
+        if !(diameter > 0.0 && diameter <= 1e3) {
             return Err(format!(
-                "bag_diameter must be positive and finite, got {diameter} m"
+                "bag_diameter must be positive and at most 1000 m, got {diameter} m"
             ));
         }
         if !(membrane_stiffness.is_finite() && membrane_stiffness >= 0.0) {

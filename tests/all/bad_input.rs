@@ -147,11 +147,14 @@ fn parse(xml: &str) -> (String, String, Vec<Var>, Option<String>) {
                     start: None,
                 });
             }
-            kind @ (b"Real" | b"Integer" | b"Boolean" | b"String") if in_variable => {
+            kind @ (b"Real" | b"Integer" | b"Enumeration" | b"Boolean" | b"String")
+                if in_variable =>
+            {
                 let v = vars.last_mut().unwrap();
                 v.kind = match kind {
                     b"Real" => Kind::Real,
-                    b"Integer" => Kind::Integer,
+                    // An Enumeration travels as an Integer.
+                    b"Integer" | b"Enumeration" => Kind::Integer,
                     b"Boolean" => Kind::Boolean,
                     _ => Kind::String,
                 };

@@ -426,13 +426,17 @@ fn steps_may_not_pass_the_stop_time() {
 /// A step takes our own clock (-0 for 0 too); a step whose end overflows is taken, after which
 /// every step is refused.
 #[test]
-fn the_clock_is_ours_to_the_bit_and_an_infinite_clock_stops_the_run() {
+fn the_clock_is_ours_to_the_bit_and_never_overflows() {
     let i = ready();
     assert_eq!(i.do_step(-0.0, 0.5), OK);
+    // 0.5 + MAX rounds to MAX: a finite end.
     assert_eq!(i.do_step(0.5, f64::MAX), OK);
-    assert_eq!(i.do_step(f64::MAX, f64::MAX), OK, "{:?}", i.log.lines());
+    // MAX + MAX overflows: refused, the clock stays finite.
+    assert_eq!(i.do_step(f64::MAX, f64::MAX), ERROR, "{:?}", i.log.lines());
+    assert!(i.log.contains("overflows to inf"), "{:?}", i.log.lines());
     assert_eq!(i.do_step(f64::INFINITY, 1.0), ERROR);
     assert!(i.log.contains("expected currentCommunicationPoint"));
+    assert_eq!(i.do_step(f64::MAX, 1.0), OK, "{:?}", i.log.lines());
 }
 
 #[test]

@@ -3,7 +3,9 @@
 //! range spans decades, the bounds themselves often). Each instance must either refuse
 //! initialization with a logged reason, or give finite Real outputs and calculated parameters after
 //! initialization and after every step (a step may be discarded, with a logged reason, keeping
-//! finite outputs). Every value inside the declared range must be accepted by the setters.
+//! finite outputs). Every value inside the declared range must be accepted by the setters, and
+//! each declared bound alone (every other value at its start) must initialize and step, or be
+//! refused for its combination with another variable, which the reason names.
 //! Prints how many cases ran (docs/compatibility.md quotes the count).
 
 use crate::common;
@@ -77,14 +79,14 @@ fn parse(xml: &str) -> Description {
                     attr("causality").unwrap_or_else(|| "local".into()),
                 ))
             }
-            tag @ (b"Real" | b"Integer" | b"Boolean") => {
+            tag @ (b"Real" | b"Integer" | b"Enumeration" | b"Boolean") => {
                 if let Some((name, vr, causality)) = current.take() {
                     d.vars.push(Var {
                         name,
                         vr,
                         kind: match tag {
                             b"Real" => Kind::Real,
-                            b"Integer" => Kind::Integer,
+                            b"Integer" | b"Enumeration" => Kind::Integer,
                             _ => Kind::Boolean,
                         },
                         causality,
@@ -195,6 +197,8 @@ struct Tally {
     refused: usize,
     steps: usize,
     discarded: usize,
+    /// The log of the last refused initialization.
+    last_refusal: String,
 }
 
 /// Steps per case (random cases draw fresh inputs for each), of this fraction of the default step size (the
@@ -241,6 +245,7 @@ fn run_case(
     // fmi2Warning: a clamped input under out_of_range_policy 1 or 2 (the outputs must be finite).
     if exit != OK && exit != WARNING {
         tally.refused += 1;
+        tally.last_refusal = i.log.lines().join(" | ");
         return (exit != ERROR || i.log.lines().is_empty())
             .then(|| format!("initialization returned {exit} without a reason"));
     }
@@ -367,7 +372,31 @@ fn every_value_in_the_declared_ranges_gives_finite_outputs_or_a_reason() {
             // Random cases draw new inputs every step; a bound alone keeps the start inputs (a
             // substep budget of 1e8 with extreme inputs would run for hours, as asked).
             let redraw = label.starts_with("random").then_some(&mut rng);
-            let failure = run_case(&api, &d, values, redraw, &mut tally);
+            let refused_before = tally.refused;
+            let mut failure = run_case(&api, &d, values, redraw, &mut tally);
+            // A bound alone (every other value at its start) is a point of the declared space
+            // that must run: a bound the model cannot meet is declared wrongly. A bound refused
+            // for its combination with another variable (the bar must fit inside the ring)
+            // names that variable: that is a reason, not a wrong range.
+            let bound_of = label.split(' ').next().unwrap_or_default();
+            let names_another = settable.iter().any(|v| {
+                v.name != bound_of
+                    && tally
+                        .last_refusal
+                        .split(|c: char| !(c.is_alphanumeric() || c == '_'))
+                        .any(|word| word == v.name)
+            });
+            if failure.is_none()
+                && !label.starts_with("random")
+                && tally.refused > refused_before
+                && !names_another
+            {
+                failure = Some(format!(
+                    "a declared bound alone was refused for a reason that names no other \
+                     variable: {}",
+                    tally.last_refusal
+                ));
+            }
             if let Some(f) = failure {
                 failures.push(format!("{model} {label} {values:?}: {f}"));
             }

@@ -18,6 +18,8 @@ mod c_abi;
 mod declared_ranges;
 mod fmi_crate;
 mod fuzz_corpus;
+mod glibc_versions;
+mod lifecycle_checks;
 mod motor_c_abi;
 mod new_model;
 mod restore_validation;

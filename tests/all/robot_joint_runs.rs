@@ -1,5 +1,5 @@
 //! The robot joint through the `fmi` crate gives the trajectory that FMPy gives: the committed
-//! reference `tests/data/robot_joint_ref.csv` was written by `examples/robot_joint.py` (FMPy's
+//! reference `tests/data/robot_joint_ref.csv` was written by `python/actuator_fmus/robot_joint.py` (FMPy's
 //! FMU2Slave), and `tests/fmpy/test_robot_joint.py` checks FMPy against the same file.
 
 use crate::common;

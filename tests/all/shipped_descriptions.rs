@@ -274,6 +274,66 @@ fn every_output_and_initial_unknown_declares_its_dependencies() {
     }
 }
 
+/// Enumerations: named items with consecutive values, a variable names its type, and its start,
+/// min and max are item values; the generator sees an Integer with the items' range.
+#[test]
+fn enumerations_are_checked_and_travel_as_integers() {
+    let m = check(SOURCE, "McKibbenMuscle").unwrap();
+    let preset = m.variables.iter().find(|v| v.name == "preset").unwrap();
+    assert_eq!(model_description::TYPES[preset.type_index], "Integer");
+    assert_eq!(
+        (preset.min.as_deref(), preset.max.as_deref()),
+        (Some("0"), Some("6"))
+    );
+    // Without min and max the items give them.
+    let effective = m
+        .variables
+        .iter()
+        .find(|v| v.name == "effective_bladder_model")
+        .unwrap();
+    assert_eq!(
+        (effective.min.as_deref(), effective.max.as_deref()),
+        (Some("0"), Some("6"))
+    );
+    let policy = r#"<Enumeration declaredType="OutOfRangePolicy" min="0" max="2" start="0"/>"#;
+    refused(
+        &edited(policy, r#"<Enumeration min="0" max="2" start="0"/>"#),
+        "an Enumeration needs a declaredType",
+    );
+    refused(
+        &edited(policy, r#"<Enumeration declaredType="Policy" start="0"/>"#),
+        "declaredType 'Policy' is not an Enumeration in TypeDefinitions",
+    );
+    refused(
+        &edited(
+            policy,
+            r#"<Enumeration declaredType="OutOfRangePolicy" start="3"/>"#,
+        ),
+        "start '3' is not an item value (0 .. 2)",
+    );
+    refused(
+        &edited(
+            r#"<Item name="warning" value="1""#,
+            r#"<Item name="warning" value="5""#,
+        ),
+        "item 'warning' has value 5, expected 1",
+    );
+    refused(
+        &edited(
+            r#"<Item name="warning" value="1""#,
+            r#"<Item name="ok" value="1""#,
+        ),
+        "item 'ok' appears twice",
+    );
+    refused(
+        &edited(
+            r#"<Integer min="1" max="4096" start="16"/>"#,
+            r#"<Integer declaredType="OutOfRangePolicy" min="1" max="4096" start="16"/>"#,
+        ),
+        "declaredType is supported for Enumerations only",
+    );
+}
+
 #[test]
 fn the_export_layer_part_stays_out_of_the_source() {
     refused(
@@ -430,8 +490,13 @@ mod rules {
             "min 10 is above max 1",
         );
         broken(
-            r#"<Integer min="0" max="2" start="0"/>"#,
-            r#"<Integer min="1" max="2" start="0"/>"#,
+            r#"<Integer min="1" max="4096" start="16"/>"#,
+            r#"<Integer min="20" max="4096" start="16"/>"#,
+            "start 16 is outside",
+        );
+        broken(
+            r#"<Enumeration declaredType="BladderModel" min="0" max="6" start="0"/>"#,
+            r#"<Enumeration declaredType="BladderModel" min="1" max="6" start="0"/>"#,
             "start 0 is outside",
         );
         broken(

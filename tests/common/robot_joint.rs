@@ -1,4 +1,4 @@
-//! The robot-joint co-simulation of `examples/robot_joint.py`, through the `fmi` crate: the same
+//! The robot-joint co-simulation of `python/actuator_fmus/robot_joint.py`, through the `fmi` crate: the same
 //! parameters (`examples/robot_joint.json`), the same controller and the same semi-implicit Euler
 //! step, operation for operation, so both importers give the same trajectory to rounding.
 

@@ -8,7 +8,9 @@
  *   R vr value | I vr value | B vr value   set a Real, Integer or Boolean
  *   X                                      exit initialization mode (entered at start)
  *   S h                                    fmi2DoStep from the current time by h
- *   G vr ...                               print the Reals (one line)
+ *   G vr ... [; vr ... [; vr ...]]         print Reals [; Integers [; Booleans]] (one line)
+ *   D unknown known                        print the directional derivative, seed 1
+ *   F | L                                  save the FMU state | restore it (and its time)
  *   N                                      a fresh instance (the old one terminated and freed)
  * Exits 1 on fmi2Discard or worse, after printing the call and status; a warning (logged on
  * stderr) lets the run go on, since the transcripts compare numbers. */
@@ -85,6 +87,15 @@ int main(int argc, char **argv) {
     int (*set_boolean)(Component, const unsigned *, size_t, const int *) =
         symbol("fmi2SetBoolean");
     int (*get_real)(Component, const unsigned *, size_t, double *) = symbol("fmi2GetReal");
+    int (*get_integer)(Component, const unsigned *, size_t, int *) = symbol("fmi2GetInteger");
+    int (*get_boolean)(Component, const unsigned *, size_t, int *) = symbol("fmi2GetBoolean");
+    int (*get_state)(Component, void **) = symbol("fmi2GetFMUstate");
+    int (*set_state)(Component, void *) = symbol("fmi2SetFMUstate");
+    int (*free_state)(Component, void **) = symbol("fmi2FreeFMUstate");
+    int (*derivative)(Component, const unsigned *, size_t, const unsigned *, size_t,
+                      const double *, double *) = symbol("fmi2GetDirectionalDerivative");
+    void *state = NULL;
+    double saved_time = 0.0;
     int (*do_step)(Component, double, double, int) = symbol("fmi2DoStep");
     int (*terminate)(Component) = symbol("fmi2Terminate");
     void (*free_instance)(Component) = symbol("fmi2FreeInstance");
@@ -124,6 +135,7 @@ int main(int argc, char **argv) {
             time += x;
             break;
         case 'N':
+            if (state) check("fmi2FreeFMUstate", free_state(c, &state));
             check("fmi2Terminate", terminate(c));
             free_instance(c);
             c = instantiate("harness", 1, argv[2], NULL, &callbacks, 0, 0);
@@ -135,18 +147,52 @@ int main(int argc, char **argv) {
             check("fmi2EnterInitializationMode", enter(c));
             time = 0.0;
             break;
-        case 'G':
-            while (sscanf(p, "%u%n", &vr, &n) == 1) {
+        case 'G': {
+            /* Reals, then after ';' Integers, then after another ';' Booleans. */
+            int section = 0;
+            for (;;) {
+                while (*p == ' ') p++;
+                if (*p == ';') {
+                    section++;
+                    p++;
+                    continue;
+                }
+                if (sscanf(p, "%u%n", &vr, &n) != 1) break;
                 p += n;
-                check("fmi2GetReal", get_real(c, &vr, 1, &x));
-                printf("%.17g ", x);
+                if (section == 0) {
+                    check("fmi2GetReal", get_real(c, &vr, 1, &x));
+                    printf("%.17g ", x);
+                } else {
+                    check(section == 1 ? "fmi2GetInteger" : "fmi2GetBoolean",
+                          (section == 1 ? get_integer : get_boolean)(c, &vr, 1, &k));
+                    printf("%d ", k);
+                }
             }
             printf("\n");
+            break;
+        }
+        case 'D': {
+            /* d unknown / d known with seed 1. */
+            unsigned known;
+            double seed = 1.0;
+            sscanf(p, "%u %u", &vr, &known);
+            check("fmi2GetDirectionalDerivative", derivative(c, &vr, 1, &known, 1, &seed, &x));
+            printf("%.17g\n", x);
+            break;
+        }
+        case 'F':
+            check("fmi2GetFMUstate", get_state(c, &state));
+            saved_time = time;
+            break;
+        case 'L':
+            check("fmi2SetFMUstate", set_state(c, state));
+            time = saved_time;
             break;
         default:
             break;
         }
     }
+    if (state) check("fmi2FreeFMUstate", free_state(c, &state));
     check("fmi2Terminate", terminate(c));
     free_instance(c);
     return 0;

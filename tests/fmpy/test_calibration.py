@@ -4,15 +4,13 @@ presets, their read-back and the contraction output, all through McKibbenMuscle.
 import csv
 import json
 import subprocess
-import sys
 
 import numpy as np
 import pytest
 
 from conftest import ROOT, Slave, fmu_path
 
-sys.path.insert(0, str(ROOT))
-from calibration.calibrate import calibrate  # noqa: E402
+from actuator_fmus.calibration import calibrate  # noqa: E402
 
 DATA = ROOT / "data" / "festo"
 DMSP_10, DMSP_40 = 5, 6

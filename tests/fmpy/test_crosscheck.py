@@ -1,4 +1,4 @@
-"""Every FMU ships FMI cross-check files (crosscheck/<Model>/, written by crosscheck/generate.py):
+"""Every FMU ships FMI cross-check files (crosscheck/<Model>/, written by `actuator-fmus crosscheck`):
 they pass FMPy's cross-check validator, and re-simulating <Model>_in.csv under FMPy with the
 settings of <Model>_ref.opt reproduces <Model>_ref.csv."""
 

@@ -17,7 +17,6 @@ import pytest
 from fmpy import extract, read_model_description
 from fmpy.fmi2 import FMU2Slave
 
-sys.path.insert(0, __import__("os").path.dirname(__file__))
 from conftest import ROOT, fmu_path  # noqa: E402
 
 def parse_values(text):

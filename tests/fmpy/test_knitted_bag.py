@@ -1,17 +1,15 @@
 """The figures docs/knitted-bag.md states (section 1.4's polyethylene bag), measured again
-through FMPy with the functions of examples/knitted_bag.py that generate it."""
+through FMPy with the functions of actuator_fmus.knitted_bag that generate it."""
 
 import math
-import sys
 
 import numpy as np
 import pytest
 from fmpy import simulate_fmu
 
-from conftest import ROOT, fmu_path
+from conftest import fmu_path
 
-sys.path.insert(0, str(ROOT / "examples"))
-import knitted_bag as kb  # noqa: E402
+from actuator_fmus import knitted_bag as kb  # noqa: E402
 
 FMU = fmu_path("KnittedMuscle")
 

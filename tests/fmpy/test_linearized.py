@@ -1,17 +1,15 @@
-"""The linearized-muscle page's claims (docs/linearized/generate.py), on a small grid: the stiffness
+"""The linearized-muscle page's claims (actuator_fmus.linearized), on a small grid: the stiffness
 read through fmi2GetDirectionalDerivative is the FMU's own `stiffness` output (friction off), it is
 affine in pressure at each length while the bladder is in contact (the page's K1 (P - P0)), and the
 threshold pressure is not where that stiffness vanishes."""
 
 import pathlib
-import sys
 
 import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "docs" / "linearized"))
-import generate  # noqa: E402
+from actuator_fmus import linearized as generate  # noqa: E402
 
 
 @pytest.mark.parametrize("name", ["A", "D"])

@@ -2,7 +2,6 @@
 actuatorInput, jointPosition and jointVelocity, calls doStep and reads jointTorque. The torque
 must be r (F_flexor - F_extensor) of two McKibbenMuscle FMUs at the same pressures and lengths."""
 
-import importlib.util
 import math
 
 import numpy as np
@@ -109,9 +108,8 @@ def test_refuses_a_common_mode_above_the_supply(recording_log):
 def test_robot_joint_with_the_joint_fmu_reproduces_the_two_muscle_trajectory():
     """The robot-joint example's pendulum with McKibbenJoint in place of two McKibbenMuscle FMUs,
     stepped like a robot simulator: the committed trajectory to 1e-9 rad."""
-    spec = importlib.util.spec_from_file_location("robot_joint", ROOT / "examples" / "robot_joint.py")
-    rj = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(rj)
+    from actuator_fmus import robot_joint as rj
+
     p = rj.load_parameters()
     joint = Slave("McKibbenJoint", moment_arm=p["moment_arm"], flexor_rest_length=p["rest_length"],
                   extensor_rest_length=p["rest_length"], common_mode_pressure=p["common_mode_pressure"],

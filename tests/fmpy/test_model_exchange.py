@@ -6,7 +6,6 @@ the runs are compared with that one-sample shift. The friction history is commit
 completed integrator step, so the agreement is exact up to rounding."""
 
 import pathlib
-import sys
 
 import numpy as np
 import pytest
@@ -16,8 +15,7 @@ from fmpy.validation import validate_fmu
 from conftest import fmu_path
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scenes"))
-import run as scenes  # noqa: E402
+from actuator_fmus import scene as scenes  # noqa: E402
 
 SHIPPED = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
 # The models without continuous states (no `derivative` attribute in their description): their

@@ -1,15 +1,11 @@
 """The figures docs/motor.md states, measured again through FMPy with the functions of
-examples/motor_characteristics.py that generate it."""
+actuator_fmus.motor that generate it."""
 
 import math
-import sys
 
 import pytest
 
-from conftest import ROOT
-
-sys.path.insert(0, str(ROOT / "examples"))
-import motor_characteristics as mc  # noqa: E402
+from actuator_fmus import motor as mc
 
 
 @pytest.fixture(scope="module")

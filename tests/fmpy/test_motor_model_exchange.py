@@ -88,7 +88,6 @@ def test_motor_torque_sensitivity_is_nonzero_where_the_physics_says():
 # --- Model Exchange against Co-Simulation on the motor's catalogue scenes --------------------------
 
 import pathlib  # noqa: E402
-import sys  # noqa: E402
 import time  # noqa: E402
 
 import numpy as np  # noqa: E402
@@ -97,8 +96,7 @@ from fmpy import read_model_description, simulate_fmu  # noqa: E402
 from conftest import fmu_path  # noqa: E402
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scenes"))
-import run as scenes  # noqa: E402
+from actuator_fmus import scene as scenes  # noqa: E402
 
 MOTOR_SCENES = [p for p in sorted((ROOT / "scenes").glob("*.json")) if scenes.load_scene(p)["fmu"] == "MultiferroicMotor"]
 ANGLE_TOLERANCE = np.radians(0.1)

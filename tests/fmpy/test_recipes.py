@@ -1,5 +1,6 @@
 """Every recipe in recipes/ runs from the repository root and exits 0 (each asserts its own
-results). docs/recipes.md explains them; this test keeps them working."""
+results) without printing a warning. docs/recipes.md explains them; this test keeps them working."""
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -23,3 +24,6 @@ def test_recipe_runs(recipe):
                          capture_output=True, text=True, timeout=600)
     assert run.returncode == 0, f"{recipe.name} exited {run.returncode}\n{run.stdout}\n{run.stderr}"
     assert run.stdout.strip(), f"{recipe.name} printed nothing"
+    # A recipe a user copies must not teach them to ignore warnings: none is printed.
+    noise = [line for line in (run.stdout + run.stderr).splitlines() if re.search(r"Warning\b", line)]
+    assert not noise, f"{recipe.name} warns:\n" + "\n".join(noise)

@@ -1,18 +1,16 @@
-"""The robot joint under FMPy's FMU2Slave (examples/robot_joint.py) reproduces the committed
+"""The robot joint under FMPy's FMU2Slave (`actuator-fmus robot-joint`) reproduces the committed
 trajectory tests/data/robot_joint_ref.csv, which tests/all/robot_joint_runs.rs checks the `fmi` crate
 against: both importers give the same trajectory."""
 
-import importlib.util
 import math
 
 from conftest import ROOT
 
 
 def _example():
-    spec = importlib.util.spec_from_file_location("robot_joint", ROOT / "examples" / "robot_joint.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    from actuator_fmus import robot_joint
+
+    return robot_joint
 
 
 def test_fmpy_matches_the_reference_trajectory():

@@ -10,8 +10,7 @@ import numpy as np
 import pytest
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-sys.path.insert(0, str(ROOT / "scenes"))
-import run as scenes  # noqa: E402
+from actuator_fmus import scene as scenes  # noqa: E402
 
 SCENES = sorted((ROOT / "scenes").glob("*.json"))
 
@@ -64,9 +63,10 @@ def test_a_misspelt_or_mistyped_field_is_refused_with_its_path(tmp_path):
     for line in ["inputs.length.form: unknown field", "step: '0.01' is not of type 'number'",
                  "plot.y_limit: unknown field", "checks[0].kind: 'zero' is not one of"]:
         assert line in text, text
-    run = subprocess.run([sys.executable, str(ROOT / "scenes" / "run.py"), str(path)],
+    run = subprocess.run([sys.executable, "-m", "actuator_fmus.cli", "scene", str(path)],
                          capture_output=True, text=True)
     assert run.returncode == 2 and "inputs.length.form: unknown field" in run.stderr
+    assert len(run.stderr.strip().splitlines()) == 1 and "Traceback" not in run.stderr, run.stderr
 
 
 def test_the_shipped_schema_accepts_every_catalogue_scene():

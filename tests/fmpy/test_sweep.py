@@ -1,22 +1,18 @@
-"""The Dask design sweep (examples/sweep_dask.py) on a small local cluster: its net work per stroke
+"""The Dask design sweep (`actuator-fmus sweep`) on a small local cluster: its net work per stroke
 is the one examples/mckibben_muscles.py reports for Table 2.1's muscle A, and the grid comes back
 complete through the scheduler, with the numbers of a run in this process."""
 
-import importlib.util
 import math
-import sys
 
 import pytest
 
-from conftest import FMU_DIR, ROOT
+from conftest import FMU_DIR
 
 
 def _sweep_module():
-    spec = importlib.util.spec_from_file_location("sweep_dask", ROOT / "examples" / "sweep_dask.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["sweep_dask"] = module  # the sweep ships its own module to the workers by value
-    spec.loader.exec_module(module)
-    return module
+    from actuator_fmus import sweep
+
+    return sweep
 
 
 def test_net_work_of_muscle_a_matches_the_work_table():

@@ -2,9 +2,8 @@
 plain connections, run as an SSP by fmpy.ssp.simulation.simulate_ssp and as a container FMU built
 by fmu-manipulation-toolbox. Both couple the FMUs Jacobi-style (every FMU steps with its inputs
 from the previous exchange), so the muscle forces reach the joint one step later than in
-examples/robot_joint.py (Gauss-Seidel): the trajectories agree closely, not to rounding."""
+`actuator-fmus robot-joint` (Gauss-Seidel): the trajectories agree closely, not to rounding."""
 
-import importlib.util
 import math
 
 import numpy as np
@@ -17,15 +16,8 @@ from conftest import ROOT
 STEP = 1e-3
 
 
-def _module(name, path):
-    spec = importlib.util.spec_from_file_location(name, path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+from actuator_fmus import robot_joint, systems
 
-
-systems = _module("systems_build", ROOT / "systems" / "build.py")
-robot_joint = _module("robot_joint", ROOT / "examples" / "robot_joint.py")
 REFERENCE = np.array(robot_joint.read_csv(ROOT / "tests" / "data" / "robot_joint_ref.csv")[1])
 PARAMS = robot_joint.load_parameters()
 

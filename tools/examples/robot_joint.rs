@@ -1,4 +1,4 @@
-//! The robot joint of `examples/robot_joint.py` through the `fmi` crate: two McKibbenMuscle
+//! The robot joint of `python/actuator_fmus/robot_joint.py` through the `fmi` crate: two McKibbenMuscle
 //! instances on a pulley, the same controller and integrator, parameters from
 //! `examples/robot_joint.json`. Writes `out/robot_joint_fmi.csv`, and runs the same loop with
 //! the McKibbenJoint FMU in place of the two muscles (`out/robot_joint_joint_fmu.csv`):

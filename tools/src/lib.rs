@@ -3,6 +3,7 @@
 //! offline calibration fit (`calibrate`).
 
 pub mod calibration;
+pub mod choices;
 pub mod package;
 pub mod scene;
 

@@ -53,7 +53,7 @@ fn package(
         .map_err(|e| format!("cannot create {}: {e}", partial.display()))?;
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    // A plot of the model's cross-check run (crosscheck/generate.py), shipped when present.
+    // A plot of the model's cross-check run (python/actuator_fmus/crosscheck.py), shipped when present.
     let plot_path = crate::repository_root()
         .join("docs/fmu")
         .join(format!("{}.png", info.name));
@@ -67,7 +67,8 @@ fn package(
             name = info.name
         ));
     }
-    let doc = documentation(info, &equations);
+    equations.insert_str(0, &choices_html(factory, info));
+    let doc = documentation(info, factory.model_exchange(), &equations);
     let mut entries: Vec<(String, &[u8])> = vec![
         (
             "modelDescription.xml".into(),
@@ -156,10 +157,75 @@ fn unit_text(unit: &str) -> String {
         .replace('3', "\u{b3}")
 }
 
-/// `documentation/index.html`: what the model is, its variables, the equations it implements.
-pub fn documentation(info: &ModelInfo, equations: &str) -> String {
+/// The page's named choices: a table per Enumeration type, and the values each preset gives.
+fn choices_html(factory: &dyn Factory, info: &ModelInfo) -> String {
+    let xml = info.model_description_xml;
+    let used_by = crate::choices::enumeration_variables(xml);
+    let mut html = String::new();
+    let enumerations = crate::choices::enumerations(xml);
+    if !enumerations.is_empty() {
+        html.push_str(
+            "<h2>Named choices</h2>\n<p>Enumeration types: an importer shows the names; the values \
+             travel as FMI Integers (fmi2SetInteger, FMPy start values by value or name).</p>\n",
+        );
+    }
+    for e in &enumerations {
+        let users: Vec<String> = used_by
+            .iter()
+            .filter(|(_, t)| *t == e.name)
+            .map(|(v, _)| format!("<code>{v}</code>"))
+            .collect();
+        html.push_str(&format!(
+            "<h3>{}</h3>\n<p>Used by {}.</p>\n<table><tr><th>value</th><th>name</th><th>meaning</th></tr>\n",
+            e.name,
+            users.join(", ")
+        ));
+        for (value, name, description) in &e.items {
+            html.push_str(&format!(
+                "<tr><td class=\"n\">{value}</td><td><code>{name}</code></td><td>{description}</td></tr>\n"
+            ));
+        }
+        html.push_str("</table>\n");
+    }
+    if let Some((parameters, presets)) = crate::choices::preset_values(factory, info) {
+        // One column per preset, one row per calculated parameter: the table stays narrow.
+        html.push_str(
+            "<h2>Presets</h2>\n<p>The calculated parameters with each <code>preset</code> and every \
+             other parameter at its start value, read from the model (SI units).</p>\n\
+             <table><tr><th>calculated parameter</th><th>unit</th>",
+        );
+        for (preset, _) in &presets {
+            html.push_str(&format!("<th><code>{preset}</code></th>"));
+        }
+        html.push_str("</tr>\n");
+        for (k, (name, unit)) in parameters.iter().enumerate() {
+            html.push_str(&format!(
+                "<tr><td><code>{name}</code></td><td>{}</td>",
+                unit_text(unit)
+            ));
+            for (_, values) in &presets {
+                let value = values.get(k).or(values.first()).map_or("", String::as_str);
+                html.push_str(&format!("<td class=\"n\">{}</td>", escape(value)));
+            }
+            html.push_str("</tr>\n");
+        }
+        html.push_str("</table>\n");
+    }
+    html
+}
+
+/// `documentation/index.html`: what the model is, its interfaces and variables, the equations it
+/// implements.
+pub fn documentation(info: &ModelInfo, model_exchange: bool, equations: &str) -> String {
+    let enumeration_of = crate::choices::enumeration_variables(info.model_description_xml);
     let mut rows = String::new();
     for v in info.variables {
+        let kind = enumeration_of
+            .iter()
+            .find(|(name, _)| name == v.name)
+            .map_or(format!("{:?}", v.kind), |(_, t)| {
+                format!("Enumeration ({t})")
+            });
         let range = match (v.min, v.max) {
             (None, None) => String::new(),
             (min, max) => format!(
@@ -169,11 +235,11 @@ pub fn documentation(info: &ModelInfo, equations: &str) -> String {
             ),
         };
         rows.push_str(&format!(
-            "<tr><td><code>{}</code></td><td>{:?}</td><td>{:?}</td><td>{:?}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>\n",
+            "<tr><td><code>{}</code></td><td>{:?}</td><td>{:?}</td><td>{}</td><td>{}</td><td class=\"n\">{}</td><td class=\"n\">{}</td><td>{}</td></tr>\n",
             v.name,
             v.causality,
             v.variability,
-            v.kind,
+            kind,
             unit_text(v.unit),
             start_text(v),
             range,
@@ -187,7 +253,7 @@ pub fn documentation(info: &ModelInfo, equations: &str) -> String {
          td,th{{border:1px solid #ccc;padding:0.2em 0.4em;vertical-align:top;text-align:left}}\
          td:first-child,td.n{{white-space:nowrap}}\
          img{{max-width:100%}}</style></head><body>\n\
-         <h1>{name}</h1>\n<p>{description}</p>\n<p>FMI 2.0 Co-Simulation, GUID <code>{guid}</code>.</p>\n\
+         <h1>{name}</h1>\n<p>{description}</p>\n<p>{interfaces}, GUID <code>{guid}</code>.</p>\n\
          <h2>Variables</h2>\n<p>Values in SI units; the model description holds them to full precision.</p>\n\
          <table><tr><th>name</th><th>causality</th><th>variability</th><th>type</th>\
          <th>unit</th><th>start</th><th>range</th><th>description</th></tr>\n{rows}</table>\n{equations}\n\
@@ -199,6 +265,11 @@ pub fn documentation(info: &ModelInfo, equations: &str) -> String {
         name = info.name,
         description = escape(info.description),
         guid = info.guid,
+        interfaces = if model_exchange {
+            "FMI 2.0 Co-Simulation and Model Exchange (one binary serves both)"
+        } else {
+            "FMI 2.0 Co-Simulation"
+        },
     )
 }
 

@@ -1,6 +1,6 @@
 //! Scene files (`scenes/*.json`): which FMU, which parameters and effects, the input signals, the
 //! communication step and stop time, the outputs to record, an optional sweep, the plot and the
-//! numbers to check against the dissertation. The FMPy runner (`scenes/run.py`) reads the same files;
+//! numbers to check against the dissertation. The FMPy runner (`actuator-fmus scene`) reads the same files;
 //! `examples/run_scene.rs` runs them through the `fmi` crate. The JSON Schema `scenes/schema/scene.schema.json`
 //! is generated from these types (`cargo run --release --example run_scene -- --schema`); a test
 //! keeps the shipped file equal to it. Unknown or mistyped fields are refused with their path.

@@ -5,10 +5,10 @@
 //!
 //! Every `unsafe` block below relies on the importer keeping the FMI 2.0 calling convention: a
 //! component from `fmi2Instantiate` (or NULL), arrays of the length it passes (or NULL), and
-//! NUL-terminated strings. `guarded` and the slice helpers check what can be checked (NULL,
-//! alignment, the instance's magic number, a NULL array of non-zero length).
+//! NUL-terminated strings. `guarded` and the slice helpers check what can be checked (the
+//! instance handle, `handles`; a NULL array of non-zero length).
 
-use super::instance::{Instance, MAGIC};
+use super::instance::Instance;
 use super::logger::Logger;
 use super::registry::REGISTRY;
 use super::types::*;
@@ -16,25 +16,13 @@ use std::ffi::{c_char, c_int, CStr};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
-/// The instance behind `c`, if `c` is a live instance of ours.
+/// The instance behind `c`, if `c` is the handle of a live instance of ours ([`handles`]).
 ///
 /// # Safety
-/// `c` must be NULL or a pointer returned by `fmi2Instantiate` (freed ones are caught by the magic
-/// number as long as the memory was not reused).
+/// No other reference to the instance may be alive (FMI 2.0: one call at a time per instance).
 unsafe fn instance<'a>(c: fmi2Component) -> Option<&'a mut Instance> {
-    let ptr = c as *mut Instance;
-    if ptr.is_null() {
-        return None;
-    }
-    // SAFETY: non-null; the caller promises it came from fmi2Instantiate. Read unaligned: the
-    // magic number's eight bytes have no period (tested), so a pointer 1-7 bytes off a live
-    // instance cannot read it and a misaligned pointer is refused without an alignment test.
-    let magic = unsafe { std::ptr::addr_of!((*ptr).magic).read_unaligned() };
-    if magic != MAGIC {
-        return None;
-    }
-    // SAFETY: a live instance of ours (the magic number matches).
-    Some(unsafe { &mut *ptr })
+    // SAFETY: a live instance of ours, owned by the handle table until fmi2FreeInstance.
+    handles::resolve(c).map(|ptr| unsafe { &mut *ptr })
 }
 
 fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
@@ -49,7 +37,7 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 /// logged and the instance becomes fatal, it never unwinds into the importer.
 ///
 /// # Safety
-/// As [`instance`]: `c` must be NULL or a pointer returned by `fmi2Instantiate`.
+/// As [`instance`].
 pub(super) unsafe fn guarded(
     c: fmi2Component,
     function: &str,
@@ -225,22 +213,37 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 ),
             }
         }
-        let mut instance = Instance::new(*factory, logger);
+        let mut instance = Box::new(Instance::new(*factory, logger));
         instance.model_exchange = model_exchange;
-        Some(Box::into_raw(Box::new(instance)) as fmi2Component)
+        let handle = handles::register(instance);
+        if handle.is_none() {
+            // The instance and its logger are gone; say why through the importer's callback.
+            Logger::new(
+                callbacks.logger,
+                callbacks.component_environment,
+                name.as_deref().unwrap_or("?"),
+            )
+            .log(
+                fmi2Status::Error,
+                &format!(
+                    "fmi2Instantiate: {} instances are alive in this process, the most it holds",
+                    handles::SLOTS
+                ),
+            );
+        }
+        handle
     });
     result.ok().flatten().unwrap_or(std::ptr::null_mut())
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2FreeInstance(c: fmi2Component) {
-    // SAFETY: `c` is NULL or from fmi2Instantiate; a live one came from Box::into_raw.
-    let Some(inst) = (unsafe { instance(c) }) else {
+    // A freed or unknown handle finds nothing: nothing is read, nothing freed.
+    let Some(inst) = handles::release(c) else {
         return;
     };
-    let ptr: *mut Instance = inst;
-    // Dropping clears the magic number and frees the instance's FMU states.
-    let _ = catch_unwind(AssertUnwindSafe(|| drop(unsafe { Box::from_raw(ptr) })));
+    // Dropping frees the instance's FMU states.
+    let _ = catch_unwind(AssertUnwindSafe(|| drop(inst)));
 }
 
 #[no_mangle]
@@ -312,6 +315,7 @@ pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
 }
 
 mod fmu_state;
+mod handles;
 mod model_exchange;
 #[cfg(test)]
 mod tests;

@@ -35,9 +35,9 @@ fn a_panic_is_logged_and_becomes_fatal() {
     };
     let env = &log as *const _ as *mut std::ffi::c_void;
     let instance = Instance::new(REGISTRY[0], Logger::new(Some(callback), env, "t"));
-    let c = Box::into_raw(Box::new(instance)) as fmi2Component;
+    let c = handles::register(Box::new(instance)).unwrap();
     assert_eq!(
-        // SAFETY: `c` is a live instance from Box::into_raw.
+        // SAFETY: `c` is a live instance's handle.
         unsafe { guarded(c, "fmi2Test", |_| panic!("boom")) },
         fmi2Status::Fatal
     );
@@ -53,36 +53,48 @@ fn a_panic_is_logged_and_becomes_fatal() {
     }
 }
 
+/// Handles of freed instances, handles a few bytes off a live one, and made-up values are refused
+/// without being read; a second free never reaches the instance that took the first one's place.
 #[test]
-fn the_magic_number_has_no_period() {
-    // What lets `instance` refuse a misaligned pointer by the magic number alone.
-    let bytes = MAGIC.to_le_bytes();
-    for shift in 1..8 {
-        assert_ne!(bytes[..8 - shift], bytes[shift..], "period {shift}");
-    }
-}
-
-#[test]
-fn a_pointer_off_a_live_instance_by_1_to_7_bytes_is_refused() {
-    let instance = Instance::new(REGISTRY[0], Logger::new(None, std::ptr::null_mut(), "t"));
-    let c = Box::into_raw(Box::new(instance)) as fmi2Component;
-    let (vr, mut value) = (0u32, 0.0);
+fn stale_and_made_up_handles_are_refused() {
+    let make = || {
+        let instance = Instance::new(REGISTRY[0], Logger::new(None, std::ptr::null_mut(), "t"));
+        handles::register(Box::new(instance)).unwrap()
+    };
+    let vr = 0u32;
+    let refused = |c: fmi2Component| unsafe {
+        // SAFETY: the calls must refuse `c` before anything is read through it.
+        let mut value = 0.0;
+        fmi2SetReal(c, &vr, 1, &value) == fmi2Status::Error
+            && fmi2DoStep(c, 0.0, 1e-3, 0) == fmi2Status::Error
+            && fmi2GetReal(c, &vr, 1, &mut value) == fmi2Status::Error
+            && fmi2Reset(c) == fmi2Status::Error
+    };
+    let first = make();
     for off in (1..8isize).flat_map(|k| [k, -k]) {
-        let bad = c.wrapping_byte_offset(off);
-        // SAFETY: `bad` lies within the live instance, so the magic number's read stays in it;
-        // the calls must refuse it before anything else is read.
-        unsafe {
-            assert_eq!(fmi2SetReal(bad, &vr, 1, &value), fmi2Status::Error, "{off}");
-            assert_eq!(fmi2DoStep(bad, 0.0, 1e-3, 0), fmi2Status::Error, "{off}");
-            assert_eq!(
-                fmi2GetReal(bad, &vr, 1, &mut value),
-                fmi2Status::Error,
-                "{off}"
-            );
-        }
+        assert!(refused(first.wrapping_byte_offset(off)), "{off}");
     }
-    // SAFETY: the live instance, freed once.
-    unsafe { fmi2FreeInstance(c) };
+    for made_up in [1usize, 0xdead_beef, usize::MAX] {
+        assert!(
+            refused(std::ptr::without_provenance_mut(made_up)),
+            "{made_up:#x}"
+        );
+    }
+    // SAFETY: a live handle, freed once; then a stale one.
+    unsafe { fmi2FreeInstance(first) };
+    assert!(refused(first));
+    // Another instance takes the freed slot: the stale handle still names nothing.
+    let second = make();
+    unsafe {
+        fmi2FreeInstance(first);
+        assert_eq!(
+            fmi2Reset(second),
+            fmi2Status::OK,
+            "the double free reached the live instance"
+        );
+        fmi2FreeInstance(second);
+    }
+    assert!(refused(second));
 }
 
 #[test]

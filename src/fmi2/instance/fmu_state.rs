@@ -39,6 +39,22 @@ struct SerializedState {
     runtime: Vec<u8>,
 }
 
+/// Why the clocks of a state are not those a run produces, if they are not: all finite, and
+/// startTime <= time <= stopTime (a step may end past the stop time by the rounding that
+/// `fmi2DoStep` allows). The clocks decide which steps are legal.
+fn clock_disorder(time: f64, start: f64, stop: Option<f64>) -> Option<String> {
+    let finite = time.is_finite() && start.is_finite() && stop.is_none_or(f64::is_finite);
+    let rounding = |t: f64| 1e3 * f64::EPSILON * t.abs().max(start.abs());
+    let ordered =
+        start <= time && stop.is_none_or(|stop| start <= stop && time <= stop + rounding(stop));
+    (!(finite && ordered)).then(|| {
+        format!(
+            "its clocks must be finite with startTime <= time <= stopTime, but startTime = {start:e}, time = {time:e}, stopTime = {}",
+            stop.map_or("undefined".into(), |s| format!("{s:e}"))
+        )
+    })
+}
+
 impl Instance {
     fn capture(&self) -> FmuState {
         FmuState {
@@ -225,15 +241,15 @@ impl Instance {
                 body.guid, self.info.guid
             )));
         }
-        // The clocks decide which steps are legal: non-finite ones would disable those checks.
-        let stop_ok = body
-            .stop_time
-            .is_none_or(|stop| stop.is_finite() && stop >= body.start_time);
-        if !body.time.is_finite() || !body.start_time.is_finite() || !stop_ok {
-            return Err(refuse(format!(
-                "corrupt state: time {}, startTime {} and stopTime {:?} must be finite, stopTime not before startTime",
-                body.time, body.start_time, body.stop_time
-            )));
+        // fmi2GetFMUstate captures every state but Fatal, which no restore may set: after it
+        // even fmi2Reset is refused.
+        if body.machine == MachineState::Fatal {
+            return Err(refuse(
+                "corrupt state: machine state Fatal is not one fmi2GetFMUstate saves".into(),
+            ));
+        }
+        if let Some(why) = clock_disorder(body.time, body.start_time, body.stop_time) {
+            return Err(refuse(format!("corrupt state: {why}")));
         }
         let mut runtime = self
             .runtime

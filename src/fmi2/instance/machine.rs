@@ -159,10 +159,11 @@ impl Instance {
             return fmi2Status::Error;
         }
         let status = self.refresh_outputs("fmi2ExitInitializationMode");
-        if status >= fmi2Status::Error {
-            // Bad parameters: the instance can be reset (or freed).
+        if status >= fmi2Status::Discard {
+            // Bad parameters, or start values the model cannot evaluate (a Discard, which has no
+            // smaller step to retry here): the instance can be reset (or freed).
             self.set_state(MachineState::Error);
-            return status;
+            return status.max(fmi2Status::Error);
         }
         self.set_state(if self.model_exchange {
             MachineState::EventMode
@@ -235,6 +236,10 @@ impl Instance {
         if !time.is_finite() || !(exact || self.within_rounding(time)) {
             return Some(self.refuse_communication_point(time));
         }
+        // Both finite, their sum may not be: the clock would become +inf.
+        if !(time + step).is_finite() {
+            return Some(self.refuse_step_end(time, step));
+        }
         if let Some(stop) = self.stop_time.filter(|&stop| time + step > stop) {
             // A step computed as stop - time may overshoot by rounding of either.
             let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
@@ -256,6 +261,16 @@ impl Instance {
     fn refuse_step(&self, step: f64) -> fmi2Status {
         self.error(&format!(
             "fmi2DoStep: communicationStepSize = {step} must be positive and finite"
+        ))
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn refuse_step_end(&self, time: f64, step: f64) -> fmi2Status {
+        self.error(&format!(
+            "fmi2DoStep: the step's end currentCommunicationPoint + communicationStepSize = \
+             {time:e} + {step:e} overflows to {}: it must be finite",
+            time + step
         ))
     }
 

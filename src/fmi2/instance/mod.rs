@@ -119,6 +119,11 @@ impl Instance {
         fmi2Status::Error
     }
 
+    /// The model's variables.
+    pub(in crate::fmi2) fn info(&self) -> &'static ModelInfo {
+        self.info
+    }
+
     /// The state of FMI's call sequence.
     pub fn state(&self) -> MachineState {
         self.state

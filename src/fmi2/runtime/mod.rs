@@ -500,10 +500,15 @@ where
         postcard::to_stdvec(self).map_err(|e| e.to_string())
     }
     fn rebuild_model(&mut self) -> Result<(), String> {
+        // The outputs are recomputed from the inputs and the model's history, never taken from
+        // the bytes: start values until a model is built, then what it evaluates.
+        self.values.outputs = Default::default();
+        self.outputs_stale = true;
         if let Some(saved) = self.model.take() {
-            let stale = std::mem::replace(&mut self.outputs_stale, true);
             self.model = Some(rebuilt(&self.values, &saved)?);
-            self.outputs_stale = stale;
+            let mut report = Report::default();
+            self.refresh_outputs(&mut report);
+            M::Variables::set_input_clamped(&mut self.values, report.clamped());
         }
         self.mirror_states();
         Ok(())

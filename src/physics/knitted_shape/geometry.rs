@@ -9,6 +9,12 @@ use std::f64::consts::PI;
 /// but finer sleeves reach the eq. 1.17 limit at the clamps before free contraction.
 pub const MAX_SEGMENTS: usize = 1600;
 
+/// Most rows accepted (see [`ShapeGeometry::new`]).
+pub const MAX_ROWS: f64 = 200.0;
+
+/// Most rows per axial segment accepted (see [`ShapeGeometry::new`]).
+pub const MAX_ROWS_PER_SEGMENT: f64 = 8.0;
+
 /// Geometry of the discretized sleeve. All lengths in metres.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct ShapeGeometry {
@@ -66,6 +72,25 @@ impl ShapeGeometry {
                  segments per row, the segments at the clamps turn radial (eq. 1.17 slant \
                  length all radius step) before free contraction and the table would end \
                  short of zero force"
+            ));
+        }
+        // The table's solver resolves the contraction pocket ring by ring: its cost grows
+        // faster than the square of the rows (at 49 segments 7 ms at 196 rows, 0.23 s at 784,
+        // 2.3 s at 1,568), so longer sleeves and coarser discretizations are refused rather
+        // than left to run.
+        if rows > MAX_ROWS {
+            return Err(format!(
+                "rows = {rows}: the non-cylindrical shape's table is built in bounded time for at \
+                 most {MAX_ROWS} rows; use shape_model 1 (tubular) for a longer sleeve"
+            ));
+        }
+        if rows > MAX_ROWS_PER_SEGMENT * segments as f64 {
+            return Err(format!(
+                "rows = {rows} on shape_segments = {segments} is {} rows per segment; the \
+                 non-cylindrical shape needs at most {MAX_ROWS_PER_SEGMENT}: set shape_segments \
+                 to at least {} (at most {MAX_SEGMENTS}), or use shape_model 1",
+                rows / segments as f64,
+                (rows / MAX_ROWS_PER_SEGMENT).ceil()
             ));
         }
         Ok(Self {

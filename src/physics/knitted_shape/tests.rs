@@ -151,6 +151,13 @@ fn rejects_bad_geometry() {
     assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS).is_ok());
     let why = ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS + 1).unwrap_err();
     assert!(why.contains("1600") && why.contains("radial"), "{why}");
+    // More rows per segment than the table resolves in bounded time: refused, naming the fix.
+    let rows = MAX_ROWS_PER_SEGMENT * 20.0;
+    assert!(ShapeGeometry::new(22.0, rows, 0.48, 0.003, 20).is_ok());
+    let why = ShapeGeometry::new(22.0, rows + 1.0, 0.48, 0.003, 20).unwrap_err();
+    assert!(why.contains("shape_segments to at least 21"), "{why}");
+    let why = ShapeGeometry::new(22.0, 201.0, 0.48, 0.003, 49).unwrap_err();
+    assert!(why.contains("at most 200 rows"), "{why}");
 }
 
 proptest::proptest! {
@@ -160,6 +167,7 @@ proptest::proptest! {
         m in 2.0f64..30.0, n in 4.0f64..80.0, s in 0.02f64..1.0, rf in 0.005f64..0.3,
         seg in 4usize..40, l in -1.0f64..2.0, p in -1e6f64..1e6,
     ) {
+        let seg = seg.max((n / MAX_ROWS_PER_SEGMENT).ceil() as usize);
         let g = ShapeGeometry::new(m, n, s, rf * s / (2.0 * PI), seg).unwrap();
         if let Ok(t) = ShapeTable::build(g, 0.0, 40) {
             let (v, d, c) = t.evaluate(l * t.max_length());

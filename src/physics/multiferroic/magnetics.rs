@@ -34,16 +34,25 @@ impl RingBar {
         thickness: f64,
         saturation_magnetization: f64,
     ) -> Result<Self, String> {
-        for (name, v) in [
-            ("ring_outer_diameter", ring_outer_diameter),
-            ("ring_inner_diameter", ring_inner_diameter),
-            ("bar_length", bar_length),
-            ("bar_width", bar_width),
-            ("thickness", thickness),
-            ("saturation_magnetization", saturation_magnetization),
+        // The declared ranges' upper ends: 1 m for the lengths, 1e7 A/m (above any known
+        // material's 2.4e6) for the magnetization.
+        for (name, v, max, unit) in [
+            ("ring_outer_diameter", ring_outer_diameter, 1.0, "m"),
+            ("ring_inner_diameter", ring_inner_diameter, 1.0, "m"),
+            ("bar_length", bar_length, 1.0, "m"),
+            ("bar_width", bar_width, 1.0, "m"),
+            ("thickness", thickness, 1.0, "m"),
+            (
+                "saturation_magnetization",
+                saturation_magnetization,
+                1.0e7,
+                "A/m",
+            ),
         ] {
-            if !(v.is_finite() && v > 0.0 && v < 1.0e6) {
-                return Err(format!("{name} must be positive and finite, got {v}"));
+            if !(v > 0.0 && v <= max) {
+                return Err(format!(
+                    "{name} must be positive and at most {max:e} {unit}, got {v} {unit}"
+                ));
             }
         }
         if ring_inner_diameter >= ring_outer_diameter {
@@ -56,8 +65,9 @@ impl RingBar {
         let corner = 0.5 * bar_length.hypot(bar_width);
         if corner >= 0.5 * ring_inner_diameter {
             return Err(format!(
-                "the bar ({bar_length} x {bar_width} m) does not fit inside the ring's hole \
-                 (inner diameter {ring_inner_diameter} m): its corners reach {corner} m"
+                "the bar (bar_length {bar_length} m x bar_width {bar_width} m) does not fit \
+                 inside the ring's hole (ring_inner_diameter {ring_inner_diameter} m): its \
+                 corners reach {corner} m from the centre"
             ));
         }
         let ring_width = 0.5 * (ring_outer_diameter - ring_inner_diameter);

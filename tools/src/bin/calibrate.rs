@@ -8,7 +8,7 @@
 //! The CSV has columns `pressure_kpa,contraction,force_n` (`#` lines are comments). Writes
 //! `OUT/params.json` (FMPy `start_values` for McKibbenMuscle.fmu), `OUT/params.ssv` (SSP parameter
 //! values), `OUT/fit.csv` (every datum with the model's force) and `OUT/fit.json` (errors per
-//! pressure, fit time). `calibration/calibrate.py` adds the report and its plot.
+//! pressure, fit time). `python/actuator_fmus/calibration.py` adds the report and its plot.
 
 use actuator_fmus_tools::calibration::{
     curves, errors, fit, model_force, Curve, Datum, FitConfig, MuscleParams,

@@ -88,7 +88,10 @@ pub fn run(scene: &Scene, scene_dir: &Path, fmu_dir: &Path) -> Result<Vec<Run>, 
         .filter_map(|v| {
             let kind = match v.elem {
                 ScalarVariableElement::Real(_) => Kind::Real,
-                ScalarVariableElement::Integer(_) => Kind::Integer,
+                // An Enumeration travels as an Integer (FMI 2.0 section 2.2.7).
+                ScalarVariableElement::Integer(_) | ScalarVariableElement::Enumeration => {
+                    Kind::Integer
+                }
                 ScalarVariableElement::Boolean(_) => Kind::Boolean,
                 _ => return None,
             };

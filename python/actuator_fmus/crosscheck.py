@@ -9,17 +9,15 @@ and docs/fmu/<Model>.png, the plot the packager puts into the FMU's documentatio
 The run is each model's default experiment with its default parameters (the rules allow no other
 settings), StepSize = the default experiment's step as the communication step, and the inputs
 below. An FMU not listed here gets no _in.csv (its inputs keep their start values) and its first
-eight Real outputs. Usage: python crosscheck/generate.py [Model ...]"""
+eight Real outputs. Usage: actuator-fmus crosscheck [Model ...]"""
 
-import math
-import pathlib
 import sys
 
 import numpy as np
 from fmpy import read_model_description, simulate_fmu
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-FMU_DIR = ROOT / "target" / "fmu"
+from .paths import FMU_DIR, ROOT, UsageError, fmu_path, models
+
 OUT = ROOT / "crosscheck"
 PLOTS = ROOT / "docs" / "fmu"
 REL_TOL = 1e-6
@@ -78,6 +76,7 @@ SPEC = {
 
 
 def experiment(md):
+    """(start, stop, step) of the model description's default experiment, in s."""
     de = md.defaultExperiment
     start = float(de.startTime or 0.0) if de else 0.0
     stop = float(de.stopTime or 1.0) if de else 1.0
@@ -86,6 +85,7 @@ def experiment(md):
 
 
 def write_csv(path, names, columns):
+    """Writes `columns` (SI units, time in s first) under the header `names` to `path`."""
     with open(path, "w") as f:
         f.write(",".join(names) + "\n")
         for row in zip(*columns):
@@ -93,6 +93,8 @@ def write_csv(path, names, columns):
 
 
 def generate(model):
+    """Writes crosscheck/<model>/ (inputs, reference outputs in SI units, options) and
+    docs/fmu/<model>.png."""
     fmu = str(FMU_DIR / f"{model}.fmu")
     md = read_model_description(fmu)
     start, stop, step = experiment(md)
@@ -182,13 +184,18 @@ def plot(model, md, signals, result, outputs):
     plt.close(fig)
 
 
-def main():
-    models = sys.argv[1:] or sorted(p.stem for p in FMU_DIR.glob("*.fmu"))
-    if not models:
-        sys.exit("no FMU in target/fmu: run `make fmus` first")
-    for model in models:
+def add_arguments(parser):
+    """The options of `actuator-fmus crosscheck`."""
+    parser.add_argument("model", nargs="*", help="FMU names (default: every packaged FMU)")
+
+
+def main(args):
+    """Writes the cross-check files of `args.model` (all packaged FMUs if none); returns 0."""
+    chosen = args.model or models()
+    if not chosen:
+        raise UsageError(f"no FMUs in {FMU_DIR}: run `make fmus` first")
+    for model in chosen:
+        fmu_path(model)  # a misspelt name fails before any run
+    for model in chosen:
         generate(model)
-
-
-if __name__ == "__main__":
-    main()
+    return 0

@@ -1,10 +1,13 @@
 """Runs a scene file (scenes/*.json, format: scenes/schema/scene.schema.json) under FMPy: writes <out>/<scene>.csv and
 <out>/<scene>.png, prints the dissertation's numbers beside ours, exits 1 if a check fails.
 
-    python scenes/run.py scenes/fig2_3_ideal_mckibben.json [--fast] [--out out]
+    actuator-fmus scene scenes/fig2_3_ideal_mckibben.json [--fast] [--out out]
+
+Before anything runs, the scene's FMU, parameter, input and output names and its values are
+checked against the FMU's model description: a mistake is one line naming the valid choices.
+Every number in a scene and in the results is in the variable's SI unit.
 """
 
-import argparse
 import json
 import math
 import pathlib
@@ -14,13 +17,14 @@ import time as clock
 
 import numpy as np
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-FMU_DIR = ROOT / "target" / "fmu"
+from . import names as checks
+from .paths import ROOT, UsageError, fmu_path
+
 LONG_RUN_STEPS = 1000  # runs with more communication steps than this show a progress bar
 SCHEMA = ROOT / "scenes" / "schema" / "scene.schema.json"
 
 
-class SceneError(ValueError):
+class SceneError(UsageError):
     """A scene file that does not follow scenes/schema/scene.schema.json."""
 
 
@@ -67,11 +71,13 @@ def schema_errors(scene):
 
 
 def load_scene(path, fast=False):
+    """The scene file at `path`, checked against the schema (SceneError otherwise); `fast`: its short
+    variant. Numbers in SI units."""
     path = pathlib.Path(path)
     scene = json.loads(path.read_text())
     errors = schema_errors(scene)
     if errors:
-        raise SceneError(f"{path}: not a valid scene (scenes/schema/scene.schema.json):\n  " + "\n  ".join(errors))
+        raise SceneError(f"{path}: not a valid scene (scenes/schema/scene.schema.json): " + "; ".join(errors))
     scene["_name"] = path.stem
     scene["_dir"] = path.parent
     if fast and scene.get("fast"):
@@ -86,7 +92,41 @@ def load_scene(path, fast=False):
     return scene
 
 
+def check_scene(scene):
+    """Checks the scene against its FMU's model description before it runs: the FMU exists; the
+    parameters, the swept variable and its `also` columns are parameters or inputs with values in
+    their declared ranges; the inputs are inputs whose signals stay in range; the outputs, the
+    plotted and the checked variables exist. Raises SceneError (one line, valid choices named)."""
+    model = scene["fmu"]
+    where = f"{scene['_dir'] / scene['_name']}.json"
+    try:
+        fmu_path(model)
+        checks.check_start_values(model, scene.get("parameters", {}))
+        checks.check_input_names(model, scene.get("inputs", {}))
+        checks.check_output_names(model, scene["outputs"])
+        plot = scene.get("plot") or {}
+        recorded = set(scene["outputs"]) | {"time"}
+        for name in [plot.get("x")] + list(plot.get("y", [])) + [
+                n for c in scene.get("checks", []) for n in (c.get("output"), c.get("x"))]:
+            if name is not None and name not in recorded:
+                raise UsageError(f"{model}: {name!r} is plotted or checked but not in the scene's outputs; "
+                                 f"outputs: {', '.join(checks.nearest_first(name, sorted(recorded)))}")
+        sweep = scene.get("sweep")
+        if sweep:
+            checks.check_name(model, sweep["variable"], checks.SETTABLE, "parameter or input")
+        step, stop = scene["step"], scene["stop_time"]
+        n = int(round(stop / step))
+        t = np.linspace(0.0, n * step, n + 1)
+        for _, _, parameters, inputs in sweep_runs(scene):
+            checks.check_start_values(model, parameters)
+            for name, signal in inputs.items():
+                checks.check_input_values(model, name, signal_values(signal, t, stop, scene["_dir"]), t)
+    except UsageError as e:
+        raise SceneError(f"{where}: {e}") from None
+
+
 def signal_values(signal, t, stop_time, directory):
+    """The input `signal` of a scene sampled at times `t` (s), in its variable's SI unit."""
     kind = signal["type"]
     if kind == "constant":
         return np.full_like(t, signal["value"])
@@ -147,7 +187,8 @@ def run_scene(scene, progress=True):
     """Returns a list of (sweep value or None, structured result array)."""
     from fmpy import simulate_fmu
 
-    fmu = str(FMU_DIR / f"{scene['fmu']}.fmu")
+    check_scene(scene)
+    fmu = fmu_path(scene["fmu"])
     sweep = scene.get("sweep")
     values = sweep["values"] if sweep else [None]
     step, stop = scene["step"], scene["stop_time"]
@@ -157,10 +198,18 @@ def run_scene(scene, progress=True):
     for k, value, parameters, inputs in sweep_runs(scene):
         signals = None
         if inputs:
-            signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in inputs])
+            # FMPy warns for every input without a column: the scene's other inputs are held at
+            # their start values (the scene's parameters, else the declared ones), as they would
+            # be without any input signal.
+            held = {name: float(parameters.get(name, v.start))
+                    for name, v in checks.variables(scene["fmu"]).items()
+                    if v.causality == "input" and name not in inputs and v.type == "Real"}
+            signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in [*inputs, *held]])
             signals["time"] = t
             for name, signal in inputs.items():
                 signals[name] = signal_values(signal, t, stop, scene["_dir"])
+            for name, start in held.items():
+                signals[name] = start
         label = f"{scene['_name']} {k + 1}/{len(values)}"
         bar = Progress(label, n) if progress and n >= LONG_RUN_STEPS else None
 
@@ -171,7 +220,7 @@ def run_scene(scene, progress=True):
 
         result = simulate_fmu(
             fmu,
-            start_values=parameters,
+            start_values=checks.check_start_values(scene["fmu"], parameters),
             input=signals,
             output=scene["outputs"],
             stop_time=n * step,
@@ -185,6 +234,7 @@ def run_scene(scene, progress=True):
 
 
 def zero_crossing(x, y):
+    """The x where y first crosses zero, linearly interpolated (units of x); NaN if it never does."""
     sign = np.sign(y)
     idx = np.nonzero(sign[:-1] * sign[1:] <= 0)[0]
     if idx.size == 0:
@@ -199,7 +249,7 @@ def units(scene):
     """Unit of every variable of the scene's FMU, from its model description."""
     from fmpy import read_model_description
 
-    md = read_model_description(str(FMU_DIR / f"{scene['fmu']}.fmu"))
+    md = read_model_description(fmu_path(scene["fmu"]))
     return {v.name: v.unit or (v.declaredType.unit if v.declaredType else "") or "" for v in md.modelVariables}
 
 
@@ -222,6 +272,7 @@ def quantity(value, unit):
 
 
 def run_label(scene, value, unit_of):
+    """"<swept variable> = <value in display units>" for a sweep run, "" without a sweep."""
     if value is None:
         return ""
     variable = scene["sweep"]["variable"]
@@ -282,6 +333,7 @@ def branches(x):
 
 
 def write_outputs(scene, runs, out):
+    """Writes <out>/<scene>.csv (SI units) and, if the scene has a plot, <out>/<scene>.png."""
     out.mkdir(parents=True, exist_ok=True)
     sweep = scene.get("sweep")
     names = list(runs[0][1].dtype.names)
@@ -337,27 +389,24 @@ def write_outputs(scene, runs, out):
     plt.close(fig)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("scene", nargs="+", help="scene files")
+def add_arguments(parser):
+    """The options of `actuator-fmus scene`."""
+    parser.add_argument("scene", nargs="+", help="scene files (scenes/*.json)")
     parser.add_argument("--fast", action="store_true", help="the scene's short variant (as in make test)")
-    parser.add_argument("--out", default="out", help="output directory")
-    args = parser.parse_args()
+    parser.add_argument("--out", default="out", help="output directory (default: out)")
+
+
+def main(args):
+    """Runs each scene of `args.scene`; exits 1 if a check fails. Raises UsageError on a mistake."""
+    scenes = [load_scene(path, fast=args.fast) for path in args.scene]
+    for scene in scenes:
+        check_scene(scene)
     failed = 0
-    for path in args.scene:
-        try:
-            scene = load_scene(path, fast=args.fast)
-        except SceneError as e:
-            print(e, file=sys.stderr)
-            sys.exit(2)
+    for scene in scenes:
         runs = run_scene(scene)
         write_outputs(scene, runs, pathlib.Path(args.out))
         for ok, text in evaluate_checks(scene, runs):
             print(f"  {'ok  ' if ok else 'FAIL'} {text}")
             failed += not ok
-        print(f"wrote {args.out}/{scene['_name']}.csv" + (f" and .png" if scene.get("plot") else ""))
-    sys.exit(1 if failed else 0)
-
-
-if __name__ == "__main__":
-    main()
+        print(f"wrote {args.out}/{scene['_name']}.csv" + (" and .png" if scene.get("plot") else ""))
+    return 1 if failed else 0

@@ -1,16 +1,15 @@
 """Runs every scene in scenes/ (full length) and writes docs/figures.md with each plot beside what
 the dissertation says, and the dissertation's numbers beside ours. `make figures`."""
 
-import pathlib
 import re
 import shutil
 
-import run as scenes
+from . import scene as scenes
+from .paths import ROOT
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
 
-
-def main():
+def main(args=None):
+    """Runs every scene and writes docs/figures.md and docs/figures/*.png; returns 0."""
     out = ROOT / "out"
     figures = ROOT / "docs" / "figures"
     figures.mkdir(parents=True, exist_ok=True)
@@ -20,7 +19,7 @@ def main():
         "Each scene in `scenes/` reproduces the model side of one of the figures of E. Ball, *Novel Methods in",
         "Meso-Scale and Nano-Scale Actuation*, M.S. thesis, Cornell University, 2014 (\"the dissertation\"; the",
         "README's [The source](../README.md#the-source) says how to obtain it). Regenerate this page with",
-        "`make figures`; run one scene with `.venv/bin/python scenes/run.py scenes/<scene>.json`. The scene",
+        "`make figures`; run one scene with `.venv/bin/actuator-fmus scene scenes/<scene>.json`. The scene",
         "format is [`scenes/schema/scene.schema.json`](../scenes/schema/scene.schema.json).",
         "",
     ]
@@ -29,6 +28,7 @@ def main():
 
     for path in sorted((ROOT / "scenes").glob("*.json"), key=figure_order):
         scene = scenes.load_scene(path)
+        scenes.check_scene(scene)
         runs = scenes.run_scene(scene)
         scenes.write_outputs(scene, runs, out)
         title, _, said = scene["description"].partition(": ")
@@ -41,7 +41,4 @@ def main():
         lines.append("")
     (ROOT / "docs" / "figures.md").write_text("\n".join(lines))
     print(f"wrote docs/figures.md and {len(list(figures.glob('*.png')))} plots")
-
-
-if __name__ == "__main__":
-    main()
+    return 0

@@ -6,23 +6,21 @@
   systems/RobotJoint.container.json (two McKibbenMuscle instances and PulleyJoint, 1 ms step).
 
 With --run both are simulated for 4 s and out/systems/robot_joint_systems.png compares them with
-the two-FMU co-simulation of examples/robot_joint.py. Usage: python systems/build.py [--run]"""
+the two-FMU co-simulation of `actuator-fmus robot-joint`. Usage: actuator-fmus systems [--run]"""
 
-import argparse
 import logging
-import pathlib
 import shutil
-import sys
 import zipfile
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-FMU_DIR = ROOT / "target" / "fmu"
+from .paths import FMU_DIR, ROOT
+
 OUT = ROOT / "out" / "systems"
 HERE = ROOT / "systems"
 STEP = 1e-3
 
 
 def build_ssp(out=OUT):
+    """Writes <out>/RobotJoint.ssp (systems/RobotJoint.ssd and the two FMUs); returns its path."""
     out.mkdir(parents=True, exist_ok=True)
     path = out / "RobotJoint.ssp"
     with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as z:
@@ -54,6 +52,8 @@ def build_container(out=OUT):
 
 
 def run_ssp(path, stop_time=4.0):
+    """Simulates the SSP for `stop_time` s with FMPy's simulate_ssp at 1 ms steps; returns its result
+    (SI units)."""
     from fmpy.ssp.simulation import simulate_ssp
 
     return simulate_ssp(str(path), stop_time=stop_time, step_size=STEP)
@@ -93,6 +93,7 @@ def _callbacks(logger):
 
 
 def run_container(path, stop_time=4.0):
+    """Simulates the container FMU for `stop_time` s; returns the result (SI units)."""
     from fmpy import extract, read_model_description, simulate_fmu
     from fmpy.fmi2 import FMU2Slave, printLogMessage
 
@@ -126,23 +127,25 @@ class _UnconnectedOutputs(logging.Filter):
         return True
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--run", action="store_true")
-    args = parser.parse_args()
+def add_arguments(parser):
+    """The options of `actuator-fmus systems`."""
+    parser.add_argument("--run", action="store_true", help="simulate both for 4 s and plot them against the two-FMU run")
+
+
+def main(args):
+    """Builds the SSP and the container FMU and, with --run, simulates and plots both; returns 0."""
     ssp = build_ssp()
     container = build_container()
     print(f"wrote {ssp} and {container}")
     if not args.run:
-        return
+        return 0
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     import numpy as np
 
-    sys.path.insert(0, str(ROOT / "examples"))
-    import robot_joint
+    from . import robot_joint
 
     reference = np.array(robot_joint.read_csv(ROOT / "tests" / "data" / "robot_joint_ref.csv")[1])
     s = run_ssp(ssp)
@@ -161,7 +164,5 @@ def main():
     fig.tight_layout()
     fig.savefig(OUT / "robot_joint_systems.png", dpi=100)
     print(f"wrote {OUT}/robot_joint_systems.png")
+    return 0
 
-
-if __name__ == "__main__":
-    main()

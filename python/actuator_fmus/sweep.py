@@ -13,10 +13,9 @@ each), or any running scheduler given by --scheduler tcp://host:8786. The FMU tr
 workers as bytes (scattered once), so remote workers need no shared file system, only this
 script's Python packages. Writes out/sweep.csv and out/sweep.png and prints runs per second.
 
-    python examples/sweep_dask.py                    # 60 x 40 = 2400 runs on a local cluster
-    python examples/sweep_dask.py --scheduler tcp://10.0.0.5:8786 --prestrains 200 --thicknesses 100"""
+    actuator-fmus sweep                    # 60 x 40 = 2400 runs on a local cluster
+    actuator-fmus sweep --scheduler tcp://10.0.0.5:8786 --prestrains 200 --thicknesses 100"""
 
-import argparse
 import hashlib
 import math
 import os
@@ -25,7 +24,7 @@ import sys
 import tempfile
 import time
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
+from .paths import fmu_path
 LISTED_LENGTH = 0.10325  # Table 2.1, muscle A
 PRESSURE = 6.9e5  # 690 kPa, the dissertation's work figure
 MUSCLE_A = {"strand_length": 0.1113, "turns": 3.74, "bladder_inner_diameter": 0.0016}
@@ -127,7 +126,7 @@ def sweep(prestrains, thicknesses, scheduler=None, workers=2, batch=20, layers=8
     def task(fmu, cases, layers, n_lengths):
         return run_batch(fmu, cases, layers, n_lengths)
 
-    fmu_bytes = (ROOT / "target" / "fmu" / "McKibbenMuscle.fmu").read_bytes()
+    fmu_bytes = pathlib.Path(fmu_path("McKibbenMuscle")).read_bytes()
     cases = [(p, t) for p in prestrains for t in thicknesses]
     batches = [cases[i:i + batch] for i in range(0, len(cases), batch)]
     cluster = None
@@ -162,10 +161,13 @@ def sweep(prestrains, thicknesses, scheduler=None, workers=2, batch=20, layers=8
 
 
 def linspace(a, b, n):
+    """`n` evenly spaced values from `a` to `b` (their unit), as a list."""
     return [a + (b - a) * i / (n - 1) for i in range(n)] if n > 1 else [a]
 
 
 def plot(rows, prestrains, thicknesses, path):
+    """Writes the map of net work per stroke (J) over pre-strain (%) and wall thickness (mm) to
+    `path`."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -177,23 +179,32 @@ def plot(rows, prestrains, thicknesses, path):
     fig, ax = plt.subplots(figsize=(7, 4.8))
     # Near the corner where the bladder barely fits the work shoots up (the stroke's top nears
     # max_length); a robust colour range keeps the rest of the map readable.
+    # The contours are drawn at levels inside that range only, so that every label can be read off
+    # the colour bar; the bar's arrow stands for the work above it.
+    from matplotlib.ticker import MaxNLocator
+
     lo, hi = np.nanpercentile(z, 1), np.nanpercentile(z, 97)
     mesh = ax.pcolormesh(np.array(prestrains) * 100, np.array(thicknesses) * 1e3, z, shading="auto",
                          vmin=lo, vmax=hi)
-    fig.colorbar(mesh, ax=ax, label="net work per stroke (J)")
-    cs = ax.contour(np.array(prestrains) * 100, np.array(thicknesses) * 1e3, z, colors="w", linewidths=0.6)
-    ax.clabel(cs, fontsize=7, fmt="%.2f")
+    bar = fig.colorbar(mesh, ax=ax, extend="both", label="net work per stroke (J)")
+    levels = [x for x in MaxNLocator(5).tick_values(lo, hi) if lo < x < hi]
+    cs = ax.contour(np.array(prestrains) * 100, np.array(thicknesses) * 1e3, z, levels=levels, colors="w",
+                    linewidths=0.6)
+    ax.clabel(cs, fontsize=7, fmt="%.2f J")
+    for level in levels:
+        bar.ax.axhline(level, color="w", linewidth=0.8)
     ax.set_xlabel("bladder pre-strain (%)")
     ax.set_ylabel("bladder wall thickness (mm)")
-    ax.set_title("McKibbenMuscle, muscle A sleeve, thick wall: net work at 690 kPa\n"
-                 "(white: the bladder does not fit the sleeve; stroke top = min(listed, 0.99 max_length))",
-                 fontsize=9)
+    ax.set_title("McKibbenMuscle, Table 2.1 muscle A sleeve, thick-walled bladder: net work per stroke at 690 kPa\n"
+                 "(blank: the bladder does not fit the sleeve; stroke top = min(listed length, 0.99 max_length);\n"
+                 "colours saturate beyond the 1st and 97th percentiles, white lines: contours in J)",
+                 fontsize=8)
     fig.tight_layout()
     fig.savefig(path, dpi=100)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def add_arguments(parser):
+    """The options of `actuator-fmus sweep`."""
     parser.add_argument("--scheduler", default=None, help="address of a running Dask scheduler (default: local cluster)")
     parser.add_argument("--workers", type=int, default=2, help="local cluster worker processes")
     parser.add_argument("--prestrains", type=int, default=60, help="pre-strain points, 0 .. 90%%")
@@ -201,8 +212,12 @@ def main():
     parser.add_argument("--layers", type=int, default=8, help="bladder_layers of the thick wall")
     parser.add_argument("--lengths", type=int, default=200, help="length samples per stroke")
     parser.add_argument("--batch", type=int, default=20, help="runs per Dask task")
-    parser.add_argument("--out", default="out")
-    args = parser.parse_args()
+    parser.add_argument("--out", default="out", help="output directory (default: out)")
+
+
+def main(args):
+    """Runs the sweep and writes <out>/sweep.csv (pre-strain 1, thickness m, net work J) and
+    sweep.png; returns 0."""
     prestrains = linspace(0.0, 0.9, args.prestrains)
     thicknesses = linspace(0.4e-3, 2.4e-3, args.thicknesses)
     rows, seconds = sweep(prestrains, thicknesses, args.scheduler, args.workers, args.batch, args.layers,
@@ -218,7 +233,5 @@ def main():
     print(f"{len(rows)} runs in {seconds:.1f} s: {len(rows) / seconds:.1f} runs/s "
           f"({args.lengths} lengths x 2 pressures each, {args.layers} layers); {failed} without a stroke")
     print(f"wrote {out}/sweep.csv and {out}/sweep.png")
+    return 0
 
-
-if __name__ == "__main__":
-    main()

@@ -1,6 +1,6 @@
 """Calibrate McKibbenMuscle to a datasheet: one Python function around the native fitter.
 
-    from calibration.calibrate import calibrate
+    from actuator_fmus.calibration import calibrate
     summary = calibrate("data/festo/festo_dmsp40.csv", length=0.4, diameter=0.04, fit_kpa=[0, 600],
                         out="out/calibrate/dmsp40")
 
@@ -8,50 +8,37 @@ runs `target/release/calibrate` (the fit, with the FMU's own physics), then chec
 parameters through the packaged McKibbenMuscle.fmu under FMPy and writes `OUT/report.md` with the
 error table and `OUT/fit.png` (data against model at every pressure). Also a command line:
 
-    python calibration/calibrate.py DATA LENGTH DIAMETER FIT OUT [STARTS]   (FIT: kPa, comma-separated)
+    actuator-fmus calibrate DATA --length 0.4 --diameter 0.04 --fit-kpa 0,600 --out OUT [--starts 24]
+
+Units: lengths and diameters in m, forces in N, pressures in Pa except where a name ends in
+`_kpa` (the datasheet's column and the fit pressures are in kPa, as datasheets give them).
 """
 
 import csv
 import json
 import pathlib
 import subprocess
-import sys
 import textwrap
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-BINARY = ROOT / "target" / "release" / "calibrate"
-FMU = ROOT / "target" / "fmu" / "McKibbenMuscle.fmu"
+from .paths import RELEASE, UsageError
+from .slave import Slave
+
+BINARY = RELEASE / "calibrate"
+MODEL = "McKibbenMuscle"
 
 
-def fmu_forces(params, points, fmu=FMU):
-    """McKibbenMuscle.fmu's force (N) at each (pressure Pa, length m) with `params` as start values."""
-    from fmpy import extract, read_model_description
-    from fmpy.fmi2 import FMU2Slave
-
-    md = read_model_description(str(fmu))
-    vr = {v.name: v for v in md.modelVariables}
-    unzipdir = extract(str(fmu))
-    slave = FMU2Slave(guid=md.guid, unzipDirectory=unzipdir,
-                      modelIdentifier=md.coSimulation.modelIdentifier, instanceName="calibration")
-    slave.instantiate()
+def fmu_forces(params, points):
+    """McKibbenMuscle.fmu's force (N) at each (gauge pressure Pa, length m), with `params` (SI
+    start values, e.g. params.json) set; one 1 ms step per point, in order."""
+    p0, l0 = points[0]
+    muscle = Slave(MODEL, **{**params, "pressure": p0, "length": l0})
     try:
-        p0, l0 = points[0]
-        setters = {"Real": slave.setReal, "Integer": slave.setInteger, "Boolean": slave.setBoolean}
-        for name, value in {**params, "pressure": p0, "length": l0}.items():
-            setters[vr[name].type]([vr[name].valueReference], [value])
-        slave.setupExperiment(startTime=0.0)
-        slave.enterInitializationMode()
-        slave.exitInitializationMode()
-        forces, t = [], 0.0
-        ins = [vr["pressure"].valueReference, vr["length"].valueReference]
+        forces = []
         for p, length in points:
-            slave.setReal(ins, [p, length])
-            slave.doStep(currentCommunicationPoint=t, communicationStepSize=1e-3)
-            t += 1e-3
-            forces.append(slave.getReal([vr["force"].valueReference])[0])
-        slave.terminate()
+            muscle.step(1e-3, pressure=p, length=length)
+            forces.append(muscle.get("force"))
     finally:
-        slave.freeInstance()
+        muscle.close()
     return forces
 
 
@@ -104,6 +91,10 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
     (m). Writes OUT/params.json, params.ssv, fit.csv, fit.json, report.md and fit.png; returns the
     summary (fit.json) with, if `verify`, the errors recomputed through the FMU."""
     out = pathlib.Path(out)
+    if not BINARY.exists():
+        raise UsageError(f"{BINARY} is missing: run `make fmus` (it builds the fitter too)")
+    if not pathlib.Path(data).is_file():
+        raise UsageError(f"no datasheet at {data}: give a CSV with columns pressure_kpa,contraction,force_n")
     cmd = [str(BINARY), "--data", str(data), "--length", repr(float(length)),
            "--diameter", repr(float(diameter)), "--fit", ",".join(f"{k:g}" for k in fit_kpa),
            "--out", str(out), "--starts", str(starts), "--layers", str(layers)]
@@ -162,9 +153,22 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
     return summary
 
 
-if __name__ == "__main__":
-    if len(sys.argv) not in (6, 7):
-        sys.exit(__doc__)
-    d, length, diameter, fit, out = sys.argv[1:6]
-    starts = int(sys.argv[6]) if len(sys.argv) == 7 else 24
-    calibrate(d, float(length), float(diameter), [float(k) for k in fit.split(",")], out, starts=starts)
+def add_arguments(parser):
+    """The options of `actuator-fmus calibrate` (lengths in m, pressures in kPa as datasheets give
+    them)."""
+    parser.add_argument("data", help="datasheet CSV with columns pressure_kpa,contraction,force_n")
+    parser.add_argument("--length", type=float, required=True, help="nominal length of the muscle, m")
+    parser.add_argument("--diameter", type=float, required=True, help="nominal inner diameter, m")
+    parser.add_argument("--fit-kpa", default="0,600", help="pressures to fit at, kPa, comma-separated (default 0,600)")
+    parser.add_argument("--out", required=True, help="output directory")
+    parser.add_argument("--starts", type=int, default=24, help="starting points of the search (default 24)")
+
+
+def main(args):
+    """Runs the fit of `args`; returns 0."""
+    try:
+        fit_kpa = [float(k) for k in args.fit_kpa.split(",")]
+    except ValueError:
+        raise UsageError(f"--fit-kpa {args.fit_kpa!r}: give pressures in kPa separated by commas, e.g. 0,600") from None
+    calibrate(args.data, args.length, args.diameter, fit_kpa, args.out, starts=args.starts)
+    return 0

@@ -1,19 +1,18 @@
 """The section 1.4 prototype's polyethylene bag and its stroke, through the KnittedMuscle FMU under
 FMPy. Run after `make fmus`:
 
-    .venv/bin/python examples/knitted_bag.py   (or `make knitted-bag-docs`)
+    actuator-fmus knitted-bag   (or `make knitted-bag-docs`)
 
 writes docs/knitted-bag.md and docs/img/knitted_bag.png. tests/fmpy/test_knitted_bag.py imports
 `stroke` and checks the figures the document states."""
 
-import pathlib
-import sys
 
 import numpy as np
 from fmpy import simulate_fmu
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-FMU = str(ROOT / "target" / "fmu" / "KnittedMuscle.fmu")
+from .paths import FMU_DIR, ROOT, fmu_path
+
+FMU = str(FMU_DIR / "KnittedMuscle.fmu")
 MEASURED = {14e3: 0.42, 100e3: 0.51}  # section 1.4.2: free contraction of the prototype
 BAG = 0.085  # m, "maximum bladder diameter roughly 85 mm"
 POLYETHYLENE = 1e4  # N/m: E t of a 50 um film at E = 0.2 GPa (low-density polyethylene)
@@ -71,7 +70,12 @@ def bag_for(target, pressure=14e3, points=2001):
     return 0.5 * (lo + hi)
 
 
-def main():
+Y_RANGE = (-2.5, 6.5)  # N/kPa, the plot's
+
+
+def main(args=None):
+    """Writes the page and its plots; returns 0."""
+    fmu_path("KnittedMuscle")
     import matplotlib
 
     matplotlib.use("Agg")
@@ -91,24 +95,47 @@ def main():
     naive = 0.42 * 0.153
     naive_stroke = stroke(14e3, bag_diameter=naive)
 
-    fig, ax = plt.subplots(figsize=(7.5, 4.5))
-    for (name, start), style in zip(CASES[1:4:2] + CASES[4:5], ("-", "--", ":")):
-        for p, colour in ((14e3, "tab:blue"), (100e3, "tab:red")):
+    fig, ax = plt.subplots(figsize=(7.5, 4.8))
+    # Per unit pressure several runs give the same curve: each distinct curve is drawn once, with
+    # every run it stands for in its label; a later curve only from where it leaves the first.
+    # Curves within 0.02 N/kPa of each other everywhere cannot be told apart on this scale.
+    bags = {CASES[1][0]: "no bag", CASES[3][0]: "85 mm bag", CASES[4][0]: "stretching bag (E t = 1e4 N/m)"}
+    curves = []  # [x (%), tension per pressure (N/kPa), {bag: [pressures in kPa]}]
+    for name, start in CASES[1:4:2] + CASES[4:5]:
+        for p in (14e3, 100e3):
             length, force, _, hi = contraction(p, **start)
-            ax.plot(100 * (1 - length / hi), force / (p * 1e-3), style, color=colour,
-                    label=f"{name}, {p / 1e3:g} kPa")
+            # Compared as drawn: inside the axes' range of tension per pressure.
+            x, y = 100 * (1 - length / hi), force / (p * 1e-3)
+            same = next((c for c in curves if c[0].shape == x.shape and np.allclose(c[0], x)
+                         and np.allclose(np.clip(c[1], *Y_RANGE), np.clip(y, *Y_RANGE), rtol=0, atol=0.02)),
+                        None)
+            if same is None:
+                curves.append([x, y, {}])
+                same = curves[-1]
+            same[2].setdefault(bags[name], []).append(f"{p / 1e3:g}")
+    for curve in curves:
+        curve[2] = ["; ".join(f"{bag} at {' and '.join(kpa)} kPa" for bag, kpa in curve[2].items())]
+    base = curves[0]
+    for k, (x, y, labels) in enumerate(curves):
+        start = 0
+        if k:
+            differs = np.nonzero(~np.isclose(y, base[1], rtol=0, atol=0.02))[0]
+            y = np.maximum(y, Y_RANGE[0] - 1)  # a drop leaves through the bottom edge, then stays off it
+            start = max(int(differs[0]) - 1, 0) if differs.size else 0
+        ax.plot(x[start:], y[start:], ("-", "--", ":", "-.")[k % 4], color=f"C{k}", lw=2 if k == 0 else 1.6,
+                label="; ".join(labels) + ("" if k == 0 else " (leaves the solid curve)"))
     for p, s in MEASURED.items():
         ax.axvline(100 * s, color="gray", ls="-.", lw=0.8)
         ax.text(100 * s, -2.3, f" measured {s:.0%} at {p / 1e3:g} kPa", rotation=90, fontsize=7)
     ax.axhline(0.0, color="black", lw=0.5)
     ax.set_xlabel("contraction (% of full extension, 514 mm)")
     ax.set_ylabel("tension per pressure (N/kPa)")
-    ax.set_ylim(-2.5, 6.5)
-    ax.set_title("Knitted prototype contracting (section 1.4): friction Cf = 0.25 with and without\n"
-                 "the 85 mm polyethylene bag; per unit pressure, 14 and 100 kPa coincide except the\n"
-                 "stretching bag", wrap=True, fontsize=10)
+    ax.set_ylim(*Y_RANGE)
+    ax.set_title("Knitted prototype contracting (section 1.4), ideal cylinder with friction Cf = 0.25:\n"
+                 "tension per unit pressure without a bag, with the 85 mm polyethylene bag and with a\n"
+                 "stretching bag; runs that give the same curve share one legend entry", fontsize=9)
     ax.set_xlim(0, 80)
-    ax.legend(fontsize=7, loc="upper right")
+    ax.legend(fontsize=7, loc="upper right", title="tension per pressure (N/kPa) of", title_fontsize=7)
     ax.grid(alpha=0.3)
     fig.tight_layout()
     img = ROOT / "docs" / "img"
@@ -119,7 +146,7 @@ def main():
     rows = "\n".join(f"| {name} | {s[14e3]:.1%} | {s[100e3]:.1%} |" for name, s in table)
     text = f"""# The knitted prototype's bag and its stroke (section 1.4)
 
-Generated by `make knitted-bag-docs` ([examples/knitted_bag.py](../examples/knitted_bag.py)) from the
+Generated by `make knitted-bag-docs` ([python/actuator_fmus/knitted_bag.py](../python/actuator_fmus/knitted_bag.py)) from the
 KnittedMuscle FMU under FMPy (`preset` 1, the 514 mm prototype: m = 22, n = 49, 153 mm sleeve).
 `tests/fmpy/test_knitted_bag.py` checks the figures stated here.
 
@@ -169,6 +196,3 @@ Free contraction (tension zero while contracting from full extension; friction z
     print(text)
     return 0
 
-
-if __name__ == "__main__":
-    sys.exit(main())

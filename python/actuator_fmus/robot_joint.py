@@ -16,21 +16,18 @@ Each communication step h (fixed-step semi-implicit Euler for the joint):
 
 Writes out/robot_joint.csv and out/robot_joint.png."""
 
-import argparse
 import json
 import math
 import pathlib
-import sys
 
-ROOT = pathlib.Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT / "tests" / "fmpy"))
-from conftest import fmu_path  # noqa: E402
+from .paths import ROOT, fmu_path
 
 PARAMETERS = ROOT / "examples" / "robot_joint.json"
 COLUMNS = ["time", "q", "dq", "q_ref", "p_flexor", "p_extensor", "f_flexor", "f_extensor", "torque"]
 
 
 def load_parameters(path=PARAMETERS):
+    """The joint's parameters from examples/robot_joint.json (SI units: m, kg, kg m2, N m s, Pa, s)."""
     with open(path) as f:
         return json.load(f)
 
@@ -74,7 +71,7 @@ class Muscle:
             vr, kind = self.vr[key]
             if kind == "Real":
                 self.fmu.setReal([vr], [float(value)])
-            elif kind == "Integer":
+            elif kind in ("Integer", "Enumeration"):
                 self.fmu.setInteger([vr], [int(value)])
             else:
                 self.fmu.setBoolean([vr], [bool(value)])
@@ -120,6 +117,7 @@ def simulate(p, stop_time=None):
 
 
 def write_csv(rows, path):
+    """Writes the trajectory rows (COLUMNS: s, rad, rad/s, rad, Pa, Pa, N, N, N m) to `path`."""
     with open(path, "w") as f:
         f.write(",".join(COLUMNS) + "\n")
         for row in rows:
@@ -127,6 +125,7 @@ def write_csv(rows, path):
 
 
 def read_csv(path):
+    """(header, rows) of a trajectory CSV written by `write_csv` (SI units)."""
     with open(path) as f:
         header = f.readline().strip().split(",")
         rows = [[float(x) for x in line.split(",")] for line in f if line.strip()]
@@ -134,6 +133,8 @@ def read_csv(path):
 
 
 def plot(rows, path):
+    """Writes the trajectory's plot to `path`: angle in deg, pressures in kPa, forces in N, torque in
+    N m."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -142,34 +143,36 @@ def plot(rows, path):
 
     a = np.array(rows)
     t = a[:, 0]
-    fig, axes = plt.subplots(3, 1, figsize=(8, 8), sharex=True)
-    axes[0].plot(t, np.degrees(a[:, 3]), "--", label="reference")
-    axes[0].plot(t, np.degrees(a[:, 1]), label="joint angle")
+    fig, axes = plt.subplots(4, 1, figsize=(8, 10), sharex=True)
+    axes[0].plot(t, np.degrees(a[:, 3]), "--", label="reference angle (deg)")
+    axes[0].plot(t, np.degrees(a[:, 1]), label="joint angle (deg)")
     axes[0].set_ylabel("angle (deg)")
-    axes[0].legend()
-    axes[1].plot(t, a[:, 4] / 1e3, label="flexor")
-    axes[1].plot(t, a[:, 5] / 1e3, label="extensor")
-    axes[1].set_ylabel("pressure (kPa)")
-    axes[1].legend()
+    axes[1].plot(t, a[:, 4] / 1e3, label="flexor pressure (kPa)")
+    axes[1].plot(t, a[:, 5] / 1e3, label="extensor pressure (kPa)")
+    axes[1].set_ylabel("gauge pressure (kPa)")
     axes[2].plot(t, a[:, 6], label="flexor force (N)")
     axes[2].plot(t, a[:, 7], label="extensor force (N)")
-    axes[2].plot(t, 100 * a[:, 8], label="joint torque (N cm)")
-    axes[2].set_ylabel("force (N), torque (N cm)")
-    axes[2].set_xlabel("time (s)")
-    axes[2].legend(fontsize=8)
+    axes[2].set_ylabel("muscle force (N)")
+    axes[3].plot(t, a[:, 8], color="C2", label="joint torque r (F_flexor - F_extensor) (N m)")
+    axes[3].set_ylabel("joint torque (N m)")
+    axes[3].set_xlabel("time (s)")
     for ax in axes:
         ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="upper right")
     fig.suptitle("Antagonistic McKibbenMuscle pair on a pulley: PD pressure control (FMPy FMU2Slave)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
 
 
-def main():
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--out", default="out")
-    parser.add_argument("--stop-time", type=float, default=None)
-    parser.add_argument("--no-plot", action="store_true")
-    args = parser.parse_args()
+def add_arguments(parser):
+    """The options of `actuator-fmus robot-joint` (stop time in s)."""
+    parser.add_argument("--out", default="out", help="output directory (default: out)")
+    parser.add_argument("--stop-time", type=float, default=None, help="s (default: the parameters file's)")
+    parser.add_argument("--no-plot", action="store_true", help="write only the CSV")
+
+
+def main(args):
+    """Simulates the joint and writes <out>/robot_joint.csv (SI units) and .png; returns 0."""
     out = pathlib.Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     p = load_parameters()
@@ -180,7 +183,5 @@ def main():
     if not args.no_plot:
         plot(rows, out / "robot_joint.png")
         print(f"wrote {out}/robot_joint.png")
+    return 0
 
-
-if __name__ == "__main__":
-    main()

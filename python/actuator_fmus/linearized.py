@@ -3,12 +3,11 @@
 fmi2GetDirectionalDerivative, and a test of chapter 2's proposal to treat a finished muscle as a
 spring whose stiffness is proportional to the applied pressure minus the threshold pressure.
 
-    .venv/bin/python docs/linearized/generate.py     (or: make linearized)
+    actuator-fmus linearized     (or: make linearized)
 
 Writes docs/linearized-muscle.md and docs/linearized/*.png; exits 1 if its own checks fail.
 """
 
-import pathlib
 import sys
 
 import matplotlib
@@ -19,8 +18,9 @@ import numpy as np  # noqa: E402
 from fmpy import extract, read_model_description  # noqa: E402
 from fmpy.fmi2 import FMU2Slave  # noqa: E402
 
-ROOT = pathlib.Path(__file__).resolve().parents[2]
-FMU = ROOT / "target" / "fmu" / "McKibbenMuscle.fmu"
+from .paths import FMU_DIR, ROOT, fmu_path
+
+FMU = FMU_DIR / "McKibbenMuscle.fmu"
 OUT = ROOT / "docs" / "linearized"
 PAGE = ROOT / "docs" / "linearized-muscle.md"
 MUSCLES = {"A": 1, "B": 2, "C": 3, "D": 4}
@@ -61,6 +61,8 @@ class Muscle:
 
 
 def sweep(name, preset):
+    """Stiffness dF/dL (N/m), pressure gain dF/dP (m2) and threshold pressure (Pa) of Table 2.1
+    muscle `name` (`preset`) over its stroke (lengths in m) and PRESSURES (Pa)."""
     m = Muscle(preset)
     lo, hi = m.min_length, m.max_length
     # The stroke: from where the muscle at the highest pressure pulls nothing (F = 0) up to 2% of
@@ -107,26 +109,52 @@ def analyse(s):
 
 
 def plot(s, a):
+    """Writes docs/linearized/muscle_<name>.png from `sweep`'s and `analyse`'s results (plotted in
+    kN/m, N/MPa, kPa, mm); returns its path."""
+    from matplotlib.lines import Line2D
+
     L = s["lengths"] * 1e3
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6))
+    fig, axes = plt.subplots(1, 3, figsize=(15, 5.4))
+    colours = {P: f"C{k}" for k, P in enumerate(CURVE_PRESSURES)}
+    gains = {}
     for P in CURVE_PRESSURES:
         j = int(np.argmin(np.abs(PRESSURES - P)))
-        line = axes[0].plot(L, s["K"][:, j] / 1e3, label=f"model, P = {P / 1e3:.0f} kPa")[0]
-        axes[0].plot(L, a["fit"][:, j] / 1e3, "--", color=line.get_color(), label=f"k (P - P_th), P = {P / 1e3:.0f} kPa")
-        axes[1].plot(L, s["G"][:, j] * 1e6, color=line.get_color(), label=f"P = {P / 1e3:.0f} kPa")
+        axes[0].plot(L, s["K"][:, j] / 1e3, color=colours[P])
+        axes[0].plot(L, a["fit"][:, j] / 1e3, "--", color=colours[P])
+        gains[P] = s["G"][:, j] * 1e6
+    # Once the bladder touches the sleeve the gain does not depend on the pressure: curves that
+    # coincide are drawn once, labelled with every pressure they stand for.
+    drawn = []
+    for P, g in gains.items():
+        same = next((d for d in drawn if np.allclose(d[1], g, rtol=1e-3, atol=0.5)), None)
+        if same:
+            same[0].append(P)
+        else:
+            drawn.append(([P], g))
+    for k, (ps, g) in enumerate(drawn):
+        axes[1].plot(L, g, color=colours[ps[0]], lw=4 - 0.8 * k, alpha=0.85,
+                     label="P = " + ", ".join(f"{P / 1e3:.0f}" for P in ps) + " kPa"
+                     + (" (the same curve)" if len(ps) > 1 else ""))
     top = 1.5 * np.nanmax(a["fit"]) / 1e3
-    axes[0].set(xlabel="muscle length L (mm)", ylabel="stiffness dF/dL (kN/m)", ylim=(min(0.0, np.nanmin(s["K"]) / 1e3), top))
-    axes[0].set_title(f"Muscle {s['name']}: stiffness, model (solid) and\nlinear spring k (P - P_th) (dashed), k = {a['k']:.3g} N/m per Pa;\nthe model's stiffness diverges at the fill limit", wrap=True)
+    axes[0].set(xlabel="muscle length L (mm)", ylabel="stiffness dF/dL (kN/m)",
+                ylim=(min(0.0, np.nanmin(s["K"]) / 1e3), top))
+    axes[0].set_title(f"stiffness dF/dL; linear spring k = {a['k']:.3g} N/m per Pa", fontsize=10)
+    axes[0].legend(handles=[Line2D([], [], color=colours[P], label=f"P = {P / 1e3:.0f} kPa") for P in CURVE_PRESSURES]
+                   + [Line2D([], [], color="0.3", label="model (diverges at the fill limit)"),
+                      Line2D([], [], color="0.3", ls="--", label="linear spring k (P - P_th)")], fontsize=7)
     axes[1].set(xlabel="muscle length L (mm)", ylabel="pressure gain dF/dP (N/MPa)")
-    axes[1].set_title(f"Muscle {s['name']}: pressure gain dF/dP over the stroke", wrap=True)
+    axes[1].set_title("pressure gain dF/dP over the stroke", fontsize=10)
+    axes[1].legend(fontsize=7, title="in contact the gain does not depend on P", title_fontsize=7)
     slope, p0 = a["per_length"].T
     axes[2].plot(L, s["threshold"] / 1e3, label="threshold pressure P_th (model)")
     axes[2].plot(L, p0 / 1e3, "--", label="pressure of zero stiffness P0 (fit per length)")
     axes[2].set(xlabel="muscle length L (mm)", ylabel="pressure (kPa)")
-    axes[2].set_title(f"Muscle {s['name']}: where K = K1 (P - P0) meets zero\nagainst the threshold pressure", wrap=True)
+    axes[2].set_title("where K = K1 (P - P0) meets zero, against P_th", fontsize=10)
+    axes[2].legend(fontsize=7)
+    fig.suptitle(f"Table 2.1 muscle {s['name']} (thick-walled bladder, 16 layers), linearized through "
+                 "fmi2GetDirectionalDerivative", fontsize=12)
     for ax in axes:
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
     fig.tight_layout()
     path = OUT / f"muscle_{s['name']}.png"
     fig.savefig(path, dpi=110)
@@ -134,9 +162,9 @@ def plot(s, a):
     return path
 
 
-def main():
-    if not FMU.exists():
-        sys.exit(f"{FMU} is missing: run `make fmus` first")
+def main(args=None):
+    """Writes docs/linearized-muscle.md and its plots; returns 1 if its own checks fail, else 0."""
+    fmu_path("McKibbenMuscle")
     rows, images, failures = [], [], []
     for name, preset in MUSCLES.items():
         s = sweep(name, preset)
@@ -159,7 +187,7 @@ def main():
             failures.append(f"muscle {name}: non-finite partials")
     text = f"""# The linearized McKibben muscle
 
-Generated by `make linearized` (`docs/linearized/generate.py`) from the McKibbenMuscle FMU; do not
+Generated by `make linearized` (`python/actuator_fmus/linearized.py`) from the McKibbenMuscle FMU; do not
 edit by hand.
 
 Chapter 2's introduction proposes that, once a muscle is designed, a controls engineer can treat it
@@ -203,8 +231,5 @@ the whole stroke, use `K1(L)` and `P0(L)` from the FMU's directional derivatives
     print(text)
     if failures:
         print("\n".join(failures), file=sys.stderr)
-        sys.exit(1)
-
-
-if __name__ == "__main__":
-    main()
+        return 1
+    return 0

@@ -1,0 +1,351 @@
+//! The cost of a step anywhere in each FMU's declared space (`make worst-case`, not part of
+//! `make test`): through the packaged linux64 binary's C ABI, every settable variable at each of
+//! its declared bounds alone, every combination of the options (Integer parameters with at most
+//! eight values, Booleans), then `WORST_CASE_POINTS` (10,000) random points of the whole box,
+//! log-uniform across decades. Each case initializes (timed from fmi2EnterInitializationMode to
+//! fmi2ExitInitializationMode, the parameters set in between) and takes `STEPS` steps of the
+//! FMU's default step size (each timed in thread CPU time, so that a loaded machine does not
+//! inflate the figures, less the clock's own cost). Prints per FMU the median, p99 and maximum step and
+//! initialization cost, the share of cases refused at initialization, and the slowest cases.
+//!
+//! `WORST_CASE_MODELS=A,B` restricts the FMUs; `WORST_CASE_POINTS=n` the random points.
+
+#[path = "../tests/common/mod.rs"]
+#[allow(dead_code)]
+mod common;
+#[path = "cpu_clock.rs"]
+mod cpu_clock;
+
+use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::variables::{Causality, ModelInfo, Start, VarType};
+use common::*;
+use cpu_clock::thread_cpu;
+use std::ffi::c_int;
+use std::time::Instant;
+
+const STEPS: usize = 3;
+const DECADES: f64 = 15.0;
+
+/// SplitMix64: reproducible draws.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn uniform(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+/// A settable variable: (value reference, type, lower and upper bound, start).
+#[derive(Clone, Copy)]
+struct Knob {
+    name: &'static str,
+    vr: u32,
+    kind: VarType,
+    lo: f64,
+    hi: f64,
+    start: f64,
+}
+
+fn knobs(info: &ModelInfo) -> Vec<Knob> {
+    info.variables
+        .iter()
+        .filter(|v| matches!(v.causality, Causality::Parameter | Causality::Input))
+        .filter(|v| v.kind != VarType::String)
+        .map(|v| {
+            let (lo, hi) = match v.kind {
+                VarType::Boolean => (0.0, 1.0),
+                VarType::Integer => (
+                    v.min.unwrap_or(i32::MIN as f64),
+                    v.max.unwrap_or(i32::MAX as f64),
+                ),
+                _ => (v.min.unwrap_or(-f64::MAX), v.max.unwrap_or(f64::MAX)),
+            };
+            let start = match v.start {
+                Start::Real(x) => x,
+                Start::Integer(i) => i as f64,
+                Start::Boolean(b) => b as i32 as f64,
+                _ => 0.0,
+            };
+            Knob {
+                name: v.name,
+                vr: v.vr,
+                kind: v.kind,
+                lo,
+                hi,
+                start,
+            }
+        })
+        .collect()
+}
+
+/// Log-uniform across decades where the range allows, through zero by magnitude.
+fn draw(rng: &mut Rng, k: &Knob) -> f64 {
+    let log_uniform = |rng: &mut Rng, lo: f64, hi: f64| {
+        (lo.ln() + rng.uniform() * (hi.ln() - lo.ln()))
+            .exp()
+            .clamp(lo, hi)
+    };
+    let x = match k.kind {
+        VarType::Boolean => (rng.next() & 1) as f64,
+        _ if k.lo > 0.0 && k.hi / k.lo > 10.0 => log_uniform(
+            rng,
+            k.lo,
+            k.hi + 0.5 * (k.kind == VarType::Integer) as i32 as f64,
+        ),
+        _ if k.lo <= 0.0 && k.hi > 0.0 && k.hi - k.lo > 100.0 => {
+            let negative = k.lo < 0.0 && rng.uniform() < 0.5;
+            let top = if negative { -k.lo } else { k.hi };
+            let m = log_uniform(rng, top * 10f64.powf(-DECADES), top);
+            if negative {
+                -m
+            } else {
+                m
+            }
+        }
+        _ => k.lo + rng.uniform() * (k.hi - k.lo + (k.kind == VarType::Integer) as i32 as f64),
+    };
+    match k.kind {
+        VarType::Real => x,
+        _ => x.floor().clamp(k.lo, k.hi),
+    }
+}
+
+/// Every combination of the options: Integer parameters with at most 8 values and Booleans.
+fn option_combinations(knobs: &[Knob]) -> Vec<Vec<(usize, f64)>> {
+    let options: Vec<(usize, Vec<f64>)> = knobs
+        .iter()
+        .enumerate()
+        .filter(|(_, k)| k.kind != VarType::Real && k.hi - k.lo < 8.0)
+        .map(|(i, k)| (i, (k.lo as i64..=k.hi as i64).map(|x| x as f64).collect()))
+        .collect();
+    let mut combos = vec![Vec::new()];
+    for (i, values) in &options {
+        combos = combos
+            .iter()
+            .flat_map(|c| {
+                values.iter().map(move |&x| {
+                    let mut c = c.clone();
+                    c.push((*i, x));
+                    c
+                })
+            })
+            .collect();
+    }
+    combos
+}
+
+fn step_size(info: &ModelInfo) -> f64 {
+    let xml = info.model_description_xml;
+    xml.find("stepSize=\"")
+        .and_then(|at| {
+            let rest = &xml[at + 10..];
+            rest[..rest.find('"')?].parse().ok()
+        })
+        .unwrap_or(1e-3)
+}
+
+struct Case {
+    label: String,
+    init: f64,
+    steps: Vec<f64>,
+    refused: bool,
+}
+
+/// The cost of reading the thread CPU clock, subtracted from each timing.
+fn clock_cost() -> f64 {
+    let mut d: Vec<f64> = (0..1001)
+        .map(|_| {
+            let a = thread_cpu();
+            thread_cpu() - a
+        })
+        .collect();
+    d.sort_by(f64::total_cmp);
+    d[500]
+}
+
+fn run(
+    api: &Api,
+    info: &ModelInfo,
+    knobs: &[Knob],
+    values: &[f64],
+    h: f64,
+    overhead: f64,
+) -> (f64, Vec<f64>, bool) {
+    let i = api
+        .instantiate("worst", info.guid)
+        .unwrap_or_else(|log| panic!("{}: {:?}", info.name, log.lines()));
+    assert_eq!(i.setup(), OK);
+    let begun = thread_cpu();
+    assert_eq!(i.enter(), OK);
+    for (k, &x) in knobs.iter().zip(values) {
+        unsafe {
+            match k.kind {
+                VarType::Real => (api.fmi2SetReal)(i.c, &k.vr, 1, &x),
+                VarType::Integer => (api.fmi2SetInteger)(i.c, &k.vr, 1, &(x as c_int)),
+                _ => (api.fmi2SetBoolean)(i.c, &k.vr, 1, &(x as c_int)),
+            };
+        }
+    }
+    let exit = i.exit();
+    let init = (thread_cpu() - begun - overhead).max(0.0);
+    if exit > WARNING {
+        return (init, Vec::new(), true);
+    }
+    let mut steps = Vec::with_capacity(STEPS);
+    let mut t = 0.0;
+    for _ in 0..STEPS {
+        let begun = thread_cpu();
+        let s = i.do_step(t, h);
+        steps.push((thread_cpu() - begun - overhead).max(0.0));
+        if s > WARNING {
+            break;
+        }
+        t += h;
+    }
+    (init, steps, false)
+}
+
+fn quantile(sorted: &[f64], q: f64) -> f64 {
+    if sorted.is_empty() {
+        return f64::NAN;
+    }
+    sorted[((sorted.len() - 1) as f64 * q).round() as usize]
+}
+
+fn main() {
+    let points: usize = std::env::var("WORST_CASE_POINTS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(10_000);
+    let only = std::env::var("WORST_CASE_MODELS").ok();
+    let overhead = clock_cost();
+    println!(
+        "(thread CPU time; the clock's own {:.0} ns subtracted)\n",
+        overhead * 1e9
+    );
+    println!(
+        "| FMU | cases | refused at init | step median | step p99 | step max | init median | init p99 | init max |"
+    );
+    println!("|---|---|---|---|---|---|---|---|---|");
+    let mut slowest_all = Vec::new();
+    for factory in REGISTRY {
+        let info = factory.info();
+        if only
+            .as_ref()
+            .is_some_and(|o| !o.split(',').any(|m| m == info.name))
+        {
+            continue;
+        }
+        let api = Api::load(&extract_binary(info.name));
+        let knobs = knobs(info);
+        let start: Vec<f64> = knobs.iter().map(|k| k.start).collect();
+        let h = step_size(info);
+        let mut plans: Vec<(String, Vec<f64>)> = Vec::new();
+        for (i, k) in knobs.iter().enumerate() {
+            for bound in [k.lo, k.hi] {
+                let mut v = start.clone();
+                v[i] = bound;
+                plans.push((format!("{} = {bound:e}", k.name), v));
+            }
+        }
+        for combo in option_combinations(&knobs) {
+            let mut v = start.clone();
+            let label: Vec<String> = combo
+                .iter()
+                .map(|&(i, x)| {
+                    v[i] = x;
+                    format!("{}={x}", knobs[i].name)
+                })
+                .collect();
+            plans.push((format!("options {}", label.join(" ")), v));
+        }
+        let mut rng = Rng(0x5eed ^ info.name.len() as u64);
+        for n in 0..points {
+            plans.push((
+                format!("random {n}"),
+                knobs.iter().map(|k| draw(&mut rng, k)).collect(),
+            ));
+        }
+        let total = plans.len();
+        let mut cases = Vec::with_capacity(total);
+        let begun = Instant::now();
+        for (n, (label, values)) in plans.into_iter().enumerate() {
+            let (init, steps, refused) = run(&api, info, &knobs, &values, h, overhead);
+            let slow = steps.iter().copied().fold(init, f64::max);
+            if slow > 1.0 {
+                let what: Vec<String> = knobs
+                    .iter()
+                    .zip(&values)
+                    .filter(|(k, x)| **x != k.start)
+                    .map(|(k, x)| format!("{}={x:e}", k.name))
+                    .collect();
+                eprintln!("{}: {label}: {slow:.2} s [{}]", info.name, what.join(" "));
+            }
+            if (n + 1) % 1000 == 0 {
+                eprintln!(
+                    "{}: {}/{total} cases, {:.0} s",
+                    info.name,
+                    n + 1,
+                    begun.elapsed().as_secs_f64()
+                );
+            }
+            let label = if label.starts_with("random") {
+                let what: Vec<String> = knobs
+                    .iter()
+                    .zip(&values)
+                    .map(|(k, x)| format!("{}={x:.3e}", k.name))
+                    .collect();
+                format!("{label} [{}]", what.join(" "))
+            } else {
+                label
+            };
+            cases.push(Case {
+                label,
+                init,
+                steps,
+                refused,
+            });
+        }
+        let mut steps: Vec<f64> = cases.iter().flat_map(|c| c.steps.clone()).collect();
+        let mut inits: Vec<f64> = cases.iter().map(|c| c.init).collect();
+        steps.sort_by(f64::total_cmp);
+        inits.sort_by(f64::total_cmp);
+        let us = |x: f64| format!("{:.1} us", x * 1e6);
+        println!(
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+            info.name,
+            cases.len(),
+            cases.iter().filter(|c| c.refused).count(),
+            us(quantile(&steps, 0.5)),
+            us(quantile(&steps, 0.99)),
+            us(quantile(&steps, 1.0)),
+            us(quantile(&inits, 0.5)),
+            us(quantile(&inits, 0.99)),
+            us(quantile(&inits, 1.0)),
+        );
+        cases.sort_by(|a, b| {
+            let worst = |c: &Case| c.steps.iter().copied().fold(c.init, f64::max);
+            worst(b).total_cmp(&worst(a))
+        });
+        for c in cases.iter().take(3) {
+            let worst_step = c.steps.iter().copied().fold(0.0, f64::max);
+            slowest_all.push(format!(
+                "{}: step {} init {}: {}",
+                info.name,
+                us(worst_step),
+                us(c.init),
+                c.label
+            ));
+        }
+    }
+    println!("\nSlowest cases:");
+    for line in slowest_all {
+        println!("- {line}");
+    }
+}
