@@ -11,7 +11,7 @@ MUJOCO_PLUGIN := target/mujoco-plugin/release/libactuator_fmus_mujoco.so
 SOURCES := $(shell find src modelDescription build tools/src -type f) Cargo.toml tools/Cargo.toml build.rs .cargo/config.toml
 
 .PHONY: mujoco-plugin mujoco-arm mujoco-docs
-.PHONY: all fmus zig-tools demo scene figures test test-rust test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs slack-docs linearized chapter2-claims py-deps scene-schema
+.PHONY: all fmus zig-tools demo scene figures test test-rust test-new-model test-fmpy bench report clean deps cross-deps interop-deps calibrate calibrate-festo motor-docs knitted-bag-docs slack-docs linearized chapter2-claims py-deps scene-schema
 
 all: fmus
 
@@ -155,6 +155,12 @@ calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
 
 test-rust: deps fmus
 	+cargo test --release --workspace
+
+## docs/adding-a-model.md's trivial model added to a scratch copy of the repository, built and put
+## through the Rust suites that cover every model (tests/all/new_model.rs; builds the crate again
+## in target/new-model, minutes).
+test-new-model: deps
+	+cargo test --release --test all new_model -- --ignored --nocapture
 
 ## ecos (ecospy, tests/fmpy/test_interop.py) needs Debian's libtbb12.
 interop-deps:
@@ -445,6 +451,7 @@ Measure and check (not part of make test)
   fuzz              random FMI call sequences (cargo-fuzz): FUZZ_SECONDS= FUZZ_JOBS= SANITIZER=
   memcheck          every FMU under valgrind, natively and through FMPy
   load              10,000 instantiate-run-free cycles per FMU with the heap counted
+  test-new-model    docs/adding-a-model.md's trivial model in a scratch copy, through the Rust suites
   clean             remove build output, out/ and the .venv
 endef
 export HELP_TEXT

@@ -35,29 +35,3 @@ const MODEL_EXCHANGE_CAPABILITIES: &str = r#"needsExecutionTool="false"
     canNotUseMemoryManagementFunctions="true"
     canGetAndSetFMUstate="true"
     canSerializeFMUstate="true""#;
-
-/// The models whose `Model::partials` gives exact partial derivatives (`src/models`), so that
-/// the export layer serves `fmi2GetDirectionalDerivative` for them; a Rust test checks that the
-/// shipped flag and the models agree.
-const PROVIDE_DIRECTIONAL_DERIVATIVE: &[&str] = &[
-    "FreeBladder",
-    "KnittedMuscle",
-    "McKibbenJoint",
-    "McKibbenMuscle",
-    "MultiferroicMotor",
-    "PassThrough",
-    "PulleyJoint",
-];
-
-/// The models that also serve Model Exchange (`Model::MODEL_EXCHANGE`: algebraic models, and
-/// models with continuous states, `src/fmi2/instance/model_exchange.rs`); a Rust test checks that the
-/// shipped block and the models agree.
-const MODEL_EXCHANGE: &[&str] = &[
-    "FreeBladder",
-    "KnittedMuscle",
-    "McKibbenJoint",
-    "McKibbenMuscle",
-    "MultiferroicMotor",
-    "PassThrough",
-    "PulleyJoint",
-];

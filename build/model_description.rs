@@ -803,20 +803,14 @@ fn shipped(
     lists: &[(&str, &[ResolvedUnknown])],
 ) -> Result<String, String> {
     let s = find_splices(text)?;
-    let derivatives = PROVIDE_DIRECTIONAL_DERIVATIVE.contains(&stem);
+    // Every model serves both interfaces and its exact partials: the registry's test
+    // (`src/fmi2/registry.rs`) checks each model against this, so that no list names them.
     let mut inserts: Vec<(usize, usize, String)> = Vec::new();
     inserts.push((
         s.after_root,
         s.after_root,
         format!(
-            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->{}\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}\n    providesDirectionalDerivative=\"{derivatives}\"/>",
-            if MODEL_EXCHANGE.contains(&stem) {
-                format!(
-                    "\n  <ModelExchange\n    modelIdentifier=\"{stem}\"\n    {MODEL_EXCHANGE_CAPABILITIES}\n    providesDirectionalDerivative=\"{derivatives}\"/>"
-                )
-            } else {
-                String::new()
-            }
+            "\n\n  <!-- Written by build.rs: the export layer's capabilities. -->\n  <ModelExchange\n    modelIdentifier=\"{stem}\"\n    {MODEL_EXCHANGE_CAPABILITIES}\n    providesDirectionalDerivative=\"true\"/>\n  <CoSimulation\n    modelIdentifier=\"{stem}\"\n    {CO_SIMULATION_CAPABILITIES}\n    providesDirectionalDerivative=\"true\"/>"
         ),
     ));
     let mut log = String::from("<LogCategories>\n");

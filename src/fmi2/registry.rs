@@ -10,6 +10,9 @@ include!(concat!(env!("OUT_DIR"), "/model_bindings.rs"));
 mod tests {
     use super::REGISTRY;
 
+    /// build.rs ships every model with both interfaces and `providesDirectionalDerivative`:
+    /// every model must serve them (`Model::partials`, and `Model::ALGEBRAIC_MODEL_EXCHANGE` or
+    /// `Model::MODEL_EXCHANGE`).
     #[test]
     fn the_shipped_capabilities_match_the_models() {
         for factory in REGISTRY {
@@ -21,9 +24,19 @@ mod tests {
             let flag = info
                 .model_description_xml
                 .contains(r#"providesDirectionalDerivative="true""#);
-            assert_eq!(provided.is_ok(), flag, "{}: {provided:?}", info.name);
+            assert_eq!(
+                provided.is_ok(),
+                flag,
+                "{}: implement Model::partials: {provided:?}",
+                info.name
+            );
             let model_exchange = info.model_description_xml.contains("<ModelExchange");
-            assert_eq!(factory.model_exchange(), model_exchange, "{}", info.name);
+            assert_eq!(
+                factory.model_exchange(),
+                model_exchange,
+                "{}: set Model::ALGEBRAIC_MODEL_EXCHANGE or Model::MODEL_EXCHANGE",
+                info.name
+            );
         }
     }
 }

@@ -196,7 +196,7 @@ pub struct EventUpdate {
 /// algebraic model compiles unchanged. A model with continuous states (declared in its model
 /// description: a `local` Real `der(x)` with `derivative="x"`, and x listed in `<Derivatives>`)
 /// implements, besides `new`, `evaluate` and `step`:
-/// - [`Model::MODEL_EXCHANGE`] `= true` (and its name in `build/export_layer.rs`'s list);
+/// - [`Model::MODEL_EXCHANGE`] `= true`;
 /// - [`Model::states`] and [`Model::set_states`]: the model owns its states (they are its
 ///   co-simulation history too, so FMU states save them with the model);
 /// - [`Model::set_time`]: the independent variable; [`Model::evaluate`] then writes the outputs

@@ -82,10 +82,14 @@ impl Var {
 }
 
 /// The modelDescription.xml of a packaged FMU.
-fn parse(xml: &str) -> (String, String, Vec<Var>) {
+/// The model name, GUID and variables of a model description, and the parameter set its test data
+/// gives as describing no physical actuator (`<Impossible values="name=value ...">` in the
+/// project's VendorAnnotations), if any.
+fn parse(xml: &str) -> (String, String, Vec<Var>, Option<String>) {
     use quick_xml::events::Event;
     let mut reader = quick_xml::Reader::from_str(xml);
     let (mut model, mut guid, mut vars) = (String::new(), String::new(), Vec::<Var>::new());
+    let mut impossible = None;
     let mut in_variable = false;
     loop {
         let event = reader
@@ -162,10 +166,11 @@ fn parse(xml: &str) -> (String, String, Vec<Var>) {
                     _ => num("start"),
                 };
             }
+            b"Impossible" => impossible = get("values"),
             _ => {}
         }
     }
-    (model, guid, vars)
+    (model, guid, vars, impossible)
 }
 
 /// A parameter value to set by name.
@@ -173,24 +178,6 @@ fn parse(xml: &str) -> (String, String, Vec<Var>) {
 enum Value {
     R(f64),
     I(c_int),
-}
-
-/// Parameter sets that describe no physical actuator, so that `fmi2ExitInitializationMode` fails
-/// and the instance reaches the Error state. Models not listed here get one searched for.
-fn impossible_parameters(model: &str) -> Vec<(&'static str, Value)> {
-    match model {
-        // The bar (600 nm) is longer than the ring's hole (500 nm) is wide.
-        "MultiferroicMotor" => vec![("bar_length", Value::R(600e-9))],
-        // A thin-walled bladder whose wall (10 mm) alone is wider than the sleeve can open
-        // (b / (n pi) = 9.5 mm for Table 2.1 muscle A).
-        "McKibbenMuscle" => vec![
-            ("bladder_model", Value::I(1)),
-            ("bladder_thickness", Value::R(0.01)),
-        ],
-        // Rubber without stiffness: eq. 2.18 holds no pressure at any diameter.
-        "FreeBladder" => vec![("mooney_c1", Value::R(0.0)), ("mooney_c2", Value::R(0.0))],
-        _ => Vec::new(),
-    }
 }
 
 /// Communication step of the normal run and of the bad-step cases.
@@ -203,6 +190,8 @@ struct Fmu {
     api: Api,
     /// The outputs of a normal run on a fresh instance.
     reference: Vec<u64>,
+    /// The parameter set the model description gives as impossible (`name=value ...`), if any.
+    listed_impossible: Option<String>,
     /// Parameters that make initialization fail, if any were found.
     impossible: Option<Vec<(String, Value)>>,
     /// A step size that the model discards (StepFailed), if any.
@@ -212,7 +201,7 @@ struct Fmu {
 impl Fmu {
     fn load(path: &std::path::Path) -> Fmu {
         let xml = read_entry(path, "modelDescription.xml");
-        let (model, guid, vars) = parse(&String::from_utf8(xml).unwrap());
+        let (model, guid, vars, impossible) = parse(&String::from_utf8(xml).unwrap());
         let stem = path.file_stem().unwrap().to_str().unwrap();
         assert_eq!(stem, model, "{}", path.display());
         let mut fmu = Fmu {
@@ -221,6 +210,7 @@ impl Fmu {
             guid,
             vars,
             reference: Vec::new(),
+            listed_impossible: impossible,
             impossible: None,
             discarded_step: None,
         };
@@ -346,12 +336,23 @@ impl Fmu {
                 .contains("fmi2ExitInitializationMode: parameters rejected: ")
     }
 
-    /// The listed impossible set, or a search over single parameters at extreme in-range values,
-    /// each with every small-range Integer parameter at each of its values.
+    /// The impossible set the model description gives, or a search over single parameters at
+    /// extreme in-range values, each with every small-range Integer parameter at each of its values.
     fn find_impossible(&self, i: &Instance) -> Option<Vec<(String, Value)>> {
-        let listed: Vec<(String, Value)> = impossible_parameters(&self.model)
-            .into_iter()
-            .map(|(n, v)| (n.to_string(), v))
+        let listed: Vec<(String, Value)> = self
+            .listed_impossible
+            .iter()
+            .flat_map(|values| values.split_whitespace())
+            .map(|item| {
+                let (name, value) = item.split_once('=').expect("name=value");
+                let value = match (self.var(name).kind, value) {
+                    (Kind::Real, x) => Value::R(x.parse().expect("a number")),
+                    (_, "true") => Value::I(1),
+                    (_, "false") => Value::I(0),
+                    (_, k) => Value::I(k.parse().expect("an integer")),
+                };
+                (name.to_string(), value)
+            })
             .collect();
         if !listed.is_empty() {
             assert!(

@@ -21,6 +21,7 @@ mod fuzz_corpus;
 mod glibc_versions;
 mod lifecycle_checks;
 mod motor_c_abi;
+mod new_model;
 mod restore_validation;
 mod robot_joint_runs;
 mod shipped_descriptions;

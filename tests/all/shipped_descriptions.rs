@@ -119,6 +119,27 @@ fn value_references_are_dense_and_names_unique() {
     );
 }
 
+/// Every `modelDescription/<Model>.xml`: the model's name and source.
+fn sources() -> Vec<(String, String)> {
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("modelDescription");
+    let mut sources: Vec<_> = std::fs::read_dir(&dir)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .filter(|p| p.extension().is_some_and(|e| e == "xml"))
+        .map(|p| {
+            let name = p.file_stem().unwrap().to_str().unwrap().to_string();
+            (name, std::fs::read_to_string(&p).unwrap())
+        })
+        .collect();
+    sources.sort();
+    assert!(
+        sources.len() > 1,
+        "no model descriptions in {}",
+        dir.display()
+    );
+    sources
+}
+
 /// The source with `force`'s Outputs entry given `attributes` instead of its own.
 fn with_dependencies(attributes: &str) -> String {
     edited(FORCE, &format!("<Unknown name=\"force\" {attributes}/>"))
@@ -243,34 +264,8 @@ fn every_output_and_initial_unknown_declares_its_dependencies() {
         "'min_length' declares no dependencies",
     );
     // Every shipped description declares them all.
-    for (name, text) in [
-        ("McKibbenMuscle", SOURCE),
-        (
-            "KnittedMuscle",
-            include_str!("../../modelDescription/KnittedMuscle.xml"),
-        ),
-        (
-            "McKibbenJoint",
-            include_str!("../../modelDescription/McKibbenJoint.xml"),
-        ),
-        (
-            "PulleyJoint",
-            include_str!("../../modelDescription/PulleyJoint.xml"),
-        ),
-        (
-            "MultiferroicMotor",
-            include_str!("../../modelDescription/MultiferroicMotor.xml"),
-        ),
-        (
-            "PassThrough",
-            include_str!("../../modelDescription/PassThrough.xml"),
-        ),
-        (
-            "FreeBladder",
-            include_str!("../../modelDescription/FreeBladder.xml"),
-        ),
-    ] {
-        let m = check(text, name).unwrap_or_else(|e| panic!("{name}: {e}"));
+    for (name, text) in sources() {
+        let m = check(&text, &name).unwrap_or_else(|e| panic!("{name}: {e}"));
         assert!(m
             .outputs
             .iter()

@@ -11,6 +11,7 @@ before initialization and the initial unknowns compared after fmi2ExitInitializa
 import shutil
 import sys
 import tempfile
+import xml.etree.ElementTree as ET
 
 import pytest
 from fmpy import extract, read_model_description
@@ -18,68 +19,27 @@ from fmpy.fmi2 import FMU2Slave
 
 from conftest import ROOT, fmu_path  # noqa: E402
 
-# Operating points: parameter overrides (the effects on) x input points.
-CONFIGS = {
-    "PassThrough": ([{}], [{}, {"u": 0.7}]),
-    # The first point lies just below (C2 38719.67 Pa) and just above (38679.73 Pa) the clamp at
-    # 0.999 of the ballooning pressure, so that the initial input_clamped shows each parameter.
-    "FreeBladder": (
-        [{}, {"mooney_c2": 38719.67}, {"mooney_c2": 38679.73}],
-        [{"pressure": 4.9322e4, "length": 0.1336}, {"pressure": 3e4, "length": 0.16},
-         {"pressure": -5e4, "length": 0.12}],
-    ),
-    "McKibbenMuscle": (
-        # Presets from one that differs from the defaults in nothing (1, Table 2.1's muscle A) to
-        # one that does (2, muscle B; 5 to 6, the Festo DMSP-10 to the DMSP-40), with and without
-        # the bladder and the pressure solver.
-        [{}, {"bladder_model": 1}, {"friction": True}, {"bladder_model": 1, "friction": True},
-         {"pressure_solver": True}, {"preset": 1}, {"preset": 1, "bladder_model": 1},
-         {"preset": 1, "pressure_solver": True}, {"preset": 5},
-         # Muscle D to the DMSP-10 (preset 4 to 5) switches the bladder model and its constants;
-         # the thick wall shows its layer count.
-         {"preset": 4}, {"bladder_model": 2, "bladder_layers": 8}, {"connector_stiffness": 5e4}],
-        [{"pressure": 2e5, "length": 0.09, "target_force": 50.0},
-         {"pressure": 4e5, "length": 0.085, "target_force": 200.0},
-         {"pressure": 0.0, "length": 0.095, "target_force": 0.0},
-         # Past the free contraction: slack unless signed_force.
-         {"pressure": 2e5, "length": 0.06, "target_force": 0.0},
-         # Taut with muscle A's bladder (max_length 97.3 mm), on the stretching strands beyond
-         # it and beyond the bare sleeve's b, taut for the DMSP-10 (preset 5).
-         {"pressure": 3e5, "length": 0.096, "target_force": 20.0},
-         {"pressure": 2e5, "length": 0.1, "target_force": 20.0},
-         {"pressure": 2e5, "length": 0.115, "target_force": 20.0},
-         {"pressure": 3e5, "length": 0.26, "target_force": 20.0}],
-    ),
-    "KnittedMuscle": (
-        [{}, {"bladder_model": 1}, {"friction": True}, {"shape_model": 1}],
-        [{"pressure": 2e4, "length": 0.4}, {"pressure": 5e4, "length": 0.35},
-         {"pressure": 0.0, "length": 0.42}, {"pressure": 2e4, "length": 0.15}],
-    ),
-    "McKibbenJoint": (
-        # common_mode_pressure at max_pressure: the flexor's pressure saturates there.
-        [{}, {"friction": True}, {"bladder_model": 1}, {"command_mode": 1},
-         {"common_mode_pressure": 7e5},
-         # Short muscles: past +-0.45 rad one goes slack (unless signed_force).
-         {"flexor_rest_length": 0.07, "extensor_rest_length": 0.07}],
-        [{"actuatorInput": 0.3, "jointPosition": 0.1, "jointVelocity": 0.2},
-         {"actuatorInput": -0.5, "jointPosition": -0.2, "jointVelocity": -1.0},
-         {"actuatorInput": 1.0, "jointPosition": 0.0, "jointVelocity": 0.0},
-         {"actuatorInput": 2e4, "jointPosition": 0.6, "jointVelocity": 0.0},
-         {"actuatorInput": -2e4, "jointPosition": -0.6, "jointVelocity": 0.0}],
-    ),
-    "PulleyJoint": (
-        [{}, {"external_pressures": True}],
-        [{"flexor_force": 100.0, "extensor_force": 50.0, "flexor_pressure_command": 2e5,
-          "extensor_pressure_command": 1e5},
-         {"flexor_force": 0.0, "extensor_force": 0.0}],
-    ),
-    "MultiferroicMotor": (
-        [{}, {"strain_drive": True}, {"onion_model": 1}, {"schedule": 1}],
-        [{"strain_direction": 0.3, "stress": 5e7, "load_torque": 1e-9, "strain": 1e-4},
-         {"strain_direction": 1.2, "stress": 2e7, "load_torque": 0.0, "strain": 5e-4}],
-    ),
-}
-MODELS = list(CONFIGS)
+def parse_values(text):
+    """`name=value ...` from a model description's test data: {name: bool or float}."""
+    values = {}
+    for item in text.split():
+        name, value = item.split("=")
+        values[name] = value == "true" if value in ("true", "false") else float(value)
+    return values
+
+
+def operating_points(model):
+    """The operating points a model's description gives for its tests (VendorAnnotations): the
+    defaults and each Parameters set (the effects on), and the Inputs points (the start values if
+    none)."""
+    root = ET.parse(ROOT / "modelDescription" / f"{model}.xml").getroot()
+    tests = root.find("VendorAnnotations/Tool[@name='actuator-fmus']/Tests")
+    given = lambda tag: [parse_values(e.get("values")) for e in tests.iter(tag)] if tests is not None else []
+    return [{}] + given("Parameters"), given("Inputs") or [{}]
+
+
+MODELS = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
+CONFIGS = {m: operating_points(m) for m in MODELS}
 
 
 class Model:
@@ -255,10 +215,14 @@ def compare(declared, measured, what):
     return sum(len(d) for d in declared.values())
 
 
-def test_every_model_has_operating_points():
-    # A model missing from CONFIGS would have its declared dependencies never measured.
-    shipped = {p.stem for p in (ROOT / "modelDescription").glob("*.xml")}
-    assert set(CONFIGS) == shipped, f"CONFIGS lacks {sorted(shipped - set(CONFIGS))}"
+@pytest.mark.parametrize("name", MODELS)
+def test_the_operating_points_name_the_models_variables(name):
+    # A renamed variable must not leave an operating point that sets nothing.
+    causality = {v.name: v.causality for v in read_model_description(fmu_path(name)).modelVariables}
+    params, points = CONFIGS[name]
+    for values, kind in [(p, "parameter") for p in params] + [(p, "input") for p in points]:
+        for variable in values:
+            assert causality.get(variable) == kind, f"{name}: {variable} is not a {kind}"
 
 
 @pytest.mark.parametrize("name", MODELS)

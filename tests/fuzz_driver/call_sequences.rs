@@ -316,10 +316,12 @@ fn time_step(u: &mut Unstructured) -> Result<f64> {
 /// The models by stable id. A model is chosen by one byte of the input, `b % 8` its id here, so
 /// that each committed seed keeps driving the model it was found with when models are added (the
 /// registry is in name order: FreeBladder's arrival once shifted every seed to another model).
-/// Never reorder or remove an entry. A new model takes the reserved id (`None`: a GUID that no
-/// model has, which must be refused); past 8 models the table must grow, and the committed
-/// corpus be re-targeted with it. Bit 3 of the byte asks `ready` for Model Exchange (the
-/// committed seeds from before Model Exchange was fuzzed have it clear).
+/// Never reorder or remove an entry. The reserved id (`None`) is a GUID that no model has, which
+/// must be refused, or, with the byte's high nibble set, a model added after this table (by name
+/// order, [`later_models`]): a new model needs no entry, and the seeds of the tabled models keep
+/// them (a seed on a later model may move to another later model when one is added). Bit 3
+/// of the byte asks `ready` for Model Exchange (the committed seeds from before Model Exchange
+/// was fuzzed have it clear).
 pub const MODEL_IDS: [Option<&str>; 8] = [
     Some("KnittedMuscle"),
     Some("McKibbenJoint"),
@@ -335,13 +337,29 @@ pub const MODEL_IDS: [Option<&str>; 8] = [
 /// instantiate it for Model Exchange.
 fn model(u: &mut Unstructured) -> Result<(Option<&'static dyn Factory>, bool)> {
     let b: u8 = u.arbitrary()?;
-    let factory = MODEL_IDS[usize::from(b % 8)].map(|name| {
-        *REGISTRY
-            .iter()
-            .find(|f| f.info().name == name)
-            .unwrap_or_else(|| panic!("MODEL_IDS names {name}, which the registry lacks"))
-    });
+    let factory = match MODEL_IDS[usize::from(b % 8)] {
+        Some(name) => Some(
+            *REGISTRY
+                .iter()
+                .find(|f| f.info().name == name)
+                .unwrap_or_else(|| panic!("MODEL_IDS names {name}, which the registry lacks")),
+        ),
+        None => {
+            let later = later_models();
+            let k = usize::from(b >> 4);
+            (k > 0 && !later.is_empty()).then(|| later[(k - 1) % later.len()])
+        }
+    };
     Ok((factory, b & 8 != 0))
+}
+
+/// The models of the registry that [`MODEL_IDS`] does not name, in name order.
+pub fn later_models() -> Vec<&'static dyn Factory> {
+    REGISTRY
+        .iter()
+        .copied()
+        .filter(|f| !MODEL_IDS.contains(&Some(f.info().name)))
+        .collect()
 }
 
 impl Driver {
