@@ -11,6 +11,7 @@
 //! [`fmi2`] is the only module that allows `unsafe_code`; `physics` and `models` forbid it.
 
 pub mod fmi2;
+pub mod fmi3;
 pub mod models;
 pub mod physics;
 pub mod variables;
