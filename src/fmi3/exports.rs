@@ -24,6 +24,7 @@ pub extern "C" fn fmi3GetVersion() -> *const c_char {
 }
 
 /// The shared part of both instantiation functions: checks the name and token, finds the model.
+#[allow(clippy::too_many_arguments)] // the FMI arguments both functions share, passed through
 fn instantiate(
     function: &str,
     instance_name: Option<String>,
