@@ -1,7 +1,7 @@
-//! FMI 2.0 and FMI 3.0 Co-Simulation and Model Exchange FMUs of novel actuators: McKibben and knitted-sleeve
-//! pneumatic muscles and a multiferroic nano-motor, after the dissertation (E. Ball, *Novel
-//! Methods in Meso-Scale and Nano-Scale Actuation*, M.S. thesis, Cornell University, 2014;
-//! Cornell's eCommons repository).
+//! FMI 2.0 and FMI 3.0 Co-Simulation and Model Exchange FMUs of novel actuators: McKibben and
+//! knitted-sleeve pneumatic muscles and a multiferroic nano-motor, after the dissertation (E.
+//! Ball, *Novel Methods in Meso-Scale and Nano-Scale Actuation*, M.S. thesis, Cornell University,
+//! 2014; Cornell's eCommons repository).
 //!
 //! Data flows one way, every arrow pointing down:
 //! [`fmi2`] (C ABI, registry, value arrays) -> [`models`] (typed variables to physics, effect
