@@ -6,8 +6,9 @@
 //! guard (`fmi2::exports`), the call-sequence state machine, the variable rules, FMU states and
 //! the out-of-range policy (`fmi2::instance`), the runtime over any model and the logger (which
 //! speaks both versions' callbacks). What is FMI 3.0's own lives here:
-//! - `exports`: instantiation, the mode changes, `fmi3DoStep`, FMU states, derivatives and
-//!   dependencies;
+//! - `exports`: instantiation, the mode changes, `fmi3DoStep`;
+//! - `fmu_state`: FMU states and their serialization;
+//! - `derivatives`: directional and adjoint derivatives, variable dependencies;
 //! - `values`: get and set by FMI 3.0 value reference ([`Fmi3Model`] maps them to FMI 2.0's);
 //! - `model_exchange`: the Model Exchange calls;
 //! - `unsupported`: every other function of the API, each an error with a logged reason.
@@ -18,7 +19,9 @@
 #![deny(unsafe_op_in_unsafe_fn)]
 #![allow(non_camel_case_types)]
 
+mod derivatives;
 mod exports;
+mod fmu_state;
 mod model_exchange;
 #[cfg(test)]
 mod tests;
