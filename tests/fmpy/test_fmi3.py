@@ -105,3 +105,41 @@ def test_every_scene_equals_the_fmi2_result_bit_for_bit(path, fmi_type):
         assert _largest_difference(r2, r3) == 0.0
         for name in r2.dtype.names:
             assert np.array_equal(r2[name], r3[name]), f"{name} differs"
+
+
+def _exported(path, platform):
+    """The function names a shared library exports, by the binutils of its platform."""
+    import re
+    import shutil
+    import subprocess
+
+    if platform.endswith("windows"):
+        tool, flag = shutil.which("x86_64-w64-mingw32-objdump") or shutil.which("objdump"), "-p"
+    elif platform.startswith("aarch64"):
+        tool, flag = shutil.which("aarch64-linux-gnu-objdump"), "-T"
+    else:
+        tool, flag = shutil.which("objdump"), "-T"
+    if tool is None:
+        pytest.skip(f"no objdump for {platform} (make cross-deps installs it)")
+    listing = subprocess.run([tool, flag, str(path)], capture_output=True, text=True, check=True).stdout
+    return set(re.findall(r"\b(fmi[23][A-Za-z0-9]+)\b", listing))
+
+
+def test_every_binary_exports_both_apis(tmp_path):
+    """Every binary in the FMI 3.0 FMUs exports every function of FMPy's FMI 3.0 and FMI 2.0 bindings
+    (FMPy resolves all of them when it loads a binary)."""
+    import fmpy.fmi2
+    import fmpy.fmi3
+
+    fmi3_names = {n for n in dir(fmpy.fmi3._FMU3) if n.startswith("fmi3")} | \
+        {n for cls in (fmpy.fmi3.FMU3Slave, fmpy.fmi3.FMU3Model) for n in dir(cls) if n.startswith("fmi3")}
+    fmi2_names = {n for cls in (fmpy.fmi2.FMU2Slave, fmpy.fmi2.FMU2Model) for n in dir(cls) if n.startswith("fmi2")}
+    assert len(fmi3_names) > 60 and len(fmi2_names) > 30
+    with zipfile.ZipFile(fmi3_path("McKibbenMuscle")) as z:
+        binaries = [n for n in z.namelist() if n.startswith("binaries/") and not n.endswith("/")]
+        assert "binaries/x86_64-linux/McKibbenMuscle.so" in binaries
+        for name in binaries:
+            platform = name.split("/")[1]
+            exported = _exported(z.extract(name, tmp_path), platform)
+            assert fmi3_names <= exported, (platform, sorted(fmi3_names - exported))
+            assert fmi2_names <= exported, (platform, sorted(fmi2_names - exported))
