@@ -432,7 +432,7 @@ Start here
   test              all Rust tests, the FMPy suite and the documentation site's checks
   help              this list
 Build
-  fmus              target/fmu/<Model>.fmu for every model (CROSS=0: linux64 binaries only)
+  fmus              target/fmu/<Model>.fmu (FMI 2.0) and target/fmu-fmi3/<Model>.fmu (FMI 3.0) (CROSS=0: x86-64 Linux only)
   docs              the documentation site into site/ (mkdocs build --strict)
 Run the models
   scene             one scene under FMPy: make scene SCENE=scenes/<name>.json
