@@ -25,7 +25,8 @@ pub struct Logger {
 
 /// The instance's code names FMI 2.0 functions in its messages; an FMI 3.0 instance's messages
 /// name the FMI 3.0 function the importer called instead.
-const FMI3_NAMES: [(&str, &str); 12] = [
+const FMI3_NAMES: [(&str, &str); 13] = [
+    ("state StepComplete", "state StepMode"),
     ("fmi2GetReal", "fmi3GetFloat64"),
     ("fmi2SetReal", "fmi3SetFloat64"),
     ("fmi2GetInteger", "fmi3GetInt32"),
