@@ -44,7 +44,7 @@ def load(path):
 stop = sys.argv[1]
 header, rows = load(sys.argv[2])
 end = rows[-1][0] if rows else math.nan
-finite = all(math.isfinite(x) for r in rows for x in r)
+finite = bool(rows) and all(math.isfinite(x) for r in rows for x in r)
 reached = stop == "-" or abs(end - float(stop)) <= 1e-9 * max(1.0, abs(float(stop)))
 line = f"{end:g} {len(rows)} {'yes' if finite else 'NO'} {'yes' if reached else 'NO'}"
 if len(sys.argv) > 3:

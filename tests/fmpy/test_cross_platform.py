@@ -298,7 +298,7 @@ def test_win64_under_wine_and_aarch64_under_qemu_match_linux64(model, interface,
 def test_gilbert_onion_bit_identical_under_qemu_and_its_wine_difference_measured(harnesses, tmp_path):
     """The motor's Gilbert onion (`onion_model` 1) over its cross-check input, in both interfaces:
     bit-identical under qemu. Its path is ill-conditioned: natively, a relative change of 1e-15 in
-    `strain_direction` changes its outputs by 1e-7 one step later and by order one a few steps on
+    `strain_direction` changes its outputs by 3e-7 one step later and by order one a few steps on
     (Co-Simulation; at once in Model Exchange). Wine's last-bit libm differences therefore take
     it onto another path. Asserted under wine: the outputs at initialization and after the first
     step within the motor's MEASURED_WINE, the transcript's shape and finiteness; the step where
