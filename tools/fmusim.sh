@@ -5,9 +5,10 @@
 # and Model Exchange), which must exit 0 with no message logged by the FMU and finite results up
 # to the stop time; finally Co-Simulation against Model Exchange at the end time, every column
 # within 1e-6 of its largest magnitude over the run. The FMI version comes from each FMU's
-# modelDescription.xml (fmiVersion), so FMI 2.0 and 3.0 FMUs are told apart by what they are.
-# Results and logs go to target/fmusim/; prints one line per FMU and interface and exits 1 on any
-# problem.
+# modelDescription.xml (fmiVersion), so FMI 2.0 and 3.0 FMUs are told apart by what they are;
+# where a model comes in both versions, its FMI 3.0 results must equal its FMI 2.0 results in
+# every row. Results and logs go to target/fmusim/; prints one line per FMU and interface (and
+# per model in both versions) and exits 1 on any problem.
 #
 # usage: FMUSIM=/path/to/fmusim tools/fmusim.sh [FMU or directory ...]
 #   A directory is searched two levels deep for *.fmu; the default is target/ (target/fmu/ and
@@ -15,6 +16,7 @@
 set -u
 fmusim=${FMUSIM:?set FMUSIM to the fmusim executable (see docs/compatibility.md, fmusim)}
 out=target/fmusim
+rm -rf "$out"
 mkdir -p "$out"
 [ $# -gt 0 ] || set -- target
 fmus=()
@@ -111,4 +113,38 @@ for fmu in "${fmus[@]}"; do
     ran+=("$result")
   done
 done
+# The same model in both FMI versions: every row of every column the two results share, FMI 3.0
+# against FMI 2.0 (Booleans parsed: fmusim prints them as true/false for 3.0, 0/1 for 2.0).
+pairs=()
+for result in "$out"/fmi3/*.csv; do
+  [ -f "$result" ] && [ -f "$out/fmi2/$(basename "$result")" ] && pairs+=("$result")
+done
+if [ ${#pairs[@]} -gt 0 ]; then
+  echo
+  printf '%-18s %-3s %6s %8s %s\n' model api rows columns "FMI 3.0 against FMI 2.0"
+  for result in "${pairs[@]}"; do
+    name=$(basename "$result" .csv)
+    python3 - "$result" "$out/fmi2/$name.csv" "${name%.*}" "${name##*.}" <<'PY' || failed=1
+import csv, math, sys
+def load(path):
+    with open(path) as f:
+        rows = [r for r in csv.reader(f) if r]
+    value = lambda x: {"true": 1.0, "false": 0.0}[x.lower()] if x.lower() in ("true", "false") else float(x)
+    return {name: [value(r[i]) for r in rows[1:]] for i, name in enumerate(rows[0])}
+three, two = load(sys.argv[1]), load(sys.argv[2])
+shared = [name for name in three if name in two]
+rows = len(three["time"])
+if len(two["time"]) != rows:
+    verdict, ok = f"row counts differ ({rows} against {len(two['time'])})", False
+else:
+    scale = {name: max(abs(x) for x in two[name]) or 1.0 for name in shared}
+    worst = max((abs(a - b) / scale[name]
+                 for name in shared for a, b in zip(three[name], two[name])), default=0.0)
+    identical = all(three[name] == two[name] for name in shared)
+    verdict, ok = ("identical" if identical else f"largest difference {worst:.1e} of the column's range"), identical
+print(f"{sys.argv[3]:<18} {sys.argv[4]:<3} {rows:>6} {len(shared) - 1:>8} {verdict}")
+sys.exit(0 if ok else 1)
+PY
+  done
+fi
 exit $failed
