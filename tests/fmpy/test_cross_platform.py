@@ -185,7 +185,8 @@ def wineserver():
     server = tool("wineserver")
     quiet = dict(env=WINE_ENV, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                  stderr=subprocess.DEVNULL)
-    subprocess.run([server, "-p"], check=True, **quiet)
+    # Kept for 120 s after its last client, should the module not reach its teardown.
+    subprocess.run([server, "-p120"], check=True, **quiet)
     subprocess.run([tool("wine64"), "cmd", "/c", "exit"], timeout=120, **quiet)
     yield
     subprocess.run([server, "-k"], env=WINE_ENV, stderr=subprocess.DEVNULL)
