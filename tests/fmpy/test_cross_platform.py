@@ -2,7 +2,8 @@
 linux64 .so, in Co-Simulation and in Model Exchange. One small C master (tests/cross/harness.c),
 built natively, with mingw-w64 and with the aarch64 cross gcc, runs the same script on each binary:
 every scene (fast variant, parameters and inputs included) whose FMU it is, then the FMU's
-cross-check input. It reads the Real, Integer and Boolean outputs after every step, directional
+cross-check input (Model Exchange by explicit Euler with event handling). It reads the Real,
+Integer, Enumeration and Boolean outputs and calculated parameters after every step, directional
 derivatives every tenth step, in Model Exchange also the states, derivatives, event indicators
 and the number of events; it saves an FMU state a third of the way through and restores it two
 steps later, and serializes one two thirds of the way through and deserializes it two steps
@@ -16,7 +17,7 @@ What is asserted, per value read:
   in the last bit: MultiferroicMotor (ring-bar magnetics) and FreeBladder (the exact tube's
   logarithm) are compared to MEASURED_WINE below, the largest relative difference measured, with
   their Integer and Boolean outputs, serialized-state sizes and event counts still exact. The
-  Gilbert onion's relaxation carries those last bits into the rotor's path: see its own test.
+  Gilbert onion's path is ill-conditioned and takes those last bits elsewhere: see its own test.
 `make fmus` builds the binaries and `make cross-deps` installs the toolchains and emulators."""
 
 import math
