@@ -186,9 +186,12 @@ def wineserver():
     server = tool("wineserver")
     quiet = dict(env=WINE_ENV, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL,
                  stderr=subprocess.DEVNULL)
+    # The server needs the prefix's directory; the first wine run below fills it.
+    pathlib.Path(WINE_ENV["WINEPREFIX"]).mkdir(parents=True, exist_ok=True)
     # Kept for 120 s after its last client, should the module not reach its teardown.
     subprocess.run([server, "-p120"], check=True, **quiet)
-    subprocess.run([tool("wine64"), "cmd", "/c", "exit"], timeout=120, **quiet)
+    # The first run in a new prefix also creates it (about 10 s here).
+    subprocess.run([tool("wine64"), "cmd", "/c", "exit"], timeout=600, **quiet)
     yield
     subprocess.run([server, "-k"], env=WINE_ENV, stderr=subprocess.DEVNULL)
 
