@@ -80,7 +80,9 @@ def script_for(model):
 def transcript(command, script, env=None):
     r = subprocess.run(command, input=script, capture_output=True, text=True, env=env, timeout=600)
     assert r.returncode == 0, f"{command[0]} failed ({r.returncode}): {r.stdout[-500:]} {r.stderr[-2000:]}"
-    return np.array([float(x) for line in r.stdout.splitlines() for x in line.split()])
+    # The FMI 2.0 master starts each line with a tag (r: Reals); the values follow.
+    return np.array([float(x) for line in r.stdout.splitlines()
+                     for x in line.split()[1 if line[:1].isalpha() else 0:]])
 
 
 def binary(model, platform, extension, directory):
