@@ -37,8 +37,27 @@ def tool(name):
     return path
 
 
+# Its own prefix: the module's wineserver is stopped at its end without touching another module's.
+WINE_ENV = dict(os.environ, WINEDEBUG="-all", WINEDLLOVERRIDES="mscoree,mshtml=",
+                WINEPREFIX=str(ROOT / "target" / "wine-prefix-fmi3"))
+
+
 @pytest.fixture(scope="module")
-def harnesses(tmp_path_factory):
+def wineserver():
+    """One wineserver for the module's wine runs: a run that starts its own waits for the server's
+    linger on its output pipe (about 3 s a run)."""
+    server = tool("wineserver")
+    quiet = dict(env=WINE_ENV, stdin=subprocess.DEVNULL, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    pathlib.Path(WINE_ENV["WINEPREFIX"]).mkdir(parents=True, exist_ok=True)
+    # Kept for 120 s after its last client, should the module not reach its teardown.
+    subprocess.run([server, "-p120"], check=True, **quiet)
+    subprocess.run([tool("wine64"), "cmd", "/c", "exit"], timeout=600, **quiet)
+    yield
+    subprocess.run([server, "-k"], env=WINE_ENV, stderr=subprocess.DEVNULL)
+
+
+@pytest.fixture(scope="module")
+def harnesses(tmp_path_factory, wineserver):
     d = tmp_path_factory.mktemp("fmi3_harness")
     win = d / "win"
     win.mkdir()
@@ -102,7 +121,7 @@ def same_bits(a, b):
 def test_fmi3_equals_fmi2_on_every_platform_and_the_platforms_agree(model, harnesses, tmp_path):
     script, fmi2_script, token = script_for(model)
     win = harnesses / "win"
-    env = dict(os.environ, WINEDEBUG="-all", WINEPREFIX=str(ROOT / "target" / "wine-prefix"))
+    env = WINE_ENV
     so = binary(model, "x86_64-linux", "so", tmp_path)
     (tmp_path / "arm").mkdir()
     arm_so = binary(model, "aarch64-linux", "so", tmp_path / "arm")
