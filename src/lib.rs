@@ -4,14 +4,16 @@
 //! 2014; Cornell's eCommons repository).
 //!
 //! Data flows one way, every arrow pointing down:
-//! [`fmi2`] (C ABI, registry, value arrays) -> [`models`] (typed variables to physics, effect
-//! switches) -> [`physics`] (pure equations). Beside them, [`variables`] holds what build.rs
-//! generates from `modelDescription/*.xml`: value references, metadata and each model's typed
-//! `Parameters`, `Inputs`, `Outputs` and `CalculatedParameters`; it names nothing above it.
-//! [`fmi3`] is a second export layer (FMI 3.0) over the same models and [`fmi2`]'s machinery.
-//! [`fmi2`] and [`fmi3`] are the only modules that allow `unsafe_code`; `physics` and `models`
-//! forbid it.
+//! [`fmi2`], [`fmi3`] (each FMI version's C ABI and its mapping) -> [`export`] (the
+//! version-neutral machinery: instance handles, panic guard, call-sequence state machine,
+//! variable rules, FMU states, logging, registry) -> [`models`] (typed variables to physics,
+//! effect switches) -> [`physics`] (pure equations). Beside them, [`variables`] holds what
+//! build.rs generates from `modelDescription/*.xml`: value references, metadata and each model's
+//! typed `Parameters`, `Inputs`, `Outputs` and `CalculatedParameters`; it names nothing above it.
+//! [`fmi2`] and [`fmi3`] never use each other. [`export`], [`fmi2`] and [`fmi3`] are the only
+//! modules that allow `unsafe_code`; `physics` and `models` forbid it.
 
+pub mod export;
 pub mod fmi2;
 pub mod fmi3;
 pub mod models;

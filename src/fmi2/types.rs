@@ -18,16 +18,8 @@ pub type fmi2Byte = c_char;
 pub const FMI2_TRUE: fmi2Boolean = 1;
 pub const FMI2_FALSE: fmi2Boolean = 0;
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-pub enum fmi2Status {
-    OK = 0,
-    Warning = 1,
-    Discard = 2,
-    Error = 3,
-    Fatal = 4,
-    Pending = 5,
-}
+/// `fmi2Status`: the values of [`crate::export::Status`] (`fmi2Pending` is never returned).
+pub type fmi2Status = crate::export::Status;
 
 /// `fmi2Type`, received as an int so that an out-of-range value cannot be undefined behaviour.
 pub const FMI2_MODEL_EXCHANGE: c_int = 0;

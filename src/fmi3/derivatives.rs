@@ -1,9 +1,9 @@
 //! Directional and adjoint derivatives, and the declared variable dependencies.
 
-use super::exports::Status;
+use super::exports::{guarded, Status};
 use super::{fmi3Instance, fmi3Status, fmi3ValueReference};
-use crate::fmi2::exports::{guarded, null_argument, slice, slice_mut};
-use crate::fmi2::instance::Instance;
+use crate::export::guard::{null_argument, slice, slice_mut};
+use crate::export::instance::{allowed, Instance};
 use std::ffi::c_int;
 
 /// Partials are served for Float64 variables (the FMI 2.0 Reals, same value references); `time`
@@ -53,7 +53,7 @@ pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
             {
                 return refused;
             }
-            inst.get_directional_derivative(unknowns, knowns, seed, sensitivity)
+            inst.get_directional_derivative(F, unknowns, knowns, seed, sensitivity)
         })
     }
 }
@@ -98,7 +98,7 @@ pub unsafe extern "C" fn fmi3GetAdjointDerivative(
             let mut column = vec![0.0; unknowns.len()];
             let mut status = Status::OK;
             for (k, &known) in knowns.iter().enumerate() {
-                let s = inst.get_directional_derivative(unknowns, &[known], &[1.0], &mut column);
+                let s = inst.get_directional_derivative(F, unknowns, &[known], &[1.0], &mut column);
                 if s >= Status::Discard {
                     return s;
                 }
@@ -184,7 +184,7 @@ fn dependencies(
     function: &str,
     vr: u32,
 ) -> Result<&'static [(u32, u8)], fmi3Status> {
-    if !inst.allowed(function, crate::fmi2::instance::allowed::ALL_BUT_FATAL) {
+    if !inst.allowed(function, allowed::ALL_BUT_FATAL) {
         return Err(Status::Error);
     }
     let Some(model) = super::model(inst.info().name) else {

@@ -1,22 +1,42 @@
 //! The FMI 3.0 functions of every interface: instantiation, the mode changes, `fmi3DoStep` (FMU
 //! states are in `fmu_state`, derivatives and dependencies in `derivatives`). Each body runs under
-//! the shared panic guard (`fmi2::exports::guarded`) on the shared `Instance`.
+//! the version-neutral panic guard ([`crate::export::guard`]) on the shared `Instance`.
 //!
 //! Every `unsafe` block relies on the importer keeping the FMI 3.0 calling convention: an
 //! instance from `fmi3Instantiate*` (or NULL), arrays of the length it passes (or NULL), and
 //! NUL-terminated strings. The shared helpers check what can be checked.
 
+use super::logger::{self, Fmi3LogMessageCallback};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status, fmi3String, fmi3ValueReference};
-use crate::fmi2::exports::handles;
-use crate::fmi2::exports::{guarded, null_argument, slice, text};
-use crate::fmi2::instance::Instance;
-use crate::fmi2::logger::{Fmi3LogMessageCallback, Logger};
-use crate::fmi2::REGISTRY;
+use crate::export::guard::{self, null_argument, slice, text};
+use crate::export::handles;
+use crate::export::instance::{Api, Instance};
+use crate::export::logger::Logger;
+pub(super) use crate::export::Status;
+use crate::export::REGISTRY;
 use std::ffi::{c_char, c_void};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 
-/// `fmi3Status` is FMI 2.0's enum.
-pub(super) use crate::fmi2::types::fmi2Status as Status;
+/// How an FMI 3.0 instance names what its messages mention.
+static API: Api = Api {
+    version: "FMI 3.0",
+    step_state: "StepMode",
+    get_fmu_state: "fmi3GetFMUState",
+    serialize_fmu_state: "fmi3SerializeFMUState",
+};
+
+/// Runs `body` on the FMI 3.0 instance behind `instance` under the panic guard
+/// ([`guard::guarded`]).
+///
+/// # Safety
+/// As [`guard::guarded`].
+pub(super) unsafe fn guarded(
+    instance: fmi3Instance,
+    function: &str,
+    body: impl FnOnce(&mut Instance) -> fmi3Status,
+) -> fmi3Status {
+    unsafe { guard::guarded(&API, instance, function, body) }
+}
 
 #[no_mangle]
 pub extern "C" fn fmi3GetVersion() -> *const c_char {
@@ -36,7 +56,7 @@ fn instantiate(
     refusal: Option<&str>,
 ) -> Option<fmi3Instance> {
     let name = instance_name.unwrap_or_default();
-    let mut logger = Logger::new_fmi3(log, environment, if name.is_empty() { "?" } else { &name });
+    let mut logger = logger::logger(log, environment, if name.is_empty() { "?" } else { &name });
     let refuse = |logger: &Logger, why: String| {
         logger.log(Status::Error, &format!("{function}: {why}"));
         None
@@ -70,11 +90,11 @@ fn instantiate(
         );
     }
     logger.debug = logging_on;
-    let mut instance = Box::new(Instance::new(*factory, logger));
+    let mut instance = Box::new(Instance::new(*factory, &API, logger));
     instance.model_exchange = model_exchange;
     let handle = handles::register(instance);
     if handle.is_none() {
-        Logger::new_fmi3(log, environment, &name).log(
+        logger::logger(log, environment, &name).log(
             Status::Error,
             &format!(
                 "{function}: {} instances are alive in this process, the most it holds",
@@ -164,7 +184,7 @@ pub unsafe extern "C" fn fmi3InstantiateScheduledExecution(
     let _ = catch_unwind(|| {
         // SAFETY: NULL or a NUL-terminated string.
         let name = unsafe { text(instance_name) }.unwrap_or_else(|| "?".into());
-        Logger::new_fmi3(log_message, instance_environment, &name).log(
+        logger::logger(log_message, instance_environment, &name).log(
             Status::Error,
             "fmi3InstantiateScheduledExecution: Scheduled Execution is not supported: the models have no clocks or model partitions (the description declares Co-Simulation and Model Exchange only)",
         );
@@ -177,7 +197,7 @@ pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
     let Some(inst) = handles::release(instance) else {
         return;
     };
-    if !inst.logger.is_fmi3() {
+    if inst.api.version != API.version {
         // An FMI 2.0 instance freed through FMI 3.0: freed all the same (nothing else can).
         inst.logger.log(
             Status::Warning,
@@ -205,7 +225,7 @@ pub unsafe extern "C" fn fmi3SetDebugLogging(
                 return null_argument(inst, F, "a category name");
             };
             let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-            inst.set_debug_logging(logging_on != 0, &refs)
+            inst.set_debug_logging(F, logging_on != 0, &refs)
         })
     }
 }
@@ -219,37 +239,37 @@ pub unsafe extern "C" fn fmi3EnterInitializationMode(
     stop_time_defined: fmi3Boolean,
     stop_time: f64,
 ) -> fmi3Status {
+    const F: &str = "fmi3EnterInitializationMode";
     unsafe {
-        guarded(instance, "fmi3EnterInitializationMode", |inst| {
+        guarded(instance, F, |inst| {
             let tolerance = (tolerance_defined != 0).then_some(tolerance);
             let stop = (stop_time_defined != 0).then_some(stop_time);
             // FMI 2.0's fmi2SetupExperiment and fmi2EnterInitializationMode in one call.
-            let status = inst.setup_experiment(tolerance, start_time, stop);
+            let status = inst.setup_experiment(F, tolerance, start_time, stop);
             if status >= Status::Error {
                 return status;
             }
-            status.max(inst.enter_initialization_mode())
+            status.max(inst.enter_initialization_mode(F))
         })
     }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3ExitInitializationMode(instance: fmi3Instance) -> fmi3Status {
-    unsafe {
-        guarded(instance, "fmi3ExitInitializationMode", |inst| {
-            inst.exit_initialization_mode()
-        })
-    }
+    const F: &str = "fmi3ExitInitializationMode";
+    unsafe { guarded(instance, F, |inst| inst.exit_initialization_mode(F)) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3Terminate(instance: fmi3Instance) -> fmi3Status {
-    unsafe { guarded(instance, "fmi3Terminate", |inst| inst.terminate()) }
+    const F: &str = "fmi3Terminate";
+    unsafe { guarded(instance, F, |inst| inst.terminate(F)) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3Reset(instance: fmi3Instance) -> fmi3Status {
-    unsafe { guarded(instance, "fmi3Reset", |inst| inst.reset()) }
+    const F: &str = "fmi3Reset";
+    unsafe { guarded(instance, F, |inst| inst.reset(F)) }
 }
 
 #[no_mangle]
@@ -279,7 +299,7 @@ pub unsafe extern "C" fn fmi3DoStep(
                     "eventHandlingNeeded, terminateSimulation, earlyReturn or lastSuccessfulTime",
                 );
             };
-            let status = inst.do_step(current_communication_point, communication_step_size);
+            let status = inst.do_step(F, current_communication_point, communication_step_size);
             // No events in Co-Simulation, never an early return; the time reached (or kept, after
             // a refused or discarded step).
             *event = 0;

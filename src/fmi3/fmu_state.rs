@@ -1,9 +1,9 @@
 //! FMU states through FMI 3.0: the shared instance's states and their checked serialization.
 
-use super::exports::Status;
+use super::exports::{guarded, Status};
 use super::{fmi3FMUState, fmi3Instance, fmi3Status};
-use crate::fmi2::exports::{guarded, null_argument, slice, slice_mut};
-use crate::fmi2::instance::FmuState;
+use crate::export::guard::{null_argument, slice, slice_mut};
+use crate::export::instance::FmuState;
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3GetFMUState(
@@ -16,7 +16,7 @@ pub unsafe extern "C" fn fmi3GetFMUState(
             let Some(slot) = state.as_mut() else {
                 return null_argument(inst, F, "FMUState");
             };
-            match inst.get_fmu_state(*slot as *mut FmuState) {
+            match inst.get_fmu_state(F, *slot as *mut FmuState) {
                 Ok(ptr) => {
                     *slot = ptr as fmi3FMUState;
                     Status::OK
@@ -32,9 +32,10 @@ pub unsafe extern "C" fn fmi3SetFMUState(
     instance: fmi3Instance,
     state: fmi3FMUState,
 ) -> fmi3Status {
+    const F: &str = "fmi3SetFMUState";
     unsafe {
-        guarded(instance, "fmi3SetFMUState", |inst| {
-            inst.set_fmu_state(state as *mut FmuState)
+        guarded(instance, F, |inst| {
+            inst.set_fmu_state(F, state as *mut FmuState)
         })
     }
 }
@@ -50,7 +51,7 @@ pub unsafe extern "C" fn fmi3FreeFMUState(
             let Some(slot) = state.as_mut() else {
                 return null_argument(inst, F, "FMUState");
             };
-            let status = inst.free_fmu_state(*slot as *mut FmuState);
+            let status = inst.free_fmu_state(F, *slot as *mut FmuState);
             if status == Status::OK {
                 *slot = std::ptr::null_mut();
             }
@@ -123,7 +124,7 @@ pub unsafe extern "C" fn fmi3DeserializeFMUState(
             let (Some(data), Some(slot)) = (slice(bytes, size), state.as_mut()) else {
                 return null_argument(inst, F, "serializedState and FMUState");
             };
-            match inst.deserialize_fmu_state(data, *slot as *mut FmuState) {
+            match inst.deserialize_fmu_state(F, data, *slot as *mut FmuState) {
                 Ok(ptr) => {
                     *slot = ptr as fmi3FMUState;
                     Status::OK

@@ -2,11 +2,13 @@
 //! [`crate::fmi2`], exported from the same shared library: the `fmi3*` and `fmi2*` symbols do not
 //! collide.
 //!
-//! It shares the version-neutral machinery of `src/fmi2`: the instance handles and the panic
-//! guard (`fmi2::exports`), the call-sequence state machine, the variable rules, FMU states and
-//! the out-of-range policy (`fmi2::instance`), the runtime over any model and the logger (which
-//! speaks both versions' callbacks). What is FMI 3.0's own lives here:
-//! - `exports`: instantiation, the mode changes, `fmi3DoStep`;
+//! It maps FMI 3.0's calls onto the version-neutral machinery of [`crate::export`] (instance
+//! handles, panic guard, call-sequence state machine, variable rules, FMU states, out-of-range
+//! policy, the runtime over any model); it never uses `src/fmi2`. What is FMI 3.0's own lives
+//! here:
+//! - `exports`: instantiation, the mode changes, `fmi3DoStep`, and the panic guard's FMI 3.0
+//!   entry (`guarded`);
+//! - `logger`: the FMI 3.0 logger callback;
 //! - `fmu_state`: FMU states and their serialization;
 //! - `derivatives`: directional and adjoint derivatives, variable dependencies;
 //! - `values`: get and set by FMI 3.0 value reference ([`Fmi3Model`] maps them to FMI 2.0's);
@@ -22,13 +24,13 @@
 mod derivatives;
 mod exports;
 mod fmu_state;
+mod logger;
 mod model_exchange;
 #[cfg(test)]
 mod tests;
 mod unsupported;
 mod values;
 
-use crate::fmi2::types::fmi2Status;
 use std::ffi::c_void;
 
 pub type fmi3Instance = *mut c_void;
@@ -37,8 +39,8 @@ pub type fmi3ValueReference = u32;
 /// A C `bool`, received as a byte so that any value the importer passes is defined.
 pub type fmi3Boolean = u8;
 pub type fmi3String = *const std::ffi::c_char;
-/// `fmi3Status` has FMI 2.0's values (OK 0 .. Fatal 4).
-pub type fmi3Status = fmi2Status;
+/// `fmi3Status` (OK 0 .. Fatal 4).
+pub type fmi3Status = crate::export::Status;
 
 /// An FMI 3.0 view of one model: its description and where its value references lie (the
 /// Float64 ones are the FMI 2.0 Real ones; see `build/fmi3_description.rs`).

@@ -1,19 +1,15 @@
 //! The FMI 3.0 Model Exchange functions (FMI 3.0 section 3.2) over the shared instance's event
 //! and continuous-time modes.
 
-use super::exports::Status;
+use super::exports::{guarded, Status};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status};
-use crate::fmi2::exports::{guarded, null_argument, slice, slice_mut};
-use crate::fmi2::instance::Vector;
-use crate::fmi2::types::{fmi2EventInfo, FMI2_FALSE};
+use crate::export::guard::{null_argument, slice, slice_mut};
+use crate::export::instance::{allowed, Vector};
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterEventMode(instance: fmi3Instance) -> fmi3Status {
-    unsafe {
-        guarded(instance, "fmi3EnterEventMode", |inst| {
-            inst.enter_event_mode()
-        })
-    }
+    const F: &str = "fmi3EnterEventMode";
+    unsafe { guarded(instance, F, |inst| inst.enter_event_mode(F)) }
 }
 
 #[no_mangle]
@@ -47,21 +43,13 @@ pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
             else {
                 return null_argument(inst, F, "an output argument");
             };
-            let mut info = fmi2EventInfo {
-                new_discrete_states_needed: FMI2_FALSE,
-                terminate_simulation: FMI2_FALSE,
-                nominals_of_continuous_states_changed: FMI2_FALSE,
-                values_of_continuous_states_changed: FMI2_FALSE,
-                next_event_time_defined: FMI2_FALSE,
-                next_event_time: 0.0,
-            };
-            let status = inst.new_discrete_states(&mut info);
-            *update = u8::from(info.new_discrete_states_needed != FMI2_FALSE);
-            *terminate = u8::from(info.terminate_simulation != FMI2_FALSE);
-            *nominals = u8::from(info.nominals_of_continuous_states_changed != FMI2_FALSE);
-            *values = u8::from(info.values_of_continuous_states_changed != FMI2_FALSE);
-            *defined = u8::from(info.next_event_time_defined != FMI2_FALSE);
-            *next = info.next_event_time;
+            let (status, iteration) = inst.new_discrete_states(F);
+            *update = u8::from(iteration.update.iterate);
+            *terminate = u8::from(iteration.update.terminate);
+            *nominals = 0;
+            *values = u8::from(iteration.update.states_changed);
+            *defined = u8::from(iteration.next_event_time.is_some());
+            *next = iteration.next_event_time.unwrap_or(0.0);
             status
         })
     }
@@ -69,11 +57,8 @@ pub unsafe extern "C" fn fmi3UpdateDiscreteStates(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3EnterContinuousTimeMode(instance: fmi3Instance) -> fmi3Status {
-    unsafe {
-        guarded(instance, "fmi3EnterContinuousTimeMode", |inst| {
-            inst.enter_continuous_time_mode()
-        })
-    }
+    const F: &str = "fmi3EnterContinuousTimeMode";
+    unsafe { guarded(instance, F, |inst| inst.enter_continuous_time_mode(F)) }
 }
 
 #[no_mangle]
@@ -91,7 +76,7 @@ pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
             else {
                 return null_argument(inst, F, "enterEventMode or terminateSimulation");
             };
-            let (status, event) = inst.completed_integrator_step();
+            let (status, event) = inst.completed_integrator_step(F);
             *enter = u8::from(event);
             *terminate = 0;
             status
@@ -101,7 +86,8 @@ pub unsafe extern "C" fn fmi3CompletedIntegratorStep(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi3SetTime(instance: fmi3Instance, time: f64) -> fmi3Status {
-    unsafe { guarded(instance, "fmi3SetTime", |inst| inst.set_time(time)) }
+    const F: &str = "fmi3SetTime";
+    unsafe { guarded(instance, F, |inst| inst.set_time(F, time)) }
 }
 
 #[no_mangle]
@@ -113,7 +99,7 @@ pub unsafe extern "C" fn fmi3SetContinuousStates(
     const F: &str = "fmi3SetContinuousStates";
     unsafe {
         guarded(instance, F, |inst| match slice(x, nx) {
-            Some(x) => inst.set_continuous_states(x),
+            Some(x) => inst.set_continuous_states(F, x),
             None => null_argument(inst, F, "continuousStates"),
         })
     }
@@ -207,7 +193,7 @@ unsafe fn count(
             let Some(n) = n.as_mut() else {
                 return null_argument(inst, function, "the count");
             };
-            if !inst.allowed(function, crate::fmi2::instance::allowed::ALL_BUT_FATAL) {
+            if !inst.allowed(function, allowed::ALL_BUT_FATAL) {
                 return Status::Error;
             }
             *n = if states {

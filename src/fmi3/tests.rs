@@ -1,7 +1,7 @@
 //! The FMI 3.0 view of each model against the FMI 2.0 one it is generated beside.
 
 use super::FMI3_MODELS;
-use crate::fmi2::REGISTRY;
+use crate::export::REGISTRY;
 
 #[test]
 fn every_model_has_an_fmi3_description_with_the_same_token() {

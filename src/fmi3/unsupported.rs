@@ -2,9 +2,8 @@
 //! clocks, no configuration mode and no event mode in Co-Simulation: each call is refused with a
 //! logged reason (a getter or setter of no variable at all does nothing and succeeds).
 
-use super::exports::Status;
+use super::exports::{guarded, Status};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status, fmi3String, fmi3ValueReference};
-use crate::fmi2::exports::guarded;
 use std::ffi::c_int;
 
 /// Refuses `function` on a live instance, saying why.

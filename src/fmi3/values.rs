@@ -3,10 +3,10 @@
 //! reference is translated to FMI 2.0's by the model's [`Fmi3Model`] layout; the shared
 //! `Instance` then applies the same state, range and NaN rules as FMI 2.0.
 
-use super::exports::Status;
+use super::exports::{guarded, Status};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status, fmi3ValueReference, Fmi3Model};
-use crate::fmi2::exports::{guarded, null_argument, slice, slice_mut};
-use crate::fmi2::instance::{CBoolean, Instance, Vector};
+use crate::export::guard::{null_argument, slice, slice_mut};
+use crate::export::instance::{allowed, CBoolean, Instance, Vector};
 use crate::variables::VarType;
 
 /// What an FMI 3.0 value reference names.
@@ -138,7 +138,7 @@ pub unsafe extern "C" fn fmi3GetFloat64(
             let reals = inst.info().counts[0] as u32;
             // The FMI 2.0 Reals in one call: the common case.
             if vrs.iter().all(|&v| v < reals) {
-                return inst.get_reals(vrs, out);
+                return inst.get_reals(F, vrs, out);
             }
             let Ok(model) = model_of(inst, F) else {
                 return Status::Error;
@@ -147,9 +147,9 @@ pub unsafe extern "C" fn fmi3GetFloat64(
             let mut status = Status::OK;
             for (&v, slot) in vrs.iter().zip(out.iter_mut()) {
                 let s = match classify(model, counts, v) {
-                    Slot::Real(r) => inst.get_reals(&[r], std::slice::from_mut(slot)),
+                    Slot::Real(r) => inst.get_reals(F, &[r], std::slice::from_mut(slot)),
                     Slot::Time => {
-                        if inst.allowed(F, crate::fmi2::instance::allowed::GET) {
+                        if inst.allowed(F, allowed::GET) {
                             *slot = inst.time;
                             Status::OK
                         } else {

@@ -1,17 +1,19 @@
 //! The FMU-state functions: get, set, free, serialize and deserialize.
 
-use super::{guarded, null_argument, slice, slice_mut};
-use crate::fmi2::instance::FmuState;
+use super::guarded;
+use crate::export::guard::{null_argument, slice, slice_mut};
+use crate::export::instance::FmuState;
 use crate::fmi2::types::*;
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUstate) -> fmi2Status {
+    const F: &str = "fmi2GetFMUstate";
     unsafe {
-        guarded(c, "fmi2GetFMUstate", |inst| {
+        guarded(c, F, |inst| {
             let Some(slot) = state.as_mut() else {
-                return null_argument(inst, "fmi2GetFMUstate", "FMUstate");
+                return null_argument(inst, F, "FMUstate");
             };
-            match inst.get_fmu_state(*slot as *mut FmuState) {
+            match inst.get_fmu_state(F, *slot as *mut FmuState) {
                 Ok(ptr) => {
                     *slot = ptr as fmi2FMUstate;
                     fmi2Status::OK
@@ -24,11 +26,8 @@ pub unsafe extern "C" fn fmi2GetFMUstate(c: fmi2Component, state: *mut fmi2FMUst
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetFMUstate(c: fmi2Component, state: fmi2FMUstate) -> fmi2Status {
-    unsafe {
-        guarded(c, "fmi2SetFMUstate", |inst| {
-            inst.set_fmu_state(state as *mut FmuState)
-        })
-    }
+    const F: &str = "fmi2SetFMUstate";
+    unsafe { guarded(c, F, |inst| inst.set_fmu_state(F, state as *mut FmuState)) }
 }
 
 #[no_mangle]
@@ -36,12 +35,13 @@ pub unsafe extern "C" fn fmi2FreeFMUstate(
     c: fmi2Component,
     state: *mut fmi2FMUstate,
 ) -> fmi2Status {
+    const F: &str = "fmi2FreeFMUstate";
     unsafe {
-        guarded(c, "fmi2FreeFMUstate", |inst| {
+        guarded(c, F, |inst| {
             let Some(slot) = state.as_mut() else {
-                return null_argument(inst, "fmi2FreeFMUstate", "FMUstate");
+                return null_argument(inst, F, "FMUstate");
             };
-            let status = inst.free_fmu_state(*slot as *mut FmuState);
+            let status = inst.free_fmu_state(F, *slot as *mut FmuState);
             if status == fmi2Status::OK {
                 *slot = std::ptr::null_mut();
             }
@@ -114,7 +114,7 @@ pub unsafe extern "C" fn fmi2DeSerializeFMUstate(
             let (Some(data), Some(slot)) = (slice(bytes as *const u8, size), state.as_mut()) else {
                 return null_argument(inst, F, "serializedState and FMUstate");
             };
-            match inst.deserialize_fmu_state(data, *slot as *mut FmuState) {
+            match inst.deserialize_fmu_state(F, data, *slot as *mut FmuState) {
                 Ok(ptr) => {
                     *slot = ptr as fmi2FMUstate;
                     fmi2Status::OK

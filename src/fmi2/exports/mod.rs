@@ -5,106 +5,37 @@
 //!
 //! Every `unsafe` block below relies on the importer keeping the FMI 2.0 calling convention: a
 //! component from `fmi2Instantiate` (or NULL), arrays of the length it passes (or NULL), and
-//! NUL-terminated strings. `guarded` and the slice helpers check what can be checked (the
-//! instance handle, `handles`; a NULL array of non-zero length).
+//! NUL-terminated strings. `guarded` and the slice helpers ([`crate::export::guard`]) check what
+//! can be checked (the instance handle; a NULL array of non-zero length).
 
-use super::instance::Instance;
-use super::logger::Logger;
-use super::registry::REGISTRY;
+use super::logger;
 use super::types::*;
-use std::ffi::{c_char, c_int, CStr};
+use crate::export::guard::{self, null_argument, slice, slice_mut, text};
+use crate::export::handles;
+use crate::export::instance::{Api, Instance};
+use crate::export::REGISTRY;
+use std::ffi::{c_char, c_int};
 use std::panic::{catch_unwind, AssertUnwindSafe};
 use std::path::PathBuf;
 
-/// The instance behind `c`, if `c` is the handle of a live instance of ours ([`handles`]).
+/// How an FMI 2.0 instance names what its messages mention.
+pub(crate) static API: Api = Api {
+    version: "FMI 2.0",
+    step_state: "StepComplete",
+    get_fmu_state: "fmi2GetFMUstate",
+    serialize_fmu_state: "fmi2SerializeFMUstate",
+};
+
+/// Runs `body` on the FMI 2.0 instance behind `c` under the panic guard ([`guard::guarded`]).
 ///
 /// # Safety
-/// No other reference to the instance may be alive (FMI 2.0: one call at a time per instance).
-unsafe fn instance<'a>(c: fmi2Component) -> Option<&'a mut Instance> {
-    // SAFETY: a live instance of ours, owned by the handle table until fmi2FreeInstance.
-    handles::resolve(c).map(|ptr| unsafe { &mut *ptr })
-}
-
-fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "unknown panic".into())
-}
-
-/// Every export's one path: checks the instance pointer, then runs `body` on it; a panic is
-/// logged and the instance becomes fatal, it never unwinds into the importer.
-///
-/// # Safety
-/// As [`instance`].
-pub(crate) unsafe fn guarded(
+/// As [`guard::guarded`].
+unsafe fn guarded(
     c: fmi2Component,
     function: &str,
     body: impl FnOnce(&mut Instance) -> fmi2Status,
 ) -> fmi2Status {
-    // SAFETY: see `instance`.
-    let Some(inst) = (unsafe { instance(c) }) else {
-        return fmi2Status::Error;
-    };
-    // One handle table serves both FMI versions: an instance answers only its own version's calls.
-    if function.starts_with("fmi3") != inst.logger.is_fmi3() {
-        return inst.error(&format!(
-            "{function}: the instance was instantiated through the other FMI version's API"
-        ));
-    }
-    let ptr: *mut Instance = inst;
-    // SAFETY: `ptr` is live for the whole call; the closure's borrow ends before the panic arm.
-    match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *ptr }))) {
-        Ok(status) => status,
-        Err(payload) => {
-            // SAFETY: as above; nothing else borrows the instance now.
-            let inst = unsafe { &mut *ptr };
-            inst.set_state(super::instance::MachineState::Fatal);
-            inst.logger.log(
-                fmi2Status::Fatal,
-                &format!("{function}: internal error: {}", panic_text(&*payload)),
-            );
-            fmi2Status::Fatal
-        }
-    }
-}
-
-/// A slice from a C array; NULL is accepted only for an empty array.
-///
-/// # Safety
-/// A non-null `ptr` must point to `n` readable elements.
-pub(crate) unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
-    match (ptr.is_null(), n) {
-        (_, 0) => Some(&[]),
-        (true, _) => None,
-        // SAFETY: the caller promises `n` readable elements at a non-null `ptr`.
-        (false, _) => Some(unsafe { std::slice::from_raw_parts(ptr, n) }),
-    }
-}
-
-/// # Safety
-/// As [`slice`], for `n` writable elements.
-pub(crate) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize) -> Option<&'a mut [T]> {
-    match (ptr.is_null(), n) {
-        (_, 0) => Some(&mut []),
-        (true, _) => None,
-        // SAFETY: the caller promises `n` writable elements at a non-null `ptr`.
-        (false, _) => Some(unsafe { std::slice::from_raw_parts_mut(ptr, n) }),
-    }
-}
-
-/// # Safety
-/// A non-null `s` must be NUL-terminated.
-pub(crate) unsafe fn text(s: fmi2String) -> Option<String> {
-    // SAFETY: non-null, and the caller promises NUL termination.
-    (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned())
-}
-
-#[cold]
-#[inline(never)]
-pub(crate) fn null_argument(inst: &Instance, function: &str, argument: &str) -> fmi2Status {
-    inst.error(&format!("{function}: {argument} must not be NULL"))
+    unsafe { guard::guarded(&API, c, function, body) }
 }
 
 #[no_mangle]
@@ -166,7 +97,7 @@ pub unsafe extern "C" fn fmi2Instantiate(
         // strings (FMI 2.0 section 2.1.5).
         let callbacks = unsafe { functions.as_ref() }?;
         let name = unsafe { text(instance_name) };
-        let logger = Logger::new(
+        let logger = logger::logger(
             callbacks.logger,
             callbacks.component_environment,
             name.as_deref().unwrap_or("?"),
@@ -219,12 +150,12 @@ pub unsafe extern "C" fn fmi2Instantiate(
                 ),
             }
         }
-        let mut instance = Box::new(Instance::new(*factory, logger));
+        let mut instance = Box::new(Instance::new(*factory, &API, logger));
         instance.model_exchange = model_exchange;
         let handle = handles::register(instance);
         if handle.is_none() {
             // The instance and its logger are gone; say why through the importer's callback.
-            Logger::new(
+            logger::logger(
                 callbacks.logger,
                 callbacks.component_environment,
                 name.as_deref().unwrap_or("?"),
@@ -269,7 +200,7 @@ pub unsafe extern "C" fn fmi2SetDebugLogging(
                 return null_argument(inst, "fmi2SetDebugLogging", "a category name");
             };
             let refs: Vec<&str> = names.iter().map(String::as_str).collect();
-            inst.set_debug_logging(logging_on != FMI2_FALSE, &refs)
+            inst.set_debug_logging("fmi2SetDebugLogging", logging_on != FMI2_FALSE, &refs)
         })
     }
 }
@@ -283,45 +214,41 @@ pub unsafe extern "C" fn fmi2SetupExperiment(
     stop_time_defined: fmi2Boolean,
     stop_time: fmi2Real,
 ) -> fmi2Status {
+    const F: &str = "fmi2SetupExperiment";
     unsafe {
-        guarded(c, "fmi2SetupExperiment", |inst| {
+        guarded(c, F, |inst| {
             let tolerance = (tolerance_defined != FMI2_FALSE).then_some(tolerance);
             let stop = (stop_time_defined != FMI2_FALSE).then_some(stop_time);
-            inst.setup_experiment(tolerance, start_time, stop)
+            inst.setup_experiment(F, tolerance, start_time, stop)
         })
     }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterInitializationMode(c: fmi2Component) -> fmi2Status {
-    unsafe {
-        guarded(c, "fmi2EnterInitializationMode", |inst| {
-            inst.enter_initialization_mode()
-        })
-    }
+    const F: &str = "fmi2EnterInitializationMode";
+    unsafe { guarded(c, F, |inst| inst.enter_initialization_mode(F)) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2ExitInitializationMode(c: fmi2Component) -> fmi2Status {
-    unsafe {
-        guarded(c, "fmi2ExitInitializationMode", |inst| {
-            inst.exit_initialization_mode()
-        })
-    }
+    const F: &str = "fmi2ExitInitializationMode";
+    unsafe { guarded(c, F, |inst| inst.exit_initialization_mode(F)) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Terminate(c: fmi2Component) -> fmi2Status {
-    unsafe { guarded(c, "fmi2Terminate", |inst| inst.terminate()) }
+    const F: &str = "fmi2Terminate";
+    unsafe { guarded(c, F, |inst| inst.terminate(F)) }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
-    unsafe { guarded(c, "fmi2Reset", |inst| inst.reset()) }
+    const F: &str = "fmi2Reset";
+    unsafe { guarded(c, F, |inst| inst.reset(F)) }
 }
 
 mod fmu_state;
-pub(crate) mod handles;
 mod model_exchange;
 #[cfg(test)]
 mod tests;
@@ -349,7 +276,7 @@ pub unsafe extern "C" fn fmi2GetDirectionalDerivative(
             ) else {
                 return null_argument(inst, F, "vUnknown_ref, vKnown_ref, dvKnown or dvUnknown");
             };
-            inst.get_directional_derivative(unknown, known, dv_known, dv_unknown)
+            inst.get_directional_derivative(F, unknown, known, dv_known, dv_unknown)
         })
     }
 }
@@ -397,9 +324,10 @@ pub unsafe extern "C" fn fmi2DoStep(
     communication_step_size: fmi2Real,
     _no_set_fmu_state_prior_to_current_point: fmi2Boolean,
 ) -> fmi2Status {
+    const F: &str = "fmi2DoStep";
     unsafe {
-        guarded(c, "fmi2DoStep", |inst| {
-            inst.do_step(current_communication_point, communication_step_size)
+        guarded(c, F, |inst| {
+            inst.do_step(F, current_communication_point, communication_step_size)
         })
     }
 }
@@ -473,7 +401,7 @@ pub unsafe extern "C" fn fmi2GetRealStatus(
                     fmi2Status::Error
                 };
             }
-            match inst.last_successful_time() {
+            match inst.last_successful_time(F) {
                 Ok(t) => {
                     *value = t;
                     fmi2Status::OK

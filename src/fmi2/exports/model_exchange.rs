@@ -1,13 +1,15 @@
 //! The Model Exchange functions of FMI 2.0 (section 3.2), for every model that serves Model
-//! Exchange; the state machine behind them is `instance/model_exchange.rs`.
+//! Exchange; the state machine behind them is `src/export/instance/model_exchange.rs`.
 
-use super::{guarded, null_argument, slice, slice_mut};
-use crate::fmi2::instance::Vector;
+use super::guarded;
+use crate::export::guard::{null_argument, slice, slice_mut};
+use crate::export::instance::Vector;
 use crate::fmi2::types::*;
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterEventMode(c: fmi2Component) -> fmi2Status {
-    unsafe { guarded(c, "fmi2EnterEventMode", |inst| inst.enter_event_mode()) }
+    const F: &str = "fmi2EnterEventMode";
+    unsafe { guarded(c, F, |inst| inst.enter_event_mode(F)) }
 }
 
 #[no_mangle]
@@ -19,21 +21,28 @@ pub unsafe extern "C" fn fmi2NewDiscreteStates(
     unsafe {
         guarded(c, F, |inst| {
             // SAFETY: a non-null pointer from the importer points to an fmi2EventInfo.
-            match event_info.as_mut() {
-                Some(info) => inst.new_discrete_states(info),
-                None => null_argument(inst, F, "fmi2eventInfo"),
-            }
+            let Some(info) = event_info.as_mut() else {
+                return null_argument(inst, F, "fmi2eventInfo");
+            };
+            let (status, iteration) = inst.new_discrete_states(F);
+            let flag = |b: bool| if b { FMI2_TRUE } else { FMI2_FALSE };
+            *info = fmi2EventInfo {
+                new_discrete_states_needed: flag(iteration.update.iterate),
+                terminate_simulation: flag(iteration.update.terminate),
+                nominals_of_continuous_states_changed: FMI2_FALSE,
+                values_of_continuous_states_changed: flag(iteration.update.states_changed),
+                next_event_time_defined: flag(iteration.next_event_time.is_some()),
+                next_event_time: iteration.next_event_time.unwrap_or(0.0),
+            };
+            status
         })
     }
 }
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2EnterContinuousTimeMode(c: fmi2Component) -> fmi2Status {
-    unsafe {
-        guarded(c, "fmi2EnterContinuousTimeMode", |inst| {
-            inst.enter_continuous_time_mode()
-        })
-    }
+    const F: &str = "fmi2EnterContinuousTimeMode";
+    unsafe { guarded(c, F, |inst| inst.enter_continuous_time_mode(F)) }
 }
 
 #[no_mangle]
@@ -52,7 +61,7 @@ pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
             else {
                 return null_argument(inst, F, "enterEventMode or terminateSimulation");
             };
-            let (status, event) = inst.completed_integrator_step();
+            let (status, event) = inst.completed_integrator_step(F);
             *enter = if event { FMI2_TRUE } else { FMI2_FALSE };
             *terminate = FMI2_FALSE;
             status
@@ -62,7 +71,8 @@ pub unsafe extern "C" fn fmi2CompletedIntegratorStep(
 
 #[no_mangle]
 pub unsafe extern "C" fn fmi2SetTime(c: fmi2Component, time: fmi2Real) -> fmi2Status {
-    unsafe { guarded(c, "fmi2SetTime", |inst| inst.set_time(time)) }
+    const F: &str = "fmi2SetTime";
+    unsafe { guarded(c, F, |inst| inst.set_time(F, time)) }
 }
 
 #[no_mangle]
@@ -76,7 +86,7 @@ pub unsafe extern "C" fn fmi2SetContinuousStates(
         guarded(c, F, |inst| {
             // SAFETY: the importer passes nx readable values (or NULL, refused here).
             match slice(x, nx) {
-                Some(x) => inst.set_continuous_states(x),
+                Some(x) => inst.set_continuous_states(F, x),
                 None => null_argument(inst, F, "x"),
             }
         })

@@ -1,5 +1,7 @@
 use super::values::{fmi2GetReal, fmi2SetReal};
 use super::*;
+use crate::fmi2::logger::logger;
+use std::ffi::CStr;
 use std::sync::Mutex;
 
 type Log = Mutex<Vec<(c_int, String)>>;
@@ -34,7 +36,7 @@ fn a_panic_is_logged_and_becomes_fatal() {
         >(record)
     };
     let env = &log as *const _ as *mut std::ffi::c_void;
-    let instance = Instance::new(REGISTRY[0], Logger::new(Some(callback), env, "t"));
+    let instance = Instance::new(REGISTRY[0], &API, logger(Some(callback), env, "t"));
     let c = handles::register(Box::new(instance)).unwrap();
     assert_eq!(
         // SAFETY: `c` is a live instance's handle.
@@ -58,7 +60,7 @@ fn a_panic_is_logged_and_becomes_fatal() {
 #[test]
 fn stale_and_made_up_handles_are_refused() {
     let make = || {
-        let instance = Instance::new(REGISTRY[0], Logger::new(None, std::ptr::null_mut(), "t"));
+        let instance = Instance::new(REGISTRY[0], &API, logger(None, std::ptr::null_mut(), "t"));
         handles::register(Box::new(instance)).unwrap()
     };
     let vr = 0u32;

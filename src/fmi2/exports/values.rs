@@ -1,8 +1,9 @@
 //! fmi2SetXXX and fmi2GetXXX: the importer's arrays as slices, handed to the instance.
 
-use super::{guarded, null_argument, slice, slice_mut, text};
-use crate::fmi2::instance::{CBoolean, Value};
-use crate::fmi2::runtime::Runtime;
+use super::guarded;
+use crate::export::guard::{null_argument, slice, slice_mut, text};
+use crate::export::instance::{CBoolean, Value};
+use crate::export::runtime::Runtime;
 use crate::fmi2::types::*;
 use crate::variables::VarType;
 
@@ -111,7 +112,7 @@ pub unsafe extern "C" fn fmi2GetReal(
             let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
                 return null_argument(inst, F, "vr and value");
             };
-            inst.get_reals(vrs, out)
+            inst.get_reals(F, vrs, out)
         })
     }
 }
@@ -163,12 +164,13 @@ pub unsafe extern "C" fn fmi2GetString(
     nvr: usize,
     value: *mut fmi2String,
 ) -> fmi2Status {
+    const F: &str = "fmi2GetString";
     unsafe {
-        guarded(c, "fmi2GetString", |inst| {
+        guarded(c, F, |inst| {
             let (Some(vrs), Some(out)) = (slice(vr, nvr), slice_mut(value, nvr)) else {
-                return null_argument(inst, "fmi2GetString", "vr and value");
+                return null_argument(inst, F, "vr and value");
             };
-            match inst.get_strings(vrs) {
+            match inst.get_strings(F, vrs) {
                 Ok(ptrs) => {
                     out.copy_from_slice(&ptrs);
                     fmi2Status::OK

@@ -2,9 +2,9 @@
 //! with range checks and the rebuild after a tunable parameter changed.
 
 use super::{allowed, type_index, Instance, MachineState};
-use crate::fmi2::logger::c_string;
-use crate::fmi2::runtime::Runtime;
-use crate::fmi2::types::fmi2Status;
+use crate::export::logger::c_string;
+use crate::export::runtime::Runtime;
+use crate::export::Status;
 use crate::variables::{Causality, Initial, VarType, Variability, Variable};
 
 /// A value that fmi2SetXXX can write into a [`Runtime`].
@@ -179,12 +179,7 @@ impl SetRule {
 
 impl Instance {
     #[inline]
-    fn lookup(
-        &self,
-        function: &str,
-        kind: VarType,
-        vr: u32,
-    ) -> Result<&'static Variable, fmi2Status> {
+    fn lookup(&self, function: &str, kind: VarType, vr: u32) -> Result<&'static Variable, Status> {
         match self.by_type[type_index(kind)].get(vr as usize) {
             Some(var) => Ok(var),
             None => Err(self.unknown_reference(function, kind, vr)),
@@ -193,7 +188,7 @@ impl Instance {
 
     #[cold]
     #[inline(never)]
-    fn unknown_reference(&self, function: &str, kind: VarType, vr: u32) -> fmi2Status {
+    fn unknown_reference(&self, function: &str, kind: VarType, vr: u32) -> Status {
         self.error(&format!(
             "{function}: {vr} is not the value reference of a {kind:?} variable of {}",
             self.info.name
@@ -201,9 +196,9 @@ impl Instance {
     }
 
     /// Sets all values or, if any is refused, none (the old values are kept).
-    pub fn set<T: Value>(&mut self, function: &str, vrs: &[u32], values: &[T]) -> fmi2Status {
+    pub fn set<T: Value>(&mut self, function: &str, vrs: &[u32], values: &[T]) -> Status {
         if !self.allowed(function, allowed::SET) {
-            return fmi2Status::Error;
+            return Status::Error;
         }
         let rules = &self.set_rules[type_index(T::KIND)];
         let state = self.state().bit();
@@ -227,19 +222,19 @@ impl Instance {
 
     #[cold]
     #[inline(never)]
-    fn not_settable(&self, function: &str, var: &Variable) -> fmi2Status {
+    fn not_settable(&self, function: &str, var: &Variable) -> Status {
         self.error(&format!(
-            "{function}: {} ({:?}, {:?}) cannot be set in state {:?}",
+            "{function}: {} ({:?}, {:?}) cannot be set in state {}",
             var.name,
             var.causality,
             var.variability,
-            self.state()
+            self.state_name(self.state())
         ))
     }
 
     #[cold]
     #[inline(never)]
-    fn refuse_value<T: Value>(&self, function: &str, value: &T, var: &Variable) -> fmi2Status {
+    fn refuse_value<T: Value>(&self, function: &str, value: &T, var: &Variable) -> Status {
         let reason = value
             .invalid_for(var)
             .unwrap_or_else(|| format!("{} is out of its declared range", var.name));
@@ -261,17 +256,17 @@ impl Instance {
     /// update hook, so the model is rebuilt from its parameters at once (its history restarts).
     /// Parameters it cannot be built from are refused and every value set by the call is undone.
     #[inline]
-    fn rebuild_or_undo(&mut self, function: &str, before: Option<Box<dyn Runtime>>) -> fmi2Status {
+    fn rebuild_or_undo(&mut self, function: &str, before: Option<Box<dyn Runtime>>) -> Status {
         match before {
-            None => fmi2Status::OK,
+            None => Status::OK,
             Some(before) => self.rebuild(function, before),
         }
     }
 
     #[inline(never)]
-    fn rebuild(&mut self, function: &str, before: Box<dyn Runtime>) -> fmi2Status {
+    fn rebuild(&mut self, function: &str, before: Box<dyn Runtime>) -> Status {
         match self.runtime.build() {
-            Ok(()) => fmi2Status::OK,
+            Ok(()) => Status::OK,
             Err(reason) => {
                 let undone = self.runtime.restore(before.as_ref());
                 self.error(&format!(
@@ -293,11 +288,11 @@ impl Instance {
         vrs: &[u32],
         out: &mut [T],
         pick: impl Fn(&dyn Runtime, usize) -> T,
-    ) -> fmi2Status {
+    ) -> Status {
         if !self.allowed(function, allowed::GET) {
-            return fmi2Status::Error;
+            return Status::Error;
         }
-        let mut status = fmi2Status::OK;
+        let mut status = Status::OK;
         if matches!(
             self.state(),
             MachineState::InitializationMode
@@ -306,7 +301,7 @@ impl Instance {
                 | MachineState::ContinuousTimeMode
         ) {
             status = self.refresh_outputs(function);
-            if status >= fmi2Status::Error {
+            if status >= Status::Error {
                 return status;
             }
         }
@@ -324,16 +319,15 @@ impl Instance {
         status
     }
 
-    /// `fmi2GetReal`: as [`Instance::get`], with the value references checked first and one call
-    /// into the runtime for all values.
-    pub fn get_reals(&mut self, vrs: &[u32], out: &mut [f64]) -> fmi2Status {
-        const F: &str = "fmi2GetReal";
-        if !self.allowed(F, allowed::GET) {
-            return fmi2Status::Error;
+    /// `fmi2GetReal`, `fmi3GetFloat64`: as [`Instance::get`], with the value references checked
+    /// first and one call into the runtime for all values.
+    pub fn get_reals(&mut self, function: &str, vrs: &[u32], out: &mut [f64]) -> Status {
+        if !self.allowed(function, allowed::GET) {
+            return Status::Error;
         }
         let count = self.by_type[type_index(VarType::Real)].len();
         if let Some(&vr) = vrs.iter().find(|&&vr| vr as usize >= count) {
-            return self.unknown_reference(F, VarType::Real, vr);
+            return self.unknown_reference(function, VarType::Real, vr);
         }
         let refreshing = matches!(
             self.state(),
@@ -344,16 +338,16 @@ impl Instance {
         );
         // After a step the outputs are current: one dynamic call reads them.
         if refreshing && self.runtime.current_reals(vrs, out) {
-            return self.finite_or_refused(F, vrs, out, fmi2Status::OK);
+            return self.finite_or_refused(function, vrs, out, Status::OK);
         }
         let status = if refreshing {
-            self.refresh_outputs(F)
+            self.refresh_outputs(function)
         } else {
-            fmi2Status::OK
+            Status::OK
         };
-        if status < fmi2Status::Error {
+        if status < Status::Error {
             self.runtime.reals(vrs, out);
-            return self.finite_or_refused(F, vrs, out, status);
+            return self.finite_or_refused(function, vrs, out, status);
         }
         status
     }
@@ -366,8 +360,8 @@ impl Instance {
         function: &str,
         vrs: &[u32],
         out: &[f64],
-        status: fmi2Status,
-    ) -> fmi2Status {
+        status: Status,
+    ) -> Status {
         match out.iter().position(|x| !x.is_finite()) {
             None => status,
             Some(k) => self.non_finite(function, vrs[k]),
@@ -376,7 +370,7 @@ impl Instance {
 
     /// Refuses to hand out a non-finite Real, naming it: a model error, not the importer's.
     #[cold]
-    fn non_finite(&self, function: &str, vr: u32) -> fmi2Status {
+    fn non_finite(&self, function: &str, vr: u32) -> Status {
         let x = self.runtime.real(vr as usize);
         let name = self.by_type[0].get(vr as usize).map_or("?", |v| v.name);
         self.error(&format!(
@@ -386,12 +380,14 @@ impl Instance {
     }
 
     /// `fmi2GetString`: the returned strings live until the next call on this instance.
-    pub fn get_strings(&mut self, vrs: &[u32]) -> Result<Vec<*const std::ffi::c_char>, fmi2Status> {
+    pub fn get_strings(
+        &mut self,
+        function: &str,
+        vrs: &[u32],
+    ) -> Result<Vec<*const std::ffi::c_char>, Status> {
         let mut refs = vec![0u32; vrs.len()];
-        let status = self.get("fmi2GetString", VarType::String, vrs, &mut refs, |_, vr| {
-            vr as u32
-        });
-        if status >= fmi2Status::Error {
+        let status = self.get(function, VarType::String, vrs, &mut refs, |_, vr| vr as u32);
+        if status >= Status::Error {
             return Err(status);
         }
         let runtime = self.runtime.as_ref();

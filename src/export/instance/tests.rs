@@ -1,8 +1,8 @@
 //! The state machine with a minimal model that has what no shipped model has yet: a tunable
 //! parameter (FMI 2.0.4 section 2.2.7 lets it change between steps).
 use super::*;
-use crate::fmi2::logger::Logger;
-use crate::fmi2::runtime::{Bindings, ModelFactory, Values};
+use crate::export::logger::{Logger, Sink};
+use crate::export::runtime::{Bindings, ModelFactory, Values};
 use crate::models::{Model, Refusal};
 use crate::variables::{Causality, Initial, Interface, Start, Variability};
 use serde::{Deserialize, Serialize};
@@ -146,7 +146,21 @@ impl Model for Gain {
 
 static FACTORY: ModelFactory<Gain> = ModelFactory::NEW;
 
-fn y(inst: &mut Instance) -> (fmi2Status, f64) {
+static API: Api = Api {
+    version: "FMI 2.0",
+    step_state: "StepComplete",
+    get_fmu_state: "fmi2GetFMUstate",
+    serialize_fmu_state: "fmi2SerializeFMUstate",
+};
+
+/// A logger that drops every message.
+struct Silent;
+
+impl Sink for Silent {
+    fn send(&self, _: Status, _: &str, _: &str) {}
+}
+
+fn y(inst: &mut Instance) -> (Status, f64) {
     let mut out = [f64::NAN];
     let s = inst.get("fmi2GetReal", VarType::Real, &[2], &mut out, |v, i| {
         v.real(i)
@@ -156,81 +170,77 @@ fn y(inst: &mut Instance) -> (fmi2Status, f64) {
 
 #[test]
 fn a_tunable_parameter_set_between_steps_takes_effect() {
-    let mut inst = Instance::new(&FACTORY, Logger::new(None, std::ptr::null_mut(), "t"));
-    assert_eq!(inst.setup_experiment(None, 0.0, None), fmi2Status::OK);
-    assert_eq!(inst.enter_initialization_mode(), fmi2Status::OK);
-    assert_eq!(inst.exit_initialization_mode(), fmi2Status::OK);
-    assert_eq!(inst.set("fmi2SetReal", &[1], &[2.0]), fmi2Status::OK);
-    assert_eq!(y(&mut inst), (fmi2Status::OK, 2.0));
-    assert_eq!(inst.set("fmi2SetReal", &[0], &[3.0]), fmi2Status::OK);
+    let mut inst = Instance::new(&FACTORY, &API, Logger::new(Silent));
+    assert_eq!(
+        inst.setup_experiment("fmi2SetupExperiment", None, 0.0, None),
+        Status::OK
+    );
+    assert_eq!(
+        inst.enter_initialization_mode("fmi2EnterInitializationMode"),
+        Status::OK
+    );
+    assert_eq!(
+        inst.exit_initialization_mode("fmi2ExitInitializationMode"),
+        Status::OK
+    );
+    assert_eq!(inst.set("fmi2SetReal", &[1], &[2.0]), Status::OK);
+    assert_eq!(y(&mut inst), (Status::OK, 2.0));
+    assert_eq!(inst.set("fmi2SetReal", &[0], &[3.0]), Status::OK);
     assert_eq!(
         y(&mut inst),
-        (fmi2Status::OK, 6.0),
+        (Status::OK, 6.0),
         "outputs follow the new gain"
     );
-    assert_eq!(inst.do_step(0.0, 0.1), fmi2Status::OK);
-    assert_eq!(y(&mut inst), (fmi2Status::OK, 6.0), "and so does the step");
-    assert_eq!(inst.set("fmi2SetReal", &[0], &[-1.0]), fmi2Status::OK);
-    assert_eq!(inst.do_step(0.1, 0.1), fmi2Status::OK);
-    assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
+    assert_eq!(inst.do_step("fmi2DoStep", 0.0, 0.1), Status::OK);
+    assert_eq!(y(&mut inst), (Status::OK, 6.0), "and so does the step");
+    assert_eq!(inst.set("fmi2SetReal", &[0], &[-1.0]), Status::OK);
+    assert_eq!(inst.do_step("fmi2DoStep", 0.1, 0.1), Status::OK);
+    assert_eq!(y(&mut inst), (Status::OK, -2.0));
     // A gain the model refuses: the whole call is undone, the model keeps running.
-    assert_eq!(
-        inst.set("fmi2SetReal", &[1, 0], &[5.0, 0.0]),
-        fmi2Status::Error
-    );
-    assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
+    assert_eq!(inst.set("fmi2SetReal", &[1, 0], &[5.0, 0.0]), Status::Error);
+    assert_eq!(y(&mut inst), (Status::OK, -2.0));
     assert_eq!([inst.runtime.real(0), inst.runtime.real(1)], [-1.0, 2.0]);
-    assert_eq!(inst.do_step(0.2, 0.1), fmi2Status::OK);
-    assert_eq!(y(&mut inst), (fmi2Status::OK, -2.0));
+    assert_eq!(inst.do_step("fmi2DoStep", 0.2, 0.1), Status::OK);
+    assert_eq!(y(&mut inst), (Status::OK, -2.0));
 }
 
 #[test]
 fn a_non_finite_output_is_refused_with_a_logged_reason_never_handed_out() {
     use std::sync::atomic::{AtomicUsize, Ordering};
     static ERRORS: AtomicUsize = AtomicUsize::new(0);
-    unsafe extern "C" fn count(
-        _: *mut std::ffi::c_void,
-        _: crate::fmi2::types::fmi2String,
-        status: std::ffi::c_int,
-        _: crate::fmi2::types::fmi2String,
-        _: crate::fmi2::types::fmi2String,
-    ) {
-        if status == fmi2Status::Error as std::ffi::c_int {
-            ERRORS.fetch_add(1, Ordering::Relaxed);
+    struct CountErrors;
+    impl Sink for CountErrors {
+        fn send(&self, status: Status, _: &str, _: &str) {
+            if status == Status::Error {
+                ERRORS.fetch_add(1, Ordering::Relaxed);
+            }
         }
     }
-    // SAFETY: called with exactly these five arguments, as the logger is (see the fuzz driver).
-    let logger = unsafe {
-        std::mem::transmute::<
-            unsafe extern "C" fn(
-                *mut std::ffi::c_void,
-                crate::fmi2::types::fmi2String,
-                std::ffi::c_int,
-                crate::fmi2::types::fmi2String,
-                crate::fmi2::types::fmi2String,
-            ),
-            crate::fmi2::types::fmi2CallbackLogger,
-        >(count)
-    };
-    let mut inst = Instance::new(
-        &FACTORY,
-        Logger::new(Some(logger), std::ptr::null_mut(), "t"),
+    let mut inst = Instance::new(&FACTORY, &API, Logger::new(CountErrors));
+    assert_eq!(
+        inst.setup_experiment("fmi2SetupExperiment", None, 0.0, None),
+        Status::OK
     );
-    assert_eq!(inst.setup_experiment(None, 0.0, None), fmi2Status::OK);
-    assert_eq!(inst.enter_initialization_mode(), fmi2Status::OK);
-    assert_eq!(inst.exit_initialization_mode(), fmi2Status::OK);
+    assert_eq!(
+        inst.enter_initialization_mode("fmi2EnterInitializationMode"),
+        Status::OK
+    );
+    assert_eq!(
+        inst.exit_initialization_mode("fmi2ExitInitializationMode"),
+        Status::OK
+    );
     // Both finite and legal; their product overflows to +inf.
     assert_eq!(
         inst.set("fmi2SetReal", &[0, 1], &[1e300, 1e300]),
-        fmi2Status::OK
+        Status::OK
     );
-    assert_eq!(inst.do_step(0.0, 0.1), fmi2Status::OK);
+    assert_eq!(inst.do_step("fmi2DoStep", 0.0, 0.1), Status::OK);
     let before = ERRORS.load(Ordering::Relaxed);
     let mut out = [7.0, 7.0];
     let s = inst.get("fmi2GetReal", VarType::Real, &[1, 2], &mut out, |v, i| {
         v.real(i)
     });
-    assert_eq!(s, fmi2Status::Error);
+    assert_eq!(s, Status::Error);
     assert_eq!(out[1], 7.0, "the infinity was written out");
     assert!(out.iter().all(|x| x.is_finite()));
     assert_eq!(
@@ -239,6 +249,6 @@ fn a_non_finite_output_is_refused_with_a_logged_reason_never_handed_out() {
         "refused without a reason"
     );
     // Back in range, the same instance hands out finite outputs again.
-    assert_eq!(inst.set("fmi2SetReal", &[1], &[2.0]), fmi2Status::OK);
-    assert_eq!(y(&mut inst), (fmi2Status::OK, 2e300));
+    assert_eq!(inst.set("fmi2SetReal", &[1], &[2.0]), Status::OK);
+    assert_eq!(y(&mut inst), (Status::OK, 2e300));
 }

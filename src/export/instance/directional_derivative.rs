@@ -1,33 +1,34 @@
-//! `fmi2GetDirectionalDerivative` on the instance: the call's state and build checks; the product
+//! Directional derivatives (`fmi2GetDirectionalDerivative`, `fmi3GetDirectionalDerivative`) on the
+//! instance: the call's state and build checks; the product
 //! itself is the runtime's (`runtime/directional_derivative.rs`), but for the parameters and
 //! the non-output initial unknowns of Initialization Mode (central differences of the rebuilt
 //! model, here).
 
 use super::{allowed, Instance, MachineState};
-use crate::fmi2::runtime::Runtime;
-use crate::fmi2::types::fmi2Status;
+use crate::export::runtime::Runtime;
+use crate::export::Status;
 use crate::variables::{Causality, VarType, Variable};
 
 impl Instance {
     pub fn get_directional_derivative(
         &mut self,
+        function: &str,
         unknown: &[u32],
         known: &[u32],
         dv_known: &[f64],
         dv_unknown: &mut [f64],
-    ) -> fmi2Status {
-        const F: &str = "fmi2GetDirectionalDerivative";
-        if !self.allowed(F, allowed::GET) {
-            return fmi2Status::Error;
+    ) -> Status {
+        if !self.allowed(function, allowed::GET) {
+            return Status::Error;
         }
         // Builds the model in initialization mode (as fmi2GetReal does); the partials need no
         // fresh outputs, so a built model skips that evaluation.
         let status = if self.runtime.is_built() {
-            fmi2Status::OK
+            Status::OK
         } else {
-            self.refresh_outputs(F)
+            self.refresh_outputs(function)
         };
-        if status >= fmi2Status::Error {
+        if status >= Status::Error {
             return status;
         }
         if self.state() == MachineState::InitializationMode
@@ -35,7 +36,7 @@ impl Instance {
         {
             return match self.initialization_derivative(unknown, known, dv_known, dv_unknown) {
                 Ok(()) => status,
-                Err(why) => self.error(&format!("{F}: {why}")),
+                Err(why) => self.error(&format!("{function}: {why}")),
             };
         }
         match self
@@ -43,7 +44,7 @@ impl Instance {
             .directional_derivative(unknown, known, dv_known, dv_unknown)
         {
             Ok(()) => status,
-            Err(why) => self.error(&format!("{F}: {why}")),
+            Err(why) => self.error(&format!("{function}: {why}")),
         }
     }
 }

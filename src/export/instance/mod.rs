@@ -1,9 +1,11 @@
-//! One FMU instance: its core (this file), the FMI 2.0.4 Co-Simulation call-sequence state
-//! machine (section 4.2.4, `machine`), the rules for which variables may be set when (section
-//! 2.2.7, `values`), FMU states (`fmu_state`), Model Exchange's modes (`model_exchange`), the
-//! out-of-range policy (`out_of_range`) and directional derivatives. The code here works on Rust
-//! slices and references; `exports` turns the importer's C pointers into them. The only `unsafe` here is in
-//! `fmu_state`, on the state pointers this instance handed out itself.
+//! One FMU instance, whichever FMI version's API created it: its core (this file), the
+//! call-sequence state machine (FMI 2.0.4 section 4.2.4, FMI 3.0 section 4.2.1; `machine`), the
+//! rules for which variables may be set when (FMI 2.0.4 section 2.2.7, `values`), FMU states
+//! (`fmu_state`), Model Exchange's modes (`model_exchange`), the out-of-range policy
+//! (`out_of_range`) and directional derivatives. The code here works on Rust slices and
+//! references and is told the name of the function the importer called; the version layers
+//! (`src/fmi2`, `src/fmi3`) turn the importer's C pointers into them. The only `unsafe` here is
+//! in `fmu_state`, on the state pointers this instance handed out itself.
 
 mod directional_derivative;
 mod fmu_state;
@@ -21,8 +23,8 @@ pub use values::{CBoolean, Value};
 
 use super::logger::Logger;
 use super::runtime::{Factory, Runtime};
-use super::types::fmi2Status;
-use crate::models::{Report, Status};
+use crate::export::Status;
+use crate::models::{Report, Status as ModelStatus};
 use crate::variables::{ModelInfo, VarType, Variable};
 use out_of_range::OutOfRange;
 use std::collections::HashSet;
@@ -31,9 +33,24 @@ use std::ffi::CString;
 /// Marks a live instance, so that a stale or foreign pointer is refused rather than used.
 pub const MAGIC: u64 = 0x6163_7475_6174_6f72;
 
+/// What an instance needs to know of the FMI version it was instantiated through: which calls are
+/// its own, and the names its messages use. Each version layer defines one.
+pub struct Api {
+    /// "FMI 2.0" or "FMI 3.0": an instance answers only its own version's calls.
+    pub version: &'static str,
+    /// The name of [`MachineState::StepComplete`] (FMI 3.0 calls it Step Mode).
+    pub step_state: &'static str,
+    /// The function that saves an FMU state, named where a restored state is refused.
+    pub get_fmu_state: &'static str,
+    /// The function that serializes an FMU state, named where a corrupt one is refused.
+    pub serialize_fmu_state: &'static str,
+}
+
 pub struct Instance {
     pub magic: u64,
     pub logger: Logger,
+    /// The FMI version the instance was instantiated through.
+    pub api: &'static Api,
     info: &'static ModelInfo,
     /// Variables by type and value reference (value references are dense per type).
     by_type: [Vec<&'static Variable>; 4],
@@ -69,17 +86,17 @@ fn quiet(report: &Report) -> bool {
     !report.clamped() && report.messages().is_empty()
 }
 
-fn to_fmi(status: Status) -> fmi2Status {
+fn to_fmi(status: ModelStatus) -> Status {
     match status {
-        Status::Ok => fmi2Status::OK,
-        Status::Warning => fmi2Status::Warning,
-        Status::Discard => fmi2Status::Discard,
-        Status::Error => fmi2Status::Error,
+        ModelStatus::Ok => Status::OK,
+        ModelStatus::Warning => Status::Warning,
+        ModelStatus::Discard => Status::Discard,
+        ModelStatus::Error => Status::Error,
     }
 }
 
 impl Instance {
-    pub fn new(factory: &'static dyn Factory, logger: Logger) -> Self {
+    pub fn new(factory: &'static dyn Factory, api: &'static Api, logger: Logger) -> Self {
         let info = factory.info();
         let by_type: [Vec<&'static Variable>; 4] = std::array::from_fn(|t| {
             (0..info.counts[t])
@@ -99,6 +116,7 @@ impl Instance {
         Self {
             magic: MAGIC,
             logger,
+            api,
             info,
             by_type,
             set_rules,
@@ -114,9 +132,9 @@ impl Instance {
         }
     }
 
-    pub fn error(&self, message: &str) -> fmi2Status {
-        self.logger.log(fmi2Status::Error, message);
-        fmi2Status::Error
+    pub fn error(&self, message: &str) -> Status {
+        self.logger.log(Status::Error, message);
+        Status::Error
     }
 
     /// The model's variables.
@@ -131,6 +149,14 @@ impl Instance {
 
     pub fn set_state(&mut self, state: MachineState) {
         self.state = state;
+    }
+
+    /// The name of `state` in this instance's FMI version.
+    pub fn state_name(&self, state: MachineState) -> &'static str {
+        match state {
+            MachineState::StepComplete => self.api.step_state,
+            _ => state.name(),
+        }
     }
 
     /// Logs and refuses a call that the current state does not allow.
@@ -149,8 +175,8 @@ impl Instance {
     #[inline(never)]
     fn illegal_call(&self, function: &str) {
         self.error(&format!(
-            "{function}: illegal call in state {:?}",
-            self.state()
+            "{function}: illegal call in state {}",
+            self.state_name(self.state())
         ));
     }
 
@@ -158,30 +184,20 @@ impl Instance {
     #[inline(never)]
     fn trace_call(&self, function: &str) {
         self.logger.log(
-            fmi2Status::OK,
-            &format!("{function} in state {:?}", self.state()),
+            Status::OK,
+            &format!("{function} in state {}", self.state_name(self.state())),
         );
     }
 
     /// Applies the out-of-range policy, passes a model's messages to the logger and turns its
     /// status into an FMI status; `in_step` for fmi2DoStep.
-    pub(super) fn forward(
-        &mut self,
-        function: &str,
-        mut report: Report,
-        in_step: bool,
-    ) -> fmi2Status {
+    pub(super) fn forward(&mut self, function: &str, mut report: Report, in_step: bool) -> Status {
         self.settle(function, &mut report, in_step)
     }
 
     /// [`Instance::forward`] on a report in place. A report with nothing to log needs only the
     /// `input_clamped` flag cleared.
-    pub(super) fn settle(
-        &mut self,
-        function: &str,
-        report: &mut Report,
-        in_step: bool,
-    ) -> fmi2Status {
+    pub(super) fn settle(&mut self, function: &str, report: &mut Report, in_step: bool) -> Status {
         if quiet(report) {
             if report.evaluated {
                 self.out_of_range.clear_flag(self.runtime.as_mut());
@@ -198,7 +214,7 @@ impl Instance {
         function: &str,
         mut report: Report,
         in_step: bool,
-    ) -> fmi2Status {
+    ) -> Status {
         let notes = self
             .out_of_range
             .apply(self.runtime.as_mut(), &mut report, in_step);
@@ -209,7 +225,7 @@ impl Instance {
             let message = format!("{function}: {message}");
             match status {
                 // A notice the user should read although nothing failed: always logged, at fmi2OK.
-                Status::Ok => self.logger.notice(&message),
+                ModelStatus::Ok => self.logger.notice(&message),
                 _ => self.logger.log(to_fmi(*status), &message),
             }
         }
@@ -218,19 +234,19 @@ impl Instance {
 
     /// Builds the model if initialization needs it and recomputes outputs that inputs made stale.
     #[inline]
-    pub(super) fn refresh_outputs(&mut self, function: &str) -> fmi2Status {
+    pub(super) fn refresh_outputs(&mut self, function: &str) -> Status {
         // After a step, or a get with no set since: nothing to recompute, nothing to report.
         if self.runtime.outputs_current() {
-            return fmi2Status::OK;
+            return Status::OK;
         }
         self.recompute_outputs(function)
     }
 
     #[inline(never)]
-    fn recompute_outputs(&mut self, function: &str) -> fmi2Status {
+    fn recompute_outputs(&mut self, function: &str) -> Status {
         if !self.runtime.is_built() {
             if self.state() != MachineState::InitializationMode {
-                return fmi2Status::OK;
+                return Status::OK;
             }
             if let Err(reason) = self.runtime.build() {
                 return self.error(&format!("{function}: parameters rejected: {reason}"));

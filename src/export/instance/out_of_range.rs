@@ -6,7 +6,7 @@
 //! Integer parameter `out_of_range_policy` asks for fmi2Warning (1) or, from fmi2DoStep,
 //! fmi2Discard (2) instead.
 
-use crate::fmi2::runtime::Runtime;
+use crate::export::runtime::Runtime;
 use crate::models::{Report, Status};
 use crate::variables::{ModelInfo, VarType};
 

@@ -1,5 +1,5 @@
 //! Access by value reference to a model's typed values: the trait the generated bindings
-//! (`fmi2/registry.rs`) implement for every model.
+//! (`export/registry.rs`) implement for every model.
 
 use super::Values;
 use crate::variables::Interface;

@@ -1,8 +1,9 @@
-//! The call-sequence state machine of FMI 2.0.4 section 4.2.4: which function may be called in
+//! The call-sequence state machine of FMI 2.0.4 section 4.2.4 (FMI 3.0 section 4.2.1 has the same
+//! states for these FMUs): which function may be called in
 //! which state, and the functions that move between states (initialization, stepping, reset).
 
 use super::Instance;
-use crate::fmi2::types::fmi2Status;
+use crate::export::Status;
 use crate::models::Report;
 use serde::{Deserialize, Serialize};
 
@@ -15,13 +16,28 @@ pub enum MachineState {
     Terminated,
     Error,
     Fatal,
-    /// Model Exchange (`src/fmi2/instance/model_exchange.rs`); after the others so that saved states keep
+    /// Model Exchange (`model_exchange.rs`); after the others so that saved states keep
     /// their encoding.
     EventMode,
     ContinuousTimeMode,
 }
 
 impl MachineState {
+    /// The state's name in messages (as FMI 2.0 names it; see [`Instance::state_name`]).
+    pub const fn name(self) -> &'static str {
+        match self {
+            MachineState::Instantiated => "Instantiated",
+            MachineState::InitializationMode => "InitializationMode",
+            MachineState::StepComplete => "StepComplete",
+            MachineState::StepFailed => "StepFailed",
+            MachineState::Terminated => "Terminated",
+            MachineState::Error => "Error",
+            MachineState::Fatal => "Fatal",
+            MachineState::EventMode => "EventMode",
+            MachineState::ContinuousTimeMode => "ContinuousTimeMode",
+        }
+    }
+
     pub(super) const fn bit(self) -> u32 {
         1 << self as u32
     }
@@ -99,71 +115,72 @@ pub mod allowed {
 }
 
 impl Instance {
-    pub fn set_debug_logging(&mut self, on: bool, categories: &[&str]) -> fmi2Status {
-        if !self.allowed("fmi2SetDebugLogging", allowed::ALL_BUT_FATAL) {
-            return fmi2Status::Error;
+    pub fn set_debug_logging(&mut self, function: &str, on: bool, categories: &[&str]) -> Status {
+        if !self.allowed(function, allowed::ALL_BUT_FATAL) {
+            return Status::Error;
         }
         if let Some(unknown) = categories
             .iter()
             .find(|c| !self.info.log_categories.contains(c))
         {
             return self.error(&format!(
-                "fmi2SetDebugLogging: unknown log category '{unknown}' (known: {})",
+                "{function}: unknown log category '{unknown}' (known: {})",
                 self.info.log_categories.join(", ")
             ));
         }
         // Warnings and errors are always logged; the switch is about call tracing.
         let calls = on && (categories.is_empty() || categories.contains(&"logCalls"));
         self.logger.debug = calls;
-        fmi2Status::OK
+        Status::OK
     }
 
     pub fn setup_experiment(
         &mut self,
+        function: &str,
         tolerance: Option<f64>,
         start: f64,
         stop: Option<f64>,
-    ) -> fmi2Status {
-        if !self.allowed("fmi2SetupExperiment", allowed::SETUP_EXPERIMENT) {
-            return fmi2Status::Error;
+    ) -> Status {
+        if !self.allowed(function, allowed::SETUP_EXPERIMENT) {
+            return Status::Error;
         }
         if !start.is_finite()
             || stop.is_some_and(|s| !s.is_finite())
             || tolerance.is_some_and(|t| !(t.is_finite() && t > 0.0))
         {
             return self.error(&format!(
-                "fmi2SetupExperiment: startTime {start}, stopTime {stop:?} and tolerance {tolerance:?} must be finite (tolerance positive)"
+                "{function}: startTime {start}, stopTime {stop:?} and tolerance {tolerance:?} must be finite (tolerance positive)"
             ));
         }
         if let Some(stop) = stop.filter(|&s| s < start) {
             return self.error(&format!(
-                "fmi2SetupExperiment: stopTime {stop} is before startTime {start}"
+                "{function}: stopTime {stop} is before startTime {start}"
             ));
         }
         self.start_time = start;
         self.time = start;
         self.set_stop_time(stop);
-        fmi2Status::OK
+        Status::OK
     }
 
-    pub fn enter_initialization_mode(&mut self) -> fmi2Status {
-        if !self.allowed("fmi2EnterInitializationMode", allowed::ENTER_INITIALIZATION) {
-            return fmi2Status::Error;
+    pub fn enter_initialization_mode(&mut self, function: &str) -> Status {
+        if !self.allowed(function, allowed::ENTER_INITIALIZATION) {
+            return Status::Error;
         }
         self.set_state(MachineState::InitializationMode);
-        fmi2Status::OK
+        Status::OK
     }
 
-    pub fn exit_initialization_mode(&mut self) -> fmi2Status {
-        if !self.allowed("fmi2ExitInitializationMode", allowed::EXIT_INITIALIZATION) {
-            return fmi2Status::Error;
+    pub fn exit_initialization_mode(&mut self, function: &str) -> Status {
+        if !self.allowed(function, allowed::EXIT_INITIALIZATION) {
+            return Status::Error;
         }
-        let status = self.refresh_outputs("fmi2ExitInitializationMode");
-        if status >= fmi2Status::Discard {
+        let status = self.refresh_outputs(function);
+        if status >= Status::Discard {
             // Bad parameters, or start values the model cannot evaluate (a Discard, which has no
             // smaller step to retry here): the instance can be reset (or freed).
             self.set_state(MachineState::Error);
-            return status.max(fmi2Status::Error);
+            return status.max(Status::Error);
         }
         self.set_state(if self.model_exchange {
             MachineState::EventMode
@@ -173,47 +190,47 @@ impl Instance {
         status
     }
 
-    pub fn terminate(&mut self) -> fmi2Status {
-        if !self.allowed("fmi2Terminate", allowed::TERMINATE) {
-            return fmi2Status::Error;
+    pub fn terminate(&mut self, function: &str) -> Status {
+        if !self.allowed(function, allowed::TERMINATE) {
+            return Status::Error;
         }
         self.set_state(MachineState::Terminated);
-        fmi2Status::OK
+        Status::OK
     }
 
     /// Back to the state after instantiation: start values, no model, time zero.
-    pub fn reset(&mut self) -> fmi2Status {
-        if !self.allowed("fmi2Reset", allowed::ALL_BUT_FATAL) {
-            return fmi2Status::Error;
+    pub fn reset(&mut self, function: &str) -> Status {
+        if !self.allowed(function, allowed::ALL_BUT_FATAL) {
+            return Status::Error;
         }
         self.runtime.reset();
         self.set_state(MachineState::Instantiated);
         self.time = 0.0;
         self.start_time = 0.0;
         self.set_stop_time(None);
-        fmi2Status::OK
+        Status::OK
     }
 
-    /// `fmi2DoStep`: checks the state and the step, steps the model and forwards its report.
-    pub fn do_step(&mut self, time: f64, step: f64) -> fmi2Status {
-        const F: &str = "fmi2DoStep";
-        if !self.allowed(F, allowed::DO_STEP) {
-            return fmi2Status::Error;
+    /// `fmi2DoStep`, `fmi3DoStep`: checks the state and the step, steps the model and forwards
+    /// its report.
+    pub fn do_step(&mut self, function: &str, time: f64, step: f64) -> Status {
+        if !self.allowed(function, allowed::DO_STEP) {
+            return Status::Error;
         }
-        if let Some(refused) = self.step_refused(time, step) {
+        if let Some(refused) = self.step_refused(function, time, step) {
             return refused;
         }
         let mut report = Report::default();
         // The runtime writes the `input_clamped` output itself: a quiet report needs nothing more.
         self.runtime.step(time, step, &mut report);
         let status = if report.is_quiet() {
-            fmi2Status::OK
+            Status::OK
         } else {
-            self.forward_messages(F, report, true)
+            self.forward_messages(function, report, true)
         };
         match status {
-            fmi2Status::OK | fmi2Status::Warning => self.time = time + step,
-            fmi2Status::Discard => self.set_state(MachineState::StepFailed),
+            Status::OK | Status::Warning => self.time = time + step,
+            Status::Discard => self.set_state(MachineState::StepFailed),
             _ => self.set_state(MachineState::Error),
         }
         status
@@ -224,27 +241,27 @@ impl Instance {
     }
 
     /// The refusal of a step of `step` from `time`, if any (the caller checked the state).
-    fn step_refused(&self, time: f64, step: f64) -> Option<fmi2Status> {
+    fn step_refused(&self, function: &str, time: f64, step: f64) -> Option<Status> {
         // Positive and finite; two comparisons (NaN fails both).
         if !(step > 0.0 && step < f64::INFINITY) {
-            return Some(self.refuse_step(step));
+            return Some(self.refuse_step(function, step));
         }
         // The importer's clock and ours may differ by rounding only; adopt the importer's. The
         // allowance scales with the clocks, not the step: a long step must not excuse a wrong
         // communication point. Most masters pass our own time back: then no allowance is needed.
         let exact = time == self.time;
         if !time.is_finite() || !(exact || self.within_rounding(time)) {
-            return Some(self.refuse_communication_point(time));
+            return Some(self.refuse_communication_point(function, time));
         }
         // Both finite, their sum may not be: the clock would become +inf.
         if !(time + step).is_finite() {
-            return Some(self.refuse_step_end(time, step));
+            return Some(self.refuse_step_end(function, time, step));
         }
         if let Some(stop) = self.stop_time.filter(|&stop| time + step > stop) {
             // A step computed as stop - time may overshoot by rounding of either.
             let tolerance = 1e3 * f64::EPSILON * time.abs().max(stop.abs()).max(step);
             if time + step > stop + tolerance {
-                return Some(self.refuse_past_stop(time + step, stop));
+                return Some(self.refuse_past_stop(function, time + step, stop));
             }
         }
         None
@@ -258,17 +275,17 @@ impl Instance {
 
     #[cold]
     #[inline(never)]
-    fn refuse_step(&self, step: f64) -> fmi2Status {
+    fn refuse_step(&self, function: &str, step: f64) -> Status {
         self.error(&format!(
-            "fmi2DoStep: communicationStepSize = {step} must be positive and finite"
+            "{function}: communicationStepSize = {step} must be positive and finite"
         ))
     }
 
     #[cold]
     #[inline(never)]
-    fn refuse_step_end(&self, time: f64, step: f64) -> fmi2Status {
+    fn refuse_step_end(&self, function: &str, time: f64, step: f64) -> Status {
         self.error(&format!(
-            "fmi2DoStep: the step's end currentCommunicationPoint + communicationStepSize = \
+            "{function}: the step's end currentCommunicationPoint + communicationStepSize = \
              {time:e} + {step:e} overflows to {}: it must be finite",
             time + step
         ))
@@ -276,24 +293,24 @@ impl Instance {
 
     #[cold]
     #[inline(never)]
-    fn refuse_communication_point(&self, time: f64) -> fmi2Status {
+    fn refuse_communication_point(&self, function: &str, time: f64) -> Status {
         self.error(&format!(
-            "fmi2DoStep: expected currentCommunicationPoint = {:.16e} but was {time:.16e}",
+            "{function}: expected currentCommunicationPoint = {:.16e} but was {time:.16e}",
             self.time
         ))
     }
 
     #[cold]
     #[inline(never)]
-    fn refuse_past_stop(&self, end: f64, stop: f64) -> fmi2Status {
+    fn refuse_past_stop(&self, function: &str, end: f64, stop: f64) -> Status {
         self.error(&format!(
-            "fmi2DoStep: a step to {end:.16e} would pass the stop time {stop:.16e}"
+            "{function}: a step to {end:.16e} would pass the stop time {stop:.16e}"
         ))
     }
 
-    pub fn last_successful_time(&self) -> Result<f64, fmi2Status> {
-        if !self.allowed("fmi2GetRealStatus", allowed::STATUS) {
-            return Err(fmi2Status::Error);
+    pub fn last_successful_time(&self, function: &str) -> Result<f64, Status> {
+        if !self.allowed(function, allowed::STATUS) {
+            return Err(Status::Error);
         }
         Ok(self.time)
     }
@@ -302,7 +319,7 @@ impl Instance {
         self.allowed(function, allowed::STATUS)
     }
 
-    pub fn unsupported(&self, function: &str, why: &str) -> fmi2Status {
+    pub fn unsupported(&self, function: &str, why: &str) -> Status {
         self.error(&format!("{function}: not supported: {why}"))
     }
 }

@@ -1,6 +1,6 @@
-//! FMI 2.0 Model Exchange for the models without continuous states
+//! Model Exchange (FMI 2.0 and FMI 3.0) for the models without continuous states
 //! ([`Model::ALGEBRAIC_MODEL_EXCHANGE`](crate::models::Model::ALGEBRAIC_MODEL_EXCHANGE)): the
-//! event-mode / continuous-time-mode state machine (FMI 2.0.4 section 3.2.3) over the same
+//! event-mode / continuous-time-mode state machine (FMI 2.0.4 section 3.2.3, FMI 3.0 section 3.2) over the same
 //! [`Instance`] and model as Co-Simulation.
 //!
 //! The outputs are algebraic in the inputs. The friction history is a discrete state: it is
@@ -11,7 +11,7 @@
 //! needs no event of its own: it is rate-independent and continuous in the length.
 
 use super::{allowed, Instance, MachineState};
-use crate::fmi2::types::{fmi2EventInfo, fmi2Status, FMI2_FALSE, FMI2_TRUE};
+use crate::export::Status;
 use crate::models::{EventUpdate, Report};
 
 impl Instance {
@@ -29,16 +29,16 @@ impl Instance {
 
     /// Gives the model the current time and builds it in initialization mode (as fmi2GetReal
     /// does); outputs are refreshed if inputs, states or time made them stale.
-    fn prepare(&mut self, function: &str) -> fmi2Status {
+    fn prepare(&mut self, function: &str) -> Status {
         self.runtime.set_time(self.time);
         self.refresh_outputs(function)
     }
 
     /// Commits the discrete state at the current inputs and time: event mode or a completed
     /// integrator step.
-    fn commit(&mut self, function: &str, event_mode: bool) -> (fmi2Status, EventUpdate, bool) {
+    fn commit(&mut self, function: &str, event_mode: bool) -> (Status, EventUpdate, bool) {
         let status = self.prepare(function);
-        if status >= fmi2Status::Error {
+        if status >= Status::Error {
             return (status, EventUpdate::default(), false);
         }
         let mut report = Report::default();
@@ -58,73 +58,65 @@ impl Instance {
         )
     }
 
-    pub fn enter_event_mode(&mut self) -> fmi2Status {
-        const F: &str = "fmi2EnterEventMode";
-        if !self.me_allowed(F, allowed::EVENT_OR_CONTINUOUS_TIME_MODE) {
-            return fmi2Status::Error;
+    pub fn enter_event_mode(&mut self, function: &str) -> Status {
+        if !self.me_allowed(function, allowed::EVENT_OR_CONTINUOUS_TIME_MODE) {
+            return Status::Error;
         }
         self.set_state(MachineState::EventMode);
-        fmi2Status::OK
+        Status::OK
     }
 
     /// One event iteration: commits the history, lets the model update its discrete states (and
     /// reinitialize continuous ones), and gives the next time event.
-    pub fn new_discrete_states(&mut self, info: &mut fmi2EventInfo) -> fmi2Status {
-        const F: &str = "fmi2NewDiscreteStates";
-        if !self.me_allowed(F, allowed::EVENT_MODE) {
-            return fmi2Status::Error;
+    pub fn new_discrete_states(&mut self, function: &str) -> (Status, EventIteration) {
+        if !self.me_allowed(function, allowed::EVENT_MODE) {
+            return (Status::Error, EventIteration::default());
         }
-        let (status, update, _) = self.commit(F, true);
-        let next = self.runtime.next_time_event(self.time);
-        let flag = |b: bool| if b { FMI2_TRUE } else { FMI2_FALSE };
-        *info = fmi2EventInfo {
-            new_discrete_states_needed: flag(update.iterate),
-            terminate_simulation: flag(update.terminate),
-            nominals_of_continuous_states_changed: FMI2_FALSE,
-            values_of_continuous_states_changed: flag(update.states_changed),
-            next_event_time_defined: flag(next.is_some()),
-            next_event_time: next.unwrap_or(0.0),
-        };
-        status
+        let (status, update, _) = self.commit(function, true);
+        let next_event_time = self.runtime.next_time_event(self.time);
+        (
+            status,
+            EventIteration {
+                update,
+                next_event_time,
+            },
+        )
     }
 
-    pub fn enter_continuous_time_mode(&mut self) -> fmi2Status {
-        const F: &str = "fmi2EnterContinuousTimeMode";
-        if !self.me_allowed(F, allowed::EVENT_MODE) {
-            return fmi2Status::Error;
+    pub fn enter_continuous_time_mode(&mut self, function: &str) -> Status {
+        if !self.me_allowed(function, allowed::EVENT_MODE) {
+            return Status::Error;
         }
         self.set_state(MachineState::ContinuousTimeMode);
-        fmi2Status::OK
+        Status::OK
     }
 
     /// Commits the history at the accepted point; the model may ask for an event there.
-    pub fn completed_integrator_step(&mut self) -> (fmi2Status, bool) {
-        const F: &str = "fmi2CompletedIntegratorStep";
-        if !self.me_allowed(F, allowed::CONTINUOUS_TIME_MODE) {
-            return (fmi2Status::Error, false);
+    pub fn completed_integrator_step(&mut self, function: &str) -> (Status, bool) {
+        if !self.me_allowed(function, allowed::CONTINUOUS_TIME_MODE) {
+            return (Status::Error, false);
         }
-        let (status, _, event) = self.commit(F, false);
+        let (status, _, event) = self.commit(function, false);
         (status, event)
     }
 
-    pub fn set_time(&mut self, time: f64) -> fmi2Status {
-        const F: &str = "fmi2SetTime";
-        if !self.me_allowed(F, allowed::EVENT_OR_CONTINUOUS_TIME_MODE) {
-            return fmi2Status::Error;
+    pub fn set_time(&mut self, function: &str, time: f64) -> Status {
+        if !self.me_allowed(function, allowed::EVENT_OR_CONTINUOUS_TIME_MODE) {
+            return Status::Error;
         }
         if !time.is_finite() {
-            return self.error(&format!("{F}: time must be finite, got {time}"));
+            return self.error(&format!("{function}: time must be finite, got {time}"));
         }
         self.time = time;
         self.runtime.set_time(time);
-        fmi2Status::OK
+        Status::OK
     }
 
     /// Checks a state-sized (or event-indicator-sized) vector call: interface, machine state,
     /// length; then builds the model if initialization needs it.
-    fn vector_call(&mut self, function: &str, mask: u32, n: usize, what: Vector) -> fmi2Status {
+    fn vector_call(&mut self, function: &str, mask: u32, n: usize, what: Vector) -> Status {
         if !self.me_allowed(function, mask) {
-            return fmi2Status::Error;
+            return Status::Error;
         }
         let (expected, count) = match what {
             Vector::EventIndicators => (
@@ -144,13 +136,13 @@ impl Instance {
             ));
         }
         if n == 0 {
-            return fmi2Status::OK;
+            return Status::OK;
         }
         // The hot path: only the time goes to the model; the outputs are not recomputed (an
         // unbuilt model is built in initialization mode, as fmi2GetReal does).
         self.runtime.set_time(self.time);
         if self.runtime.is_built() {
-            fmi2Status::OK
+            Status::OK
         } else {
             self.refresh_outputs(function)
         }
@@ -158,9 +150,9 @@ impl Instance {
 
     /// `fmi2GetContinuousStates`, `fmi2GetDerivatives`, `fmi2GetEventIndicators`,
     /// `fmi2GetNominalsOfContinuousStates` on a checked buffer.
-    pub fn get_vector(&mut self, function: &str, what: Vector, out: &mut [f64]) -> fmi2Status {
+    pub fn get_vector(&mut self, function: &str, what: Vector, out: &mut [f64]) -> Status {
         let status = self.vector_call(function, allowed::GET_STATES, out.len(), what);
-        if status >= fmi2Status::Error || out.is_empty() {
+        if status >= Status::Error || out.is_empty() {
             return status;
         }
         let result = match what {
@@ -188,17 +180,29 @@ impl Instance {
 
     /// `fmi2SetContinuousStates`: finite values the model accepts, or an error and the states
     /// kept.
-    pub fn set_continuous_states(&mut self, x: &[f64]) -> fmi2Status {
-        const F: &str = "fmi2SetContinuousStates";
-        let status = self.vector_call(F, allowed::CONTINUOUS_TIME_MODE, x.len(), Vector::States);
-        if status >= fmi2Status::Error || x.is_empty() {
+    pub fn set_continuous_states(&mut self, function: &str, x: &[f64]) -> Status {
+        let status = self.vector_call(
+            function,
+            allowed::CONTINUOUS_TIME_MODE,
+            x.len(),
+            Vector::States,
+        );
+        if status >= Status::Error || x.is_empty() {
             return status;
         }
         match self.runtime.set_continuous_states(x) {
             Ok(()) => status,
-            Err(why) => self.error(&format!("{F}: {why}")),
+            Err(why) => self.error(&format!("{function}: {why}")),
         }
     }
+}
+
+/// What an event iteration tells the importer (FMI 2.0's `fmi2EventInfo`, the outputs of FMI
+/// 3.0's `fmi3UpdateDiscreteStates`); the nominals of the continuous states never change.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct EventIteration {
+    pub update: EventUpdate,
+    pub next_event_time: Option<f64>,
 }
 
 /// The state-sized vectors of Model Exchange (and the event indicators).

@@ -1,6 +1,7 @@
-//! The `fmi2Component` an importer holds is a handle, not the instance's address: a slot of a
-//! fixed table and a generation number that no other instance of this process ever gets. A freed
-//! instance's handle (a second `fmi2FreeInstance`, any call after the first) finds its slot
+//! The `fmi2Component` or `fmi3Instance` an importer holds is a handle, not the instance's
+//! address: a slot of a fixed table and a generation number that no other instance of this
+//! process ever gets; one table serves both FMI versions. A freed instance's handle (a second
+//! `fmi2FreeInstance`, any call after the first) finds its slot
 //! empty or re-used under another generation and is refused without reading freed memory; it
 //! can never reach an instance allocated later at the same address, or in the same slot. A
 //! handle off by a few bytes, or any other value, names no live generation and is refused too.
@@ -8,8 +9,8 @@
 //! The table is static (`SLOTS` instances alive at once; 16 bytes each, in pages touched only when
 //! used); handles are 64-bit (the slot in the low 16 bits, the generation above).
 
-use crate::fmi2::instance::Instance;
-use crate::fmi2::types::fmi2Component;
+use crate::export::instance::Instance;
+use std::ffi::c_void;
 use std::sync::atomic::{AtomicPtr, AtomicU64, Ordering};
 use std::sync::Mutex;
 
@@ -39,14 +40,17 @@ static NEXT_GENERATION: AtomicU64 = AtomicU64::new(1);
 /// Slots never used yet start at `.0`; freed ones are in `.1`.
 static FREE: Mutex<(usize, Vec<usize>)> = Mutex::new((0, Vec::new()));
 
-fn split(c: fmi2Component) -> (usize, u64) {
+/// What the importer holds: `fmi2Component`, `fmi3Instance`.
+pub type Handle = *mut c_void;
+
+fn split(c: Handle) -> (usize, u64) {
     let handle = c.addr();
     (handle & (SLOTS - 1), (handle >> SLOT_BITS) as u64)
 }
 
 /// A handle for `instance`, which the table owns from now on; `None` (the instance dropped) when
 /// `SLOTS` instances are alive.
-pub(crate) fn register(instance: Box<Instance>) -> Option<fmi2Component> {
+pub(crate) fn register(instance: Box<Instance>) -> Option<Handle> {
     let index = {
         let mut free = FREE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         match free.1.pop() {
@@ -70,7 +74,7 @@ pub(crate) fn register(instance: Box<Instance>) -> Option<fmi2Component> {
 
 /// The live instance behind handle `c`, if any.
 #[inline(always)]
-pub(crate) fn resolve(c: fmi2Component) -> Option<*mut Instance> {
+pub(crate) fn resolve(c: Handle) -> Option<*mut Instance> {
     let (index, generation) = split(c);
     let slot = &TABLE[index];
     if generation == 0 || slot.generation.load(Ordering::Acquire) != generation {
@@ -82,7 +86,7 @@ pub(crate) fn resolve(c: fmi2Component) -> Option<*mut Instance> {
 
 /// Takes the instance behind `c` out of the table, once: a second call with the same handle
 /// gets `None`, even from another thread at the same time.
-pub(crate) fn release(c: fmi2Component) -> Option<Box<Instance>> {
+pub(crate) fn release(c: Handle) -> Option<Box<Instance>> {
     let (index, generation) = split(c);
     let slot = &TABLE[index];
     if generation == 0 {

@@ -1,8 +1,9 @@
-//! FMU states (`fmi2GetFMUstate` and friends) and their versioned, checksummed serialization.
+//! FMU states (`fmi2GetFMUstate`, `fmi3GetFMUState` and friends) and their versioned,
+//! checksummed serialization.
 
 use super::{allowed, values::range_check, Instance, MachineState};
-use crate::fmi2::runtime::Runtime;
-use crate::fmi2::types::fmi2Status;
+use crate::export::runtime::Runtime;
+use crate::export::Status;
 use crate::variables::{Causality, VarType};
 use serde::{Deserialize, Serialize};
 
@@ -71,23 +72,26 @@ impl Instance {
         self.fmu_states.contains(&(state as usize))
     }
 
-    fn refuse_foreign(&self, function: &str, state: *mut FmuState) -> Option<fmi2Status> {
+    fn refuse_foreign(&self, function: &str, state: *mut FmuState) -> Option<Status> {
         (!self.owns_state(state))
             .then(|| self.error(&format!("{function}: unknown FMU state {state:p}")))
     }
 
     /// `fmi2GetFMUstate`: a new state, or `existing` overwritten.
-    pub fn get_fmu_state(&mut self, existing: *mut FmuState) -> Result<*mut FmuState, fmi2Status> {
-        const F: &str = "fmi2GetFMUstate";
-        if !self.allowed(F, allowed::ALL_BUT_FATAL) {
-            return Err(fmi2Status::Error);
+    pub fn get_fmu_state(
+        &mut self,
+        function: &str,
+        existing: *mut FmuState,
+    ) -> Result<*mut FmuState, Status> {
+        if !self.allowed(function, allowed::ALL_BUT_FATAL) {
+            return Err(Status::Error);
         }
         if existing.is_null() {
             let ptr = Box::into_raw(Box::new(self.capture()));
             self.fmu_states.insert(ptr as usize);
             return Ok(ptr);
         }
-        if let Some(s) = self.refuse_foreign(F, existing) {
+        if let Some(s) = self.refuse_foreign(function, existing) {
             return Err(s);
         }
         // SAFETY: `existing` is in `fmu_states`, so it came from Box::into_raw and is not freed.
@@ -95,20 +99,19 @@ impl Instance {
         Ok(existing)
     }
 
-    pub fn set_fmu_state(&mut self, state: *mut FmuState) -> fmi2Status {
-        const F: &str = "fmi2SetFMUstate";
-        if !self.allowed(F, allowed::ALL_BUT_FATAL) {
-            return fmi2Status::Error;
+    pub fn set_fmu_state(&mut self, function: &str, state: *mut FmuState) -> Status {
+        if !self.allowed(function, allowed::ALL_BUT_FATAL) {
+            return Status::Error;
         }
-        if let Some(s) = self.refuse_foreign(F, state) {
+        if let Some(s) = self.refuse_foreign(function, state) {
             return s;
         }
         // SAFETY: owned, live (see get_fmu_state).
         let saved = unsafe { &*state };
-        self.restore(F, saved)
+        self.restore(function, saved)
     }
 
-    fn restore(&mut self, function: &str, saved: &FmuState) -> fmi2Status {
+    fn restore(&mut self, function: &str, saved: &FmuState) -> Status {
         use MachineState::*;
         // A state saved mid-run by one interface cannot continue in the other's state machine.
         let interface_of = |m| match m {
@@ -118,8 +121,8 @@ impl Instance {
         };
         if interface_of(saved.machine).is_some_and(|me| me != self.model_exchange) {
             return self.error(&format!(
-                "{function}: the FMU state was saved in state {:?}, which this {} instance has not",
-                saved.machine,
+                "{function}: the FMU state was saved in state {}, which this {} instance has not",
+                self.state_name(saved.machine),
                 if self.model_exchange {
                     "Model Exchange"
                 } else {
@@ -134,30 +137,29 @@ impl Instance {
         self.start_time = saved.start_time;
         self.set_stop_time(saved.stop_time);
         self.set_state(saved.machine);
-        fmi2Status::OK
+        Status::OK
     }
 
-    pub fn free_fmu_state(&mut self, state: *mut FmuState) -> fmi2Status {
-        const F: &str = "fmi2FreeFMUstate";
+    pub fn free_fmu_state(&mut self, function: &str, state: *mut FmuState) -> Status {
         if state.is_null() {
-            return fmi2Status::OK;
+            return Status::OK;
         }
-        if let Some(s) = self.refuse_foreign(F, state) {
+        if let Some(s) = self.refuse_foreign(function, state) {
             return s;
         }
         self.fmu_states.remove(&(state as usize));
         // SAFETY: owned and live until this line, removed from the set so never freed twice.
         drop(unsafe { Box::from_raw(state) });
-        fmi2Status::OK
+        Status::OK
     }
 
     pub fn serialize_fmu_state(
         &self,
         function: &str,
         state: *mut FmuState,
-    ) -> Result<Vec<u8>, fmi2Status> {
+    ) -> Result<Vec<u8>, Status> {
         if !self.allowed(function, allowed::ALL_BUT_FATAL) {
-            return Err(fmi2Status::Error);
+            return Err(Status::Error);
         }
         if let Some(s) = self.refuse_foreign(function, state) {
             return Err(s);
@@ -206,14 +208,14 @@ impl Instance {
 
     pub fn deserialize_fmu_state(
         &mut self,
+        function: &str,
         bytes: &[u8],
         existing: *mut FmuState,
-    ) -> Result<*mut FmuState, fmi2Status> {
-        const F: &str = "fmi2DeSerializeFMUstate";
-        if !self.allowed(F, allowed::ALL_BUT_FATAL) {
-            return Err(fmi2Status::Error);
+    ) -> Result<*mut FmuState, Status> {
+        if !self.allowed(function, allowed::ALL_BUT_FATAL) {
+            return Err(Status::Error);
         }
-        let refuse = |why: String| self.error(&format!("{F}: {why}"));
+        let refuse = |why: String| self.error(&format!("{function}: {why}"));
         if bytes.len() < 10 || &bytes[..8] != STATE_MAGIC {
             return Err(refuse("not a serialized FMU state of this FMU".into()));
         }
@@ -228,10 +230,10 @@ impl Instance {
             return Err(refuse("corrupt state: too short".into()));
         };
         if checksum(sealed) != u64::from_le_bytes(*sum) {
-            return Err(refuse(
-                "corrupt state: checksum mismatch (the bytes changed since fmi2SerializeFMUstate)"
-                    .into(),
-            ));
+            return Err(refuse(format!(
+                "corrupt state: checksum mismatch (the bytes changed since {})",
+                self.api.serialize_fmu_state
+            )));
         }
         let body: SerializedState = postcard::from_bytes(&sealed[10..])
             .map_err(|e| refuse(format!("corrupt state: {e}")))?;
@@ -241,12 +243,13 @@ impl Instance {
                 body.guid, self.info.guid
             )));
         }
-        // fmi2GetFMUstate captures every state but Fatal, which no restore may set: after it
-        // even fmi2Reset is refused.
+        // Saving captures every state but Fatal, which no restore may set: after it even a reset
+        // is refused.
         if body.machine == MachineState::Fatal {
-            return Err(refuse(
-                "corrupt state: machine state Fatal is not one fmi2GetFMUstate saves".into(),
-            ));
+            return Err(refuse(format!(
+                "corrupt state: machine state Fatal is not one {} saves",
+                self.api.get_fmu_state
+            )));
         }
         if let Some(why) = clock_disorder(body.time, body.start_time, body.stop_time) {
             return Err(refuse(format!("corrupt state: {why}")));
@@ -272,7 +275,7 @@ impl Instance {
             self.fmu_states.insert(ptr as usize);
             return Ok(ptr);
         }
-        if let Some(s) = self.refuse_foreign(F, existing) {
+        if let Some(s) = self.refuse_foreign(function, existing) {
             return Err(s);
         }
         // SAFETY: owned, live.
