@@ -11,7 +11,7 @@ mod common;
 #[path = "cpu_clock.rs"]
 mod cpu_clock;
 
-use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::export::REGISTRY;
 use actuator_fmus::variables::VarType;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 use std::time::Duration;

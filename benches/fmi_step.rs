@@ -4,7 +4,7 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::export::REGISTRY;
 use actuator_fmus::physics::gaylord::Sleeve;
 use common::mckibben::*;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};

@@ -23,7 +23,7 @@
 #[path = "../tests/common/mod.rs"]
 mod common;
 
-use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::export::REGISTRY;
 use actuator_fmus::variables::{ModelInfo, VarType};
 use std::hint::black_box;
 use std::path::{Path, PathBuf};

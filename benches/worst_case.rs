@@ -16,7 +16,7 @@ mod common;
 #[path = "cpu_clock.rs"]
 mod cpu_clock;
 
-use actuator_fmus::fmi2::REGISTRY;
+use actuator_fmus::export::REGISTRY;
 use actuator_fmus::variables::{Causality, ModelInfo, Start, VarType};
 use common::*;
 use cpu_clock::thread_cpu;

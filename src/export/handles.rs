@@ -1,10 +1,10 @@
 //! The `fmi2Component` or `fmi3Instance` an importer holds is a handle, not the instance's
 //! address: a slot of a fixed table and a generation number that no other instance of this
 //! process ever gets; one table serves both FMI versions. A freed instance's handle (a second
-//! `fmi2FreeInstance`, any call after the first) finds its slot
-//! empty or re-used under another generation and is refused without reading freed memory; it
-//! can never reach an instance allocated later at the same address, or in the same slot. A
-//! handle off by a few bytes, or any other value, names no live generation and is refused too.
+//! free, any call after the first) finds its slot empty or re-used under another generation and
+//! is refused without reading freed memory; it can never reach an instance allocated later at
+//! the same address, or in the same slot. A handle off by a few bytes, or any other value, names
+//! no live generation and is refused too.
 //!
 //! The table is static (`SLOTS` instances alive at once; 16 bytes each, in pages touched only when
 //! used); handles are 64-bit (the slot in the low 16 bits, the generation above).

@@ -1,7 +1,7 @@
 //! The named choices of an FMU page: the Enumeration types of a shipped model description, and
 //! the values each preset gives, read from the model itself.
 
-use actuator_fmus::fmi2::runtime::Factory;
+use actuator_fmus::export::runtime::Factory;
 use actuator_fmus::variables::{Causality, ModelInfo, VarType};
 
 /// One Enumeration type: its name and (value, item name, description) per item.

@@ -1,6 +1,6 @@
 //! Writes `<Model>.fmu` archives: model description, binary, and generated documentation.
 
-use actuator_fmus::fmi2::runtime::Factory;
+use actuator_fmus::export::runtime::Factory;
 use actuator_fmus::variables::{ModelInfo, Start, Variable};
 use std::io::Write;
 use std::path::{Path, PathBuf};
@@ -33,7 +33,7 @@ pub fn package_all_platforms(
         .collect::<Result<Vec<_>, String>>()?;
     std::fs::create_dir_all(out_dir)
         .map_err(|e| format!("cannot create {}: {e}", out_dir.display()))?;
-    actuator_fmus::fmi2::REGISTRY
+    actuator_fmus::export::REGISTRY
         .iter()
         .map(|f| package(*f, &binaries, out_dir))
         .collect()
