@@ -360,7 +360,11 @@ fn run() -> Result<(), String> {
             r.value,
             r.lower,
             r.upper,
-            if r.fixed { "fixed" } else { "yes" },
+            match (r.fixed, r.name) {
+                (false, _) => "yes",
+                (true, "sleeve_diameter") if cfg.sleeve_on_wall => "bore + 2 wall",
+                (true, _) => "fixed",
+            },
             if at_bound { "  AT A BOUND" } else { "" }
         );
     }
