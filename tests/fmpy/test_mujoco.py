@@ -477,7 +477,7 @@ ERRORS = [
     ({"length_input": "lenght"}, "has no variable 'lenght'"),
     ({"force_output": "pressure"}, "'pressure' must be a Real output"),
     ({"parameters": "preset=99"}, "preset refused"),
-    ({"parameters": "preset=DMSP-99"}, "preset name (none, A, B, C, D, DMSP-10, DMSP-40)"),
+    ({"parameters": "preset=DMSP-99"}, "preset name (none, A, B, C, D, DMSP-10, DMSP-40, DMSP-5, DMSP-20)"),
     ({"parameters": "turnz=3"}, "parameter 'turnz': McKibbenMuscle has no such variable"),
     ({"parameters": "force=3"}, "'force' is an output, not a parameter or input"),
     ({"parameters": "friction=maybe"}, "'friction' = 'maybe' is not true or false"),

@@ -119,7 +119,7 @@ mod tests {
         let docs = include_str!("../../docs/calibration.md");
         let readme = include_str!("../../README.md");
         for stated in LEAVE_ONE_OUT_WORST_RMS {
-            let text = format!("{:.0}%", 100.0 * stated);
+            let text = format!("{:.1}%", 100.0 * stated);
             assert!(
                 docs.contains(&text) && readme.contains(&text),
                 "{text} not stated"
