@@ -126,4 +126,23 @@ mod tests {
             );
         }
     }
+
+    /// A number the law does not use: its DMSP-20 at 600 kPa and the nominal length pulls 1587 N,
+    /// within 6% of the catalogue's 1500 N.
+    #[test]
+    fn the_dmsp_20_pulls_near_its_catalogue_force() {
+        use actuator_fmus::physics::festo::{preset, DMSP_20};
+        use actuator_fmus::physics::friction::HysteresisState;
+        let (p, c) = preset(8).unwrap();
+        assert_eq!(c, DMSP_20);
+        let l = p.nominal_length;
+        let f = p
+            .muscle()
+            .unwrap()
+            .evaluate(6e5, l, &HysteresisState::at_rest(l))
+            .unwrap()
+            .force;
+        assert!((f / c.max_force - 1.0).abs() < 0.06, "{f} N");
+        assert!((f - 1586.65).abs() < 0.1, "{f} N");
+    }
 }
