@@ -16,6 +16,34 @@ use crate::physics::friction::HysteresisState;
 /// near 3.5%, polyester near 12%; 5% of `b` is where the out-of-range policy takes over.
 pub const SURVIVABLE_STRAND_STRAIN: f64 = 0.05;
 
+/// The Festo DMSP datasheets' largest forces, N, which size their aramid strands.
+pub const DMSP_10_LARGEST_FORCE: f64 = 630.0;
+pub const DMSP_40_LARGEST_FORCE: f64 = 6000.0;
+
+/// Kevlar 49's modulus (112 GPa) over a working stress of a tenth of its strength (0.3 GPa).
+const ARAMID_MODULUS_PER_WORKING_STRESS: f64 = 112e9 / 0.3e9;
+
+/// `E A` of all strands together, N: the user's `rigidity` if `set`; else, for a Festo muscle
+/// whose datasheet's largest force is `festo_largest_force`, aramid strands working at a tenth of
+/// their strength there; else `rigidity` (the default for Table 2.1's polyester strands).
+pub fn strand_rigidity(
+    rigidity: f64,
+    set: bool,
+    festo_largest_force: Option<f64>,
+) -> Result<f64, String> {
+    let rigidity = match festo_largest_force {
+        Some(force) if !set => ARAMID_MODULUS_PER_WORKING_STRESS * force,
+        _ => rigidity,
+    };
+    if rigidity.is_finite() && rigidity > 0.0 {
+        Ok(rigidity)
+    } else {
+        Err(format!(
+            "strand_rigidity must be positive and finite, got {rigidity} N"
+        ))
+    }
+}
+
 /// Where the strands take over at one pressure.
 #[derive(Clone, Copy, Debug)]
 pub struct StrandTransition {
@@ -42,8 +70,7 @@ impl McKibben {
 
     /// The transition at `pressure` for an input `length` where the rigid muscle is out of reach
     /// or under tension and stiffer than the strands (`k_s`, N/m); `None` where the rigid model
-    /// holds. Bisection between a length where the rigid braid holds and softer than `k_s` and
-    /// one where it does not (at most 30 + 60 evaluations, only in this regime).
+    /// holds (see [`transition`]).
     pub fn strand_transition(
         &self,
         pressure: f64,
@@ -51,40 +78,88 @@ impl McKibben {
         strand_stiffness: f64,
         history: &HysteresisState,
     ) -> Option<StrandTransition> {
-        let holds = |l: f64| {
+        let rigid = |l: f64| {
             self.evaluate(pressure, l, history)
                 .ok()
-                .filter(|o| !(o.force > 0.0 && o.stiffness > strand_stiffness))
+                .map(|o| (o.force, o.stiffness, o))
         };
-        let (lo, hi) = (self.min_length(), self.max_length());
-        if !(length > 0.5 * (lo + hi)) || holds(length).is_some() {
-            return None;
-        }
-        let mut stiff = length.min(hi);
-        let mut soft = None;
-        for k in 1..=30 {
-            let l = stiff - (stiff - lo) * 0.5f64.powi(k);
-            if let Some(out) = holds(l) {
-                soft = Some((l, out));
-                break;
-            }
-        }
-        let (mut l, mut rigid) = soft?;
-        for _ in 0..60 {
-            let mid = 0.5 * (l + stiff);
-            if mid <= l || mid >= stiff {
-                break;
-            }
-            match holds(mid) {
-                Some(out) => (l, rigid) = (mid, out),
-                None => stiff = mid,
-            }
-        }
-        let interior = (rigid.stiffness - strand_stiffness).abs() <= 1e-6 * strand_stiffness;
-        Some(StrandTransition {
-            length: l,
-            rigid,
-            interior,
+        let range = (self.min_length(), self.max_length());
+        transition(range, length, strand_stiffness, rigid).map(|t| StrandTransition {
+            length: t.length,
+            rigid: t.rigid,
+            interior: t.interior,
         })
     }
+}
+
+/// Where the strands take over, for any muscle whose rigid model `rigid(L)` gives force, stiffness
+/// and its outputs (`None` where it has no solution).
+#[derive(Clone, Copy, Debug)]
+pub struct Transition<T> {
+    /// Input length `L_t` up to which the rigid model holds, m.
+    pub length: f64,
+    /// The rigid outputs at `L_t`.
+    pub rigid: T,
+    /// The rigid slope reaches `k_s` at `L_t` (else `L_t` is the reach, fixed).
+    pub interior: bool,
+}
+
+/// The rigid model holds at `L` unless it has no solution there or pulls and is stiffer than the
+/// strands (`k_s`, N/m).
+/// Returns its stiffness and outputs there.
+fn holds<T>(rigid: &impl Fn(f64) -> Option<(f64, f64, T)>, l: f64, k_s: f64) -> Option<(f64, T)> {
+    rigid(l)
+        .filter(|(force, stiffness, _)| !(*force > 0.0 && *stiffness > k_s))
+        .map(|(_, stiffness, out)| (stiffness, out))
+}
+
+/// The transition for an input `length` in the upper half of the rigid model's `range` where
+/// that model does not hold; `None` where it holds. At or past the reach, the reach itself when
+/// the rigid model holds there (a closed range, as the knitted sleeve's); otherwise bisection
+/// between a length where it holds and one where it does not (at most 30 + 60 evaluations, only
+/// in this regime).
+pub fn transition<T>(
+    (lo, hi): (f64, f64),
+    length: f64,
+    k_s: f64,
+    rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+) -> Option<Transition<T>> {
+    let upper_half = length > 0.5 * (lo + hi);
+    if !upper_half || holds(&rigid, length, k_s).is_some() {
+        return None;
+    }
+    if length >= hi {
+        if let Some((_, out)) = holds(&rigid, hi, k_s) {
+            return Some(Transition {
+                length: hi,
+                rigid: out,
+                interior: false,
+            });
+        }
+    }
+    let mut stiff = length.min(hi);
+    let mut soft = None;
+    for k in 1..=30 {
+        let l = stiff - (stiff - lo) * 0.5f64.powi(k);
+        if let Some(out) = holds(&rigid, l, k_s) {
+            soft = Some((l, out));
+            break;
+        }
+    }
+    let (mut l, (mut slope, mut out)) = soft?;
+    for _ in 0..60 {
+        let mid = 0.5 * (l + stiff);
+        if mid <= l || mid >= stiff {
+            break;
+        }
+        match holds(&rigid, mid, k_s) {
+            Some((s, o)) => (l, slope, out) = (mid, s, o),
+            None => stiff = mid,
+        }
+    }
+    Some(Transition {
+        length: l,
+        rigid: out,
+        interior: (slope - k_s).abs() <= 1e-6 * k_s,
+    })
 }

@@ -1,0 +1,158 @@
+//! The bare sleeve (eq. 2.2-2.3 alone: no bladder, friction or connector) with stretching strands
+//! (see [`super::strands`]): the McKibbenMuscle FMU's fastest path, in closed form.
+
+use super::limits::OutOfRange;
+use super::{McKibbenPartials, SURVIVABLE_STRAND_STRAIN};
+use crate::physics::gaylord::Sleeve;
+
+/// The bare sleeve's outputs at one point.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct SleeveState {
+    /// Signed tension, N (eq. 2.3; on the strands `F(L_t) + k_s (L - L_t)`).
+    pub force: f64,
+    /// Gas volume, m^3 (eq. 2.2).
+    pub volume: f64,
+    /// `max(P, 0)`, Pa: under vacuum the bladder leaves the sleeve.
+    pub effective_pressure: f64,
+    /// `dF/dL`, N/m.
+    pub stiffness: f64,
+    /// The bladder presses on the sleeve (`P > 0`).
+    pub contact: bool,
+}
+
+/// Where the bare sleeve's strands take over at `p_eff`: at `b` (straight strands) or where eq.
+/// 2.3's stiffness `6 P L / (4 pi n^2)` reaches the strands' `k_s`, whichever comes first.
+#[inline(always)]
+pub fn reach(sleeve: &Sleeve, k_s: f64, p_eff: f64) -> f64 {
+    sleeve.max_length().min(k_s / sleeve.stiffness(p_eff, 1.0))
+}
+
+/// The input length past which no muscle survives: [`SURVIVABLE_STRAND_STRAIN`] of `b` beyond `b`.
+pub fn breaking_length(sleeve: &Sleeve) -> f64 {
+    sleeve.max_length() * (1.0 + SURVIVABLE_STRAND_STRAIN)
+}
+
+/// Eq. 2.3 for the bare sleeve with strands of stiffness `k_s` (N/m) at `(pressure, length)`;
+/// past the breaking length, evaluated there (returned with why).
+#[inline(always)]
+pub fn evaluate(
+    sleeve: &Sleeve,
+    k_s: f64,
+    pressure: f64,
+    length: f64,
+) -> (SleeveState, Option<OutOfRange>) {
+    let p_eff = pressure.max(0.0);
+    let reach = reach(sleeve, k_s, p_eff);
+    if length > reach {
+        return on_strands(sleeve, k_s, reach, pressure, length);
+    }
+    let state = SleeveState {
+        force: sleeve.force(p_eff, length),
+        volume: sleeve.volume(length),
+        effective_pressure: p_eff,
+        stiffness: sleeve.stiffness(p_eff, length),
+        contact: pressure > 0.0,
+    };
+    (state, None)
+}
+
+/// The bare sleeve past `reach`, where its strands stretch: `F = F(reach) + k_s (L - reach)`;
+/// past the breaking length no muscle survives: evaluated there. Out of line, so that the
+/// per-step path of the ideal muscle stays small enough to inline.
+#[cold]
+#[inline(never)]
+fn on_strands(
+    sleeve: &Sleeve,
+    k_s: f64,
+    reach: f64,
+    pressure: f64,
+    requested: f64,
+) -> (SleeveState, Option<OutOfRange>) {
+    let b = sleeve.max_length();
+    let breaking = breaking_length(sleeve);
+    let clamp = (requested > breaking).then(|| OutOfRange {
+        reason: format!(
+            "length {requested} m stretches the strands more than {}% past b = {b} m, which no muscle survives",
+            100.0 * SURVIVABLE_STRAND_STRAIN
+        ),
+        range: (0.0, breaking),
+        point: Some((pressure, breaking)),
+    });
+    let length = requested.min(breaking);
+    let p_eff = pressure.max(0.0);
+    let state = SleeveState {
+        force: sleeve.force(p_eff, reach) + k_s * (length - reach),
+        volume: sleeve.volume(reach),
+        effective_pressure: p_eff,
+        stiffness: k_s,
+        contact: pressure > 0.0,
+    };
+    (state, clamp)
+}
+
+/// The signed force below the strands (eq. 2.3 at `min(L, b)`).
+pub fn signed_force(sleeve: &Sleeve, pressure: f64, length: f64) -> f64 {
+    sleeve.force(pressure.max(0.0), length.min(sleeve.max_length()))
+}
+
+/// Whether `(pressure, length)` lies on the stretching strands.
+pub fn on_the_strands(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> bool {
+    length > reach(sleeve, k_s, pressure.max(0.0))
+}
+
+/// `[d/dP, d/dL]` of the signed outputs of [`evaluate`]. On the strands, with
+/// `reach = k_s / (6 P / (4 pi n^2))` inside `b`: `dreach/dP = -reach / P`, and the force
+/// `F(P, reach(P)) + k_s (L - reach(P))` moves with the length by `k_s` up to the breaking
+/// length. The bare sleeve's stretches and stresses are constants (no bladder).
+pub fn partials(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> McKibbenPartials {
+    let p_eff = pressure.max(0.0);
+    let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+    let reach = reach(sleeve, k_s, p_eff);
+    if length > reach {
+        let moves = length <= breaking_length(sleeve);
+        let dreach = if reach < sleeve.max_length() && p_eff > 0.0 {
+            -reach / p_eff
+        } else {
+            0.0
+        };
+        let per_pa = sleeve.force(1.0, reach);
+        return McKibbenPartials {
+            force: [
+                on * (per_pa + (sleeve.stiffness(p_eff, reach) - k_s) * dreach),
+                if moves { k_s } else { 0.0 },
+            ],
+            effective_pressure: [on, 0.0],
+            volume: [-on * per_pa * dreach, 0.0],
+            ..Default::default()
+        };
+    }
+    let inside = length <= sleeve.max_length();
+    let l = length.min(sleeve.max_length());
+    let per_pa = sleeve.force(1.0, l);
+    let dl = if inside { 1.0 } else { 0.0 };
+    McKibbenPartials {
+        force: [on * per_pa, dl * sleeve.stiffness(p_eff, l)],
+        effective_pressure: [on, 0.0],
+        volume: [0.0, -dl * per_pa],
+        ..Default::default()
+    }
+}
+
+/// `[d/dP, d/dL]` of the signed stiffness of [`evaluate`]: 0 on the strands (their constant
+/// `k_s`); below them eq. 2.3's stiffness `6 P_eff L / (4 pi n^2)`, bilinear in `P_eff` and `L`.
+pub fn stiffness_partials(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> [f64; 2] {
+    if on_the_strands(sleeve, k_s, pressure, length) {
+        return [0.0; 2];
+    }
+    let on = if pressure > 0.0 { 1.0 } else { 0.0 };
+    let inside = if length <= sleeve.max_length() {
+        1.0
+    } else {
+        0.0
+    };
+    let l = length.min(sleeve.max_length());
+    [
+        on * sleeve.stiffness(1.0, l),
+        inside * sleeve.stiffness(pressure.max(0.0), 1.0),
+    ]
+}
