@@ -16,16 +16,13 @@ use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::inverse::{difference_for_torque, pair_pressures};
 use crate::physics::mckibben::{
-    BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
+    is_slack, strand_rigidity, BladderModel, FrictionParams, McKibben, McKibbenOutput,
+    MuscleGeometry, DMSP_10_LARGEST_FORCE, DMSP_40_LARGEST_FORCE,
 };
 use crate::variables::mckibben_joint::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
 };
 use serde::{Deserialize, Serialize};
-
-/// As in McKibbenMuscle: with a bladder the force grows without bound at both length limits, so
-/// an out-of-range length is evaluated this fraction of the range inside the limit.
-const LIMIT_MARGIN: f64 = 1e-3;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct McKibbenJoint {
@@ -47,6 +44,9 @@ pub struct McKibbenJoint {
     torque_command: bool,
     /// The dissertation's signed muscle forces (`signed_force`); else tension only.
     signed_force: bool,
+    /// The straight strands' axial stiffness `k_s = E A / b` of each muscle, N/m (from
+    /// `strand_rigidity`): past `max_length` the strands stretch, as in McKibbenMuscle.
+    strand_stiffness: f64,
 }
 
 /// Both muscles' operating point at the current inputs.
@@ -109,6 +109,18 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
     }
 }
 
+/// `E A` of all strands of one muscle, N: the user's `strand_rigidity`, or for the Festo presets
+/// (unless set) their aramid strands, as McKibbenMuscle's.
+fn rigidity(p: &Parameters) -> Result<f64, String> {
+    let festo = match p.preset {
+        5 => Some(DMSP_10_LARGEST_FORCE),
+        6 => Some(DMSP_40_LARGEST_FORCE),
+        _ => None,
+    };
+    let set = p.strand_rigidity != Parameters::default().strand_rigidity;
+    strand_rigidity(p.strand_rigidity, set, festo)
+}
+
 fn positive(name: &str, x: f64) -> Result<f64, Refusal> {
     if x.is_finite() && x > 0.0 {
         Ok(x)
@@ -121,7 +133,7 @@ impl McKibbenJoint {
     /// Whether a muscle with this signed force is slack: a braided muscle cannot push, so past
     /// its free contraction it carries no force and has no stiffness (unless `signed_force`).
     fn slack(&self, force: f64) -> bool {
-        !self.signed_force && force < 0.0
+        is_slack(force, self.signed_force)
     }
 
     /// The muscle's output, tension only unless `signed_force`.
@@ -133,7 +145,8 @@ impl McKibbenJoint {
         out
     }
 
-    /// One muscle at (pressure, length); out of range, the nearest valid length (flagged).
+    /// One muscle at (pressure, length), its strands stretching past `max_length`; beyond the
+    /// length no muscle survives, the nearest point evaluated (why, in `clamped`).
     fn evaluate_muscle(
         &self,
         pressure: f64,
@@ -141,45 +154,47 @@ impl McKibbenJoint {
         history: &HysteresisState,
         clamped: &mut Option<String>,
     ) -> Option<McKibbenOutput> {
-        let reason = match self.muscle.evaluate(pressure, length, history) {
-            Ok(out) => return Some(out),
-            Err(reason) => reason,
-        };
-        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() {
-            LIMIT_MARGIN * (hi - lo)
-        } else {
-            0.0
-        };
-        let inside = length.max(lo + margin).min(hi - margin); // max/min: no panic on odd limits
-        clamped.get_or_insert(format!(
-            "{reason} (valid muscle lengths {lo} .. {hi} m); evaluating at {inside} m until the inputs return"
-        ));
-        self.muscle.evaluate(pressure, inside, history).ok()
+        let (out, excursion) =
+            self.muscle
+                .evaluate_with_strands(pressure, length, self.strand_stiffness, history);
+        if let Some(e) = excursion {
+            clamped.get_or_insert(e.message());
+        }
+        out
     }
 
-    /// Force and dF/dP of one muscle, at the nearest valid length as [`Self::evaluate_muscle`].
+    /// Signed force and `[dF/dP, dF/dL]` of one muscle on the branch [`Self::evaluate_muscle`]
+    /// takes (on the strands, their slope; at a clamped length the length no longer moves it).
+    fn signed_force_and_partials(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Option<(f64, [f64; 2])> {
+        let k_s = self.strand_stiffness;
+        let (out, _) = self
+            .muscle
+            .evaluate_with_strands(pressure, length, k_s, history);
+        let d = self
+            .muscle
+            .partials_with_strands(pressure, length, k_s, history)
+            .ok()?;
+        Some((out?.force, d.force))
+    }
+
+    /// Force and dF/dP of one muscle, tension only unless `signed_force`.
     fn force_and_slope(
         &self,
         pressure: f64,
         length: f64,
         history: &HysteresisState,
     ) -> Option<(f64, f64)> {
-        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() {
-            LIMIT_MARGIN * (hi - lo)
-        } else {
-            0.0
-        };
-        let inside = length.max(lo + margin).min(hi - margin);
-        [length, inside]
-            .into_iter()
-            .find_map(|l| self.muscle.partials(pressure, l, history).ok())
-            .map(|(out, d)| {
-                if self.slack(out.force) {
+        self.signed_force_and_partials(pressure, length, history)
+            .map(|(force, d)| {
+                if self.slack(force) {
                     (0.0, 0.0)
                 } else {
-                    (out.force, d.force[0])
+                    (force, d[0])
                 }
             })
     }
@@ -260,28 +275,12 @@ impl McKibbenJoint {
         })
     }
 
-    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: at a clamped length
-    /// the length no longer moves the force.
+    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: 0 while slack.
     fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
-        if let Ok((out, d)) = self.muscle.partials(pressure, length, history) {
-            return if self.slack(out.force) {
-                [0.0; 2]
-            } else {
-                d.force
-            };
+        match self.signed_force_and_partials(pressure, length, history) {
+            Some((force, d)) if !self.slack(force) => d,
+            _ => [0.0; 2],
         }
-        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() {
-            LIMIT_MARGIN * (hi - lo)
-        } else {
-            0.0
-        };
-        let inside = length.max(lo + margin).min(hi - margin);
-        self.muscle
-            .partials(pressure, inside, history)
-            .ok()
-            .filter(|(out, _)| !self.slack(out.force))
-            .map_or([0.0, 0.0], |(_, d)| [d.force[0], 0.0])
     }
 
     fn write(&self, out: &mut Outputs, pair: &Pair) {
@@ -325,6 +324,7 @@ impl Model for McKibbenJoint {
             ).into());
         }
         let muscle = muscle(p)?;
+        let strand_stiffness = muscle.strand_stiffness(rigidity(p)?);
         let (lo, hi) = (muscle.min_length(), muscle.max_length());
         // Flexor L0f - r q and extensor L0e + r q both inside (lo, hi).
         let min_position =
@@ -362,6 +362,7 @@ impl Model for McKibbenJoint {
             position_range: (min_position, max_position),
             torque_command,
             signed_force: p.signed_force,
+            strand_stiffness,
         })
     }
 

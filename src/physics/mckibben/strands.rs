@@ -163,3 +163,45 @@ pub fn transition<T>(
         interior: (slope - k_s).abs() <= 1e-6 * k_s,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A rigid model singular at its reach, `F = a / (hi - L)`, stiffness `a / (hi - L)^2`:
+    /// the strands (`k_s`) take over exactly where that stiffness is `k_s`,
+    /// `L_t = hi - sqrt(a / k_s)`.
+    #[test]
+    fn transition_is_where_the_rigid_stiffness_reaches_the_strands() {
+        let (lo, hi, a, k_s) = (0.05, 0.1, 2.0, 1e5);
+        let rigid = |l: f64| (l < hi).then(|| (a / (hi - l), a / (hi - l).powi(2), l));
+        let exact = hi - (a / k_s).sqrt();
+        for length in [exact + 1e-6, hi, hi + 0.01] {
+            let t = transition((lo, hi), length, k_s, rigid).unwrap();
+            assert!((t.length - exact).abs() < 1e-12, "{}", t.length);
+            assert!(t.interior && t.rigid == t.length);
+        }
+        assert!(transition((lo, hi), exact - 1e-6, k_s, rigid).is_none());
+    }
+
+    /// A rigid model that holds up to and including its reach, softer than the strands there
+    /// (the knitted sleeve): the strands take over at the reach itself.
+    #[test]
+    fn closed_range_hands_over_at_its_reach() {
+        let (lo, hi, k_s) = (0.05, 0.1, 1e5);
+        let rigid = |l: f64| (lo..=hi).contains(&l).then_some((1e3 * l, 1e3, l));
+        let t = transition((lo, hi), hi + 0.01, k_s, rigid).unwrap();
+        assert_eq!(t.length, hi);
+        assert!(!t.interior);
+        assert!(transition((lo, hi), hi, k_s, rigid).is_none());
+    }
+
+    #[test]
+    fn festo_strands_are_aramid_unless_set() {
+        let aramid = strand_rigidity(9400.0, false, Some(DMSP_10_LARGEST_FORCE)).unwrap();
+        assert!((aramid - 112e9 / 0.3e9 * 630.0).abs() < 1e-6);
+        assert_eq!(strand_rigidity(5e4, true, Some(630.0)).unwrap(), 5e4);
+        assert_eq!(strand_rigidity(9400.0, false, None).unwrap(), 9400.0);
+        assert!(strand_rigidity(0.0, true, None).is_err());
+    }
+}
