@@ -447,3 +447,166 @@ impl Model for McKibbenJoint {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn joint(p: &Parameters) -> McKibbenJoint {
+        McKibbenJoint::new(p, &Inputs::default()).unwrap()
+    }
+
+    fn at(j: &mut McKibbenJoint, u: f64, q: f64) -> (Outputs, bool) {
+        let x = Inputs {
+            actuator_input: u,
+            joint_position: q,
+            joint_velocity: 0.0,
+        };
+        let mut out = Outputs::default();
+        let mut report = Report::default();
+        j.step(&x, &mut out, 0.0, 1e-3, &mut report);
+        (out, report.clamped())
+    }
+
+    /// The bare sleeves past b: the extensor (`L0 + r q`) follows eq. 2.3 at `b` plus the
+    /// strands' `E A / b` times the stretch, computed here in closed form; nothing is clamped
+    /// before 5% strand strain past b, and the torque is continuous through `max_position`.
+    #[test]
+    fn extensor_strands_stretch_past_b() {
+        let p = Parameters::default();
+        let mut j = joint(&p);
+        let (b, n, r, l0) = (
+            p.strand_length,
+            p.turns,
+            p.moment_arm,
+            p.extensor_rest_length,
+        );
+        let k_s = p.strand_rigidity / b;
+        let u = 1e5;
+        let extensor_pressure = p.common_mode_pressure - 0.5 * u;
+        let eq_2_3_at_b = extensor_pressure * 2.0 * b * b / (4.0 * PI * n * n);
+        let max_position = j.calculated_parameters().max_position;
+        assert!((max_position - (b - l0) / r).abs() < 1e-12);
+        for stretch in [1e-4, 0.01, 0.049] {
+            let q = (b * (1.0 + stretch) - l0) / r;
+            let (out, clamped) = at(&mut j, u, q);
+            let expected = eq_2_3_at_b + k_s * stretch * b;
+            assert!(!clamped && !out.extensor_slack);
+            assert!(
+                (out.extensor_force - expected).abs() < 1e-9 * expected,
+                "{stretch}: {} vs {expected}",
+                out.extensor_force
+            );
+        }
+        // Left and right limits at max_position.
+        let eps = 1e-9;
+        let (left, _) = at(&mut j, u, max_position - eps);
+        let (right, _) = at(&mut j, u, max_position + eps);
+        let jump = (right.joint_torque - left.joint_torque).abs();
+        assert!(jump <= 2.0 * eps * r * r * k_s * 1.01, "{jump} N m");
+        // Past 5% strand strain: held at the breaking length, flagged.
+        let (out, clamped) = at(&mut j, u, (1.1 * b - l0) / r);
+        assert!(clamped);
+        let at_break = eq_2_3_at_b + k_s * 0.05 * b;
+        assert!((out.extensor_force - at_break).abs() < 1e-9 * at_break);
+    }
+
+    /// Monotone and finite through the breaking length with a bladder (muscle A, thin wall): the
+    /// extensor's force rises by at most `k_s` per metre of its length, by exactly `k_s` past
+    /// `max_length`.
+    #[test]
+    fn bladder_muscle_is_continuous_through_max_length() {
+        let p = Parameters {
+            preset: 1,
+            bladder_model: 1,
+            ..Default::default()
+        };
+        let mut j = joint(&p);
+        let (r, l0) = (p.moment_arm, p.extensor_rest_length);
+        let hi = j.muscle.max_length();
+        let k_s = p.strand_rigidity / j.muscle.sleeve().strand_length;
+        let breaking = j.muscle.breaking_length();
+        let (from, to) = (hi - 0.02 * (hi - j.muscle.min_length()), breaking);
+        let steps = 2000;
+        let dl = (to - from) / steps as f64;
+        let force_at = |j: &mut McKibbenJoint, l: f64| at(j, 0.0, (l - l0) / r);
+        let mut previous = force_at(&mut j, from).0.extensor_force;
+        for i in 1..=steps {
+            let l = from + dl * i as f64;
+            let (out, clamped) = force_at(&mut j, l);
+            let rise = out.extensor_force - previous;
+            assert!(!clamped && out.extensor_force.is_finite(), "{l}");
+            assert!(rise > 0.0 && rise <= k_s * dl * (1.0 + 1e-5), "{l}: {rise}");
+            if l - dl > hi {
+                assert!((rise - k_s * dl).abs() < 1e-5 * k_s * dl, "{l}: {rise}");
+            }
+            previous = out.extensor_force;
+        }
+    }
+
+    /// The partials are central differences of the outputs, on the strands, in both command
+    /// modes, and 0 for a slack muscle's force.
+    #[test]
+    fn partials_are_the_slopes_on_the_strands_and_zero_while_slack() {
+        for (preset, model, mode) in [(0, 0, 0), (0, 0, 1), (1, 3, 0), (1, 3, 1)] {
+            let p = Parameters {
+                preset,
+                bladder_model: model,
+                command_mode: mode,
+                ..Default::default()
+            };
+            let mut j = joint(&p);
+            let hi = j.muscle.max_length();
+            let q = (hi + 0.01 * j.muscle.sleeve().strand_length - p.extensor_rest_length)
+                / p.moment_arm;
+            let u = if mode == 1 { 0.5 } else { 1e5 };
+            let x = Inputs {
+                actuator_input: u,
+                joint_position: q,
+                joint_velocity: 0.0,
+            };
+            let d = j.partials(&x).unwrap();
+            let names = ["jointTorque", "flexor_force", "extensor_force"];
+            let value = |j: &mut McKibbenJoint, u: f64, q: f64| {
+                let (o, clamped) = at(j, u, q);
+                assert!(!clamped);
+                [o.joint_torque, o.flexor_force, o.extensor_force]
+            };
+            for (column, h) in [(0, if mode == 1 { 1e-4 } else { 1.0 }), (1, 1e-7)] {
+                let (du, dq) = if column == 0 { (h, 0.0) } else { (0.0, h) };
+                let up = value(&mut j, u + du, q + dq);
+                let down = value(&mut j, u - du, q - dq);
+                for (k, name) in names.iter().enumerate() {
+                    let fd = (up[k] - down[k]) / (2.0 * h);
+                    let exact = d.get(name).unwrap()[column].1;
+                    let scale = fd.abs().max(exact.abs()).max(1e-9);
+                    assert!(
+                        (fd - exact).abs() < 1e-4 * scale,
+                        "preset {preset} mode {mode} {name}[{column}]: {exact} vs {fd}"
+                    );
+                }
+            }
+        }
+        // Short muscles: the flexor goes slack; its force's partials are 0.
+        let p = Parameters {
+            flexor_rest_length: 0.07,
+            extensor_rest_length: 0.07,
+            ..Default::default()
+        };
+        let mut j = joint(&p);
+        let (out, _) = at(&mut j, 0.0, 0.6);
+        assert!(out.flexor_slack && out.flexor_force == 0.0 && !out.extensor_slack);
+        let x = Inputs {
+            actuator_input: 0.0,
+            joint_position: 0.6,
+            joint_velocity: 0.0,
+        };
+        let d = j.partials(&x).unwrap();
+        assert!(d
+            .get("flexor_force")
+            .unwrap()
+            .iter()
+            .all(|(_, v)| *v == 0.0));
+    }
+}
