@@ -232,3 +232,4 @@ impl McKibben {
         at(pressure.max(0.0), clamped).map(|d| (d, false, false))
     }
 }
+
