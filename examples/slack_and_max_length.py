@@ -77,30 +77,35 @@ def main():
 
 
 def simulate(fmu, inputs, outputs, start):
-    """`outputs` along the input columns `inputs` ({name: array}), one sample per step."""
+    """`outputs` along the input columns `inputs` ({name: array}), one sample per step: FMPy
+    records the outputs of the step that starts at a sample at the next one, so sample `k + 1`
+    holds the outputs for input `k`; returned aligned with the inputs (the last input repeated)."""
     names = list(inputs)
-    n = len(inputs[names[0]])
+    columns = [np.append(inputs[k], inputs[k][-1]) for k in names]
+    n = len(columns[0])
     t = np.linspace(0.0, 1.0, n)
-    signal = np.array(list(zip(t, *(inputs[k] for k in names))),
-                      dtype=[("time", float)] + [(k, float) for k in names])
-    return simulate_fmu(fmu, stop_time=1.0, output_interval=1.0 / (n - 1), start_values=start,
-                        input=signal, output=outputs)
+    signal = np.array(list(zip(t, *columns)), dtype=[("time", float)] + [(k, float) for k in names])
+    r = simulate_fmu(fmu, stop_time=1.0, output_interval=1.0 / (n - 1), start_values=start,
+                     input=signal, output=outputs)
+    return {k: r[k][1:] for k in outputs}
 
 
 def joint_and_knitted():
-    """McKibbenJoint (bare sleeves, b = 111.3 mm, rest lengths 90 mm, moment arm 15 mm) against
-    the joint angle, and KnittedMuscle (the section 1.4 prototype's geometry) against its length."""
+    """McKibbenJoint (bare sleeves, b = 111.3 mm, short muscles: rest lengths 70 mm, moment arm
+    15 mm) against the joint angle, and KnittedMuscle (the section 1.4 prototype's geometry)
+    against its length."""
     fig, ((j_lin, j_log), (k_lin, k_log)) = plt.subplots(2, 2, figsize=(12, 9.6))
-    one = simulate(JOINT, {"jointPosition": np.zeros(2)}, ["max_position"], {})
+    b, rest, arm = 0.1113, 0.07, 0.015
+    short = {"flexor_rest_length": rest, "extensor_rest_length": rest}
+    one = simulate(JOINT, {"jointPosition": np.zeros(2)}, ["max_position"], short)
     max_position = one["max_position"][0]
-    b, rest, arm = 0.1113, 0.09, 0.015
     breaking = (1.05 * b - rest) / arm
-    q = np.linspace(-breaking - 0.05, breaking + 0.05, 1601)
+    q = np.linspace(-breaking - 0.1, breaking + 0.1, 3201)
     u = 1e5
     outputs = ["jointTorque", "flexor_force", "extensor_force", "flexor_slack", "input_clamped"]
-    r = simulate(JOINT, {"actuatorInput": np.full(q.size, u), "jointPosition": q}, outputs, {})
+    r = simulate(JOINT, {"actuatorInput": np.full(q.size, u), "jointPosition": q}, outputs, short)
     s = simulate(JOINT, {"actuatorInput": np.full(q.size, u), "jointPosition": q}, outputs,
-                 {"signed_force": True})
+                 {**short, "signed_force": True})
     j_lin.plot(q, r["jointTorque"], color="tab:blue", label="jointTorque, tension only (N m)")
     j_lin.plot(q, s["jointTorque"], color="tab:blue", ls="--", label="jointTorque, signed_force (N m)")
     j_log.semilogy(q, np.maximum(r["flexor_force"], 1e-3), color="tab:red", label="flexor_force (N)")
@@ -120,9 +125,9 @@ def joint_and_knitted():
             a.axvline(-x, color="k", lw=0.8, ls=":" if x == max_position else "-.")
         a.set_xlabel("jointPosition (rad)")
         a.grid(alpha=0.3)
-    j_lin.set_ylim(-2.0, 2.0)
+    j_lin.set_ylim(-6.0, 6.0)
     j_lin.set_ylabel("jointTorque (N m)")
-    j_lin.set_title("McKibbenJoint: torque (linear, clipped to +-2 N m)")
+    j_lin.set_title("McKibbenJoint: torque (linear, clipped to +-6 N m)")
     j_log.set_ylabel("muscle force (N, log scale; 1e-3 N shown for 0)")
     j_log.set_title("McKibbenJoint: muscle forces, slack and on the strands (log)")
 
@@ -145,7 +150,7 @@ def joint_and_knitted():
         on_yarn = (lengths > k_max) & (lengths <= k_break)
         slope = np.polyfit(lengths[on_yarn], r["force"][on_yarn], 1)[0]
         print(f"KnittedMuscle {kpa:.0f} kPa: slack below {taut.min() * 1e3:.1f} mm; force at max_length "
-              f"{np.interp(k_max, lengths, r['force']):.4g} N, at the breaking length "
+              f"{r['force'][inside][-1]:.4g} N, at the breaking length "
               f"{r['force'][on_yarn].max():.4g} N (slope {slope:.4g} N/m); clamped beyond "
               f"{bool(r['input_clamped'][lengths > k_break].all())}")
     for a in (k_lin, k_log):
@@ -163,8 +168,8 @@ def joint_and_knitted():
     k_log.set_title("KnittedMuscle: up to and past max_length, on the yarn (log)")
     for a in (j_lin, j_log, k_lin, k_log):
         a.legend(fontsize=7, loc="best")
-    fig.suptitle("McKibbenJoint (actuatorInput 100 kPa, bare sleeves) and KnittedMuscle (prototype "
-                 "geometry): slack and the stretching strands")
+    fig.suptitle("Slack and the stretching strands: McKibbenJoint (actuatorInput 100 kPa, bare sleeves, "
+                 "rest lengths 70 mm)\nand KnittedMuscle (the section 1.4 prototype's knit)")
     fig.tight_layout()
     out = ROOT / "docs" / "img" / "slack_and_max_length_joint_knitted.png"
     fig.savefig(out, dpi=110)
