@@ -156,3 +156,60 @@ pub fn stiffness_partials(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64)
         inside * sleeve.stiffness(pressure.max(0.0), 1.0),
     ]
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    /// Eq. 2.3 written out here, with the straight strands' `E A / b` past `b`.
+    #[test]
+    fn eq_2_3_then_the_strands_in_closed_form() {
+        let (b, n, rigidity, pressure) = (0.1113, 3.74, 9400.0, 3e5);
+        let sleeve = Sleeve::new(b, n).unwrap();
+        let k_s = rigidity / b;
+        let eq_2_3 = |l: f64| pressure * (3.0 * l * l - b * b) / (4.0 * PI * n * n);
+        for (l, expected) in [
+            (0.9 * b, eq_2_3(0.9 * b)),
+            (1.02 * b, eq_2_3(b) + k_s * 0.02 * b),
+            (1.2 * b, eq_2_3(b) + k_s * 0.05 * b),
+        ] {
+            let (state, excursion) = evaluate(&sleeve, k_s, pressure, l);
+            assert!((state.force - expected).abs() < 1e-12 * expected, "{l}");
+            assert_eq!(excursion.is_some(), l > 1.05 * b);
+        }
+    }
+
+    /// The partials are central differences of [`evaluate`], below and on the strands, also
+    /// where soft strands (`k_s` 1 kN/m, taking over at 97.7 mm) take over inside `b`.
+    #[test]
+    fn partials_are_central_differences() {
+        let sleeve = Sleeve::new(0.1113, 3.74).unwrap();
+        for (k_s, pressure, l) in [
+            (84_456.0, 3e5, 0.1),
+            (84_456.0, 3e5, 0.113),
+            (1e3, 3e5, 0.1),
+        ] {
+            let d = partials(&sleeve, k_s, pressure, l);
+            let dk = stiffness_partials(&sleeve, k_s, pressure, l);
+            let at = |p: f64, l: f64| {
+                let s = evaluate(&sleeve, k_s, p, l).0;
+                [s.force, s.volume, s.stiffness]
+            };
+            for (column, h) in [(0, 1.0), (1, 1e-8)] {
+                let (dp, dl) = if column == 0 { (h, 0.0) } else { (0.0, h) };
+                let (up, down) = (at(pressure + dp, l + dl), at(pressure - dp, l - dl));
+                let exact = [d.force[column], d.volume[column], dk[column]];
+                for k in 0..3 {
+                    let fd = (up[k] - down[k]) / (2.0 * h);
+                    let scale = fd.abs().max(exact[k].abs()).max(1e-12);
+                    assert!(
+                        (fd - exact[k]).abs() < 1e-5 * scale,
+                        "k_s {k_s} L {l} output {k} column {column}: {} vs {fd}",
+                        exact[k]
+                    );
+                }
+            }
+        }
+    }
+}

@@ -232,4 +232,3 @@ impl McKibben {
         at(pressure.max(0.0), clamped).map(|d| (d, false, false))
     }
 }
-
