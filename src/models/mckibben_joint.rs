@@ -172,14 +172,10 @@ impl McKibbenJoint {
         history: &HysteresisState,
     ) -> Option<(f64, [f64; 2])> {
         let k_s = self.strand_stiffness;
-        let (out, _) = self
-            .muscle
-            .evaluate_with_strands(pressure, length, k_s, history);
-        let d = self
-            .muscle
-            .partials_with_strands(pressure, length, k_s, history)
-            .ok()?;
-        Some((out?.force, d.force))
+        self.muscle
+            .force_and_partials_with_strands(pressure, length, k_s, history)
+            .ok()
+            .map(|(force, d)| (force, d.force))
     }
 
     /// Force and dF/dP of one muscle, tension only unless `signed_force`.

@@ -157,6 +157,31 @@ impl McKibben {
         Ok(d)
     }
 
+    /// The signed force of [`Self::evaluate_with_strands`] with [`Self::partials_with_strands`]:
+    /// where the rigid model holds, one pass of [`McKibben::partials`] (the torque solver's
+    /// per-iteration cost).
+    pub fn force_and_partials_with_strands(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> Result<(f64, McKibbenPartials), String> {
+        if let Ok((out, d)) = self.partials(pressure, length, history) {
+            if !(out.force > 0.0 && out.stiffness > k_s) {
+                return Ok((out.force, d));
+            }
+        }
+        let (out, _) = self.evaluate_with_strands(pressure, length, k_s, history);
+        let force = out
+            .ok_or("the muscle cannot be evaluated at this length")?
+            .force;
+        Ok((
+            force,
+            self.partials_with_strands(pressure, length, k_s, history)?,
+        ))
+    }
+
     /// `[d/dpressure, d/dlength]` of the signed stiffness on the branch
     /// [`Self::evaluate_with_strands`] takes: 0 on the strands (their constant `k_s`), else
     /// [`McKibben::stiffness_partials`] (a second-order pass through the bladder).
