@@ -541,6 +541,27 @@ mod tests {
         }
     }
 
+    /// The Festo presets' strands are aramid sized by the datasheet's largest force (Kevlar 49,
+    /// 112 GPa, at a tenth of its 3 GPa strength), unless `strand_rigidity` is set.
+    #[test]
+    fn festo_strands_are_aramid_unless_set() {
+        for (preset, force) in [(5, 630.0), (6, 6000.0)] {
+            let p = Parameters {
+                preset,
+                ..Default::default()
+            };
+            let j = joint(&p);
+            let b = j.muscle.sleeve().strand_length;
+            let aramid = 112e9 / 0.3e9 * force / b;
+            assert!((j.strand_stiffness - aramid).abs() < 1e-9 * aramid);
+            let set = joint(&Parameters {
+                strand_rigidity: 5e4,
+                ..p
+            });
+            assert!((set.strand_stiffness - 5e4 / b).abs() < 1e-9 * set.strand_stiffness);
+        }
+    }
+
     /// The partials are central differences of the outputs, on the strands, in both command
     /// modes, and 0 for a slack muscle's force.
     #[test]
