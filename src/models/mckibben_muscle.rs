@@ -194,6 +194,24 @@ fn log_excursion(logged: &mut bool, report: &mut Report, excursion: Option<OutOf
     }
 }
 
+/// The bare sleeve on its stretching strands, logged past the breaking length. Out of line, so
+/// that the per-step path of the ideal muscle stays small enough to inline.
+#[cold]
+#[inline(never)]
+fn sleeve_on_strands(
+    sleeve: &Sleeve,
+    strand_stiffness: f64,
+    inputs: &Inputs,
+    logged: &mut bool,
+    report: &mut Report,
+) -> bare_sleeve::SleeveState {
+    let (pressure, length) = (inputs.pressure, inputs.length);
+    let (state, excursion) =
+        bare_sleeve::on_the_strands_state(sleeve, strand_stiffness, pressure, length);
+    log_excursion(logged, report, excursion);
+    state
+}
+
 /// Eq. 2.3 for the bare sleeve, with its stretching strands.
 #[inline(always)]
 fn sleeve_outputs(
@@ -204,11 +222,14 @@ fn sleeve_outputs(
     logged: &mut bool,
     report: &mut Report,
 ) {
-    let (state, excursion) =
-        bare_sleeve::evaluate(sleeve, strand_stiffness, inputs.pressure, inputs.length);
-    if excursion.is_some() || *logged {
-        log_excursion(logged, report, excursion);
-    }
+    let (pressure, length) = (inputs.pressure, inputs.length);
+    let state = match bare_sleeve::below_the_strands(sleeve, strand_stiffness, pressure, length) {
+        Some(state) => {
+            *logged = false;
+            state
+        }
+        None => sleeve_on_strands(sleeve, strand_stiffness, inputs, logged, report),
+    };
     out.force = state.force;
     out.volume = state.volume;
     out.effective_pressure = state.effective_pressure;

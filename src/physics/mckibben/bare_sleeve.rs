@@ -41,33 +41,43 @@ pub fn evaluate(
     pressure: f64,
     length: f64,
 ) -> (SleeveState, Option<OutOfRange>) {
-    let p_eff = pressure.max(0.0);
-    let reach = reach(sleeve, k_s, p_eff);
-    if length > reach {
-        return on_strands(sleeve, k_s, reach, pressure, length);
+    match below_the_strands(sleeve, k_s, pressure, length) {
+        Some(state) => (state, None),
+        None => on_the_strands_state(sleeve, k_s, pressure, length),
     }
-    let state = SleeveState {
+}
+
+/// Eq. 2.3 where the strands have not taken over (`None` where they have): the per-step path of
+/// the ideal muscle, small enough to inline.
+#[inline(always)]
+pub fn below_the_strands(
+    sleeve: &Sleeve,
+    k_s: f64,
+    pressure: f64,
+    length: f64,
+) -> Option<SleeveState> {
+    let p_eff = pressure.max(0.0);
+    if length > reach(sleeve, k_s, p_eff) {
+        return None;
+    }
+    Some(SleeveState {
         force: sleeve.force(p_eff, length),
         volume: sleeve.volume(length),
         effective_pressure: p_eff,
         stiffness: sleeve.stiffness(p_eff, length),
         contact: pressure > 0.0,
-    };
-    (state, None)
+    })
 }
 
 /// The bare sleeve past `reach`, where its strands stretch: `F = F(reach) + k_s (L - reach)`;
-/// past the breaking length no muscle survives: evaluated there. Out of line, so that the
-/// per-step path of the ideal muscle stays small enough to inline.
-#[cold]
-#[inline(never)]
-fn on_strands(
+/// past the breaking length no muscle survives: evaluated there.
+pub fn on_the_strands_state(
     sleeve: &Sleeve,
     k_s: f64,
-    reach: f64,
     pressure: f64,
     requested: f64,
 ) -> (SleeveState, Option<OutOfRange>) {
+    let reach = reach(sleeve, k_s, pressure.max(0.0));
     let b = sleeve.max_length();
     let breaking = breaking_length(sleeve);
     let clamp = (requested > breaking).then(|| OutOfRange {

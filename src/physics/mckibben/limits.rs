@@ -40,6 +40,7 @@ impl OutOfRange {
 /// Whether a muscle with this signed force is slack: a braid cannot push, so past its free
 /// contraction (signed force < 0) its strands buckle and it carries no force and has no
 /// stiffness, unless the dissertation's `signed` force is asked for.
+#[inline]
 pub fn is_slack(force: f64, signed: bool) -> bool {
     !signed && force < 0.0
 }
