@@ -221,6 +221,15 @@ pub fn preset(preset: i32) -> Option<(MuscleParams, Catalogue)> {
     ScalingLaw::festo().params(c).ok().map(|p| (p, *c))
 }
 
+/// The catalogue's largest force of the DMSP preset `preset`, N (it sizes the aramid strands),
+/// `None` for any other value.
+pub fn largest_force(preset: i32) -> Option<f64> {
+    PRESETS
+        .iter()
+        .find(|(k, _)| *k == preset)
+        .map(|(_, c)| c.max_force)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
