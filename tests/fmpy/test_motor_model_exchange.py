@@ -257,7 +257,7 @@ def test_motor_model_exchange_runs_under_fmpy_defaults(case):
     parameters = DEFAULT_RUNS[case]
     path = fmu_path("MultiferroicMotor")
     me = simulate_fmu(path, fmi_type="ModelExchange", start_values=parameters, output=["rotor_angle"], record_events=False)
-    cs = simulate_fmu(path, start_values=parameters, output=["rotor_angle"], output_interval=1e-6, logger=lambda *a: None)
+    cs = simulate_fmu(path, start_values=parameters, output=["rotor_angle"], output_interval=1e-6)
     stop = read_model_description(path).defaultExperiment.stopTime
     assert me["time"][-1] == pytest.approx(float(stop), rel=1e-12)
     idx = np.clip(np.searchsorted(cs["time"], me["time"] - 1e-12), 0, len(cs) - 1)
