@@ -366,7 +366,7 @@ impl Motor {
                 p.tolerance
             ));
         }
-        // The FMU declares at most 1e5 (a bounded step); references in tests resolve further.
+        // The FMU declares at most 2e4 (a bounded step); references in tests resolve further.
         if p.max_substeps == 0 || p.max_substeps > 100_000_000 {
             return Err(format!(
                 "max_substeps must be within [1, 1e8], got {}",
