@@ -441,7 +441,16 @@ impl Motor {
         let remaining = run.t_end - t;
         let left = budget.saturating_sub(run.attempts).max(1);
         let per_segment = (left / SEGMENT_BUDGET_SHARE).max(1);
-        let dt_min = (remaining / left as f64).min((segment_end - t) / per_segment as f64);
+        // While more than half the budget is left, the floor is 64 times finer than an even
+        // spread: a short stiff transient at the start of a step (the Gilbert onion's ringing
+        // after a switch) is resolved there, and the even spread of the half left still ends
+        // the step.
+        let spread = if 2 * u64::from(left) > u64::from(budget) + 1 {
+            64 * left as u64
+        } else {
+            left as u64
+        };
+        let dt_min = (remaining / spread as f64).min((segment_end - t) / per_segment as f64);
         let mut dt_try = run.dt.max(dt_min).min(segment_end - t);
         let clipped = dt_try < run.dt;
         if dt_try < 1e-300 {
