@@ -11,7 +11,7 @@
 
 use super::{partial_rows, write_outputs, MultiferroicMotor};
 use crate::models::{Partials, Report, Status};
-use crate::physics::multiferroic::model_exchange::{by, MeEvaluation};
+use crate::physics::multiferroic::model_exchange::{by, MeEvaluation, MAX_RINGING_WINDOWS};
 use crate::physics::multiferroic::{Motor, OnionModel};
 use crate::variables::multiferroic_motor::{Inputs, Outputs};
 use serde::{Deserialize, Serialize};
@@ -49,7 +49,7 @@ impl Discrete {
             && finite(&self.held)
             && finite(&self.ringing)
             && finite(&self.ringing_drive)
-            && self.ringing[1] >= 0.0
+            && self.windows_bounded()
         {
             Ok(self)
         } else {
@@ -57,6 +57,18 @@ impl Discrete {
                 "Model Exchange discrete state is not finite: {self:?}"
             ))
         }
+    }
+}
+
+impl Discrete {
+    /// No window, or at most [`MAX_RINGING_WINDOWS`] positive ones (a restored state cannot ask
+    /// for an unbounded number of time events).
+    fn windows_bounded(&self) -> bool {
+        let [from, window, until] = self.ringing;
+        window == 0.0
+            || (window > 0.0
+                && until >= from
+                && (until - from) / window <= MAX_RINGING_WINDOWS + 1.0)
     }
 }
 
@@ -175,7 +187,7 @@ impl MultiferroicMotor {
             let n = ((now - from) / window + 1e-3).floor() + 1.0;
             from + n * window
         });
-        match (switch, ringing.filter(|&t| t < until)) {
+        match (switch, ringing.filter(|&t| t < until && t > now)) {
             (Some(a), Some(b)) => Some(a.min(b)),
             (a, b) => a.or(b),
         }
@@ -344,6 +356,13 @@ mod tests {
         }
         assert_eq!(events[windows], 1e-6);
         assert!((events[windows + 1] - (1e-6 + window)).abs() < 1e-9 * window);
+        // A restored state may not ask for more windows than a jump gives.
+        let crafted = Discrete {
+            ringing: [0.0, 1e-300, 1.0],
+            ..m.me
+        };
+        assert!(crafted.validated().is_err());
+        assert!(m.me.validated().is_ok());
         // Without the Gilbert onion, only the switches.
         let mut q = stepping(1e-6, false);
         q.me_event(&inputs, 0.0).unwrap();
