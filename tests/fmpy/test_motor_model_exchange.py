@@ -256,7 +256,7 @@ DEFAULT_RUN_TOLERANCE = 1e-3
 def test_motor_model_exchange_runs_under_fmpy_defaults(case):
     parameters = DEFAULT_RUNS[case]
     path = fmu_path("MultiferroicMotor")
-    me = simulate_fmu(path, fmi_type="ModelExchange", start_values=parameters, output=["rotor_angle"], record_events=False)
+    me = simulate_fmu(path, fmi_type="ModelExchange", start_values=parameters, output=["rotor_angle"])
     cs = simulate_fmu(path, start_values=parameters, output=["rotor_angle"], output_interval=1e-6)
     stop = read_model_description(path).defaultExperiment.stopTime
     assert me["time"][-1] == pytest.approx(float(stop), rel=1e-12)
