@@ -411,6 +411,16 @@ compliance: fmus
 	@test -n "$(FMUCHECKER)" || { echo "set FMUCHECKER=path/to/fmuCheck.linux64 (docs/compatibility.md: FMU Compliance Checker)"; exit 2; }
 	FMUCHECKER="$(FMUCHECKER)" tools/compliance.sh
 
+.PHONY: fmusim
+## fmusim (modelica/fmusim, the Modelica Association's FMI 2.0/3.0 simulator) on every FMU under
+## target/, FMI 2.0 and 3.0 told apart by each modelDescription's fmiVersion: `fmusim validate`
+## reports nothing, `fmusim simulate` runs each interface with default settings, Co-Simulation
+## equals Model Exchange at the end time: `make fmusim FMUSIM=path/to/fmusim` (FMUSIM_FMUS= other
+## FMUs or directories). Built once from its repository (docs/compatibility.md, "fmusim").
+fmusim: fmus
+	@test -n "$(FMUSIM)" || { echo "set FMUSIM=path/to/fmusim (docs/compatibility.md: fmusim)"; exit 2; }
+	FMUSIM="$(FMUSIM)" tools/fmusim.sh $(FMUSIM_FMUS)
+
 ## ---- The documentation site and `make help` ----
 .PHONY: docs help
 
@@ -450,6 +460,7 @@ Measure and check (not part of make test)
   parity            the FMI layer against a C pass-through FMU: docs/performance.md's table
   report            docs/accuracy-cost.md and the tables of docs/performance.md
   compliance        the FMU Compliance Checker on every FMU: FMUCHECKER=path/to/fmuCheck.linux64
+  fmusim            fmusim validate and simulate (CS, ME) on every FMU, FMI 2.0 and 3.0: FMUSIM=path/to/fmusim
   fuzz              random FMI call sequences (cargo-fuzz): FUZZ_SECONDS= FUZZ_JOBS= SANITIZER=
   memcheck          every FMU under valgrind, natively and through FMPy
   load              10,000 instantiate-run-free cycles per FMU with the heap counted
