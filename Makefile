@@ -47,8 +47,8 @@ py-deps:
 
 ## One recipe for both tools (`&:`): under `make -j` it must run once, not once per file.
 ## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
-target/release/package_fmus target/release/calibrate &: $(SOURCES)
-	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin calibrate
+target/release/package_fmus target/release/package_fmi3 target/release/calibrate &: $(SOURCES)
+	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin package_fmi3 --bin calibrate
 
 ## Linux binaries for every maintained distribution: linked against glibc 2.17 (the manylinux2014
 ## baseline: RHEL/Rocky 7-9, Ubuntu 18.04+, Debian 10+) by cargo-zigbuild with zig as the linker,
@@ -108,15 +108,18 @@ $(ARM_SO): $(SOURCES) $(LIB) | zig-tools cross-deps
 	+$(ZIG_ENV) cargo zigbuild --release --lib -p actuator-fmus --target-dir $(GLIBC_TARGET_DIR) \
 	  --target aarch64-unknown-linux-gnu.$(GLIBC)
 
-## target/fmu/<Model>.fmu for every model in modelDescription/, with binaries for linux64, win64 and
-## aarch64-linux (`make fmus CROSS=0`: linux64 only, no cross toolchains needed).
+## target/fmu/<Model>.fmu (FMI 2.0) for every model in modelDescription/, with binaries for linux64,
+## win64 and aarch64-linux (`make fmus CROSS=0`: linux64 only, no cross toolchains needed), and
+## target/fmu-fmi3/<Model>.fmu, the FMI 3.0 FMUs with the same binaries (one library exports both
+## APIs) under x86_64-linux, x86_64-windows and aarch64-linux.
 CROSS ?= 1
 ifeq ($(CROSS),1)
 CROSS_BINARIES := $(WIN_DLL) $(ARM_SO)
 CROSS_ARGS := win64=$(WIN_DLL) aarch64-linux=$(ARM_SO)
 endif
-fmus: $(LIB) target/release/package_fmus $(CROSS_BINARIES)
+fmus: $(LIB) target/release/package_fmus target/release/package_fmi3 $(CROSS_BINARIES)
 	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
+	target/release/package_fmi3 target/fmu target/fmu-fmi3
 
 DEFAULT_SCENE := scenes/fig2_3_ideal_mckibben.json
 
@@ -297,6 +300,7 @@ robot-joint: deps fmus $(VENV)/.installed
 crosscheck: fmus $(VENV)/.installed
 	$(AF) crosscheck
 	target/release/package_fmus $(LIB) target/fmu $(CROSS_ARGS)
+	target/release/package_fmi3 target/fmu target/fmu-fmi3
 
 ## The robot joint as a system: out/systems/RobotJoint.ssp (fmpy simulate_ssp) and the container
 ## FMU out/systems/RobotJoint.fmu (fmu-manipulation-toolbox), both run and plotted against the
@@ -440,7 +444,7 @@ Start here
   test              all Rust tests, the FMPy suite and the documentation site's checks
   help              this list
 Build
-  fmus              target/fmu/<Model>.fmu for every model (CROSS=0: linux64 binaries only)
+  fmus              target/fmu/<Model>.fmu (FMI 2.0) and target/fmu-fmi3/<Model>.fmu (FMI 3.0) (CROSS=0: x86-64 Linux only)
   docs              the documentation site into site/ (mkdocs build --strict)
 Run the models
   scene             one scene under FMPy: make scene SCENE=scenes/<name>.json

@@ -5,13 +5,17 @@
 //! - `model_tables.rs`: value references, metadata and the typed `Parameters`, `Inputs`,
 //!   `Outputs` and `CalculatedParameters` of each model (included by `src/variables.rs`);
 //! - `model_bindings.rs`: the export layer's access to those structs' fields by value reference,
-//!   and the registry of models (included by `src/fmi2/registry.rs`).
+//!   and the registry of models (included by `src/fmi2/registry.rs`);
+//! - `<Model>.fmi3.xml` and `fmi3_tables.rs`: the FMI 3.0 model description from the same source
+//!   and the value-reference layout `src/fmi3` serves it with (`build/fmi3_description.rs`).
 //!
 //! The XML is the single source of truth: a renamed or removed variable breaks the model code at
 //! compile time.
 
 #[path = "build/codegen.rs"]
 mod codegen;
+#[path = "build/fmi3_description.rs"]
+mod fmi3_description;
 #[path = "build/model_description.rs"]
 mod model_description;
 
@@ -45,6 +49,7 @@ fn main() {
         model_description::LOG_CATEGORIES.map(|(name, _)| name)
     );
     let mut bindings = String::from(header);
+    let mut fmi3_tables = String::from(header);
     let mut models = Vec::new();
     for path in &paths {
         println!("cargo:rerun-if-changed={}", path.display());
@@ -60,12 +65,33 @@ fn main() {
         codegen::tables(&model, &xml_path.display().to_string(), &mut tables)
             .unwrap_or_else(|e| fail(path, &e));
         codegen::bindings(&model, &mut bindings).unwrap_or_else(|e| fail(path, &e));
+        let fmi3_xml = fmi3_description::xml(&text, &model).unwrap_or_else(|e| fail(path, &e));
+        let fmi3_path = Path::new(&out_dir).join(format!("{stem}.fmi3.xml"));
+        std::fs::write(&fmi3_path, fmi3_xml).unwrap_or_else(|e| fail(path, &e.to_string()));
+        fmi3_description::tables(
+            &model,
+            &text,
+            &fmi3_path.display().to_string(),
+            &mut fmi3_tables,
+        )
+        .unwrap_or_else(|e| fail(path, &e));
         models.push(model);
     }
     codegen::registry(&models, &mut bindings);
     let out = Path::new(&out_dir);
     std::fs::write(out.join("model_tables.rs"), tables).expect("write tables");
     std::fs::write(out.join("model_bindings.rs"), bindings).expect("write bindings");
+    let names: Vec<String> = models
+        .iter()
+        .map(|m| model_description::field_name(&m.name).to_uppercase())
+        .collect();
+    let _ =
+        writeln!(
+        fmi3_tables,
+        "/// Every model, in the registry's order.\npub static FMI3_MODELS: &[&Fmi3Model] = &[{}];",
+        names.iter().map(|n| format!("&{n}")).collect::<Vec<_>>().join(", ")
+    );
+    std::fs::write(out.join("fmi3_tables.rs"), fmi3_tables).expect("write FMI 3.0 tables");
 }
 
 fn fail(path: &Path, message: &str) -> ! {

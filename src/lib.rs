@@ -1,16 +1,19 @@
-//! FMI 2.0 Co-Simulation and Model Exchange FMUs of novel actuators: McKibben and knitted-sleeve
-//! pneumatic muscles and a multiferroic nano-motor, after the dissertation (E. Ball, *Novel
-//! Methods in Meso-Scale and Nano-Scale Actuation*, M.S. thesis, Cornell University, 2014;
-//! Cornell's eCommons repository).
+//! FMI 2.0 and FMI 3.0 Co-Simulation and Model Exchange FMUs of novel actuators: McKibben and
+//! knitted-sleeve pneumatic muscles and a multiferroic nano-motor, after the dissertation (E.
+//! Ball, *Novel Methods in Meso-Scale and Nano-Scale Actuation*, M.S. thesis, Cornell University,
+//! 2014; Cornell's eCommons repository).
 //!
 //! Data flows one way, every arrow pointing down:
 //! [`fmi2`] (C ABI, registry, value arrays) -> [`models`] (typed variables to physics, effect
 //! switches) -> [`physics`] (pure equations). Beside them, [`variables`] holds what build.rs
 //! generates from `modelDescription/*.xml`: value references, metadata and each model's typed
 //! `Parameters`, `Inputs`, `Outputs` and `CalculatedParameters`; it names nothing above it.
-//! [`fmi2`] is the only module that allows `unsafe_code`; `physics` and `models` forbid it.
+//! [`fmi3`] is a second export layer (FMI 3.0) over the same models and [`fmi2`]'s machinery.
+//! [`fmi2`] and [`fmi3`] are the only modules that allow `unsafe_code`; `physics` and `models`
+//! forbid it.
 
 pub mod fmi2;
+pub mod fmi3;
 pub mod models;
 pub mod physics;
 pub mod variables;

@@ -1,14 +1,20 @@
 """Where the project's files are: the repository, the packaged FMUs, the native tools.
 
 The package is installed editable from a clone (`make .venv/.installed`), so the repository is two
-folders above this file. `ACTUATOR_FMUS_DIR` points the package at another folder of `.fmu` files.
+folders above this file. `make fmus` writes the FMI 2.0 FMUs to target/fmu/ and the FMI 3.0 FMUs
+(same models, same names) to target/fmu-fmi3/. The package uses the FMI 2.0 ones unless
+`ACTUATOR_FMUS_FMI=3` picks the FMI 3.0 ones; `ACTUATOR_FMUS_DIR` points it at any other folder of
+`.fmu` files.
 """
 
 import os
 import pathlib
 
 ROOT = pathlib.Path(__file__).resolve().parents[2]
-FMU_DIR = pathlib.Path(os.environ.get("ACTUATOR_FMUS_DIR", ROOT / "target" / "fmu"))
+FMI2_DIR = ROOT / "target" / "fmu"
+FMI3_DIR = ROOT / "target" / "fmu-fmi3"
+FMU_DIR = pathlib.Path(os.environ.get(
+    "ACTUATOR_FMUS_DIR", FMI3_DIR if os.environ.get("ACTUATOR_FMUS_FMI") == "3" else FMI2_DIR))
 RELEASE = ROOT / "target" / "release"
 DOCS = ROOT / "docs"
 OUT = ROOT / "out"

@@ -183,12 +183,14 @@ def sweep_runs(scene, indices=None):
         yield k, values[k], parameters, inputs
 
 
-def run_scene(scene, progress=True):
-    """Returns a list of (sweep value or None, structured result array)."""
+def run_scene(scene, progress=True, fmu=None, fmi_type=None):
+    """Returns a list of (sweep value or None, structured result array). `fmu`: the path of another
+    .fmu of the scene's model (e.g. its FMI 3.0 FMU); `fmi_type`: "CoSimulation" (FMPy's default) or
+    "ModelExchange"."""
     from fmpy import simulate_fmu
 
     check_scene(scene)
-    fmu = fmu_path(scene["fmu"])
+    fmu = fmu or fmu_path(scene["fmu"])
     sweep = scene.get("sweep")
     values = sweep["values"] if sweep else [None]
     step, stop = scene["step"], scene["stop_time"]
@@ -226,6 +228,7 @@ def run_scene(scene, progress=True):
             stop_time=n * step,
             output_interval=step,
             step_finished=step_finished,
+            fmi_type=fmi_type,
         )
         if bar:
             bar.close()

@@ -14,9 +14,9 @@
 
 #![deny(unsafe_op_in_unsafe_fn)]
 
-mod exports;
-mod instance;
-mod logger;
+pub(crate) mod exports;
+pub(crate) mod instance;
+pub(crate) mod logger;
 pub mod registry;
 pub mod runtime;
 pub mod types;

@@ -18,7 +18,7 @@ compile_error!("instance handles are 64-bit: a slot in the low 16 bits, the gene
 
 const SLOT_BITS: u32 = 16;
 /// How many instances may be alive at once in one process.
-pub(super) const SLOTS: usize = 1 << SLOT_BITS;
+pub(crate) const SLOTS: usize = 1 << SLOT_BITS;
 
 struct Slot {
     /// The generation of the instance in the slot; 0 while empty.
@@ -46,7 +46,7 @@ fn split(c: fmi2Component) -> (usize, u64) {
 
 /// A handle for `instance`, which the table owns from now on; `None` (the instance dropped) when
 /// `SLOTS` instances are alive.
-pub(super) fn register(instance: Box<Instance>) -> Option<fmi2Component> {
+pub(crate) fn register(instance: Box<Instance>) -> Option<fmi2Component> {
     let index = {
         let mut free = FREE.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
         match free.1.pop() {
@@ -70,7 +70,7 @@ pub(super) fn register(instance: Box<Instance>) -> Option<fmi2Component> {
 
 /// The live instance behind handle `c`, if any.
 #[inline(always)]
-pub(super) fn resolve(c: fmi2Component) -> Option<*mut Instance> {
+pub(crate) fn resolve(c: fmi2Component) -> Option<*mut Instance> {
     let (index, generation) = split(c);
     let slot = &TABLE[index];
     if generation == 0 || slot.generation.load(Ordering::Acquire) != generation {
@@ -82,7 +82,7 @@ pub(super) fn resolve(c: fmi2Component) -> Option<*mut Instance> {
 
 /// Takes the instance behind `c` out of the table, once: a second call with the same handle
 /// gets `None`, even from another thread at the same time.
-pub(super) fn release(c: fmi2Component) -> Option<Box<Instance>> {
+pub(crate) fn release(c: fmi2Component) -> Option<Box<Instance>> {
     let (index, generation) = split(c);
     let slot = &TABLE[index];
     if generation == 0 {

@@ -38,7 +38,7 @@ fn panic_text(payload: &(dyn std::any::Any + Send)) -> String {
 ///
 /// # Safety
 /// As [`instance`].
-pub(super) unsafe fn guarded(
+pub(crate) unsafe fn guarded(
     c: fmi2Component,
     function: &str,
     body: impl FnOnce(&mut Instance) -> fmi2Status,
@@ -47,6 +47,12 @@ pub(super) unsafe fn guarded(
     let Some(inst) = (unsafe { instance(c) }) else {
         return fmi2Status::Error;
     };
+    // One handle table serves both FMI versions: an instance answers only its own version's calls.
+    if function.starts_with("fmi3") != inst.logger.is_fmi3() {
+        return inst.error(&format!(
+            "{function}: the instance was instantiated through the other FMI version's API"
+        ));
+    }
     let ptr: *mut Instance = inst;
     // SAFETY: `ptr` is live for the whole call; the closure's borrow ends before the panic arm.
     match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *ptr }))) {
@@ -68,7 +74,7 @@ pub(super) unsafe fn guarded(
 ///
 /// # Safety
 /// A non-null `ptr` must point to `n` readable elements.
-pub(super) unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
+pub(crate) unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
     match (ptr.is_null(), n) {
         (_, 0) => Some(&[]),
         (true, _) => None,
@@ -79,7 +85,7 @@ pub(super) unsafe fn slice<'a, T>(ptr: *const T, n: usize) -> Option<&'a [T]> {
 
 /// # Safety
 /// As [`slice`], for `n` writable elements.
-pub(super) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize) -> Option<&'a mut [T]> {
+pub(crate) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize) -> Option<&'a mut [T]> {
     match (ptr.is_null(), n) {
         (_, 0) => Some(&mut []),
         (true, _) => None,
@@ -90,14 +96,14 @@ pub(super) unsafe fn slice_mut<'a, T>(ptr: *mut T, n: usize) -> Option<&'a mut [
 
 /// # Safety
 /// A non-null `s` must be NUL-terminated.
-unsafe fn text(s: fmi2String) -> Option<String> {
+pub(crate) unsafe fn text(s: fmi2String) -> Option<String> {
     // SAFETY: non-null, and the caller promises NUL termination.
     (!s.is_null()).then(|| unsafe { CStr::from_ptr(s) }.to_string_lossy().into_owned())
 }
 
 #[cold]
 #[inline(never)]
-pub(super) fn null_argument(inst: &Instance, function: &str, argument: &str) -> fmi2Status {
+pub(crate) fn null_argument(inst: &Instance, function: &str, argument: &str) -> fmi2Status {
     inst.error(&format!("{function}: {argument} must not be NULL"))
 }
 
@@ -315,7 +321,7 @@ pub unsafe extern "C" fn fmi2Reset(c: fmi2Component) -> fmi2Status {
 }
 
 mod fmu_state;
-mod handles;
+pub(crate) mod handles;
 mod model_exchange;
 #[cfg(test)]
 mod tests;

@@ -42,11 +42,11 @@ pub struct Instance {
     /// Where the instance is in FMI's call sequence.
     state: MachineState,
     /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
-    pub(super) model_exchange: bool,
-    pub(super) time: f64,
+    pub(crate) model_exchange: bool,
+    pub(crate) time: f64,
     start_time: f64,
     stop_time: Option<f64>,
-    pub(super) runtime: Box<dyn Runtime>,
+    pub(crate) runtime: Box<dyn Runtime>,
     /// Keeps the strings handed out by `fmi2GetString` alive until the next call.
     string_values: Vec<CString>,
     /// The FMU states this instance handed out and has not freed; others are refused.
@@ -120,7 +120,7 @@ impl Instance {
     }
 
     /// The model's variables.
-    pub(in crate::fmi2) fn info(&self) -> &'static ModelInfo {
+    pub(crate) fn info(&self) -> &'static ModelInfo {
         self.info
     }
 

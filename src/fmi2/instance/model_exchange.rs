@@ -211,7 +211,7 @@ pub enum Vector {
 }
 
 impl Vector {
-    pub(in crate::fmi2) fn name(self) -> &'static str {
+    pub(crate) fn name(self) -> &'static str {
         match self {
             Vector::States => "states",
             Vector::Derivatives => "derivatives",

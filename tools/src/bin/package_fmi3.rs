@@ -1,0 +1,71 @@
+//! `package_fmi3 <FMI 2.0 FMU dir> <output dir>`: writes `<output dir>/<Model>.fmu`, the FMI 3.0
+//! FMU of every model, from the FMI 2.0 FMU that `package_fmus` wrote: the same binaries (one
+//! library exports both APIs) under FMI 3.0's platform tuples, the same documentation, and the
+//! FMI 3.0 model description generated from the same source.
+
+use std::io::{Read, Write};
+use std::path::Path;
+
+/// FMI 2.0 platform folders and their FMI 3.0 tuples (FMI 3.0 section 2.5.1.1).
+const PLATFORMS: [(&str, &str); 3] = [
+    ("binaries/linux64/", "binaries/x86_64-linux/"),
+    ("binaries/win64/", "binaries/x86_64-windows/"),
+    ("binaries/aarch64-linux/", "binaries/aarch64-linux/"),
+];
+
+fn repackage(fmi2: &Path, out: &Path, description: &str) -> Result<(), String> {
+    let file =
+        std::fs::File::open(fmi2).map_err(|e| format!("cannot read {}: {e}", fmi2.display()))?;
+    let mut archive = zip::ZipArchive::new(file).map_err(|e| format!("{}: {e}", fmi2.display()))?;
+    let partial = out.with_extension(format!("fmu.{}.partial", std::process::id()));
+    let target = std::fs::File::create(&partial)
+        .map_err(|e| format!("cannot create {}: {e}", partial.display()))?;
+    let mut zip = zip::ZipWriter::new(target);
+    let options = zip::write::SimpleFileOptions::default()
+        .compression_method(zip::CompressionMethod::Deflated);
+    zip.start_file("modelDescription.xml", options)
+        .map_err(|e| e.to_string())?;
+    zip.write_all(description.as_bytes())
+        .map_err(|e| e.to_string())?;
+    for i in 0..archive.len() {
+        let mut entry = archive.by_index(i).map_err(|e| e.to_string())?;
+        let name = entry.name().to_string();
+        if name == "modelDescription.xml" || entry.is_dir() {
+            continue;
+        }
+        let renamed = PLATFORMS
+            .iter()
+            .find_map(|(from, to)| name.strip_prefix(from).map(|rest| format!("{to}{rest}")))
+            .unwrap_or(name);
+        let mut data = Vec::new();
+        entry.read_to_end(&mut data).map_err(|e| e.to_string())?;
+        zip.start_file(renamed.as_str(), options)
+            .map_err(|e| e.to_string())?;
+        zip.write_all(&data).map_err(|e| e.to_string())?;
+    }
+    zip.finish().map_err(|e| e.to_string())?;
+    std::fs::rename(&partial, out).map_err(|e| format!("cannot write {}: {e}", out.display()))
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let [_, fmi2_dir, out_dir] = &args[..] else {
+        eprintln!("usage: package_fmi3 <directory of the FMI 2.0 FMUs> <output directory>");
+        std::process::exit(2);
+    };
+    if let Err(e) = std::fs::create_dir_all(out_dir) {
+        eprintln!("package_fmi3: cannot create {out_dir}: {e}");
+        std::process::exit(1);
+    }
+    for model in actuator_fmus::fmi3::FMI3_MODELS {
+        let fmi2 = Path::new(fmi2_dir).join(format!("{}.fmu", model.name));
+        let out = Path::new(out_dir).join(format!("{}.fmu", model.name));
+        match repackage(&fmi2, &out, model.model_description_xml) {
+            Ok(()) => println!("wrote {}", out.display()),
+            Err(e) => {
+                eprintln!("package_fmi3: {e}");
+                std::process::exit(1);
+            }
+        }
+    }
+}
