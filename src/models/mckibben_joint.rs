@@ -11,7 +11,7 @@
 
 use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
-use crate::physics::festo::{DMSP_10, DMSP_40};
+use crate::physics::festo;
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::inverse::{difference_for_torque, pair_pressures};
@@ -86,9 +86,10 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
                 .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
             McKibben::from_geometry(&geometry, model, friction, 0.0)
         }
-        // The Festo muscles fitted to their datasheets carry their own rubber and thin wall.
-        k @ 5..=6 => {
-            let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
+        // The Festo muscles (the DMSP scaling law) carry their own rubber and exact wall.
+        k @ 5..=8 => {
+            let (festo, _) =
+                festo::preset(k).ok_or_else(|| format!("preset {k} has no DMSP size"))?;
             McKibben::new(
                 Sleeve::new(festo.strand_length, festo.turns)?,
                 BladderTube {
@@ -104,7 +105,7 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
             )
         }
         k => Err(format!(
-            "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10) or 6 (Festo DMSP-40), got {k}"
+            "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10), 6 (DMSP-40), 7 (DMSP-5) or 8 (DMSP-20), got {k}"
         )),
     }
 }
