@@ -222,12 +222,14 @@ parity: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	$(PY) benches/report.py --parity
 
 ## The motor's step in CPU time (stepping scene, large load torques; benches/cpu_time.rs), its
-## Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step.
+## Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step, and its
+## Model Exchange runs under FMPy's default settings.
 .PHONY: bench-motor
 bench-motor: deps fmus $(VENV)/.installed
 	cargo bench --bench cpu_time
 	cargo bench --bench motor_model_exchange
 	$(PY) benches/motor_me_fmpy.py
+	$(PY) benches/motor_me_fmpy.py --defaults
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
