@@ -104,3 +104,14 @@ fn bad_flanges_are_refused() {
         "unique",
     );
 }
+
+#[test]
+fn the_fmi2_description_ships_without_the_flanges() {
+    // FMI 2.0's schema allows a VendorAnnotations Tool one element: the Tests stay, the
+    // Terminals (FMI 3.0 only) go, with their comment.
+    let shipped = model_description::check(SOURCE, "McKibbenMuscle")
+        .unwrap()
+        .shipped_xml;
+    assert!(!shipped.contains("Terminals") && !shipped.contains("<Flange"));
+    assert!(shipped.contains("<Tool name=\"actuator-fmus\">\n      <Tests>"));
+}
