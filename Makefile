@@ -47,8 +47,8 @@ py-deps:
 
 ## One recipe for both tools (`&:`): under `make -j` it must run once, not once per file.
 ## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
-target/release/package_fmus target/release/package_fmi3 target/release/calibrate &: $(SOURCES)
-	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin package_fmi3 --bin calibrate
+target/release/package_fmus target/release/package_fmi3 target/release/calibrate target/release/festo_law &: $(SOURCES)
+	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin package_fmi3 --bin calibrate --bin festo_law
 
 ## Linux binaries for every maintained distribution: linked against glibc 2.17 (the manylinux2014
 ## baseline: RHEL/Rocky 7-9, Ubuntu 18.04+, Debian 10+) by cargo-zigbuild with zig as the linker,
@@ -151,10 +151,13 @@ STARTS ?= 24
 calibrate: fmus target/release/calibrate $(VENV)/.installed
 	$(AF) calibrate $(DATA) --length $(LENGTH) --diameter $(DIAMETER) --fit-kpa $(FIT) --out $(OUT) --starts $(STARTS)
 
-## The Festo presets' fits (src/physics/festo.rs) and their reports: docs/calibration/dmsp{40,10}/.
-calibrate-festo: fmus target/release/calibrate $(VENV)/.installed
+## The Festo fits (src/physics/festo.rs) and their reports, docs/calibration/dmsp{40,10}/; the
+## DMSP scaling law's page and figure with leave-one-out, docs/calibration/scaling.{md,png}.
+calibrate-festo: fmus target/release/calibrate target/release/festo_law $(VENV)/.installed
 	$(AF) calibrate data/festo/festo_dmsp40.csv --length 0.4 --diameter 0.04 --fit-kpa 0,600 --out docs/calibration/dmsp40
 	$(AF) calibrate data/festo/festo_dmsp10.csv --length 0.25 --diameter 0.01 --fit-kpa 0,600 --out docs/calibration/dmsp10
+	target/release/festo_law --out docs/calibration
+	$(VENV)/bin/python -m actuator_fmus.festo_scaling docs/calibration
 
 test-rust: deps fmus
 	+cargo test --release --workspace
@@ -219,12 +222,14 @@ parity: deps fmus $(VENV)/.installed $(C_PASSTHROUGH)
 	$(PY) benches/report.py --parity
 
 ## The motor's step in CPU time (stepping scene, large load torques; benches/cpu_time.rs), its
-## Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step.
+## Model Exchange calls (right-hand side, exact partials) against a Co-Simulation step, and its
+## Model Exchange runs under FMPy's default settings.
 .PHONY: bench-motor
 bench-motor: deps fmus $(VENV)/.installed
 	cargo bench --bench cpu_time
 	cargo bench --bench motor_model_exchange
 	$(PY) benches/motor_me_fmpy.py
+	$(PY) benches/motor_me_fmpy.py --defaults
 
 ## docs/accuracy-cost.md: error against a converged reference and native time per step for every
 ## fidelity knob, work-precision plots, and the cost under FMPy beside the PassThrough FMU.
@@ -448,7 +453,7 @@ Run the models
   scene             one scene under FMPy: make scene SCENE=scenes/<name>.json
   figures           every scene of the catalogue, and docs/figures.md
   calibrate         fit McKibbenMuscle to a datasheet: DATA= LENGTH= DIAMETER= FIT= OUT= STARTS=
-  calibrate-festo   refit the Festo presets and rewrite docs/calibration/dmsp{10,40}/
+  calibrate-festo   refit the Festo presets, rewrite docs/calibration/dmsp{10,40}/ and scaling.md
   robot-joint       an antagonistic muscle pair on a pulley, co-simulated: out/robot_joint.{csv,png}
   systems           the robot joint as an SSP and as a container FMU: out/systems/
   crosscheck        FMI cross-check files crosscheck/<Model>/ and the FMU pages' plots

@@ -8,7 +8,9 @@
 //! inflate the figures, less the clock's own cost). Prints per FMU the median, p99 and maximum step and
 //! initialization cost, the share of cases refused at initialization, and the slowest cases.
 //!
-//! `WORST_CASE_MODELS=A,B` restricts the FMUs; `WORST_CASE_POINTS=n` the random points.
+//! `WORST_CASE_MODELS=A,B` restricts the FMUs; `WORST_CASE_POINTS=n` the random points;
+//! `WORST_CASE_REPORT_ABOVE=s` lists every case whose step or initialization takes longer than
+//! `s` seconds (default 1).
 
 #[path = "../tests/common/mod.rs"]
 #[allow(dead_code)]
@@ -224,6 +226,10 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(10_000);
     let only = std::env::var("WORST_CASE_MODELS").ok();
+    let report_above: f64 = std::env::var("WORST_CASE_REPORT_ABOVE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(1.0);
     let overhead = clock_cost();
     println!(
         "(thread CPU time; the clock's own {:.0} ns subtracted)\n",
@@ -278,7 +284,7 @@ fn main() {
         for (n, (label, values)) in plans.into_iter().enumerate() {
             let (init, steps, refused) = run(&api, info, &knobs, &values, h, overhead);
             let slow = steps.iter().copied().fold(init, f64::max);
-            if slow > 1.0 {
+            if slow > report_above {
                 let what: Vec<String> = knobs
                     .iter()
                     .zip(&values)

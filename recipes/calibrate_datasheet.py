@@ -18,7 +18,7 @@ print(f"\nfit time {summary['seconds']:.2f} s; error as a share of each curve's 
 for e in summary["errors"]:
     role = "fitted   " if e["fitted"] else "predicted"
     print(f"  {e['pressure_kpa']:5g} kPa  {role}  RMS {100 * e['rms']:5.2f}%  max {100 * e['max']:5.2f}%")
-assert all(e["rms"] < 0.05 for e in summary["errors"]), "goal: within 5% RMS at every pressure"
+assert all(e["rms"] < 0.02 for e in summary["errors"]), "goal: within 2% RMS at every pressure"
 assert summary["fmu_max_force_difference_n"] < 1e-9, "the FMU must reproduce the fit exactly"
 
 # The fitted parameters are FMPy start values as they are: the force at 300 kPa and 10% contraction.

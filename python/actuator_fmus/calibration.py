@@ -87,7 +87,7 @@ def _plot(rows, summary, path, title, dense=None):
     plt.close(fig)
 
 
-def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=True):
+def calibrate(data, length, diameter, fit_kpa, out, starts=24, verify=True):
     """Fits McKibbenMuscle to the curves of `data` (CSV `pressure_kpa,contraction,force_n`) at the
     pressures `fit_kpa` for a muscle of nominal length `length` (m) and inner diameter `diameter`
     (m). Writes OUT/params.json, params.ssv, fit.csv, fit.json, report.md and fit.png; returns the
@@ -99,7 +99,7 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
         raise UsageError(f"no datasheet at {data}: give a CSV with columns pressure_kpa,contraction,force_n")
     cmd = [str(BINARY), "--data", str(data), "--length", repr(float(length)),
            "--diameter", repr(float(diameter)), "--fit", ",".join(f"{k:g}" for k in fit_kpa),
-           "--out", str(out), "--starts", str(starts), "--layers", str(layers)]
+           "--out", str(out), "--starts", str(starts)]
     subprocess.run(cmd, check=True)
     summary = json.loads((out / "fit.json").read_text())
     params = json.loads((out / "params.json").read_text())
@@ -128,7 +128,7 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
     name = pathlib.Path(data).stem
     title = (f"{name}: datasheet force against McKibbenMuscle fitted at "
              f"{' + '.join(f'{k:g}' for k in fit_kpa)} kPa (nominal length {length:g} m, "
-             f"{'thin' if layers == 1 else f'{layers}-layer thick'}-walled bladder)")
+             f"bladder_model {summary['bladder_model']}, the exact wall)")
     _plot(rows, summary, out / "fit.png", title, dense)
     lines = [f"# Calibration of McKibbenMuscle to `{name}`", "",
              f"Fitted at {', '.join(f'{k:g}' for k in fit_kpa)} kPa in {summary['seconds']:.2f} s "
@@ -148,6 +148,17 @@ def calibrate(data, length, diameter, fit_kpa, out, starts=24, layers=1, verify=
     if verify:
         lines += ["", f"Largest difference between the fitter's and the FMU's force at the data points: "
                   f"{summary['fmu_max_force_difference_n']:.3g} N."]
+    lines += ["", "Every parameter beside the search's bounds (fixed: not identifiable from force curves, "
+              "set from the datasheet or physics; see docs/calibration.md):", "",
+              "| parameter | value | lower bound | upper bound | fitted | position in the bounds |",
+              "|---|---|---|---|---|---|"]
+    for p in summary["parameters"]:
+        role = "fixed" if p["fixed"] else "fitted"
+        if p["name"] == "sleeve_diameter" and p["fixed"]:
+            role = "bore + 2 wall"
+        position = "" if p["fixed"] else f"{p['position']:.3f}"
+        lines.append(f"| `{p['name']}` ({p['unit']}) | {p['value']:.6g} | {p['lower']:.4g} | {p['upper']:.4g} | "
+                     f"{role} | {position} |")
     lines += ["", "![datasheet against model](fit.png)", "", "Parameters (`params.json`, FMPy `start_values`):",
               "", "```json", (out / "params.json").read_text().strip(), "```", ""]
     (out / "report.md").write_text("\n".join(lines))

@@ -2,7 +2,7 @@
 
     from actuator_fmus import pressure_for_force
     pressure_pa, out_of_reach = pressure_for_force(2000.0, 0.36, {"preset": "DMSP_40"})
-    # 359710 Pa (359.71 kPa): a DMSP-40 at 10% contraction pulls 2000 N
+    # 356670 Pa (356.67 kPa): a DMSP-40 at 10% contraction pulls 2000 N
 
 It asks McKibbenMuscle.fmu itself (`pressure_solver` on): the FMU inverts its own force model with
 the solver of McKibbenJoint's torque mode, so the answer holds for every bladder model, preset and

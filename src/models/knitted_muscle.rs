@@ -13,7 +13,7 @@ use crate::physics::bladder::{Bladder, BladderTube, KnittedCylinder};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
 use crate::physics::knitted_muscle::{Friction, KnittedAssembly, KnittedOutput};
-use crate::physics::mckibben::BladderModel;
+use crate::physics::mckibben::{is_slack, BladderModel};
 use crate::variables::knitted_muscle::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
 };
@@ -38,13 +38,16 @@ pub struct KnittedMuscle {
     partials_cache: Option<([u64; 4], bool, Partials)>,
     /// The dissertation's signed force (`signed_force`); else tension only (see [`tension_only`]).
     signed_force: bool,
+    /// The straight yarn's axial stiffness `k_s = 2 m E A / L_max`, N/m (from
+    /// `strand_rigidity`): past `max_length` the yarn stretches.
+    yarn_stiffness: f64,
 }
 
 /// A knitted sleeve cannot push: past its free contraction (signed force < 0, eq. 1.8's
 /// `-P dV/dL` changing sign) its strands go slack and so does the muscle: no force, no
 /// stiffness. With `signed` the dissertation's force stands.
 fn tension_only(out: &mut Outputs, signed: bool) {
-    out.slack = !signed && out.force < 0.0;
+    out.slack = is_slack(out.force, signed);
     if out.slack {
         out.force = 0.0;
         out.stiffness = 0.0;
@@ -108,42 +111,33 @@ fn shape_kind(p: &Parameters) -> Result<ShapeKind, String> {
 }
 
 impl KnittedMuscle {
-    /// The physics at the current inputs; a length outside `[min_length, max_length]` is
-    /// evaluated at the nearer limit, where the sleeve is rigid (logged once per excursion).
-    /// `None` when the physics refuses (logged); the outputs then keep their values.
+    /// The physics at the current inputs: past `max_length` on the stretching yarn; below
+    /// `min_length` or past the breaking length evaluated at the nearest length (logged once per
+    /// excursion). `None` when the physics refuses (logged); the outputs then keep their values.
     fn compute(&mut self, inputs: &Inputs, report: &mut Report) -> Option<KnittedOutput> {
         let (pressure, length) = (inputs.pressure, inputs.length);
-        let (lo, hi) = self.assembly.valid_lengths();
-        let l = if length.is_nan() {
-            hi
-        } else {
-            length.max(lo).min(hi)
-        };
-        if l == length {
-            self.out_of_range = false;
-        } else {
-            report.clamp(!self.out_of_range, || {
-                format!(
-                    "length {length} m is outside the valid lengths {} .. {} m (max_length {} m); \
-                     evaluating at length {l} m until the inputs return",
-                    lo,
-                    hi,
-                    self.assembly.length_range().1
-                )
-            });
-            self.out_of_range = true;
-        }
-        match self.assembly.evaluate(pressure, l, &self.history) {
-            Ok((out, fallback)) => {
-                if let Some(reason) = &fallback {
+        let k_s = self.yarn_stiffness;
+        match self
+            .assembly
+            .evaluate_with_yarn(pressure, length, k_s, &self.history)
+        {
+            Ok(y) => {
+                match &y.out_of_range {
+                    Some(e) => {
+                        report.clamp(!self.out_of_range, || e.message());
+                        self.out_of_range = true;
+                    }
+                    None => self.out_of_range = false,
+                }
+                if let Some(reason) = &y.collapsed {
                     report.clamp(!self.collapsed, || {
                         format!(
                             "{reason}; evaluating at zero gauge pressure until the inputs return"
                         )
                     });
                 }
-                self.collapsed = fallback.is_some();
-                Some(out)
+                self.collapsed = y.collapsed.is_some();
+                Some(y.out)
             }
             Err(reason) => {
                 // Unreachable with finite inputs in range.
@@ -168,7 +162,7 @@ impl KnittedMuscle {
 
 impl KnittedMuscle {
     /// Exact partials on the branch [`Self::compute`] takes (see docs/model-exchange.md for
-    /// the one-sided choices), from [`KnittedAssembly::partial_rows`]; with a bladder, the
+    /// the one-sided choices), from [`KnittedAssembly::rows_with_yarn`]; with a bladder, the
     /// stiffness's row only if `stiffness`; force and stiffness 0 while `slack`.
     fn partials_at(
         &self,
@@ -177,40 +171,26 @@ impl KnittedMuscle {
         slack: bool,
     ) -> Result<Partials, String> {
         let (pressure, length) = (inputs.pressure, inputs.length);
-        if !(pressure.is_finite() && length.is_finite()) {
-            return Err(format!(
-                "partials need finite inputs, got pressure {pressure} Pa and length {length} m"
-            ));
-        }
-        let (lo, hi) = self.assembly.valid_lengths();
-        let l = length.max(lo).min(hi);
-        // A clamped length no longer moves with the input.
-        let length_moves = if l == length { 1.0 } else { 0.0 };
-        let direction = if l >= self.history.position {
-            1.0
-        } else {
-            -1.0
-        };
-        let mut r = self
-            .assembly
-            .partial_rows(pressure, l, &self.history, direction, stiffness)?;
+        let k_s = self.yarn_stiffness;
+        let mut r =
+            self.assembly
+                .rows_with_yarn(pressure, length, k_s, &self.history, stiffness)?;
         if slack {
             // Tension only: the slack muscle's force and stiffness are 0 nearby.
             r.force = [0.0; 2];
             r.stiffness = r.stiffness.map(|_| [0.0; 2]);
         }
         let mut table = Partials::default();
-        let mut add = |name: &'static str, row: &mut [f64; 2]| {
-            row[1] *= length_moves;
+        let mut add = |name: &'static str, row: [f64; 2]| {
             table.row(name, &[("pressure", row[0]), ("length", row[1])]);
         };
-        add("force", &mut r.force);
-        add("volume", &mut r.volume);
-        add("effective_pressure", &mut r.effective_pressure);
-        add("friction_force", &mut r.friction_force);
-        add("max_radius", &mut r.max_radius);
-        if let Some(mut stiffness) = r.stiffness {
-            add("stiffness", &mut stiffness);
+        add("force", r.force);
+        add("volume", r.volume);
+        add("effective_pressure", r.effective_pressure);
+        add("friction_force", r.friction_force);
+        add("max_radius", r.max_radius);
+        if let Some(stiffness) = r.stiffness {
+            add("stiffness", stiffness);
         }
         Ok(table)
     }
@@ -242,6 +222,13 @@ impl Model for KnittedMuscle {
             None
         };
         let assembly = KnittedAssembly::new(sleeve, bladder, bag, friction)?;
+        let rigidity = p.strand_rigidity;
+        if !(rigidity.is_finite() && rigidity > 0.0) {
+            return Err(
+                format!("strand_rigidity must be positive and finite, got {rigidity} N").into(),
+            );
+        }
+        let yarn_stiffness = assembly.yarn_stiffness(rigidity);
         let valid = assembly.valid_lengths();
         // Friction starts relaxed (z = 0) where the sleeve is at initialization.
         let start = start.length;
@@ -257,6 +244,7 @@ impl Model for KnittedMuscle {
             collapsed: false,
             partials_cache: None,
             signed_force: p.signed_force,
+            yarn_stiffness,
         })
     }
 
@@ -378,11 +366,14 @@ mod tests {
     #[test]
     fn out_of_range_is_the_nearest_limit_warned_once_per_excursion() {
         let (mut m, mut inputs, mut out, calculated) = built(&parameters_with(2, false));
-        let (lo, hi) = (calculated.min_length, calculated.max_length);
+        // Past max_length the yarn stretches; past the breaking length the force is held there.
+        let (lo, hi) = (calculated.min_length, m.assembly.breaking_length());
+        assert!(hi > calculated.max_length);
         inputs.pressure = 14e3;
         inputs.length = hi;
         let mut report = Report::default();
         m.evaluate(&inputs, &mut out, &mut report);
+        assert!(!report.clamped());
         let at_limit = out.clone();
         let mut warned = 0;
         for length in [hi + 1.0, 2.0 * hi, 0.4, 0.0, lo - 1e-9] {
@@ -655,15 +646,195 @@ mod tests {
 
     #[test]
     fn partials_are_zero_out_of_range() {
-        let (mut m, _, _, c) = built(&parameters_with(1, false));
+        let (mut m, _, _, _) = built(&parameters_with(1, false));
         let beyond = Inputs {
             pressure: 1e5,
-            length: c.max_length + 0.01,
+            length: m.assembly.breaking_length() + 0.01,
         };
         let d = m.partials(&beyond).unwrap();
         for name in OUTPUTS {
             assert_eq!(d.get(name).unwrap()[1], ("length", 0.0), "{name}");
         }
         assert!(d.get("force").unwrap()[0].1 != 0.0);
+    }
+}
+
+#[cfg(test)]
+mod yarn_tests {
+    use super::*;
+    use crate::physics::knitted_yarn::SPECTRA_LINE_RIGIDITY;
+
+    fn step(m: &mut KnittedMuscle, pressure: f64, length: f64) -> (Outputs, bool) {
+        let mut out = Outputs::default();
+        let mut report = Report::default();
+        m.step(
+            &Inputs { pressure, length },
+            &mut out,
+            0.0,
+            1e-3,
+            &mut report,
+        );
+        (out, report.clamped())
+    }
+
+    /// The knit fully extended: `2 m` legs of `L_max / n` per row in parallel, `n` rows in
+    /// series, computed here from the sleeve's parameters.
+    fn yarn_stiffness(m: &KnittedMuscle, rigidity: f64) -> f64 {
+        let s = m.assembly.sleeve();
+        let (legs, rows) = (2.0 * s.params().stitches_per_row, s.params().rows);
+        let leg = s.max_length() / rows;
+        let row_stiffness = legs * rigidity / leg;
+        row_stiffness / rows
+    }
+
+    /// The default strand rigidity is the prototype's Spectra line.
+    #[test]
+    fn default_rigidity_is_the_spectra_line() {
+        assert_eq!(Parameters::default().strand_rigidity, SPECTRA_LINE_RIGIDITY);
+        assert!((SPECTRA_LINE_RIGIDITY - 220.0 / 0.035).abs() < 0.01 * SPECTRA_LINE_RIGIDITY);
+    }
+
+    /// Through `max_length` the force is finite, continuous (left and right limits agree to the
+    /// yarn's slope times the gap) and monotone; past it the slope is the yarn's `k_s` exactly,
+    /// nothing is clamped before the breaking length, and past it the force is held there.
+    fn continuous_through_max_length(p: Parameters, pressure: f64) -> (f64, f64, f64) {
+        let mut m = KnittedMuscle::new(&p, &Inputs::default()).unwrap();
+        let k_s = yarn_stiffness(&m, p.strand_rigidity);
+        assert!((m.yarn_stiffness - k_s).abs() < 1e-12 * k_s);
+        let hi = m.calculated_parameters().max_length;
+        let breaking = m.assembly.breaking_length();
+        let eps = 1e-9 * hi;
+        let (left, _) = step(&mut m, pressure, hi - eps);
+        let (right, _) = step(&mut m, pressure, hi + eps);
+        let jump = right.force - left.force;
+        assert!(
+            jump.abs() <= 2.0 * eps * k_s.max(left.stiffness) * (1.0 + 1e-6) + 1e-9 * left.force,
+            "{jump} N at {hi} m"
+        );
+        let n = 2000;
+        let (from, to) = (hi - 0.01 * hi, breaking);
+        let dl = (to - from) / n as f64;
+        let mut previous = step(&mut m, pressure, from).0.force;
+        for i in 1..=n {
+            let l = from + dl * i as f64;
+            let (out, clamped) = step(&mut m, pressure, l);
+            assert!(
+                out.force.is_finite() && !clamped && !out.slack,
+                "{l}: {out:?}"
+            );
+            let rise = out.force - previous;
+            // No jump anywhere; the rigid knit may soften towards its reach (its radius nears
+            // the strand thickness), past it the yarn only rises.
+            assert!(rise.abs() <= k_s * dl * (1.0 + 1e-6), "{l}: rise {rise} N");
+            if l - dl >= hi {
+                assert!(rise > 0.0, "{l}: rise {rise} N");
+            }
+            if l - dl > hi {
+                assert_eq!(out.stiffness, m.yarn_stiffness);
+                assert!((rise - k_s * dl).abs() < 1e-6 * k_s * dl, "{l}: {rise} N");
+            }
+            previous = out.force;
+        }
+        let (at_break, _) = step(&mut m, pressure, breaking);
+        let (beyond, clamped) = step(&mut m, pressure, breaking + 0.01);
+        assert!(clamped && beyond.force == at_break.force);
+        let slope = (step(&mut m, pressure, hi + 2e-3).0.force
+            - step(&mut m, pressure, hi + 1e-3).0.force)
+            / 1e-3;
+        (jump, slope, k_s)
+    }
+
+    #[test]
+    fn sleeves_are_continuous_through_max_length() {
+        for (shape, preset, bladder) in [(0, 0, 0), (1, 1, 0), (0, 2, 1), (1, 2, 2)] {
+            let p = Parameters {
+                shape_model: shape,
+                preset,
+                bladder_model: bladder,
+                ..Default::default()
+            };
+            let (jump, slope, k_s) = continuous_through_max_length(p, 2e4);
+            eprintln!(
+                "shape {shape} preset {preset} bladder {bladder}: jump {jump:e} N, slope {slope:.6e} N/m, k_s {k_s:.6e} N/m"
+            );
+        }
+    }
+
+    /// On the yarn the partials are central differences of the outputs (both transitions: at
+    /// the sleeve's reach without a bladder, interior where a bladder stiffens the knit).
+    #[test]
+    fn partials_on_the_yarn_are_the_slopes() {
+        for (bladder, preset) in [(0, 0), (1, 2)] {
+            let p = Parameters {
+                preset,
+                bladder_model: bladder,
+                ..Default::default()
+            };
+            let mut m = KnittedMuscle::new(&p, &Inputs::default()).unwrap();
+            let hi = m.calculated_parameters().max_length;
+            let x = Inputs {
+                pressure: 2e4,
+                length: hi + 0.005,
+            };
+            let d = m.partials(&x).unwrap();
+            let value = |m: &mut KnittedMuscle, pressure: f64, length: f64| {
+                let (o, _) = step(m, pressure, length);
+                [
+                    o.force,
+                    o.volume,
+                    o.effective_pressure,
+                    o.max_radius,
+                    o.stiffness,
+                ]
+            };
+            let names = [
+                "force",
+                "volume",
+                "effective_pressure",
+                "max_radius",
+                "stiffness",
+            ];
+            for (column, h) in [(0, 1.0), (1, 1e-7)] {
+                let (dp, dl) = if column == 0 { (h, 0.0) } else { (0.0, h) };
+                let up = value(&mut m, x.pressure + dp, x.length + dl);
+                let down = value(&mut m, x.pressure - dp, x.length - dl);
+                for (k, name) in names.iter().enumerate() {
+                    let fd = (up[k] - down[k]) / (2.0 * h);
+                    let exact = d.get(name).unwrap()[column].1;
+                    let scale = fd.abs().max(exact.abs()).max(1e-12);
+                    assert!(
+                        (fd - exact).abs() < 1e-4 * scale,
+                        "bladder {bladder} {name}[{column}]: {exact} vs {fd}"
+                    );
+                }
+            }
+        }
+    }
+
+    /// Tension only holds on the yarn's side too: below the free contraction slack, force and
+    /// stiffness 0 with partials 0; `signed_force` gives the negative force.
+    #[test]
+    fn slack_below_the_free_contraction() {
+        let p = Parameters::default();
+        let mut m = KnittedMuscle::new(&p, &Inputs::default()).unwrap();
+        let free = m.calculated_parameters().free_contraction_length;
+        let x = Inputs {
+            pressure: 2e4,
+            length: 0.9 * free,
+        };
+        let (out, _) = step(&mut m, x.pressure, x.length);
+        assert!(out.slack && out.force == 0.0 && out.stiffness == 0.0);
+        let d = m.partials(&x).unwrap();
+        assert!(d.get("force").unwrap().iter().all(|(_, v)| *v == 0.0));
+        let mut signed = KnittedMuscle::new(
+            &Parameters {
+                signed_force: true,
+                ..p
+            },
+            &Inputs::default(),
+        )
+        .unwrap();
+        let (out, _) = step(&mut signed, x.pressure, x.length);
+        assert!(!out.slack && out.force < 0.0);
     }
 }

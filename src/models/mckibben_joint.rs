@@ -11,21 +11,18 @@
 
 use super::{Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
-use crate::physics::festo::{DMSP_10, DMSP_40};
+use crate::physics::festo;
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::inverse::{difference_for_torque, pair_pressures};
 use crate::physics::mckibben::{
-    BladderModel, FrictionParams, McKibben, McKibbenOutput, MuscleGeometry,
+    is_slack, strand_rigidity, BladderModel, FrictionParams, McKibben, McKibbenOutput,
+    MuscleGeometry,
 };
 use crate::variables::mckibben_joint::{
     CalculatedParameters, Inputs, Outputs, Parameters, Variables,
 };
 use serde::{Deserialize, Serialize};
-
-/// As in McKibbenMuscle: with a bladder the force grows without bound at both length limits, so
-/// an out-of-range length is evaluated this fraction of the range inside the limit.
-const LIMIT_MARGIN: f64 = 1e-3;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct McKibbenJoint {
@@ -47,6 +44,9 @@ pub struct McKibbenJoint {
     torque_command: bool,
     /// The dissertation's signed muscle forces (`signed_force`); else tension only.
     signed_force: bool,
+    /// The straight strands' axial stiffness `k_s = E A / b` of each muscle, N/m (from
+    /// `strand_rigidity`): past `max_length` the strands stretch, as in McKibbenMuscle.
+    strand_stiffness: f64,
 }
 
 /// Both muscles' operating point at the current inputs.
@@ -86,9 +86,10 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
                 .ok_or_else(|| format!("preset {k} has no Table 2.1 row"))?;
             McKibben::from_geometry(&geometry, model, friction, 0.0)
         }
-        // The Festo muscles fitted to their datasheets carry their own rubber and thin wall.
-        k @ 5..=6 => {
-            let festo = if k == 5 { DMSP_10 } else { DMSP_40 };
+        // The Festo muscles (the DMSP scaling law) carry their own rubber and exact wall.
+        k @ 5..=8 => {
+            let (festo, _) =
+                festo::preset(k).ok_or_else(|| format!("preset {k} has no DMSP size"))?;
             McKibben::new(
                 Sleeve::new(festo.strand_length, festo.turns)?,
                 BladderTube {
@@ -104,9 +105,16 @@ fn muscle(p: &Parameters) -> Result<McKibben, String> {
             )
         }
         k => Err(format!(
-            "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10) or 6 (Festo DMSP-40), got {k}"
+            "preset must be 0 (none), 1-4 (Table 2.1 A-D), 5 (Festo DMSP-10), 6 (DMSP-40), 7 (DMSP-5) or 8 (DMSP-20), got {k}"
         )),
     }
+}
+
+/// `E A` of all strands of one muscle, N: the user's `strand_rigidity`, or for the Festo presets
+/// (unless set) their aramid strands, as McKibbenMuscle's.
+fn rigidity(p: &Parameters) -> Result<f64, String> {
+    let set = p.strand_rigidity != Parameters::default().strand_rigidity;
+    strand_rigidity(p.strand_rigidity, set, festo::largest_force(p.preset))
 }
 
 fn positive(name: &str, x: f64) -> Result<f64, Refusal> {
@@ -121,7 +129,7 @@ impl McKibbenJoint {
     /// Whether a muscle with this signed force is slack: a braided muscle cannot push, so past
     /// its free contraction it carries no force and has no stiffness (unless `signed_force`).
     fn slack(&self, force: f64) -> bool {
-        !self.signed_force && force < 0.0
+        is_slack(force, self.signed_force)
     }
 
     /// The muscle's output, tension only unless `signed_force`.
@@ -133,7 +141,8 @@ impl McKibbenJoint {
         out
     }
 
-    /// One muscle at (pressure, length); out of range, the nearest valid length (flagged).
+    /// One muscle at (pressure, length), its strands stretching past `max_length`; beyond the
+    /// length no muscle survives, the nearest point evaluated (why, in `clamped`).
     fn evaluate_muscle(
         &self,
         pressure: f64,
@@ -141,45 +150,43 @@ impl McKibbenJoint {
         history: &HysteresisState,
         clamped: &mut Option<String>,
     ) -> Option<McKibbenOutput> {
-        let reason = match self.muscle.evaluate(pressure, length, history) {
-            Ok(out) => return Some(out),
-            Err(reason) => reason,
-        };
-        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() {
-            LIMIT_MARGIN * (hi - lo)
-        } else {
-            0.0
-        };
-        let inside = length.max(lo + margin).min(hi - margin); // max/min: no panic on odd limits
-        clamped.get_or_insert(format!(
-            "{reason} (valid muscle lengths {lo} .. {hi} m); evaluating at {inside} m until the inputs return"
-        ));
-        self.muscle.evaluate(pressure, inside, history).ok()
+        let (out, excursion) =
+            self.muscle
+                .evaluate_with_strands(pressure, length, self.strand_stiffness, history);
+        if let Some(e) = excursion {
+            clamped.get_or_insert(e.message());
+        }
+        out
     }
 
-    /// Force and dF/dP of one muscle, at the nearest valid length as [`Self::evaluate_muscle`].
+    /// Signed force and `[dF/dP, dF/dL]` of one muscle on the branch [`Self::evaluate_muscle`]
+    /// takes (on the strands, their slope; at a clamped length the length no longer moves it).
+    fn signed_force_and_partials(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Option<(f64, [f64; 2])> {
+        let k_s = self.strand_stiffness;
+        self.muscle
+            .force_and_partials_with_strands(pressure, length, k_s, history)
+            .ok()
+            .map(|(force, d)| (force, d.force))
+    }
+
+    /// Force and dF/dP of one muscle, tension only unless `signed_force`.
     fn force_and_slope(
         &self,
         pressure: f64,
         length: f64,
         history: &HysteresisState,
     ) -> Option<(f64, f64)> {
-        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() {
-            LIMIT_MARGIN * (hi - lo)
-        } else {
-            0.0
-        };
-        let inside = length.max(lo + margin).min(hi - margin);
-        [length, inside]
-            .into_iter()
-            .find_map(|l| self.muscle.partials(pressure, l, history).ok())
-            .map(|(out, d)| {
-                if self.slack(out.force) {
+        self.signed_force_and_partials(pressure, length, history)
+            .map(|(force, d)| {
+                if self.slack(force) {
                     (0.0, 0.0)
                 } else {
-                    (out.force, d.force[0])
+                    (force, d[0])
                 }
             })
     }
@@ -260,28 +267,12 @@ impl McKibbenJoint {
         })
     }
 
-    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: at a clamped length
-    /// the length no longer moves the force.
+    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: 0 while slack.
     fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
-        if let Ok((out, d)) = self.muscle.partials(pressure, length, history) {
-            return if self.slack(out.force) {
-                [0.0; 2]
-            } else {
-                d.force
-            };
+        match self.signed_force_and_partials(pressure, length, history) {
+            Some((force, d)) if !self.slack(force) => d,
+            _ => [0.0; 2],
         }
-        let (lo, hi) = (self.muscle.min_length(), self.muscle.max_length());
-        let margin = if self.muscle.bladder().is_some() {
-            LIMIT_MARGIN * (hi - lo)
-        } else {
-            0.0
-        };
-        let inside = length.max(lo + margin).min(hi - margin);
-        self.muscle
-            .partials(pressure, inside, history)
-            .ok()
-            .filter(|(out, _)| !self.slack(out.force))
-            .map_or([0.0, 0.0], |(_, d)| [d.force[0], 0.0])
     }
 
     fn write(&self, out: &mut Outputs, pair: &Pair) {
@@ -325,6 +316,7 @@ impl Model for McKibbenJoint {
             ).into());
         }
         let muscle = muscle(p)?;
+        let strand_stiffness = muscle.strand_stiffness(rigidity(p)?);
         let (lo, hi) = (muscle.min_length(), muscle.max_length());
         // Flexor L0f - r q and extensor L0e + r q both inside (lo, hi).
         let min_position =
@@ -362,6 +354,7 @@ impl Model for McKibbenJoint {
             position_range: (min_position, max_position),
             torque_command,
             signed_force: p.signed_force,
+            strand_stiffness,
         })
     }
 
@@ -444,5 +437,189 @@ impl Model for McKibbenJoint {
             self.flexor_friction = pair.flexor.friction_state;
             self.extensor_friction = pair.extensor.friction_state;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::PI;
+
+    fn joint(p: &Parameters) -> McKibbenJoint {
+        McKibbenJoint::new(p, &Inputs::default()).unwrap()
+    }
+
+    fn at(j: &mut McKibbenJoint, u: f64, q: f64) -> (Outputs, bool) {
+        let x = Inputs {
+            actuator_input: u,
+            joint_position: q,
+            joint_velocity: 0.0,
+        };
+        let mut out = Outputs::default();
+        let mut report = Report::default();
+        j.step(&x, &mut out, 0.0, 1e-3, &mut report);
+        (out, report.clamped())
+    }
+
+    /// The bare sleeves past b: the extensor (`L0 + r q`) follows eq. 2.3 at `b` plus the
+    /// strands' `E A / b` times the stretch, computed here in closed form; nothing is clamped
+    /// before 5% strand strain past b, and the torque is continuous through `max_position`.
+    #[test]
+    fn extensor_strands_stretch_past_b() {
+        let p = Parameters::default();
+        let mut j = joint(&p);
+        let (b, n, r, l0) = (
+            p.strand_length,
+            p.turns,
+            p.moment_arm,
+            p.extensor_rest_length,
+        );
+        let k_s = p.strand_rigidity / b;
+        let u = 1e5;
+        let extensor_pressure = p.common_mode_pressure - 0.5 * u;
+        let eq_2_3_at_b = extensor_pressure * 2.0 * b * b / (4.0 * PI * n * n);
+        let max_position = j.calculated_parameters().max_position;
+        assert!((max_position - (b - l0) / r).abs() < 1e-12);
+        for stretch in [1e-4, 0.01, 0.049] {
+            let q = (b * (1.0 + stretch) - l0) / r;
+            let (out, clamped) = at(&mut j, u, q);
+            let expected = eq_2_3_at_b + k_s * stretch * b;
+            assert!(!clamped && !out.extensor_slack);
+            assert!(
+                (out.extensor_force - expected).abs() < 1e-9 * expected,
+                "{stretch}: {} vs {expected}",
+                out.extensor_force
+            );
+        }
+        // Left and right limits at max_position.
+        let eps = 1e-9;
+        let (left, _) = at(&mut j, u, max_position - eps);
+        let (right, _) = at(&mut j, u, max_position + eps);
+        let jump = (right.joint_torque - left.joint_torque).abs();
+        assert!(jump <= 2.0 * eps * r * r * k_s * 1.01, "{jump} N m");
+        // Past 5% strand strain: held at the breaking length, flagged.
+        let (out, clamped) = at(&mut j, u, (1.1 * b - l0) / r);
+        assert!(clamped);
+        let at_break = eq_2_3_at_b + k_s * 0.05 * b;
+        assert!((out.extensor_force - at_break).abs() < 1e-9 * at_break);
+    }
+
+    /// Monotone and finite through the breaking length with a bladder (muscle A, thin wall): the
+    /// extensor's force rises by at most `k_s` per metre of its length, by exactly `k_s` past
+    /// `max_length`.
+    #[test]
+    fn bladder_muscle_is_continuous_through_max_length() {
+        let p = Parameters {
+            preset: 1,
+            bladder_model: 1,
+            ..Default::default()
+        };
+        let mut j = joint(&p);
+        let (r, l0) = (p.moment_arm, p.extensor_rest_length);
+        let hi = j.muscle.max_length();
+        let k_s = p.strand_rigidity / j.muscle.sleeve().strand_length;
+        let breaking = j.muscle.breaking_length();
+        let (from, to) = (hi - 0.02 * (hi - j.muscle.min_length()), breaking);
+        let steps = 2000;
+        let dl = (to - from) / steps as f64;
+        let force_at = |j: &mut McKibbenJoint, l: f64| at(j, 0.0, (l - l0) / r);
+        let mut previous = force_at(&mut j, from).0.extensor_force;
+        for i in 1..=steps {
+            let l = from + dl * i as f64;
+            let (out, clamped) = force_at(&mut j, l);
+            let rise = out.extensor_force - previous;
+            assert!(!clamped && out.extensor_force.is_finite(), "{l}");
+            assert!(rise > 0.0 && rise <= k_s * dl * (1.0 + 1e-5), "{l}: {rise}");
+            if l - dl > hi {
+                assert!((rise - k_s * dl).abs() < 1e-5 * k_s * dl, "{l}: {rise}");
+            }
+            previous = out.extensor_force;
+        }
+    }
+
+    /// The Festo presets' strands are aramid sized by the datasheet's largest force (Kevlar 49,
+    /// 112 GPa, at a tenth of its 3 GPa strength), unless `strand_rigidity` is set.
+    #[test]
+    fn festo_strands_are_aramid_unless_set() {
+        for (preset, force) in [(5, 630.0), (6, 6000.0)] {
+            let p = Parameters {
+                preset,
+                ..Default::default()
+            };
+            let j = joint(&p);
+            let b = j.muscle.sleeve().strand_length;
+            let aramid = 112e9 / 0.3e9 * force / b;
+            assert!((j.strand_stiffness - aramid).abs() < 1e-9 * aramid);
+            let set = joint(&Parameters {
+                strand_rigidity: 5e4,
+                ..p
+            });
+            assert!((set.strand_stiffness - 5e4 / b).abs() < 1e-9 * set.strand_stiffness);
+        }
+    }
+
+    /// The partials are central differences of the outputs, on the strands, in both command
+    /// modes, and 0 for a slack muscle's force.
+    #[test]
+    fn partials_are_the_slopes_on_the_strands_and_zero_while_slack() {
+        for (preset, model, mode) in [(0, 0, 0), (0, 0, 1), (1, 3, 0), (1, 3, 1)] {
+            let p = Parameters {
+                preset,
+                bladder_model: model,
+                command_mode: mode,
+                ..Default::default()
+            };
+            let mut j = joint(&p);
+            let hi = j.muscle.max_length();
+            let q = (hi + 0.01 * j.muscle.sleeve().strand_length - p.extensor_rest_length)
+                / p.moment_arm;
+            let u = if mode == 1 { 0.5 } else { 1e5 };
+            let x = Inputs {
+                actuator_input: u,
+                joint_position: q,
+                joint_velocity: 0.0,
+            };
+            let d = j.partials(&x).unwrap();
+            let names = ["jointTorque", "flexor_force", "extensor_force"];
+            let value = |j: &mut McKibbenJoint, u: f64, q: f64| {
+                let (o, clamped) = at(j, u, q);
+                assert!(!clamped);
+                [o.joint_torque, o.flexor_force, o.extensor_force]
+            };
+            for (column, h) in [(0, if mode == 1 { 1e-4 } else { 1.0 }), (1, 1e-7)] {
+                let (du, dq) = if column == 0 { (h, 0.0) } else { (0.0, h) };
+                let up = value(&mut j, u + du, q + dq);
+                let down = value(&mut j, u - du, q - dq);
+                for (k, name) in names.iter().enumerate() {
+                    let fd = (up[k] - down[k]) / (2.0 * h);
+                    let exact = d.get(name).unwrap()[column].1;
+                    let scale = fd.abs().max(exact.abs()).max(1e-9);
+                    assert!(
+                        (fd - exact).abs() < 1e-4 * scale,
+                        "preset {preset} mode {mode} {name}[{column}]: {exact} vs {fd}"
+                    );
+                }
+            }
+        }
+        // Short muscles: the flexor goes slack; its force's partials are 0.
+        let p = Parameters {
+            flexor_rest_length: 0.07,
+            extensor_rest_length: 0.07,
+            ..Default::default()
+        };
+        let mut j = joint(&p);
+        let (out, _) = at(&mut j, 0.0, 0.6);
+        assert!(out.flexor_slack && out.flexor_force == 0.0 && !out.extensor_slack);
+        let x = Inputs {
+            actuator_input: 0.0,
+            joint_position: 0.6,
+            joint_velocity: 0.0,
+        };
+        let d = j.partials(&x).unwrap();
+        assert!(d
+            .get("flexor_force")
+            .unwrap()
+            .iter()
+            .all(|(_, v)| *v == 0.0));
     }
 }

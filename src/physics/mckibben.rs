@@ -11,10 +11,16 @@ use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
 use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 
+pub mod bare_sleeve;
+mod limits;
 mod partials;
 mod strands;
+mod target;
+pub use limits::{is_slack, OutOfRange, LIMIT_MARGIN};
 pub use partials::McKibbenPartials;
-pub use strands::{StrandTransition, SURVIVABLE_STRAND_STRAIN};
+pub use strands::{
+    strand_rigidity, transition, StrandTransition, Transition, SURVIVABLE_STRAND_STRAIN,
+};
 
 /// Iteration caps of the connector solve (bracket search doubles its step; root is Newton-bisection).
 const BRACKET_STEPS: usize = 64;

@@ -13,6 +13,7 @@ pub mod knitted_bag;
 pub mod knitted_muscle;
 pub mod knitted_partials;
 pub mod knitted_shape;
+pub mod knitted_yarn;
 pub mod mckibben;
 pub mod multiferroic;
 pub mod muscle_params;

@@ -14,7 +14,7 @@ pub struct MuscleParams {
     pub strand_length: f64,
     /// `turns` n.
     pub turns: f64,
-    /// `bladder_model`: 4 the dissertation's thin wall, 5 its layers (the presets' fits).
+    /// `bladder_model` (3, the exact wall, for the Festo presets and the calibration).
     pub bladder_model: i32,
     /// `bladder_layers` (thick wall).
     pub bladder_layers: i32,

@@ -283,7 +283,7 @@ fn enumerations_are_checked_and_travel_as_integers() {
     assert_eq!(model_description::TYPES[preset.type_index], "Integer");
     assert_eq!(
         (preset.min.as_deref(), preset.max.as_deref()),
-        (Some("0"), Some("6"))
+        (Some("0"), Some("8"))
     );
     // Without min and max the items give them.
     let effective = m

@@ -212,8 +212,14 @@ def test_joint_partials_match_central_differences(parameters):
     try:
         # Inside the pressure range (no saturation) and with friction mid-presliding.
         torque = parameters.get("command_mode") == 1
-        for u, q in [(0.3, 0.05), (-0.5, -0.1)] if torque else [(1e5, 0.05), (-2e5, -0.1)]:
-            s.step(actuatorInput=u, jointPosition=q + 1e-3)
+        # And past max_position, the extensor on its stretching strands (2% of b past its reach).
+        on_strands = s.get("max_position") + 0.02 * 0.1113 / s.get("moment_arm")
+        points = [(0.3, 0.05), (-0.5, -0.1), (0.3, on_strands)] if torque else [
+            (1e5, 0.05), (-2e5, -0.1), (1e5, on_strands)]
+        for u, q in points:
+            # Stepped at another command: on the strands the braid stays where they took over,
+            # so a step at the same pressures would leave the friction history at a reversal.
+            s.step(actuatorInput=0.9 * u, jointPosition=q + 1e-3)
             base = dict(actuatorInput=u, jointPosition=q, jointVelocity=0.0)
             s.set(**base)
             for j, name in enumerate(JOINT_INPUTS):
@@ -264,10 +270,13 @@ def test_knitted_partials_match_central_differences(case):
     outputs = KNITTED_OUTPUTS
     lo, hi = s.get("min_length", "max_length")
     try:
-        for frac in [0.4, 0.8]:
+        # 1.02: past max_length, on the stretching yarn.
+        for frac in [0.4, 0.8, 1.02]:
             length = lo + frac * (hi - lo)
             for pressure in pressures:
-                s.step(pressure=pressure, length=length - 3e-5)
+                # At another pressure: on the yarn the knit stays where the yarn took over, so a
+                # step at the same pressure would leave the friction history at a reversal.
+                s.step(pressure=0.99 * pressure, length=length - 3e-5)
                 base = dict(pressure=pressure, length=length)
                 for j, name in enumerate(INPUTS):
                     h = 1e-6 * abs(base[name]) + (1e-3 if name == "pressure" else 0.0)

@@ -259,9 +259,12 @@ def test_dense_grid_never_gives_nan(shape, friction, recording_log):
 def test_out_of_range_length_is_the_nearest_limit_and_logged_once(recording_log):
     m = knitted(log=recording_log, shape_model=NON_CYLINDRICAL)
     lo, top = m.get("min_length", "max_length")
-    at_top = m.at("force", "volume", pressure=14e3, length=top)
-    for L in (top * 1.01, top * 1.5, 5.0):
-        assert m.at("force", "volume", pressure=14e3, length=L) == at_top
+    # The yarn stretches up to 5% of the full extension past max_length; beyond, the breaking
+    # length is evaluated.
+    breaking = top + 0.05 * top
+    at_break = m.at("force", "volume", pressure=14e3, length=breaking)
+    for L in (top * 1.06, top * 1.5, 5.0):
+        assert m.at("force", "volume", pressure=14e3, length=L) == at_break
     m.at("force", pressure=14e3, length=0.4)
     assert m.at("force", pressure=14e3, length=0.0) == m.at("force", pressure=14e3, length=lo)
     warnings = [x for x in recording_log.messages() if "until the inputs return" in x]
@@ -474,3 +477,51 @@ def test_bladder_dense_grid_never_gives_nan(shape, friction, model, recording_lo
 def test_bladder_with_the_non_cylindrical_shape_fails_initialization():
     with pytest.raises(Exception):
         knitted(shape_model=NON_CYLINDRICAL, bladder_model=1)
+
+
+@pytest.mark.parametrize("parameters", [dict(), dict(shape_model=TUBULAR), dict(preset=2, bladder_model=1)],
+                         ids=["ideal", "tubular", "Fig. 1.16 thin wall"])
+def test_yarn_stretches_past_max_length(parameters):
+    """Fully extended, each row's yarn lies along the axis as 2 m legs of L_max / n: the yarn is a
+    spring of k_s = 2 m E A / L_max (E A = 6300 N, the Spectra line). The force is continuous at
+    max_length, rises by exactly k_s past it, is finite and monotone up to the breaking length
+    (5% of L_max past max_length), and is clamped beyond."""
+    s = Slave(MODEL, **parameters)
+    m = 8.0 if parameters.get("preset") == 2 else M
+    hi = s.get("max_length")
+    # The sleeve's own full extension: max_length without a bladder.
+    bare = {k: v for k, v in parameters.items() if k != "bladder_model"}
+    sleeve_max = Slave(MODEL, **bare).get("max_length")
+    k_s = 2 * m * 6300.0 / sleeve_max
+    p = 2e4
+    left = s.at("force", pressure=p, length=hi - 1e-9)
+    right = s.at("force", pressure=p, length=hi + 1e-9)
+    assert abs(right - left) <= 2e-9 * k_s * 1.01 + 1e-9 * abs(left)
+    breaking = hi + 0.05 * sleeve_max
+    lengths = np.linspace(hi + 1e-6, breaking, 101)
+    rows = sweep(s, p, lengths, "force", "stiffness", "input_clamped", "slack")
+    assert np.all(np.isfinite(rows[:, 0])) and np.all(np.diff(rows[:, 0]) > 0)
+    assert np.allclose(np.diff(rows[:, 0]) / np.diff(lengths), k_s, rtol=1e-6)
+    assert np.allclose(rows[:, 1], k_s, rtol=1e-12)
+    assert not rows[:, 2].any() and not rows[:, 3].any()
+    beyond = s.at("force", "input_clamped", pressure=p, length=breaking + 0.01)
+    assert beyond[1] and beyond[0] == pytest.approx(rows[-1, 0], rel=1e-12)
+    s.close()
+
+
+def test_tension_only_below_the_free_contraction():
+    """By default the knit cannot push: below its free contraction force and stiffness are 0,
+    `slack` is set and the directional derivatives of force are 0; signed_force gives eq. 1.8."""
+    s = Slave(MODEL)
+    free = s.get("free_contraction_length")
+    length = 0.8 * free
+    force, stiffness, slack = s.at("force", "stiffness", "slack", pressure=2e4, length=length)
+    assert slack and force == 0.0 and stiffness == 0.0
+    vr = [s.vars[n].valueReference for n in ("pressure", "length")]
+    d = s.fmu.getDirectionalDerivative([s.vars["force"].valueReference], vr[:1], [1.0])
+    d += s.fmu.getDirectionalDerivative([s.vars["force"].valueReference], vr[1:], [1.0])
+    assert list(d) == [0.0, 0.0]
+    signed = knitted(length=length)
+    assert signed.at("force", pressure=2e4, length=length) < 0.0
+    s.close()
+    signed.close()

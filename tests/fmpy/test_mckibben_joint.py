@@ -132,3 +132,36 @@ def test_robot_joint_with_the_joint_fmu_reproduces_the_two_muscle_trajectory():
     for (q, torque), want in zip(rows, reference):
         assert abs(q - want[1]) <= 1e-9
         assert abs(torque - want[8]) <= 1e-9
+
+
+def test_strands_stretch_past_max_position_and_a_short_muscle_goes_slack():
+    """Bare sleeves (b = 111.3 mm, E A = 9400 N): past max_position the extensor's strands stretch,
+    F = eq. 2.3 at b + (E A / b) (L - b), continuous at max_position; the flexor, shorter than its
+    free contraction b / sqrt(3), is slack with force 0; past 5% strand strain the angle is clamped."""
+    joint = Slave("McKibbenJoint")
+    b, n, ea = 0.1113, 3.74, 9400.0  # the start values of strand_length, turns, strand_rigidity
+    k_s = ea / b
+    u = 1e5
+    extensor_pressure = PC - 0.5 * u
+    at_b = extensor_pressure * 2 * b * b / (4 * math.pi * n * n)  # eq. 2.3 at L = b
+    hi = joint.get("max_position")
+    assert hi == pytest.approx((b - L0) / R, rel=1e-12)
+    left = joint.at("extensor_force", actuatorInput=u, jointPosition=hi - 1e-9)
+    right = joint.at("extensor_force", actuatorInput=u, jointPosition=hi + 1e-9)
+    assert abs(right - left) <= 2e-9 * R * k_s * 1.01
+    breaking = (1.05 * b - L0) / R
+    forces = []
+    for q in np.linspace(hi, breaking, 201):
+        force, clamped, slack = joint.at("extensor_force", "input_clamped", "flexor_slack", actuatorInput=u,
+                                         jointPosition=q)
+        length = L0 + R * q
+        assert not clamped
+        assert force == pytest.approx(at_b + k_s * (length - b), rel=1e-9)
+        # The flexor (L0 - R q) is slack below b / sqrt(3) and carries no force there.
+        assert bool(slack) == (L0 - R * q < b / math.sqrt(3))
+        forces.append(force)
+    assert np.all(np.diff(forces) > 0)
+    flexor, slack = joint.at("flexor_force", "flexor_slack", actuatorInput=u, jointPosition=1.75)
+    assert slack and flexor == 0.0
+    assert joint.at("input_clamped", actuatorInput=u, jointPosition=breaking + 0.01)
+    joint.close()

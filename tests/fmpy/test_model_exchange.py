@@ -123,6 +123,71 @@ def test_joint_model_exchange_matches_co_simulation():
     assert max(worst.values()) <= TOLERANCE, worst
 
 
+STRAND_RUNS = {
+    # The joint's muscles alternately slack and on their stretching strands (max_position 1.42 rad,
+    # breaking angle 1.79 rad with the defaults), with friction.
+    "McKibbenJoint": (dict(friction=True), {
+        "actuatorInput": lambda t: 1e5 * np.sin(2 * np.pi * t),
+        "jointPosition": lambda t: 1.75 * np.sin(np.pi * t),
+        "jointVelocity": lambda t: 1.75 * np.pi * np.cos(np.pi * t),
+    }, ["jointTorque", "flexor_force", "extensor_force", "flexor_slack", "extensor_slack"]),
+    # The knit through its free contraction (178 mm) and on its stretching yarn (max_length 514 mm,
+    # breaking length 540 mm).
+    "KnittedMuscle": (dict(friction=True), {
+        "pressure": lambda t: 2e4 + 1e4 * np.sin(2 * np.pi * t),
+        "length": lambda t: 0.36 + 0.17 * np.sin(np.pi * t),
+    }, ["force", "volume", "stiffness", "slack"]),
+}
+
+
+@pytest.mark.parametrize("model", STRAND_RUNS)
+def test_model_exchange_matches_co_simulation_slack_and_on_the_strands(model):
+    parameters, inputs, outputs = STRAND_RUNS[model]
+    step, stop = 0.01, 2.0
+    t = np.arange(0.0, stop + step / 2, step)
+    signals = np.zeros(t.size, dtype=[("time", float)] + [(n, float) for n in inputs])
+    signals["time"] = t
+    for name, f in inputs.items():
+        signals[name] = f(t)
+    worst = compare(model, parameters, signals, outputs, step, stop)
+    assert max(worst.values()) <= TOLERANCE, worst
+
+
+@pytest.mark.parametrize("model,point", [
+    ("McKibbenJoint", {"actuatorInput": 1e5, "jointPosition": 1.6}),
+    ("McKibbenJoint", {"actuatorInput": 0.0, "jointPosition": 1.75}),  # flexor slack
+    ("KnittedMuscle", {"pressure": 2e4, "length": 0.52}),
+    ("KnittedMuscle", {"pressure": 2e4, "length": 0.15}),  # slack
+])
+def test_model_exchange_directional_derivatives_on_the_strands_and_slack(model, point):
+    """Model Exchange's directional derivatives are Co-Simulation's, on the strands and slack."""
+    from fmpy import extract
+    from fmpy.fmi2 import FMU2Model, FMU2Slave
+
+    path = fmu_path(model)
+    md = read_model_description(path)
+    where = extract(path)
+    vr = {v.name: v.valueReference for v in md.modelVariables}
+    known = [vr[n] for n in point]
+    unknown = [u.variable.valueReference for u in md.outputs if u.variable.type == "Real"]
+    results = []
+    for cls in (FMU2Slave, FMU2Model):
+        fmu = cls(guid=md.guid, unzipDirectory=where, modelIdentifier=model, instanceName="d")
+        fmu.instantiate()
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        if cls is FMU2Model:
+            fmu.enterContinuousTimeMode()
+        fmu.setReal(known, list(point.values()))
+        results.append([list(fmu.getDirectionalDerivative(unknown, known, seed))
+                        for seed in np.eye(len(known)).tolist()])
+        fmu.terminate()
+        fmu.freeInstance()
+    assert results[0] == results[1]
+    assert any(v != 0.0 for row in results[0] for v in row)
+
+
 @pytest.mark.parametrize("model", SHIPPED)
 def test_both_interfaces_validate_clean(model):
     assert validate_fmu(fmu_path(model)) == []

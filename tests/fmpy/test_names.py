@@ -25,11 +25,11 @@ BLADDER = ["none", "thin_wall", "layers", "exact_wall", "dissertation_thin_wall"
            "dissertation_continuum"]
 # Every Integer that selects among named options, by model: (variable, type, item names in value order).
 ENUMERATIONS = {
-    "McKibbenMuscle": {"preset": ["none", "A", "B", "C", "D", "DMSP_10", "DMSP_40"],
+    "McKibbenMuscle": {"preset": ["none", "A", "B", "C", "D", "DMSP_10", "DMSP_40", "DMSP_5", "DMSP_20"],
                        "bladder_model": BLADDER,
                        "effective_bladder_model": BLADDER,
                        "out_of_range_policy": ["ok", "warning", "discard"]},
-    "McKibbenJoint": {"preset": ["none", "A", "B", "C", "D", "DMSP_10", "DMSP_40"],
+    "McKibbenJoint": {"preset": ["none", "A", "B", "C", "D", "DMSP_10", "DMSP_40", "DMSP_5", "DMSP_20"],
                       "bladder_model": BLADDER,
                       "command_mode": ["pressure_difference", "joint_torque"],
                       "out_of_range_policy": ["ok", "warning", "discard"]},
@@ -109,13 +109,13 @@ def test_an_item_by_name_equals_its_value():
     by_name = Slave("McKibbenMuscle", preset="DMSP_40", length=0.36)
     by_value = Slave("McKibbenMuscle", preset=6, length=0.36)
     assert by_name.at("force", pressure=3e5) == by_value.at("force", pressure=3e5)
-    assert by_name.get("effective_bladder_model") == 4  # the dissertation's thin wall, as the Festo presets fit
+    assert by_name.get("effective_bladder_model") == 3  # the exact wall, as the Festo presets fit
     by_name.close()
     by_value.close()
-    with pytest.raises(UsageError, match=r"preset = 'DMSP40' is not one of its items; valid: DMSP_40, DMSP_10,"):
+    with pytest.raises(UsageError, match=r"preset = 'DMSP40' is not one of its items; valid: DMSP_40, DMSP_20, DMSP_10,"):
         Slave("McKibbenMuscle", preset="DMSP40")
-    with pytest.raises(UsageError, match=r"preset = 7 is not one of its items; valid: 0 none, 1 A,"):
-        Slave("McKibbenMuscle", preset=7)
+    with pytest.raises(UsageError, match=r"preset = 9 is not one of its items; valid: 0 none, 1 A,"):
+        Slave("McKibbenMuscle", preset=9)
 
 
 def test_pressure_for_force_answers_in_pascal():
@@ -178,9 +178,9 @@ def test_the_presets_table_gives_each_presets_values():
     header = re.findall(r"<th><code>(\w+)</code></th>", table)
     assert header == ENUMERATIONS["McKibbenMuscle"]["preset"]
     row = re.search(r"<td><code>effective_nominal_length</code></td><td>m</td>(.*?)</tr>", table).group(1)
-    # Table 2.1's listed lengths (mm) and the Festo fits' nominal lengths, in m.
+    # Table 2.1's listed lengths (mm) and the Festo presets' nominal lengths, in m.
     assert re.findall(r'<td class="n">([^<]*)</td>', row) == ["0.10325", "0.10325", "0.1088", "0.0989",
-                                                               "0.1358", "0.25", "0.4"]
+                                                               "0.1358", "0.25", "0.4", "0.1", "0.3"]
 
 
 def test_inputs_without_a_column_keep_their_start_values_and_nothing_warns(capfd):

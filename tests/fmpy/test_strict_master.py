@@ -150,12 +150,7 @@ def option_values():
             else:
                 continue
             cases += [(fmu.stem, v.name, value) for value in values]
-    # Open: the Gilbert onion's relaxation exhausts the default substep budget at the motor's
-    # 1 us steps and returns fmi2Warning (with its reason) at every step.
-    gilbert = ("MultiferroicMotor", "onion_model", 1)
-    return [pytest.param(*c, marks=pytest.mark.xfail(strict=True, reason="Gilbert onion: "
-                                                     "substep budget at 1 us steps"))
-            if c == gilbert else c for c in cases]
+    return cases
 
 
 @pytest.mark.parametrize("model, option, value", option_values(),

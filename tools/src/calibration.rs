@@ -1,12 +1,13 @@
 //! Fitting McKibbenMuscle's physical parameters to measured force-contraction curves.
 //!
 //! The model is the FMU's own chapter 2 physics ([`McKibben`]: ideal sleeve, eq. 2.1-2.3, with the
-//! Mooney-Rivlin bladder, thin wall eq. 2.6-2.18 or layered thick wall eq. 2.19-2.20), with no
-//! empirical correction term. Free parameters: the braid angle at the nominal length and the
+//! Mooney-Rivlin bladder, by default the exact thick wall, `bladder_model` 3), with no empirical
+//! correction term. The parameters ([`Param`]): the braid angle at the nominal length and the
 //! sleeve diameter there (together the strand length `b` and turns `n`), the bladder's bore, wall
-//! and unstretched length (pre-strain), and the Mooney-Rivlin constants `C1`, `C2`. The residual of
-//! a point is its force error as a fraction of its curve's largest force, each curve weighted
-//! equally; a Levenberg-Marquardt search from several deterministic starts keeps the best.
+//! and unstretched length (pre-strain), and the Mooney-Rivlin constants `C1`, `C2`; any of them can
+//! be held fixed (by default the rubber's, [`RUBBER`]). The residual of a point is its force error
+//! as a fraction of its curve's largest force, each curve weighted equally; the
+//! `levenberg-marquardt` crate's search from several deterministic starts keeps the best.
 //!
 //! Pure: no I/O. `src/bin/calibrate.rs` reads the datasheet and writes the results. Offline, so
 //! here in the tools crate: the FMU binary neither runs it nor links nalgebra.
@@ -14,10 +15,9 @@
 use actuator_fmus::physics::friction::HysteresisState;
 use actuator_fmus::physics::mckibben::McKibben;
 pub use actuator_fmus::physics::muscle_params::MuscleParams;
-use nalgebra::{SMatrix, SVector};
+use levenberg_marquardt::{LeastSquaresProblem, LevenbergMarquardt};
+use nalgebra::{DMatrix, DVector, Dyn, VecStorage, U1};
 
-/// Number of free parameters.
-pub const DIM: usize = 7;
 /// Residual of a point the model cannot evaluate (length outside the bladder's range): ten times
 /// its curve's largest force, large against any fit yet finite for the least-squares step.
 const INFEASIBLE: f64 = 10.0;
@@ -64,19 +64,254 @@ pub fn curves(data: &[Datum]) -> Vec<Curve> {
     out
 }
 
+/// The parameters the calibration can fit, in the order of its search vector.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Param {
+    /// Braid angle at the nominal length, rad (with the nominal length: `strand_length`).
+    BraidAngle,
+    /// Sleeve diameter at the nominal length, m (with the braid angle: `turns`).
+    SleeveDiameter,
+    BladderInnerDiameter,
+    BladderThickness,
+    BladderLength,
+    MooneyC1,
+    MooneyC2,
+}
+
+pub const PARAMS: [Param; 7] = [
+    Param::BraidAngle,
+    Param::SleeveDiameter,
+    Param::BladderInnerDiameter,
+    Param::BladderThickness,
+    Param::BladderLength,
+    Param::MooneyC1,
+    Param::MooneyC2,
+];
+
+impl Param {
+    pub fn name(self) -> &'static str {
+        match self {
+            Param::BraidAngle => "braid_angle",
+            Param::SleeveDiameter => "sleeve_diameter",
+            Param::BladderInnerDiameter => "bladder_inner_diameter",
+            Param::BladderThickness => "bladder_thickness",
+            Param::BladderLength => "bladder_length",
+            Param::MooneyC1 => "mooney_c1",
+            Param::MooneyC2 => "mooney_c2",
+        }
+    }
+
+    pub fn unit(self) -> &'static str {
+        match self {
+            Param::BraidAngle => "rad",
+            Param::MooneyC1 | Param::MooneyC2 => "Pa",
+            _ => "m",
+        }
+    }
+
+    /// The search's bounds for a muscle of nominal length `l_n` and inner diameter `d`, and
+    /// whether the search runs on a log scale.
+    pub fn bounds(self, l_n: f64, d: f64) -> (f64, f64, bool) {
+        match self {
+            // Beyond 54.7 degrees the sleeve pushes (eq. 2.3).
+            Param::BraidAngle => (5f64.to_radians(), 54f64.to_radians(), false),
+            Param::SleeveDiameter => (0.5 * d, 2.5 * d, false),
+            Param::BladderInnerDiameter => (0.3 * d, 1.5 * d, false),
+            Param::BladderThickness => (0.01 * d, 0.5 * d, true),
+            // A bladder longer than the muscle it sits in is no real muscle's.
+            Param::BladderLength => (0.6 * l_n, l_n, false),
+            Param::MooneyC1 | Param::MooneyC2 => (1e3, 3e6, true),
+        }
+    }
+
+    fn get(self, p: &Geometry) -> f64 {
+        match self {
+            Param::BraidAngle => p.braid_angle,
+            Param::SleeveDiameter => p.sleeve_diameter,
+            Param::BladderInnerDiameter => p.bladder_inner_diameter,
+            Param::BladderThickness => p.bladder_thickness,
+            Param::BladderLength => p.bladder_length,
+            Param::MooneyC1 => p.mooney_c1,
+            Param::MooneyC2 => p.mooney_c2,
+        }
+    }
+
+    fn set(self, p: &mut Geometry, v: f64) {
+        match self {
+            Param::BraidAngle => p.braid_angle = v,
+            Param::SleeveDiameter => p.sleeve_diameter = v,
+            Param::BladderInnerDiameter => p.bladder_inner_diameter = v,
+            Param::BladderThickness => p.bladder_thickness = v,
+            Param::BladderLength => p.bladder_length = v,
+            Param::MooneyC1 => p.mooney_c1 = v,
+            Param::MooneyC2 => p.mooney_c2 = v,
+        }
+    }
+}
+
+/// A muscle in the calibration's own coordinates (the braid by its angle and diameter at the
+/// nominal length rather than by `b` and `n`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Geometry {
+    pub braid_angle: f64,
+    pub sleeve_diameter: f64,
+    pub bladder_inner_diameter: f64,
+    pub bladder_thickness: f64,
+    pub bladder_length: f64,
+    pub mooney_c1: f64,
+    pub mooney_c2: f64,
+}
+
+impl Geometry {
+    /// The muscle's parameters at nominal length `l_n` with bladder `model` (`bladder_model`,
+    /// `bladder_layers`): `b = L_N / cos theta`, `n = b sin theta / (pi D)` (eq. 2.1's geometry).
+    pub fn params(&self, l_n: f64, (model, layers): (i32, i32)) -> MuscleParams {
+        let b = l_n / self.braid_angle.cos();
+        MuscleParams {
+            nominal_length: l_n,
+            strand_length: b,
+            turns: b * self.braid_angle.sin() / (std::f64::consts::PI * self.sleeve_diameter),
+            bladder_model: model,
+            bladder_layers: layers,
+            bladder_length: self.bladder_length,
+            bladder_inner_diameter: self.bladder_inner_diameter,
+            bladder_thickness: self.bladder_thickness,
+            mooney_c1: self.mooney_c1,
+            mooney_c2: self.mooney_c2,
+        }
+    }
+
+    /// The inverse of [`Self::params`].
+    pub fn of(p: &MuscleParams) -> Self {
+        let theta = p.braid_angle();
+        Self {
+            braid_angle: theta,
+            sleeve_diameter: p.strand_length * theta.sin() / (std::f64::consts::PI * p.turns),
+            bladder_inner_diameter: p.bladder_inner_diameter,
+            bladder_thickness: p.bladder_thickness,
+            bladder_length: p.bladder_length,
+            mooney_c1: p.mooney_c1,
+            mooney_c2: p.mooney_c2,
+        }
+    }
+}
+
+/// The bladder's rubber, `mooney_c1` and `mooney_c2` in Pa, fixed: force curves identify the
+/// wall's stiffness (thickness times the constants), not the constants apart from the wall. One
+/// compound for every size: small-strain shear modulus `2 (C1 + C2)` = 1.26 MPa (a chloroprene
+/// rubber near Shore A 60) with its stiffness in `C2`, which the DMSP-40's curves ask for (with
+/// `C2 = C1 / 4` its 100 kPa curve errs by 3.7% RMS).
+pub const RUBBER: (f64, f64) = (3e4, 6e5);
+
 /// What to fit and how hard to search.
 #[derive(Clone, Debug)]
 pub struct FitConfig {
     /// Nominal length `L_N`, m (the curves' contraction is relative to it).
     pub nominal_length: f64,
-    /// Nominal inner diameter of the muscle, m: the scale of the starting diameters.
+    /// Nominal inner diameter of the muscle, m: the scale of the bounds and starts.
     pub diameter: f64,
-    /// `bladder_layers`: 1 = thin wall (`bladder_model` 4), more = layers (`bladder_model` 5).
-    pub layers: i32,
+    /// `bladder_model` and `bladder_layers` (3, 16: the exact wall).
+    pub model: (i32, i32),
+    /// Parameters held at a value instead of fitted.
+    pub fixed: Vec<(Param, f64)>,
+    /// The braid sits on the bladder's outer wall at the nominal length (Festo's strands are
+    /// embedded in it): sleeve diameter = bore + 2 wall, not searched.
+    pub sleeve_on_wall: bool,
     /// Number of starting points of the Levenberg-Marquardt search.
     pub starts: usize,
     /// Iteration cap per start.
     pub iterations: usize,
+}
+
+impl FitConfig {
+    /// What `make calibrate` fits: the exact wall (16 nodes) with the bladder unstretched at the
+    /// nominal length (a datasheet's force at 0 kPa and 0% contraction is 0), the rubber
+    /// [`RUBBER`] and the braid on the wall. Fitted: braid angle, bore and wall thickness.
+    pub fn exact_wall(nominal_length: f64, diameter: f64) -> Self {
+        Self {
+            nominal_length,
+            diameter,
+            model: (3, 16),
+            fixed: vec![
+                (Param::BladderLength, nominal_length),
+                (Param::MooneyC1, RUBBER.0),
+                (Param::MooneyC2, RUBBER.1),
+            ],
+            sleeve_on_wall: true,
+            starts: 24,
+            iterations: 200,
+        }
+    }
+
+    /// The parameters searched, in order.
+    pub fn free(&self) -> Vec<Param> {
+        PARAMS
+            .into_iter()
+            .filter(|p| !self.fixed.iter().any(|(f, _)| f == p))
+            .filter(|p| !(self.sleeve_on_wall && *p == Param::SleeveDiameter))
+            .collect()
+    }
+
+    fn bounds(&self, p: Param) -> (f64, f64, bool) {
+        p.bounds(self.nominal_length, self.diameter)
+    }
+
+    /// Search coordinate (unbounded) to value: a logistic between the bounds, on a log scale
+    /// where the bounds span decades.
+    fn value(&self, p: Param, x: f64) -> f64 {
+        let (lo, hi, log) = self.bounds(p);
+        let s = 1.0 / (1.0 + (-x).exp());
+        if log {
+            (lo.ln() + (hi / lo).ln() * s).exp()
+        } else {
+            lo + (hi - lo) * s
+        }
+    }
+
+    /// The inverse of [`Self::value`] (for starting points).
+    fn coordinate(&self, p: Param, v: f64) -> f64 {
+        let (lo, hi, log) = self.bounds(p);
+        let s = if log {
+            (v / lo).ln() / (hi / lo).ln()
+        } else {
+            (v - lo) / (hi - lo)
+        };
+        let s = s.clamp(1e-9, 1.0 - 1e-9);
+        (s / (1.0 - s)).ln()
+    }
+
+    /// Where a value sits between its bounds, 0 at the lower and 1 at the upper (on the search's
+    /// scale).
+    pub fn position(&self, p: Param, v: f64) -> f64 {
+        let (lo, hi, log) = self.bounds(p);
+        if log {
+            (v / lo).ln() / (hi / lo).ln()
+        } else {
+            (v - lo) / (hi - lo)
+        }
+    }
+
+    fn decode(&self, x: &DVector<f64>) -> Geometry {
+        let mut g = Geometry {
+            braid_angle: 0.0,
+            sleeve_diameter: 0.0,
+            bladder_inner_diameter: 0.0,
+            bladder_thickness: 0.0,
+            bladder_length: 0.0,
+            mooney_c1: 0.0,
+            mooney_c2: 0.0,
+        };
+        for &(p, v) in &self.fixed {
+            p.set(&mut g, v);
+        }
+        for (p, xi) in self.free().into_iter().zip(x.iter()) {
+            p.set(&mut g, self.value(p, *xi));
+        }
+        if self.sleeve_on_wall {
+            g.sleeve_diameter = g.bladder_inner_diameter + 2.0 * g.bladder_thickness;
+        }
+        g
+    }
 }
 
 /// Error of the model against one curve, as fractions of the curve's largest force.
@@ -90,7 +325,8 @@ pub struct CurveError {
     pub infeasible: usize,
 }
 
-/// The model's force at a datum, `Err` outside its range.
+/// The model's force at a datum, `Err` outside its range: the signed force with inextensible
+/// strands (the datasheets list signed forces; the FMU's `signed_force`).
 pub fn model_force(muscle: &McKibben, nominal_length: f64, d: &Datum) -> Result<f64, String> {
     let length = nominal_length * (1.0 - d.contraction);
     let rest = HysteresisState::at_rest(length);
@@ -129,131 +365,70 @@ pub fn errors(params: &MuscleParams, curves: &[Curve]) -> Vec<CurveError> {
         .collect()
 }
 
-/// Rubber constants stay those of real rubbers, Pa: without the bound a vanishing wall of an
-/// absurdly stiff rubber fits as well (only their product matters in the thin-wall limit).
-const MOONEY: (f64, f64) = (1e3, 3e6);
-/// Wall thickness as a fraction of the nominal diameter.
-const WALL: (f64, f64) = (0.002, 0.3);
-
-/// `lo .. hi` on a log scale from an unbounded `v` (logistic).
-fn log_between(v: f64, (lo, hi): (f64, f64)) -> f64 {
-    (lo.ln() + (hi / lo).ln() / (1.0 + (-v).exp())).exp()
+/// The least-squares problem: weighted residuals of the fitted curves (each curve's errors over
+/// its largest force, divided by the square root of its point count so that every curve weighs
+/// the same), in the search coordinates, for the `levenberg-marquardt` crate.
+struct Problem<'a> {
+    cfg: &'a FitConfig,
+    fit: &'a [Curve],
+    x: DVector<f64>,
 }
 
-/// The inverse of [`log_between`] (for starting points).
-fn log_logit(x: f64, (lo, hi): (f64, f64)) -> f64 {
-    let p = (x / lo).ln() / (hi / lo).ln();
-    (p / (1.0 - p)).ln()
-}
-
-/// Maps an unbounded search vector to parameters (the bounds live in these maps).
-fn decode(x: &SVector<f64, DIM>, cfg: &FitConfig) -> MuscleParams {
-    let sigmoid = |v: f64| 1.0 / (1.0 + (-v).exp());
-    let l_n = cfg.nominal_length;
-    // Braid angle at L_N between 5 and 54 degrees (beyond 54.7 the sleeve pushes, eq. 2.3).
-    let theta = (5.0 + 49.0 * sigmoid(x[0])).to_radians();
-    // Sleeve diameter at L_N between 0.5 and 2 nominal diameters.
-    let d_sleeve = cfg.diameter * (0.5 + 1.5 * sigmoid(x[1]));
-    let b = l_n / theta.cos();
-    let n = b * theta.sin() / (std::f64::consts::PI * d_sleeve);
-    MuscleParams {
-        nominal_length: l_n,
-        strand_length: b,
-        turns: n,
-        bladder_model: if cfg.layers > 1 { 5 } else { 4 },
-        bladder_layers: cfg.layers.max(1),
-        bladder_length: l_n * x[4].exp(),
-        bladder_inner_diameter: cfg.diameter * x[2].exp(),
-        bladder_thickness: cfg.diameter * log_between(x[3], WALL),
-        mooney_c1: log_between(x[5], MOONEY),
-        mooney_c2: log_between(x[6], MOONEY),
-    }
-}
-
-/// Weighted residuals of the fitted curves (each curve's errors over its largest force, divided
-/// by the square root of its point count so that every curve weighs the same).
-fn residuals(x: &SVector<f64, DIM>, cfg: &FitConfig, fit: &[Curve], out: &mut Vec<f64>) {
-    out.clear();
-    let params = decode(x, cfg);
-    let muscle = params.muscle().ok();
-    for c in fit {
-        let w = 1.0 / (c.scale() * (c.points.len() as f64).sqrt());
-        for d in &c.points {
-            out.push(
-                match muscle
-                    .as_ref()
-                    .map(|m| model_force(m, cfg.nominal_length, d))
-                {
-                    Some(Ok(f)) if f.is_finite() => (f - d.force) * w,
-                    _ => INFEASIBLE * c.scale() * w,
-                },
-            );
+impl Problem<'_> {
+    fn residuals_at(&self, x: &DVector<f64>) -> DVector<f64> {
+        let params = self
+            .cfg
+            .decode(x)
+            .params(self.cfg.nominal_length, self.cfg.model);
+        let muscle = params.muscle().ok();
+        let mut out = Vec::new();
+        for c in self.fit {
+            let w = 1.0 / (c.scale() * (c.points.len() as f64).sqrt());
+            for d in &c.points {
+                out.push(
+                    match muscle
+                        .as_ref()
+                        .map(|m| model_force(m, self.cfg.nominal_length, d))
+                    {
+                        Some(Ok(f)) if f.is_finite() => (f - d.force) * w,
+                        _ => INFEASIBLE * c.scale() * w,
+                    },
+                );
+            }
         }
+        DVector::from_vec(out)
     }
 }
 
-fn cost(r: &[f64]) -> f64 {
-    r.iter().map(|v| v * v).sum()
-}
+impl LeastSquaresProblem<f64, Dyn, Dyn> for Problem<'_> {
+    type ResidualStorage = VecStorage<f64, Dyn, U1>;
+    type JacobianStorage = VecStorage<f64, Dyn, Dyn>;
+    type ParameterStorage = VecStorage<f64, Dyn, U1>;
 
-/// Levenberg-Marquardt (Marquardt's diagonal scaling, forward-difference Jacobian) from `x`.
-fn levenberg_marquardt(
-    mut x: SVector<f64, DIM>,
-    cfg: &FitConfig,
-    fit: &[Curve],
-) -> (SVector<f64, DIM>, f64) {
-    let mut r = Vec::new();
-    residuals(&x, cfg, fit, &mut r);
-    let mut c = cost(&r);
-    let mut lambda = 1e-2;
-    let (mut r_trial, mut jac_col) = (Vec::new(), Vec::new());
-    let mut jac = vec![[0.0; DIM]; r.len()];
-    for _ in 0..cfg.iterations {
-        for k in 0..DIM {
-            let h = 1e-6 * (1.0 + x[k].abs());
-            let mut xh = x;
+    fn set_params(&mut self, x: &DVector<f64>) {
+        self.x.copy_from(x);
+    }
+
+    fn params(&self) -> DVector<f64> {
+        self.x.clone()
+    }
+
+    fn residuals(&self) -> Option<DVector<f64>> {
+        Some(self.residuals_at(&self.x))
+    }
+
+    /// Forward differences: the physics has no parameter derivatives.
+    fn jacobian(&self) -> Option<DMatrix<f64>> {
+        let r0 = self.residuals_at(&self.x);
+        let mut jac = DMatrix::zeros(r0.len(), self.x.len());
+        for k in 0..self.x.len() {
+            let h = 1e-6 * (1.0 + self.x[k].abs());
+            let mut xh = self.x.clone();
             xh[k] += h;
-            residuals(&xh, cfg, fit, &mut jac_col);
-            for (row, (rh, r0)) in jac.iter_mut().zip(jac_col.iter().zip(&r)) {
-                row[k] = (rh - r0) / h;
-            }
+            jac.set_column(k, &((self.residuals_at(&xh) - &r0) / h));
         }
-        let mut jtj = SMatrix::<f64, DIM, DIM>::zeros();
-        let mut jtr = SVector::<f64, DIM>::zeros();
-        for (row, ri) in jac.iter().zip(&r) {
-            let j = SVector::<f64, DIM>::from_row_slice(row);
-            jtj += j * j.transpose();
-            jtr += j * *ri;
-        }
-        let mut improved = false;
-        while lambda < 1e12 {
-            let mut a = jtj;
-            for k in 0..DIM {
-                a[(k, k)] += lambda * jtj[(k, k)].max(1e-12);
-            }
-            let Some(step) = a.cholesky().map(|ch| ch.solve(&(-jtr))) else {
-                lambda *= 10.0;
-                continue;
-            };
-            let trial = x + step;
-            residuals(&trial, cfg, fit, &mut r_trial);
-            let c_trial = cost(&r_trial);
-            if c_trial.is_finite() && c_trial < c {
-                let gain = (c - c_trial) / c.max(f64::MIN_POSITIVE);
-                x = trial;
-                std::mem::swap(&mut r, &mut r_trial);
-                c = c_trial;
-                lambda = (lambda / 3.0).max(1e-12);
-                improved = gain > 1e-10;
-                break;
-            }
-            lambda *= 4.0;
-        }
-        if !improved {
-            break;
-        }
+        Some(jac)
     }
-    (x, c)
 }
 
 /// Deterministic pseudo-random numbers in [0, 1) (xorshift64*), so that a fit is reproducible.
@@ -289,25 +464,37 @@ pub fn fit(
     if fit.iter().all(|c| c.points.is_empty()) {
         return Err("no data points at the pressures to fit".into());
     }
+    let (l_n, d) = (cfg.nominal_length, cfg.diameter);
     let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
     let mut best: Option<Fit> = None;
+    let free = cfg.free();
     for start in 0..cfg.starts.max(1) {
-        // Starts spread over plausible muscles: braid 15-40 degrees, bladder near the bore,
-        // walls 1-10% of the bore, 0-30% pre-strain, rubber 10 kPa - 1 MPa.
-        let logit = |p: f64| (p / (1.0 - p)).ln();
-        let x0 = SVector::<f64, DIM>::from_column_slice(&[
-            logit((rng.between(15.0, 40.0) - 5.0) / 49.0),
-            logit((rng.between(1.0, 1.4) - 0.5) / 1.5),
-            rng.between(0.7, 1.0f64).ln(),
-            log_logit(rng.between(0.005, 0.1), WALL),
-            rng.between(0.75, 1.02f64).ln(),
-            log_logit(rng.between(1e4, 1e6), MOONEY),
-            log_logit(rng.between(1e4, 1e6), MOONEY),
-        ]);
-        let (x, c) = levenberg_marquardt(x0, cfg, fit);
-        if best.as_ref().is_none_or(|b| c < b.cost) {
+        // Starts spread over plausible muscles: braid 15-40 degrees, a bore near the nominal
+        // diameter, walls 5-25% of it, 0-20% pre-strain, rubber 30 kPa - 1 MPa.
+        let bore = d * rng.between(0.7, 1.1);
+        let wall = d * rng.between(0.05, 0.25);
+        let start_at = Geometry {
+            braid_angle: rng.between(15.0, 40.0).to_radians(),
+            sleeve_diameter: (bore + 2.0 * wall) * rng.between(1.0, 1.2),
+            bladder_inner_diameter: bore,
+            bladder_thickness: wall,
+            bladder_length: l_n * rng.between(0.8, 0.99),
+            mooney_c1: rng.between(3e4, 1e6),
+            mooney_c2: rng.between(3e4, 1e6),
+        };
+        let x0 = DVector::from_iterator(
+            free.len(),
+            free.iter().map(|&p| cfg.coordinate(p, p.get(&start_at))),
+        );
+        let problem = Problem { cfg, fit, x: x0 };
+        let (problem, _report) = LevenbergMarquardt::new()
+            .with_patience(cfg.iterations)
+            .minimize(problem);
+        let r = problem.residuals_at(&problem.x);
+        let c = r.norm_squared();
+        if c.is_finite() && best.as_ref().is_none_or(|b| c < b.cost) {
             best = Some(Fit {
-                params: decode(&x, cfg),
+                params: cfg.decode(&problem.x).params(l_n, cfg.model),
                 cost: c,
             });
         }
@@ -325,128 +512,44 @@ pub fn fit(
     Ok(best)
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A thin-walled muscle inside the fit's bounds (about a 10 mm Festo-like muscle).
-    fn truth() -> MuscleParams {
-        MuscleParams {
-            nominal_length: 0.25,
-            strand_length: 0.25 / 25f64.to_radians().cos(),
-            turns: 0.25 * 25f64.to_radians().tan() / (std::f64::consts::PI * 0.011),
-            bladder_model: 4,
-            bladder_layers: 1,
-            bladder_length: 0.24,
-            bladder_inner_diameter: 0.009,
-            bladder_thickness: 0.5e-3,
-            mooney_c1: 4e5,
-            mooney_c2: 1e5,
-        }
-    }
-
-    fn synthetic(p: &MuscleParams, kpa: &[f64]) -> Vec<Datum> {
-        let m = p.muscle().unwrap();
-        let mut data = Vec::new();
-        for &k in kpa {
-            for i in 0..9 {
-                let mut d = Datum {
-                    pressure: k * 1e3,
-                    contraction: -0.02 + 0.025 * i as f64,
-                    force: 0.0,
-                };
-                if let Ok(f) = model_force(&m, p.nominal_length, &d) {
-                    d.force = f;
-                    data.push(d);
-                }
-            }
-        }
-        data
-    }
-
-    #[test]
-    fn fit_reproduces_curves_generated_by_the_model_itself() {
-        // The model can represent its own curves exactly: the fit at 0 + 600 kPa must predict
-        // the 300 kPa curve of the same muscle (a regression on the search, not on Festo data).
-        let truth = truth();
-        let cfg = FitConfig {
-            nominal_length: 0.25,
-            diameter: 0.01,
-            layers: 1,
-            starts: 12,
-            iterations: 200,
-        };
-        let fitted = curves(&synthetic(&truth, &[0.0, 600.0]));
-        let best = fit(&cfg, &fitted, |_, _, _| {}).unwrap();
-        let check = curves(&synthetic(&truth, &[300.0]));
-        for e in errors(&best.params, &check)
-            .iter()
-            .chain(&errors(&best.params, &fitted))
-        {
-            assert!(e.rms < 2e-3 && e.infeasible == 0, "{e:?}");
-        }
-    }
-
-    #[test]
-    fn scaling_the_nominal_length_keeps_force_at_each_contraction() {
-        let p = truth();
-        let q = p.scaled_to(0.6);
-        let mq = q.muscle().unwrap();
-        assert!((q.braid_angle() - p.braid_angle()).abs() < 1e-12);
-        for d in synthetic(&p, &[0.0, 300.0, 600.0]) {
-            let f = model_force(&mq, q.nominal_length, &d).unwrap();
-            assert!(
-                (f - d.force).abs() <= 1e-9 * d.force.abs().max(1.0),
-                "{f} vs {d:?}"
-            );
-        }
-    }
-
-    #[test]
-    fn errors_are_fractions_of_each_curves_largest_force() {
-        let p = truth();
-        let mut data = synthetic(&p, &[600.0]);
-        let scale = data.iter().map(|d| d.force.abs()).fold(0.0, f64::max);
-        let last = data.len() - 1; // the weakest point, so the largest force stays
-        data[last].force += 0.1 * scale; // one point 10% off: max 0.1, rms 0.1/sqrt(n)
-        let e = errors(&p, &curves(&data))[0];
-        assert!((e.max - 0.1).abs() < 1e-9, "{e:?}");
-        assert!(
-            (e.rms - 0.1 / (data.len() as f64).sqrt()).abs() < 1e-9,
-            "{e:?}"
-        );
-    }
-
-    // The Festo presets of the FMU (`src/physics/festo.rs`) against their datasheets.
-    use actuator_fmus::physics::festo::{DMSP_10, DMSP_40};
-
-    fn datasheet(text: &str) -> Vec<Datum> {
-        text.lines()
-            .filter(|l| !l.starts_with('#') && !l.starts_with("pressure"))
-            .map(|l| {
-                let v: Vec<f64> = l.split(',').map(|s| s.trim().parse().unwrap()).collect();
-                Datum {
-                    pressure: v[0] * 1e3,
-                    contraction: v[1],
-                    force: v[2],
-                }
-            })
-            .collect()
-    }
-
-    /// The presets predict every datasheet curve within 2% RMS and 5% max of its largest force
-    /// (measured: at most 1.69% / 4.09%, DMSP-40 at 100 kPa).
-    #[test]
-    fn presets_match_their_datasheets_at_every_pressure() {
-        for (preset, text) in [
-            (DMSP_40, include_str!("../../data/festo/festo_dmsp40.csv")),
-            (DMSP_10, include_str!("../../data/festo/festo_dmsp10.csv")),
-        ] {
-            let all = curves(&datasheet(text));
-            assert!(all.len() >= 8);
-            for e in errors(&preset, &all) {
-                assert!(e.infeasible == 0 && e.rms < 0.02 && e.max < 0.05, "{e:?}");
-            }
-        }
-    }
+/// One fitted or fixed parameter beside its bounds, for the report.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ParamReport {
+    pub name: &'static str,
+    pub unit: &'static str,
+    pub value: f64,
+    pub lower: f64,
+    pub upper: f64,
+    /// Fixed (not fitted).
+    pub fixed: bool,
+    /// Where the value sits between the bounds on the search's scale, 0 .. 1.
+    pub position: f64,
 }
+
+/// Share of a bound's range within which a fitted value counts as sitting at the bound.
+pub const AT_BOUND: f64 = 0.01;
+
+/// Every parameter of `params` beside its bounds.
+pub fn parameter_report(cfg: &FitConfig, params: &MuscleParams) -> Vec<ParamReport> {
+    let g = Geometry::of(params);
+    PARAMS
+        .iter()
+        .map(|&p| {
+            let (lower, upper, _) = cfg.bounds(p);
+            let value = p.get(&g);
+            ParamReport {
+                name: p.name(),
+                unit: p.unit(),
+                value,
+                lower,
+                upper,
+                fixed: !cfg.free().contains(&p),
+                position: cfg.position(p, value),
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+#[path = "calibration_tests.rs"]
+mod tests;

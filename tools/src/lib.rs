@@ -4,6 +4,7 @@
 
 pub mod calibration;
 pub mod choices;
+pub mod festo_law;
 pub mod package;
 pub mod scene;
 

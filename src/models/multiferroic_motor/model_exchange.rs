@@ -11,7 +11,7 @@
 
 use super::{partial_rows, write_outputs, MultiferroicMotor};
 use crate::models::{Partials, Report, Status};
-use crate::physics::multiferroic::model_exchange::{by, MeEvaluation};
+use crate::physics::multiferroic::model_exchange::{by, MeEvaluation, MAX_RINGING_WINDOWS};
 use crate::physics::multiferroic::{Motor, OnionModel};
 use crate::variables::multiferroic_motor::{Inputs, Outputs};
 use serde::{Deserialize, Serialize};
@@ -35,17 +35,40 @@ pub(super) struct Discrete {
     schedule_time: f64,
     /// Quasi-static option: the values of the onion's two states, held between events.
     held: [f64; 2],
+    /// Gilbert option: the onion's ringing after the last jump of its drive (see
+    /// [`Motor::me_ringing`]): its start, window length and end (s; a zero window: none), and the
+    /// drive (strain direction, stress) that started it.
+    ringing: [f64; 3],
+    ringing_drive: [f64; 2],
 }
 
 impl Discrete {
     pub(super) fn validated(self) -> Result<Self, String> {
-        if self.schedule_time.is_finite() && self.held.iter().all(|x| x.is_finite()) {
+        let finite = |x: &[f64]| x.iter().all(|x| x.is_finite());
+        if self.schedule_time.is_finite()
+            && finite(&self.held)
+            && finite(&self.ringing)
+            && finite(&self.ringing_drive)
+            && self.windows_bounded()
+        {
             Ok(self)
         } else {
             Err(format!(
                 "Model Exchange discrete state is not finite: {self:?}"
             ))
         }
+    }
+}
+
+impl Discrete {
+    /// No window, or at most [`MAX_RINGING_WINDOWS`] positive ones (a restored state cannot ask
+    /// for an unbounded number of time events).
+    fn windows_bounded(&self) -> bool {
+        let [from, window, until] = self.ringing;
+        window == 0.0
+            || (window > 0.0
+                && until >= from
+                && (until - from) / window <= MAX_RINGING_WINDOWS + 1.0)
     }
 }
 
@@ -134,6 +157,14 @@ impl MultiferroicMotor {
         let mut next = self.state;
         next.time = time;
         let mut changed = self.motor.me_event_update(&mut next, &inputs)?;
+        // A jump of the drive (or the first event) starts the Gilbert onion's ringing windows;
+        // the windows' own events change nothing.
+        let drive = self.motor.me_drive(&inputs, time);
+        if !self.me.active || drive != self.me.ringing_drive {
+            let (window, length) = self.motor.me_ringing(drive[1]).unwrap_or((0.0, 0.0));
+            self.me.ringing = [time, window, time + length];
+            self.me.ringing_drive = drive;
+        }
         self.state = next;
         self.me.active = true;
         self.me.schedule_time = time;
@@ -145,11 +176,21 @@ impl MultiferroicMotor {
         Ok(changed)
     }
 
-    /// The next switch of the schedule, if one runs.
+    /// The next switch of the schedule, if one runs, or the end of the Gilbert onion's present
+    /// ringing window, if sooner.
     pub(super) fn me_next_time_event(&self) -> Option<f64> {
-        self.schedule
-            .get()
-            .map(|s| s.next_switch_after(self.me.schedule_time))
+        let now = self.me.schedule_time;
+        let switch = self.schedule.get().map(|s| s.next_switch_after(now));
+        let [from, window, until] = self.me.ringing;
+        let ringing = (window > 0.0 && now < until).then(|| {
+            // The next window end at least a thousandth of a window ahead (rounding).
+            let n = ((now - from) / window + 1e-3).floor() + 1.0;
+            from + n * window
+        });
+        match (switch, ringing.filter(|&t| t < until && t > now)) {
+            (Some(a), Some(b)) => Some(a.min(b)),
+            (a, b) => a.or(b),
+        }
     }
 
     /// Exact partials of the outputs and of the state derivatives by the inputs and the states,
@@ -289,6 +330,43 @@ mod tests {
                 assert!(angles[periods - 1].to_degrees() > 150.0, "{angles:?}");
             }
         }
+    }
+
+    /// After an event that moves the Gilbert onion's drive, a time event at every window's end
+    /// until its ringing is over, then the schedule's switch; the windows' own events change
+    /// nothing and start no new windows, the switch starts new ones.
+    #[test]
+    fn gilbert_ringing_windows_are_time_events_until_the_next_switch() {
+        let mut m = stepping(1e-6, true);
+        let (window, length) = m.motor.me_ringing(2e8).unwrap();
+        let inputs = Inputs::default();
+        let mut events = vec![];
+        let mut t = 0.0;
+        while t < 1.5e-6 {
+            assert!(!m.me_event(&inputs, t).unwrap());
+            t = m.me_next_time_event().unwrap();
+            events.push(t);
+        }
+        let windows = (length / window).ceil() as usize - 1;
+        for (n, t) in events[..windows].iter().enumerate() {
+            assert!(
+                (t - (n + 1) as f64 * window).abs() < 1e-9 * window,
+                "{n}: {t}"
+            );
+        }
+        assert_eq!(events[windows], 1e-6);
+        assert!((events[windows + 1] - (1e-6 + window)).abs() < 1e-9 * window);
+        // A restored state may not ask for more windows than a jump gives.
+        let crafted = Discrete {
+            ringing: [0.0, 1e-300, 1.0],
+            ..m.me
+        };
+        assert!(crafted.validated().is_err());
+        assert!(m.me.validated().is_ok());
+        // Without the Gilbert onion, only the switches.
+        let mut q = stepping(1e-6, false);
+        q.me_event(&inputs, 0.0).unwrap();
+        assert_eq!(q.me_next_time_event(), Some(1e-6));
     }
 
     #[test]

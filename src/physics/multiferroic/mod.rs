@@ -366,7 +366,7 @@ impl Motor {
                 p.tolerance
             ));
         }
-        // The FMU declares at most 1e5 (a bounded step); references in tests resolve further.
+        // The FMU declares at most 2e4 (a bounded step); references in tests resolve further.
         if p.max_substeps == 0 || p.max_substeps > 100_000_000 {
             return Err(format!(
                 "max_substeps must be within [1, 1e8], got {}",
@@ -601,7 +601,9 @@ impl Motor {
     ///   for the default schedule), at the cost of one substep;
     /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
     ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
-    ///   budget`; a substep at that minimum is accepted even if its error exceeds the tolerance
+    ///   budget`, 64 times less while more than half the budget is left (so that a short stiff
+    ///   transient at the start of a step, such as the Gilbert onion's ringing after a switch, is
+    ///   resolved); a substep at that minimum is accepted even if its error exceeds the tolerance
     ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]). A substep across a snap of
     ///   the quasi-static onion to its other branch is cut at the snap (located by bisection),
     ///   since the torque jumps there and no error estimate shrinks with a substep across it;

@@ -20,6 +20,14 @@ use super::angles::turned_back;
 use super::branch::Branch;
 use super::{Drive, Motor, MotorInputs, MotorOutputs, MotorState, OnionModel};
 
+/// The Gilbert onion's integration windows after a jump of its drive ([`Motor::me_ringing`]):
+/// precession periods per window (a few hundred CVode steps at its default tolerance, where 500
+/// are allowed), envelope decay times covered (e^-25 ~ 1e-11, below any tolerance), and at most
+/// this many windows per jump (a weakly damped onion gets longer windows).
+pub const RINGING_WINDOW_PERIODS: f64 = 4.0;
+pub const RINGING_RELAXATIONS: f64 = 25.0;
+pub const MAX_RINGING_WINDOWS: f64 = 1000.0;
+
 /// Indices of the independent variables of an [`MeGradient`]: the four states (the last two only
 /// in the Gilbert option) and the three real inputs of [`MotorInputs`].
 pub mod by {
@@ -91,6 +99,43 @@ impl Motor {
         } else {
             4
         }
+    }
+
+    /// The strain direction and stress in effect at `time` (the inputs', or the schedule's there).
+    pub fn me_drive(&self, inputs: &MotorInputs, time: f64) -> [f64; 2] {
+        let d = self.drive_at(inputs, time);
+        [d.direction, d.stress]
+    }
+
+    /// The Gilbert onion's ringing after a jump of its drive at stress `stress`: the length of
+    /// one integration window and of the whole ringing (s), or `None` when it does not ring (the
+    /// quasi-static option, no damping, or an overdamped onion).
+    ///
+    /// Linearized about its minimum (in-plane stiffness `k`, tilt stiffness `t = mu0 Ms^2 V`), the
+    /// macrospin of [`Motor::onion_relaxation_time`] is a damped oscillator with eigenvalues
+    /// `g (-alpha (k + t) / 2 +- i sqrt(k t (1 + alpha^2)))` to first order: for Table 3.1 a
+    /// 0.14 ns precession whose envelope decays in 0.41 ns, 86 degrees from the negative real
+    /// axis. A variable-order BDF (CVode) must resolve that ringing to its tolerance, some
+    /// hundreds of steps within a few nanoseconds of every jump, more than FMPy's CVode allows
+    /// between two output points (500). Model Exchange therefore announces time events every
+    /// [`RINGING_WINDOW_PERIODS`] precession periods until the envelope has decayed by
+    /// `exp(-RINGING_RELAXATIONS)`: each ends the importer's integrator call, which then starts
+    /// the next window afresh. Nothing changes at these events.
+    pub fn me_ringing(&self, stress: f64) -> Option<(f64, f64)> {
+        let alpha = self.params.gilbert_damping;
+        if self.quasi_static() || alpha <= 0.0 {
+            return None;
+        }
+        // Largest in-plane stiffness: the ring-bar spring at alignment plus the magnetoelastic
+        // one at its steepest (2 |E|).
+        let k =
+            self.alignment_stiffness.abs() + 2.0 * (self.magnetoelastic_per_stress * stress).abs();
+        let precession = self.llg_rate * (k * self.tilt_stiffness * (1.0 + alpha * alpha)).sqrt();
+        let window = RINGING_WINDOW_PERIODS * 2.0 * std::f64::consts::PI / precession;
+        let ringing = RINGING_RELAXATIONS * self.onion_relaxation_time();
+        let window = window.max(ringing / MAX_RINGING_WINDOWS);
+        (window.is_finite() && window > 0.0 && ringing.is_finite() && window < ringing)
+            .then_some((window, ringing))
     }
 
     /// The next switch of the schedule after the one in effect at `schedule_time` (the time of the

@@ -469,3 +469,82 @@ proptest::proptest! {
         }
     }
 }
+
+/// The Gilbert onion's ringing windows ([`Motor::me_ringing`]) against the macrospin itself: a
+/// fine RK4 of the Model Exchange right-hand side after a jump of the drive (tension at -40
+/// degrees, 200 MPa, on a locked rotor) rings with the period of the linearized LLG matrix at the
+/// new minimum, and has settled to 1e-7 of its jump by the end of the windows.
+#[test]
+fn gilbert_ringing_windows_cover_the_onion_ringing() {
+    let m = gilbert();
+    let inputs = MotorInputs {
+        rotor_locked: true,
+        ..MotorInputs::fixed(-0.7, 2e8)
+    };
+    let (window, length) = m.me_ringing(2e8).unwrap();
+    // The precession at the new minimum: the eigenvalues of g [[-a k, -t], [k, -a t]] with the
+    // landscape's curvature k there and the tilt stiffness t = mu0 Ms^2 V.
+    let settled = m.landscape(0.0, -0.7, 2e8).settle(0.0);
+    let k = m.landscape(0.0, -0.7, 2e8).curvature(settled);
+    let (alpha, ms, v) = (0.045, 4.85e5, m.params.wall_volume);
+    let t = magnetics::MU0 * ms * ms * v;
+    let g = magnetics::GYROMAGNETIC_RATIO / (ms * v * (1.0 + alpha * alpha));
+    let (trace, det) = (-g * alpha * (k + t), g * g * (1.0 + alpha * alpha) * k * t);
+    let precession = (det - 0.25 * trace * trace).sqrt();
+    let periods = window * precession / (2.0 * PI);
+    assert!(
+        (1.0..=model_exchange::RINGING_WINDOW_PERIODS).contains(&periods),
+        "{periods} periods per window"
+    );
+    assert!((length - 25.0 * m.onion_relaxation_time()).abs() < 1e-9 * length);
+    // RK4 at 1/500 of a precession period, well past the windows.
+    let h = 2.0 * PI / precession / 500.0;
+    let mut s = MotorState::aligned(0.0);
+    let mut samples = vec![];
+    while s.time < 3.0 * length {
+        let rate = |y: &MotorState| m.me_evaluate(y, &inputs, 0.0).unwrap().derivatives;
+        let shift = |y: &MotorState, k: [f64; 4], f: f64| MotorState {
+            onion_angle: y.onion_angle + f * k[2],
+            onion_tilt: y.onion_tilt + f * k[3],
+            ..*y
+        };
+        let k1 = rate(&s);
+        let k2 = rate(&shift(&s, k1, 0.5 * h));
+        let k3 = rate(&shift(&s, k2, 0.5 * h));
+        let k4 = rate(&shift(&s, k3, h));
+        let k: [f64; 4] =
+            std::array::from_fn(|i| (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]) / 6.0);
+        s = shift(&s, k, h);
+        s.time += h;
+        samples.push((s.time, s.onion_angle));
+    }
+    let last = s.onion_angle;
+    assert!((last - settled).abs() < 1e-9, "{last} {settled}");
+    let jump = settled.abs();
+    let deviation_after = |from: f64| {
+        samples
+            .iter()
+            .filter(|(time, _)| *time >= from)
+            .map(|(_, psi)| (psi - last).abs())
+            .fold(0.0, f64::max)
+    };
+    assert!(
+        deviation_after(length) < 1e-7 * jump,
+        "{}",
+        deviation_after(length)
+    );
+    // It does ring: a window after the jump it is still far from settled.
+    assert!(deviation_after(window) > 1e-2 * jump);
+}
+
+/// Neither the quasi-static onion nor an undamped macrospin (which never settles) has windows.
+#[test]
+fn only_a_damped_gilbert_onion_rings() {
+    assert!(gilbert().me_ringing(2e8).is_some());
+    assert!(motor().me_ringing(2e8).is_none());
+    let undamped = motor_with(|p| {
+        p.onion_model = OnionModel::Gilbert;
+        p.gilbert_damping = 0.0
+    });
+    assert!(undamped.me_ringing(2e8).is_none());
+}

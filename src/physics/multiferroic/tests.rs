@@ -1021,3 +1021,54 @@ fn joint_torque_and_energy_agree_with_the_separate_ones() {
         assert!((energy - e).abs() <= 1e-14 * e.abs().max(rb.energy_of_cos(1.0).abs()));
     }
 }
+
+/// The Gilbert onion on the default schedule at the FMU's default 1 us step: its ringing after
+/// each switch is resolved within the budget (no step is accuracy-limited, so no fmi2Warning),
+/// and the rotor matches a resolved reference (tolerance 1e-10, 10 ns steps) at every step.
+#[test]
+fn gilbert_onion_on_the_schedule_needs_no_forced_substep_at_one_microsecond() {
+    let m = motor_with(|p| p.onion_model = OnionModel::Gilbert);
+    let reference = motor_with(|p| {
+        p.onion_model = OnionModel::Gilbert;
+        p.tolerance = 1e-10;
+        p.max_substeps = 10_000_000;
+    });
+    let inputs = schedule(20e-6);
+    let (mut s, mut r) = (MotorState::aligned(0.0), MotorState::aligned(0.0));
+    let mut worst: f64 = 0.0;
+    for _ in 0..50 {
+        let report = m.step(&mut s, &inputs, 1e-6).unwrap();
+        assert!(!report.accuracy_limited, "t = {}: {report:?}", s.time);
+        for _ in 0..100 {
+            reference.step(&mut r, &inputs, 1e-8).unwrap();
+        }
+        worst = worst.max((s.rotor_angle - r.rotor_angle).abs());
+    }
+    assert!(worst < 1e-5, "{worst}");
+    // It stepped: 60 degrees by the end of the first 20 us period, and on.
+    assert!(
+        s.rotor_angle.to_degrees() > 100.0,
+        "{}",
+        s.rotor_angle.to_degrees()
+    );
+}
+
+/// However small the budget, a step over switches ends (the finer substep floor of the first
+/// half of the budget leaves the even spread of the rest to finish it).
+#[test]
+fn any_budget_ends_the_step() {
+    for budget in [1, 2, 3, 16, 100] {
+        for gilbert in [false, true] {
+            let m = motor_with(|p| {
+                p.max_substeps = budget;
+                if gilbert {
+                    p.onion_model = OnionModel::Gilbert;
+                }
+            });
+            let mut s = MotorState::aligned(0.0);
+            let report = m.step(&mut s, &schedule(20e-6), 1e-5).unwrap();
+            assert!(report.substeps <= 2 * budget + 16, "{budget}: {report:?}");
+            assert!((s.time - 1e-5).abs() < 1e-18 && s.rotor_angle.is_finite());
+        }
+    }
+}

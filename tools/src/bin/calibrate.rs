@@ -3,15 +3,20 @@
 //!
 //! ```text
 //! calibrate --data festo_dmsp40.csv --length 0.4 --diameter 0.04 --fit 0,600 --out out/dmsp40
-//!           [--layers 1|N] [--starts 24] [--iterations 200]
+//!           [--model 3] [--layers 16] [--fix NAME=VALUE,...|none] [--starts 24] [--iterations 200]
 //! ```
+//! `--model`/`--layers`: `bladder_model` and `bladder_layers` (default the exact wall, 16 nodes).
+//! `--fix`: parameters held instead of fitted, replacing the default (bladder unstretched at the
+//! nominal length, `mooney_c1` 30 kPa, `mooney_c2` 600 kPa, braid on the wall); `none`
+//! fits all seven; `sleeve_diameter=on_wall` puts the braid on the wall.
 //! The CSV has columns `pressure_kpa,contraction,force_n` (`#` lines are comments). Writes
 //! `OUT/params.json` (FMPy `start_values` for McKibbenMuscle.fmu), `OUT/params.ssv` (SSP parameter
 //! values), `OUT/fit.csv` (every datum with the model's force) and `OUT/fit.json` (errors per
 //! pressure, fit time). `python/actuator_fmus/calibration.py` adds the report and its plot.
 
 use actuator_fmus_tools::calibration::{
-    curves, errors, fit, model_force, Curve, Datum, FitConfig, MuscleParams,
+    curves, errors, fit, model_force, parameter_report, Curve, Datum, FitConfig, MuscleParams,
+    AT_BOUND, PARAMS,
 };
 use std::fmt::Write as _;
 use std::path::PathBuf;
@@ -26,7 +31,8 @@ struct Args {
 
 const USAGE: &str =
     "usage: calibrate --data CSV --length M --diameter M --fit KPA[,KPA...] --out DIR \
-                     [--layers N (1 = thin wall)] [--starts N] [--iterations N]";
+                     [--model BLADDER_MODEL (3)] [--layers N (16)] [--fix NAME=VALUE,...|none] \
+                     [--starts N] [--iterations N]";
 
 fn parse_args() -> Result<Args, String> {
     let mut get = std::collections::HashMap::new();
@@ -63,17 +69,48 @@ fn parse_args() -> Result<Args, String> {
                 .map_err(|_| format!("--fit: '{s}' is not a pressure in kPa"))
         })
         .collect::<Result<Vec<_>, _>>()?;
+    let mut cfg = FitConfig::exact_wall(number("length", None)?, number("diameter", None)?);
+    cfg.model = (
+        get.get("model").map_or(Ok(cfg.model.0), |v| {
+            v.parse::<i32>()
+                .map_err(|_| format!("--model must be a bladder_model (1-6), got '{v}'"))
+        })?,
+        number("layers", Some(cfg.model.1 as f64))? as i32,
+    );
+    cfg.starts = number("starts", Some(24.0))? as usize;
+    cfg.iterations = number("iterations", Some(200.0))? as usize;
+    if let Some(fix) = get.get("fix") {
+        cfg.fixed.clear();
+        cfg.sleeve_on_wall = false;
+        for item in fix.split(',').filter(|s| *s != "none" && !s.is_empty()) {
+            let (name, value) = item
+                .split_once('=')
+                .ok_or_else(|| format!("--fix: write NAME=VALUE, got '{item}'"))?;
+            if name.trim() == "sleeve_diameter" && value.trim() == "on_wall" {
+                cfg.sleeve_on_wall = true;
+                continue;
+            }
+            let param = PARAMS
+                .into_iter()
+                .find(|p| p.name() == name.trim())
+                .ok_or_else(|| {
+                    let names: Vec<_> = PARAMS.iter().map(|p| p.name()).collect();
+                    format!("--fix: '{name}' is none of {}", names.join(", "))
+                })?;
+            let value = value
+                .trim()
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite() && *v > 0.0)
+                .ok_or_else(|| format!("--fix {name}: '{value}' is not a positive number"))?;
+            cfg.fixed.push((param, value));
+        }
+    }
     Ok(Args {
         data: text("data")?.into(),
         out: text("out")?.into(),
         fit_kpa,
-        cfg: FitConfig {
-            nominal_length: number("length", None)?,
-            diameter: number("diameter", None)?,
-            layers: number("layers", Some(1.0))? as i32,
-            starts: number("starts", Some(24.0))? as usize,
-            iterations: number("iterations", Some(200.0))? as usize,
-        },
+        cfg,
     })
 }
 
@@ -193,12 +230,14 @@ fn run() -> Result<(), String> {
     }
     let cfg = &args.cfg;
     eprintln!(
-        "calibrate: {} points in {} curves; fitting {} curves ({} points), {} wall, {} starts",
+        "calibrate: {} points in {} curves; fitting {} curves ({} points), bladder_model {} \
+         ({} layers or nodes), {} starts",
         data.len(),
         all.len(),
         fitted.len(),
         fitted.iter().map(|c| c.points.len()).sum::<usize>(),
-        if cfg.layers > 1 { "thick" } else { "thin" },
+        cfg.model.0,
+        cfg.model.1,
         cfg.starts
     );
     let t0 = Instant::now();
@@ -258,12 +297,24 @@ fn run() -> Result<(), String> {
             })
         })
         .collect();
+    let report = parameter_report(cfg, &p);
+    let parameters: Vec<serde_json::Value> = report
+        .iter()
+        .map(|r| {
+            serde_json::json!({
+                "name": r.name, "unit": r.unit, "value": r.value, "lower": r.lower,
+                "upper": r.upper, "fixed": r.fixed, "position": r.position,
+            })
+        })
+        .collect();
     let summary = serde_json::json!({
         "data": args.data.display().to_string(),
         "nominal_length": cfg.nominal_length,
         "diameter": cfg.diameter,
         "fit_kpa": args.fit_kpa,
-        "layers": cfg.layers,
+        "bladder_model": cfg.model.0,
+        "bladder_layers": cfg.model.1,
+        "parameters": parameters,
         "starts": cfg.starts,
         "seconds": seconds,
         "cost": best.cost,
@@ -298,6 +349,23 @@ fn run() -> Result<(), String> {
             } else {
                 String::new()
             }
+        );
+    }
+    println!("parameter               value        lower        upper      fitted");
+    for r in &report {
+        let at_bound = !r.fixed && (r.position < AT_BOUND || r.position > 1.0 - AT_BOUND);
+        println!(
+            "{:<22} {:>11.4e}  {:>11.4e}  {:>11.4e}  {}{}",
+            r.name,
+            r.value,
+            r.lower,
+            r.upper,
+            match (r.fixed, r.name) {
+                (false, _) => "yes",
+                (true, "sleeve_diameter") if cfg.sleeve_on_wall => "bore + 2 wall",
+                (true, _) => "fixed",
+            },
+            if at_bound { "  AT A BOUND" } else { "" }
         );
     }
     println!("wrote {}", args.out.display());

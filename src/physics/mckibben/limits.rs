@@ -1,0 +1,260 @@
+//! The muscle at both ends of its stroke: the strands stretching past the rigid braid's reach
+//! (see [`super::strands`]), the out-of-range policy for lengths no muscle survives, and the
+//! partials on the branch each takes. Shared by the McKibbenMuscle and McKibbenJoint FMUs.
+
+use super::SURVIVABLE_STRAND_STRAIN;
+use super::{McKibben, McKibbenOutput, McKibbenPartials, StrandTransition};
+use crate::physics::friction::HysteresisState;
+
+/// With a bladder the force grows without bound at both length limits; an out-of-range length
+/// the strands do not take is evaluated this fraction of the range inside the limit (finite,
+/// steep force).
+pub const LIMIT_MARGIN: f64 = 1e-3;
+
+/// An input without a solution, and the point evaluated instead.
+#[derive(Clone, Debug, PartialEq)]
+pub struct OutOfRange {
+    /// Why the input has no solution.
+    pub reason: String,
+    /// The lengths the model evaluates, m.
+    pub range: (f64, f64),
+    /// `(pressure, length)` evaluated instead; `None` if none could be.
+    pub point: Option<(f64, f64)>,
+}
+
+impl OutOfRange {
+    /// The log message, explaining what is evaluated until the inputs return.
+    pub fn message(&self) -> String {
+        let (lo, hi) = self.range;
+        let what = match self.point {
+            Some((p, l)) => format!("evaluating at pressure {p} Pa and length {l} m"),
+            None => "holding the previous outputs".into(),
+        };
+        format!(
+            "{} (lengths the model evaluates: {lo} .. {hi} m); {what} until the inputs return",
+            self.reason
+        )
+    }
+}
+
+/// Whether a muscle with this signed force is slack: a braid cannot push, so past its free
+/// contraction (signed force < 0) its strands buckle and it carries no force and has no
+/// stiffness, unless the dissertation's `signed` force is asked for.
+#[inline]
+pub fn is_slack(force: f64, signed: bool) -> bool {
+    !signed && force < 0.0
+}
+
+impl McKibben {
+    /// The muscle with strands of axial stiffness `k_s` (N/m) at `(pressure, length)`: the rigid
+    /// model where it holds, else on the stretching strands up to the breaking length; beyond
+    /// it, or for a length without a solution below the strands, the nearest point inside the
+    /// range (returned with why). `None` only if no point can be evaluated.
+    pub fn evaluate_with_strands(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> (Option<McKibbenOutput>, Option<OutOfRange>) {
+        let (reason, rigid) = match self.evaluate(pressure, length, history) {
+            Ok(out) if !(out.force > 0.0 && out.stiffness > k_s) => return (Some(out), None),
+            Ok(out) => (String::new(), Some(out)),
+            Err(reason) => (reason, None),
+        };
+        let (lo, hi) = (self.min_length(), self.max_length());
+        // Out of the rigid braid's reach, or stiffer than its strands: the strands stretch.
+        let breaking = self.breaking_length();
+        let on_strands = length.min(breaking);
+        if let Some(t) = self.strand_transition(pressure, on_strands, k_s, history) {
+            let clamp = (length > breaking).then(|| OutOfRange {
+                reason: format!(
+                    "length {length} m stretches the strands more than {}% of their length past max_length, which no muscle survives",
+                    100.0 * SURVIVABLE_STRAND_STRAIN
+                ),
+                range: (lo, breaking),
+                point: Some((pressure, breaking)),
+            });
+            let mut out = t.rigid;
+            out.force += k_s * (on_strands - t.length);
+            out.stiffness = k_s;
+            return (Some(out), clamp);
+        }
+        if let Some(out) = rigid {
+            return (Some(out), None);
+        }
+        let clamped = self.solvable_length(length);
+        let fallback = [(pressure, clamped), (pressure.max(0.0), clamped)]
+            .into_iter()
+            .find_map(|(p, l)| self.evaluate(p, l, history).ok().map(|o| (p, l, o)));
+        let clamp = OutOfRange {
+            reason,
+            range: (lo, hi),
+            point: fallback.as_ref().map(|(p, l, _)| (*p, *l)),
+        };
+        (fallback.map(|(_, _, out)| out), Some(clamp))
+    }
+
+    /// The nearest length the rigid model evaluates: inside the muscle's limits, and by
+    /// [`LIMIT_MARGIN`] of the stroke inside them when a bladder makes the limits singular.
+    pub fn solvable_length(&self, length: f64) -> f64 {
+        let (lo, hi) = (self.min_length(), self.max_length());
+        let margin = if self.bladder().is_some() {
+            LIMIT_MARGIN * (hi - lo)
+        } else {
+            0.0
+        };
+        // max/min rather than clamp: never panics, even on limits from a crafted FMU state.
+        length.max(lo + margin).min(hi - margin)
+    }
+
+    /// The transition [`Self::evaluate_with_strands`] uses at these inputs, if on the strands.
+    pub fn strand_point(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> Option<StrandTransition> {
+        match self.evaluate(pressure, length, history) {
+            Ok(out) if !(out.force > 0.0 && out.stiffness > k_s) => None,
+            _ => self.strand_transition(pressure, length.min(self.breaking_length()), k_s, history),
+        }
+    }
+
+    /// The signed force on the branch [`Self::evaluate_with_strands`] takes below the strands
+    /// (at the clamped length out of range); on the strands the force is positive.
+    pub fn signed_force_on_branch(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Result<f64, String> {
+        let at = |p: f64, l: f64| self.evaluate(p, l, history);
+        self.on_branch(pressure, length, at)
+            .map(|(o, _, _)| o.force)
+    }
+
+    /// The partials of the signed outputs on the branch [`Self::evaluate_with_strands`] takes:
+    /// on the strands see [`Self::strand_partials`]; out of range it evaluates at a clamped
+    /// length (and, under a vacuum it cannot hold, at zero pressure), which the input no longer
+    /// moves, so those columns are zero.
+    pub fn partials_with_strands(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> Result<McKibbenPartials, String> {
+        if let Some(d) = self.strand_partials(pressure, length, k_s, history)? {
+            return Ok(d);
+        }
+        let at = |p: f64, l: f64| self.partials(p, l, history).map(|(_, d)| d);
+        let (mut d, by_l, by_p) = self.on_branch(pressure, length, at)?;
+        for y in d.rows_mut() {
+            y[0] *= f64::from(u8::from(by_p));
+            y[1] *= f64::from(u8::from(by_l));
+        }
+        Ok(d)
+    }
+
+    /// The signed force of [`Self::evaluate_with_strands`] with [`Self::partials_with_strands`]:
+    /// where the rigid model holds, one pass of [`McKibben::partials`] (the torque solver's
+    /// per-iteration cost).
+    pub fn force_and_partials_with_strands(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> Result<(f64, McKibbenPartials), String> {
+        if let Ok((out, d)) = self.partials(pressure, length, history) {
+            if !(out.force > 0.0 && out.stiffness > k_s) {
+                return Ok((out.force, d));
+            }
+        }
+        let (out, _) = self.evaluate_with_strands(pressure, length, k_s, history);
+        let force = out
+            .ok_or("the muscle cannot be evaluated at this length")?
+            .force;
+        Ok((
+            force,
+            self.partials_with_strands(pressure, length, k_s, history)?,
+        ))
+    }
+
+    /// `[d/dpressure, d/dlength]` of the signed stiffness on the branch
+    /// [`Self::evaluate_with_strands`] takes: 0 on the strands (their constant `k_s`), else
+    /// [`McKibben::stiffness_partials`] (a second-order pass through the bladder).
+    pub fn stiffness_partials_with_strands(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> Result<[f64; 2], String> {
+        if self.strand_point(pressure, length, k_s, history).is_some() {
+            return Ok([0.0; 2]);
+        }
+        let at = |p: f64, l: f64| self.stiffness_partials(p, l, history);
+        let (row, by_l, by_p) = self.on_branch(pressure, length, at)?;
+        Ok([
+            if by_p { row[0] } else { 0.0 },
+            if by_l { row[1] } else { 0.0 },
+        ])
+    }
+
+    /// On the strands `F = F(P, L_t(P)) + k_s (L - L_t(P))` and every other output is the
+    /// rigid muscle's at `L_t`: by the chain rule with `dL_t/dP = -K_P / K_L` at an interior
+    /// transition (where the rigid stiffness `K` equals `k_s`), 0 at the braid's reach. The
+    /// length moves only the force, by `k_s`, up to the breaking length. `None` off the strands.
+    pub fn strand_partials(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> Result<Option<McKibbenPartials>, String> {
+        let Some(t) = self.strand_point(pressure, length, k_s, history) else {
+            return Ok(None);
+        };
+        let (_, mut d) = self.partials(pressure, t.length, history)?;
+        let dlt = if t.interior {
+            let [kp, kl] = self.stiffness_partials(pressure, t.length, history)?;
+            if kl != 0.0 {
+                -kp / kl
+            } else {
+                0.0
+            }
+        } else {
+            0.0
+        };
+        let [fp, fl] = d.force;
+        for y in d.rows_mut() {
+            *y = [y[0] + y[1] * dlt, 0.0];
+        }
+        let moves = length <= self.breaking_length();
+        d.force = [fp + (fl - k_s) * dlt, if moves { k_s } else { 0.0 }];
+        Ok(Some(d))
+    }
+
+    /// Runs `at` on the branch [`Self::evaluate_with_strands`] takes below the strands: at the
+    /// inputs, or out of range at the clamped length (whose column the input no longer moves)
+    /// and, under a vacuum the muscle cannot hold there, at zero pressure (neither column
+    /// moves). Returns `at`'s result with whether the length and the pressure columns move.
+    fn on_branch<T>(
+        &self,
+        pressure: f64,
+        length: f64,
+        at: impl Fn(f64, f64) -> Result<T, String>,
+    ) -> Result<(T, bool, bool), String> {
+        if let Ok(d) = at(pressure, length) {
+            return Ok((d, true, true));
+        }
+        let clamped = self.solvable_length(length);
+        if let Ok(d) = at(pressure, clamped) {
+            return Ok((d, false, true));
+        }
+        at(pressure.max(0.0), clamped).map(|d| (d, false, false))
+    }
+}
