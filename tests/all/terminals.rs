@@ -9,7 +9,7 @@ mod codegen;
 #[path = "../../build/model_description.rs"]
 mod model_description;
 #[path = "../../build/terminals.rs"]
-mod terminals;
+mod flanges;
 
 const SOURCE: &str = include_str!("../../modelDescription/McKibbenMuscle.xml");
 const FLANGE: &str =
@@ -17,7 +17,7 @@ const FLANGE: &str =
 
 fn generated(text: &str) -> Result<Option<String>, String> {
     let model = model_description::check(text, "McKibbenMuscle")?;
-    terminals::xml(text, &model)
+    flanges::xml(text, &model)
 }
 
 /// The McKibben description with its flange declaration replaced by `to`.
@@ -37,7 +37,7 @@ fn every_source_passes_and_only_passthrough_has_no_flange() {
         let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
         let text = std::fs::read_to_string(&path).unwrap();
         let model = model_description::check(&text, &stem).unwrap();
-        let xml = terminals::xml(&text, &model).unwrap();
+        let xml = flanges::xml(&text, &model).unwrap();
         assert_eq!(xml.is_none(), stem == "PassThrough", "{stem}");
     }
 }
