@@ -145,3 +145,23 @@ def test_the_flow_signs_are_modelicas():
                          start_values={"load_torque": load}, output=["rotor_speed", "torque"])
         assert r["torque"][-1] == 0.0  # no strain: the load alone drives the rotor
         assert r["rotor_speed"][-1] * load > 0
+
+
+def test_the_joint_torque_is_the_torque_on_the_outside():
+    """McKibbenJoint's `jointTorque` is an outflow: the torque the FMU applies to the shaft towards
+    +phi. By virtual work, the tensions pulling the muscles' ends together give the shaft
+    -(F_flexor dL_flexor/dphi + F_extensor dL_extensor/dphi), from the FMU's own lengths and
+    forces (the lengths are linear in the angle)."""
+    def at(angle):
+        r = simulate_fmu(fmu("McKibbenJoint"), stop_time=0.01, output_interval=0.01,
+                         start_values={"actuatorInput": 1e5, "jointPosition": angle},
+                         output=["jointTorque", "flexor_force", "extensor_force",
+                                 "flexor_length", "extensor_length"])
+        return {name: float(r[name][-1]) for name in r.dtype.names}
+
+    step = 1e-3
+    a, b = at(0.1), at(0.1 + step)
+    virtual_work = -sum(a[f"{m}_force"] * (b[f"{m}_length"] - a[f"{m}_length"]) / step
+                        for m in ("flexor", "extensor"))
+    assert a["jointTorque"] > 0
+    assert a["jointTorque"] == pytest.approx(virtual_work, rel=1e-9)
