@@ -7,7 +7,10 @@
 //! - `model_bindings.rs`: the export layer's access to those structs' fields by value reference,
 //!   and the registry of models (included by `src/fmi2/registry.rs`);
 //! - `<Model>.fmi3.xml` and `fmi3_tables.rs`: the FMI 3.0 model description from the same source
-//!   and the value-reference layout `src/fmi3` serves it with (`build/fmi3_description.rs`).
+//!   and the value-reference layout `src/fmi3` serves it with (`build/fmi3_description.rs`);
+//! - `<Model>.terminalsAndIcons.xml` and `terminals.rs`: the FMI 3.0 terminals of the flanges a
+//!   model declares, which the FMI 3.0 packager writes into the FMU (`build/terminals.rs`,
+//!   included by `src/terminals.rs`).
 //!
 //! The XML is the single source of truth: a renamed or removed variable breaks the model code at
 //! compile time.
@@ -18,6 +21,8 @@ mod codegen;
 mod fmi3_description;
 #[path = "build/model_description.rs"]
 mod model_description;
+#[path = "build/terminals.rs"]
+mod terminals;
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -50,6 +55,7 @@ fn main() {
     );
     let mut bindings = String::from(header);
     let mut fmi3_tables = String::from(header);
+    let mut terminal_files = Vec::new();
     let mut models = Vec::new();
     for path in &paths {
         println!("cargo:rerun-if-changed={}", path.display());
@@ -75,6 +81,14 @@ fn main() {
             &mut fmi3_tables,
         )
         .unwrap_or_else(|e| fail(path, &e));
+        if let Some(xml) = terminals::xml(&text, &model).unwrap_or_else(|e| fail(path, &e)) {
+            let terminals_path = Path::new(&out_dir).join(format!("{stem}.terminalsAndIcons.xml"));
+            std::fs::write(&terminals_path, xml).unwrap_or_else(|e| fail(path, &e.to_string()));
+            terminal_files.push(format!(
+                "    ({stem:?}, include_str!({:?})),",
+                terminals_path.display().to_string()
+            ));
+        }
         models.push(model);
     }
     codegen::registry(&models, &mut bindings);
@@ -92,6 +106,11 @@ fn main() {
         names.iter().map(|n| format!("&{n}")).collect::<Vec<_>>().join(", ")
     );
     std::fs::write(out.join("fmi3_tables.rs"), fmi3_tables).expect("write FMI 3.0 tables");
+    let terminal_table = format!(
+        "{header}/// (model name, terminalsAndIcons.xml) of every model that declares a flange.\npub static TERMINALS_AND_ICONS: &[(&str, &str)] = &[\n{}\n];\n",
+        terminal_files.join("\n")
+    );
+    std::fs::write(out.join("terminals.rs"), terminal_table).expect("write terminals table");
 }
 
 fn fail(path: &Path, message: &str) -> ! {

@@ -746,6 +746,9 @@ struct Splices {
     variables: Vec<usize>,
     /// The source's ModelStructure element, start and end.
     model_structure: Option<(usize, usize)>,
+    /// The source's `<Tool><Terminals>` element (the FMI 3.0 flanges, `build/terminals.rs`),
+    /// from the start of its line: FMI 2.0's schema allows a Tool one element, its `<Tests>`.
+    terminals: Option<(usize, usize)>,
 }
 
 fn find_splices(text: &str) -> Result<Splices, String> {
@@ -754,6 +757,7 @@ fn find_splices(text: &str) -> Result<Splices, String> {
     let mut splices = Splices::default();
     let mut depth = 0usize;
     let mut structure_start = None;
+    let mut terminals_start = None;
     loop {
         let before = reader.buffer_position() as usize;
         let event = reader
@@ -770,6 +774,11 @@ fn find_splices(text: &str) -> Result<Splices, String> {
                         splices.model_structure = Some((start, after));
                     }
                 }
+                if depth == 3 {
+                    if let Some(start) = terminals_start.take() {
+                        splices.terminals = Some((start, after));
+                    }
+                }
                 continue;
             }
             Event::Eof => break,
@@ -782,6 +791,14 @@ fn find_splices(text: &str) -> Result<Splices, String> {
             }
             (1, b"ModelStructure") if empty => splices.model_structure = Some((before, after)),
             (1, b"ModelStructure") => structure_start = Some(before),
+            (3, b"Terminals") => {
+                let line = text[..before].rfind('\n').unwrap_or(before);
+                if empty {
+                    splices.terminals = Some((line, after));
+                } else {
+                    terminals_start = Some(line);
+                }
+            }
             (2, b"ScalarVariable") => splices.variables.push(before),
             _ => {}
         }
@@ -823,6 +840,9 @@ fn shipped(
     log.push_str("  </LogCategories>\n\n  ");
     let at = s.log_categories.ok_or("no ModelVariables element found")?;
     inserts.push((at, at, log));
+    if let Some((start, end)) = s.terminals {
+        inserts.push((start, end, String::new()));
+    }
     for (i, &at) in s.variables.iter().enumerate() {
         inserts.push((at, at, format!("<!-- {} -->", i + 1)));
     }

@@ -10,6 +10,7 @@
 //! effect switches) -> [`physics`] (pure equations). Beside them, [`variables`] holds what
 //! build.rs generates from `modelDescription/*.xml`: value references, metadata and each model's
 //! typed `Parameters`, `Inputs`, `Outputs` and `CalculatedParameters`; it names nothing above it.
+//! [`terminals`] holds the FMI 3.0 terminals the packager adds to its FMUs.
 //! [`fmi2`] and [`fmi3`] never use each other. [`export`], [`fmi2`] and [`fmi3`] are the only
 //! modules that allow `unsafe_code`; `physics` and `models` forbid it.
 
@@ -18,4 +19,5 @@ pub mod fmi2;
 pub mod fmi3;
 pub mod models;
 pub mod physics;
+pub mod terminals;
 pub mod variables;

@@ -12,6 +12,8 @@ PRESSURES_KPA = (0.0, 200.0, 400.0, 600.0)
 
 
 def plot(directory):
+    """Writes `directory`/scaling.png from `directory`/scaling.csv: force (N) against contraction (%)
+    per DMSP size and pressure (kPa), the datasheet beside the law and the leave-one-out fits."""
     import matplotlib
 
     matplotlib.use("Agg")

@@ -26,6 +26,7 @@ mod new_model;
 mod restore_validation;
 mod robot_joint_runs;
 mod shipped_descriptions;
+mod terminals;
 
 /// Every file in `tests/all/` is a module of this binary: a file dropped here but not listed
 /// above would silently never run.

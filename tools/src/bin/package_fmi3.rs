@@ -1,7 +1,8 @@
 //! `package_fmi3 <FMI 2.0 FMU dir> <output dir>`: writes `<output dir>/<Model>.fmu`, the FMI 3.0
 //! FMU of every model, from the FMI 2.0 FMU that `package_fmus` wrote: the same binaries (one
-//! library exports both APIs) under FMI 3.0's platform tuples, the same documentation, and the
-//! FMI 3.0 model description generated from the same source.
+//! library exports both APIs) under FMI 3.0's platform tuples, the same documentation, the
+//! FMI 3.0 model description generated from the same source, and the model's mechanical flanges
+//! as `terminalsAndIcons/terminalsAndIcons.xml` when it declares any.
 
 use std::io::{Read, Write};
 use std::path::Path;
@@ -13,7 +14,12 @@ const PLATFORMS: [(&str, &str); 3] = [
     ("binaries/aarch64-linux/", "binaries/aarch64-linux/"),
 ];
 
-fn repackage(fmi2: &Path, out: &Path, description: &str) -> Result<(), String> {
+fn repackage(
+    fmi2: &Path,
+    out: &Path,
+    description: &str,
+    terminals: Option<&str>,
+) -> Result<(), String> {
     let file =
         std::fs::File::open(fmi2).map_err(|e| format!("cannot read {}: {e}", fmi2.display()))?;
     let mut archive = zip::ZipArchive::new(file).map_err(|e| format!("{}: {e}", fmi2.display()))?;
@@ -27,6 +33,12 @@ fn repackage(fmi2: &Path, out: &Path, description: &str) -> Result<(), String> {
         .map_err(|e| e.to_string())?;
     zip.write_all(description.as_bytes())
         .map_err(|e| e.to_string())?;
+    if let Some(terminals) = terminals {
+        zip.start_file("terminalsAndIcons/terminalsAndIcons.xml", options)
+            .map_err(|e| e.to_string())?;
+        zip.write_all(terminals.as_bytes())
+            .map_err(|e| e.to_string())?;
+    }
     for i in 0..archive.len() {
         let mut entry = archive.by_index(i).map_err(|e| e.to_string())?;
         let name = entry.name().to_string();
@@ -60,7 +72,8 @@ fn main() {
     for model in actuator_fmus::fmi3::FMI3_MODELS {
         let fmi2 = Path::new(fmi2_dir).join(format!("{}.fmu", model.name));
         let out = Path::new(out_dir).join(format!("{}.fmu", model.name));
-        match repackage(&fmi2, &out, model.model_description_xml) {
+        let terminals = actuator_fmus::terminals::terminals_and_icons(model.name);
+        match repackage(&fmi2, &out, model.model_description_xml, terminals) {
             Ok(()) => println!("wrote {}", out.display()),
             Err(e) => {
                 eprintln!("package_fmi3: {e}");
