@@ -5,7 +5,7 @@
 //! - `model_tables.rs`: value references, metadata and the typed `Parameters`, `Inputs`,
 //!   `Outputs` and `CalculatedParameters` of each model (included by `src/variables.rs`);
 //! - `model_bindings.rs`: the export layer's access to those structs' fields by value reference,
-//!   and the registry of models (included by `src/fmi2/registry.rs`);
+//!   and the registry of models (included by `src/export/registry.rs`);
 //! - `<Model>.fmi3.xml` and `fmi3_tables.rs`: the FMI 3.0 model description from the same source
 //!   and the value-reference layout `src/fmi3` serves it with (`build/fmi3_description.rs`);
 //! - `<Model>.terminalsAndIcons.xml` and `terminals.rs`: the FMI 3.0 terminals of the flanges a

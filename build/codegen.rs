@@ -2,7 +2,7 @@
 //! - `model_tables.rs`, included by `src/variables.rs`: per model, the value references, the
 //!   variable metadata and the typed `Parameters`, `Inputs`, `Outputs` and
 //!   `CalculatedParameters` structs. It names nothing above the variables module.
-//! - `model_bindings.rs`, included by `src/fmi2/registry.rs`: per model, the access by value
+//! - `model_bindings.rs`, included by `src/export/registry.rs`: per model, the access by value
 //!   reference to those structs' fields, and the registry of every model.
 
 use super::model_description::{field_name, Model, Variable, TYPES};
@@ -431,7 +431,7 @@ pub fn bindings(model: &Model, code: &mut String) -> Result<(), String> {
         let _ = writeln!(code, "        }}");
         let _ = writeln!(code, "    }}");
     }
-    // The out-of-range flag (`src/fmi2/instance/out_of_range.rs`) written by its field: every
+    // The out-of-range flag (`src/export/instance/out_of_range.rs`) written by its field: every
     // model that clamps has it, under the same name.
     let flag = arms_of(model, 2)?
         .into_iter()

@@ -27,7 +27,7 @@ const CO_SIMULATION_CAPABILITIES: &str = r#"needsExecutionTool="false"
     canGetAndSetFMUstate="true"
     canSerializeFMUstate="true""#;
 
-/// The Model Exchange capabilities of the export layer (`src/fmi2/instance/model_exchange.rs`): the friction
+/// The Model Exchange capabilities of the export layer (`src/export/instance/model_exchange.rs`): the friction
 /// history is committed at completed integrator steps, so the importer must call them.
 const MODEL_EXCHANGE_CAPABILITIES: &str = r#"needsExecutionTool="false"
     completedIntegratorStepNotNeeded="false"

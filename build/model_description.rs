@@ -414,7 +414,7 @@ fn check_variable(
     let (causality, variability) = (v.causality.as_str(), v.variability.as_str());
     // Case letters of the spec's table: which initial values are legal, the first being the default.
     // Tunable parameters are accepted: the export layer rebuilds the model when one changes
-    // between steps (src/fmi2/values.rs).
+    // between steps (src/export/instance/values.rs).
     let allowed: &[&'static str] = match (variability, causality) {
         ("constant", "output" | "local") => &["exact"],
         ("fixed" | "tunable", "parameter") => &["exact"],
@@ -821,7 +821,7 @@ fn shipped(
 ) -> Result<String, String> {
     let s = find_splices(text)?;
     // Every model serves both interfaces and its exact partials: the registry's test
-    // (`src/fmi2/registry.rs`) checks each model against this, so that no list names them.
+    // (`src/export/registry.rs`) checks each model against this, so that no list names them.
     let mut inserts: Vec<(usize, usize, String)> = Vec::new();
     inserts.push((
         s.after_root,

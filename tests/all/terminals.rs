@@ -5,11 +5,11 @@
 #[allow(dead_code)]
 #[path = "../../build/codegen.rs"]
 mod codegen;
+#[path = "../../build/terminals.rs"]
+mod flanges;
 #[allow(dead_code)]
 #[path = "../../build/model_description.rs"]
 mod model_description;
-#[path = "../../build/terminals.rs"]
-mod flanges;
 
 const SOURCE: &str = include_str!("../../modelDescription/McKibbenMuscle.xml");
 const FLANGE: &str =
