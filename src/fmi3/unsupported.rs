@@ -250,17 +250,6 @@ pub unsafe extern "C" fn fmi3EvaluateDiscreteStates(instance: fmi3Instance) -> f
 }
 
 #[no_mangle]
-pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-    unsafe {
-        refuse(
-            instance,
-            "fmi3EnterStepMode",
-            "Co-Simulation has no event mode here (hasEventMode is false): the instance is in step mode after initialization",
-        )
-    }
-}
-
-#[no_mangle]
 pub unsafe extern "C" fn fmi3GetOutputDerivatives(
     instance: fmi3Instance,
     _vr: *const fmi3ValueReference,
