@@ -195,3 +195,25 @@ def test_step_mode_calls_out_of_place_are_logged_errors(lib):
     assert s("fmi3EnterStepMode") == ERROR  # already in Step Mode
     assert s("fmi3Terminate") == OK
     s.free()
+
+
+def test_fmpy_simulate_fmu_lands_on_the_switches(lib):
+    """FMPy's own Co-Simulation loop (an independent importer) with event mode and early return:
+    a result row at every switch, and the communication points as without event mode."""
+    from fmpy import simulate_fmu
+
+    def run(events):
+        return simulate_fmu(str(FMI3_DIR / "MultiferroicMotor.fmu"), stop_time=STEPS * H, output_interval=H,
+                            start_values={"schedule": 1, "step_period": PERIOD}, output=OUTPUTS,
+                            use_event_mode=events, early_return_allowed=events)
+
+    plain, events = run(False), run(True)
+    switches = [j * PERIOD for j in range(1, switch_index(STEPS * H) + 1)]
+    for switch in switches:
+        assert min(abs(t - switch) for t in events["time"]) <= 1e-15 * switch, switch
+    on_grid = {t: row for t, row in zip(events["time"], events)}
+    for row in plain:
+        other = on_grid[row["time"]]  # the last row at that time (after the event)
+        for name in OUTPUTS:
+            scale = max(abs(plain[name]).max(), 1e-300)
+            assert abs(other[name] - row[name]) <= 1e-11 * scale, (row["time"], name)
