@@ -217,3 +217,19 @@ def test_fmpy_simulate_fmu_lands_on_the_switches(lib):
         for name in OUTPUTS:
             scale = max(abs(plain[name]).max(), 1e-300)
             assert abs(other[name] - row[name]) <= 1e-11 * scale, (row["time"], name)
+
+
+def test_pulley_joint_returns_at_its_segment_boundaries():
+    """PulleyJoint's other time events, the reference trajectory's segment boundaries k *
+    segment_time (1 s), are reported the same way; its fixed substeps make the split exact."""
+    from fmpy import simulate_fmu
+
+    path = str(FMI3_DIR / "PulleyJoint.fmu")
+    outputs = ["flexor_length", "extensor_length", "flexor_pressure", "extensor_pressure"]
+    plain = simulate_fmu(path, stop_time=5.0, output_interval=0.07, output=outputs)
+    events = simulate_fmu(path, stop_time=5.0, output_interval=0.07, output=outputs,
+                          use_event_mode=True, early_return_allowed=True)
+    assert sorted(set(events["time"]) - set(plain["time"])) == [1.0, 2.0, 3.0, 4.0]
+    on_grid = {t: row for t, row in zip(events["time"], events)}
+    for row in plain:
+        assert [on_grid[row["time"]][n] for n in outputs] == [row[n] for n in outputs], row["time"]
