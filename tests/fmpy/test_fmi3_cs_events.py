@@ -233,3 +233,24 @@ def test_pulley_joint_returns_at_its_segment_boundaries():
     on_grid = {t: row for t, row in zip(events["time"], events)}
     for row in plain:
         assert [on_grid[row["time"]][n] for n in outputs] == [row[n] for n in outputs], row["time"]
+
+
+def test_an_fmu_state_saved_at_a_switch_restores_in_event_mode(lib):
+    s = Slave(lib, "MultiferroicMotor", True, True)
+    s.initialize()
+    assert s.handle_event(enter=False) == PERIOD
+    event, early, t = s.do_step(0.0, 1.5 * PERIOD)
+    assert early and t == PERIOD
+    assert s("fmi3EnterEventMode") == OK
+    state = c_void_p()
+    assert s("fmi3GetFMUState", byref(state)) == OK
+    before = s.get(OUTPUTS)
+    assert s.handle_event(enter=False) == 2 * PERIOD
+    s.do_step(t, 0.5 * PERIOD)
+    # Back at the switch, in Event Mode: the same outputs, and stepping on needs Step Mode.
+    assert s("fmi3SetFMUState", state) == OK, s.messages
+    assert s.get(OUTPUTS) == before
+    assert s.handle_event(enter=False) == 2 * PERIOD
+    assert s.do_step(PERIOD, 0.5 * PERIOD)[2] == 1.5 * PERIOD
+    assert s("fmi3FreeFMUState", byref(state)) == OK
+    s.free()
