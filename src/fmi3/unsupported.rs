@@ -1,6 +1,5 @@
 //! Every other function of the FMI 3.0 API. The models have no variables of these types, no
-//! clocks, no configuration mode and no event mode in Co-Simulation: each call is refused with a
-//! logged reason (a getter or setter of no variable at all does nothing and succeeds).
+//! clocks and no configuration mode: each call is refused with a logged reason (a getter or setter of no variable at all does nothing and succeeds).
 
 use super::exports::{guarded, Status};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status, fmi3String, fmi3ValueReference};

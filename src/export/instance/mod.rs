@@ -1,7 +1,8 @@
 //! One FMU instance, whichever FMI version's API created it: its core (this file), the
 //! call-sequence state machine (FMI 2.0.4 section 4.2.4, FMI 3.0 section 4.2.1; `machine`), the
 //! rules for which variables may be set when (FMI 2.0.4 section 2.2.7, `values`), FMU states
-//! (`fmu_state`), Model Exchange's modes (`model_exchange`), the out-of-range policy
+//! (`fmu_state`), Model Exchange's modes (`model_exchange`), FMI 3.0 Co-Simulation's event mode
+//! (`co_simulation_events`), the out-of-range policy
 //! (`out_of_range`) and directional derivatives. The code here works on Rust slices and
 //! references and is told the name of the function the importer called; the version layers
 //! (`src/fmi2`, `src/fmi3`) turn the importer's C pointers into them. The only `unsafe` here is
