@@ -254,3 +254,50 @@ def test_an_fmu_state_saved_at_a_switch_restores_in_event_mode(lib):
     assert s.do_step(PERIOD, 0.5 * PERIOD)[2] == 1.5 * PERIOD
     assert s("fmi3FreeFMUState", byref(state)) == OK
     s.free()
+
+
+def serialized(s, state):
+    size = c_size_t()
+    assert s("fmi3SerializedFMUStateSize", state, byref(size)) == OK, s.messages
+    data = (ctypes.c_ubyte * size.value)()
+    assert s("fmi3SerializeFMUState", state, data, size) == OK, s.messages
+    return data, size
+
+
+def test_a_state_saved_in_event_mode_continues_only_in_the_interface_that_saved_it(lib):
+    """Event Mode exists in Model Exchange and in Co-Simulation with event mode: a state saved there
+    by one of them is refused by the others (its history belongs to that interface's branch)."""
+    lib.fmi3InstantiateModelExchange.restype = c_void_p
+    me = Slave.__new__(Slave)
+    me.lib, me.md, me.messages = lib, read_model_description(str(FMI3_DIR / "MultiferroicMotor.fmu")), []
+    me.vr = {v.name: v.valueReference for v in me.md.modelVariables}
+    me.log = LOG(lambda env, status, category, message: me.messages.append(message.decode()))
+    me.c = c_void_p(lib.fmi3InstantiateModelExchange(b"me", me.md.instantiationToken.encode(), None,
+                                                      False, False, None, me.log))
+    me.initialize()  # Model Exchange is in Event Mode after initialization
+    events = Slave(lib, "MultiferroicMotor", True, True)
+    events.initialize()  # so is Co-Simulation with event mode
+    plain = Slave(lib, "MultiferroicMotor", False, False)
+    plain.initialize()
+    saved = {}
+    for name, s in (("me", me), ("events", events)):
+        state = c_void_p()
+        assert s("fmi3GetFMUState", byref(state)) == OK
+        saved[name] = serialized(s, state)
+        assert s("fmi3FreeFMUState", byref(state)) == OK
+    for source, target in (("me", events), ("events", me), ("events", plain)):
+        data, size = saved[source]
+        state = c_void_p()
+        assert target("fmi3DeserializeFMUState", data, size, byref(state)) == OK, target.messages
+        assert target("fmi3SetFMUState", state) == ERROR, (source, target.messages)
+        assert "saved mid-run in state EventMode" in target.messages[-1], target.messages[-1]
+        assert target("fmi3FreeFMUState", byref(state)) == OK
+    # Each interface's own state restores.
+    for name, s in (("me", me), ("events", events)):
+        data, size = saved[name]
+        state = c_void_p()
+        assert s("fmi3DeserializeFMUState", data, size, byref(state)) == OK
+        assert s("fmi3SetFMUState", state) == OK, s.messages
+        assert s("fmi3FreeFMUState", byref(state)) == OK
+    for s in (me, events, plain):
+        s.free()

@@ -286,7 +286,7 @@ def test_a_co_simulation_state_is_not_restored_into_model_exchange(recording_log
     state = me.deSerializeFMUstate(serialized)
     with pytest.raises(Exception):
         me.setFMUstate(state)
-    assert recording_log.contains("saved in state StepComplete, which this Model Exchange instance has not")
+    assert recording_log.contains("saved mid-run in state StepComplete by a Co-Simulation instance; this one is Model Exchange")
     # Its own state round-trips.
     own = me.getFMUstate()
     me.setFMUstate(own)

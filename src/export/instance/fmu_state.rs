@@ -13,14 +13,35 @@ pub struct FmuState {
     start_time: f64,
     stop_time: Option<f64>,
     machine: MachineState,
+    /// The interface that saved it: Model Exchange, or Co-Simulation (with or without FMI 3.0's
+    /// event mode). A state saved mid-run continues only in the same interface.
+    interface: Interface,
     runtime: Box<dyn Runtime>,
 }
 
+#[derive(Clone, Copy, PartialEq, Eq, Debug, Serialize, Deserialize)]
+enum Interface {
+    ModelExchange,
+    CoSimulation,
+    CoSimulationWithEvents,
+}
+
+impl Interface {
+    fn name(self) -> &'static str {
+        match self {
+            Interface::ModelExchange => "Model Exchange",
+            Interface::CoSimulation => "Co-Simulation",
+            Interface::CoSimulationWithEvents => "Co-Simulation (event mode)",
+        }
+    }
+}
+
 /// Versioned byte format of a serialized FMU state: magic, format version, postcard, then a
-/// 64-bit FNV-1a checksum of everything before it (format 3: the variables are the models' typed
-/// structs; format 2 held them as arrays by value reference; format 1 had no checksum).
+/// 64-bit FNV-1a checksum of everything before it (format 4: the saving interface is recorded;
+/// format 3 did not; format 2 held the variables as arrays by value reference; format 1 had no
+/// checksum).
 const STATE_MAGIC: &[u8; 8] = b"AFMUSTAT";
-const STATE_FORMAT: u16 = 3;
+const STATE_FORMAT: u16 = 4;
 
 /// FNV-1a, 64 bit: catches accidental corruption of a stored state (a flipped byte in the model's
 /// history would otherwise reach the physics as garbage), not tampering.
@@ -37,6 +58,7 @@ struct SerializedState {
     start_time: f64,
     stop_time: Option<f64>,
     machine: MachineState,
+    interface: Interface,
     runtime: Vec<u8>,
 }
 
@@ -57,12 +79,23 @@ fn clock_disorder(time: f64, start: f64, stop: Option<f64>) -> Option<String> {
 }
 
 impl Instance {
+    fn interface(&self) -> Interface {
+        if self.model_exchange {
+            Interface::ModelExchange
+        } else if self.co_simulation_events() {
+            Interface::CoSimulationWithEvents
+        } else {
+            Interface::CoSimulation
+        }
+    }
+
     fn capture(&self) -> FmuState {
         FmuState {
             time: self.time,
             start_time: self.start_time,
             stop_time: self.stop_time,
             machine: self.state(),
+            interface: self.interface(),
             runtime: self.runtime.snapshot(),
         }
     }
@@ -113,24 +146,18 @@ impl Instance {
 
     fn restore(&mut self, function: &str, saved: &FmuState) -> Status {
         use MachineState::*;
-        // A state saved mid-run by one interface cannot continue in the other's state machine.
-        let interface_of = |m| match m {
-            StepComplete | StepFailed => Some(false),
-            EventMode | ContinuousTimeMode => Some(true),
-            _ => None,
-        };
-        // FMI 3.0 Co-Simulation with event mode has an Event Mode too.
-        let cs_event_mode = saved.machine == EventMode && self.co_simulation_events();
-        if !cs_event_mode && interface_of(saved.machine).is_some_and(|me| me != self.model_exchange)
-        {
+        // A state saved mid-run by one interface cannot continue in another's state machine (FMI
+        // 3.0 Co-Simulation with event mode has an Event Mode of its own).
+        let mid_run = matches!(
+            saved.machine,
+            StepComplete | StepFailed | EventMode | ContinuousTimeMode
+        );
+        if mid_run && saved.interface != self.interface() {
             return self.error(&format!(
-                "{function}: the FMU state was saved in state {}, which this {} instance has not",
+                "{function}: the FMU state was saved mid-run in state {} by a {} instance; this one is {}",
                 self.state_name(saved.machine),
-                if self.model_exchange {
-                    "Model Exchange"
-                } else {
-                    "Co-Simulation"
-                }
+                saved.interface.name(),
+                self.interface().name()
             ));
         }
         if let Err(reason) = self.runtime.restore(saved.runtime.as_ref()) {
@@ -179,6 +206,7 @@ impl Instance {
             start_time: saved.start_time,
             stop_time: saved.stop_time,
             machine: saved.machine,
+            interface: saved.interface,
             runtime,
         };
         let mut bytes = STATE_MAGIC.to_vec();
@@ -271,6 +299,7 @@ impl Instance {
             start_time: body.start_time,
             stop_time: body.stop_time,
             machine: body.machine,
+            interface: body.interface,
             runtime,
         };
         if existing.is_null() {
