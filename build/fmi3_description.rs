@@ -161,8 +161,8 @@ const CO_SIMULATION_CAPABILITIES_3: &str = r#"needsExecutionTool="false"
     canHandleVariableCommunicationStepSize="true"
     maxOutputDerivativeOrder="0"
     providesIntermediateUpdate="false"
-    mightReturnEarlyFromDoStep="false"
-    hasEventMode="false""#;
+    mightReturnEarlyFromDoStep="true"
+    hasEventMode="true""#;
 
 /// The friction history is committed at completed integrator steps: the importer must call them.
 const MODEL_EXCHANGE_CAPABILITIES_3: &str = r#"needsExecutionTool="false"

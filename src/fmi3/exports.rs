@@ -53,7 +53,7 @@ fn instantiate(
     logging_on: bool,
     environment: *mut c_void,
     log: Option<Fmi3LogMessageCallback>,
-    refusal: Option<&str>,
+    (event_mode_used, early_return_allowed): (bool, bool),
 ) -> Option<fmi3Instance> {
     let name = instance_name.unwrap_or_default();
     let mut logger = logger::logger(log, environment, if name.is_empty() { "?" } else { &name });
@@ -61,9 +61,6 @@ fn instantiate(
         logger.log(Status::Error, &format!("{function}: {why}"));
         None
     };
-    if let Some(why) = refusal {
-        return refuse(&logger, why.to_string());
-    }
     if name.is_empty() {
         return refuse(&logger, "instanceName must be a non-empty string".into());
     }
@@ -92,6 +89,8 @@ fn instantiate(
     logger.debug = logging_on;
     let mut instance = Box::new(Instance::new(*factory, &API, logger));
     instance.model_exchange = model_exchange;
+    instance.event_mode_used = event_mode_used;
+    instance.early_return_allowed = early_return_allowed;
     let handle = handles::register(instance);
     if handle.is_none() {
         logger::logger(log, environment, &name).log(
@@ -113,7 +112,7 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     _visible: fmi3Boolean,
     logging_on: fmi3Boolean,
     event_mode_used: fmi3Boolean,
-    _early_return_allowed: fmi3Boolean,
+    early_return_allowed: fmi3Boolean,
     _required_intermediate_variables: *const fmi3ValueReference,
     _n_required_intermediate_variables: usize,
     instance_environment: *mut c_void,
@@ -123,10 +122,6 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
     let result = catch_unwind(|| {
         // SAFETY: NULL or NUL-terminated strings (FMI 3.0 section 2.2.3).
         let (name, token) = unsafe { (text(instance_name), text(instantiation_token)) };
-        // The FMU has no Co-Simulation event mode (hasEventMode="false"): FMI 3.0 section
-        // 4.2.1 asks it to refuse an importer that would use it.
-        let refusal = (event_mode_used != 0)
-            .then_some("eventModeUsed is true, but this FMU has no event mode in Co-Simulation (hasEventMode=\"false\")");
         instantiate(
             "fmi3InstantiateCoSimulation",
             name,
@@ -135,7 +130,7 @@ pub unsafe extern "C" fn fmi3InstantiateCoSimulation(
             logging_on != 0,
             instance_environment,
             log_message,
-            refusal,
+            (event_mode_used != 0, early_return_allowed != 0),
         )
     });
     result.ok().flatten().unwrap_or(std::ptr::null_mut())
@@ -162,7 +157,7 @@ pub unsafe extern "C" fn fmi3InstantiateModelExchange(
             logging_on != 0,
             instance_environment,
             log_message,
-            None,
+            (false, false),
         )
     });
     result.ok().flatten().unwrap_or(std::ptr::null_mut())
@@ -299,14 +294,20 @@ pub unsafe extern "C" fn fmi3DoStep(
                     "eventHandlingNeeded, terminateSimulation, earlyReturn or lastSuccessfulTime",
                 );
             };
-            let status = inst.do_step(F, current_communication_point, communication_step_size);
-            // No events in Co-Simulation, never an early return; the time reached (or kept, after
-            // a refused or discarded step).
-            *event = 0;
+            let (status, end) =
+                inst.do_step_with_events(F, current_communication_point, communication_step_size);
+            *event = u8::from(end.event_handling_needed);
             *terminate = 0;
-            *early = 0;
-            *last = inst.time;
+            *early = u8::from(end.early_return);
+            *last = end.last_successful_time;
             status
         })
     }
+}
+
+/// Co-Simulation with `eventModeUsed`: from Event Mode to Step Mode.
+#[no_mangle]
+pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
+    const F: &str = "fmi3EnterStepMode";
+    unsafe { guarded(instance, F, |inst| inst.enter_step_mode(F)) }
 }

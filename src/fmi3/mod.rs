@@ -6,8 +6,8 @@
 //! handles, panic guard, call-sequence state machine, variable rules, FMU states, out-of-range
 //! policy, the runtime over any model); it never uses `src/fmi2`. What is FMI 3.0's own lives
 //! here:
-//! - `exports`: instantiation, the mode changes, `fmi3DoStep`, and the panic guard's FMI 3.0
-//!   entry (`guarded`);
+//! - `exports`: instantiation, the mode changes, `fmi3DoStep` (with Co-Simulation event mode and
+//!   early return at the models' time events), and the panic guard's FMI 3.0 entry (`guarded`);
 //! - `logger`: the FMI 3.0 logger callback;
 //! - `fmu_state`: FMU states and their serialization;
 //! - `derivatives`: directional and adjoint derivatives, variable dependencies;

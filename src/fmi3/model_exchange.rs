@@ -1,5 +1,6 @@
 //! The FMI 3.0 Model Exchange functions (FMI 3.0 section 3.2) over the shared instance's event
-//! and continuous-time modes.
+//! and continuous-time modes. `fmi3EnterEventMode` and `fmi3UpdateDiscreteStates` also serve
+//! Co-Simulation with event mode.
 
 use super::exports::{guarded, Status};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status};

@@ -1,6 +1,5 @@
 //! Every other function of the FMI 3.0 API. The models have no variables of these types, no
-//! clocks, no configuration mode and no event mode in Co-Simulation: each call is refused with a
-//! logged reason (a getter or setter of no variable at all does nothing and succeeds).
+//! clocks and no configuration mode: each call is refused with a logged reason (a getter or setter of no variable at all does nothing and succeeds).
 
 use super::exports::{guarded, Status};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status, fmi3String, fmi3ValueReference};
@@ -245,17 +244,6 @@ pub unsafe extern "C" fn fmi3EvaluateDiscreteStates(instance: fmi3Instance) -> f
             instance,
             "fmi3EvaluateDiscreteStates",
             "providesEvaluateDiscreteStates is false",
-        )
-    }
-}
-
-#[no_mangle]
-pub unsafe extern "C" fn fmi3EnterStepMode(instance: fmi3Instance) -> fmi3Status {
-    unsafe {
-        refuse(
-            instance,
-            "fmi3EnterStepMode",
-            "Co-Simulation has no event mode here (hasEventMode is false): the instance is in step mode after initialization",
         )
     }
 }

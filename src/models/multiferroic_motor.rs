@@ -285,8 +285,15 @@ impl Model for MultiferroicMotor {
         Ok(())
     }
 
-    fn next_time_event(&self, _time: f64) -> Option<f64> {
-        self.me_next_time_event()
+    /// Model Exchange: the schedule's next switch or the Gilbert onion's window end (from its
+    /// own event clock). Co-Simulation (FMI 3.0 event mode): the schedule's next switch after
+    /// `time`; the steps integrate through the ringing on their own.
+    fn next_time_event(&self, time: f64) -> Option<f64> {
+        if self.model_exchange_active() {
+            self.me_next_time_event()
+        } else {
+            self.schedule.get().map(|s| s.next_switch_after(time))
+        }
     }
 
     /// Event mode: the schedule's direction in effect, the quasi-static onion settled by the

@@ -80,10 +80,7 @@ def test_a_wrong_token_is_refused_with_a_reason(lib):
     assert "wrong instantiationToken" in inst.last()
 
 
-def test_scheduled_execution_and_co_simulation_event_mode_are_refused_with_a_reason(lib):
-    inst = Instance(lib, "McKibbenMuscle", event_mode_used=True)
-    assert not inst.c.value
-    assert "eventModeUsed" in inst.last()
+def test_scheduled_execution_is_refused_with_a_reason(lib):
     messages = []
     log = LOG(lambda env, status, category, message: messages.append(message.decode()))
     md = read_model_description(str(FMI3_DIR / "McKibbenMuscle.fmu"))

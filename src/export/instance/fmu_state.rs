@@ -119,7 +119,10 @@ impl Instance {
             EventMode | ContinuousTimeMode => Some(true),
             _ => None,
         };
-        if interface_of(saved.machine).is_some_and(|me| me != self.model_exchange) {
+        // FMI 3.0 Co-Simulation with event mode has an Event Mode too.
+        let cs_event_mode = saved.machine == EventMode && self.co_simulation_events();
+        if !cs_event_mode && interface_of(saved.machine).is_some_and(|me| me != self.model_exchange)
+        {
             return self.error(&format!(
                 "{function}: the FMU state was saved in state {}, which this {} instance has not",
                 self.state_name(saved.machine),

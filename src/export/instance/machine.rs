@@ -182,7 +182,8 @@ impl Instance {
             self.set_state(MachineState::Error);
             return status.max(Status::Error);
         }
-        self.set_state(if self.model_exchange {
+        // FMI 3.0 section 4.2.1: Co-Simulation with eventModeUsed starts in Event Mode too.
+        self.set_state(if self.model_exchange || self.event_mode_used {
             MachineState::EventMode
         } else {
             MachineState::StepComplete

@@ -1,12 +1,14 @@
 //! One FMU instance, whichever FMI version's API created it: its core (this file), the
 //! call-sequence state machine (FMI 2.0.4 section 4.2.4, FMI 3.0 section 4.2.1; `machine`), the
 //! rules for which variables may be set when (FMI 2.0.4 section 2.2.7, `values`), FMU states
-//! (`fmu_state`), Model Exchange's modes (`model_exchange`), the out-of-range policy
+//! (`fmu_state`), Model Exchange's modes (`model_exchange`), FMI 3.0 Co-Simulation's event mode
+//! (`co_simulation_events`), the out-of-range policy
 //! (`out_of_range`) and directional derivatives. The code here works on Rust slices and
 //! references and is told the name of the function the importer called; the version layers
 //! (`src/fmi2`, `src/fmi3`) turn the importer's C pointers into them. The only `unsafe` here is
 //! in `fmu_state`, on the state pointers this instance handed out itself.
 
+mod co_simulation_events;
 mod directional_derivative;
 mod fmu_state;
 mod machine;
@@ -60,6 +62,11 @@ pub struct Instance {
     state: MachineState,
     /// Instantiated for Model Exchange (fmuType 0) rather than Co-Simulation.
     pub(crate) model_exchange: bool,
+    /// FMI 3.0 Co-Simulation with event mode (`eventModeUsed`): `fmi3DoStep` reports the
+    /// model's time events and the instance has an event mode (`co_simulation_events`).
+    pub(crate) event_mode_used: bool,
+    /// The importer accepts a step that ends early, at an event (`earlyReturnAllowed`).
+    pub(crate) early_return_allowed: bool,
     pub(crate) time: f64,
     start_time: f64,
     stop_time: Option<f64>,
@@ -122,6 +129,8 @@ impl Instance {
             set_rules,
             state: MachineState::Instantiated,
             model_exchange: false,
+            event_mode_used: false,
+            early_return_allowed: false,
             time: 0.0,
             start_time: 0.0,
             stop_time: None,

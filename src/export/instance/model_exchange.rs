@@ -59,6 +59,9 @@ impl Instance {
     }
 
     pub fn enter_event_mode(&mut self, function: &str) -> Status {
+        if self.co_simulation_events() {
+            return self.co_simulation_enter_event_mode(function);
+        }
         if !self.me_allowed(function, allowed::EVENT_OR_CONTINUOUS_TIME_MODE) {
             return Status::Error;
         }
@@ -69,6 +72,9 @@ impl Instance {
     /// One event iteration: commits the history, lets the model update its discrete states (and
     /// reinitialize continuous ones), and gives the next time event.
     pub fn new_discrete_states(&mut self, function: &str) -> (Status, EventIteration) {
+        if self.co_simulation_events() {
+            return self.co_simulation_update_discrete_states(function);
+        }
         if !self.me_allowed(function, allowed::EVENT_MODE) {
             return (Status::Error, EventIteration::default());
         }

@@ -385,4 +385,27 @@ mod tests {
         assert!(by_name("rotor_angle") < 0.0, "a restoring stiffness");
         assert!(p.get("torque").is_some() && p.get("der(onion_tilt)").is_some());
     }
+
+    #[test]
+    fn co_simulation_time_events_are_the_switches_after_the_given_time() {
+        // Co-Simulation (FMI 3.0 event mode): the switches k T after `time`, Model Exchange's
+        // event clock untouched; a switch at `time` is behind it.
+        let period = 1e-4;
+        let m = stepping(period, true);
+        assert_eq!(m.next_time_event(0.0), Some(period));
+        assert_eq!(m.next_time_event(period), Some(2.0 * period));
+        assert_eq!(m.next_time_event(2.5 * period), Some(3.0 * period));
+        // 30 communication steps of 3e-5 s end a rounding short of the ninth switch: it counts
+        // as reached (the instance reports it at that step's end).
+        assert_eq!(m.next_time_event(0.00087), Some(9.0 * period));
+        assert_eq!(m.next_time_event(30.0 * 3e-5), Some(10.0 * period));
+        assert!(!m.model_exchange_active());
+        // Without the schedule, no events.
+        let off = MultiferroicMotor::new(&Parameters::default(), &Inputs::default()).unwrap();
+        assert_eq!(off.next_time_event(0.5), None);
+        // Model Exchange keeps its own clock: the next event after its last event time.
+        let mut me = stepping(1e-4, false);
+        me.me_event(&Inputs::default(), 0.0).unwrap();
+        assert_eq!(me.next_time_event(0.5), Some(1e-4));
+    }
 }
