@@ -1,7 +1,8 @@
 //! Reads every `modelDescription/<Model>.xml`, checks it against the FMI 2.0 rules that importers
 //! enforce, and writes into `$OUT_DIR`:
 //! - `<Model>.xml`: the shipped model description, with the export layer's `<CoSimulation>`,
-//!   `<LogCategories>`, ModelStructure indices and GUID added (`build/model_description.rs`);
+//!   `<LogCategories>`, ModelStructure indices and GUID added (`build/model_description.rs`, which
+//!   checks the variables in `build/variable_checks.rs` and splices in `build/shipped_xml.rs`);
 //! - `model_tables.rs`: value references, metadata and the typed `Parameters`, `Inputs`,
 //!   `Outputs` and `CalculatedParameters` of each model (included by `src/variables.rs`);
 //! - `model_bindings.rs`: the export layer's access to those structs' fields by value reference,

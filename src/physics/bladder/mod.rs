@@ -34,10 +34,12 @@ mod continuum_tests;
 mod exact;
 #[cfg(test)]
 mod exact_tests;
+mod free;
 mod geometry;
 mod hyper_dual;
 mod knitted_cylinder;
 mod partials;
+mod state;
 mod stiffness_partials;
 #[cfg(test)]
 mod tests;
@@ -45,12 +47,13 @@ mod tests;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::knitted::KnittedSleeve;
 use crate::physics::numerics::dual::Dual;
-use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 use continuum::WallNode;
 pub use geometry::SleeveGeometry;
 use hyper_dual::KernelScalar;
 pub use knitted_cylinder::KnittedCylinder;
 pub use partials::BladderPartials;
+use state::check_state;
+pub use state::BladderState;
 use std::f64::consts::PI;
 pub use stiffness_partials::BladderCurvature;
 
@@ -60,11 +63,6 @@ pub const MOONEY_C1: f64 = 161e3;
 pub const MOONEY_C2: f64 = 39e3;
 /// Largest accepted number of layers: far past convergence, and it bounds the per-call work.
 pub const MAX_LAYERS: usize = 4096;
-
-/// Iteration cap of the free-bladder root finder (safeguarded Newton-bisection converges in <10).
-const ROOT_ITERATIONS: usize = 100;
-/// Halvings allowed when looking for the collapsed side of the free-bladder bracket under vacuum.
-const BRACKET_HALVINGS: usize = 200;
 
 /// The relaxed bladder tube before it is clamped into the sleeve (Table 2.1 columns).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -154,52 +152,6 @@ pub struct Bladder<S = Sleeve> {
     rubber_volume: f64,
     min_length: f64,
     max_length: f64,
-}
-
-/// Everything the bladder model says at one pressure and muscle length.
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct BladderState {
-    /// Muscle tension, N: strands + pressure end force + bladder elastic force (eq. 2.4 without
-    /// friction, eq. 2.16 + 2.17).
-    pub force: f64,
-    /// `F_strands = P_eff (A - dV/dL)`, N (eq. 2.16; `P_eff L^2 / (2 pi n^2)` for the helical
-    /// sleeve): the sleeve's strand tension.
-    pub strand_force: f64,
-    /// `dF_strands/dL` along the current branch, N/m (zero when free).
-    pub strand_stiffness: f64,
-    /// `F_pressure = -P A_fluid`, N (eq. 2.5).
-    pub pressure_force: f64,
-    /// `F_elastic`, the axial force carried by the rubber, summed over layers, N (eq. 2.17).
-    pub elastic_force: f64,
-    /// Contact pressure of bladder on sleeve, Pa, never negative (eq. 2.12, 2.19).
-    pub effective_pressure: f64,
-    /// `dP_eff/dL` along the current branch, Pa/m (zero when free).
-    pub effective_pressure_slope: f64,
-    /// Whether the bladder presses on the sleeve (`P >= threshold_pressure`).
-    pub contact: bool,
-    /// See [`Bladder::threshold_pressure`], Pa.
-    pub threshold_pressure: f64,
-    /// Gas volume inside the bladder, `pi/4 D_in^2 L`, m^3.
-    pub fluid_volume: f64,
-    /// Inner diameter of the bladder, m (eq. 2.7 in contact, eq. 2.18 when free).
-    pub inner_diameter: f64,
-    /// Outer diameter of the bladder, m (the sleeve's diameter in contact).
-    pub outer_diameter: f64,
-    /// `lambda_1 = L / L_R0` (eq. 2.8a).
-    pub stretch_axial: f64,
-    /// `lambda_2` of the inner wall, `D_in / D_RI` (eq. 2.8b).
-    pub stretch_hoop: f64,
-    /// `lambda_3 = 1 / (lambda_1 lambda_2)` of the inner wall (eq. 2.8c).
-    pub stretch_radial: f64,
-    /// True axial stress of the innermost layer, Pa (eq. 2.9a; the thin-wall value for one layer).
-    pub stress_axial: f64,
-    /// True hoop stress of the innermost layer, Pa (eq. 2.9b, 2.11).
-    pub stress_hoop: f64,
-    /// True radial stress of the innermost layer, `-P`, Pa.
-    pub stress_radial: f64,
-    /// `dF/dL`, N/m, analytic (forward-mode derivative through the layer recursion; when free,
-    /// through the root of eq. 2.18 by the implicit function theorem).
-    pub stiffness: f64,
 }
 
 impl Bladder<KnittedCylinder> {
@@ -388,24 +340,6 @@ impl<S: SleeveGeometry> Bladder<S> {
         check_state(state, length)
     }
 
-    /// Whether the free bladder's equilibrium pressure rises with its diameter at the sleeve's
-    /// diameter (at `length`), i.e. whether losing contact is gradual rather than a snap.
-    ///
-    /// For one layer this always holds: eq. 2.18 gives the free equilibrium pressure
-    /// `P = 2 (C1/l1 + C2 l1) (u - a/u) / (c + r u)` with `u = l2^2`, `a = 1/l1^2`, `c = 1/l1`,
-    /// `r = D_RI/(D_RO - D_RI)`, whose `u`-derivative has the sign of `c + a c/u^2 + 2 r a/u > 0`.
-    /// (With the sleeve's clamps fixing `l1`, the tube has no balloon limit point.) For layered
-    /// walls it is checked by a property test over random tubes. `Err` outside the length range.
-    pub fn free_contact_is_stable(&self, length: f64) -> Result<bool, String> {
-        self.check_length(length)?;
-        let (_, x) = self.contact_seed(length);
-        // P_hold = c/a; its x-slope has the sign of (c' a - c a').
-        let k = self
-            .kernel(0.0, Dual::var_l(length), Dual::var_x(x.v))
-            .ok_or_else(|| self.domain_error(length))?;
-        Ok(k.c.dx * k.a.v - k.c.v * k.a.dx > 0.0)
-    }
-
     fn check_length(&self, length: f64) -> Result<(), String> {
         if !length.is_finite() {
             return Err(format!("length must be finite, got {length} m"));
@@ -538,162 +472,6 @@ impl<S: SleeveGeometry> Bladder<S> {
             inner,
         })
     }
-
-    fn fluid_area<T: KernelScalar>(&self, inner_l2_sq: T) -> T {
-        let d_ri = self.tube.inner_diameter;
-        inner_l2_sq * (PI / 4.0 * d_ri * d_ri)
-    }
-
-    fn contact_state(&self, pressure: f64, length: f64, k: &Kernel) -> BladderState {
-        let (g, g_slope) = self.sleeve.strand_area(length);
-        let strand_area = Dual {
-            v: g,
-            dl: g_slope,
-            dx: 0.0,
-        };
-        // Eq. 2.16: P_eff (A - dV/dL) - P A_fluid, plus eq. 2.17.
-        let strands = k.p_eff * strand_area;
-        let area = self.fluid_area(k.inner.l2_sq);
-        let pressure_force = area * (-pressure);
-        let force = strands + pressure_force + k.elastic;
-        // The dual-number seed carried the contact branch's total d/dL in `dl`.
-        self.state(
-            pressure,
-            length,
-            k,
-            Parts {
-                force: force.v,
-                strand: strands.v,
-                strand_slope: strands.dl,
-                pressure_force: pressure_force.v,
-                p_eff: k.p_eff.v,
-                p_eff_slope: k.p_eff.dl,
-                contact: true,
-                threshold: k.threshold,
-                area: area.v,
-                stiffness: force.dl,
-            },
-        )
-    }
-
-    fn free_state(&self, pressure: f64, length: f64, k: &Kernel, threshold: f64) -> BladderState {
-        let area = self.fluid_area(k.inner.l2_sq);
-        let pressure_force = area * (-pressure);
-        let force = pressure_force + k.elastic;
-        // Implicit function theorem on P_eff(L, x) = 0: dx/dL = -dP_eff/dL / dP_eff/dx.
-        let dx_dl = if k.p_eff.dx != 0.0 {
-            -k.p_eff.dl / k.p_eff.dx
-        } else {
-            0.0
-        };
-        self.state(
-            pressure,
-            length,
-            k,
-            Parts {
-                force: force.v,
-                strand: 0.0,
-                strand_slope: 0.0,
-                pressure_force: pressure_force.v,
-                p_eff: 0.0,
-                p_eff_slope: 0.0,
-                contact: false,
-                threshold,
-                area: area.v,
-                stiffness: force.dl + force.dx * dx_dl,
-            },
-        )
-    }
-
-    fn state(&self, pressure: f64, length: f64, k: &Kernel, p: Parts) -> BladderState {
-        let lambda1 = length / self.tube.unstretched_length;
-        let lambda2 = k.inner.l2_sq.v.sqrt();
-        let d_in = lambda2 * self.tube.inner_diameter;
-        let d_out = (d_in * d_in + 4.0 * self.rubber_volume / (PI * length)).sqrt();
-        BladderState {
-            force: p.force,
-            strand_force: p.strand,
-            strand_stiffness: p.strand_slope,
-            pressure_force: p.pressure_force,
-            elastic_force: k.elastic.v,
-            effective_pressure: p.p_eff,
-            effective_pressure_slope: p.p_eff_slope,
-            contact: p.contact,
-            threshold_pressure: p.threshold,
-            fluid_volume: p.area * length,
-            inner_diameter: d_in,
-            outer_diameter: d_out,
-            stretch_axial: lambda1,
-            stretch_hoop: lambda2,
-            stretch_radial: 1.0 / (lambda1 * lambda2),
-            stress_axial: k.inner.axial.v - pressure,
-            stress_hoop: k.inner.hoop.v - pressure,
-            stress_radial: -pressure,
-            stiffness: p.stiffness,
-        }
-    }
-
-    /// Outer diameter of the free bladder (eq. 2.18 generalised to the layers): the root of
-    /// `P_eff(x) = 0` for `x` below the sleeve's diameter `x_contact`, where `P_eff < 0`.
-    /// Hand-written safeguarded Newton-bisection on the analytic slope, for speed on the per-step
-    /// path; every loop is capped.
-    fn free_outer_diameter(
-        &self,
-        pressure: f64,
-        length: f64,
-        x_contact: f64,
-    ) -> Result<f64, String> {
-        let lambda1 = length / self.tube.unstretched_length;
-        let d_ro = self.outer_diameter;
-        let d_ri = self.tube.inner_diameter;
-        // Inner wall collapses at x_min; all layers are unstrained at x_rest = D_RO/sqrt(lambda_1),
-        // where P_eff = P (a = 1... times P, c = 0), so for P > 0 the root lies above x_rest.
-        let x_min = ((d_ro * d_ro - d_ri * d_ri) / lambda1).sqrt();
-        let x_rest = d_ro / lambda1.sqrt();
-        let residual = |x: f64| {
-            self.kernel(pressure, Dual::var_l(length), Dual::var_x(x))
-                .map(|k| (k.p_eff.v, k.p_eff.dx))
-        };
-        let hi = x_contact;
-        let start = if x_rest < hi { x_rest } else { hi };
-        let mut lo = start;
-        let mut r_lo = None;
-        for j in 0..BRACKET_HALVINGS {
-            if j > 0 {
-                lo = x_min + (start - x_min) * 0.5f64.powi(j as i32);
-            }
-            if let Some((r, _)) = residual(lo) {
-                if r >= 0.0 {
-                    r_lo = Some(r);
-                    break;
-                }
-            }
-        }
-        let Some(r_lo) = r_lo else {
-            return Err(format!(
-                "pressure {pressure} Pa at length {length} m: the free bladder has no equilibrium \
-                 short of collapse (vacuum too deep; collapse is not modelled)"
-            ));
-        };
-        if r_lo == 0.0 {
-            return Ok(lo);
-        }
-        // Newton from the unstrained side (seen to approach monotonically, ~6 steps); P_eff falls
-        // from positive at `lo` to negative at `hi`.
-        let options = RootOptions {
-            absolute: 0.0,
-            relative: 1e-14,
-            max_iterations: ROOT_ITERATIONS,
-        };
-        let root = newton_bisection(lo, hi, lo, false, options, |x| {
-            Ok::<_, ()>(residual(x).map(|(value, slope)| Sample {
-                value,
-                slope,
-                payload: (),
-            }))
-        });
-        Ok(root.map_or(0.5 * (lo + hi), |r| r.x))
-    }
 }
 
 fn finite_or(v: f64, what: &str, length: f64) -> Result<f64, String> {
@@ -704,49 +482,6 @@ fn finite_or(v: f64, what: &str, length: f64) -> Result<f64, String> {
             "{what} overflows at length {length} m (too close to a length limit)"
         ))
     }
-}
-
-fn check_state(s: BladderState, length: f64) -> Result<BladderState, String> {
-    let all = [
-        s.force,
-        s.strand_force,
-        s.strand_stiffness,
-        s.pressure_force,
-        s.elastic_force,
-        s.effective_pressure,
-        s.effective_pressure_slope,
-        s.threshold_pressure,
-        s.fluid_volume,
-        s.inner_diameter,
-        s.outer_diameter,
-        s.stretch_axial,
-        s.stretch_hoop,
-        s.stretch_radial,
-        s.stress_axial,
-        s.stress_hoop,
-        s.stress_radial,
-        s.stiffness,
-    ];
-    if all.iter().all(|v| v.is_finite()) {
-        Ok(s)
-    } else {
-        Err(format!(
-            "bladder state overflows at length {length} m (too close to a length limit)"
-        ))
-    }
-}
-
-struct Parts {
-    force: f64,
-    strand: f64,
-    strand_slope: f64,
-    pressure_force: f64,
-    p_eff: f64,
-    p_eff_slope: f64,
-    contact: bool,
-    threshold: f64,
-    area: f64,
-    stiffness: f64,
 }
 
 /// The innermost layer: squared hoop stretch, and the axial and hoop stresses without the

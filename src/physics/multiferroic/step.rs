@@ -1,0 +1,216 @@
+//! One communication step of the motor: the loop that cuts it at the schedule's switches and
+//! advances each piece of constant drive (see [`Motor::step`]).
+
+use super::{Angles, Drive, Motor, MotorInputs, MotorState, StepReport, Vector, MAX_STEP};
+
+/// Progress through one call of [`Motor::step`].
+pub(super) struct StepRun {
+    pub(super) y: Vector,
+    pub(super) t: f64,
+    pub(super) t_end: f64,
+    /// Attempted substeps (accepted and rejected), settles and turn jumps.
+    pub(super) attempts: u32,
+    pub(super) limited: bool,
+    /// Next substep size to try (s).
+    pub(super) dt: f64,
+    /// The segment whose settle was tried.
+    pub(super) settle_tried_for: f64,
+    /// The load-dominated closed form ([`Motor::advance_load_dominated`]) was tried in this call
+    /// and did not apply: its onion cycle (two turns of strides) is not tried again on every pass.
+    pub(super) load_dominated_failed: bool,
+    /// The segment in progress: its end, strain direction, and whether it began at a switch (a
+    /// whole period of the schedule).
+    pub(super) segment_end: f64,
+    pub(super) segment_direction: f64,
+    pub(super) whole_period: bool,
+    /// The state at the end of the last whole period relative to its strain direction (rotor,
+    /// onion, speed) and how far it was from the one before (rad).
+    pub(super) period_end: Option<[f64; 3]>,
+    pub(super) period_mismatch: f64,
+    /// The eq. 3.3-3.4 angles' sines and cosines at the last evaluated state, the starting point
+    /// of the next evaluation's (see [`angles`](super::angles)).
+    pub(super) angles: Option<Angles>,
+    /// Whether `angles` are those of a quasi-static onion settled at `y` for the present drive
+    /// (then the next [`Motor::constrain`] has nothing to do).
+    pub(super) settled: bool,
+}
+
+impl StepRun {
+    pub(super) fn new(state: &MotorState, h: f64) -> Self {
+        Self {
+            y: [
+                state.rotor_angle,
+                state.rotor_speed,
+                state.onion_angle,
+                state.onion_tilt,
+            ],
+            t: state.time,
+            t_end: state.time + h,
+            attempts: 0,
+            limited: false,
+            dt: if state.substep_hint > 0.0 {
+                state.substep_hint
+            } else {
+                1e-10
+            },
+            settle_tried_for: f64::NAN,
+            load_dominated_failed: false,
+            segment_end: f64::NAN,
+            segment_direction: 0.0,
+            whole_period: false,
+            period_end: None,
+            period_mismatch: f64::INFINITY,
+            angles: None,
+            settled: false,
+        }
+    }
+
+    /// Whether the state is the settled one whose angles are kept, for the drive `d`.
+    pub(super) fn is_settled(&self, d: &Drive) -> bool {
+        match (&self.angles, self.settled) {
+            (Some(a), true) => {
+                !d.locked && a.onion == self.y[2] && a.bar == self.y[0] && a.strain == d.direction
+            }
+            _ => false,
+        }
+    }
+
+    /// Records the segment of constant drive ending at `segment_end` if it is a new one.
+    pub(super) fn enter_segment(&mut self, segment_end: f64, direction: f64) {
+        if segment_end != self.segment_end {
+            self.whole_period = self.t == self.segment_end;
+            self.segment_end = segment_end;
+            self.segment_direction = direction;
+        }
+    }
+}
+
+impl Motor {
+    /// Advances `state` by `h` seconds with `inputs` held (the schedule, if any, switching inside
+    /// the step) and returns the outputs at the end. On `Err` the state is untouched.
+    ///
+    /// The step is cut at every switch of the schedule (no substep ever spans one), and each
+    /// piece of constant drive (a "segment") is advanced by one of:
+    /// - the overdamped settle ([`Self::settle_rotor`]) when the segment is longer than 10 rotor
+    ///   relaxation times and the rotor ends it within [`MAX_SETTLE_RESIDUAL`] of its
+    ///   equilibrium, on the exponential tail (agrees with resolved integration within 3e-7 rad
+    ///   for the default schedule), at the cost of one substep;
+    /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
+    ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
+    ///   budget`, 64 times less while more than half the budget is left (so that a short stiff
+    ///   transient at the start of a step, such as the Gilbert onion's ringing after a switch, is
+    ///   resolved); a substep at that minimum is accepted even if its error exceeds the tolerance
+    ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]). A substep across a snap of
+    ///   the quasi-static onion to its other branch is cut at the snap (located by bisection),
+    ///   since the torque jumps there and no error estimate shrinks with a substep across it;
+    /// - a slipping rotor (no equilibrium ahead) advances by whole overdamped turns
+    ///   ([`Self::slip_turns`], flagged).
+    ///
+    /// Each segment may use at most 1/16 of the substeps left. With the stepping schedule, once
+    /// three consecutive whole periods have ended in the same state relative to the strain
+    /// direction (within `tolerance / 100` and then `tolerance / 1000`), every later whole period
+    /// repeats the last one turned by `step_angle` (the equations are invariant under a common
+    /// rotation of rotor, onion and strain), so those periods are advanced at once. This covers
+    /// periods that let the rotor settle and faster ones where it turns continuously on a
+    /// periodic orbit. Hence what "accurate" means for a long step: the state at its end, and at
+    /// every switch inside it, is the resolved trajectory's within the tolerance; the transients
+    /// inside it are not reported.
+    ///
+    /// Costs (release): a 1 s step of a steady rotor takes one settle; a 1 s step over the
+    /// 10 000 switches of the default schedule a few settles (~0.1 ms); with 25-60 us periods a
+    /// few hundred to two thousand substeps (~6 ms). A step whose switches outnumber the budget
+    /// and never repeat (a schedule too fast for the rotor, which loses steps) is refused.
+    pub fn step(
+        &self,
+        state: &mut MotorState,
+        inputs: &MotorInputs,
+        h: f64,
+    ) -> Result<StepReport, String> {
+        self.validate_inputs(inputs)?;
+        Self::validate_state(state)?;
+        if !(h.is_finite() && h > 0.0 && h <= MAX_STEP) {
+            return Err(format!(
+                "communication step must be positive and at most {MAX_STEP} s, got {h}"
+            ));
+        }
+        let budget = self.params.max_substeps;
+        let mut run = StepRun::new(state, h);
+        let long_segment = 10.0 * self.rotor_relaxation_time();
+        // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
+        // repeated periods; the minimum substep reaches the segment's end once the budget is
+        // spent, so the cap ends the loop early only when the switches outnumber the budget.
+        for _ in 0..(2 * budget as u64 + 16) {
+            if run.t >= run.t_end {
+                break;
+            }
+            if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
+                if self.skip_repeated_periods(&mut run, s) {
+                    continue;
+                }
+            }
+            let d = self.drive_at(inputs, run.t);
+            if !run.is_settled(&d) {
+                run.angles = Some(self.constrain(&mut run.y, &d, run.angles.as_ref()));
+                run.settled = self.quasi_static();
+            }
+            let segment_end = match inputs.schedule.get() {
+                Some(s) => s.next_switch_after(run.t).min(run.t_end),
+                None => run.t_end,
+            };
+            run.enter_segment(segment_end, d.direction);
+            if self.advance_load_dominated(&mut run, &d, segment_end) {
+                continue;
+            }
+            if run.settle_tried_for != segment_end && segment_end - run.t > long_segment {
+                run.settle_tried_for = segment_end;
+                if self.advance_overdamped(&mut run, &d, segment_end) {
+                    continue;
+                }
+            }
+            self.substep(&mut run, &d, segment_end, budget);
+        }
+        if run.t < run.t_end {
+            return Err(format!(
+                "the step from t = {} s by {h} s spans more schedule switches than \
+                 max_substeps = {budget} allows to resolve (the rotor cannot settle within a \
+                 period of the schedule); shorten the step or raise max_substeps",
+                state.time
+            ));
+        }
+        let d = self.drive_at(inputs, run.t_end);
+        let angles = match run.angles {
+            Some(a) if run.is_settled(&d) => a,
+            _ => self.constrain(&mut run.y, &d, run.angles.as_ref()),
+        };
+        let y = run.y;
+        *state = MotorState {
+            time: run.t_end,
+            rotor_angle: y[0],
+            rotor_speed: y[1],
+            onion_angle: y[2],
+            onion_tilt: y[3],
+            substep_hint: run.dt.clamp(1e-300, MAX_STEP),
+        };
+        Ok(StepReport {
+            outputs: self.outputs_with(&y, &d, &angles),
+            substeps: run.attempts,
+            accuracy_limited: run.limited,
+        })
+    }
+
+    /// The constraints that hold at every instant: a locked rotor does not turn, and the
+    /// quasi-static onion sits settled for the present drive.
+    /// Returns the angles at the constrained state (turned from `hint` when close).
+    pub(super) fn constrain(&self, y: &mut Vector, d: &Drive, hint: Option<&Angles>) -> Angles {
+        if d.locked {
+            y[1] = 0.0;
+        }
+        if self.quasi_static() {
+            let a = self.settle_angles(y, d, hint);
+            y[2] = a.onion;
+            a
+        } else {
+            Self::angles_at(y, d, hint)
+        }
+    }
+}
