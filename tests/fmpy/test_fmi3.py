@@ -83,6 +83,19 @@ def test_the_binaries_are_the_fmi2_ones_under_fmi3_platform_tuples(model):
             assert z3.read(renamed) == data
 
 
+@pytest.mark.parametrize("model", MODELS)
+def test_the_documentation_names_its_own_fmi_version(model):
+    """The FMI 3.0 FMU ships the FMI 2.0 FMU's page but for the version it names."""
+    with zipfile.ZipFile(FMI2_DIR / f"{model}.fmu") as z2, zipfile.ZipFile(fmi3_path(model)) as z3:
+        page2 = z2.read("documentation/index.html").decode()
+        page3 = z3.read("documentation/index.html").decode()
+    assert "FMI 2.0 Co-Simulation" in page2 and "FMI 3.0" not in page2
+    assert "FMI 3.0 Co-Simulation" in page3 and "FMI 2.0" not in page3
+    assert page3 == page2.replace("FMI 2.0 Co-Simulation", "FMI 3.0 Co-Simulation")
+    assert sorted(n for n in z3.namelist() if n.startswith("documentation/")) == \
+        sorted(n for n in z2.namelist() if n.startswith("documentation/"))
+
+
 def _largest_difference(a, b):
     worst = 0.0
     for name in a.dtype.names:

@@ -39,6 +39,31 @@ pub fn package_all_platforms(
         .collect()
 }
 
+/// The cross-check run's plot of model `name` (python/actuator_fmus/crosscheck.py), shipped in the
+/// FMU's documentation when present.
+fn plot_path(name: &str) -> PathBuf {
+    crate::repository_root()
+        .join("docs/fmu")
+        .join(format!("{name}.png"))
+}
+
+/// `documentation/index.html` of `factory`'s model as an FMI `fmi_version` FMU ("2.0" or "3.0"):
+/// the same page in both, but for the interfaces it names.
+pub fn documentation_page(factory: &dyn Factory, fmi_version: &str) -> String {
+    let info = factory.info();
+    let mut equations = factory.documentation().to_string();
+    if plot_path(info.name).exists() {
+        equations.push_str(&format!(
+            "\n<h2>Plot</h2>\n<p>The cross-check run (default experiment, inputs from \
+             <code>{name}_in.csv</code>):</p>\n<p><img src=\"plot.png\" alt=\"{name} cross-check run\" \
+             style=\"max-width:100%\"></p>\n",
+            name = info.name
+        ));
+    }
+    equations.insert_str(0, &choices_html(factory, info));
+    documentation(info, factory.model_exchange(), fmi_version, &equations)
+}
+
 fn package(
     factory: &dyn Factory,
     binaries: &[(String, &str, Vec<u8>)],
@@ -54,21 +79,8 @@ fn package(
     let mut zip = zip::ZipWriter::new(file);
     let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
     // A plot of the model's cross-check run (python/actuator_fmus/crosscheck.py), shipped when present.
-    let plot_path = crate::repository_root()
-        .join("docs/fmu")
-        .join(format!("{}.png", info.name));
-    let plot = std::fs::read(&plot_path).ok();
-    let mut equations = factory.documentation().to_string();
-    if plot.is_some() {
-        equations.push_str(&format!(
-            "\n<h2>Plot</h2>\n<p>The cross-check run (default experiment, inputs from \
-             <code>{name}_in.csv</code>):</p>\n<p><img src=\"plot.png\" alt=\"{name} cross-check run\" \
-             style=\"max-width:100%\"></p>\n",
-            name = info.name
-        ));
-    }
-    equations.insert_str(0, &choices_html(factory, info));
-    let doc = documentation(info, factory.model_exchange(), &equations);
+    let plot = std::fs::read(plot_path(info.name)).ok();
+    let doc = documentation_page(factory, "2.0");
     let mut entries: Vec<(String, &[u8])> = vec![
         (
             "modelDescription.xml".into(),
@@ -216,7 +228,12 @@ fn choices_html(factory: &dyn Factory, info: &ModelInfo) -> String {
 
 /// `documentation/index.html`: what the model is, its interfaces and variables, the equations it
 /// implements.
-pub fn documentation(info: &ModelInfo, model_exchange: bool, equations: &str) -> String {
+pub fn documentation(
+    info: &ModelInfo,
+    model_exchange: bool,
+    fmi_version: &str,
+    equations: &str,
+) -> String {
     let enumeration_of = crate::choices::enumeration_variables(info.model_description_xml);
     let mut rows = String::new();
     for v in info.variables {
@@ -266,9 +283,9 @@ pub fn documentation(info: &ModelInfo, model_exchange: bool, equations: &str) ->
         description = escape(info.description),
         guid = info.guid,
         interfaces = if model_exchange {
-            "FMI 2.0 Co-Simulation and Model Exchange (one binary serves both)"
+            format!("FMI {fmi_version} Co-Simulation and Model Exchange (one binary serves both)")
         } else {
-            "FMI 2.0 Co-Simulation"
+            format!("FMI {fmi_version} Co-Simulation")
         },
     )
 }

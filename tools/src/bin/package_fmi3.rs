@@ -1,6 +1,6 @@
 //! `package_fmi3 <FMI 2.0 FMU dir> <output dir>`: writes `<output dir>/<Model>.fmu`, the FMI 3.0
 //! FMU of every model, from the FMI 2.0 FMU that `package_fmus` wrote: the same binaries (one
-//! library exports both APIs) under FMI 3.0's platform tuples, the same documentation, the
+//! library exports both APIs) under FMI 3.0's platform tuples, its documentation page naming FMI 3.0, the
 //! FMI 3.0 model description generated from the same source, and the model's mechanical flanges
 //! as `terminalsAndIcons/terminalsAndIcons.xml` when it declares any.
 
@@ -18,6 +18,7 @@ fn repackage(
     fmi2: &Path,
     out: &Path,
     description: &str,
+    documentation: &str,
     terminals: Option<&str>,
 ) -> Result<(), String> {
     let file =
@@ -33,6 +34,10 @@ fn repackage(
         .map_err(|e| e.to_string())?;
     zip.write_all(description.as_bytes())
         .map_err(|e| e.to_string())?;
+    zip.start_file("documentation/index.html", options)
+        .map_err(|e| e.to_string())?;
+    zip.write_all(documentation.as_bytes())
+        .map_err(|e| e.to_string())?;
     if let Some(terminals) = terminals {
         zip.start_file("terminalsAndIcons/terminalsAndIcons.xml", options)
             .map_err(|e| e.to_string())?;
@@ -42,7 +47,7 @@ fn repackage(
     for i in 0..archive.len() {
         let mut entry = archive.by_index(i).map_err(|e| e.to_string())?;
         let name = entry.name().to_string();
-        if name == "modelDescription.xml" || entry.is_dir() {
+        if name == "modelDescription.xml" || name == "documentation/index.html" || entry.is_dir() {
             continue;
         }
         let renamed = PLATFORMS
@@ -73,7 +78,15 @@ fn main() {
         let fmi2 = Path::new(fmi2_dir).join(format!("{}.fmu", model.name));
         let out = Path::new(out_dir).join(format!("{}.fmu", model.name));
         let terminals = actuator_fmus::terminals::terminals_and_icons(model.name);
-        match repackage(&fmi2, &out, model.model_description_xml, terminals) {
+        let Some(factory) = actuator_fmus::export::REGISTRY
+            .iter()
+            .find(|f| f.info().name == model.name)
+        else {
+            eprintln!("package_fmi3: {} is not in the registry", model.name);
+            std::process::exit(1);
+        };
+        let page = actuator_fmus_tools::package::documentation_page(*factory, "3.0");
+        match repackage(&fmi2, &out, model.model_description_xml, &page, terminals) {
             Ok(()) => println!("wrote {}", out.display()),
             Err(e) => {
                 eprintln!("package_fmi3: {e}");
