@@ -18,6 +18,52 @@ fn check_float64(inst: &Instance, function: &str, vrs: &[u32]) -> Option<fmi3Sta
     })
 }
 
+/// The raw arguments both derivative calls share, with their lengths.
+struct Arguments {
+    unknowns: (*const fmi3ValueReference, usize),
+    knowns: (*const fmi3ValueReference, usize),
+    seed: (*const f64, usize),
+    sensitivity: (*mut f64, usize),
+}
+
+/// The arguments as slices of Float64 value references and values.
+type Checked<'a> = (&'a [u32], &'a [u32], &'a [f64], &'a mut [f64]);
+
+impl Arguments {
+    /// No NULL array of non-zero length, and every value reference a Float64 variable.
+    ///
+    /// # Safety
+    /// Each non-NULL pointer points to as many values as its length says.
+    unsafe fn checked<'a>(
+        &self,
+        inst: &Instance,
+        function: &str,
+    ) -> Result<Checked<'a>, fmi3Status> {
+        // SAFETY: the caller's contract.
+        let arrays = unsafe {
+            (
+                slice(self.unknowns.0, self.unknowns.1),
+                slice(self.knowns.0, self.knowns.1),
+                slice(self.seed.0, self.seed.1),
+                slice_mut(self.sensitivity.0, self.sensitivity.1),
+            )
+        };
+        let (Some(unknowns), Some(knowns), Some(seed), Some(sensitivity)) = arrays else {
+            return Err(null_argument(
+                inst,
+                function,
+                "unknowns, knowns, seed or sensitivity",
+            ));
+        };
+        match check_float64(inst, function, unknowns)
+            .or_else(|| check_float64(inst, function, knowns))
+        {
+            Some(refused) => Err(refused),
+            None => Ok((unknowns, knowns, seed, sensitivity)),
+        }
+    }
+}
+
 #[no_mangle]
 #[allow(clippy::too_many_arguments)]
 pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
@@ -40,19 +86,16 @@ pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
                      ({n_sensitivity}) nUnknowns ({n_unknowns}): the variables are scalars"
                 ));
             }
-            let (Some(unknowns), Some(knowns), Some(seed), Some(sensitivity)) = (
-                slice(unknowns, n_unknowns),
-                slice(knowns, n_knowns),
-                slice(seed, n_seed),
-                slice_mut(sensitivity, n_sensitivity),
-            ) else {
-                return null_argument(inst, F, "unknowns, knowns, seed or sensitivity");
+            let arguments = Arguments {
+                unknowns: (unknowns, n_unknowns),
+                knowns: (knowns, n_knowns),
+                seed: (seed, n_seed),
+                sensitivity: (sensitivity, n_sensitivity),
             };
-            if let Some(refused) =
-                check_float64(inst, F, unknowns).or_else(|| check_float64(inst, F, knowns))
-            {
-                return refused;
-            }
+            let (unknowns, knowns, seed, sensitivity) = match arguments.checked(inst, F) {
+                Ok(a) => a,
+                Err(refused) => return refused,
+            };
             inst.get_directional_derivative(F, unknowns, knowns, seed, sensitivity)
         })
     }
@@ -82,19 +125,16 @@ pub unsafe extern "C" fn fmi3GetAdjointDerivative(
                      ({n_sensitivity}) nKnowns ({n_knowns}): the variables are scalars"
                 ));
             }
-            let (Some(unknowns), Some(knowns), Some(seed), Some(sensitivity)) = (
-                slice(unknowns, n_unknowns),
-                slice(knowns, n_knowns),
-                slice(seed, n_seed),
-                slice_mut(sensitivity, n_sensitivity),
-            ) else {
-                return null_argument(inst, F, "unknowns, knowns, seed or sensitivity");
+            let arguments = Arguments {
+                unknowns: (unknowns, n_unknowns),
+                knowns: (knowns, n_knowns),
+                seed: (seed, n_seed),
+                sensitivity: (sensitivity, n_sensitivity),
             };
-            if let Some(refused) =
-                check_float64(inst, F, unknowns).or_else(|| check_float64(inst, F, knowns))
-            {
-                return refused;
-            }
+            let (unknowns, knowns, seed, sensitivity) = match arguments.checked(inst, F) {
+                Ok(a) => a,
+                Err(refused) => return refused,
+            };
             let mut column = vec![0.0; unknowns.len()];
             let mut status = Status::OK;
             for (k, &known) in knowns.iter().enumerate() {
