@@ -107,7 +107,14 @@ pub trait Interface: 'static {
         + Serialize
         + DeserializeOwned;
     /// Inputs; `Default` gives the start values.
-    type Inputs: Clone + std::fmt::Debug + Default + PartialEq + Send + Serialize + DeserializeOwned;
+    type Inputs: Clone
+        + std::fmt::Debug
+        + Default
+        + PartialEq
+        + Identical
+        + Send
+        + Serialize
+        + DeserializeOwned;
     /// Outputs; `Default` gives zeros (or declared start values).
     type Outputs: Clone
         + std::fmt::Debug
@@ -127,6 +134,10 @@ pub trait Interface: 'static {
     /// The continuous states, in the order of `<ModelStructure><Derivatives>`; the same type
     /// holds their derivatives. An empty struct for models without states.
     type States: ContinuousStates;
+    /// The knowns of the Jacobian: the Real inputs, then the continuous states.
+    type Known: Identifier;
+    /// The unknowns of the Jacobian: the Real outputs, then the state derivatives.
+    type Unknown: Identifier;
     /// `numberOfEventIndicators` of the model description.
     const EVENT_INDICATORS: usize;
     /// Metadata of every variable.
@@ -166,6 +177,45 @@ impl ContinuousStates for () {
     const NOMINALS: &'static [f64] = &[];
     fn from_slice(_: &[f64]) -> Self {}
     fn write_to(&self, _: &mut [f64]) {}
+}
+
+/// One known (an input or a continuous state) or one unknown (an output or a state derivative) of
+/// a model's Jacobian, generated per model description as `crate::variables::<model>::{Known,
+/// Unknown}`: one variant per variable, named after it (`der(joint_angle)` becoming
+/// `DerJointAngle`), so that a renamed variable is a compile error in the model's partials.
+pub trait Identifier: Copy + Eq + std::fmt::Debug + Send + Sync + 'static {
+    /// Every identifier, in the order of [`Identifier::index`].
+    const ALL: &'static [Self];
+    /// The value reference (Real) of each identifier, in the same order.
+    const VALUE_REFERENCES: &'static [u32];
+    /// The position in [`Identifier::ALL`].
+    fn index(self) -> usize;
+    /// The identifier of a Real value reference, if it is one of these.
+    fn from_value_reference(vr: u32) -> Option<Self>;
+}
+
+/// No knowns or unknowns (hand-written interfaces in tests).
+impl Identifier for () {
+    const ALL: &'static [Self] = &[];
+    const VALUE_REFERENCES: &'static [u32] = &[];
+    fn index(self) -> usize {
+        0
+    }
+    fn from_value_reference(_: u32) -> Option<Self> {
+        None
+    }
+}
+
+/// Equality bit for bit (Reals by `f64::to_bits`): the export layer reuses partials only at
+/// exactly the inputs they were taken at. Generated for each model's `Inputs`.
+pub trait Identical {
+    fn identical(&self, other: &Self) -> bool;
+}
+
+impl Identical for f64 {
+    fn identical(&self, other: &Self) -> bool {
+        self.to_bits() == other.to_bits()
+    }
 }
 
 include!(concat!(env!("OUT_DIR"), "/model_tables.rs"));

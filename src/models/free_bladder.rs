@@ -7,10 +7,10 @@
 //! Exchange. Inputs outside the solvable range are evaluated at the nearest valid point and
 //! flagged (`input_clamped`, `out_of_range_policy`), each excursion logged once.
 
-use super::{Model, Partials, Refusal, Report, Status};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::free_bladder::{FreeBladder as Tube, FreeBladderState};
-use crate::variables::free_bladder::{Inputs, Outputs, Parameters, Variables};
+use crate::variables::free_bladder::{Inputs, Known, Outputs, Parameters, Unknown, Variables};
 use serde::{Deserialize, Serialize};
 
 /// Gauge pressure of an absolute vacuum at standard atmosphere, Pa: nothing lower is physical.
@@ -117,6 +117,23 @@ impl FreeBladder {
     }
 }
 
+impl FreeBladder {
+    /// Each Real output with the field of the physics' state it is.
+    const REAL_OUTPUTS: [(Unknown, fn(&FreeBladderState) -> f64); 11] = [
+        (Unknown::InnerDiameter, |s| s.inner_diameter),
+        (Unknown::OuterDiameter, |s| s.outer_diameter),
+        (Unknown::Volume, |s| s.fluid_volume),
+        (Unknown::Compliance, |s| s.compliance),
+        (Unknown::StretchAxial, |s| s.stretch_axial),
+        (Unknown::StretchHoop, |s| s.stretch_hoop),
+        (Unknown::StretchRadial, |s| s.stretch_radial),
+        (Unknown::StressAxial, |s| s.stress_axial),
+        (Unknown::StressHoop, |s| s.stress_hoop),
+        (Unknown::Force, |s| s.force),
+        (Unknown::BallooningPressure, |s| s.ballooning_pressure),
+    ];
+}
+
 impl Model for FreeBladder {
     type Variables = Variables;
     const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
@@ -156,62 +173,28 @@ impl Model for FreeBladder {
     /// Every Real output by `pressure` and `length`, exact (the free bladder's implicit function
     /// theorem on eq. 2.18), chained through the input clamp: a clamped input's column is 0, and
     /// at the ballooning clamp the pressure evaluated follows the length.
-    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+    fn partials(&mut self, inputs: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
         let point = self.operating_point(inputs);
         let (_, d) = self
             .tube
             .evaluate_with_partials(point.pressure, point.length)?;
         let by_pressure = d.along(point.pressure_slope[0], 0.0);
         let by_length = d.along(point.pressure_slope[1], point.length_slope);
-        let mut p = Partials::default();
-        for (output, dp, dl) in [
-            (
-                "inner_diameter",
-                by_pressure.inner_diameter,
-                by_length.inner_diameter,
-            ),
-            (
-                "outer_diameter",
-                by_pressure.outer_diameter,
-                by_length.outer_diameter,
-            ),
-            ("volume", by_pressure.fluid_volume, by_length.fluid_volume),
-            ("compliance", by_pressure.compliance, by_length.compliance),
-            (
-                "stretch_axial",
-                by_pressure.stretch_axial,
-                by_length.stretch_axial,
-            ),
-            (
-                "stretch_hoop",
-                by_pressure.stretch_hoop,
-                by_length.stretch_hoop,
-            ),
-            (
-                "stretch_radial",
-                by_pressure.stretch_radial,
-                by_length.stretch_radial,
-            ),
-            (
-                "stress_axial",
-                by_pressure.stress_axial,
-                by_length.stress_axial,
-            ),
-            (
-                "stress_hoop",
-                by_pressure.stress_hoop,
-                by_length.stress_hoop,
-            ),
-            ("force", by_pressure.force, by_length.force),
-            (
-                "ballooning_pressure",
-                by_pressure.ballooning_pressure,
-                by_length.ballooning_pressure,
-            ),
-        ] {
-            p.row(output, &[("pressure", dp), ("length", dl)]);
+        for (output, field) in Self::REAL_OUTPUTS {
+            p.row(
+                output,
+                &[
+                    (Known::Pressure, field(&by_pressure)),
+                    (Known::Length, field(&by_length)),
+                ],
+            );
         }
-        Ok(p)
+        Ok(())
+    }
+
+    /// The partials are those of the inputs alone.
+    fn partials_key(&self) -> Option<HistoryKey> {
+        Some(HistoryKey::NONE)
     }
 
     fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
@@ -222,6 +205,7 @@ impl Model for FreeBladder {
 
 #[cfg(test)]
 mod tests {
+    use super::super::all_partials;
     use super::*;
 
     fn run(p: &Parameters, pressure: f64, length: f64) -> (Outputs, Report) {
@@ -290,20 +274,20 @@ mod tests {
         assert!(volumes[0] > 20.0 * volumes[2] && volumes[3] < volumes[5]);
     }
 
-    /// The Real outputs by name.
-    fn reals(o: &Outputs) -> [(&'static str, f64); 11] {
+    /// The Real outputs by identifier.
+    fn reals(o: &Outputs) -> [(Unknown, f64); 11] {
         [
-            ("inner_diameter", o.inner_diameter),
-            ("outer_diameter", o.outer_diameter),
-            ("volume", o.volume),
-            ("compliance", o.compliance),
-            ("stretch_axial", o.stretch_axial),
-            ("stretch_hoop", o.stretch_hoop),
-            ("stretch_radial", o.stretch_radial),
-            ("stress_axial", o.stress_axial),
-            ("stress_hoop", o.stress_hoop),
-            ("force", o.force),
-            ("ballooning_pressure", o.ballooning_pressure),
+            (Unknown::InnerDiameter, o.inner_diameter),
+            (Unknown::OuterDiameter, o.outer_diameter),
+            (Unknown::Volume, o.volume),
+            (Unknown::Compliance, o.compliance),
+            (Unknown::StretchAxial, o.stretch_axial),
+            (Unknown::StretchHoop, o.stretch_hoop),
+            (Unknown::StretchRadial, o.stretch_radial),
+            (Unknown::StressAxial, o.stress_axial),
+            (Unknown::StressHoop, o.stress_hoop),
+            (Unknown::Force, o.force),
+            (Unknown::BallooningPressure, o.ballooning_pressure),
         ]
     }
 
@@ -338,14 +322,17 @@ mod tests {
                     .ballooning_pressure(length.clamp(0.1 * l0, 10.0 * l0));
                 let pressure = fraction * top;
                 let inputs = Inputs { pressure, length };
-                let partials = m.partials(&inputs).unwrap();
+                let partials = all_partials(&mut m, &inputs).unwrap();
                 let gap = if fraction < 1.0 { 1.0 - fraction } else { 1.0 };
-                for (input, h) in [("pressure", 1e-5 * gap * top), ("length", 1e-7 * l0)] {
+                for (input, h) in [
+                    (Known::Pressure, 1e-5 * gap * top),
+                    (Known::Length, 1e-7 * l0),
+                ] {
                     let at = |sign: f64| {
                         let mut shifted = inputs.clone();
                         match input {
-                            "pressure" => shifted.pressure += sign * h,
-                            _ => shifted.length += sign * h,
+                            Known::Pressure => shifted.pressure += sign * h,
+                            Known::Length => shifted.length += sign * h,
                         }
                         run(&p, shifted.pressure, shifted.length).0
                     };
@@ -353,10 +340,8 @@ mod tests {
                     for ((name, hi), (_, lo)) in reals(&up).into_iter().zip(reals(&down)) {
                         let central = (hi - lo) / (2.0 * h);
                         let exact = partials
-                            .get(name)
-                            .and_then(|row| row.iter().find(|(n, _)| *n == input))
-                            .map(|(_, d)| *d)
-                            .unwrap_or_else(|| panic!("no partial of {name} by {input}"));
+                            .partial(name, input)
+                            .unwrap_or_else(|| panic!("no partial of {name:?} by {input:?}"));
                         let size = hi.abs().max(lo.abs()).max(1e-30);
                         // Near the ballooning pressure the volume ratio is ill-conditioned (the
                         // pressure is flat in it), so its rounding is larger there.
@@ -364,7 +349,7 @@ mod tests {
                         let scale = exact.abs().max(central.abs()) + noise * size / h.max(1e-30);
                         assert!(
                             (exact - central).abs() <= 1e-6 * scale,
-                            "lambda {lambda}, P {pressure}: d{name}/d{input} exact {exact}, \
+                            "lambda {lambda}, P {pressure}: d{name:?}/d{input:?} exact {exact}, \
                              central {central}"
                         );
                         zero_columns += usize::from(exact == 0.0 && central == 0.0);

@@ -8,14 +8,14 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{Model, Partials, Refusal, Report, Status};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{Bladder, BladderTube, KnittedCylinder};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
 use crate::physics::knitted_muscle::{Friction, KnittedAssembly, KnittedOutput};
 use crate::physics::mckibben::{is_slack, BladderModel};
 use crate::variables::knitted_muscle::{
-    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -31,11 +31,6 @@ pub struct KnittedMuscle {
     /// Whether the last evaluation needed the zero-pressure fallback of a collapsing bladder:
     /// logged once per excursion.
     collapsed: bool,
-    /// The last partials, the point (pressure, length, friction z and position, as bits) they
-    /// were taken at, and whether they hold the bladder's stiffness row (a second-order pass): a
-    /// Jacobian's further seeds reuse them. Not part of the FMU state.
-    #[serde(skip)]
-    partials_cache: Option<([u64; 4], bool, Partials)>,
     /// The dissertation's signed force (`signed_force`); else tension only (see [`tension_only`]).
     signed_force: bool,
     /// The straight yarn's axial stiffness `k_s = 2 m E A / L_max`, N/m (from
@@ -164,12 +159,13 @@ impl KnittedMuscle {
     /// Exact partials on the branch [`Self::compute`] takes (see docs/model-exchange.md for
     /// the one-sided choices), from [`KnittedAssembly::rows_with_yarn`]; with a bladder, the
     /// stiffness's row only if `stiffness`; force and stiffness 0 while `slack`.
-    fn partials_at(
+    fn write_partials(
         &self,
         inputs: &Inputs,
-        stiffness: bool,
         slack: bool,
-    ) -> Result<Partials, String> {
+        table: &mut Partials<Variables>,
+    ) -> Result<(), String> {
+        let stiffness = table.wants(Unknown::Stiffness);
         let (pressure, length) = (inputs.pressure, inputs.length);
         let k_s = self.yarn_stiffness;
         let mut r =
@@ -180,19 +176,21 @@ impl KnittedMuscle {
             r.force = [0.0; 2];
             r.stiffness = r.stiffness.map(|_| [0.0; 2]);
         }
-        let mut table = Partials::default();
-        let mut add = |name: &'static str, row: [f64; 2]| {
-            table.row(name, &[("pressure", row[0]), ("length", row[1])]);
+        let mut add = |output: Unknown, row: [f64; 2]| {
+            table.row(
+                output,
+                &[(Known::Pressure, row[0]), (Known::Length, row[1])],
+            );
         };
-        add("force", r.force);
-        add("volume", r.volume);
-        add("effective_pressure", r.effective_pressure);
-        add("friction_force", r.friction_force);
-        add("max_radius", r.max_radius);
+        add(Unknown::Force, r.force);
+        add(Unknown::Volume, r.volume);
+        add(Unknown::EffectivePressure, r.effective_pressure);
+        add(Unknown::FrictionForce, r.friction_force);
+        add(Unknown::MaxRadius, r.max_radius);
         if let Some(stiffness) = r.stiffness {
-            add("stiffness", stiffness);
+            add(Unknown::Stiffness, stiffness);
         }
-        Ok(table)
+        Ok(())
     }
 }
 
@@ -242,7 +240,6 @@ impl Model for KnittedMuscle {
             history,
             out_of_range: false,
             collapsed: false,
-            partials_cache: None,
             signed_force: p.signed_force,
             yarn_stiffness,
         })
@@ -279,17 +276,15 @@ impl Model for KnittedMuscle {
             self.history = out.history;
         }
     }
-    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
-        self.cached_partials(inputs, true)
+    /// Every row; with a bladder the stiffness's (a second-order pass) only when wanted.
+    fn partials(&mut self, inputs: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
+        let slack = !self.signed_force && self.signed_force_at(inputs).is_some_and(|f| f < 0.0);
+        self.write_partials(inputs, slack, p)
     }
 
-    fn partials_for(
-        &mut self,
-        inputs: &Inputs,
-        outputs: &[&'static str],
-    ) -> Result<Partials, String> {
-        // With a bladder the stiffness's row costs a second-order pass: only when asked.
-        self.cached_partials(inputs, outputs.contains(&"stiffness"))
+    /// The partials read the friction history besides the inputs.
+    fn partials_key(&self) -> Option<HistoryKey> {
+        Some(HistoryKey::of([self.history.z, self.history.position]))
     }
 }
 
@@ -304,24 +299,11 @@ impl KnittedMuscle {
         (self.out_of_range, self.collapsed) = flags;
         force
     }
-
-    fn cached_partials(&mut self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
-        let h = &self.history;
-        let key = [inputs.pressure, inputs.length, h.z, h.position].map(f64::to_bits);
-        if let Some((cached, has_stiffness, rows)) = &self.partials_cache {
-            if *cached == key && (*has_stiffness || !stiffness) {
-                return Ok(rows.clone());
-            }
-        }
-        let slack = !self.signed_force && self.signed_force_at(inputs).is_some_and(|f| f < 0.0);
-        let rows = self.partials_at(inputs, stiffness, slack)?;
-        self.partials_cache = Some((key, stiffness, rows.clone()));
-        Ok(rows)
-    }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::all_partials;
     use super::*;
     use crate::models::Status;
     use std::f64::consts::SQRT_2;
@@ -452,13 +434,13 @@ mod tests {
         assert!(KnittedMuscle::new(&p, &Inputs::default()).is_err());
     }
 
-    const OUTPUTS: [&str; 6] = [
-        "force",
-        "volume",
-        "effective_pressure",
-        "friction_force",
-        "max_radius",
-        "stiffness",
+    const OUTPUTS: [Unknown; 6] = [
+        Unknown::Force,
+        Unknown::Volume,
+        Unknown::EffectivePressure,
+        Unknown::FrictionForce,
+        Unknown::MaxRadius,
+        Unknown::Stiffness,
     ];
 
     fn values(o: &Outputs) -> [f64; 6] {
@@ -525,7 +507,7 @@ mod tests {
                 let mut m = KnittedMuscle::new(p, &start).unwrap();
                 for &pressure in pressures {
                     let x = Inputs { pressure, length };
-                    let exact = m.partials(&x).unwrap();
+                    let exact = all_partials(&mut m, &x).unwrap();
                     if let Some(bag) = m.assembly.bag() {
                         let p_eff = pressure.max(0.0);
                         bag_binds += usize::from(
@@ -551,12 +533,11 @@ mod tests {
                     let base = at(0.0, 0.0);
                     let h = [1e-6 * pressure.abs() + 1e-3, 1e-7 * length];
                     let steps = [[h[0], 0.0], [0.0, h[1]]];
-                    for (j, input) in ["pressure", "length"].into_iter().enumerate() {
+                    for (j, input) in [Known::Pressure, Known::Length].into_iter().enumerate() {
                         let (up, down) =
                             (at(steps[j][0], steps[j][1]), at(-steps[j][0], -steps[j][1]));
                         for (k, name) in OUTPUTS.into_iter().enumerate() {
-                            let row = exact.get(name).unwrap();
-                            let e = row.iter().find(|(n, _)| *n == input).unwrap().1;
+                            let e = exact.partial(name, input).unwrap();
                             let central = (up[k] - down[k]) / (2.0 * h[j]);
                             let (right, left) =
                                 ((up[k] - base[k]) / h[j], (base[k] - down[k]) / h[j]);
@@ -569,7 +550,7 @@ mod tests {
                             assert!(
                                 err < 1e-5 || (e - central).abs() < 1e-10 * (1.0 + base[k].abs()),
                                 "shape {} bladder {} bag {} friction {} P {pressure} L {length}: \
-                                 d{name}/d{input} exact {e} central {central}",
+                                 d{name:?}/d{input:?} exact {e} central {central}",
                                 p.shape_model,
                                 p.bladder_model,
                                 p.bag_diameter,
@@ -620,13 +601,15 @@ mod tests {
             );
             out.force
         };
-        let d = m
-            .partials(&Inputs {
+        let d = all_partials(
+            &mut m,
+            &Inputs {
                 pressure,
                 length: l,
-            })
-            .unwrap();
-        let exact = d.get("force").unwrap()[1].1;
+            },
+        )
+        .unwrap();
+        let exact = d.partial(Unknown::Force, Known::Length).unwrap();
         let h = 1e-7 * l;
         let above = (force(&mut m, l + h) - force(&mut m, l)) / h;
         assert!(
@@ -637,11 +620,14 @@ mod tests {
         // no length slope.
         let bag_force = -pressure * std::f64::consts::PI * 0.0425f64.powi(2);
         assert!((force(&mut m, l - h) - bag_force).abs() < 1e-12 * bag_force.abs());
-        let d = m.partials(&Inputs {
-            pressure,
-            length: l - h,
-        });
-        assert_eq!(d.unwrap().get("force").unwrap()[1], ("length", 0.0));
+        let d = all_partials(
+            &mut m,
+            &Inputs {
+                pressure,
+                length: l - h,
+            },
+        );
+        assert_eq!(d.unwrap().partial(Unknown::Force, Known::Length), Some(0.0));
     }
 
     #[test]
@@ -651,16 +637,17 @@ mod tests {
             pressure: 1e5,
             length: m.assembly.breaking_length() + 0.01,
         };
-        let d = m.partials(&beyond).unwrap();
+        let d = all_partials(&mut m, &beyond).unwrap();
         for name in OUTPUTS {
-            assert_eq!(d.get(name).unwrap()[1], ("length", 0.0), "{name}");
+            assert_eq!(d.partial(name, Known::Length), Some(0.0), "{name:?}");
         }
-        assert!(d.get("force").unwrap()[0].1 != 0.0);
+        assert!(d.partial(Unknown::Force, Known::Pressure).unwrap() != 0.0);
     }
 }
 
 #[cfg(test)]
 mod yarn_tests {
+    use super::super::all_partials;
     use super::*;
     use crate::physics::knitted_yarn::SPECTRA_LINE_RIGIDITY;
 
@@ -776,7 +763,7 @@ mod yarn_tests {
                 pressure: 2e4,
                 length: hi + 0.005,
             };
-            let d = m.partials(&x).unwrap();
+            let d = all_partials(&mut m, &x).unwrap();
             let value = |m: &mut KnittedMuscle, pressure: f64, length: f64| {
                 let (o, _) = step(m, pressure, length);
                 [
@@ -788,11 +775,11 @@ mod yarn_tests {
                 ]
             };
             let names = [
-                "force",
-                "volume",
-                "effective_pressure",
-                "max_radius",
-                "stiffness",
+                Unknown::Force,
+                Unknown::Volume,
+                Unknown::EffectivePressure,
+                Unknown::MaxRadius,
+                Unknown::Stiffness,
             ];
             for (column, h) in [(0, 1.0), (1, 1e-7)] {
                 let (dp, dl) = if column == 0 { (h, 0.0) } else { (0.0, h) };
@@ -800,11 +787,11 @@ mod yarn_tests {
                 let down = value(&mut m, x.pressure - dp, x.length - dl);
                 for (k, name) in names.iter().enumerate() {
                     let fd = (up[k] - down[k]) / (2.0 * h);
-                    let exact = d.get(name).unwrap()[column].1;
+                    let exact = d.get(*name).unwrap()[column];
                     let scale = fd.abs().max(exact.abs()).max(1e-12);
                     assert!(
                         (fd - exact).abs() < 1e-4 * scale,
-                        "bladder {bladder} {name}[{column}]: {exact} vs {fd}"
+                        "bladder {bladder} {name:?}[{column}]: {exact} vs {fd}"
                     );
                 }
             }
@@ -824,8 +811,8 @@ mod yarn_tests {
         };
         let (out, _) = step(&mut m, x.pressure, x.length);
         assert!(out.slack && out.force == 0.0 && out.stiffness == 0.0);
-        let d = m.partials(&x).unwrap();
-        assert!(d.get("force").unwrap().iter().all(|(_, v)| *v == 0.0));
+        let d = all_partials(&mut m, &x).unwrap();
+        assert!(d.get(Unknown::Force).unwrap().iter().all(|v| *v == 0.0));
         let mut signed = KnittedMuscle::new(
             &Parameters {
                 signed_force: true,

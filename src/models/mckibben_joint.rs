@@ -20,7 +20,7 @@ use crate::physics::mckibben::{
     MuscleGeometry,
 };
 use crate::variables::mckibben_joint::{
-    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -370,7 +370,7 @@ impl Model for McKibbenJoint {
     /// `command_mode` 1, `d` solves `torque(d, q) = u`: `dd/du = 1/torque_d` and
     /// `dd/dq = -torque_q/torque_d` (implicit function theorem), both 0 when saturated.
     /// jointVelocity moves nothing.
-    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+    fn partials(&mut self, inputs: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
         let q = inputs.joint_position;
         let (pmax, r) = (self.max_pressure, self.moment_arm);
         // The operating point as `evaluate` finds it (a copy: the warning state stays put).
@@ -401,19 +401,18 @@ impl Model for McKibbenJoint {
         };
         let flexor = [ff_d * dd_du, ff_d * dd_dq + ff_q];
         let extensor = [fe_d * dd_du, fe_d * dd_dq + fe_q];
-        let mut p = Partials::default();
-        let row = |d: [f64; 2]| [("actuatorInput", d[0]), ("jointPosition", d[1])];
+        let row = |d: [f64; 2]| [(Known::ActuatorInput, d[0]), (Known::JointPosition, d[1])];
         p.row(
-            "jointTorque",
+            Unknown::JointTorque,
             &row([r * (flexor[0] - extensor[0]), r * (flexor[1] - extensor[1])]),
         )
-        .row("flexor_force", &row(flexor))
-        .row("extensor_force", &row(extensor))
-        .row("flexor_pressure", &row([dpf * dd_du, dpf * dd_dq]))
-        .row("extensor_pressure", &row([dpe * dd_du, dpe * dd_dq]))
-        .row("flexor_length", &row([0.0, -r]))
-        .row("extensor_length", &row([0.0, r]));
-        Ok(p)
+        .row(Unknown::FlexorForce, &row(flexor))
+        .row(Unknown::ExtensorForce, &row(extensor))
+        .row(Unknown::FlexorPressure, &row([dpf * dd_du, dpf * dd_dq]))
+        .row(Unknown::ExtensorPressure, &row([dpe * dd_du, dpe * dd_dq]))
+        .row(Unknown::FlexorLength, &row([0.0, -r]))
+        .row(Unknown::ExtensorLength, &row([0.0, r]));
+        Ok(())
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
@@ -442,6 +441,7 @@ impl Model for McKibbenJoint {
 
 #[cfg(test)]
 mod tests {
+    use super::super::all_partials;
     use super::*;
     use std::f64::consts::PI;
 
@@ -579,8 +579,12 @@ mod tests {
                 joint_position: q,
                 joint_velocity: 0.0,
             };
-            let d = j.partials(&x).unwrap();
-            let names = ["jointTorque", "flexor_force", "extensor_force"];
+            let d = all_partials(&mut j, &x).unwrap();
+            let names = [
+                Unknown::JointTorque,
+                Unknown::FlexorForce,
+                Unknown::ExtensorForce,
+            ];
             let value = |j: &mut McKibbenJoint, u: f64, q: f64| {
                 let (o, clamped) = at(j, u, q);
                 assert!(!clamped);
@@ -592,11 +596,11 @@ mod tests {
                 let down = value(&mut j, u - du, q - dq);
                 for (k, name) in names.iter().enumerate() {
                     let fd = (up[k] - down[k]) / (2.0 * h);
-                    let exact = d.get(name).unwrap()[column].1;
+                    let exact = d.get(*name).unwrap()[column];
                     let scale = fd.abs().max(exact.abs()).max(1e-9);
                     assert!(
                         (fd - exact).abs() < 1e-4 * scale,
-                        "preset {preset} mode {mode} {name}[{column}]: {exact} vs {fd}"
+                        "preset {preset} mode {mode} {name:?}[{column}]: {exact} vs {fd}"
                     );
                 }
             }
@@ -615,11 +619,11 @@ mod tests {
             joint_position: 0.6,
             joint_velocity: 0.0,
         };
-        let d = j.partials(&x).unwrap();
+        let d = all_partials(&mut j, &x).unwrap();
         assert!(d
-            .get("flexor_force")
+            .get(Unknown::FlexorForce)
             .unwrap()
             .iter()
-            .all(|(_, v)| *v == 0.0));
+            .all(|v| *v == 0.0));
     }
 }

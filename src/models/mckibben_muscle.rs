@@ -5,7 +5,7 @@
 //! friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
-use super::{Model, Partials, Refusal, Report, Status};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::festo;
 use crate::physics::friction::HysteresisState;
@@ -16,7 +16,7 @@ use crate::physics::mckibben::{
 };
 use crate::physics::muscle_params::MuscleParams;
 use crate::variables::mckibben_muscle::{
-    CalculatedParameters, Inputs, Outputs, Parameters, Variables,
+    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -51,30 +51,10 @@ pub struct McKibbenMuscle {
     notice: Option<String>,
     /// `pressure_solver` on: the muscle to invert and `max_pressure`.
     solver: Option<(McKibben, f64)>,
-    /// The last partials, the point (inputs and friction history) they were taken at, and
-    /// whether they hold the stiffness's (second-order) row: the further seeds of a Jacobian at
-    /// the same point reuse them. Not part of the FMU state.
-    #[serde(skip)]
-    partials_cache: Option<(PartialsKey, bool, Partials)>,
     /// The dissertation's signed force (`signed_force`); else tension only (see [`tension_only`]).
     signed_force: bool,
     /// The straight strands' axial stiffness `k_s = E A / b`, N/m (from `strand_rigidity`).
     strand_stiffness: f64,
-}
-
-/// Bit patterns of what the partials depend on: pressure, length, target_force, friction z and
-/// position.
-type PartialsKey = [u64; 5];
-
-fn partials_key(inputs: &Inputs, history: &HysteresisState) -> PartialsKey {
-    [
-        inputs.pressure,
-        inputs.length,
-        inputs.target_force,
-        history.z,
-        history.position,
-    ]
-    .map(f64::to_bits)
 }
 
 /// The muscle the parameters (or the preset) describe, with the parameters the user set that
@@ -347,13 +327,23 @@ impl McKibbenMuscle {
     }
 }
 
-/// The partials as the FMU's rows, by variable name.
-fn partial_rows(d: &McKibbenPartials) -> Partials {
-    let mut p = Partials::default();
-    for (name, [dp, dl]) in d.named() {
-        p.row(name, &[("pressure", dp), ("length", dl)]);
+/// Writes the rows of the physics' partials, by pressure and length.
+fn write_rows(d: &McKibbenPartials, p: &mut Partials<Variables>) {
+    for (output, [dp, dl]) in [
+        (Unknown::Force, d.force),
+        (Unknown::EffectivePressure, d.effective_pressure),
+        (Unknown::FrictionForce, d.friction_force),
+        (Unknown::Volume, d.volume),
+        (Unknown::ThresholdPressure, d.threshold_pressure),
+        (Unknown::StretchAxial, d.stretch_axial),
+        (Unknown::StretchHoop, d.stretch_hoop),
+        (Unknown::StretchRadial, d.stretch_radial),
+        (Unknown::StressAxial, d.stress_axial),
+        (Unknown::StressHoop, d.stress_hoop),
+        (Unknown::StressRadial, d.stress_radial),
+    ] {
+        p.row(output, &[(Known::Pressure, dp), (Known::Length, dl)]);
     }
-    p
 }
 
 impl McKibbenMuscle {
@@ -477,7 +467,6 @@ impl Model for McKibbenMuscle {
             effective: params,
             notice,
             solver,
-            partials_cache: None,
             signed_force: p.signed_force,
             strand_stiffness: rigidity(p)? / params.strand_length,
         })
@@ -524,44 +513,20 @@ impl Model for McKibbenMuscle {
         self.outputs(inputs, outputs, report, true)
     }
 
-    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
-        self.cached_partials(inputs, true)
-    }
-
-    fn partials_for(
-        &mut self,
-        inputs: &Inputs,
-        outputs: &[&'static str],
-    ) -> Result<Partials, String> {
-        // The stiffness's row costs a second-order pass through the bladder: only when asked.
-        self.cached_partials(inputs, outputs.contains(&"stiffness"))
-    }
-}
-
-impl McKibbenMuscle {
-    fn cached_partials(&mut self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
-        let key = partials_key(inputs, &self.friction);
-        if let Some((cached, has_stiffness, rows)) = &self.partials_cache {
-            if *cached == key && (*has_stiffness || !stiffness) {
-                return Ok(rows.clone());
-            }
-        }
-        let rows = self.fresh_partials(inputs, stiffness)?;
-        self.partials_cache = Some((key, stiffness, rows.clone()));
-        Ok(rows)
-    }
-
-    /// Every row; the stiffness's only if `stiffness` (or, for the bare sleeve, always: it is
-    /// eq. 2.3's closed form).
-    fn fresh_partials(&self, inputs: &Inputs, stiffness: bool) -> Result<Partials, String> {
-        let mut rows = self.partials_at(inputs).map(|d| partial_rows(&d))?;
-        if stiffness || matches!(self.pipeline, Pipeline::Sleeve(_)) {
+    /// Every row; the stiffness's (a second-order pass through the bladder) only when wanted
+    /// (for the bare sleeve always: it is eq. 2.3's closed form).
+    fn partials(&mut self, inputs: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
+        write_rows(&self.partials_at(inputs)?, p);
+        if p.wants(Unknown::Stiffness) || matches!(self.pipeline, Pipeline::Sleeve(_)) {
             let [dp, dl] = self.stiffness_row(inputs)?;
-            rows.row("stiffness", &[("pressure", dp), ("length", dl)]);
+            p.row(
+                Unknown::Stiffness,
+                &[(Known::Pressure, dp), (Known::Length, dl)],
+            );
         }
         // contraction = 1 - length / nominal_length.
         let per_length = -1.0 / self.effective.nominal_length;
-        rows.row("contraction", &[("pressure", 0.0), ("length", per_length)]);
+        p.row(Unknown::Contraction, &[(Known::Length, per_length)]);
         let target = match &self.solver {
             Some((muscle, max_pressure)) => muscle.target_pressure_partials(
                 *max_pressure,
@@ -571,67 +536,28 @@ impl McKibbenMuscle {
             ),
             None => [0.0; 2],
         };
-        rows.row(
-            "target_pressure",
-            &[
-                ("pressure", 0.0),
-                ("length", target[0]),
-                ("target_force", target[1]),
-            ],
+        p.row(
+            Unknown::TargetPressure,
+            &[(Known::Length, target[0]), (Known::TargetForce, target[1])],
         );
-        Ok(rows)
+        Ok(())
+    }
+
+    /// The partials read the friction history besides the inputs.
+    fn partials_key(&self) -> Option<HistoryKey> {
+        Some(HistoryKey::of([self.friction.z, self.friction.position]))
     }
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::all_partials;
     use super::*;
 
-    /// The cached partials are those of the current point: a further seed at the same inputs and
-    /// history reuses them, new inputs or a committed friction history recompute them.
+    /// The stiffness's row (a second-order pass through the bladder) is written only for a call
+    /// that wants it, and then equals the physics' partials.
     #[test]
-    fn cached_partials_follow_the_inputs_and_the_history() {
-        let p = Parameters {
-            preset: 2,
-            friction: true,
-            ..Default::default()
-        };
-        let at = |length: f64| Inputs {
-            pressure: 3e5,
-            length,
-            ..Default::default()
-        };
-        let start = at(0.7
-            * McKibbenMuscle::new(&p, &at(0.0))
-                .unwrap()
-                .calculated_parameters()
-                .max_length);
-        let (a, b) = (at(start.length + 3e-5), at(start.length + 1e-4));
-        let mut m = McKibbenMuscle::new(&p, &start).unwrap();
-        let first = m.partials(&a).unwrap();
-        assert_eq!(m.partials(&a).unwrap(), first);
-        let other = m.partials(&b).unwrap();
-        assert_ne!(other, first);
-        assert_eq!(other, m.fresh_partials(&b, true).unwrap());
-        assert_eq!(m.partials(&a).unwrap(), first);
-        // A step to `b` moves the friction history: the partials at `a` change with it.
-        m.step(
-            &b,
-            &mut Outputs::default(),
-            0.0,
-            1e-3,
-            &mut Report::default(),
-        );
-        let after = m.partials(&a).unwrap();
-        assert_eq!(after, m.fresh_partials(&a, true).unwrap());
-        assert_ne!(after.get("friction_force"), first.get("friction_force"));
-    }
-
-    /// The stiffness's row (a second-order pass through the bladder) is built only for a call that
-    /// asks for it, and then equals the physics' partials; a later call for it is not served
-    /// from a cache that lacks it.
-    #[test]
-    fn stiffness_row_only_when_asked() {
+    fn stiffness_row_only_when_wanted() {
         let p = Parameters {
             preset: 4,
             bladder_model: 2,
@@ -646,19 +572,21 @@ mod tests {
             ..Default::default()
         };
         let mut m = McKibbenMuscle::new(&p, &x).unwrap();
-        let first = m.partials_for(&x, &["force"]).unwrap();
-        assert!(first.get("stiffness").is_none());
-        let with = m.partials_for(&x, &["force", "stiffness"]).unwrap();
+        let mut first = Partials::default();
+        first.ask_for([Unknown::Force].into_iter());
+        m.partials(&x, &mut first).unwrap();
+        assert!(first.get(Unknown::Stiffness).is_none());
+        let with = all_partials(&mut m, &x).unwrap();
         let Pipeline::Full(muscle) = &m.pipeline else {
             panic!("a bladder needs the full pipeline");
         };
         let exact = muscle.stiffness_partials(3e5, 0.12, &m.friction).unwrap();
-        let row = with.get("stiffness").unwrap();
-        assert_eq!(row, &[("pressure", exact[0]), ("length", exact[1])]);
+        assert_eq!(
+            with.get(Unknown::Stiffness),
+            Some(&[exact[0], exact[1], 0.0][..])
+        );
         assert!(exact.iter().all(|d| *d != 0.0));
-        assert_eq!(with.get("force"), first.get("force"));
-        // Served from the cache, stiffness included.
-        assert_eq!(m.partials_for(&x, &["force"]).unwrap(), with);
+        assert_eq!(with.get(Unknown::Force), first.get(Unknown::Force));
     }
 
     /// The bare sleeve writes the neutral outputs of the absent effects once per model, and every
@@ -717,6 +645,7 @@ mod tests {
 
 #[cfg(test)]
 mod slack_tests {
+    use super::super::all_partials;
     use super::*;
 
     fn at(m: &mut McKibbenMuscle, pressure: f64, length: f64) -> Outputs {
@@ -854,23 +783,25 @@ mod slack_tests {
             length,
             ..Default::default()
         };
-        let slack = m.partials(&x(0.17)).unwrap();
-        for name in ["force", "stiffness"] {
+        let slack = all_partials(&mut m, &x(0.17)).unwrap();
+        for output in [Unknown::Force, Unknown::Stiffness] {
             assert!(
-                slack.get(name).unwrap().iter().all(|(_, d)| *d == 0.0),
-                "{name}"
+                slack.get(output).unwrap().iter().all(|d| *d == 0.0),
+                "{output:?}"
             );
         }
-        assert_ne!(
-            s.partials(&x(0.17)).unwrap().get("force").unwrap()[0].1,
-            0.0
+        let signed = all_partials(&mut s, &x(0.17)).unwrap();
+        assert_ne!(signed.partial(Unknown::Force, Known::Pressure), Some(0.0));
+        assert_eq!(
+            all_partials(&mut m, &x(0.19)).unwrap(),
+            all_partials(&mut s, &x(0.19)).unwrap()
         );
-        assert_eq!(m.partials(&x(0.19)).unwrap(), s.partials(&x(0.19)).unwrap());
     }
 }
 
 #[cfg(test)]
 mod strand_tests {
+    use super::super::all_partials;
     use super::*;
 
     fn step(m: &mut McKibbenMuscle, pressure: f64, length: f64) -> (Outputs, bool) {
@@ -970,23 +901,28 @@ mod strand_tests {
                 ..Default::default()
             };
             assert!(m.on_strands(&x));
-            let d = m.partials(&x).unwrap();
+            let d = all_partials(&mut m, &x).unwrap();
             let value = |m: &mut McKibbenMuscle, pressure: f64, length: f64| {
                 let (o, _) = step(m, pressure, length);
                 [o.force, o.volume, o.effective_pressure, o.stiffness]
             };
-            let names = ["force", "volume", "effective_pressure", "stiffness"];
+            let names = [
+                Unknown::Force,
+                Unknown::Volume,
+                Unknown::EffectivePressure,
+                Unknown::Stiffness,
+            ];
             for (column, h) in [(0, 1.0), (1, 1e-7)] {
                 let (dp, dl) = if column == 0 { (h, 0.0) } else { (0.0, h) };
                 let up = value(&mut m, x.pressure + dp, x.length + dl);
                 let down = value(&mut m, x.pressure - dp, x.length - dl);
                 for (k, name) in names.iter().enumerate() {
                     let fd = (up[k] - down[k]) / (2.0 * h);
-                    let exact = d.get(name).unwrap()[column].1;
+                    let exact = d.get(*name).unwrap()[column];
                     let scale = fd.abs().max(exact.abs()).max(1e-12);
                     assert!(
                         (fd - exact).abs() < 1e-4 * scale,
-                        "{name}[{column}]: {exact} vs {fd}"
+                        "{name:?}[{column}]: {exact} vs {fd}"
                     );
                 }
             }

@@ -7,8 +7,9 @@
 
 #![forbid(unsafe_code)]
 
-use crate::variables::Interface;
+use crate::variables::{Identifier, Interface};
 use serde::{de::DeserializeOwned, Serialize};
+use std::marker::PhantomData;
 
 pub mod free_bladder;
 pub mod knitted_muscle;
@@ -132,37 +133,147 @@ impl From<&str> for Refusal {
     }
 }
 
-/// Exact partial derivatives of some outputs with respect to the inputs, by variable name, at one
-/// point: what `fmi2GetDirectionalDerivative` combines with the importer's seed. An output without
-/// a row is not provided; an input missing from a row does not affect that output.
-#[derive(Clone, Debug, Default, PartialEq)]
-pub struct Partials {
-    /// Each output with the range of its row in `entries`: two allocations for the whole
-    /// Jacobian, so that building (and caching) it costs little beside the physics.
-    rows: Vec<(&'static str, std::ops::Range<usize>)>,
-    entries: Vec<(&'static str, f64)>,
+/// Exact partial derivatives of a model's unknowns (outputs, state derivatives) with respect to
+/// its knowns (inputs, continuous states) at one point, written against the identifiers generated
+/// from its model description (`crate::variables::<model>::{Known, Unknown}`): what
+/// `fmi2GetDirectionalDerivative` combines with the importer's seed. An unknown without a row is
+/// not provided; a known missing from a row does not affect that unknown.
+pub struct Partials<V: Interface> {
+    /// One row per unknown, one column per known (`Identifier::index`), row after row.
+    values: Vec<f64>,
+    /// Which rows the model wrote.
+    written: Vec<bool>,
+    /// Which rows the call reads ([`Partials::wants`]).
+    wanted: Vec<bool>,
+    marker: PhantomData<fn() -> V>,
 }
 
-impl Partials {
-    /// Adds the row of `output`: its partial with respect to each listed input.
-    pub fn row(&mut self, output: &'static str, by_input: &[(&'static str, f64)]) -> &mut Self {
-        let start = self.entries.len();
-        self.entries.extend_from_slice(by_input);
-        self.rows.push((output, start..self.entries.len()));
+impl<V: Interface> Partials<V> {
+    const COLUMNS: usize = <V::Known as Identifier>::ALL.len();
+    const ROWS: usize = <V::Unknown as Identifier>::ALL.len();
+
+    /// No rows yet, every row wanted.
+    pub fn new() -> Self {
+        let mut partials = Self::default();
+        partials.ask_for(V::Unknown::ALL.iter().copied());
+        partials
+    }
+
+    /// Forgets every row and asks for the rows of `unknowns` (the storage is kept: a Jacobian
+    /// taken again allocates nothing).
+    pub fn ask_for(&mut self, unknowns: impl Iterator<Item = V::Unknown>) {
+        self.values.clear();
+        self.values.resize(Self::ROWS * Self::COLUMNS, 0.0);
+        self.written.clear();
+        self.written.resize(Self::ROWS, false);
+        self.wanted.clear();
+        self.wanted.resize(Self::ROWS, false);
+        for unknown in unknowns {
+            self.wanted[unknown.index()] = true;
+        }
+    }
+
+    /// Whether the call reads the row of `unknown`: a model may leave out a costly row (the
+    /// stiffness's second derivatives) that is not wanted. Writing it anyway is never wrong.
+    pub fn wants(&self, unknown: V::Unknown) -> bool {
+        self.wanted.get(unknown.index()).copied().unwrap_or(true)
+    }
+
+    /// Writes the row of `unknown`: its partial with respect to each listed known, zero for the
+    /// others.
+    pub fn row(&mut self, unknown: V::Unknown, by_known: &[(V::Known, f64)]) -> &mut Self {
+        if self.written.is_empty() {
+            self.ask_for(std::iter::empty());
+        }
+        let start = unknown.index() * Self::COLUMNS;
+        let row = &mut self.values[start..start + Self::COLUMNS];
+        row.fill(0.0);
+        for &(known, d) in by_known {
+            row[known.index()] = d;
+        }
+        self.written[unknown.index()] = true;
         self
     }
 
-    /// The row of `output`, if provided.
-    pub fn get(&self, output: &str) -> Option<&[(&'static str, f64)]> {
-        self.rows
-            .iter()
-            .find(|(name, _)| *name == output)
-            .map(|(_, range)| &self.entries[range.clone()])
+    /// The row of `unknown`, by known ([`Identifier::index`]), if provided.
+    pub fn get(&self, unknown: V::Unknown) -> Option<&[f64]> {
+        let start = unknown.index() * Self::COLUMNS;
+        match self.written.get(unknown.index()) {
+            Some(true) => Some(&self.values[start..start + Self::COLUMNS]),
+            _ => None,
+        }
     }
 
-    /// The outputs that have a row.
-    pub fn outputs(&self) -> impl Iterator<Item = &'static str> + '_ {
-        self.rows.iter().map(|(name, _)| *name)
+    /// `d unknown / d known`, if the row of `unknown` is provided.
+    pub fn partial(&self, unknown: V::Unknown, known: V::Known) -> Option<f64> {
+        self.get(unknown).map(|row| row[known.index()])
+    }
+
+    /// The unknowns that have a row.
+    pub fn unknowns(&self) -> impl Iterator<Item = V::Unknown> + '_ {
+        V::Unknown::ALL
+            .iter()
+            .copied()
+            .filter(|u| self.get(*u).is_some())
+    }
+}
+
+/// Empty: no storage until the first row.
+impl<V: Interface> Default for Partials<V> {
+    fn default() -> Self {
+        Self {
+            values: Vec::new(),
+            written: Vec::new(),
+            wanted: Vec::new(),
+            marker: PhantomData,
+        }
+    }
+}
+
+// By hand: a derive would ask the marker type for them.
+impl<V: Interface> Clone for Partials<V> {
+    fn clone(&self) -> Self {
+        Self {
+            values: self.values.clone(),
+            written: self.written.clone(),
+            wanted: self.wanted.clone(),
+            marker: PhantomData,
+        }
+    }
+}
+
+/// Equal when the same rows hold the same values (what was asked for aside).
+impl<V: Interface> PartialEq for Partials<V> {
+    fn eq(&self, other: &Self) -> bool {
+        V::Unknown::ALL.iter().all(|&u| self.get(u) == other.get(u))
+    }
+}
+
+impl<V: Interface> std::fmt::Debug for Partials<V> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_map()
+            .entries(self.unknowns().map(|u| (u, self.get(u))))
+            .finish()
+    }
+}
+
+/// What a model's partials depend on besides its inputs ([`Model::partials_key`]): up to four
+/// numbers of its history, compared bit for bit.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct HistoryKey([u64; 4]);
+
+impl HistoryKey {
+    /// The partials depend on the inputs alone.
+    pub const NONE: Self = Self([0; 4]);
+
+    /// The partials depend on `history` (at most four numbers) besides the inputs.
+    pub fn of<const N: usize>(history: [f64; N]) -> Self {
+        const { assert!(N <= 4, "a HistoryKey holds at most four numbers") };
+        let mut bits = [0; 4];
+        for (slot, x) in bits.iter_mut().zip(history) {
+            *slot = x.to_bits();
+        }
+        Self(bits)
     }
 }
 
@@ -207,8 +318,8 @@ pub struct EventUpdate {
 ///   `numberOfEventIndicators`), [`Model::update_discrete_states`] (event mode: may move the
 ///   states, say so in [`EventUpdate`]) and [`Model::completed_integrator_step`];
 /// - optionally [`Model::partials`] with rows for the outputs and the derivative variables
-///   (`"der(x)"`) and columns for the inputs and the states (`"x"`): the export layer then serves
-///   `fmi2GetDirectionalDerivative` for Model Exchange's Jacobian.
+///   (`Unknown::DerX`) and columns for the inputs and the states (`Known::X`): the export layer
+///   then serves `fmi2GetDirectionalDerivative` for Model Exchange's Jacobian.
 ///
 /// The export layer calls, for one right-hand side: `set_time`, `set_states` (only when the
 /// importer set them), then `derivatives`, `event_indicators` or `evaluate` in any order.
@@ -317,22 +428,28 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
 
     /// Exact partial derivatives of the outputs (and, with states, of the derivative variables
     /// `der(x)`) with respect to the inputs (and the states `x`) at `inputs` and the current
-    /// history, on the branch [`Model::evaluate`] takes there (analytic or forward-mode,
-    /// never finite differences). `Err` says why there are none: by default this model does not
-    /// provide them, and its model description says `providesDirectionalDerivative="false"`.
-    fn partials(&mut self, _inputs: &Inputs<Self>) -> Result<Partials, String> {
+    /// history, on the branch [`Model::evaluate`] takes (analytic or forward-mode, never finite
+    /// differences), written as rows of `partials` against the generated identifiers
+    /// (`partials.row(Unknown::Y, &[(Known::U, 2.0)])`). `partials` comes empty; a row the call
+    /// does not read (`!partials.wants(unknown)`) may be left out when it costs more than the
+    /// others (the stiffness's second derivatives). `Err` says why there are none: by default
+    /// this model does not provide them, and its model description says
+    /// `providesDirectionalDerivative="false"`.
+    fn partials(
+        &mut self,
+        _inputs: &Inputs<Self>,
+        _partials: &mut Partials<Self::Variables>,
+    ) -> Result<(), String> {
         Err("this model does not provide partial derivatives".into())
     }
 
-    /// [`Model::partials`] for a call that reads only the rows of `outputs`: a model whose rows
-    /// differ in cost (the stiffness's second derivatives) may leave out the costly rows nobody
-    /// asked for. By default, every row.
-    fn partials_for(
-        &mut self,
-        inputs: &Inputs<Self>,
-        _outputs: &[&'static str],
-    ) -> Result<Partials, String> {
-        self.partials(inputs)
+    /// What [`Model::partials`] depends on besides the inputs, so that the export layer may reuse
+    /// them for the further seeds of a Jacobian at the same point: [`HistoryKey::NONE`] for
+    /// partials of the inputs alone, [`HistoryKey::of`] the history they read (friction state)
+    /// otherwise. `None`, the default, reuses nothing: the partials are taken afresh at every
+    /// call, right whatever they depend on (time, states, schedules).
+    fn partials_key(&self) -> Option<HistoryKey> {
+        None
     }
 
     /// Takes over the history of `saved`, a model deserialized from an importer's bytes, after
@@ -343,4 +460,15 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     fn adopt_history(&mut self, _saved: &Self) -> Result<(), String> {
         Ok(())
     }
+}
+
+/// Every row of [`Model::partials`] at `inputs`, in a fresh [`Partials`]: for the models' tests.
+#[cfg(test)]
+pub(crate) fn all_partials<M: Model>(
+    model: &mut M,
+    inputs: &Inputs<M>,
+) -> Result<Partials<M::Variables>, String> {
+    let mut partials = Partials::new();
+    model.partials(inputs, &mut partials)?;
+    Ok(partials)
 }

@@ -12,7 +12,7 @@ use crate::physics::multiferroic::{
     SteppingSchedule,
 };
 use crate::variables::multiferroic_motor::{
-    CalculatedParameters, Inputs, Outputs, Parameters, States, Variables,
+    CalculatedParameters, Inputs, Known, Outputs, Parameters, States, Unknown, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -106,36 +106,51 @@ fn write_outputs(out: &mut Outputs, o: &MotorOutputs) {
 }
 
 /// The rows of `fmi2GetDirectionalDerivative` from the physics' partials: by each input (and, in
-/// Model Exchange, by each state). With `strain_drive` the stress comes from the `strain` input.
+/// Model Exchange, by each of `states`, with its column in the physics' gradients). With
+/// `strain_drive` the stress comes from the `strain` input.
 fn partial_rows(
     p: &MePartials,
     strain_modulus: Option<f64>,
-    states: &[(&'static str, usize)],
-) -> Partials {
-    let mut rows = Partials::default();
-    let stress = |g: &MeGradient| g[by::STRESS];
-    for (name, g) in [
-        ("torque", &p.torque),
-        ("rotor_angle", &p.rotor_angle),
-        ("rotor_speed", &p.rotor_speed),
-        ("onion_angle", &p.onion_angle),
-        ("offset_angle", &p.offset_angle),
-        ("magnetostatic_energy", &p.magnetostatic_energy),
-        ("magnetoelastic_energy", &p.magnetoelastic_energy),
-        ("applied_strain_direction", &p.applied_strain_direction),
+    states: &[(Known, usize)],
+    rows: &mut Partials<Variables>,
+) {
+    for (output, g) in [
+        (Unknown::Torque, &p.torque),
+        (Unknown::RotorAngle, &p.rotor_angle),
+        (Unknown::RotorSpeed, &p.rotor_speed),
+        (Unknown::OnionAngle, &p.onion_angle),
+        (Unknown::OffsetAngle, &p.offset_angle),
+        (Unknown::MagnetostaticEnergy, &p.magnetostatic_energy),
+        (Unknown::MagnetoelasticEnergy, &p.magnetoelastic_energy),
+        (Unknown::AppliedStrainDirection, &p.applied_strain_direction),
     ] {
-        let mut row = vec![
-            ("strain_direction", g[by::STRAIN_DIRECTION]),
-            ("load_torque", g[by::LOAD_TORQUE]),
-        ];
-        match strain_modulus {
-            Some(modulus) => row.extend([("stress", 0.0), ("strain", modulus * stress(g))]),
-            None => row.extend([("stress", stress(g)), ("strain", 0.0)]),
-        }
-        row.extend(states.iter().map(|&(state, i)| (state, g[i])));
-        rows.row(name, &row);
+        gradient_row(rows, output, g, strain_modulus, states);
     }
-    rows
+}
+
+/// The row of `output` from its gradient `g` (see [`partial_rows`]).
+fn gradient_row(
+    rows: &mut Partials<Variables>,
+    output: Unknown,
+    g: &MeGradient,
+    strain_modulus: Option<f64>,
+    states: &[(Known, usize)],
+) {
+    let (stress, strain) = match strain_modulus {
+        Some(modulus) => (0.0, modulus * g[by::STRESS]),
+        None => (g[by::STRESS], 0.0),
+    };
+    let mut row = [(Known::Stress, 0.0); 8];
+    row[..4].copy_from_slice(&[
+        (Known::StrainDirection, g[by::STRAIN_DIRECTION]),
+        (Known::LoadTorque, g[by::LOAD_TORQUE]),
+        (Known::Stress, stress),
+        (Known::Strain, strain),
+    ]);
+    for (slot, &(state, i)) in row[4..].iter_mut().zip(states) {
+        *slot = (state, g[i]);
+    }
+    rows.row(output, &row[..4 + states.len().min(4)]);
 }
 
 /// An Integer switch that must be 0 or 1 (the model description's bounds say so too).
@@ -339,9 +354,9 @@ impl Model for MultiferroicMotor {
     /// [`Model::evaluate`] takes (the quasi-static onion settled for the present inputs first, by
     /// the memory rule; then the implicit function theorem on its minimum). Model Exchange: also
     /// by the states, and the state derivatives, on the branch the onion follows.
-    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+    fn partials(&mut self, inputs: &Inputs, rows: &mut Partials<Variables>) -> Result<(), String> {
         if self.model_exchange_active() {
-            return self.me_partials(inputs);
+            return self.me_partials(inputs, rows);
         }
         let inputs = self.inputs(inputs);
         let outputs = self.motor.outputs(&self.state, &inputs)?;
@@ -350,7 +365,8 @@ impl Model for MultiferroicMotor {
             ..self.state
         };
         let p = self.motor.me_partials(&settled, &inputs, settled.time)?;
-        Ok(partial_rows(&p, self.strain_drive, &[]))
+        partial_rows(&p, self.strain_drive, &[], rows);
+        Ok(())
     }
 
     fn step(

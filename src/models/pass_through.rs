@@ -1,8 +1,8 @@
 //! PassThrough FMU: `y = u`. A measurement baseline: an importer's cost per step measured on it
 //! is the share of any other FMU's step time that is not the model's (docs/accuracy-cost.md).
 
-use super::{Model, Partials, Refusal, Report};
-use crate::variables::pass_through::{Inputs, Outputs, Parameters, Variables};
+use super::{HistoryKey, Model, Partials, Refusal, Report};
+use crate::variables::pass_through::{Inputs, Known, Outputs, Parameters, Unknown, Variables};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -27,9 +27,12 @@ impl Model for PassThrough {
         outputs.y = inputs.u;
     }
 
-    fn partials(&mut self, _: &Inputs) -> Result<Partials, String> {
-        let mut p = Partials::default();
-        p.row("y", &[("u", 1.0)]);
-        Ok(p)
+    fn partials(&mut self, _: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
+        p.row(Unknown::Y, &[(Known::U, 1.0)]);
+        Ok(())
+    }
+
+    fn partials_key(&self) -> Option<HistoryKey> {
+        Some(HistoryKey::NONE)
     }
 }

@@ -14,7 +14,9 @@
 //! third derivative jumps, so a step-size controller is better off restarting there).
 
 use super::{EventUpdate, Model, Partials, Refusal, Report, Status};
-use crate::variables::pulley_joint::{Inputs, Outputs, Parameters, States, Variables};
+use crate::variables::pulley_joint::{
+    Inputs, Known, Outputs, Parameters, States, Unknown, Variables,
+};
 use serde::{Deserialize, Serialize};
 
 /// Substep cap: a long communication step is split so that each Euler substep stays well
@@ -326,60 +328,63 @@ impl Model for PulleyJoint {
     /// Exact partials of the outputs and of `der(joint_angle)`, `der(joint_velocity)` with
     /// respect to the inputs and the states, on the branch `write` takes (saturated pressures
     /// have slope 0, including at the kinks).
-    fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
+    fn partials(&mut self, inputs: &Inputs, d: &mut Partials<Variables>) -> Result<(), String> {
+        use Known::{ExtensorForce, FlexorForce, JointAngle, JointVelocity};
         let p = &self.p;
         let (r, inertia) = (p.moment_arm, p.inertia);
         let (q_ref, dq_ref) = p.reference(self.time);
         let u =
             p.feedforward_gain * q_ref.sin() + p.kp * (q_ref - self.q) + p.kd * (dq_ref - self.dq);
-        let mut d = Partials::default();
-        d.row("flexor_length", &[("joint_angle", -r)])
-            .row("extensor_length", &[("joint_angle", r)]);
+        d.row(Unknown::FlexorLength, &[(JointAngle, -r)])
+            .row(Unknown::ExtensorLength, &[(JointAngle, r)]);
         if p.external_pressures {
             let flexor = p.saturation_slope(inputs.flexor_pressure_command);
             let extensor = p.saturation_slope(inputs.extensor_pressure_command);
-            d.row("flexor_pressure", &[("flexor_pressure_command", flexor)])
-                .row(
-                    "extensor_pressure",
-                    &[("extensor_pressure_command", extensor)],
-                );
+            d.row(
+                Unknown::FlexorPressure,
+                &[(Known::FlexorPressureCommand, flexor)],
+            )
+            .row(
+                Unknown::ExtensorPressure,
+                &[(Known::ExtensorPressureCommand, extensor)],
+            );
         } else {
             // p = pc +/- u/2 with du/dq = -kp, du/d(dq) = -kd.
             let flexor = 0.5 * p.saturation_slope(p.common_mode_pressure + 0.5 * u);
             let extensor = -0.5 * p.saturation_slope(p.common_mode_pressure - 0.5 * u);
             d.row(
-                "flexor_pressure",
+                Unknown::FlexorPressure,
                 &[
-                    ("joint_angle", -p.kp * flexor),
-                    ("joint_velocity", -p.kd * flexor),
+                    (JointAngle, -p.kp * flexor),
+                    (JointVelocity, -p.kd * flexor),
                 ],
             )
             .row(
-                "extensor_pressure",
+                Unknown::ExtensorPressure,
                 &[
-                    ("joint_angle", -p.kp * extensor),
-                    ("joint_velocity", -p.kd * extensor),
+                    (JointAngle, -p.kp * extensor),
+                    (JointVelocity, -p.kd * extensor),
                 ],
             );
         }
-        d.row("joint_angle", &[("joint_angle", 1.0)])
-            .row("joint_velocity", &[("joint_velocity", 1.0)])
-            .row("reference_angle", &[])
+        d.row(Unknown::JointAngle, &[(JointAngle, 1.0)])
+            .row(Unknown::JointVelocity, &[(JointVelocity, 1.0)])
+            .row(Unknown::ReferenceAngle, &[])
             .row(
-                "joint_torque",
-                &[("flexor_force", r), ("extensor_force", -r)],
+                Unknown::JointTorque,
+                &[(FlexorForce, r), (ExtensorForce, -r)],
             )
-            .row("der(joint_angle)", &[("joint_velocity", 1.0)])
+            .row(Unknown::DerJointAngle, &[(JointVelocity, 1.0)])
             .row(
-                "der(joint_velocity)",
+                Unknown::DerJointVelocity,
                 &[
-                    ("flexor_force", r / inertia),
-                    ("extensor_force", -r / inertia),
-                    ("joint_angle", -p.gravity_torque * self.q.cos() / inertia),
-                    ("joint_velocity", -p.damping / inertia),
+                    (FlexorForce, r / inertia),
+                    (ExtensorForce, -r / inertia),
+                    (JointAngle, -p.gravity_torque * self.q.cos() / inertia),
+                    (JointVelocity, -p.damping / inertia),
                 ],
             );
-        Ok(d)
+        Ok(())
     }
 }
 

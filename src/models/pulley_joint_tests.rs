@@ -7,50 +7,60 @@ fn joint(parameters: &Parameters) -> PulleyJoint {
     PulleyJoint::new(parameters, &Inputs::default()).expect("valid parameters")
 }
 
-/// Every unknown of the Jacobian: the outputs and the state derivatives, by variable name.
-fn unknowns(m: &mut PulleyJoint, inputs: &Inputs) -> Vec<(&'static str, f64)> {
+/// Every unknown of the Jacobian: the outputs and the state derivatives.
+fn unknowns(m: &mut PulleyJoint, inputs: &Inputs) -> Vec<(Unknown, f64)> {
     let mut o = Outputs::default();
     m.evaluate(inputs, &mut o, &mut Report::default());
     let d = m.derivatives(inputs).expect("finite torque");
     vec![
-        ("flexor_length", o.flexor_length),
-        ("extensor_length", o.extensor_length),
-        ("flexor_pressure", o.flexor_pressure),
-        ("extensor_pressure", o.extensor_pressure),
-        ("joint_angle", o.joint_angle),
-        ("joint_velocity", o.joint_velocity),
-        ("reference_angle", o.reference_angle),
-        ("joint_torque", o.joint_torque),
-        ("der(joint_angle)", d.joint_angle),
-        ("der(joint_velocity)", d.joint_velocity),
+        (Unknown::FlexorLength, o.flexor_length),
+        (Unknown::ExtensorLength, o.extensor_length),
+        (Unknown::FlexorPressure, o.flexor_pressure),
+        (Unknown::ExtensorPressure, o.extensor_pressure),
+        (Unknown::JointAngle, o.joint_angle),
+        (Unknown::JointVelocity, o.joint_velocity),
+        (Unknown::ReferenceAngle, o.reference_angle),
+        (Unknown::JointTorque, o.joint_torque),
+        (Unknown::DerJointAngle, d.joint_angle),
+        (Unknown::DerJointVelocity, d.joint_velocity),
     ]
 }
 
-/// The knowns: the inputs and the states, each as a setter on (inputs, states).
+/// The knowns: the inputs and the states, each with its getter and setter on (inputs, states).
+type Getter = fn(&Inputs, &States) -> f64;
 type Setter = fn(&mut Inputs, &mut States, f64);
-const KNOWNS: [(&str, Setter); 6] = [
-    ("flexor_force", |i, _, x| i.flexor_force = x),
-    ("extensor_force", |i, _, x| i.extensor_force = x),
-    ("flexor_pressure_command", |i, _, x| {
-        i.flexor_pressure_command = x
-    }),
-    ("extensor_pressure_command", |i, _, x| {
-        i.extensor_pressure_command = x
-    }),
-    ("joint_angle", |_, s, x| s.joint_angle = x),
-    ("joint_velocity", |_, s, x| s.joint_velocity = x),
+const KNOWNS: [(Known, Getter, Setter); 6] = [
+    (
+        Known::FlexorForce,
+        |i, _| i.flexor_force,
+        |i, _, x| i.flexor_force = x,
+    ),
+    (
+        Known::ExtensorForce,
+        |i, _| i.extensor_force,
+        |i, _, x| i.extensor_force = x,
+    ),
+    (
+        Known::FlexorPressureCommand,
+        |i, _| i.flexor_pressure_command,
+        |i, _, x| i.flexor_pressure_command = x,
+    ),
+    (
+        Known::ExtensorPressureCommand,
+        |i, _| i.extensor_pressure_command,
+        |i, _, x| i.extensor_pressure_command = x,
+    ),
+    (
+        Known::JointAngle,
+        |_, s| s.joint_angle,
+        |_, s, x| s.joint_angle = x,
+    ),
+    (
+        Known::JointVelocity,
+        |_, s| s.joint_velocity,
+        |_, s, x| s.joint_velocity = x,
+    ),
 ];
-
-fn known_value(name: &str, inputs: &Inputs, states: &States) -> f64 {
-    match name {
-        "flexor_force" => inputs.flexor_force,
-        "extensor_force" => inputs.extensor_force,
-        "flexor_pressure_command" => inputs.flexor_pressure_command,
-        "extensor_pressure_command" => inputs.extensor_pressure_command,
-        "joint_angle" => states.joint_angle,
-        _ => states.joint_velocity,
-    }
-}
 
 /// Central differences of every unknown with respect to every known at (inputs, states, time),
 /// against `partials` (a known missing from a row has slope 0).
@@ -58,9 +68,9 @@ fn check_partials(parameters: &Parameters, inputs: &Inputs, states: &States, tim
     let mut m = joint(parameters);
     m.set_time(time);
     m.set_states(states).expect("valid state");
-    let partials = m.partials(inputs).expect("provided");
-    for (known, set) in KNOWNS {
-        let x = known_value(known, inputs, states);
+    let partials = super::super::all_partials(&mut m, inputs).expect("provided");
+    for (known, get, set) in KNOWNS {
+        let x = get(inputs, states);
         let h = 1e-6 * x.abs().max(1e-2);
         let at = |x: f64| {
             let (mut i, mut s) = (inputs.clone(), *states);
@@ -73,17 +83,13 @@ fn check_partials(parameters: &Parameters, inputs: &Inputs, states: &States, tim
         let (up, down) = (at(x + h), at(x - h));
         for ((unknown, a), (_, b)) in up.iter().zip(&down) {
             let numeric = (a - b) / (2.0 * h);
-            let row = partials
-                .get(unknown)
-                .unwrap_or_else(|| panic!("no row for {unknown}"));
-            let exact = row
-                .iter()
-                .find(|(name, _)| *name == known)
-                .map_or(0.0, |(_, d)| *d);
+            let exact = partials
+                .partial(*unknown, known)
+                .unwrap_or_else(|| panic!("no row for {unknown:?}"));
             let scale = numeric.abs().max(exact.abs()).max(1.0);
             assert!(
                 (exact - numeric).abs() <= 1e-6 * scale,
-                "d {unknown} / d {known} at {states:?}, t = {time}: exact {exact}, central difference {numeric}"
+                "d {unknown:?} / d {known:?} at {states:?}, t = {time}: exact {exact}, central difference {numeric}"
             );
         }
     }
@@ -128,27 +134,28 @@ fn the_saturated_pressures_have_no_slope_and_the_free_ones_the_gains() {
         joint_velocity: 0.0,
     })
     .expect("valid");
-    let d = m.partials(&Inputs::default()).expect("provided");
-    for row in ["flexor_pressure", "extensor_pressure"] {
+    let d = super::super::all_partials(&mut m, &Inputs::default()).expect("provided");
+    for row in [Unknown::FlexorPressure, Unknown::ExtensorPressure] {
         assert!(
-            d.get(row).expect("row").iter().all(|(_, v)| *v == 0.0),
-            "{row}"
+            d.get(row).expect("row").iter().all(|v| *v == 0.0),
+            "{row:?}"
         );
     }
     // At rest on the reference: both inside, slopes -/+ kp/2 and -/+ kd/2.
     let mut m = joint(&Parameters::default());
-    let d = m.partials(&Inputs::default()).expect("provided");
+    let d = super::super::all_partials(&mut m, &Inputs::default()).expect("provided");
     let p = Parameters::default();
+    let slopes = |u: Unknown| {
+        [Known::JointAngle, Known::JointVelocity, Known::FlexorForce]
+            .map(|k| d.partial(u, k).expect("row"))
+    };
     assert_eq!(
-        d.get("flexor_pressure").expect("row"),
-        &[
-            ("joint_angle", -0.5 * p.kp),
-            ("joint_velocity", -0.5 * p.kd)
-        ]
+        slopes(Unknown::FlexorPressure),
+        [-0.5 * p.kp, -0.5 * p.kd, 0.0]
     );
     assert_eq!(
-        d.get("extensor_pressure").expect("row"),
-        &[("joint_angle", 0.5 * p.kp), ("joint_velocity", 0.5 * p.kd)]
+        slopes(Unknown::ExtensorPressure),
+        [0.5 * p.kp, 0.5 * p.kd, 0.0]
     );
 }
 

@@ -94,6 +94,8 @@ impl Interface for GainVariables {
     type Outputs = f64;
     type CalculatedParameters = ();
     type States = ();
+    type Known = ();
+    type Unknown = ();
     const EVENT_INDICATORS: usize = 0;
     const INFO: &'static ModelInfo = &INFO;
 }

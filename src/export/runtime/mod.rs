@@ -7,6 +7,7 @@ mod directional_derivative;
 use crate::models::{EventUpdate, Model, Report};
 use crate::variables::{ContinuousStates, Interface, ModelInfo};
 pub use bindings::Bindings;
+use directional_derivative::PartialsCache;
 use serde::{Deserialize, Serialize};
 use std::any::Any;
 use std::marker::PhantomData;
@@ -93,6 +94,7 @@ where
             outputs_stale: true,
             time: None,
             rejected: None,
+            partials: PartialsCache::default(),
         })
     }
 }
@@ -189,6 +191,10 @@ struct RuntimeOf<M: Model> {
     /// the build at every get. Compared when building, so that a set clears nothing.
     #[serde(skip)]
     rejected: Option<Rejected<M::Variables>>,
+    /// The model's last partials, for the further seeds of a Jacobian. Not saved; forgotten
+    /// whenever the model is replaced.
+    #[serde(skip)]
+    partials: PartialsCache<M::Variables>,
 }
 
 /// A failed build: the parameters and start inputs [`Model::new`] refused, and why.
@@ -264,6 +270,7 @@ impl<M: Model> Clone for RuntimeOf<M> {
             outputs_stale: self.outputs_stale,
             time: self.time,
             rejected: self.rejected.clone(),
+            partials: PartialsCache::default(),
         }
     }
 }
@@ -355,6 +362,7 @@ where
             model.set_time(time);
         }
         self.model = Some(model);
+        self.partials.forget();
         self.outputs_stale = true;
         Ok(())
     }
@@ -471,6 +479,7 @@ where
     ) -> Result<(), String> {
         directional_derivative::directional_derivative(
             self.model.as_mut(),
+            &mut self.partials,
             &self.values.inputs,
             unknown,
             known,
@@ -481,6 +490,7 @@ where
     fn reset(&mut self) {
         self.values = Values::default();
         self.model = None;
+        self.partials.forget();
         self.outputs_stale = true;
         self.time = None;
         self.rejected = None;
@@ -506,6 +516,7 @@ where
         self.outputs_stale = true;
         if let Some(saved) = self.model.take() {
             self.model = Some(rebuilt(&self.values, &saved)?);
+            self.partials.forget();
             let mut report = Report::default();
             self.refresh_outputs(&mut report);
             M::Variables::set_input_clamped(&mut self.values, report.clamped());

@@ -9,19 +9,27 @@
 //! events at the onion's angle at the last event and zero tilt, with zero derivatives. The
 //! description's state count is fixed, hence four in both options.
 
-use super::{partial_rows, write_outputs, MultiferroicMotor};
+use super::{gradient_row, partial_rows, write_outputs, MultiferroicMotor};
 use crate::models::{Partials, Report, Status};
 use crate::physics::multiferroic::model_exchange::{by, MeEvaluation, MAX_RINGING_WINDOWS};
 use crate::physics::multiferroic::{Motor, OnionModel};
-use crate::variables::multiferroic_motor::{Inputs, Outputs};
+use crate::variables::multiferroic_motor::{Inputs, Known, Outputs, Unknown, Variables};
 use serde::{Deserialize, Serialize};
 
-/// The continuous states by name, with their column in the physics' partials.
-pub const STATES: [(&str, usize); 4] = [
-    ("rotor_angle", by::ROTOR_ANGLE),
-    ("rotor_speed", by::ROTOR_SPEED),
-    ("onion_state_angle", by::ONION_ANGLE),
-    ("onion_tilt", by::ONION_TILT),
+/// The continuous states, with their column in the physics' partials.
+pub const STATES: [(Known, usize); 4] = [
+    (Known::RotorAngle, by::ROTOR_ANGLE),
+    (Known::RotorSpeed, by::ROTOR_SPEED),
+    (Known::OnionStateAngle, by::ONION_ANGLE),
+    (Known::OnionTilt, by::ONION_TILT),
+];
+
+/// The states' derivatives, in the order of [`STATES`].
+const DERIVATIVES: [Unknown; 4] = [
+    Unknown::DerRotorAngle,
+    Unknown::DerRotorSpeed,
+    Unknown::DerOnionStateAngle,
+    Unknown::DerOnionTilt,
 ];
 
 /// Model Exchange's discrete states, part of the FMU state.
@@ -194,38 +202,21 @@ impl MultiferroicMotor {
     }
 
     /// Exact partials of the outputs and of the state derivatives by the inputs and the states,
-    /// on the branch the evaluation takes. Rows by output name, and by `der(state)` for the
-    /// derivatives.
-    pub(super) fn me_partials(&self, inputs: &Inputs) -> Result<Partials, String> {
+    /// on the branch the evaluation takes.
+    pub(super) fn me_partials(
+        &self,
+        inputs: &Inputs,
+        rows: &mut Partials<Variables>,
+    ) -> Result<(), String> {
         let inputs = self.inputs(inputs);
         let p = self
             .motor
             .me_partials(&self.state, &inputs, self.me.schedule_time)?;
-        let mut rows = partial_rows(&p, self.strain_drive, &STATES);
-        for (k, (state, _)) in STATES.iter().enumerate() {
-            let g = &p.derivatives[k];
-            let mut row = vec![
-                ("strain_direction", g[by::STRAIN_DIRECTION]),
-                ("load_torque", g[by::LOAD_TORQUE]),
-            ];
-            match self.strain_drive {
-                Some(modulus) => row.extend([("stress", 0.0), ("strain", modulus * g[by::STRESS])]),
-                None => row.extend([("stress", g[by::STRESS]), ("strain", 0.0)]),
-            }
-            row.extend(STATES.iter().map(|&(name, i)| (name, g[i])));
-            rows.row(derivative_name(state), &row);
+        partial_rows(&p, self.strain_drive, &STATES, rows);
+        for (derivative, g) in DERIVATIVES.into_iter().zip(&p.derivatives) {
+            gradient_row(rows, derivative, g, self.strain_drive, &STATES);
         }
-        Ok(rows)
-    }
-}
-
-/// The name of a state's derivative row (`der(x)`, Modelica's convention).
-fn derivative_name(state: &str) -> &'static str {
-    match state {
-        "rotor_angle" => "der(rotor_angle)",
-        "rotor_speed" => "der(rotor_speed)",
-        "onion_state_angle" => "der(onion_state_angle)",
-        _ => "der(onion_tilt)",
+        Ok(())
     }
 }
 
@@ -375,15 +366,15 @@ mod tests {
         m.me_event(&Inputs::default(), 0.0).unwrap();
         m.set_time(1e-5);
         m.me_set_states(&[0.3, 100.0, 0.0, 0.0]).unwrap();
-        let p = m.me_partials(&Inputs::default()).unwrap();
-        let row = p.get("der(rotor_speed)").unwrap();
-        let by_name = |n: &str| row.iter().find(|(k, _)| *k == n).unwrap().1;
+        let mut p = Partials::new();
+        m.me_partials(&Inputs::default(), &mut p).unwrap();
+        let by = |k: Known| p.partial(Unknown::DerRotorSpeed, k).unwrap();
         // I w' = tau - c w: d/dw = -c/I, and the schedule makes stress no input.
         let c_over_i = m.motor.drag / m.motor.inertia;
-        assert!((by_name("rotor_speed") + c_over_i).abs() < 1e-9 * c_over_i);
-        assert_eq!(by_name("stress"), 0.0);
-        assert!(by_name("rotor_angle") < 0.0, "a restoring stiffness");
-        assert!(p.get("torque").is_some() && p.get("der(onion_tilt)").is_some());
+        assert!((by(Known::RotorSpeed) + c_over_i).abs() < 1e-9 * c_over_i);
+        assert_eq!(by(Known::Stress), 0.0);
+        assert!(by(Known::RotorAngle) < 0.0, "a restoring stiffness");
+        assert!(p.get(Unknown::Torque).is_some() && p.get(Unknown::DerOnionTilt).is_some());
     }
 
     #[test]
