@@ -117,9 +117,12 @@ impl FreeBladder {
     }
 }
 
+/// One field of the physics' state.
+type Field = fn(&FreeBladderState) -> f64;
+
 impl FreeBladder {
     /// Each Real output with the field of the physics' state it is.
-    const REAL_OUTPUTS: [(Unknown, fn(&FreeBladderState) -> f64); 11] = [
+    const REAL_OUTPUTS: [(Unknown, Field); 11] = [
         (Unknown::InnerDiameter, |s| s.inner_diameter),
         (Unknown::OuterDiameter, |s| s.outer_diameter),
         (Unknown::Volume, |s| s.fluid_volume),

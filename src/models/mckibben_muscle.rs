@@ -7,12 +7,13 @@
 
 use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
+use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::festo;
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::mckibben::{
     bare_sleeve, is_slack, strand_rigidity, BladderModel, FrictionParams, McKibben, McKibbenOutput,
-    McKibbenPartials, MuscleGeometry, OutOfRange,
+    MuscleGeometry, OutOfRange,
 };
 use crate::physics::muscle_params::MuscleParams;
 use crate::variables::mckibben_muscle::{
@@ -328,7 +329,7 @@ impl McKibbenMuscle {
 }
 
 /// Writes the rows of the physics' partials, by pressure and length.
-fn write_rows(d: &McKibbenPartials, p: &mut Partials<Variables>) {
+fn write_rows(d: &ByPressureLength, p: &mut Partials<Variables>) {
     for (output, [dp, dl]) in [
         (Unknown::Force, d.force),
         (Unknown::EffectivePressure, d.effective_pressure),
@@ -365,7 +366,7 @@ impl McKibbenMuscle {
 
     /// Partials on the branch [`Model::evaluate`] takes (see
     /// [`McKibben::partials_with_strands`]); the force's 0 while slack.
-    fn partials_at(&self, inputs: &Inputs) -> Result<McKibbenPartials, String> {
+    fn partials_at(&self, inputs: &Inputs) -> Result<ByPressureLength, String> {
         let (pressure, length, k_s) = (inputs.pressure, inputs.length, self.strand_stiffness);
         let mut d = match &self.pipeline {
             Pipeline::Sleeve(s) => bare_sleeve::partials(s, k_s, pressure, length),

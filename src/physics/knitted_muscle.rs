@@ -5,6 +5,7 @@
 //! FMU (`models/knitted_muscle.rs`) maps its variables to this and logs what it reports.
 
 use crate::physics::bladder::{Bladder, BladderState, KnittedCylinder, SleeveGeometry};
+use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{FluidContainer, KnittedSleeve, ShapeModel, StrandFriction};
 use crate::physics::knitted_bag::Bag;
@@ -49,19 +50,6 @@ pub struct KnittedOutput {
     pub max_radius: f64,
     pub stiffness: f64,
     pub history: HysteresisState,
-}
-
-/// `[d/dP, d/dL]` of the outputs at one point.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct KnittedRows {
-    pub force: [f64; 2],
-    pub volume: [f64; 2],
-    pub effective_pressure: [f64; 2],
-    pub friction_force: [f64; 2],
-    pub max_radius: [f64; 2],
-    /// `None` with a bladder unless asked for: its stiffness is itself a derivative, whose
-    /// partials need the bladder's second-order pass.
-    pub stiffness: Option<[f64; 2]>,
 }
 
 impl KnittedAssembly {
@@ -254,7 +242,7 @@ impl KnittedAssembly {
         history: &HysteresisState,
         direction: f64,
         stiffness: bool,
-    ) -> Result<KnittedRows, String> {
+    ) -> Result<ByPressureLength, String> {
         match &self.bladder {
             Some(b) => self.bladder_rows(b, pressure, l, history, direction, stiffness),
             None => Ok(self.sleeve_rows(pressure, l, history, direction)),
@@ -270,7 +258,7 @@ impl KnittedAssembly {
         l: f64,
         history: &HysteresisState,
         direction: f64,
-    ) -> KnittedRows {
+    ) -> ByPressureLength {
         let s = &self.sleeve;
         let p_eff = pressure.max(0.0);
         let on = if pressure > 0.0 { 1.0 } else { 0.0 };
@@ -281,13 +269,14 @@ impl KnittedAssembly {
         }
         let (v, v1, v2) = s.volume_derivatives(l);
         let v3 = s.volume_third_derivative(l);
-        let mut r = KnittedRows {
+        let mut r = ByPressureLength {
             force: [-on * v1, -p_eff * v2],
             volume: [0.0, v1],
             effective_pressure: [on, 0.0],
             friction_force: [0.0, 0.0],
             max_radius: [0.0, s.max_radius_slope(l)],
             stiffness: Some([-on * v2, -p_eff * v3]),
+            ..Default::default()
         };
         let Some(f) = &self.friction else {
             return r;
@@ -330,7 +319,7 @@ impl KnittedAssembly {
         history: &HysteresisState,
         direction: f64,
         stiffness: bool,
-    ) -> Result<KnittedRows, String> {
+    ) -> Result<ByPressureLength, String> {
         let ((state, d), on, used) = match b.evaluate_with_partials(pressure, l) {
             Ok(x) => (x, 1.0, pressure),
             Err(_) => (b.evaluate_with_partials(0.0, l)?, 0.0, 0.0),
@@ -340,13 +329,14 @@ impl KnittedAssembly {
         } else {
             None
         };
-        let mut r = KnittedRows {
+        let mut r = ByPressureLength {
             force: d.force,
-            volume: d.fluid_volume,
+            volume: d.volume,
             effective_pressure: d.effective_pressure,
             friction_force: [0.0, 0.0],
             max_radius: [0.0, 0.5 * b.sleeve().diameter_and_slope(l).1],
             stiffness: curvature.map(|c| c.stiffness),
+            ..Default::default()
         };
         if let Some(f) = &self.friction {
             let next = f.operator.advance(history, l);
@@ -421,7 +411,7 @@ pub(crate) fn bag_rows(
     p_eff: f64,
     l: f64,
     on: f64,
-) -> Option<KnittedRows> {
+) -> Option<ByPressureLength> {
     if bag.volume_derivatives(s, p_eff, l) == s.volume_derivatives(l) {
         return None;
     }
@@ -434,12 +424,13 @@ pub(crate) fn bag_rows(
     } else {
         [0.0, s.max_radius_slope(l)]
     };
-    Some(KnittedRows {
+    Some(ByPressureLength {
         force: [-on * area - p_eff * area_p, 0.0],
         volume: [area_p * l, area],
         effective_pressure: [on, 0.0],
         friction_force: [0.0, 0.0],
         max_radius,
         stiffness: Some([0.0, 0.0]),
+        ..Default::default()
     })
 }

@@ -10,8 +10,9 @@
 //! the rigid knit is as stiff as its yarn or at its reach, whichever comes first:
 //! `F = F(L_t) + k_s (L - L_t)`.
 
+use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::friction::HysteresisState;
-use crate::physics::knitted_muscle::{KnittedAssembly, KnittedOutput, KnittedRows};
+use crate::physics::knitted_muscle::{KnittedAssembly, KnittedOutput};
 use crate::physics::mckibben::{transition, OutOfRange, Transition, SURVIVABLE_STRAND_STRAIN};
 
 /// `E A` of the section 1.4 prototype's yarn, N: Spectra (UHMWPE) braided line rated 220 N,
@@ -130,7 +131,7 @@ impl KnittedAssembly {
         k_s: f64,
         history: &HysteresisState,
         stiffness: bool,
-    ) -> Result<KnittedRows, String> {
+    ) -> Result<ByPressureLength, String> {
         if !(pressure.is_finite() && length.is_finite()) {
             return Err(format!(
                 "partials need finite inputs, got pressure {pressure} Pa and length {length} m"
@@ -145,12 +146,7 @@ impl KnittedAssembly {
                 _ => 0.0,
             };
             let [fp, fl] = r.force;
-            for y in [
-                &mut r.volume,
-                &mut r.effective_pressure,
-                &mut r.friction_force,
-                &mut r.max_radius,
-            ] {
+            for y in r.rows_mut() {
                 *y = [y[0] + y[1] * dlt, 0.0];
             }
             let moves = length <= self.breaking_length();
@@ -163,13 +159,7 @@ impl KnittedAssembly {
         let mut r = self.partial_rows(pressure, l, history, direction(l), stiffness)?;
         if l != length {
             // A clamped length no longer moves with the input.
-            for y in [
-                &mut r.force,
-                &mut r.volume,
-                &mut r.effective_pressure,
-                &mut r.friction_force,
-                &mut r.max_radius,
-            ] {
+            for y in r.rows_mut() {
                 y[1] = 0.0;
             }
             if let Some(s) = r.stiffness.as_mut() {

@@ -17,7 +17,6 @@ mod partials;
 mod strands;
 mod target;
 pub use limits::{is_slack, OutOfRange, LIMIT_MARGIN};
-pub use partials::McKibbenPartials;
 pub use strands::{
     strand_rigidity, transition, StrandTransition, Transition, SURVIVABLE_STRAND_STRAIN,
 };

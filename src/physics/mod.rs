@@ -3,6 +3,7 @@
 #![forbid(unsafe_code)]
 
 pub mod bladder;
+pub mod by_pressure_length;
 pub mod festo;
 pub mod free_bladder;
 pub mod friction;

@@ -51,7 +51,6 @@ use continuum::WallNode;
 pub use geometry::SleeveGeometry;
 use hyper_dual::KernelScalar;
 pub use knitted_cylinder::KnittedCylinder;
-pub use partials::BladderPartials;
 use state::check_state;
 pub use state::BladderState;
 use std::f64::consts::PI;

@@ -13,27 +13,7 @@
 //! `x(P, L)` gives them; the threshold is always taken at the contact diameter `D(L)`.
 
 use super::{check_state, Bladder, BladderState, Dual, Kernel, SleeveGeometry};
-
-/// `[d/dP, d/dL]` of the bladder's outputs, per Pa and per m.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct BladderPartials {
-    /// Muscle tension `F` (eq. 2.16 + 2.17), N/Pa and N/m.
-    pub force: [f64; 2],
-    /// Contact pressure `P_eff` (eq. 2.12, 2.19), 1 and Pa/m; zero when free.
-    pub effective_pressure: [f64; 2],
-    /// Gas volume `pi/4 D_in^2 L`, m^3/Pa and m^2.
-    pub fluid_volume: [f64; 2],
-    /// Threshold pressure `c/a` at the contact diameter, 1 and Pa/m (its `P`-slope is zero).
-    pub threshold_pressure: [f64; 2],
-    /// Stretches of the innermost layer (eq. 2.8a-c), 1/Pa and 1/m.
-    pub stretch_axial: [f64; 2],
-    pub stretch_hoop: [f64; 2],
-    pub stretch_radial: [f64; 2],
-    /// True stresses of the innermost layer (eq. 2.9a-b; radial `-P`), 1 and Pa/m.
-    pub stress_axial: [f64; 2],
-    pub stress_hoop: [f64; 2],
-    pub stress_radial: [f64; 2],
-}
+use crate::physics::by_pressure_length::ByPressureLength;
 
 /// `[d/dP, d/dL]` of a function of `(L, x)` through `x = x(P, L)`.
 fn chain(q: Dual, dx_dp: f64, dx_dl: f64) -> [f64; 2] {
@@ -42,7 +22,7 @@ fn chain(q: Dual, dx_dp: f64, dx_dl: f64) -> [f64; 2] {
 
 impl<S: SleeveGeometry> Bladder<S> {
     /// The partials at `pressure` and `length`, on the branch [`Bladder::evaluate`] takes there.
-    pub fn partials(&self, pressure: f64, length: f64) -> Result<BladderPartials, String> {
+    pub fn partials(&self, pressure: f64, length: f64) -> Result<ByPressureLength, String> {
         self.evaluate_with_partials(pressure, length)
             .map(|(_, d)| d)
     }
@@ -53,7 +33,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         &self,
         pressure: f64,
         length: f64,
-    ) -> Result<(BladderState, BladderPartials), String> {
+    ) -> Result<(BladderState, ByPressureLength), String> {
         let (x, contact) = self.contact_point(pressure, length)?;
         if contact.p_eff.v >= 0.0 {
             // The dual numbers seeded by `contact_seed` carry the contact branch's total d/dL in `dl`.
@@ -65,7 +45,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             let state = check_state(self.contact_state(pressure, length, &contact), length)?;
             return Ok((
                 state,
-                BladderPartials {
+                ByPressureLength {
                     // F = P_eff g - P A_fluid + elastic (eq. 2.16, 2.17).
                     force: [
                         a * g - area.v + contact.elastic_dp_value(),
@@ -73,7 +53,7 @@ impl<S: SleeveGeometry> Bladder<S> {
                             + contact.elastic.dl,
                     ],
                     effective_pressure: [a, contact.p_eff.dl],
-                    fluid_volume: [0.0, area.dl * length + area.v],
+                    volume: [0.0, area.dl * length + area.v],
                     ..kinematics
                 },
             ));
@@ -98,13 +78,13 @@ impl<S: SleeveGeometry> Bladder<S> {
         )?;
         Ok((
             state,
-            BladderPartials {
+            ByPressureLength {
                 force: [
                     -area.v + k.elastic_dp_value() + force_dx * dx_dp,
                     force_dl + force_dx * dx_dl,
                 ],
                 effective_pressure: [0.0, 0.0],
-                fluid_volume: [
+                volume: [
                     area.dx * dx_dp * length,
                     area.v + (area.dl + area.dx * dx_dl) * length,
                 ],
@@ -122,7 +102,7 @@ impl<S: SleeveGeometry> Bladder<S> {
         k: &Kernel,
         dx_dp: f64,
         dx_dl: f64,
-    ) -> BladderPartials {
+    ) -> ByPressureLength {
         let (a, c) = (contact.a, contact.c);
         let threshold = [0.0, (c.dl * a.v - c.v * a.dl) / (a.v * a.v)];
         // lambda_1 = L / L_R0, lambda_2 = sqrt(l2_sq), lambda_3 = 1 / (lambda_1 lambda_2).
@@ -138,7 +118,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             let [dp, dl] = chain(q, dx_dp, dx_dl);
             [dp - 1.0, dl]
         };
-        BladderPartials {
+        ByPressureLength {
             threshold_pressure: threshold,
             stretch_axial: lambda1_d,
             stretch_hoop: lambda2_d,

@@ -2,7 +2,8 @@
 //! (see [`super::strands`]): the McKibbenMuscle FMU's fastest path, in closed form.
 
 use super::limits::OutOfRange;
-use super::{McKibbenPartials, SURVIVABLE_STRAND_STRAIN};
+use super::SURVIVABLE_STRAND_STRAIN;
+use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::gaylord::Sleeve;
 
 /// The bare sleeve's outputs at one point.
@@ -114,7 +115,7 @@ pub fn on_the_strands(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> 
 /// `reach = k_s / (6 P / (4 pi n^2))` inside `b`: `dreach/dP = -reach / P`, and the force
 /// `F(P, reach(P)) + k_s (L - reach(P))` moves with the length by `k_s` up to the breaking
 /// length. The bare sleeve's stretches and stresses are constants (no bladder).
-pub fn partials(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> McKibbenPartials {
+pub fn partials(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> ByPressureLength {
     let p_eff = pressure.max(0.0);
     let on = if pressure > 0.0 { 1.0 } else { 0.0 };
     let reach = reach(sleeve, k_s, p_eff);
@@ -126,7 +127,7 @@ pub fn partials(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> McKibb
             0.0
         };
         let per_pa = sleeve.force(1.0, reach);
-        return McKibbenPartials {
+        return ByPressureLength {
             force: [
                 on * (per_pa + (sleeve.stiffness(p_eff, reach) - k_s) * dreach),
                 if moves { k_s } else { 0.0 },
@@ -140,7 +141,7 @@ pub fn partials(sleeve: &Sleeve, k_s: f64, pressure: f64, length: f64) -> McKibb
     let l = length.min(sleeve.max_length());
     let per_pa = sleeve.force(1.0, l);
     let dl = if inside { 1.0 } else { 0.0 };
-    McKibbenPartials {
+    ByPressureLength {
         force: [on * per_pa, dl * sleeve.stiffness(p_eff, l)],
         effective_pressure: [on, 0.0],
         volume: [0.0, -dl * per_pa],

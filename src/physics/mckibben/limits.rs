@@ -3,7 +3,8 @@
 //! partials on the branch each takes. Shared by the McKibbenMuscle and McKibbenJoint FMUs.
 
 use super::SURVIVABLE_STRAND_STRAIN;
-use super::{McKibben, McKibbenOutput, McKibbenPartials, StrandTransition};
+use super::{McKibben, McKibbenOutput, StrandTransition};
+use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::friction::HysteresisState;
 
 /// With a bladder the force grows without bound at both length limits; an out-of-range length
@@ -145,7 +146,7 @@ impl McKibben {
         length: f64,
         k_s: f64,
         history: &HysteresisState,
-    ) -> Result<McKibbenPartials, String> {
+    ) -> Result<ByPressureLength, String> {
         if let Some(d) = self.strand_partials(pressure, length, k_s, history)? {
             return Ok(d);
         }
@@ -167,7 +168,7 @@ impl McKibben {
         length: f64,
         k_s: f64,
         history: &HysteresisState,
-    ) -> Result<(f64, McKibbenPartials), String> {
+    ) -> Result<(f64, ByPressureLength), String> {
         if let Ok((out, d)) = self.partials(pressure, length, history) {
             if !(out.force > 0.0 && out.stiffness > k_s) {
                 return Ok((out.force, d));
@@ -214,7 +215,7 @@ impl McKibben {
         length: f64,
         k_s: f64,
         history: &HysteresisState,
-    ) -> Result<Option<McKibbenPartials>, String> {
+    ) -> Result<Option<ByPressureLength>, String> {
         let Some(t) = self.strand_point(pressure, length, k_s, history) else {
             return Ok(None);
         };

@@ -12,67 +12,8 @@
 //! slope for increasing length.
 
 use super::{McKibben, McKibbenOutput};
+use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::friction::HysteresisState;
-
-/// `[d/dP, d/dlength]` of the outputs, with `length` the input (reported) length.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
-pub struct McKibbenPartials {
-    /// N/Pa and N/m.
-    pub force: [f64; 2],
-    /// 1 and Pa/m.
-    pub effective_pressure: [f64; 2],
-    /// N/Pa and N/m.
-    pub friction_force: [f64; 2],
-    /// m^3/Pa and m^2.
-    pub volume: [f64; 2],
-    /// Pa/Pa and Pa/m; zero without a bladder.
-    pub threshold_pressure: [f64; 2],
-    /// Innermost layer's stretches (eq. 2.8a-c), 1/Pa and 1/m; zero without a bladder.
-    pub stretch_axial: [f64; 2],
-    pub stretch_hoop: [f64; 2],
-    pub stretch_radial: [f64; 2],
-    /// Innermost layer's true stresses (eq. 2.9a-b, radial `-P`), 1 and Pa/m; zero without a
-    /// bladder.
-    pub stress_axial: [f64; 2],
-    pub stress_hoop: [f64; 2],
-    pub stress_radial: [f64; 2],
-}
-
-impl McKibbenPartials {
-    /// Every row with its output's name, in the FMU's variable names.
-    pub fn named(&self) -> [(&'static str, [f64; 2]); 11] {
-        [
-            ("force", self.force),
-            ("effective_pressure", self.effective_pressure),
-            ("friction_force", self.friction_force),
-            ("volume", self.volume),
-            ("threshold_pressure", self.threshold_pressure),
-            ("stretch_axial", self.stretch_axial),
-            ("stretch_hoop", self.stretch_hoop),
-            ("stretch_radial", self.stretch_radial),
-            ("stress_axial", self.stress_axial),
-            ("stress_hoop", self.stress_hoop),
-            ("stress_radial", self.stress_radial),
-        ]
-    }
-
-    /// Every row, mutable, in the order of [`Self::named`].
-    pub fn rows_mut(&mut self) -> [&mut [f64; 2]; 11] {
-        [
-            &mut self.force,
-            &mut self.effective_pressure,
-            &mut self.friction_force,
-            &mut self.volume,
-            &mut self.threshold_pressure,
-            &mut self.stretch_axial,
-            &mut self.stretch_hoop,
-            &mut self.stretch_radial,
-            &mut self.stress_axial,
-            &mut self.stress_hoop,
-            &mut self.stress_radial,
-        ]
-    }
-}
 
 impl McKibben {
     /// The outputs of [`McKibben::evaluate`] and their partials at the same point.
@@ -81,7 +22,7 @@ impl McKibben {
         pressure: f64,
         length: f64,
         history: &HysteresisState,
-    ) -> Result<(McKibbenOutput, McKibbenPartials), String> {
+    ) -> Result<(McKibbenOutput, ByPressureLength), String> {
         let (out, mut d) = self.own_partials(pressure, length, history)?;
         if let Some(c) = self.connector_compliance {
             // reported = L + c F(P, L): dL/dP = -c F_P / (1 + c F_L), dL/dreported = 1/(1 + c F_L).
@@ -91,7 +32,7 @@ impl McKibben {
                 *y = [y[0] + y[1] * dl_dp, y[1] * dl_dr];
             }
         }
-        if finite(&d) {
+        if d.is_finite() {
             Ok((out, d))
         } else {
             Err(format!(
@@ -107,7 +48,7 @@ impl McKibben {
         pressure: f64,
         length: f64,
         history: &HysteresisState,
-    ) -> Result<(McKibbenOutput, McKibbenPartials), String> {
+    ) -> Result<(McKibbenOutput, ByPressureLength), String> {
         // Without a connector the bladder's state and partials come from one pass; through a
         // connector the actual length is a root first.
         let (out, bladder) = match (&self.bladder, self.connector_compliance) {
@@ -133,7 +74,7 @@ impl McKibben {
                 let on = if pressure > 0.0 { 1.0 } else { 0.0 };
                 // Eq. 2.3 and 2.2: F = P_eff (3L^2 - b^2)/(4 pi n^2), dV/dL = -F/P_eff.
                 let per_pa = s.force(1.0, l);
-                McKibbenPartials {
+                ByPressureLength {
                     force: [on * per_pa, s.stiffness(pressure.max(0.0), l)],
                     effective_pressure: [on, 0.0],
                     friction_force: [0.0, 0.0],
@@ -141,19 +82,8 @@ impl McKibben {
                     ..Default::default()
                 }
             }
-            Some(p) => McKibbenPartials {
-                force: p.force,
-                effective_pressure: p.effective_pressure,
-                friction_force: [0.0, 0.0],
-                volume: p.fluid_volume,
-                threshold_pressure: p.threshold_pressure,
-                stretch_axial: p.stretch_axial,
-                stretch_hoop: p.stretch_hoop,
-                stretch_radial: p.stretch_radial,
-                stress_axial: p.stress_axial,
-                stress_hoop: p.stress_hoop,
-                stress_radial: p.stress_radial,
-            },
+            // The bladder's own rows: no friction yet.
+            Some(p) => p,
         };
         if let Some(f) = &self.friction {
             let z = out.friction_state.z;
@@ -227,18 +157,27 @@ impl McKibben {
     }
 }
 
-fn finite(d: &McKibbenPartials) -> bool {
-    d.named()
-        .iter()
-        .all(|(_, v)| v.iter().all(|x| x.is_finite()))
-}
-
 #[cfg(test)]
 mod tests {
     use super::super::{BladderModel, FrictionParams, MuscleGeometry};
     use super::*;
 
-    /// The outputs in the order of [`McKibbenPartials::named`].
+    /// The outputs in the order of [`ByPressureLength::rows`] (the muscle has no `max_radius`).
+    const NAMES: [&str; 11] = [
+        "force",
+        "effective_pressure",
+        "friction_force",
+        "volume",
+        "threshold_pressure",
+        "stretch_axial",
+        "stretch_hoop",
+        "stretch_radial",
+        "stress_axial",
+        "stress_hoop",
+        "stress_radial",
+    ];
+
+    /// The outputs in the order of [`NAMES`].
     fn values(o: &McKibbenOutput) -> [f64; 11] {
         [
             o.force,
@@ -276,7 +215,7 @@ mod tests {
         // Through a connector the actual length is a root (tolerance 1e-14 relative), whose
         // noise the central difference amplifies.
         let tolerance = if m.has_connector() { 1e-4 } else { 2e-5 };
-        for ((name, e), c) in exact.named().into_iter().zip(fd) {
+        for ((name, e), c) in NAMES.into_iter().zip(exact.rows()).zip(fd) {
             for k in 0..2 {
                 let scale = e[k].abs().max(c[k].abs()).max(1e-12);
                 let err = (e[k] - c[k]).abs() / scale;
