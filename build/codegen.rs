@@ -454,11 +454,6 @@ fn identifier_enum(
         "        const ALL: &'static [Self] = &[{}];",
         all.join(", ")
     );
-    let vrs: Vec<u32> = members.iter().map(|v| v.value_reference).collect();
-    let _ = writeln!(
-        code,
-        "        const VALUE_REFERENCES: &'static [u32] = &{vrs:?};"
-    );
     let _ = writeln!(code, "        #[inline]");
     let _ = writeln!(code, "        fn index(self) -> usize {{");
     let _ = writeln!(code, "            match self {{");

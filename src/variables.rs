@@ -186,8 +186,6 @@ impl ContinuousStates for () {
 pub trait Identifier: Copy + Eq + std::fmt::Debug + Send + Sync + 'static {
     /// Every identifier, in the order of [`Identifier::index`].
     const ALL: &'static [Self];
-    /// The value reference (Real) of each identifier, in the same order.
-    const VALUE_REFERENCES: &'static [u32];
     /// The position in [`Identifier::ALL`].
     fn index(self) -> usize;
     /// The identifier of a Real value reference, if it is one of these.
@@ -197,7 +195,6 @@ pub trait Identifier: Copy + Eq + std::fmt::Debug + Send + Sync + 'static {
 /// No knowns or unknowns (hand-written interfaces in tests).
 impl Identifier for () {
     const ALL: &'static [Self] = &[];
-    const VALUE_REFERENCES: &'static [u32] = &[];
     fn index(self) -> usize {
         0
     }
