@@ -239,4 +239,36 @@ mod tests {
         cache.forget();
         assert_eq!(cache.partials_of(&mut m, &x, &[FORCE]).unwrap(), &first);
     }
+
+    /// A model rebuilt from other parameters (a tunable parameter set between steps, an FMU
+    /// state restored) never gets the partials kept for the one it replaced, though the inputs
+    /// and its history are the same.
+    #[test]
+    fn kept_partials_go_with_the_model() -> Result<(), String> {
+        use crate::export::runtime::{Factory, ModelFactory, Runtime};
+        let (pressure, length, turns) = (real::PRESSURE, real::LENGTH, real::TURNS);
+        let derivative = |runtime: &mut dyn Runtime| -> Result<f64, String> {
+            let mut dv = [0.0];
+            runtime.directional_derivative(&[FORCE], &[pressure as u32], &[1.0], &mut dv)?;
+            Ok(dv[0])
+        };
+        let runtime_with = |n: f64| -> Result<Box<dyn Runtime>, String> {
+            let mut runtime = ModelFactory::<McKibbenMuscle>::NEW.create();
+            runtime.set_real(turns, n);
+            runtime.set_real(pressure, 3e5);
+            runtime.set_real(length, 0.1);
+            runtime.changed(true);
+            runtime.build()?;
+            Ok(runtime)
+        };
+        let mut runtime = runtime_with(3.74)?;
+        let before = derivative(&mut *runtime)?;
+        runtime.set_real(turns, 4.5);
+        runtime.changed(true);
+        runtime.build()?;
+        let after = derivative(&mut *runtime)?;
+        assert_ne!(after, before);
+        assert_eq!(after, derivative(&mut *runtime_with(4.5)?)?);
+        Ok(())
+    }
 }
