@@ -9,7 +9,7 @@
 //! with `command_mode` 1 it is a joint torque, met by solving for that difference through the same
 //! muscle physics ([`crate::physics::inverse::difference_for_torque`]).
 
-use super::{Model, Partials, Refusal, Report, Status};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
 use crate::physics::festo;
 use crate::physics::friction::HysteresisState;
@@ -413,6 +413,12 @@ impl Model for McKibbenJoint {
         .row(Unknown::FlexorLength, &row([0.0, -r]))
         .row(Unknown::ExtensorLength, &row([0.0, r]));
         Ok(())
+    }
+
+    /// The partials read both muscles' friction histories besides the inputs.
+    fn partials_key(&self) -> Option<HistoryKey> {
+        let (f, e) = (&self.flexor_friction, &self.extensor_friction);
+        Some(HistoryKey::of([f.z, f.position, e.z, e.position]))
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
