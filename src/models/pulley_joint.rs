@@ -97,8 +97,9 @@ impl Params {
     /// `q' = q + h dq'`. Stable for any `h` where gravity restores (`cos q > 0`); where it
     /// overturns, its slope stays explicit, as the physics is unstable there too.
     fn implicit_substep(&self, torque: f64, q: f64, dq: f64, h: f64) -> (f64, f64) {
-        let restoring = self.gravity_torque * q.cos().max(0.0);
-        let dq = (self.inertia * dq + h * (torque - self.gravity_torque * q.sin()))
+        let (sin, cos) = q.sin_cos();
+        let restoring = self.gravity_torque * cos.max(0.0);
+        let dq = (self.inertia * dq + h * (torque - self.gravity_torque * sin))
             / (self.inertia + h * (self.damping + h * restoring));
         (q + h * dq, dq)
     }
