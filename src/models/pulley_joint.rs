@@ -22,7 +22,7 @@ use serde::{Deserialize, Serialize};
 /// Substep cap: a long communication step is split so that each Euler substep stays well
 /// inside the stability limit of the joint's fastest mode; a step that would need more is taken
 /// in this many linearly implicit substeps instead, stable for any stiffness (bounded work).
-const MAX_SUBSTEPS: usize = 256;
+const MAX_SUBSTEPS: usize = 64;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PulleyJoint {
