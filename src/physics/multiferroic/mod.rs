@@ -47,6 +47,9 @@ mod onion_tests;
 mod params;
 pub mod phi;
 pub mod schedule;
+mod spin;
+#[cfg(test)]
+mod spin_tests;
 mod step;
 #[cfg(test)]
 mod tests;

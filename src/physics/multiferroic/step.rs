@@ -15,9 +15,11 @@ pub(super) struct StepRun {
     pub(super) dt: f64,
     /// The segment whose settle was tried.
     pub(super) settle_tried_for: f64,
-    /// The load-dominated closed form ([`Motor::advance_load_dominated`]) was tried in this call
+    /// The averaged spin ([`Motor::advance_spinning`]) was tried in this call
     /// and did not apply: its onion cycle (two turns of strides) is not tried again on every pass.
-    pub(super) load_dominated_failed: bool,
+    pub(super) spin_failed: bool,
+    /// The onion's cycle of the averaged spin for the segment ending at the given time.
+    pub(super) spin_cycle: Option<(f64, super::spin::OnionCycle)>,
     /// The segment in progress: its end, strain direction, and whether it began at a switch (a
     /// whole period of the schedule).
     pub(super) segment_end: f64,
@@ -54,7 +56,8 @@ impl StepRun {
                 1e-10
             },
             settle_tried_for: f64::NAN,
-            load_dominated_failed: false,
+            spin_failed: false,
+            spin_cycle: None,
             segment_end: f64::NAN,
             segment_direction: 0.0,
             whole_period: false,
@@ -158,7 +161,7 @@ impl Motor {
                 None => run.t_end,
             };
             run.enter_segment(segment_end, d.direction);
-            if self.advance_load_dominated(&mut run, &d, segment_end) {
+            if self.advance_spinning(&mut run, &d, segment_end) {
                 continue;
             }
             if run.settle_tried_for != segment_end && segment_end - run.t > long_segment {
