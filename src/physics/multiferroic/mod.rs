@@ -61,6 +61,7 @@ pub use params::*;
 pub use schedule::{ScheduleSwitch, SteppingSchedule};
 use std::f64::consts::PI;
 use step::StepRun;
+pub use step::GILBERT_SUBSTEP_WEIGHT;
 
 /// The motor built from its parameters, with everything that depends only on them precomputed.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
