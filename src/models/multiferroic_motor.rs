@@ -305,8 +305,14 @@ impl Model for MultiferroicMotor {
         time: f64,
         report: &mut Report,
     ) -> EventUpdate {
+        let first = !self.model_exchange_active();
         match self.me_event(inputs, time) {
             Ok(states_changed) => {
+                if first {
+                    if let Some(why) = self.me_light_damping() {
+                        report.warn(why);
+                    }
+                }
                 self.me_outputs(inputs, outputs, report);
                 EventUpdate {
                     states_changed,
