@@ -271,9 +271,11 @@ def test_motor_model_exchange_runs_under_fmpy_defaults(case):
         assert me["rotor_angle"][-1] > 0.9 * periods * np.radians(60)
 
 
-def test_motor_model_exchange_below_the_default_bdf_damping_says_why():
+def test_motor_model_exchange_below_the_default_bdf_damping_says_why(recording_log):
     """Below gilbert_damping 0.005 FMPy's default CVode (BDF up to order 5) cannot follow the
-    Gilbert onion's precession: the FMU says why at its first event, before the solver stops."""
+    Gilbert onion's precession: the FMU says why at its first event, before the solver stops.
+    (`recording_log` puts FMPy's process-global logger back afterwards: the callbacks
+    simulate_fmu builds for `logger` do not outlive it.)"""
     messages = []
 
     def logger(_env, _name, _status, _category, message):
