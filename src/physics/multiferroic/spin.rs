@@ -136,7 +136,11 @@ impl Motor {
         let epsilon = bound / load.abs();
         let h = segment_end - run.t;
         let speed = dir * run.y[1];
-        let resolved_free = epsilon <= LOAD_DOMINATED * tol && speed >= 0.0;
+        // From rest, or once the integrator has had to force a substep beyond the tolerance
+        // while the rotor speeds up (the spin from there is far closer to the resolved motion:
+        // see the tests), as long as the periodic part stays small against the load.
+        let resolved_free = speed >= 0.0
+            && (epsilon <= LOAD_DOMINATED * tol || (run.limited && epsilon <= MAX_SPIN_EPSILON));
         // Near enough its terminal speed: the deviation (at most `2 tau_max / (omega
         // sqrt(c^2 + I^2 omega^2))`) times the mean speed's relative distance to the terminal
         // one below tol / 10 (here the speed's own deviation, up to `2 epsilon`, allowed for;
