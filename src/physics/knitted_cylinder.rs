@@ -1,6 +1,6 @@
 //! The cylindrical knitted sleeves of chapter 1 as the bladder sees them (section 1.3.6).
 
-use super::SleeveGeometry;
+use crate::physics::bladder::{Bladder, BladderTube, SleeveGeometry, Wall};
 use crate::physics::knitted::{KnittedSleeve, ShapeModel};
 use std::f64::consts::PI;
 
@@ -76,6 +76,28 @@ impl KnittedCylinder {
         } else {
             self.sleeve_max_length
         }
+    }
+}
+
+impl Bladder<KnittedCylinder> {
+    /// The bladder inside a cylindrical knitted sleeve (section 1.3.6); `Err` for the
+    /// non-cylindrical shape (see [`KnittedCylinder::new`]) or a tube that does not fit. The
+    /// length range is the sleeve's own (strand thickness) intersected with where the rubber fits.
+    pub fn knitted(
+        sleeve: &KnittedSleeve,
+        tube: BladderTube,
+        layers: usize,
+    ) -> Result<Self, String> {
+        Self::dissertation_layers(KnittedCylinder::new(sleeve)?, tube, layers)
+    }
+
+    /// As [`Self::knitted`] with any [`Wall`].
+    pub fn knitted_wall(
+        sleeve: &KnittedSleeve,
+        tube: BladderTube,
+        wall: Wall,
+    ) -> Result<Self, String> {
+        Self::with_wall(KnittedCylinder::new(sleeve)?, tube, wall)
     }
 }
 
