@@ -102,11 +102,13 @@ pub struct Transition<T> {
 
 /// The rigid model holds at `L` unless it has no solution there or pulls and is stiffer than the
 /// strands (`k_s`, N/m).
-/// Returns its stiffness and outputs there.
-fn holds<T>(rigid: &impl Fn(f64) -> Option<(f64, f64, T)>, l: f64, k_s: f64) -> Option<(f64, T)> {
-    rigid(l)
-        .filter(|(force, stiffness, _)| !(*force > 0.0 && *stiffness > k_s))
-        .map(|(_, stiffness, out)| (stiffness, out))
+/// Returns its force, stiffness and outputs there.
+fn holds<T>(
+    rigid: &impl Fn(f64) -> Option<(f64, f64, T)>,
+    l: f64,
+    k_s: f64,
+) -> Option<(f64, f64, T)> {
+    rigid(l).filter(|(force, stiffness, _)| !(*force > 0.0 && *stiffness > k_s))
 }
 
 /// The transition for an input `length` in the upper half of the rigid model's `range` where
@@ -122,12 +124,17 @@ pub fn transition<T>(
     k_s: f64,
     rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
 ) -> Option<Transition<T>> {
-    let upper_half = length > 0.5 * (lo + hi);
-    if !upper_half || holds(&rigid, length, k_s).is_some() {
+    if length <= 0.5 * (lo + hi) {
+        return None;
+    }
+    let pulls_stiffer = |(force, stiffness, _): &(f64, f64, T)| *force > 0.0 && *stiffness > k_s;
+    let mut at_stiff = rigid(length);
+    if at_stiff.as_ref().is_some_and(|o| !pulls_stiffer(o)) {
         return None;
     }
     if length >= hi {
-        if let Some((_, out)) = holds(&rigid, hi, k_s) {
+        at_stiff = rigid(hi);
+        if let Some((_, _, out)) = at_stiff.take_if(|o| !pulls_stiffer(o)) {
             return Some(Transition {
                 length: hi,
                 rigid: out,
@@ -144,27 +151,36 @@ pub fn transition<T>(
             break;
         }
     }
-    let (mut l, (mut slope, mut out)) = soft?;
-    // ITP (interpolate, truncate, project; Oliveira and Takahashi, ACM TOMS 47, 2020) on
-    // `g = stiffness - k_s` where the soft end pulls below `k_s` and the stiff end has a
-    // stiffness above it, else bisection: it converges superlinearly on a smooth `g` and never
-    // takes more than one evaluation beyond bisection's count. It stops only at adjacent floats,
-    // not at a tolerance: the boundary must be as exact as bisection's (the partials through it
-    // are differentiated against central differences).
+    let (mut l, (force, mut slope, mut out)) = soft?;
+    // ITP (interpolate, truncate, project; Oliveira and Takahashi, ACM TOMS 47, 2020) on the
+    // quantity whose sign change ends the rigid model: `g = stiffness - k_s` where the soft end
+    // pulls below `k_s`, else its force (it holds because it pushes); bisection where the stiff
+    // end has no solution. It converges superlinearly on a smooth function and never takes more
+    // than two evaluations beyond bisection's count. It stops only at adjacent floats, not at a
+    // tolerance: the boundary must be as exact as bisection's (the partials through it are
+    // differentiated against central differences).
     let width = stiff - l;
     let half_ulp = 0.5 * f64::EPSILON * stiff.abs();
-    let most = (width / half_ulp).log2().ceil() + 1.0;
+    let most = (width / half_ulp).log2().ceil() + 2.0;
     let truncation = 0.2 / width;
-    let mut g_soft = Some(slope - k_s).filter(|g| *g < 0.0);
-    let mut g_stiff: Option<f64> = None;
+    // (force, stiffness - k_s) at each end; the soft end's force is only needed where it pushes.
+    let mut soft_end = (force, slope - k_s);
+    let mut stiff_end = at_stiff.map(|(force, stiffness, _)| (force, stiffness - k_s));
     for taken in 0..120 {
         let mid = 0.5 * (l + stiff);
         if mid <= l || mid >= stiff {
             break;
         }
         let width = stiff - l;
-        let next = match (g_soft, g_stiff) {
-            (Some(a), Some(b)) => {
+        let ends = stiff_end.map(|(force, excess)| {
+            if soft_end.1 < 0.0 {
+                (soft_end.1, excess)
+            } else {
+                (soft_end.0, force)
+            }
+        });
+        let next = match ends {
+            Some((a, b)) if a <= 0.0 && b > 0.0 => {
                 let falsi = l - a * width / (b - a);
                 let toward_mid = (mid - falsi).signum();
                 // At least a few ulps: else, once one end sits on the boundary, the other
@@ -182,19 +198,25 @@ pub fn transition<T>(
                     mid - toward_mid * radius.max(0.0)
                 }
             }
+            // No solution at the stiff end: first try just below it (the common case of a
+            // transition at the rigid model's reach), then bisect.
+            _ if taken == 0 => stiff - 8.0 * half_ulp,
             _ => mid,
         };
         let next = if next > l && next < stiff { next } else { mid };
         match rigid(next) {
             Some((force, stiffness, o)) if !(force > 0.0 && stiffness > k_s) => {
                 (l, slope, out) = (next, stiffness, o);
-                g_soft = Some(stiffness - k_s).filter(|g| *g < 0.0);
+                soft_end = (force, stiffness - k_s);
             }
             evaluated => {
                 stiff = next;
-                g_stiff = evaluated
-                    .map(|(_, stiffness, _)| stiffness - k_s)
-                    .filter(|g| *g > 0.0);
+                // Not the probe just below a reach without solution: its values, next to a
+                // singularity, would only slow the interpolation.
+                let probe = taken == 0 && stiff_end.is_none();
+                stiff_end = evaluated
+                    .filter(|_| !probe)
+                    .map(|(force, stiffness, _)| (force, stiffness - k_s));
             }
         }
     }
@@ -249,7 +271,11 @@ mod tests {
         type Model = fn(f64) -> Option<(f64, f64, f64)>;
         // Bisection to adjacent floats takes 50-odd evaluations; where the stiff end has no
         // stiffness ("ends") the search is bisection.
-        let models: [(&str, Model, f64, usize); 4] = [
+        let models: [(&str, Model, f64, usize); 6] = [
+            // Pushes (holds) up to the end of its solutions.
+            ("reach", |l| (l < 0.1).then_some((-1.0, 1e9, l)), 1e3, 25),
+            // Stiffer than the strands throughout: ends where its force turns to a pull.
+            ("pulls", |l| Some((1e3 * (l - 0.08), 1e9, l)), 1e3, 25),
             (
                 "pole",
                 |l| (l < 0.1).then(|| (2.0 / (0.1 - l), 2.0 / (0.1 - l).powi(2), l)),
@@ -279,7 +305,10 @@ mod tests {
             let holds_at = |l: f64| holds(&model, l, k_s).is_some();
             for length in [0.097, hi, hi + 0.01] {
                 calls.set(0);
-                let t = transition((lo, hi), length, k_s, counted).unwrap();
+                let Some(t) = transition((lo, hi), length, k_s, counted) else {
+                    assert!(holds_at(length), "{name} at {length}");
+                    continue;
+                };
                 let stiff = length.min(hi);
                 let soft = (1..=30)
                     .map(|k| stiff - (stiff - lo) * 0.5f64.powi(k))
