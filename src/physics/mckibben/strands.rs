@@ -115,9 +115,9 @@ fn holds<T>(
 /// that model does not hold; `None` where it holds. At or past the reach, the reach itself when
 /// the rigid model holds there (a closed range, as the knitted sleeve's); otherwise the boundary
 /// between a length where it holds and one where it does not, narrowed until the two are
-/// adjacent floats (the same point bisection reaches), by false position on the stiffness where
-/// both ends have one, else bisection (at most 30 + 120 evaluations, typically 30 fewer than
-/// bisection's 50-odd; only in this regime).
+/// adjacent floats (the same point bisection reaches): ITP where both ends have a value to
+/// interpolate, else bisection (at most 30 + 55-odd evaluations; 15-25 instead of bisection's
+/// 50-odd where the rigid model's stiffness or force crosses over; only in this regime).
 pub fn transition<T>(
     (lo, hi): (f64, f64),
     length: f64,
