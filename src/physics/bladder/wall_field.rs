@@ -47,7 +47,12 @@ impl<S: SleeveGeometry> Bladder<S> {
     /// The wall's stress field at gauge pressure `pressure` (Pa) and muscle length `length` (m),
     /// written to `out`: its first element is the inner surface, its last the outer one (one
     /// element: the inner surface). `Err` where [`Bladder::evaluate`] has no solution.
-    pub fn wall_field(&self, pressure: f64, length: f64, out: &mut [WallPoint]) -> Result<(), String> {
+    pub fn wall_field(
+        &self,
+        pressure: f64,
+        length: f64,
+        out: &mut [WallPoint],
+    ) -> Result<(), String> {
         let state = self.evaluate(pressure, length)?;
         self.field_at(pressure, state.stretch_axial, state.outer_diameter, out);
         if out.iter().all(|p| {

@@ -95,7 +95,10 @@ fn a_rubber_without_stiffness_is_hydrostatic_in_the_exact_family_only() {
         let (_, b) = bladder(wall, Some(tube));
         for p in field(&b, pressure, 0.85 * b.max_length(), 9) {
             for sigma in [p.stress_radial, p.stress_hoop, p.stress_axial] {
-                assert!((sigma + pressure).abs() < 1e-9 * pressure, "{wall:?}: {p:?}");
+                assert!(
+                    (sigma + pressure).abs() < 1e-9 * pressure,
+                    "{wall:?}: {p:?}"
+                );
             }
         }
     }
@@ -105,7 +108,10 @@ fn a_rubber_without_stiffness_is_hydrostatic_in_the_exact_family_only() {
     let f = field(&b, pressure, 0.85 * b.max_length(), 9);
     for p in &f {
         let expected = pressure * p.radius / f[0].radius;
-        assert!((p.stress_radial + expected).abs() < 1e-9 * pressure, "{p:?}");
+        assert!(
+            (p.stress_radial + expected).abs() < 1e-9 * pressure,
+            "{p:?}"
+        );
     }
     assert!(f[8].stress_radial < -1.5 * pressure);
 }
@@ -114,6 +120,8 @@ fn a_rubber_without_stiffness_is_hydrostatic_in_the_exact_family_only() {
 fn outside_the_fill_range_is_an_error_not_a_number() {
     let (_, b) = bladder(Wall::Exact(8), None);
     let mut out = [WallPoint::default(); 5];
-    assert!(b.wall_field(300e3, b.max_length() * 1.01, &mut out).is_err());
+    assert!(b
+        .wall_field(300e3, b.max_length() * 1.01, &mut out)
+        .is_err());
     assert!(b.wall_field(f64::NAN, 0.1, &mut out).is_err());
 }
