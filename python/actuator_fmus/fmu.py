@@ -86,3 +86,9 @@ class CoSimulation:
 
     def freeInstance(self):
         self.fmu.freeInstance()
+
+    def __getattr__(self, name):
+        # Anything else is the version's own call (getFMUstate in FMI 2.0, getFMUState in 3.0).
+        if name == "fmu":  # not set yet: no slave to ask
+            raise AttributeError(name)
+        return getattr(self.fmu, name)
