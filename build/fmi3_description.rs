@@ -25,7 +25,11 @@
 //! Its dependencies, as an output and as an initial unknown, are those of the scalar output it
 //! names in `dependenciesOf`.
 
+#[path = "fmi3_arrays.rs"]
+mod arrays;
+
 use super::model_description::{Model, ResolvedUnknown, Variable};
+use arrays::{array_outputs, VendorAnnotations};
 use serde::Deserialize;
 use std::fmt::Write as _;
 
@@ -41,97 +45,6 @@ struct Source {
     variables: Variables,
     #[serde(rename = "VendorAnnotations")]
     vendor_annotations: Option<VendorAnnotations>,
-}
-
-#[derive(Deserialize)]
-struct VendorAnnotations {
-    #[serde(rename = "Tool", default)]
-    tools: Vec<Tool>,
-}
-
-#[derive(Deserialize)]
-struct Tool {
-    #[serde(rename = "@name")]
-    name: String,
-    #[serde(rename = "Arrays")]
-    arrays: Option<Arrays>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct Arrays {
-    #[serde(rename = "Array", default)]
-    arrays: Vec<ArrayDeclaration>,
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct ArrayDeclaration {
-    #[serde(rename = "@name")]
-    name: String,
-    #[serde(rename = "@size")]
-    size: u64,
-    #[serde(rename = "@unit")]
-    unit: Option<String>,
-    #[serde(rename = "@description")]
-    description: Option<String>,
-    #[serde(rename = "@dependenciesOf")]
-    dependencies_of: String,
-}
-
-/// A checked array output: its declaration, value reference and the scalar output whose
-/// dependencies it has (as an output, and as an initial unknown if that one is).
-struct ArrayOutput<'a> {
-    declaration: ArrayDeclaration,
-    vr: u32,
-    output: &'a ResolvedUnknown,
-    initial: Option<&'a ResolvedUnknown>,
-}
-
-/// The array outputs the source declares, checked against `model`.
-fn array_outputs<'a>(
-    source: Option<VendorAnnotations>,
-    model: &'a Model,
-    layout: &Layout,
-) -> Result<Vec<ArrayOutput<'a>>, String> {
-    let declarations = source
-        .into_iter()
-        .flat_map(|a| a.tools)
-        .filter(|t| t.name == "actuator-fmus")
-        .filter_map(|t| t.arrays)
-        .flat_map(|a| a.arrays);
-    let mut names = std::collections::BTreeSet::new();
-    let mut out = Vec::new();
-    for (i, declaration) in declarations.enumerate() {
-        let context = |e: &str| format!("Arrays: array '{}': {e}", declaration.name);
-        if declaration.name.trim().is_empty()
-            || !names.insert(declaration.name.clone())
-            || model.variables.iter().any(|v| v.name == declaration.name)
-        {
-            return Err(context(
-                "the name must be non-empty and unique among the variables",
-            ));
-        }
-        if declaration.size == 0 {
-            return Err(context("size must be at least 1"));
-        }
-        let named =
-            |u: &&ResolvedUnknown| model.variables[u.index - 1].name == declaration.dependencies_of;
-        let output = model.outputs.iter().find(named).ok_or_else(|| {
-            context(&format!(
-                "dependenciesOf '{}' is not an output",
-                declaration.dependencies_of
-            ))
-        })?;
-        let initial = model.initial_unknowns.iter().find(named);
-        out.push(ArrayOutput {
-            declaration,
-            vr: layout.arrays + i as u32,
-            output,
-            initial,
-        });
-    }
-    Ok(out)
 }
 
 #[derive(Deserialize, Default)]
