@@ -87,6 +87,15 @@ class CoSimulation:
     def freeInstance(self):
         self.fmu.freeInstance()
 
+    @property
+    def fmiCallLogger(self):
+        return self.fmu.fmiCallLogger
+
+    @fmiCallLogger.setter
+    def fmiCallLogger(self, logger):
+        # FMPy's trace of every FMI call, on the slave that makes them.
+        self.fmu.fmiCallLogger = logger
+
     def __getattr__(self, name):
         # Anything else is the version's own call (getFMUstate in FMI 2.0, getFMUState in 3.0).
         if name == "fmu":  # not set yet: no slave to ask
