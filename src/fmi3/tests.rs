@@ -54,7 +54,10 @@ fn value_references_are_unique_and_the_float64_ones_are_the_fmi2_reals() {
         );
         // The array outputs follow the Booleans, one value reference each.
         for (k, array) in model.arrays.iter().enumerate() {
-            assert_eq!(array.value_reference, model.booleans + (booleans + k) as u32);
+            assert_eq!(
+                array.value_reference,
+                model.booleans + (booleans + k) as u32
+            );
             assert!(array.size >= 1);
         }
     }

@@ -8,7 +8,7 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{Model, Partials, Refusal, Report, Status};
+use super::{wall_arrays, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{Bladder, BladderTube, KnittedCylinder};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
@@ -281,6 +281,16 @@ impl Model for KnittedMuscle {
     }
     fn partials(&mut self, inputs: &Inputs) -> Result<Partials, String> {
         self.cached_partials(inputs, true)
+    }
+
+    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+        let Some(bladder) = self.assembly.bladder() else {
+            return wall_arrays::absent(name, out);
+        };
+        // At the length the muscle is evaluated at (the nearer valid one beyond them).
+        let (lo, hi) = self.assembly.valid_lengths();
+        let length = inputs.length.max(lo).min(hi);
+        wall_arrays::write(bladder, inputs.pressure, length, name, out)
     }
 
     fn partials_for(

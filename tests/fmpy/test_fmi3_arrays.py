@@ -1,4 +1,4 @@
-"""The FMI 3.0 array outputs (the bladder wall's field, McKibbenMuscle) under FMPy: declared with a
+"""The FMI 3.0 array outputs (the bladder wall's field, McKibbenMuscle and KnittedMuscle) under FMPy: declared with a
 fixed Dimension and their dependencies, read with `getFloat64(..., nValues)`, equal to the thick
 tube solved independently here (scipy's adaptive quadrature in the deformed radius), meeting the
 tube's boundary conditions and the equilibrium of a half tube, refused with a reason for a wrong
@@ -212,3 +212,33 @@ def test_the_fmu_state_keeps_the_arrays(md, unzipped):
         assert np.array_equal(values, before[name]), name
     m.fmu.freeFMUState(state)
     m.close()
+
+
+def test_the_knitted_muscle_has_the_same_wall():
+    """KnittedMuscle's bladder is the same wall in the knitted cylinder (section 1.3.6): its
+    boundary conditions, and no wall without a bladder."""
+    path = str(FMI3_DIR / "KnittedMuscle.fmu")
+    md = read_model_description(path)
+    vr = {v.name: v for v in md.modelVariables}
+    assert [int(d.start) for d in vr["wall_stress_radial"].dimensions] == [9]
+    for bladder_model in (EXACT, 0):
+        fmu = FMU3Slave(guid=md.guid, unzipDirectory=extract(path), modelIdentifier="KnittedMuscle")
+        fmu.instantiate()
+        fmu.enterInitializationMode()
+        fmu.setInt64([vr["preset"].valueReference], [1])  # the section 1.4 prototype
+        fmu.setInt64([vr["bladder_model"].valueReference], [bladder_model])
+        fmu.exitInitializationMode()
+        lo, hi = fmu.getFloat64([vr["min_length"].valueReference, vr["max_length"].valueReference])
+        pressure = 100e3
+        fmu.setFloat64([vr["pressure"].valueReference, vr["length"].valueReference],
+                       [pressure, lo + 0.7 * (hi - lo)])
+        radial = fmu.getFloat64([vr["wall_stress_radial"].valueReference], nValues=9)
+        p_eff = fmu.getFloat64([vr["effective_pressure"].valueReference])[0]
+        if bladder_model:
+            assert radial[0] == -pressure
+            assert radial[-1] == pytest.approx(-p_eff, abs=1e-9 * pressure)
+            assert 0 < p_eff < pressure
+        else:
+            assert radial == [0.0] * 9
+        fmu.terminate()
+        fmu.freeInstance()
