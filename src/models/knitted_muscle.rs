@@ -290,7 +290,9 @@ impl Model for KnittedMuscle {
         // At the length the muscle is evaluated at (the nearer valid one beyond them).
         let (lo, hi) = self.assembly.valid_lengths();
         let length = inputs.length.max(lo).min(hi);
-        wall_arrays::write(bladder, inputs.pressure, length, name, out)
+        wall_arrays::write(name, out, |f| {
+            bladder.wall_field(inputs.pressure, length, f)
+        })
     }
 
     fn partials_for(

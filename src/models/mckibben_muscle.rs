@@ -521,7 +521,8 @@ impl Model for McKibbenMuscle {
         let (p, k_s) = (inputs.pressure, self.strand_stiffness);
         let (state, _) = muscle.evaluate_with_strands(p, inputs.length, k_s, &self.friction);
         let state = state.ok_or("no solution at these inputs")?;
-        wall_arrays::write(bladder, p, state.actual_length, name, out)
+        let length = state.actual_length;
+        wall_arrays::write(name, out, |f| bladder.wall_field(p, length, f))
     }
 
     #[inline]

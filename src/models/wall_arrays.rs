@@ -1,22 +1,24 @@
 //! The FMI 3.0 array outputs of the models with a bladder: the wall's radius and true stresses at
-//! material circles from the inner surface to the outer one ([`Bladder::wall_field`]), one array
-//! per quantity, sized by the model description (`<Array name=... size=...>`).
+//! material circles from the inner surface to the outer one ([`Bladder::wall_field`],
+//! [`FreeBladder::wall_field`]), one array per quantity, sized by the model description
+//! (`<Array name=... size=...>`).
+//!
+//! [`Bladder::wall_field`]: crate::physics::bladder::Bladder::wall_field
+//! [`FreeBladder::wall_field`]: crate::physics::free_bladder::FreeBladder::wall_field
 
-use crate::physics::bladder::{Bladder, SleeveGeometry, WallPoint};
+use crate::physics::bladder::WallPoint;
 
-/// Writes the array `name` of the wall of `bladder` at gauge pressure `pressure` (Pa) and the
-/// bladder's length `length` (m) into `out`.
-pub(crate) fn write<S: SleeveGeometry>(
-    bladder: &Bladder<S>,
-    pressure: f64,
-    length: f64,
+/// Writes the array `name` of the wall that `field` computes (as many points as `out` holds)
+/// into `out`.
+pub(crate) fn write(
     name: &str,
     out: &mut [f64],
+    field: impl FnOnce(&mut [WallPoint]) -> Result<(), String>,
 ) -> Result<(), String> {
     let quantity = quantity(name)?;
-    let mut field = vec![WallPoint::default(); out.len()];
-    bladder.wall_field(pressure, length, &mut field)?;
-    for (o, point) in out.iter_mut().zip(&field) {
+    let mut points = vec![WallPoint::default(); out.len()];
+    field(&mut points)?;
+    for (o, point) in out.iter_mut().zip(&points) {
         *o = quantity(point);
     }
     Ok(())

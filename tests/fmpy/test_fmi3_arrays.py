@@ -1,4 +1,4 @@
-"""The FMI 3.0 array outputs (the bladder wall's field, McKibbenMuscle and KnittedMuscle) under FMPy: declared with a
+"""The FMI 3.0 array outputs (the bladder wall's field: McKibbenMuscle, KnittedMuscle, FreeBladder) under FMPy: declared with a
 fixed Dimension and their dependencies, read with `getFloat64(..., nValues)`, equal to the thick
 tube solved independently here (scipy's adaptive quadrature in the deformed radius), meeting the
 tube's boundary conditions and the equilibrium of a half tube, refused with a reason for a wrong
@@ -34,7 +34,7 @@ class Muscle:
     def __init__(self, md, unzipped, log, **parameters):
         self.vr = {v.name: v for v in md.modelVariables}
         self.fmu = FMU3Slave(guid=md.guid, unzipDirectory=unzipped,
-                             modelIdentifier="McKibbenMuscle", instanceName="arrays")
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName="arrays")
         self.fmu.instantiate(logMessage=lambda *args: log.append(args[-1].decode()))
         self.fmu.enterInitializationMode()
         for name, value in parameters.items():
@@ -66,14 +66,14 @@ class Muscle:
         self.fmu.freeInstance()
 
 
-def thick_tube(m, pressure):
+def thick_tube(m, pressure, names=("effective_bladder_inner_diameter", "effective_bladder_thickness",
+                                     "effective_mooney_c1", "effective_mooney_c2")):
     """The exact thick Mooney-Rivlin tube at the muscle's deformation (its axial stretch and
     inner hoop stretch as the FMU reports them): the radius of each sampled material circle and
     the stress functions of the deformed radius r, by eq. 2.8-2.9 and radial equilibrium
-    d sigma_rr / dr = (sigma_tt - sigma_rr) / r from sigma_rr = -P at the inner wall."""
-    d_ri, t, c1, c2, lam1, lam2_in = m.get(
-        "effective_bladder_inner_diameter", "effective_bladder_thickness", "effective_mooney_c1",
-        "effective_mooney_c2", "stretch_axial", "stretch_hoop")
+    d sigma_rr / dr = (sigma_tt - sigma_rr) / r from sigma_rr = -P at the inner wall. `names`:
+    the tube's inner diameter, thickness, C1 and C2 among the FMU's variables."""
+    d_ri, t, c1, c2, lam1, lam2_in = m.get(*names, "stretch_axial", "stretch_hoop")
     d_ro = d_ri + 2 * t
     r_in = lam2_in * d_ri / 2
     # Incompressibility: the annulus between two material circles keeps its area times length.
@@ -242,3 +242,30 @@ def test_the_knitted_muscle_has_the_same_wall():
             assert radial == [0.0] * 9
         fmu.terminate()
         fmu.freeInstance()
+
+
+def test_the_free_tube_is_the_thick_tube_with_nothing_outside():
+    """FreeBladder's closed form against the thick tube solved here, and its free outer surface."""
+    path = str(FMI3_DIR / "FreeBladder.fmu")
+    md = read_model_description(path)
+    log = []
+    m = Muscle(md, extract(path), log)
+    names = ("bladder_inner_diameter", "bladder_thickness", "mooney_c1", "mooney_c2")
+    for stretch, fraction in [(0.8, 0.5), (1.0, 0.9), (1.3, 0.3)]:
+        length = stretch * m.get("bladder_length")[0]
+        m.set(0.0, length)
+        pressure = fraction * m.get("ballooning_pressure")[0]
+        m.set(pressure, length)
+        a = m.arrays()
+        radii, stresses, r_in, r_out = thick_tube(m, pressure, names)
+        assert np.allclose(a["wall_radius"], radii, rtol=1e-12, atol=0)
+        for k, r in enumerate(radii):
+            for name, value in zip(ARRAYS[1:], stresses(r)):
+                assert a[name][k] == pytest.approx(value, abs=1e-9 * pressure), (name, k)
+        assert a["wall_stress_radial"][0] == -pressure
+        assert abs(a["wall_stress_radial"][-1]) < 1e-9 * pressure
+        hoop_force = quad(lambda r: stresses(r)[1], r_in, r_out, epsrel=1e-12)[0]
+        assert hoop_force == pytest.approx(pressure * r_in, rel=1e-9)
+        assert a["wall_stress_hoop"][0] == pytest.approx(m.get("stress_hoop")[0], abs=1e-9 * pressure)
+    assert not log
+    m.close()
