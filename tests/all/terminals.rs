@@ -40,7 +40,11 @@ fn every_source_passes_and_only_passthrough_has_no_flange() {
         let xml = flanges::xml(&text, &model).unwrap();
         // Every model has its icon; only PassThrough has no terminal.
         assert!(xml.contains(r#"<Icon x1="-100" y1="-100" x2="100" y2="100"/>"#));
-        assert_eq!(!xml.contains("<Terminals>"), stem == "PassThrough", "{stem}");
+        assert_eq!(
+            !xml.contains("<Terminals>"),
+            stem == "PassThrough",
+            "{stem}"
+        );
     }
 }
 

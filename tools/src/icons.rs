@@ -267,8 +267,10 @@ fn png(shapes: &[Shape], px: u32) -> Result<Vec<u8>, String> {
         let path = pb
             .finish()
             .ok_or("an icon shape has no area and no length")?;
-        let mut paint = Paint::default();
-        paint.anti_alias = true;
+        let mut paint = Paint {
+            anti_alias: true,
+            ..Paint::default()
+        };
         if let Some((r, g, b)) = s.fill {
             paint.set_color_rgba8(r, g, b, 255);
             pixmap.fill_path(&path, &paint, FillRule::Winding, transform, None);
