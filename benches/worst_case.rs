@@ -5,8 +5,10 @@
 //! log-uniform across decades. Each case initializes (timed from fmi2EnterInitializationMode to
 //! fmi2ExitInitializationMode, the parameters set in between) and takes `STEPS` steps of the
 //! FMU's default step size (each timed in thread CPU time, so that a loaded machine does not
-//! inflate the figures, less the clock's own cost). Prints per FMU the median, p99 and maximum step and
-//! initialization cost, the share of cases refused at initialization, and the slowest cases.
+//! inflate the figures, less the clock's own cost). The cases whose step or initialization lands
+//! in the slowest 0.1% are run again and keep their minimum (see [`RETIMES`]). Prints per FMU the
+//! median, p99 and maximum step and initialization cost, the share of cases refused at
+//! initialization, and the slowest cases.
 //!
 //! `WORST_CASE_MODELS=A,B` restricts the FMUs; `WORST_CASE_POINTS=n` the random points;
 //! `WORST_CASE_REPORT_ABOVE=s` lists every case whose step or initialization takes longer than
@@ -154,9 +156,51 @@ fn step_size(info: &ModelInfo) -> f64 {
 
 struct Case {
     label: String,
+    values: Vec<f64>,
     init: f64,
     steps: Vec<f64>,
     refused: bool,
+}
+
+/// Repeats of a case whose step or initialization lands in the top [`RETIME_SHARE`] of its FMU:
+/// the minimum over the first run and these is that case's cost, so that a preemption or page
+/// fault during one run does not stand in for the FMU's own worst case.
+const RETIMES: usize = 4;
+const RETIME_SHARE: f64 = 0.001;
+
+/// Re-times the slowest cases (see [`RETIMES`]); returns how many were re-timed.
+fn retime_slowest(
+    api: &Api,
+    info: &ModelInfo,
+    knobs: &[Knob],
+    cases: &mut [Case],
+    h: f64,
+    overhead: f64,
+) -> usize {
+    let sorted = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v
+    };
+    let steps = sorted(cases.iter().flat_map(|c| c.steps.clone()).collect());
+    let inits = sorted(cases.iter().map(|c| c.init).collect());
+    let step_cut = quantile(&steps, 1.0 - RETIME_SHARE);
+    let init_cut = quantile(&inits, 1.0 - RETIME_SHARE);
+    let mut retimed = 0;
+    for case in cases.iter_mut() {
+        let slow_step = case.steps.iter().any(|&s| s >= step_cut);
+        if !(slow_step || case.init >= init_cut) {
+            continue;
+        }
+        retimed += 1;
+        for _ in 0..RETIMES {
+            let (init, steps, _) = run(api, info, knobs, &case.values, h, overhead);
+            case.init = case.init.min(init);
+            for (kept, again) in case.steps.iter_mut().zip(steps) {
+                *kept = kept.min(again);
+            }
+        }
+    }
+    retimed
 }
 
 /// The cost of reading the thread CPU clock, subtracted from each timing.
@@ -313,11 +357,17 @@ fn main() {
             };
             cases.push(Case {
                 label,
+                values,
                 init,
                 steps,
                 refused,
             });
         }
+        let retimed = retime_slowest(&api, info, &knobs, &mut cases, h, overhead);
+        eprintln!(
+            "{}: {retimed} slowest cases re-timed {RETIMES} more times, their minima kept",
+            info.name
+        );
         let mut steps: Vec<f64> = cases.iter().flat_map(|c| c.steps.clone()).collect();
         let mut inits: Vec<f64> = cases.iter().map(|c| c.init).collect();
         steps.sort_by(f64::total_cmp);

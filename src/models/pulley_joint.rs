@@ -2,7 +2,9 @@
 //!
 //! Muscle forces in; the pendulum joint `I q'' = r (F_f - F_e) - c q' - m g l sin q`, stepped by
 //! semi-implicit Euler with the forces held over the communication step (the same update as
-//! `python/actuator_fmus/robot_joint.py`); out come the muscle lengths `L0 -/+ r q` and the PD pressure
+//! `python/actuator_fmus/robot_joint.py`; a joint too stiff for that, with a tiny inertia against
+//! its damping or gravity, takes linearly implicit substeps, which settle its unresolved fast
+//! mode instead of diverging); out come the muscle lengths `L0 -/+ r q` and the PD pressure
 //! commands for the next step, so that two McKibbenMuscle FMUs wired to it by plain connections
 //! (SSP, container FMU) close the loop. Rigid-body mechanics and a controller, no dissertation
 //! physics: it lives here rather than in `src/physics/`. With `external_pressures` the controller is
@@ -18,8 +20,9 @@ use crate::variables::pulley_joint::{Inputs, Outputs, Parameters, States, Variab
 use serde::{Deserialize, Serialize};
 
 /// Substep cap: a long communication step is split so that each Euler substep stays well
-/// inside the stability limit of the joint's fastest mode (bounded work per step).
-const MAX_SUBSTEPS: usize = 100_000;
+/// inside the stability limit of the joint's fastest mode; a step that would need more is taken
+/// in this many linearly implicit substeps instead, stable for any stiffness (bounded work).
+const MAX_SUBSTEPS: usize = 64;
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct PulleyJoint {
@@ -87,6 +90,18 @@ impl Params {
     /// The angular acceleration `(torque - c dq - m g l sin q) / I` of the joint.
     fn acceleration(&self, torque: f64, q: f64, dq: f64) -> f64 {
         (torque - self.damping * dq - self.gravity_torque * q.sin()) / self.inertia
+    }
+
+    /// One substep `h` with the damping and the gravity torque taken at the substep's end, the
+    /// latter linearized: `(I + h c + h^2 m g l cos q) dq' = I dq + h (torque - m g l sin q)`, then
+    /// `q' = q + h dq'`. Stable for any `h` where gravity restores (`cos q > 0`); where it
+    /// overturns, its slope stays explicit, as the physics is unstable there too.
+    fn implicit_substep(&self, torque: f64, q: f64, dq: f64, h: f64) -> (f64, f64) {
+        let (sin, cos) = q.sin_cos();
+        let restoring = self.gravity_torque * cos.max(0.0);
+        let dq = (self.inertia * dq + h * (torque - self.gravity_torque * sin))
+            / (self.inertia + h * (self.damping + h * restoring));
+        (q + h * dq, dq)
     }
 
     /// Slope of the saturation `x.max(0).min(max_pressure)` at `x`: 1 strictly inside, else 0
@@ -245,13 +260,22 @@ impl Model for PulleyJoint {
         let p = &self.p;
         let torque = self.torque(inputs);
         // One Euler step per communication step, as the example does; a step longer than the
-        // joint's own stability limit is split (bounded by MAX_SUBSTEPS).
-        let n = ((step / p.max_substep).ceil() as usize).clamp(1, MAX_SUBSTEPS);
-        let h = step / n as f64;
+        // joint's own stability limit is split, into at most MAX_SUBSTEPS; a stiffer joint (tiny
+        // inertia against its damping or gravity) takes MAX_SUBSTEPS implicit substeps.
+        let stable_substeps = (step / p.max_substep).ceil();
         let (mut q, mut dq) = (self.q, self.dq);
-        for _ in 0..n {
-            dq += h * p.acceleration(torque, q, dq);
-            q += h * dq;
+        if stable_substeps <= MAX_SUBSTEPS as f64 {
+            let n = (stable_substeps as usize).max(1);
+            let h = step / n as f64;
+            for _ in 0..n {
+                dq += h * p.acceleration(torque, q, dq);
+                q += h * dq;
+            }
+        } else {
+            let h = step / MAX_SUBSTEPS as f64;
+            for _ in 0..MAX_SUBSTEPS {
+                (q, dq) = p.implicit_substep(torque, q, dq, h);
+            }
         }
         if !(p.representable(q, dq) && torque.is_finite()) {
             report.add(

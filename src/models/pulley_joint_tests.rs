@@ -222,3 +222,80 @@ fn a_state_whose_outputs_cannot_be_represented_is_refused_and_the_old_one_kept()
     assert!(m.set_states(&bad).is_err());
     assert_eq!(m.states(), good);
 }
+
+/// Steps `m` `steps` times by `h` from t = 0 with `inputs`; every step must be accepted.
+fn run_steps(m: &mut PulleyJoint, inputs: &Inputs, h: f64, steps: usize) {
+    for k in 0..steps {
+        let mut report = Report::default();
+        m.step(
+            inputs,
+            &mut Outputs::default(),
+            k as f64 * h,
+            h,
+            &mut report,
+        );
+        assert!(m.states().joint_angle.is_finite(), "step {k}");
+    }
+    assert!(
+        (m.time - steps as f64 * h).abs() <= 1e-12,
+        "a step was refused"
+    );
+}
+
+#[test]
+fn a_joint_too_stiff_for_explicit_substeps_follows_its_exact_overdamped_motion() {
+    // Inertia 1e-12 kg m^2 against damping 1 N m s: explicit Euler would need 2e9 substeps of the
+    // 1 ms step. I q'' + c q' = T from rest has q = (T/c) (t - tau (1 - e^(-t/tau))), tau = I/c.
+    let p = Parameters {
+        inertia: 1e-12,
+        damping: 1.0,
+        mass: 0.0,
+        ..Parameters::default()
+    };
+    let inputs = Inputs {
+        flexor_force: 80.0,
+        extensor_force: 20.0,
+        ..Inputs::default()
+    };
+    let mut m = joint(&p);
+    let (h, steps) = (1e-3, 100);
+    run_steps(&mut m, &inputs, h, steps);
+    let (torque, t, tau) = (p.moment_arm * 60.0, steps as f64 * h, p.inertia / p.damping);
+    let exact = torque / p.damping * (t - tau * (1.0 - (-t / tau).exp()));
+    let s = m.states();
+    // The first substep (1/64 of a step) lags the exact start: 1/(64 steps) of the angle.
+    assert!(
+        (s.joint_angle - exact).abs() <= 2e-4 * exact,
+        "{} vs {exact}",
+        s.joint_angle
+    );
+    assert!((s.joint_velocity - torque / p.damping).abs() <= 1e-9 * torque / p.damping);
+}
+
+#[test]
+fn a_joint_too_stiff_for_explicit_substeps_settles_where_gravity_balances_the_torque() {
+    // Inertia 1e-12 kg m^2, no damping, gravity torque m g l = 2.94 N m against 0.3 N m: the
+    // substeps reach the static balance m g l sin q = T (the fast swing about it is not resolved).
+    let p = Parameters {
+        inertia: 1e-12,
+        damping: 0.0,
+        mass: 2.5,
+        ..Parameters::default()
+    };
+    let inputs = Inputs {
+        flexor_force: 30.0,
+        extensor_force: 10.0,
+        ..Inputs::default()
+    };
+    let mut m = joint(&p);
+    run_steps(&mut m, &inputs, 1e-3, 3);
+    let k = p.mass * p.gravity * p.com_distance;
+    let balance = (p.moment_arm * 20.0 / k).asin();
+    let s = m.states();
+    assert!(
+        (s.joint_angle - balance).abs() <= 1e-9,
+        "{} vs {balance}",
+        s.joint_angle
+    );
+    assert!(s.joint_velocity.abs() <= 1e-6, "{}", s.joint_velocity);
+}

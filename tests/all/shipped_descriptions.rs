@@ -327,8 +327,8 @@ fn enumerations_are_checked_and_travel_as_integers() {
     );
     refused(
         &edited(
-            r#"<Integer min="1" max="4096" start="16"/>"#,
-            r#"<Integer declaredType="OutOfRangePolicy" min="1" max="4096" start="16"/>"#,
+            r#"<Integer min="1" max="64" start="16"/>"#,
+            r#"<Integer declaredType="OutOfRangePolicy" min="1" max="64" start="16"/>"#,
         ),
         "declaredType is supported for Enumerations only",
     );
@@ -490,8 +490,8 @@ mod rules {
             "min 10 is above max 1",
         );
         broken(
-            r#"<Integer min="1" max="4096" start="16"/>"#,
-            r#"<Integer min="20" max="4096" start="16"/>"#,
+            r#"<Integer min="1" max="64" start="16"/>"#,
+            r#"<Integer min="20" max="64" start="16"/>"#,
             "start 16 is outside",
         );
         broken(

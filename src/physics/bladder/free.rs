@@ -7,7 +7,8 @@ use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 
 /// Iteration cap of the free-bladder root finder (safeguarded Newton-bisection converges in <10).
 const ROOT_ITERATIONS: usize = 100;
-/// Halvings allowed when looking for the collapsed side of the free-bladder bracket under vacuum.
+/// Halvings of the way to collapse searched for the collapsed side of the free-bladder bracket
+/// under vacuum.
 const BRACKET_HALVINGS: usize = 200;
 
 impl<S: SleeveGeometry> Bladder<S> {
@@ -52,20 +53,57 @@ impl<S: SleeveGeometry> Bladder<S> {
         };
         let hi = x_contact;
         let start = if x_rest < hi { x_rest } else { hi };
-        let mut lo = start;
-        let mut r_lo = None;
-        for j in 0..BRACKET_HALVINGS {
-            if j > 0 {
-                lo = x_min + (start - x_min) * 0.5f64.powi(j as i32);
+        // The collapsed side of the bracket: the first of the points halving the way from `start`
+        // to x_min where P_eff >= 0. P_eff falls as x grows, so "P_eff >= 0, or x_min reached"
+        // holds from that point on: found by doubling then bisecting the halving count (about
+        // 2 log2 of it evaluations, not one per halving: under a deep vacuum the root sits
+        // dozens of halvings deep).
+        let point = |j: usize| {
+            if j == 0 {
+                start
+            } else {
+                x_min + (start - x_min) * 0.5f64.powi(j as i32)
             }
-            if let Some((r, _)) = residual(lo) {
-                if r >= 0.0 {
-                    r_lo = Some(r);
-                    break;
+        };
+        // Some(r) with r >= 0 where found, None where not yet (P_eff < 0), Err at x_min.
+        let probe = |j: usize| -> Result<Option<f64>, ()> {
+            let x = point(j);
+            match residual(x) {
+                Some((r, _)) if r >= 0.0 => Ok(Some(r)),
+                _ if x > x_min => Ok(None),
+                _ => Err(()),
+            }
+        };
+        let past = |p: &Result<Option<f64>, ()>| !matches!(p, Ok(None));
+        let last = BRACKET_HALVINGS - 1;
+        let (mut below, mut found) = (None, None);
+        let mut j = 0;
+        loop {
+            let p = probe(j);
+            if past(&p) {
+                found = Some((j, p));
+                break;
+            }
+            below = Some(j);
+            if j == last {
+                break;
+            }
+            j = (2 * j).clamp(1, last);
+        }
+        // Bisect between the last count short of it and the first past it.
+        if let (Some(mut short), Some((mut at, mut p))) = (below, found) {
+            while at - short > 1 {
+                let mid = short + (at - short) / 2;
+                let q = probe(mid);
+                if past(&q) {
+                    (at, p) = (mid, q);
+                } else {
+                    short = mid;
                 }
             }
+            found = Some((at, p));
         }
-        let Some(r_lo) = r_lo else {
+        let Some((lo, r_lo)) = found.and_then(|(j, p)| Some((point(j), p.ok()??))) else {
             return Err(format!(
                 "pressure {pressure} Pa at length {length} m: the free bladder has no equilibrium \
                  short of collapse (vacuum too deep; collapse is not modelled)"

@@ -36,8 +36,12 @@ impl KnittedCylinder {
             ShapeModel::Ideal => 4.0 * m * m,
             ShapeModel::Tubular => 4.0 * m * m - 1.0,
             ShapeModel::NonCylindrical(_) => {
-                return Err("the hyperelastic bladder (section 1.3.6 with eq. 2.6-2.20) needs a                             cylindrical sleeve: use shape_model 0 (ideal) or 1 (tubular knit);                             the non-cylindrical shape has no single bladder diameter"
-                    .into())
+                return Err(
+                    "the hyperelastic bladder (section 1.3.6 with eq. 2.6-2.20) needs a \
+                            cylindrical sleeve: use shape_model 0 (ideal) or 1 (tubular knit); \
+                            the non-cylindrical shape has no single bladder diameter"
+                        .into(),
+                )
             }
         };
         let d_sq = [
