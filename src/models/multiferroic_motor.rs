@@ -9,7 +9,7 @@ use super::{EventUpdate, Model, Partials, Refusal, Report, Status};
 use crate::physics::multiferroic::model_exchange::{by, MeGradient, MePartials};
 use crate::physics::multiferroic::{
     drive, Motor, MotorInputs, MotorOutputs, MotorParams, MotorState, OnionModel, ScheduleSwitch,
-    SteppingSchedule,
+    SteppingSchedule, GILBERT_SUBSTEP_WEIGHT,
 };
 use crate::variables::multiferroic_motor::{
     CalculatedParameters, Inputs, Outputs, Parameters, States, Variables,
@@ -305,8 +305,14 @@ impl Model for MultiferroicMotor {
         time: f64,
         report: &mut Report,
     ) -> EventUpdate {
+        let first = !self.model_exchange_active();
         match self.me_event(inputs, time) {
             Ok(states_changed) => {
+                if first {
+                    if let Some(why) = self.me_light_damping() {
+                        report.warn(why);
+                    }
+                }
                 self.me_outputs(inputs, outputs, report);
                 EventUpdate {
                     states_changed,
@@ -378,9 +384,9 @@ impl Model for MultiferroicMotor {
                 if r.accuracy_limited {
                     report.warn(format!(
                         "the step from t = {time} s by {step} s was completed beyond tolerance \
-                         = {} rad (its substep budget max_substeps = {} ran out, or a slipping \
-                         rotor or the Gilbert onion model was advanced over many periods at \
-                         once); shorten the step or raise max_substeps where this matters",
+                         = {} rad (its substep budget max_substeps = {} ran out, a Gilbert \
+                         onion substep counting as {GILBERT_SUBSTEP_WEIGHT}, or a slipping rotor \
+                         or the Gilbert onion model was advanced over many periods at once); shorten the step or raise max_substeps where this matters",
                         self.motor.params.tolerance, self.motor.params.max_substeps
                     ));
                 }

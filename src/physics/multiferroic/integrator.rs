@@ -439,7 +439,9 @@ impl Motor {
     pub(super) fn substep(&self, run: &mut StepRun, d: &Drive, segment_end: f64, budget: u32) {
         let t = run.t;
         let remaining = run.t_end - t;
-        let left = budget.saturating_sub(run.attempts).max(1);
+        let left = budget
+            .saturating_sub(run.attempts.saturating_add(run.extra_cost))
+            .max(1);
         let per_segment = (left / SEGMENT_BUDGET_SHARE).max(1);
         // While more than half the budget is left, the floor is 64 times finer than an even
         // spread: a short stiff transient at the start of a step (the Gilbert onion's ringing
@@ -457,6 +459,11 @@ impl Motor {
             dt_try = segment_end - t;
         }
         run.attempts = run.attempts.saturating_add(1);
+        if !self.quasi_static() {
+            run.extra_cost = run
+                .extra_cost
+                .saturating_add(super::GILBERT_SUBSTEP_WEIGHT - 1);
+        }
         if d.locked && self.quasi_static() {
             // Nothing moves but the onion, which follows the inputs: jump to the next switch.
             run.t = segment_end.max(t + dt_try).min(run.t_end);

@@ -47,6 +47,9 @@ mod onion_tests;
 mod params;
 pub mod phi;
 pub mod schedule;
+mod spin;
+#[cfg(test)]
+mod spin_tests;
 mod step;
 #[cfg(test)]
 mod tests;
@@ -58,6 +61,7 @@ pub use params::*;
 pub use schedule::{ScheduleSwitch, SteppingSchedule};
 use std::f64::consts::PI;
 use step::StepRun;
+pub use step::GILBERT_SUBSTEP_WEIGHT;
 
 /// The motor built from its parameters, with everything that depends only on them precomputed.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]

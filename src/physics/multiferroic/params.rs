@@ -67,7 +67,8 @@ pub struct MotorParams {
     /// budget still reaches the end of the step: accuracy degrades (reported in
     /// [`StepReport::accuracy_limited`](super::StepReport::accuracy_limited)) but the cost and
     /// stability do not. Substeps never span a schedule switch, so a step whose switches
-    /// outnumber the budget and cannot be settled is refused.
+    /// outnumber the budget and cannot be settled is refused. A substep of the Gilbert onion
+    /// counts as [`GILBERT_SUBSTEP_WEIGHT`](super::GILBERT_SUBSTEP_WEIGHT) (its cost).
     pub max_substeps: u32,
 }
 

@@ -10,14 +10,18 @@ pub(super) struct StepRun {
     pub(super) t_end: f64,
     /// Attempted substeps (accepted and rejected), settles and turn jumps.
     pub(super) attempts: u32,
+    /// Budget spent beyond `attempts`: a Gilbert substep costs [`GILBERT_SUBSTEP_WEIGHT`].
+    pub(super) extra_cost: u32,
     pub(super) limited: bool,
     /// Next substep size to try (s).
     pub(super) dt: f64,
     /// The segment whose settle was tried.
     pub(super) settle_tried_for: f64,
-    /// The load-dominated closed form ([`Motor::advance_load_dominated`]) was tried in this call
+    /// The averaged spin ([`Motor::advance_spinning`]) was tried in this call
     /// and did not apply: its onion cycle (two turns of strides) is not tried again on every pass.
-    pub(super) load_dominated_failed: bool,
+    pub(super) spin_failed: bool,
+    /// The onion's cycle of the averaged spin for the segment ending at the given time.
+    pub(super) spin_cycle: Option<(f64, super::spin::OnionCycle)>,
     /// The segment in progress: its end, strain direction, and whether it began at a switch (a
     /// whole period of the schedule).
     pub(super) segment_end: f64,
@@ -47,6 +51,7 @@ impl StepRun {
             t: state.time,
             t_end: state.time + h,
             attempts: 0,
+            extra_cost: 0,
             limited: false,
             dt: if state.substep_hint > 0.0 {
                 state.substep_hint
@@ -54,7 +59,8 @@ impl StepRun {
                 1e-10
             },
             settle_tried_for: f64::NAN,
-            load_dominated_failed: false,
+            spin_failed: false,
+            spin_cycle: None,
             segment_end: f64::NAN,
             segment_direction: 0.0,
             whole_period: false,
@@ -158,7 +164,7 @@ impl Motor {
                 None => run.t_end,
             };
             run.enter_segment(segment_end, d.direction);
-            if self.advance_load_dominated(&mut run, &d, segment_end) {
+            if self.advance_spinning(&mut run, &d, segment_end) {
                 continue;
             }
             if run.settle_tried_for != segment_end && segment_end - run.t > long_segment {
@@ -214,3 +220,8 @@ impl Motor {
         }
     }
 }
+
+/// A Gilbert substep's share of the budget `max_substeps`, in substeps of the quasi-static onion:
+/// its two 5x5 exponentials cost about 2.7 us against 0.3-0.9 us (release, x86-64), so the budget
+/// bounds a step's cost alike in both onion models (about 7 ms at the default 20,000).
+pub const GILBERT_SUBSTEP_WEIGHT: u32 = 8;

@@ -898,7 +898,7 @@ fn stepping_scene_at_microsecond_steps_within_tolerance() {
 }
 
 /// A load far beyond the ring's peak torque (2.16e-18 N m) spins the rotor so fast that the
-/// ring's torque averages out within each turn (see `Motor::advance_load_dominated`): a step is
+/// ring's torque averages out within each turn (see `Motor::advance_spinning`): a step is
 /// then one closed-form segment plus one march around the onion's cycle, where the resolved
 /// integration took the whole substep budget. Against the resolved reference (tolerance 1e-10,
 /// which never takes the shortcut) over steps short enough to resolve: 1e-8 N m over 0.1 ns

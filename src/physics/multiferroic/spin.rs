@@ -1,0 +1,451 @@
+//! A rotor that turns many times within a step: the ring's torque averaged over the onion's
+//! hysteresis cycle, with the periodic deviation from the mean motion added back (the method of
+//! averaging to first order in `tau_max / |load|`, its secular drift to second order).
+
+use super::{Drive, Motor, StepRun};
+use std::f64::consts::PI;
+
+/// The quasi-static onion's hysteresis cycle as the rotor turns without end in one direction.
+pub(super) struct OnionCycle {
+    /// Whole turns of rotor and onion taken off the state the cycle was found from, so that its
+    /// march works near zero (rad).
+    turns: f64,
+    onion_turns: f64,
+    /// A rotor angle on the cycle and the onion angle there (rad), less `turns` and
+    /// `turns + onion_turns`.
+    rotor: f64,
+    onion: f64,
+    /// Onion turns per rotor turn (0 when the onion swings back and forth, +-1 when it follows).
+    winding: f64,
+    /// `int tau dphi` over one turn (J): the energy the onion's snaps dissipate, `<= 0`.
+    work: f64,
+    /// The ring's torque along one turn of the cycle, in the direction of motion: pairs
+    /// `(s, tau_s)` with `s = dir (phi - rotor)` from 0 to 2 pi, both sides of every snap.
+    torque: Vec<(f64, f64)>,
+}
+
+/// The rotor's periodic deviation from its mean motion at one mean speed, sampled where
+/// [`OnionCycle::torque`] is, in the direction of motion.
+struct Wobble {
+    /// Angle `delta(s)` (rad, zero mean over a turn) and speed `u(s)` (rad/s) deviations.
+    angle: Vec<f64>,
+    speed: Vec<f64>,
+    /// The second-order mean force `<tau'(s) delta(s)> = -<tau(s) u(s)> / Omega` (N m).
+    drift_force: f64,
+    /// The mean speed (rad/s), the decay per radian `kappa` and the cycle's mean torque (N m).
+    omega: f64,
+    kappa: f64,
+    mean: f64,
+}
+
+impl Wobble {
+    fn amplitude(&self) -> f64 {
+        self.angle.iter().fold(0.0, |a: f64, x| a.max(x.abs()))
+    }
+
+    /// One stride `h` (rad) of `I omega du/ds + c u = tau~(s)` for `tau~` linear over it:
+    /// `u_end = e u_0 + a tau~_0 + b tau~_end`.
+    fn stride(&self, h: f64, c: f64) -> (f64, f64, f64) {
+        let x = self.kappa * h;
+        let one_minus_e = -(-x).exp_m1();
+        // 1 - (1 - e^-x) / x, by its series where it cancels.
+        let ramp = if x < 1e-3 {
+            x / 2.0 - x * x / 6.0 + x * x * x / 24.0
+        } else {
+            1.0 - one_minus_e / x
+        };
+        (1.0 - one_minus_e, (one_minus_e - ramp) / c, ramp / c)
+    }
+
+    /// Angle and speed deviation at phase `s`: from the sample below it, the same exact stride
+    /// (so no interpolation error between samples).
+    fn at(&self, cycle: &OnionCycle, s: f64, c: f64) -> (f64, f64) {
+        let tau = &cycle.torque;
+        let s = OnionCycle::phase(s);
+        let j = tau
+            .partition_point(|&(x, _)| x <= s)
+            .clamp(1, tau.len() - 1)
+            - 1;
+        let (s0, t0) = tau[j];
+        let (s1, t1) = tau[j + 1];
+        let h = (s - s0).max(0.0);
+        let t_s = if s1 > s0 {
+            t0 + (t1 - t0) * (h / (s1 - s0)).min(1.0)
+        } else {
+            t1
+        };
+        let (e, a, b) = self.stride(h, c);
+        let u = e * self.speed[j] + a * (t0 - self.mean) + b * (t_s - self.mean);
+        let delta = self.angle[j] + 0.5 * h * (self.speed[j] + u) / self.omega;
+        (delta, u)
+    }
+}
+
+/// What [`Motor::spin`] did.
+enum Spin {
+    /// Not near enough its terminal speed yet: the integrator goes on.
+    NotYet,
+    /// The averaged spin does not apply in this step.
+    Failed,
+    Ended(super::Vector),
+}
+
+impl OnionCycle {
+    /// Turn `s` modulo one turn.
+    fn phase(s: f64) -> f64 {
+        s.rem_euclid(2.0 * PI)
+    }
+}
+
+impl Motor {
+    /// A rotor driven by a load torque far beyond anything the ring can exert, turning many times
+    /// within the segment. The ring's torque, periodic in the rotor angle along the onion's
+    /// hysteresis cycle, is then a small perturbation `epsilon = tau_max / |load|` of a uniform
+    /// spin (`tau_max` a bound of eq. 3.3's torque). With `phi = theta + delta(theta)` and
+    /// `omega = Omega + u(theta)` the mean angle and speed obey
+    /// `I Omega' = load + <tau> + <tau' delta> - c Omega` (section 3.2.2's rotor averaged over a
+    /// turn), solved exactly over the segment, where `<tau>` is the ring's mean torque over the
+    /// cycle (the energy its snaps dissipate per turn over 2 pi, see [`Self::onion_cycle`]) and
+    /// `<tau' delta>` the second-order drift; `u` is the periodic solution of
+    /// `I Omega du/dtheta + c u = tau - <tau>` and `delta' = u / Omega` ([`Self::wobble`]).
+    /// The deviation is taken off at the start and added back at the end, so the rotor angle and
+    /// speed stay right at any phase. The onion ends on its cycle at the end angle.
+    ///
+    /// Applies (else `false`) with a quasi-static onion and a free rotor, in either of:
+    /// - `epsilon <= 0.5 tolerance`, also from rest: the speed's rise through the first turns
+    ///   leaves a phase error of about `epsilon` (against a fine RK4 from rest, Table 3.1:
+    ///   8.5e-8, 1.9e-6 and 1.1e-5 rad at `epsilon` = 1e-7, 1e-6 and 1e-5, i.e. loads of 1e-10,
+    ///   1e-11 and 1e-12 N m, where the error-controlled integrator was 0.12, 0.92 and 0.43 rad
+    ///   off), and later the periodic part moves it by at most `tau_max / (I omega^2)`;
+    /// - with drag, `epsilon <= MAX_SPIN_EPSILON`, the rotor already turning with the load at
+    ///   least [`MIN_SPIN_TURNS`] turns within the segment, near enough its terminal speed
+    ///   (the deviation's amplitude times the speed's relative distance to it below `tol / 10`),
+    ///   and the third-order drift `epsilon^3` times the angle turned below `tol / 10`. Before
+    ///   that (a rotor starting from rest), the error-controlled integrator resolves the few
+    ///   turns of its speed's rise.
+    ///
+    /// Resolving every turn took the whole substep budget here (20,000 substeps, 11-40 ms per
+    /// 1 us step for loads of 1e-14 to 1e-10 N m on Table 3.1).
+    pub(super) fn advance_spinning(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
+        let (i, c) = (self.inertia, self.drag);
+        let load = d.load;
+        if run.spin_failed || d.locked || !self.quasi_static() || load == 0.0 {
+            return false;
+        }
+        let dir = load.signum();
+        let tol = self.params.tolerance;
+        let bound = self.torque_bound();
+        let epsilon = bound / load.abs();
+        let h = segment_end - run.t;
+        let speed = dir * run.y[1];
+        // From rest, or once the integrator has had to force a substep beyond the tolerance
+        // while the rotor speeds up (the spin from there is far closer to the resolved motion:
+        // see the tests), as long as the periodic part stays small against the load.
+        let resolved_free = speed >= 0.0
+            && (epsilon <= LOAD_DOMINATED * tol || (run.limited && epsilon <= MAX_SPIN_EPSILON));
+        // Near enough its terminal speed: the deviation (at most `2 tau_max / (omega
+        // sqrt(c^2 + I^2 omega^2))`) times the mean speed's relative distance to the terminal
+        // one below tol / 10 (here the speed's own deviation, up to `2 epsilon`, allowed for;
+        // checked precisely in `spin`); a rotor still speeding up from rest is resolved until
+        // then.
+        let corrected = c > 0.0
+            && speed > 0.0
+            && epsilon <= MAX_SPIN_EPSILON
+            && h * speed >= MIN_SPIN_TURNS * 2.0 * PI
+            && 2.0 * bound / (speed * c.hypot(i * speed))
+                * ((1.0 - load.abs() / (c * speed)).abs() - 2.0 * epsilon).max(0.0)
+                <= 0.1 * tol;
+        if !(resolved_free || corrected) {
+            return false;
+        }
+        // The cycle is the same for the whole segment (constant drive): marched once.
+        if run
+            .spin_cycle
+            .as_ref()
+            .is_none_or(|(end, _)| *end != segment_end)
+        {
+            match self.onion_cycle(&run.y, d, dir) {
+                Some(cycle) => run.spin_cycle = Some((segment_end, cycle)),
+                None => {
+                    run.spin_failed = true;
+                    return false;
+                }
+            }
+        }
+        let Some((end, cycle)) = run.spin_cycle.take() else {
+            return false;
+        };
+        let spun = self.spin(&run.y, &cycle, d, h, !resolved_free);
+        run.spin_cycle = Some((end, cycle));
+        match spun {
+            Spin::NotYet => false,
+            Spin::Failed => {
+                run.spin_failed = true;
+                false
+            }
+            Spin::Ended(y) => {
+                run.y = y;
+                run.t = segment_end;
+                run.settled = false;
+                run.attempts = run.attempts.saturating_add(1);
+                true
+            }
+        }
+    }
+
+    /// The state `y` advanced by `h` at constant drive on the averaged spin of `cycle`, with the
+    /// periodic deviation taken off at the start (`correct_start`) and added back at the end.
+    fn spin(
+        &self,
+        y: &super::Vector,
+        cycle: &OnionCycle,
+        d: &Drive,
+        h: f64,
+        correct_start: bool,
+    ) -> Spin {
+        let (i, c) = (self.inertia, self.drag);
+        let dir = d.load.signum();
+        let tol = self.params.tolerance;
+        let speed = dir * y[1];
+        // In the direction of motion, from the cycle's reference angle.
+        let s_of = |phi: f64| dir * (phi - cycle.turns - cycle.rotor);
+        let force = d.load.abs() + cycle.work / (2.0 * PI);
+        // The mean motion at constant force over `h`: advance and end speed.
+        let mean_motion = |omega0: f64, force: f64| -> (f64, f64) {
+            if c > 0.0 {
+                let rate = c / i;
+                let terminal = force / c;
+                // 1 - exp(-h c / I) without cancellation.
+                let approach = -(-h * rate).exp_m1();
+                (
+                    terminal * h + (omega0 - terminal) * approach / rate,
+                    terminal + (omega0 - terminal) * (1.0 - approach),
+                )
+            } else {
+                (omega0 * h + 0.5 * force / i * h * h, omega0 + force / i * h)
+            }
+        };
+        let (mut theta, mut speed0) = (y[0], speed);
+        if correct_start {
+            // The error against resolved integration (see the tests) at the speed it will spin
+            // at: the second-order periodic terms left out, `amplitude (epsilon + 1e-3)`, and the
+            // third-order drift, `epsilon^3` per radian turned.
+            let terminal = self.wobble(cycle, force / c);
+            let amplitude = terminal.amplitude();
+            let epsilon = cycle
+                .torque
+                .iter()
+                .fold(0.0, |a: f64, t| a.max((t.1 - terminal.mean).abs()))
+                / force;
+            let turned = h * force / c;
+            if amplitude * (epsilon + 1e-3) + epsilon.powi(3) * turned > tol {
+                return Spin::Failed;
+            }
+            // The deviation's dependence on the mean speed, neglected while that approaches its
+            // terminal value, stays below tol / 10.
+            let start = self.wobble(cycle, speed);
+            let (delta, u) = start.at(cycle, s_of(y[0]), c);
+            theta -= dir * delta;
+            speed0 -= u;
+            if start.amplitude() * (1.0 - force / (c * speed0)).abs() > 0.1 * tol {
+                return Spin::NotYet;
+            }
+        }
+        let (mut advance, mut omega) = mean_motion(speed0, force);
+        let mut end_wobble = None;
+        if c > 0.0 && omega > 0.0 {
+            let end = self.wobble(cycle, omega);
+            (advance, omega) = mean_motion(speed0, force + end.drift_force);
+            end_wobble = Some(end);
+        }
+        theta += dir * advance;
+        let (mut phi, mut omega) = (theta, dir * omega);
+        if let Some(end) = &end_wobble {
+            let (delta, u) = end.at(cycle, s_of(theta), c);
+            phi += dir * delta;
+            omega += dir * u;
+        }
+        if !(phi.is_finite() && phi.abs() <= super::MAX_ANGLE && omega.is_finite()) {
+            return Spin::Failed;
+        }
+        // The onion on its cycle at the end angle: whole turns shift it by the winding, the rest
+        // is marched.
+        let from_cycle = phi - cycle.turns - cycle.rotor;
+        let whole = (dir * from_cycle / (2.0 * PI)).floor();
+        let rest = from_cycle - dir * whole * 2.0 * PI;
+        let Some(onion) = self.march_onion(cycle.rotor, cycle.onion, cycle.rotor + rest, d, None)
+        else {
+            return Spin::Failed;
+        };
+        let psi =
+            onion.0 + cycle.turns + cycle.onion_turns + cycle.winding * dir * whole * 2.0 * PI;
+        if !(psi.is_finite() && psi.abs() <= super::MAX_ANGLE) {
+            return Spin::Failed;
+        }
+        Spin::Ended([phi, omega, psi, 0.0])
+    }
+
+    /// The periodic deviation from the mean motion at mean speed `omega` (> 0, in the direction
+    /// of motion), for a drag `c > 0`: `I omega du/ds + c u = tau~(s)` with `tau~` the cycle's
+    /// torque less its mean, solved exactly for `tau~` linear between samples (an exponential
+    /// integrator over the phase, decay `kappa = c / (I omega)` per radian) and made periodic by
+    /// `u(0) = u_1(2 pi) / (1 - exp(-2 pi kappa))` (`u_1` started from 0). `delta` integrates
+    /// `u / omega` (trapezoid) less its mean.
+    fn wobble(&self, cycle: &OnionCycle, omega: f64) -> Wobble {
+        let (i, c) = (self.inertia, self.drag);
+        let tau = &cycle.torque;
+        let n = tau.len();
+        let mut mean = 0.0;
+        for w in tau.windows(2) {
+            mean += 0.5 * (w[1].0 - w[0].0) * (w[0].1 + w[1].1);
+        }
+        mean /= 2.0 * PI;
+        let mut wobble = Wobble {
+            angle: vec![0.0; n],
+            speed: vec![0.0; n],
+            drift_force: 0.0,
+            omega,
+            kappa: c / (i * omega),
+            mean,
+        };
+        let sweep = |w: &mut Wobble, u0: f64| {
+            w.speed[0] = u0;
+            for j in 1..n {
+                let (e, a, b) = w.stride(tau[j].0 - tau[j - 1].0, c);
+                w.speed[j] = e * w.speed[j - 1] + a * (tau[j - 1].1 - mean) + b * (tau[j].1 - mean);
+            }
+        };
+        sweep(&mut wobble, 0.0);
+        let period_decay = -(-2.0 * PI * wobble.kappa).exp_m1();
+        let periodic_start = wobble.speed[n - 1] / period_decay;
+        sweep(&mut wobble, periodic_start);
+        let (speed, angle) = (&wobble.speed, &mut wobble.angle);
+        let (mut angle_mean, mut drift) = (0.0, 0.0);
+        for j in 1..n {
+            let h = tau[j].0 - tau[j - 1].0;
+            angle[j] = angle[j - 1] + 0.5 * h * (speed[j - 1] + speed[j]) / omega;
+            angle_mean += 0.5 * h * (angle[j - 1] + angle[j]);
+            drift +=
+                0.5 * h * ((tau[j - 1].1 - mean) * speed[j - 1] + (tau[j].1 - mean) * speed[j]);
+        }
+        angle_mean /= 2.0 * PI;
+        for a in angle.iter_mut() {
+            *a -= angle_mean;
+        }
+        wobble.drift_force = -drift / (2.0 * PI * omega);
+        wobble
+    }
+
+    /// An upper bound of eq. 3.3's torque on the bar (N m): `K a r (1/(r - a)^3 + 1/(r + a)^3)`.
+    fn torque_bound(&self) -> f64 {
+        let rb = &self.ring_bar;
+        let (a, r) = (rb.bar_charge_radius, rb.wall_radius);
+        (rb.coupling * a * r * ((r - a).powi(-3) + (r + a).powi(-3))).abs()
+    }
+
+    /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
+    /// `psi0`: one turn to land on it, one to measure it (and sample its torque). `None` if it
+    /// does not close.
+    fn onion_cycle(&self, y: &super::Vector, d: &Drive, dir: f64) -> Option<OnionCycle> {
+        // The landscape depends on psi - phi and psi - gamma (mod pi): turn rotor and onion back
+        // by whole turns so that the march works near zero (the onion by its own turns too, for
+        // a state whose onion is far from its rotor).
+        let turns = (y[0] / (2.0 * PI)).round() * 2.0 * PI;
+        let onion_turns = ((y[2] - y[0]) / (2.0 * PI)).round() * 2.0 * PI;
+        let phi0 = y[0] - turns;
+        let psi0 = self
+            .landscape(phi0, d.direction, d.stress)
+            .settle(y[2] - turns - onion_turns);
+        let start = phi0 + dir * 2.0 * PI;
+        let (psi1, _) = self.march_onion(phi0, psi0, start, d, None)?;
+        let mut torque = Vec::with_capacity(160);
+        let (psi2, work) =
+            self.march_onion(start, psi1, start + dir * 2.0 * PI, d, Some(&mut torque))?;
+        let winding = ((psi2 - psi1) / (2.0 * PI)).round();
+        if (psi2 - psi1 - winding * 2.0 * PI).abs() > 1e-6 {
+            return None;
+        }
+        for sample in &mut torque {
+            *sample = (dir * (sample.0 - start), dir * sample.1);
+        }
+        Some(OnionCycle {
+            turns,
+            onion_turns,
+            rotor: start,
+            onion: psi1,
+            winding: winding * dir,
+            work,
+            torque,
+        })
+    }
+
+    /// The quasi-static onion while the rotor turns from `from` to `to` (its memory rule, snaps
+    /// included), and the energy the snaps changed `U` by on the way (J). Strides of at most
+    /// [`CYCLE_STRIDE`]; a snap is placed by bisection within [`SNAP_PLACEMENT`] rad, where its
+    /// energy change is taken. `samples`, if given, receives the ring's torque `(phi, tau)` at
+    /// every stride's end and on both sides of every snap.
+    fn march_onion(
+        &self,
+        from: f64,
+        psi: f64,
+        to: f64,
+        d: &Drive,
+        mut samples: Option<&mut Vec<(f64, f64)>>,
+    ) -> Option<(f64, f64)> {
+        let settle = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).settle(onion);
+        let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
+        let mut record = |at: f64, onion: f64| {
+            if let Some(s) = samples.as_deref_mut() {
+                s.push((at, self.ring_bar.torque_stiffness(onion - at).0));
+            }
+        };
+        let strides = ((to - from).abs() / CYCLE_STRIDE).ceil().max(1.0);
+        if strides > 1e6 {
+            return None;
+        }
+        let (mut phi, mut psi, mut work) = (from, psi, 0.0);
+        record(phi, psi);
+        for k in 1..=strides as usize {
+            let next = from + (to - from) * k as f64 / strides;
+            let psi_next = settle(next, psi);
+            if (psi_next - psi).abs() <= ONION_JUMP + 4.0 * (next - phi).abs() {
+                (phi, psi) = (next, psi_next);
+                record(phi, psi);
+                continue;
+            }
+            // A snap inside the stride: bisect for it on the rotor angle.
+            let (mut lo, mut psi_lo, mut hi, mut psi_hi) = (phi, psi, next, psi_next);
+            for _ in 0..64 {
+                if (hi - lo).abs() <= SNAP_PLACEMENT {
+                    break;
+                }
+                let mid = 0.5 * (lo + hi);
+                let psi_mid = settle(mid, psi_lo);
+                if (psi_mid - psi_lo).abs() <= ONION_JUMP + 4.0 * (mid - lo).abs() {
+                    (lo, psi_lo) = (mid, psi_mid);
+                } else {
+                    (hi, psi_hi) = (mid, psi_mid);
+                }
+            }
+            work += energy(hi, psi_hi) - energy(lo, psi_lo);
+            record(lo, psi_lo);
+            record(hi, psi_hi);
+            (phi, psi) = (next, settle(next, psi_hi));
+            record(phi, psi);
+        }
+        (psi.is_finite() && work.is_finite()).then_some((psi, work))
+    }
+}
+
+/// The regime of [`Motor::advance_spinning`] from rest: `tau_max / |load|` at most this times the
+/// tolerance.
+const LOAD_DOMINATED: f64 = 0.5;
+/// The corrected regime of [`Motor::advance_spinning`]: `tau_max / |load|` at most this, and at
+/// least this many turns within the segment (fewer cost less resolved than the cycle's march).
+const MAX_SPIN_EPSILON: f64 = 0.05;
+const MIN_SPIN_TURNS: f64 = 2.0;
+/// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
+const CYCLE_STRIDE: f64 = 0.05;
+const SNAP_PLACEMENT: f64 = 1e-10;
+/// An onion turn beyond its branch's that marks a snap (rad), as in the integrator.
+const ONION_JUMP: f64 = 0.05;

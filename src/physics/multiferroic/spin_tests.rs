@@ -1,0 +1,145 @@
+//! The averaged spin ([`Motor::advance_spinning`]) against the same rotor integrated finely here.
+
+use super::tests::motor_with;
+use super::*;
+
+/// Section 3.2.2's rotor `I phi'' = tau(psi - phi) + load - c phi'` with the quasi-static onion
+/// settled downhill from its last value at every evaluation, by classical RK4 at a fixed step:
+/// an implementation independent of the motor's integrators, sharing only eq. 3.3-3.4.
+fn fine_rotor(m: &Motor, d: (f64, f64, f64), state: &mut MotorState, h: f64, dt: f64) {
+    let (direction, stress, load) = d;
+    let (i, c) = (m.inertia, m.drag);
+    let mut psi = state.onion_angle;
+    let accel = |phi: f64, omega: f64, psi: &mut f64| {
+        *psi = m.landscape(phi, direction, stress).settle(*psi);
+        (m.ring_bar.torque_stiffness(*psi - phi).0 + load - c * omega) / i
+    };
+    let n = (h / dt).ceil() as usize;
+    let dt = h / n as f64;
+    let (mut phi, mut omega) = (state.rotor_angle, state.rotor_speed);
+    for _ in 0..n {
+        let mut p = psi;
+        let a1 = accel(phi, omega, &mut p);
+        let a2 = accel(phi + 0.5 * dt * omega, omega + 0.5 * dt * a1, &mut p);
+        let a3 = accel(
+            phi + 0.5 * dt * (omega + 0.5 * dt * a1),
+            omega + 0.5 * dt * a2,
+            &mut p,
+        );
+        let a4 = accel(phi + dt * (omega + 0.5 * dt * a2), omega + dt * a3, &mut p);
+        phi += dt * (omega + dt * (a1 + a2 + a3) / 6.0);
+        omega += dt * (a1 + 2.0 * a2 + 2.0 * a3 + a4) / 6.0;
+        psi = m.landscape(phi, direction, stress).settle(psi);
+    }
+    *state = MotorState {
+        time: state.time + h,
+        rotor_angle: phi,
+        rotor_speed: omega,
+        onion_angle: psi,
+        ..*state
+    };
+}
+
+/// A Table 3.1 rotor spinning at its terminal speed under loads from 1e-14 to 1e-10 N m (4,600 to
+/// 5e7 times eq. 3.3's peak torque): two steps of about 100 turns each. The motor takes each in
+/// one averaged segment; angle and speed agree with the fine RK4 (0.1 ns or 1e-3 rad per step)
+/// within the tolerance, at whatever phase the steps end.
+#[test]
+fn spinning_rotor_agrees_with_fine_integration() {
+    let m = motor_with(|p| p.max_substeps = 20_000);
+    let d = (0.3, CALIBRATION_STRESS);
+    for load in [-1e-14, 3e-14, 1e-13, -1e-12, 1e-11, 1e-10] {
+        let terminal = load / m.drag;
+        let h = 600.0 / terminal.abs();
+        let start = MotorState {
+            rotor_speed: terminal,
+            ..MotorState::aligned(0.0)
+        };
+        let inputs = MotorInputs {
+            load_torque: load,
+            ..MotorInputs::fixed(d.0, d.1)
+        };
+        let (mut s, mut r) = (start, start);
+        s.onion_angle = m.outputs(&s, &inputs).unwrap().onion_angle;
+        r.onion_angle = s.onion_angle;
+        let dt = (1e-3 / terminal.abs()).min(0.05 * m.inertial_time());
+        for k in 0..2 {
+            let report = m.step(&mut s, &inputs, h).unwrap();
+            fine_rotor(&m, (d.0, d.1, load), &mut r, h, dt);
+            eprintln!(
+                "{load:e} step {k}: {} substeps, rotor {} against {} ({:e}), speed {} against {} ({:e})",
+                report.substeps,
+                s.rotor_angle,
+                r.rotor_angle,
+                s.rotor_angle - r.rotor_angle,
+                s.rotor_speed,
+                r.rotor_speed,
+                (s.rotor_speed - r.rotor_speed) / r.rotor_speed
+            );
+            assert!(
+                !report.accuracy_limited && report.substeps <= 2,
+                "{report:?}"
+            );
+            assert!((s.rotor_angle - r.rotor_angle).abs() < 1e-6, "{load:e}");
+            assert!((s.rotor_speed - r.rotor_speed).abs() < 1e-6 * r.rotor_speed.abs());
+        }
+    }
+}
+
+/// A Gilbert substep costs about eight of the quasi-static onion's, and counts so in the budget:
+/// a step that needs more than the budget (tolerance 1e-12 through the ringing after a switch)
+/// attempts at most `max_substeps / GILBERT_SUBSTEP_WEIGHT` Gilbert substeps (plus the few
+/// that finish it), so `max_substeps` bounds a step's cost alike in both onion models.
+#[test]
+fn a_gilbert_substep_counts_as_its_cost_in_the_budget() {
+    for budget in [800, 20_000] {
+        let m = motor_with(|p| {
+            p.onion_model = OnionModel::Gilbert;
+            p.tolerance = 1e-12;
+            p.max_substeps = budget;
+        });
+        let mut s = MotorState::aligned(0.0);
+        let report = m
+            .step(&mut s, &super::tests::schedule(20e-6), 1e-6)
+            .unwrap();
+        assert!(report.accuracy_limited, "{report:?}");
+        assert!(
+            report.substeps <= budget / GILBERT_SUBSTEP_WEIGHT + 16,
+            "{budget}: {report:?}"
+        );
+        assert!(s.rotor_angle.is_finite() && (s.time - 1e-6).abs() < 1e-18);
+    }
+}
+
+/// From rest, where `tau_max / |load|` is at most half the tolerance (Table 3.1: from about
+/// 2e-11 N m), the averaged spin takes the whole speed-up in one segment: within the tolerance
+/// of the fine RK4 (3.7e-7 and 8.6e-8 rad) at the end of a step of 0.44 and 0.15 inertial times
+/// (580 and 210 rad, still speeding up).
+#[test]
+fn spinning_rotor_from_rest_agrees_with_fine_integration() {
+    let m = motor_with(|p| p.max_substeps = 20_000);
+    let d = (0.3, CALIBRATION_STRESS);
+    for load in [1e-10f64, -3e-10] {
+        let h = 3000.0 * m.drag / load.abs();
+        let inputs = MotorInputs {
+            load_torque: load,
+            ..MotorInputs::fixed(d.0, d.1)
+        };
+        let mut s = MotorState::aligned(0.0);
+        s.onion_angle = m.outputs(&s, &inputs).unwrap().onion_angle;
+        let mut r = s;
+        let dt = (1e-3 * m.drag / load.abs()).min(0.05 * m.inertial_time());
+        let report = m.step(&mut s, &inputs, h).unwrap();
+        fine_rotor(&m, (d.0, d.1, load), &mut r, h, dt);
+        eprintln!(
+            "{load:e}: {} substeps, rotor {} against {}, speed {} against {}",
+            report.substeps, s.rotor_angle, r.rotor_angle, s.rotor_speed, r.rotor_speed
+        );
+        assert!(
+            !report.accuracy_limited && report.substeps <= 2,
+            "{report:?}"
+        );
+        assert!((s.rotor_angle - r.rotor_angle).abs() < 1e-6, "{load:e}");
+        assert!((s.rotor_speed - r.rotor_speed).abs() < 1e-6 * r.rotor_speed.abs());
+    }
+}
