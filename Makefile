@@ -318,7 +318,7 @@ sweep: fmus $(VENV)/.installed
 	$(AF) sweep --out out $(if $(SCHEDULER),--scheduler $(SCHEDULER))
 
 ## ---- Reliability jobs: longer runs, not part of `make test`. ----
-.PHONY: fuzz memcheck load
+.PHONY: fuzz fuzz-cmin memcheck load
 
 ## tests/load.rs with its 10,000-cycle heap test of every FMU in both interfaces (ignored by
 ## `make test`: a minute of CPU, most of it the motor).
@@ -365,6 +365,23 @@ fuzz:
 	@grep -h 'stat::number_of_executed_units' \
 	  $(if $(FUZZ_PARALLEL),fuzz/logs/$(SANITIZER)-job-*.log,fuzz/logs/$(SANITIZER).log) \
 	  | awk '{n += $$2} END {print "make fuzz SANITIZER=$(SANITIZER): " n " sequences without a finding"}'
+	@git diff --exit-code --stat -- fuzz/Cargo.lock
+
+## Rewrites fuzz/corpus/call_sequences as the smallest set of inputs libFuzzer's greedy set cover
+## finds with the edge coverage of the committed corpus and the run corpus (fuzz/corpus-run/)
+## together: -set_cover_merge over edges only (-use_counters=0, hit counts do not count), plain
+## build. The past findings in fuzz/regressions/ stay as they are. Commit the result.
+fuzz-cmin:
+	@command -v cargo-fuzz >/dev/null || cargo install cargo-fuzz --locked
+	@rustup toolchain list | grep -q '^nightly' || rustup toolchain install nightly --profile minimal
+	rm -rf fuzz/corpus-min && mkdir -p fuzz/corpus-min/call_sequences fuzz/corpus-run/call_sequences
+	cargo +nightly fuzz run -s none call_sequences $(CURDIR)/fuzz/corpus-min/call_sequences \
+	  $(CURDIR)/fuzz/corpus/call_sequences $(CURDIR)/fuzz/corpus-run/call_sequences \
+	  -- -set_cover_merge=1 -use_counters=0 -timeout=$(FUZZ_TIMEOUT) -rss_limit_mb=2048 \
+	  2>&1 | grep -E '^MERGE-OUTER: [0-9]+ new files'; test $${PIPESTATUS[0]} = 0
+	rm -rf fuzz/corpus/call_sequences && mv fuzz/corpus-min/call_sequences fuzz/corpus/call_sequences
+	rmdir fuzz/corpus-min
+	@echo "fuzz/corpus/call_sequences: $$(ls fuzz/corpus/call_sequences | wc -l) inputs"
 	@git diff --exit-code --stat -- fuzz/Cargo.lock
 
 ## Valgrind memcheck, two halves, each with its whole log kept in out/memcheck/ and its summary
@@ -469,6 +486,7 @@ Measure and check (not part of make test)
   compliance        the FMU Compliance Checker on every FMU: FMUCHECKER=path/to/fmuCheck.linux64
   fmusim            fmusim validate and simulate (CS, ME) on every FMU, FMI 2.0 and 3.0: FMUSIM=path/to/fmusim
   fuzz              random FMI call sequences (cargo-fuzz): FUZZ_SECONDS= FUZZ_JOBS= SANITIZER=
+  fuzz-cmin         the committed fuzz corpus cut to a set cover of its and fuzz/corpus-run's edges
   memcheck          every FMU under valgrind, natively and through FMPy
   load              10,000 instantiate-run-free cycles per FMU with the heap counted
   test-new-model    docs/adding-a-model.md's trivial model in a scratch copy, through the Rust suites

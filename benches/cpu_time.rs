@@ -14,6 +14,7 @@
 //! `-- walls` the two walls.
 
 use actuator_fmus::physics::bladder::{Bladder, Wall};
+use actuator_fmus::physics::gaylord::Sleeve;
 use actuator_fmus::physics::mckibben::MuscleGeometry;
 use actuator_fmus::physics::multiferroic::{
     Motor, MotorInputs, MotorParams, MotorState, ScheduleSwitch, SteppingSchedule,
@@ -92,7 +93,7 @@ fn measure(motor: &Motor, s: &Scenario) -> (f64, f64) {
 
 /// The parity bench's wall scenario: Table 2.1's muscle A at 690 kPa over 0.75-0.93 of its
 /// length (bladder on the sleeve), 200 lengths.
-fn wall_round(bladder: &Bladder) -> f64 {
+fn wall_round(bladder: &Bladder<Sleeve>) -> f64 {
     let start = thread_cpu();
     for k in 0..200 {
         let length = 0.10325 * (0.75 + 0.18 * k as f64 / 200.0);
@@ -116,7 +117,7 @@ fn walls(rounds: usize) -> Vec<(&'static str, f64)> {
         ),
         ("McKibbenMuscle, exact wall, 16 nodes", Wall::Exact(16)),
     ];
-    let bladders: Vec<Bladder> = walls
+    let bladders: Vec<Bladder<Sleeve>> = walls
         .iter()
         .map(|(_, w)| Bladder::with_wall(a.sleeve().unwrap(), a.tube(), *w).unwrap())
         .collect();

@@ -1,16 +1,17 @@
-//! Parsing and checking of `modelDescription/<Model>.xml`, and the shipped model description that
-//! build.rs writes from it. Used by build.rs (with `build/codegen.rs`, which writes the Rust
-//! code), and by `tests/all/shipped_descriptions.rs` to prove that bad descriptions fail.
+//! Checking of `modelDescription/<Model>.xml` (read once, into the typed `description.rs`), and
+//! the shipped model description that build.rs writes from it. Used by build.rs (with
+//! `build/codegen.rs`, which writes the Rust code), and by `tests/all/shipped_descriptions.rs` to
+//! prove that bad descriptions fail.
 //!
 //! A source description holds only the model's own: its variables, units, default experiment and
 //! output dependencies (by variable name). The export layer's part is written here: the
 //! `<CoSimulation>` block, the `<LogCategories>`, the 1-based ModelStructure indices and the GUID.
 
-use serde::de::IgnoredAny;
-use serde::Deserialize;
 use sha2::{Digest, Sha256};
 use std::collections::BTreeSet;
 
+#[path = "description.rs"]
+pub mod description;
 #[path = "rules.rs"]
 pub mod rules;
 #[path = "shipped_xml.rs"]
@@ -25,164 +26,6 @@ const GUID_PLACEHOLDER: &str = "@GUID@";
 
 // The export layer's part of every shipped description: log categories and capabilities.
 include!("export_layer.rs");
-
-#[derive(Deserialize)]
-struct ModelDescription {
-    #[serde(rename = "@fmiVersion")]
-    fmi_version: String,
-    #[serde(rename = "@modelName")]
-    model_name: String,
-    #[serde(rename = "@guid")]
-    guid: String,
-    #[serde(rename = "@description", default)]
-    description: String,
-    #[serde(rename = "@numberOfEventIndicators")]
-    number_of_event_indicators: Option<String>,
-    #[serde(rename = "CoSimulation")]
-    co_simulation: Option<IgnoredAny>,
-    #[serde(rename = "ModelExchange")]
-    model_exchange: Option<IgnoredAny>,
-    #[serde(rename = "LogCategories")]
-    log_categories: Option<IgnoredAny>,
-    #[serde(rename = "UnitDefinitions", default)]
-    unit_definitions: UnitDefinitions,
-    #[serde(rename = "TypeDefinitions", default)]
-    type_definitions: TypeDefinitions,
-    #[serde(rename = "ModelVariables")]
-    model_variables: ModelVariables,
-    #[serde(rename = "ModelStructure", default)]
-    model_structure: ModelStructure,
-}
-
-#[derive(Deserialize, Default)]
-struct UnitDefinitions {
-    #[serde(rename = "Unit", default)]
-    units: Vec<Named>,
-}
-
-/// Only Enumeration types: a variable's unit is given directly (see `check_variable`).
-#[derive(Deserialize, Default)]
-struct TypeDefinitions {
-    #[serde(rename = "SimpleType", default)]
-    types: Vec<SimpleType>,
-}
-
-#[derive(Deserialize)]
-struct SimpleType {
-    #[serde(rename = "@name")]
-    name: String,
-    #[serde(rename = "Enumeration")]
-    enumeration: Option<EnumerationType>,
-}
-
-#[derive(Deserialize)]
-struct EnumerationType {
-    #[serde(rename = "Item", default)]
-    items: Vec<Item>,
-}
-
-#[derive(Deserialize)]
-struct Item {
-    #[serde(rename = "@name")]
-    name: String,
-    #[serde(rename = "@value")]
-    value: i32,
-}
-
-#[derive(Deserialize)]
-struct Named {
-    #[serde(rename = "@name")]
-    name: String,
-}
-
-#[derive(Deserialize)]
-struct ModelVariables {
-    #[serde(rename = "ScalarVariable", default)]
-    variables: Vec<ScalarVariable>,
-}
-
-#[derive(Deserialize)]
-struct ScalarVariable {
-    #[serde(rename = "@name")]
-    name: String,
-    #[serde(rename = "@valueReference")]
-    value_reference: u32,
-    #[serde(rename = "@description", default)]
-    description: String,
-    #[serde(rename = "@causality", default = "default_causality")]
-    causality: String,
-    #[serde(rename = "@variability", default = "default_variability")]
-    variability: String,
-    #[serde(rename = "@initial")]
-    initial: Option<String>,
-    #[serde(rename = "Real")]
-    real: Option<TypeAttributes>,
-    #[serde(rename = "Integer")]
-    integer: Option<TypeAttributes>,
-    #[serde(rename = "Boolean")]
-    boolean: Option<TypeAttributes>,
-    #[serde(rename = "String")]
-    string: Option<TypeAttributes>,
-    /// Travels as an Integer through fmi2Set/GetInteger (FMI 2.0 section 2.2.7).
-    #[serde(rename = "Enumeration")]
-    enumeration: Option<TypeAttributes>,
-}
-
-fn default_causality() -> String {
-    "local".into()
-}
-fn default_variability() -> String {
-    "continuous".into()
-}
-
-#[derive(Deserialize)]
-struct TypeAttributes {
-    #[serde(rename = "@start")]
-    start: Option<String>,
-    #[serde(rename = "@min")]
-    min: Option<String>,
-    #[serde(rename = "@max")]
-    max: Option<String>,
-    #[serde(rename = "@unit")]
-    unit: Option<String>,
-    #[serde(rename = "@declaredType")]
-    declared_type: Option<String>,
-    /// In the source, the NAME of the state this variable is the derivative of; the shipped
-    /// description gets its index.
-    #[serde(rename = "@derivative")]
-    derivative: Option<String>,
-    #[serde(rename = "@nominal")]
-    nominal: Option<String>,
-}
-
-#[derive(Deserialize, Default)]
-struct ModelStructure {
-    #[serde(rename = "Outputs", default)]
-    outputs: Unknowns,
-    #[serde(rename = "Derivatives", default)]
-    derivatives: Unknowns,
-    #[serde(rename = "InitialUnknowns", default)]
-    initial_unknowns: Unknowns,
-}
-
-#[derive(Deserialize, Default)]
-struct Unknowns {
-    #[serde(rename = "Unknown", default)]
-    unknowns: Vec<Unknown>,
-}
-
-/// `<Unknown name="force" dependencies="pressure length" dependenciesKind="dependent dependent"/>`
-#[derive(Deserialize)]
-struct Unknown {
-    #[serde(rename = "@name")]
-    name: Option<String>,
-    #[serde(rename = "@index")]
-    index: Option<IgnoredAny>,
-    #[serde(rename = "@dependencies")]
-    dependencies: Option<String>,
-    #[serde(rename = "@dependenciesKind")]
-    dependencies_kind: Option<String>,
-}
 
 pub const TYPES: [&str; 4] = ["Real", "Integer", "Boolean", "String"];
 
@@ -240,8 +83,7 @@ pub struct Model {
 
 /// Checks the model description `text` of file `<stem>.xml`; the error says what is wrong.
 pub fn check(text: &str, stem: &str) -> Result<Model, String> {
-    let md: ModelDescription =
-        quick_xml::de::from_str(text).map_err(|e| format!("cannot parse: {e}"))?;
+    let md = description::parse(text)?;
     if md.fmi_version != "2.0" {
         return Err(format!("fmiVersion must be 2.0, found {}", md.fmi_version));
     }
@@ -320,7 +162,7 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
     };
     let (outputs, derivatives, initial_unknowns) =
         resolve_structure(&md.model_structure, &variables, &states)?;
-    rules::check(text)?;
+    rules::check_description(&md, rules::Form::Source)?;
     let structure = [
         ("Outputs", outputs.as_slice()),
         ("Derivatives", derivatives.as_slice()),

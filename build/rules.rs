@@ -1,13 +1,14 @@
 //! FMI 2.0 chapter 2 rules that conformance checkers test (the INTO-CPS VDMCheck inventory) and
-//! that the structural checker in `model_description.rs` does not cover. They read the XML as
-//! events, so they hold whatever shape the generator's own structs take. Each rule has a test in
-//! `tests/all/shipped_descriptions.rs` that feeds it a bad description.
+//! that the structural checks in `variable_checks.rs` do not cover, as checks over the typed
+//! description of `description.rs`. build.rs runs them on the source and again on the shipped
+//! description. Each rule has a test in `tests/all/shipped_descriptions.rs` that feeds it a bad
+//! description.
 
 // `!(x > y)` is deliberate: it also refuses NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
-use quick_xml::events::{BytesStart, Event};
-use std::collections::{BTreeMap, BTreeSet};
+use super::description::{self, Description, ToolElement, Unknowns};
+use std::collections::BTreeSet;
 
 /// The rules, one line each: docs/compatibility.md quotes this list.
 #[allow(dead_code)]
@@ -29,8 +30,36 @@ pub const RULES: &[&str] = &[
      dependency (2.2.8)",
     "a Real's derivative attribute is the index of a continuous Real output or local, and each \
      Derivatives entry is a variable that has one (2.2.7, 2.2.8)",
+    "a VendorAnnotations Tool holds at most one element (2.2.6, the schema's fmi2Annotation)",
 ];
 
+/// Which form of a description the rules judge. A source names its unknowns, dependencies and
+/// states (build.rs resolves them to indices) and may declare `<Terminals>` and `<Arrays>` in its
+/// Tool, which build.rs moves to the FMI 3.0 FMU; what ships must hold every rule as written.
+#[derive(Clone, Copy, PartialEq)]
+pub enum Form {
+    Source,
+    Shipped,
+}
+
+/// Checks every rule of [`RULES`] on a shipped model description's text.
+pub fn check(text: &str) -> Result<(), String> {
+    check_description(&description::parse(text)?, Form::Shipped)
+}
+
+/// Checks every rule of [`RULES`] on a description read by `description::parse`; the first
+/// violation found is the error.
+pub fn check_description(md: &Description, form: Form) -> Result<(), String> {
+    check_flags(md)?;
+    check_definitions(md)?;
+    check_experiment(md)?;
+    check_vendor_annotations(md, form)?;
+    let variables = check_variables(md)?;
+    check_derivatives(&variables, &md.model_structure.derivatives)?;
+    check_unknowns(&variables, md)
+}
+
+/// What the ModelStructure rules need of a variable.
 struct Variable {
     name: String,
     causality: String,
@@ -40,24 +69,8 @@ struct Variable {
     continuous_real: bool,
 }
 
-fn attributes(e: &BytesStart) -> Result<BTreeMap<String, String>, String> {
-    e.attributes()
-        .map(|a| {
-            let a = a.map_err(|e| format!("bad attribute: {e}"))?;
-            let value = a
-                .unescape_value()
-                .map_err(|e| format!("bad attribute value: {e}"))?;
-            Ok((
-                String::from_utf8_lossy(a.key.as_ref()).into_owned(),
-                value.into_owned(),
-            ))
-        })
-        .collect()
-}
-
-fn number(attrs: &BTreeMap<String, String>, key: &str, at: &str) -> Result<Option<f64>, String> {
-    attrs
-        .get(key)
+fn number(value: Option<&str>, key: &str, at: &str) -> Result<Option<f64>, String> {
+    value
         .map(|v| {
             v.trim()
                 .parse::<f64>()
@@ -66,24 +79,195 @@ fn number(attrs: &BTreeMap<String, String>, key: &str, at: &str) -> Result<Optio
         .transpose()
 }
 
-/// Boolean-valued attributes of the elements this project writes.
-const BOOLEAN_ATTRIBUTES: &[&str] = &[
-    "needsExecutionTool",
-    "canHandleVariableCommunicationStepSize",
-    "canInterpolateInputs",
-    "canRunAsynchronuously",
-    "canBeInstantiatedOnlyOncePerProcess",
-    "canNotUseMemoryManagementFunctions",
-    "canGetAndSetFMUstate",
-    "canSerializeFMUstate",
-    "providesDirectionalDerivative",
-    "canHandleMultipleSetPerTimeInstant",
-    "completedIntegratorStepNotNeeded",
-    "relativeQuantity",
-    "unbounded",
-    "reinit",
-    "canHandleEvents",
-];
+/// Boolean-valued attributes hold 'true' or 'false'.
+fn check_flags(md: &Description) -> Result<(), String> {
+    let mut flags: Vec<(&str, &str, &str)> = Vec::new();
+    for (tag, capabilities) in [
+        ("ModelExchange", &md.model_exchange),
+        ("CoSimulation", &md.co_simulation),
+    ] {
+        for (key, value) in capabilities.iter().flat_map(|c| c.flags()) {
+            flags.push((tag, key, value));
+        }
+    }
+    for t in &md.type_definitions.types {
+        for (key, value) in t.real.iter().flat_map(|r| r.flags()) {
+            flags.push(("Real", key, value));
+        }
+    }
+    for v in &md.model_variables.variables {
+        if let Some(value) = &v.can_handle_multiple_set_per_time_instant {
+            flags.push((
+                "ScalarVariable",
+                "canHandleMultipleSetPerTimeInstant",
+                value,
+            ));
+        }
+        for (kind, attrs) in v.types() {
+            for (key, value) in attrs.flags() {
+                flags.push((kind, key, value));
+            }
+        }
+    }
+    match flags.iter().find(|(_, _, v)| *v != "true" && *v != "false") {
+        Some((tag, key, v)) => Err(format!("{tag}: {key} = '{v}' must be 'true' or 'false'")),
+        None => Ok(()),
+    }
+}
+
+/// Unique unit, type and log category names; integer BaseUnit exponents and a non-zero factor.
+fn check_definitions(md: &Description) -> Result<(), String> {
+    let mut units = BTreeSet::new();
+    for unit in &md.unit_definitions.units {
+        if !units.insert(unit.name.as_str()) {
+            return Err(format!(
+                "unit '{}' is defined twice in UnitDefinitions",
+                unit.name
+            ));
+        }
+        let Some(base) = &unit.base_unit else {
+            continue;
+        };
+        if number(base.factor.as_deref(), "factor", "BaseUnit")? == Some(0.0) {
+            return Err("BaseUnit factor must not be zero".into());
+        }
+        number(base.offset.as_deref(), "offset", "BaseUnit")?;
+        for (key, value) in base.exponents() {
+            if value.trim().parse::<i32>().is_err() {
+                return Err(format!(
+                    "BaseUnit exponent {key} = '{value}' must be an integer"
+                ));
+            }
+        }
+    }
+    let mut types = BTreeSet::new();
+    for t in &md.type_definitions.types {
+        if !types.insert(t.name.as_str()) {
+            return Err(format!(
+                "type '{}' is defined twice in TypeDefinitions",
+                t.name
+            ));
+        }
+    }
+    let mut categories = BTreeSet::new();
+    for c in md.log_categories.iter().flat_map(|l| &l.categories) {
+        if !categories.insert(c.name.as_str()) {
+            return Err(format!("log category '{}' is declared twice", c.name));
+        }
+    }
+    Ok(())
+}
+
+fn check_experiment(md: &Description) -> Result<(), String> {
+    let Some(e) = &md.default_experiment else {
+        return Ok(());
+    };
+    let at = "DefaultExperiment";
+    let start = number(e.start_time.as_deref(), "startTime", at)?.unwrap_or(0.0);
+    if let Some(stop) = number(e.stop_time.as_deref(), "stopTime", at)? {
+        if !(stop > start) {
+            return Err(format!(
+                "DefaultExperiment: stopTime {stop} must be after startTime {start}"
+            ));
+        }
+    }
+    for (key, value) in [("stepSize", &e.step_size), ("tolerance", &e.tolerance)] {
+        if let Some(x) = number(value.as_deref(), key, at)? {
+            if !(x > 0.0) {
+                return Err(format!("DefaultExperiment: {key} {x} must be positive"));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The FMI 2.0 schema gives a `<Tool>` at most one child element (`xs:any`, `minOccurs="0"`).
+fn check_vendor_annotations(md: &Description, form: Form) -> Result<(), String> {
+    for tool in md.vendor_annotations.iter().flat_map(|a| &a.tools) {
+        let counted = tool
+            .elements
+            .iter()
+            .filter(|e| {
+                form == Form::Shipped || !matches!(e, ToolElement::Terminals | ToolElement::Arrays)
+            })
+            .count();
+        if counted > 1 {
+            return Err(format!(
+                "VendorAnnotations: Tool '{}' holds {counted} elements; FMI 2.0 allows at most one",
+                tool.name
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The variables' own rules: structured names, attribute ranges, what each type may carry.
+fn check_variables(md: &Description) -> Result<Vec<Variable>, String> {
+    let structured_names = md.variable_naming_convention.as_deref() == Some("structured");
+    let mut variables = Vec::new();
+    for v in &md.model_variables.variables {
+        let name = &v.name;
+        if structured_names && !structured(name) {
+            return Err(format!(
+                "variable name '{name}' does not follow the structured naming convention"
+            ));
+        }
+        let at = format!("variable '{name}'");
+        let mut derivative = None;
+        for (kind, attrs) in v.types() {
+            if let Some(d) = &attrs.derivative {
+                if kind != "Real" {
+                    return Err(format!("{at}: only a Real has a derivative attribute"));
+                }
+                // A source names the state (build.rs resolves it); a shipped one indexes it.
+                derivative = d.trim().parse().ok();
+            }
+            if matches!(kind, "Boolean" | "String") {
+                let given = [
+                    ("min", &attrs.min),
+                    ("max", &attrs.max),
+                    ("unit", &attrs.unit),
+                    ("nominal", &attrs.nominal),
+                    ("quantity", &attrs.quantity),
+                ];
+                if let Some((key, _)) = given.iter().find(|(_, value)| value.is_some()) {
+                    return Err(format!("{at}: a {kind} has no attribute {key}"));
+                }
+                continue;
+            }
+            let min = number(attrs.min.as_deref(), "min", &at)?;
+            let max = number(attrs.max.as_deref(), "max", &at)?;
+            if let (Some(lo), Some(hi)) = (min, max) {
+                if !(lo <= hi) {
+                    return Err(format!("{at}: min {lo} is above max {hi}"));
+                }
+            }
+            if let Some(start) = number(attrs.start.as_deref(), "start", &at)? {
+                if min.is_some_and(|lo| start < lo) || max.is_some_and(|hi| start > hi) {
+                    return Err(format!(
+                        "{at}: start {start} is outside [{}, {}]",
+                        min.unwrap_or(f64::NEG_INFINITY),
+                        max.unwrap_or(f64::INFINITY)
+                    ));
+                }
+            }
+            if let Some(nominal) = number(attrs.nominal.as_deref(), "nominal", &at)? {
+                if !(nominal > 0.0) {
+                    return Err(format!("{at}: nominal {nominal} must be positive"));
+                }
+            }
+        }
+        let types = v.types();
+        variables.push(Variable {
+            name: name.clone(),
+            causality: v.causality.clone(),
+            derivative,
+            continuous_real: v.variability == "continuous"
+                && types.iter().all(|(kind, _)| *kind == "Real"),
+        });
+    }
+    Ok(variables)
+}
 
 /// `name` in the structured convention (FMI 2.0 section 2.2.9): dot-separated identifiers or
 /// quoted names, each optionally indexed `[1,2]`, or `der(name)` / `der(name, n)`.
@@ -119,166 +303,6 @@ fn structured_part(part: &str) -> bool {
     (identifier || quoted) && index_ok
 }
 
-/// Checks every rule of [`RULES`] on a model description; the first violation is the error.
-pub fn check(text: &str) -> Result<(), String> {
-    let mut reader = quick_xml::Reader::from_str(text);
-    let mut units = BTreeSet::new();
-    let mut types = BTreeSet::new();
-    let mut categories = BTreeSet::new();
-    let mut variables: Vec<Variable> = Vec::new();
-    let mut structured_names = false;
-    // (list, attributes) of every ModelStructure Unknown.
-    let mut unknowns: Vec<(String, BTreeMap<String, String>)> = Vec::new();
-    let mut path: Vec<String> = Vec::new();
-    loop {
-        let (e, empty) = match reader
-            .read_event()
-            .map_err(|e| format!("cannot parse: {e}"))?
-        {
-            Event::Start(e) => (e, false),
-            Event::Empty(e) => (e, true),
-            Event::End(_) => {
-                path.pop();
-                continue;
-            }
-            Event::Eof => break,
-            _ => continue,
-        };
-        let tag = String::from_utf8_lossy(e.name().as_ref()).into_owned();
-        let attrs = attributes(&e)?;
-        let parent = path.last().map(String::as_str).unwrap_or("");
-        let name = attrs.get("name").cloned().unwrap_or_default();
-        for key in BOOLEAN_ATTRIBUTES {
-            if let Some(v) = attrs.get(*key) {
-                if v != "true" && v != "false" {
-                    return Err(format!("{tag}: {key} = '{v}' must be 'true' or 'false'"));
-                }
-            }
-        }
-        match (parent, tag.as_str()) {
-            ("", "fmiModelDescription") => {
-                structured_names =
-                    attrs.get("variableNamingConvention").map(String::as_str) == Some("structured")
-            }
-            ("UnitDefinitions", "Unit") if !units.insert(name.clone()) => {
-                return Err(format!("unit '{name}' is defined twice in UnitDefinitions"));
-            }
-            ("Unit", "BaseUnit") => {
-                for (key, value) in &attrs {
-                    if key == "factor" {
-                        if number(&attrs, key, "BaseUnit")? == Some(0.0) {
-                            return Err("BaseUnit factor must not be zero".into());
-                        }
-                    } else if key != "offset" && value.trim().parse::<i32>().is_err() {
-                        return Err(format!(
-                            "BaseUnit exponent {key} = '{value}' must be an integer"
-                        ));
-                    }
-                }
-            }
-            ("TypeDefinitions", "SimpleType") if !types.insert(name.clone()) => {
-                return Err(format!("type '{name}' is defined twice in TypeDefinitions"));
-            }
-            ("LogCategories", "Category") if !categories.insert(name.clone()) => {
-                return Err(format!("log category '{name}' is declared twice"));
-            }
-            (_, "DefaultExperiment") => {
-                let at = "DefaultExperiment";
-                let start = number(&attrs, "startTime", at)?.unwrap_or(0.0);
-                if let Some(stop) = number(&attrs, "stopTime", at)? {
-                    if !(stop > start) {
-                        return Err(format!(
-                            "DefaultExperiment: stopTime {stop} must be after startTime {start}"
-                        ));
-                    }
-                }
-                for key in ["stepSize", "tolerance"] {
-                    if let Some(x) = number(&attrs, key, at)? {
-                        if !(x > 0.0) {
-                            return Err(format!("DefaultExperiment: {key} {x} must be positive"));
-                        }
-                    }
-                }
-            }
-            ("ModelVariables", "ScalarVariable") => {
-                if structured_names && !structured(&name) {
-                    return Err(format!(
-                        "variable name '{name}' does not follow the structured naming convention"
-                    ));
-                }
-                variables.push(Variable {
-                    name,
-                    causality: attrs
-                        .get("causality")
-                        .cloned()
-                        .unwrap_or_else(|| "local".into()),
-                    derivative: None,
-                    continuous_real: attrs.get("variability").is_none_or(|v| v == "continuous"),
-                });
-            }
-            (
-                "ScalarVariable",
-                kind @ ("Real" | "Integer" | "Boolean" | "String" | "Enumeration"),
-            ) => {
-                let var = variables.last().map_or("?", |v| v.name.as_str());
-                let at = format!("variable '{var}'");
-                if kind != "Real" {
-                    if let Some(last) = variables.last_mut() {
-                        last.continuous_real = false;
-                    }
-                }
-                if let Some(d) = attrs.get("derivative") {
-                    if kind != "Real" {
-                        return Err(format!("{at}: only a Real has a derivative attribute"));
-                    }
-                    // A source names the state (build.rs resolves it); a shipped one indexes it.
-                    if let (Ok(index), Some(last)) = (d.trim().parse(), variables.last_mut()) {
-                        last.derivative = Some(index);
-                    }
-                }
-                if matches!(kind, "Boolean" | "String") {
-                    if let Some(key) = ["min", "max", "unit", "nominal", "quantity"]
-                        .into_iter()
-                        .find(|k| attrs.contains_key(*k))
-                    {
-                        return Err(format!("{at}: a {kind} has no attribute {key}"));
-                    }
-                } else {
-                    let (min, max) = (number(&attrs, "min", &at)?, number(&attrs, "max", &at)?);
-                    if let (Some(lo), Some(hi)) = (min, max) {
-                        if !(lo <= hi) {
-                            return Err(format!("{at}: min {lo} is above max {hi}"));
-                        }
-                    }
-                    if let Some(start) = number(&attrs, "start", &at)? {
-                        if min.is_some_and(|lo| start < lo) || max.is_some_and(|hi| start > hi) {
-                            return Err(format!(
-                                "{at}: start {start} is outside [{}, {}]",
-                                min.unwrap_or(f64::NEG_INFINITY),
-                                max.unwrap_or(f64::INFINITY)
-                            ));
-                        }
-                    }
-                    if let Some(nominal) = number(&attrs, "nominal", &at)? {
-                        if !(nominal > 0.0) {
-                            return Err(format!("{at}: nominal {nominal} must be positive"));
-                        }
-                    }
-                }
-            }
-            (list @ ("Outputs" | "Derivatives" | "InitialUnknowns"), "Unknown") => {
-                unknowns.push((list.to_string(), attrs.clone()));
-            }
-            _ => {}
-        }
-        if !empty {
-            path.push(tag);
-        }
-    }
-    check_derivatives(&variables, &unknowns)?;
-    check_unknowns(&variables, &unknowns)
-}
-
 /// The continuous states: the variables a `derivative` attribute points to, 1-based.
 fn states(variables: &[Variable]) -> Result<BTreeSet<usize>, String> {
     let mut states = BTreeSet::new();
@@ -301,14 +325,10 @@ fn states(variables: &[Variable]) -> Result<BTreeSet<usize>, String> {
     Ok(states)
 }
 
-fn check_derivatives(
-    variables: &[Variable],
-    unknowns: &[(String, BTreeMap<String, String>)],
-) -> Result<(), String> {
+fn check_derivatives(variables: &[Variable], derivatives: &Unknowns) -> Result<(), String> {
     states(variables)?;
-    for (list, attrs) in unknowns {
-        let index = attrs.get("index").and_then(|i| i.parse::<usize>().ok());
-        if let (Some(i), "Derivatives") = (index, list.as_str()) {
+    for u in &derivatives.unknowns {
+        if let Some(i) = u.index.as_deref().and_then(|i| i.parse::<usize>().ok()) {
             let v = i.checked_sub(1).and_then(|i| variables.get(i));
             if v.is_none_or(|v| v.derivative.is_none()) {
                 return Err(format!(
@@ -320,21 +340,23 @@ fn check_derivatives(
     Ok(())
 }
 
-fn check_unknowns(
-    variables: &[Variable],
-    unknowns: &[(String, BTreeMap<String, String>)],
-) -> Result<(), String> {
+fn check_unknowns(variables: &[Variable], md: &Description) -> Result<(), String> {
     let mut seen: BTreeSet<(&str, usize)> = BTreeSet::new();
     let states = states(variables)?;
-    for (list, attrs) in unknowns {
+    let lists = md.model_structure.lists();
+    let unknowns = lists
+        .iter()
+        .flat_map(|(list, u)| u.unknowns.iter().map(move |u| (*list, u)));
+    for (list, u) in unknowns {
         let at = format!("ModelStructure/{list}");
-        if !attrs.contains_key("index") && attrs.contains_key("name") {
+        if u.index.is_none() && u.name.is_some() {
             // A source description names its unknowns; build.rs resolves and checks them, and
             // these rules run again on the shipped indices.
             continue;
         }
-        let index: usize = attrs
-            .get("index")
+        let index: usize = u
+            .index
+            .as_deref()
             .and_then(|i| i.parse().ok())
             .ok_or_else(|| format!("{at}: every Unknown needs a numeric index"))?;
         if !(1..=variables.len()).contains(&index) {
@@ -343,11 +365,11 @@ fn check_unknowns(
                 variables.len()
             ));
         }
-        if !seen.insert((list.as_str(), index)) {
+        if !seen.insert((list, index)) {
             return Err(format!("{at}: Unknown index {index} is listed twice"));
         }
-        let Some(deps) = attrs.get("dependencies") else {
-            if attrs.contains_key("dependenciesKind") {
+        let Some(deps) = &u.dependencies else {
+            if u.dependencies_kind.is_some() {
                 return Err(format!(
                     "{at}: Unknown {index} has dependenciesKind without dependencies"
                 ));
@@ -376,7 +398,7 @@ fn check_unknowns(
             };
             // Outputs and derivatives depend on the knowns: inputs, continuous states and time;
             // initial unknowns on the inputs, parameters and start values (FMI 2.0 section 2.2.8).
-            let allowed = match list.as_str() {
+            let allowed = match list {
                 "InitialUnknowns" => {
                     matches!(v.causality.as_str(), "input" | "parameter" | "independent")
                         || states.contains(&d)
@@ -390,7 +412,7 @@ fn check_unknowns(
                 ));
             }
         }
-        if let Some(kinds) = attrs.get("dependenciesKind") {
+        if let Some(kinds) = &u.dependencies_kind {
             let kinds: Vec<&str> = kinds.split_whitespace().collect();
             if kinds.len() != deps.len() {
                 return Err(format!(

@@ -2,10 +2,8 @@
 //! each variable's causality, variability and attributes, the enumerations, the continuous states,
 //! and the ModelStructure resolved to 1-based indices.
 
-use super::{
-    field_name, ModelStructure, ResolvedUnknown, ScalarVariable, TypeDefinitions, Unknowns,
-    Variable,
-};
+use super::description::{ModelStructure, ScalarVariable, TypeDefinitions, Unknowns};
+use super::{field_name, ResolvedUnknown, Variable};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// The (lowest, highest) item value of each Enumeration type by name. The items must be the

@@ -9,9 +9,10 @@
 //! non-cylindrical shape, which has no single bladder diameter.
 
 use super::{wall_arrays, Model, Partials, Refusal, Report, Status};
-use crate::physics::bladder::{Bladder, BladderTube, KnittedCylinder};
+use crate::physics::bladder::{Bladder, BladderTube};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
+use crate::physics::knitted_cylinder::KnittedCylinder;
 use crate::physics::knitted_muscle::{Friction, KnittedAssembly, KnittedOutput};
 use crate::physics::mckibben::{is_slack, BladderModel};
 use crate::variables::knitted_muscle::{

@@ -4,10 +4,11 @@
 //! hysteresis, and section 1.4's polyethylene bag. The counterpart of [`super::mckibben`]: the
 //! FMU (`models/knitted_muscle.rs`) maps its variables to this and logs what it reports.
 
-use crate::physics::bladder::{Bladder, BladderState, KnittedCylinder, SleeveGeometry};
+use crate::physics::bladder::{Bladder, BladderState, SleeveGeometry};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{FluidContainer, KnittedSleeve, ShapeModel, StrandFriction};
 use crate::physics::knitted_bag::Bag;
+use crate::physics::knitted_cylinder::KnittedCylinder;
 use serde::{Deserialize, Serialize};
 
 /// With a bladder the force grows without bound where the rubber fills the sleeve; a length beyond

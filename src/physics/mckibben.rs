@@ -197,7 +197,7 @@ struct Friction {
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 pub struct McKibben {
     sleeve: Sleeve,
-    bladder: Option<Bladder>,
+    bladder: Option<Bladder<Sleeve>>,
     friction: Option<Friction>,
     /// `1/k` of the series connector, m/N; `None` = rigid.
     connector_compliance: Option<f64>,
@@ -308,7 +308,7 @@ impl McKibben {
         &self.sleeve
     }
 
-    pub fn bladder(&self) -> Option<&Bladder> {
+    pub fn bladder(&self) -> Option<&Bladder<Sleeve>> {
         self.bladder.as_ref()
     }
 

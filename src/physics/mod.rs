@@ -10,6 +10,7 @@ pub mod gaylord;
 pub mod inverse;
 pub mod knitted;
 pub mod knitted_bag;
+pub mod knitted_cylinder;
 pub mod knitted_muscle;
 pub mod knitted_partials;
 pub mod knitted_shape;

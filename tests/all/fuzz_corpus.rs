@@ -1,4 +1,4 @@
-//! The committed fuzz corpus (`fuzz/corpus/call_sequences/`, kept small with `cargo fuzz cmin`)
+//! The committed fuzz corpus (`fuzz/corpus/call_sequences/`, kept small with `make fuzz-cmin`)
 //! and the inputs that once were findings (`fuzz/regressions/call_sequences/`, kept out of the
 //! corpus so that `cmin` cannot drop them) replayed through the fuzz harness's own logic, without
 //! libFuzzer or a nightly toolchain: no input makes any FMU return fmi2Fatal, crash, refuse

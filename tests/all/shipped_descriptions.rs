@@ -422,7 +422,7 @@ mod rules {
     #[test]
     fn the_shipped_descriptions_pass_every_rule() {
         rules::check(&shipped()).unwrap();
-        assert_eq!(rules::RULES.len(), 14);
+        assert_eq!(rules::RULES.len(), 15);
     }
 
     #[test]
@@ -430,9 +430,9 @@ mod rules {
         let unit = r#"<Unit name="m"><BaseUnit m="1"/></Unit>"#;
         broken(unit, &format!("{unit}{unit}"), "unit 'm' is defined twice");
         broken(
-            "<LogCategories>",
+            "<TypeDefinitions>",
             "<TypeDefinitions><SimpleType name=\"T\"><Real/></SimpleType>\
-             <SimpleType name=\"T\"><Real/></SimpleType></TypeDefinitions>\n  <LogCategories>",
+             <SimpleType name=\"T\"><Real/></SimpleType>",
             "type 'T' is defined twice",
         );
         broken(
@@ -504,6 +504,33 @@ mod rules {
             r#"min="1e-3" max="1e4" nominal="0" start="3.74""#,
             "nominal 0 must be positive",
         );
+    }
+
+    /// FMI 2.0's schema gives a `<Tool>` one child element at most; the source's `<Terminals>`
+    /// (the FMI 3.0 flanges) beside its `<Tests>` does not ship.
+    #[test]
+    fn a_tool_holds_one_element() {
+        let tests = "<Tests>";
+        broken(
+            tests,
+            "<Extra/><Tests>",
+            "Tool 'actuator-fmus' holds 2 elements; FMI 2.0 allows at most one",
+        );
+        broken(
+            tests,
+            "<Terminals/><Tests>",
+            "Tool 'actuator-fmus' holds 2 elements",
+        );
+        assert!(SOURCE.contains("<Terminals>") && !shipped().contains("<Terminals>"));
+        super::refused(
+            &SOURCE.replacen(tests, "<Extra/><Tests>", 1),
+            "holds 2 elements",
+        );
+        let source = super::model_description::description::parse(SOURCE).unwrap();
+        rules::check_description(&source, rules::Form::Source).unwrap();
+        assert!(rules::check_description(&source, rules::Form::Shipped)
+            .unwrap_err()
+            .contains("holds 2 elements"));
     }
 
     #[test]

@@ -1,6 +1,7 @@
 //! The continuum wall against the layered wall's limit, its convergence, and its safety.
 
 use super::*;
+use crate::physics::gaylord::Sleeve;
 use proptest::prelude::*;
 
 /// Table 2.1's muscle C (the thickest wall relative to its bore, with pre-strain) and muscle D
@@ -8,7 +9,7 @@ use proptest::prelude::*;
 const MUSCLE_C: (f64, f64, f64, f64, f64, f64) = (0.0989, 0.0541, 1.6e-3, 1.6e-3, 0.1051, 3.40);
 const MUSCLE_D: (f64, f64, f64, f64, f64, f64) = (0.1358, 0.1336, 3.8e-3, 0.25e-3, 0.1423, 4.53);
 
-fn bladder(m: (f64, f64, f64, f64, f64, f64), wall: Wall) -> Bladder {
+fn bladder(m: (f64, f64, f64, f64, f64, f64), wall: Wall) -> Bladder<Sleeve> {
     let (_, lr0, d_ri, t, b, n) = m;
     let tube = BladderTube::latex(d_ri, t, lr0);
     Bladder::with_wall(Sleeve::new(b, n).unwrap(), tube, wall).unwrap()
@@ -16,7 +17,7 @@ fn bladder(m: (f64, f64, f64, f64, f64, f64), wall: Wall) -> Bladder {
 
 /// Lengths across the whole range to within 0.5% of the fill limits, where the inner wall
 /// nearly collapses and the force diverges.
-fn stroke(bl: &Bladder, count: usize) -> Vec<f64> {
+fn stroke(bl: &Bladder<Sleeve>, count: usize) -> Vec<f64> {
     let (lo, hi) = (bl.min_length(), bl.max_length());
     (0..count)
         .map(|i| lo + (hi - lo) * (0.005 + 0.99 * i as f64 / (count - 1) as f64))
@@ -48,11 +49,11 @@ fn layered_limit(m: (f64, f64, f64, f64, f64, f64), p: f64, lengths: &[f64]) -> 
         .collect()
 }
 
-fn lengths_of(bl: &Bladder) -> Vec<f64> {
+fn lengths_of(bl: &Bladder<Sleeve>) -> Vec<f64> {
     stroke(bl, 41)
 }
 
-fn largest_error(bl: &Bladder, p: f64, lengths: &[f64], limit: &[f64]) -> f64 {
+fn largest_error(bl: &Bladder<Sleeve>, p: f64, lengths: &[f64], limit: &[f64]) -> f64 {
     let peak = limit.iter().fold(0.0f64, |a, f| a.max(f.abs()));
     lengths
         .iter()

@@ -4,6 +4,7 @@
 //! of the same kinematics, the thin-wall limit, and the layers' order of convergence.
 
 use super::*;
+use crate::physics::gaylord::Sleeve;
 use crate::physics::mckibben::MuscleGeometry;
 
 const MUSCLES: [(char, MuscleGeometry); 4] = [
@@ -13,12 +14,12 @@ const MUSCLES: [(char, MuscleGeometry); 4] = [
     ('D', MuscleGeometry::muscle_d()),
 ];
 
-fn bladder_of(g: &MuscleGeometry, tube: BladderTube, wall: Wall) -> Bladder {
+fn bladder_of(g: &MuscleGeometry, tube: BladderTube, wall: Wall) -> Bladder<Sleeve> {
     Bladder::with_wall(g.sleeve().unwrap(), tube, wall).unwrap()
 }
 
 /// Lengths from 0.6 of the listed length to just inside `max_length` (0.9999 of the way).
-fn lengths(g: &MuscleGeometry, bl: &Bladder, count: usize) -> Vec<f64> {
+fn lengths(g: &MuscleGeometry, bl: &Bladder<Sleeve>, count: usize) -> Vec<f64> {
     let (lo, hi) = (
         (0.6 * g.length).max(bl.min_length() * 1.001),
         bl.max_length(),

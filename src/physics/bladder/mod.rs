@@ -37,7 +37,6 @@ mod exact_tests;
 mod free;
 mod geometry;
 mod hyper_dual;
-mod knitted_cylinder;
 mod partials;
 mod state;
 mod stiffness_partials;
@@ -47,13 +46,10 @@ mod wall_field;
 #[cfg(test)]
 mod wall_field_tests;
 
-use crate::physics::gaylord::Sleeve;
-use crate::physics::knitted::KnittedSleeve;
 use crate::physics::numerics::dual::Dual;
 use continuum::WallNode;
 pub use geometry::SleeveGeometry;
 use hyper_dual::KernelScalar;
-pub use knitted_cylinder::KnittedCylinder;
 pub use partials::BladderPartials;
 use state::check_state;
 pub use state::BladderState;
@@ -140,11 +136,12 @@ struct Layer {
     rubber_volume: f64,
 }
 
-/// A Mooney-Rivlin bladder inside a given sleeve (the helical McKibben [`Sleeve`] by default, or a
-/// [`KnittedCylinder`]), with everything that depends only on parameters precomputed (layer
+/// A Mooney-Rivlin bladder inside a given sleeve (the helical McKibben
+/// [`Sleeve`](crate::physics::gaylord::Sleeve) or a
+/// [`KnittedCylinder`](crate::physics::knitted_cylinder::KnittedCylinder)), with everything that depends only on parameters precomputed (layer
 /// constants, rubber volume, length limits).
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
-pub struct Bladder<S = Sleeve> {
+pub struct Bladder<S> {
     sleeve: S,
     tube: BladderTube,
     wall: Wall,
@@ -156,28 +153,6 @@ pub struct Bladder<S = Sleeve> {
     rubber_volume: f64,
     min_length: f64,
     max_length: f64,
-}
-
-impl Bladder<KnittedCylinder> {
-    /// The bladder inside a cylindrical knitted sleeve (section 1.3.6); `Err` for the
-    /// non-cylindrical shape (see [`KnittedCylinder::new`]) or a tube that does not fit. The
-    /// length range is the sleeve's own (strand thickness) intersected with where the rubber fits.
-    pub fn knitted(
-        sleeve: &KnittedSleeve,
-        tube: BladderTube,
-        layers: usize,
-    ) -> Result<Self, String> {
-        Self::dissertation_layers(KnittedCylinder::new(sleeve)?, tube, layers)
-    }
-
-    /// As [`Self::knitted`] with any [`Wall`].
-    pub fn knitted_wall(
-        sleeve: &KnittedSleeve,
-        tube: BladderTube,
-        wall: Wall,
-    ) -> Result<Self, String> {
-        Self::with_wall(KnittedCylinder::new(sleeve)?, tube, wall)
-    }
 }
 
 impl<S: SleeveGeometry> Bladder<S> {

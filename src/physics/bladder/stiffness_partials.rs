@@ -114,10 +114,11 @@ impl<S: SleeveGeometry> Bladder<S> {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{BladderTube, KnittedCylinder, Wall};
+    use super::super::{BladderTube, Wall};
     use super::*;
     use crate::physics::gaylord::Sleeve;
     use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
+    use crate::physics::knitted_cylinder::KnittedCylinder;
 
     /// Central differences of the three slopes of `evaluate` against the exact partials; returns
     /// the worst relative difference and whether the point was free.

@@ -1,4 +1,6 @@
 use super::*;
+use crate::physics::gaylord::Sleeve;
+use crate::physics::knitted_cylinder::KnittedCylinder;
 use approx::assert_relative_eq;
 use proptest::prelude::*;
 
@@ -27,7 +29,7 @@ const B: usize = 1;
 const C: usize = 2;
 const D: usize = 3;
 
-fn muscle(which: usize, layers: usize) -> Bladder {
+fn muscle(which: usize, layers: usize) -> Bladder<Sleeve> {
     let (_, lr0, d_ri, t, b, n) = TABLE_2_1[which];
     let tube = BladderTube::latex(d_ri, t, lr0);
     Bladder::dissertation_layers(Sleeve::new(b, n).unwrap(), tube, layers).unwrap()
@@ -39,7 +41,7 @@ fn listed_length(which: usize) -> f64 {
 
 /// Eq. 2.6-2.17 written out directly for the thin-walled tube in contact:
 /// returns (force, P_eff, lambda_2, sigma_11, sigma_22).
-fn thin_reference(bl: &Bladder, p: f64, l: f64) -> (f64, f64, f64, f64, f64) {
+fn thin_reference(bl: &Bladder<Sleeve>, p: f64, l: f64) -> (f64, f64, f64, f64, f64) {
     let (b, n) = (bl.sleeve.strand_length, bl.sleeve.turns);
     let t = bl.tube;
     let (d_ri, d_ro) = (t.inner_diameter, t.inner_diameter + 2.0 * t.thickness);
@@ -427,7 +429,7 @@ fn rejects_bad_parameters() {
     }
 }
 
-use crate::physics::knitted::{KnittedParams, ShapeKind};
+use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
 
 /// Fig. 1.16 knitted sleeve (110 mm stretched, 14.6 mm at free contraction).
 fn knitted_sleeve(kind: ShapeKind, strand_thickness: f64) -> KnittedSleeve {
