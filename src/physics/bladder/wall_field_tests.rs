@@ -5,15 +5,16 @@
 //! stresses that `evaluate` reports.
 
 use super::*;
+use crate::physics::gaylord::Sleeve;
 use crate::physics::mckibben::MuscleGeometry;
 
-fn bladder(wall: Wall, tube: Option<BladderTube>) -> (MuscleGeometry, Bladder) {
+fn bladder(wall: Wall, tube: Option<BladderTube>) -> (MuscleGeometry, Bladder<Sleeve>) {
     let g = MuscleGeometry::muscle_a();
     let b = Bladder::with_wall(g.sleeve().unwrap(), tube.unwrap_or(g.tube()), wall).unwrap();
     (g, b)
 }
 
-fn field(b: &Bladder, pressure: f64, length: f64, points: usize) -> Vec<WallPoint> {
+fn field(b: &Bladder<Sleeve>, pressure: f64, length: f64, points: usize) -> Vec<WallPoint> {
     let mut out = vec![WallPoint::default(); points];
     b.wall_field(pressure, length, &mut out).unwrap();
     out
