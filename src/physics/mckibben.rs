@@ -15,7 +15,6 @@ pub mod bare_sleeve;
 mod limits;
 mod partials;
 mod strands;
-mod target;
 pub use limits::{is_slack, OutOfRange, LIMIT_MARGIN};
 pub use partials::McKibbenPartials;
 pub use strands::{

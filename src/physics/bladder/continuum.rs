@@ -17,10 +17,35 @@
 //! unstretched wall, and an `n`-point Gauss-Legendre rule converges like `rho^-2n` where the
 //! layered sum (a left Riemann sum) converges like `1/n`.
 
-use super::hyper_dual::KernelScalar;
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
 use crate::physics::numerics::dual::Dual;
 use std::f64::consts::{LOG2_E, PI};
+use std::ops::{Add, Mul, Sub};
+
+/// The number the layer recursion and the continuum quadrature are written over: [`Dual`] for
+/// every step and first-order partial, [`HyperDual`](crate::physics::numerics::hyper_dual::HyperDual)
+/// only when the partials of `stiffness` (itself `dF/dL`) are asked for (the impls are in
+/// `kernel_scalar.rs`). It needs arithmetic and the few elementary functions the kernel calls.
+pub(super) trait KernelScalar:
+    Copy
+    + Add<Output = Self>
+    + Add<f64, Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Mul<f64, Output = Self>
+{
+    fn constant(v: f64) -> Self;
+    fn value(self) -> f64;
+    fn recip(self) -> Self;
+    fn ln(self) -> Self;
+    fn exp(self) -> Self;
+    fn rsqrt(self) -> Self;
+    fn sqrt(self) -> Self;
+    /// The continuum wall's sums over its quadrature nodes.
+    fn wall_sums(nodes: &[WallNode], call: &WallCall<Self>) -> Option<WallSums<Self>> {
+        node_sums(nodes, call)
+    }
+}
 
 /// Nodes whose positions are computed ahead of their algebra, at a time (stack buffer).
 const NODE_CHUNK: usize = 16;

@@ -231,7 +231,7 @@ fn dual_node_sums_agree_with_the_generic_path() {
     // The kernel on Dual numbers (vectorized node sums) against the same kernel on hyper-dual
     // numbers (the generic node by node sums), value and first derivatives, over both muscles,
     // node counts with and without a middle node and past one block, in contact and below it.
-    use super::hyper_dual::HyperDual;
+    use crate::physics::numerics::hyper_dual::HyperDual;
     for m in [MUSCLE_C, MUSCLE_D] {
         for nodes in [1, 2, 3, 7, 8, 9, 16, 17, 23] {
             let bl = bladder(m, Wall::DissertationContinuum(nodes));

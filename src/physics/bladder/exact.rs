@@ -26,8 +26,8 @@
 //! the wall is three smooth integrals in `u`, evaluated by the same Gauss-Legendre nodes (placed
 //! evenly in the logarithm of the distance to the nearer singular point) as the continuum wall.
 
+use super::continuum::KernelScalar;
 use super::continuum::{WallCall, WallWeight};
-use super::hyper_dual::KernelScalar;
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
 use std::f64::consts::PI;
 

@@ -1,7 +1,7 @@
 //! The bladder's outputs at one operating point: forces, contact pressure, diameters, stretches
 //! and the stresses of the innermost layer, on the contact branch and on the free one.
 
-use super::hyper_dual::KernelScalar;
+use super::continuum::KernelScalar;
 use super::{Bladder, Kernel, SleeveGeometry};
 use crate::physics::numerics::dual::Dual;
 use std::f64::consts::PI;

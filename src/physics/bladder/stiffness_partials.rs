@@ -17,8 +17,8 @@
 //!
 //! At the contact threshold the partials are the contact branch's, as for the first order.
 
-use super::hyper_dual::HyperDual;
 use super::{Bladder, SleeveGeometry};
+use crate::physics::numerics::hyper_dual::HyperDual;
 
 /// `[d/dP, d/dL]` of the bladder's length slopes at one point.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]

@@ -102,30 +102,39 @@ pub struct Transition<T> {
 
 /// The rigid model holds at `L` unless it has no solution there or pulls and is stiffer than the
 /// strands (`k_s`, N/m).
-/// Returns its stiffness and outputs there.
-fn holds<T>(rigid: &impl Fn(f64) -> Option<(f64, f64, T)>, l: f64, k_s: f64) -> Option<(f64, T)> {
-    rigid(l)
-        .filter(|(force, stiffness, _)| !(*force > 0.0 && *stiffness > k_s))
-        .map(|(_, stiffness, out)| (stiffness, out))
+/// Returns its force, stiffness and outputs there.
+fn holds<T>(
+    rigid: &impl Fn(f64) -> Option<(f64, f64, T)>,
+    l: f64,
+    k_s: f64,
+) -> Option<(f64, f64, T)> {
+    rigid(l).filter(|(force, stiffness, _)| !(*force > 0.0 && *stiffness > k_s))
 }
 
 /// The transition for an input `length` in the upper half of the rigid model's `range` where
 /// that model does not hold; `None` where it holds. At or past the reach, the reach itself when
-/// the rigid model holds there (a closed range, as the knitted sleeve's); otherwise bisection
-/// between a length where it holds and one where it does not (at most 30 + 60 evaluations, only
-/// in this regime).
+/// the rigid model holds there (a closed range, as the knitted sleeve's); otherwise the boundary
+/// between a length where it holds and one where it does not, narrowed until the two are
+/// adjacent floats (the same point bisection reaches): ITP where both ends have a value to
+/// interpolate, else bisection (at most 30 + 55-odd evaluations; 15-25 instead of bisection's
+/// 50-odd where the rigid model's stiffness or force crosses over; only in this regime).
 pub fn transition<T>(
     (lo, hi): (f64, f64),
     length: f64,
     k_s: f64,
     rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
 ) -> Option<Transition<T>> {
-    let upper_half = length > 0.5 * (lo + hi);
-    if !upper_half || holds(&rigid, length, k_s).is_some() {
+    if length <= 0.5 * (lo + hi) {
+        return None;
+    }
+    let pulls_stiffer = |(force, stiffness, _): &(f64, f64, T)| *force > 0.0 && *stiffness > k_s;
+    let mut at_stiff = rigid(length);
+    if at_stiff.as_ref().is_some_and(|o| !pulls_stiffer(o)) {
         return None;
     }
     if length >= hi {
-        if let Some((_, out)) = holds(&rigid, hi, k_s) {
+        at_stiff = rigid(hi);
+        if let Some((_, _, out)) = at_stiff.take_if(|o| !pulls_stiffer(o)) {
             return Some(Transition {
                 length: hi,
                 rigid: out,
@@ -142,15 +151,73 @@ pub fn transition<T>(
             break;
         }
     }
-    let (mut l, (mut slope, mut out)) = soft?;
-    for _ in 0..60 {
+    let (mut l, (force, mut slope, mut out)) = soft?;
+    // ITP (interpolate, truncate, project; Oliveira and Takahashi, ACM TOMS 47, 2020) on the
+    // quantity whose sign change ends the rigid model: `g = stiffness - k_s` where the soft end
+    // pulls below `k_s`, else its force (it holds because it pushes); bisection where the stiff
+    // end has no solution. It converges superlinearly on a smooth function and never takes more
+    // than two evaluations beyond bisection's count. It stops only at adjacent floats, not at a
+    // tolerance: the boundary must be as exact as bisection's (the partials through it are
+    // differentiated against central differences).
+    let width = stiff - l;
+    let half_ulp = 0.5 * f64::EPSILON * stiff.abs();
+    let most = (width / half_ulp).log2().ceil() + 2.0;
+    let truncation = 0.2 / width;
+    // (force, stiffness - k_s) at each end; the soft end's force is only needed where it pushes.
+    let mut soft_end = (force, slope - k_s);
+    let mut stiff_end = at_stiff.map(|(force, stiffness, _)| (force, stiffness - k_s));
+    for taken in 0..120 {
         let mid = 0.5 * (l + stiff);
         if mid <= l || mid >= stiff {
             break;
         }
-        match holds(&rigid, mid, k_s) {
-            Some((s, o)) => (l, slope, out) = (mid, s, o),
-            None => stiff = mid,
+        let width = stiff - l;
+        let ends = stiff_end.map(|(force, excess)| {
+            if soft_end.1 < 0.0 {
+                (soft_end.1, excess)
+            } else {
+                (soft_end.0, force)
+            }
+        });
+        let next = match ends {
+            Some((a, b)) if a <= 0.0 && b > 0.0 => {
+                let falsi = l - a * width / (b - a);
+                let toward_mid = (mid - falsi).signum();
+                // At least a few ulps: else, once one end sits on the boundary, the other
+                // closes in by bisection alone.
+                let shift = (truncation * width * width).max(8.0 * half_ulp);
+                let truncated = if shift <= (mid - falsi).abs() {
+                    falsi + toward_mid * shift
+                } else {
+                    mid
+                };
+                let radius = half_ulp * (most - f64::from(taken)).exp2() - 0.5 * width;
+                if (truncated - mid).abs() <= radius {
+                    truncated
+                } else {
+                    mid - toward_mid * radius.max(0.0)
+                }
+            }
+            // No solution at the stiff end: first try just below it (the common case of a
+            // transition at the rigid model's reach), then bisect.
+            _ if taken == 0 => stiff - 8.0 * half_ulp,
+            _ => mid,
+        };
+        let next = if next > l && next < stiff { next } else { mid };
+        match rigid(next) {
+            Some((force, stiffness, o)) if !(force > 0.0 && stiffness > k_s) => {
+                (l, slope, out) = (next, stiffness, o);
+                soft_end = (force, stiffness - k_s);
+            }
+            evaluated => {
+                stiff = next;
+                // Not the probe just below a reach without solution: its values, next to a
+                // singularity, would only slow the interpolation.
+                let probe = taken == 0 && stiff_end.is_none();
+                stiff_end = evaluated
+                    .filter(|_| !probe)
+                    .map(|(force, stiffness, _)| (force, stiffness - k_s));
+            }
         }
     }
     Some(Transition {
@@ -178,6 +245,84 @@ mod tests {
             assert!(t.interior && t.rigid == t.length);
         }
         assert!(transition((lo, hi), exact - 1e-6, k_s, rigid).is_none());
+    }
+
+    /// The last length where `holds` is true by plain bisection to adjacent floats, from the
+    /// soft point `l` and the stiff point `stiff`.
+    fn bisected(mut l: f64, mut stiff: f64, holds: impl Fn(f64) -> bool) -> f64 {
+        loop {
+            let mid = 0.5 * (l + stiff);
+            if mid <= l || mid >= stiff {
+                return l;
+            }
+            if holds(mid) {
+                l = mid;
+            } else {
+                stiff = mid;
+            }
+        }
+    }
+
+    /// The boundary is the very float bisection reaches, in fewer evaluations, for rigid models
+    /// that stiffen past `k_s` smoothly, steeply, or end without a solution before stiffening.
+    #[test]
+    fn boundary_is_bisections_to_the_last_float() {
+        let (lo, hi) = (0.05, 0.1);
+        type Model = fn(f64) -> Option<(f64, f64, f64)>;
+        // Bisection to adjacent floats takes 50-odd evaluations; where the stiff end has no
+        // stiffness ("ends") the search is bisection.
+        let models: [(&str, Model, f64, usize); 6] = [
+            // Pushes (holds) up to the end of its solutions.
+            ("reach", |l| (l < 0.1).then_some((-1.0, 1e9, l)), 1e3, 25),
+            // Stiffer than the strands throughout: ends where its force turns to a pull.
+            ("pulls", |l| Some((1e3 * (l - 0.08), 1e9, l)), 1e3, 25),
+            (
+                "pole",
+                |l| (l < 0.1).then(|| (2.0 / (0.1 - l), 2.0 / (0.1 - l).powi(2), l)),
+                1e5,
+                25,
+            ),
+            (
+                "cubic",
+                |l| Some((1e6 * (l - 0.05).powi(3), 3e6 * (l - 0.05).powi(2), l)),
+                2e3,
+                25,
+            ),
+            (
+                "exp",
+                |l| Some(((l * 200.0).exp(), 200.0 * (l * 200.0).exp(), l)),
+                1e10,
+                25,
+            ),
+            ("ends", |l| (l < 0.083).then_some((10.0, 1.0, l)), 1e3, 60),
+        ];
+        for (name, model, k_s, most) in models {
+            let calls = std::cell::Cell::new(0);
+            let counted = |l: f64| {
+                calls.set(calls.get() + 1);
+                model(l)
+            };
+            let holds_at = |l: f64| holds(&model, l, k_s).is_some();
+            for length in [0.097, hi, hi + 0.01] {
+                calls.set(0);
+                let Some(t) = transition((lo, hi), length, k_s, counted) else {
+                    assert!(holds_at(length), "{name} at {length}");
+                    continue;
+                };
+                let stiff = length.min(hi);
+                let soft = (1..=30)
+                    .map(|k| stiff - (stiff - lo) * 0.5f64.powi(k))
+                    .find(|l| holds_at(*l))
+                    .unwrap();
+                let reference = bisected(soft, stiff, holds_at);
+                assert_eq!(t.length, reference, "{name} at {length}");
+                assert!(
+                    calls.get() <= most,
+                    "{name} at {length}: {} evaluations",
+                    calls.get()
+                );
+            }
+        }
     }
 
     /// A rigid model that holds up to and including its reach, softer than the strands there

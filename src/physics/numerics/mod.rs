@@ -6,4 +6,5 @@
 pub mod bounds;
 pub mod dual;
 pub mod expm;
+pub mod hyper_dual;
 pub mod root;

@@ -1,82 +1,21 @@
-//! Second-order forward mode for the bladder's kernel: the scalar trait the layer recursion and
-//! the continuum quadrature are written over, and a hyper-dual number that carries the value,
-//! the gradient and the Hessian with respect to the muscle length `l` and the bladder's outer
-//! diameter `x`. The kernel runs on [`Dual`] for every step and first-order partial; it runs on
-//! [`HyperDual`] only when the partials of `stiffness` (itself `dF/dL`) are asked for.
+//! Hyper-dual numbers of two variables: value, gradient and Hessian with respect to the muscle
+//! length `l` and the bladder's outer diameter `x`, the second-order companion of
+//! [`Dual`](super::dual::Dual). Hand-written like it: the bladder's stiffness partials run its
+//! whole kernel on these numbers.
 
-use super::continuum::{dual_node_sums, node_sums, WallCall, WallNode, WallSums};
-use crate::physics::numerics::dual::Dual;
 use std::ops::{Add, Mul, Sub};
-
-/// What the kernel needs of a number: arithmetic and the few elementary functions it calls.
-pub(super) trait KernelScalar:
-    Copy
-    + Add<Output = Self>
-    + Add<f64, Output = Self>
-    + Sub<Output = Self>
-    + Mul<Output = Self>
-    + Mul<f64, Output = Self>
-{
-    fn constant(v: f64) -> Self;
-    fn value(self) -> f64;
-    fn recip(self) -> Self;
-    fn ln(self) -> Self;
-    fn exp(self) -> Self;
-    fn rsqrt(self) -> Self;
-    fn sqrt(self) -> Self;
-    /// The continuum wall's sums over its quadrature nodes (`continuum.rs`).
-    fn wall_sums(nodes: &[WallNode], call: &WallCall<Self>) -> Option<WallSums<Self>> {
-        node_sums(nodes, call)
-    }
-}
-
-impl KernelScalar for Dual {
-    #[inline]
-    fn constant(v: f64) -> Self {
-        Dual::constant(v)
-    }
-    #[inline]
-    fn value(self) -> f64 {
-        self.v
-    }
-    #[inline]
-    fn recip(self) -> Self {
-        Dual::recip(self)
-    }
-    #[inline]
-    fn ln(self) -> Self {
-        Dual::ln(self)
-    }
-    #[inline]
-    fn exp(self) -> Self {
-        Dual::exp(self)
-    }
-    #[inline]
-    fn rsqrt(self) -> Self {
-        Dual::rsqrt(self)
-    }
-    #[inline]
-    fn sqrt(self) -> Self {
-        Dual::sqrt(self)
-    }
-    /// Vectorized across the nodes: the hot path.
-    #[inline]
-    fn wall_sums(nodes: &[WallNode], call: &WallCall<Self>) -> Option<WallSums<Self>> {
-        dual_node_sums(nodes, call)
-    }
-}
 
 /// Value, gradient `[d/dl, d/dx]` and Hessian `[d2/dl2, d2/dl dx, d2/dx2]`.
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub(super) struct HyperDual {
-    pub(super) v: f64,
-    pub(super) d: [f64; 2],
-    pub(super) h: [f64; 3],
+pub struct HyperDual {
+    pub v: f64,
+    pub d: [f64; 2],
+    pub h: [f64; 3],
 }
 
 impl HyperDual {
     /// A seed: value, gradient and Hessian as given (a function of the variables `l`, `x`).
-    pub(super) fn seed(v: f64, d: [f64; 2], h: [f64; 3]) -> Self {
+    pub fn seed(v: f64, d: [f64; 2], h: [f64; 3]) -> Self {
         Self { v, d, h }
     }
 
@@ -95,38 +34,34 @@ impl HyperDual {
             ],
         }
     }
-}
 
-impl KernelScalar for HyperDual {
-    fn constant(v: f64) -> Self {
+    /// A number that depends on neither variable.
+    pub fn constant(v: f64) -> Self {
         Self {
             v,
             d: [0.0; 2],
             h: [0.0; 3],
         }
     }
-    fn value(self) -> f64 {
-        self.v
-    }
-    fn recip(self) -> Self {
+    pub fn recip(self) -> Self {
         let r = 1.0 / self.v;
         self.chain(r, -r * r, 2.0 * r * r * r)
     }
-    fn ln(self) -> Self {
+    pub fn ln(self) -> Self {
         let r = 1.0 / self.v;
         self.chain(self.v.ln(), r, -r * r)
     }
-    fn exp(self) -> Self {
+    pub fn exp(self) -> Self {
         let e = self.v.exp();
         self.chain(e, e, e)
     }
-    fn rsqrt(self) -> Self {
+    pub fn rsqrt(self) -> Self {
         // v^(-1/2): first -v^(-3/2)/2, second 3 v^(-5/2)/4.
         let r = 1.0 / self.v.sqrt();
         let r3 = r * r * r;
         self.chain(r, -0.5 * r3, 0.75 * r3 * r * r)
     }
-    fn sqrt(self) -> Self {
+    pub fn sqrt(self) -> Self {
         // v^(1/2): first v^(-1/2)/2, second -v^(-3/2)/4.
         let s = self.v.sqrt();
         let r = 1.0 / s;
@@ -193,12 +128,16 @@ impl Mul<f64> for HyperDual {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::physics::numerics::dual::Dual;
 
     /// `f(l, x) = exp(l x) sqrt(l) / x + ln(l + x) rsqrt(x)` against its hand-derived Hessian's
     /// central differences of the exact gradient.
     #[test]
     fn hessian_of_a_composite_matches_differences_of_its_gradient() {
-        fn f<T: KernelScalar>(l: T, x: T) -> T {
+        fn f(l: HyperDual, x: HyperDual) -> HyperDual {
+            (l * x).exp() * l.sqrt() * x.recip() + (l + x).ln() * x.rsqrt()
+        }
+        fn f_dual(l: Dual, x: Dual) -> Dual {
             (l * x).exp() * l.sqrt() * x.recip() + (l + x).ln() * x.rsqrt()
         }
         let at = |l: f64, x: f64| {
@@ -210,8 +149,8 @@ mod tests {
         let (l, x, h) = (0.7, 1.3, 1e-6);
         let y = at(l, x);
         let first = |l: f64, x: f64| {
-            let dl = f(Dual::var_l(l), Dual::constant(x)).dl;
-            let dx = f(Dual::constant(l), Dual::var_x(x)).dx;
+            let dl = f_dual(Dual::var_l(l), Dual::constant(x)).dl;
+            let dx = f_dual(Dual::constant(l), Dual::var_x(x)).dx;
             [dl, dx]
         };
         assert!((y.d[0] - first(l, x)[0]).abs() < 1e-12 * y.d[0].abs());
