@@ -82,14 +82,13 @@ fn main() {
             &mut fmi3_tables,
         )
         .unwrap_or_else(|e| fail(path, &e));
-        if let Some(xml) = terminals::xml(&text, &model).unwrap_or_else(|e| fail(path, &e)) {
-            let terminals_path = Path::new(&out_dir).join(format!("{stem}.terminalsAndIcons.xml"));
-            std::fs::write(&terminals_path, xml).unwrap_or_else(|e| fail(path, &e.to_string()));
-            terminal_files.push(format!(
-                "    ({stem:?}, include_str!({:?})),",
-                terminals_path.display().to_string()
-            ));
-        }
+        let xml = terminals::xml(&text, &model).unwrap_or_else(|e| fail(path, &e));
+        let terminals_path = Path::new(&out_dir).join(format!("{stem}.terminalsAndIcons.xml"));
+        std::fs::write(&terminals_path, xml).unwrap_or_else(|e| fail(path, &e.to_string()));
+        terminal_files.push(format!(
+            "    ({stem:?}, include_str!({:?})),",
+            terminals_path.display().to_string()
+        ));
         models.push(model);
     }
     codegen::registry(&models, &mut bindings);
@@ -108,7 +107,7 @@ fn main() {
     );
     std::fs::write(out.join("fmi3_tables.rs"), fmi3_tables).expect("write FMI 3.0 tables");
     let terminal_table = format!(
-        "{header}/// (model name, terminalsAndIcons.xml) of every model that declares a flange.\npub static TERMINALS_AND_ICONS: &[(&str, &str)] = &[\n{}\n];\n",
+        "{header}/// (model name, terminalsAndIcons.xml) of every model: its icon, and its flanges' terminals.\npub static TERMINALS_AND_ICONS: &[(&str, &str)] = &[\n{}\n];\n",
         terminal_files.join("\n")
     );
     std::fs::write(out.join("terminals.rs"), terminal_table).expect("write terminals table");

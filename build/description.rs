@@ -237,11 +237,12 @@ pub struct Tool {
     pub elements: Vec<ToolElement>,
 }
 
-/// A child of a `<Tool>`: the source's `<Terminals>` (the FMI 3.0 flanges, which build.rs moves
-/// out of the FMI 2.0 description) or any other element.
+/// A child of a `<Tool>`: the source's `<Terminals>` (the FMI 3.0 flanges) or `<Arrays>` (the FMI
+/// 3.0 array outputs), which build.rs moves out of the FMI 2.0 description, or any other element.
 #[derive(Deserialize, PartialEq)]
 pub enum ToolElement {
     Terminals,
+    Arrays,
     #[serde(other)]
     Other,
 }

@@ -9,9 +9,27 @@
 //! - `time`, the independent variable, is `nReal`;
 //! - the event indicators (local Float64) follow: `nReal + 1 + k`;
 //! - then the Int32 and Enumeration variables (FMI 2.0 Integer `i`): `nReal + 1 + nEvent + i`;
-//! - then the Booleans (FMI 2.0 Boolean `b`): after the integers.
+//! - then the Booleans (FMI 2.0 Boolean `b`): after the integers;
+//! - then the array outputs, FMI 3.0's own (FMI 2.0 has no arrays).
+//!
+//! An array output is declared in the source's VendorAnnotations, which the FMI 2.0 description
+//! ships without (`shipped_xml.rs`):
+//!
+//! ```xml
+//! <Arrays><Array name="wall_radius" size="9" unit="m" dependenciesOf="stress_hoop"/></Arrays>
+//! ```
+//!
+//! It is a continuous `Float64` output with a fixed `<Dimension start="size"/>`: a Dimension that
+//! names a variable must name a UInt64 structural parameter, which an importer may change only in
+//! Configuration Mode (FMI 3.0 section 2.3), so no parameter an FMI 2.0 importer sets can size it.
+//! Its dependencies, as an output and as an initial unknown, are those of the scalar output it
+//! names in `dependenciesOf`.
 
-use super::model_description::{Model, Variable};
+#[path = "fmi3_arrays.rs"]
+mod arrays;
+
+use super::model_description::{Model, ResolvedUnknown, Variable};
+use arrays::{array_outputs, VendorAnnotations};
 use serde::Deserialize;
 use std::fmt::Write as _;
 
@@ -25,6 +43,8 @@ struct Source {
     default_experiment: Option<Experiment>,
     #[serde(rename = "ModelVariables")]
     variables: Variables,
+    #[serde(rename = "VendorAnnotations")]
+    vendor_annotations: Option<VendorAnnotations>,
 }
 
 #[derive(Deserialize, Default)]
@@ -97,10 +117,12 @@ pub struct Layout {
     pub event_indicators: u32,
     pub integers: u32,
     pub booleans: u32,
+    /// The first array output's value reference.
+    pub arrays: u32,
 }
 
 pub fn layout(model: &Model) -> Layout {
-    let [reals, integers, _, _] = model.counts.map(|c| c as u32);
+    let [reals, integers, booleans, _] = model.counts.map(|c| c as u32);
     let time = reals;
     let event_indicators = time + 1;
     let first_integer = event_indicators + model.event_indicators as u32;
@@ -120,6 +142,7 @@ pub fn layout(model: &Model) -> Layout {
         event_indicators,
         integers: first_integer,
         booleans: first_boolean,
+        arrays: first_boolean + booleans,
     }
 }
 
@@ -285,9 +308,27 @@ pub fn xml(text: &str, model: &Model) -> Result<String, String> {
             k + 1
         );
     }
+    let arrays = array_outputs(source.vendor_annotations, model, &layout)?;
+    for a in &arrays {
+        let d = &a.declaration;
+        let mut attributes = format!("name=\"{}\" valueReference=\"{}\"", escape(&d.name), a.vr);
+        if let Some(description) = &d.description {
+            let _ = write!(attributes, " description=\"{}\"", escape(description));
+        }
+        attributes
+            .push_str(" causality=\"output\" variability=\"continuous\" initial=\"calculated\"");
+        if let Some(unit) = &d.unit {
+            let _ = write!(attributes, " unit=\"{}\"", escape(unit));
+        }
+        let _ = writeln!(
+            x,
+            "    <Float64 {attributes}>\n      <Dimension start=\"{}\"/>\n    </Float64>",
+            d.size
+        );
+    }
     x.push_str("  </ModelVariables>\n\n  <ModelStructure>\n");
-    let unknown = |x: &mut String, element: &str, u: &super::model_description::ResolvedUnknown| {
-        let mut attributes = format!("valueReference=\"{}\"", layout.vr[u.index - 1]);
+    let unknown = |x: &mut String, element: &str, u: &ResolvedUnknown, vr: u32, name: &str| {
+        let mut attributes = format!("valueReference=\"{vr}\"");
         if let Some(d) = &u.dependencies {
             let pairs = sorted_dependencies(&layout, d, u.kinds.as_deref());
             let d: Vec<String> = pairs.iter().map(|(vr, _)| vr.to_string()).collect();
@@ -297,20 +338,28 @@ pub fn xml(text: &str, model: &Model) -> Result<String, String> {
                 let _ = write!(attributes, " dependenciesKind=\"{}\"", k.join(" "));
             }
         }
-        let _ = writeln!(
-            x,
-            "    <{element} {attributes}/> <!-- {} -->",
-            model.variables[u.index - 1].name
-        );
+        let _ = writeln!(x, "    <{element} {attributes}/> <!-- {name} -->");
     };
+    let scalar = |u: &ResolvedUnknown| (layout.vr[u.index - 1], &model.variables[u.index - 1].name);
     for u in &model.outputs {
-        unknown(&mut x, "Output", u);
+        let (vr, name) = scalar(u);
+        unknown(&mut x, "Output", u, vr, name);
+    }
+    for a in &arrays {
+        unknown(&mut x, "Output", a.output, a.vr, &a.declaration.name);
     }
     for u in &model.derivatives {
-        unknown(&mut x, "ContinuousStateDerivative", u);
+        let (vr, name) = scalar(u);
+        unknown(&mut x, "ContinuousStateDerivative", u, vr, name);
     }
     for u in &model.initial_unknowns {
-        unknown(&mut x, "InitialUnknown", u);
+        let (vr, name) = scalar(u);
+        unknown(&mut x, "InitialUnknown", u, vr, name);
+    }
+    for a in &arrays {
+        if let Some(u) = a.initial {
+            unknown(&mut x, "InitialUnknown", u, a.vr, &a.declaration.name);
+        }
     }
     for k in 0..model.event_indicators {
         let _ = writeln!(
@@ -388,15 +437,18 @@ pub fn tables(model: &Model, text: &str, xml_path: &str, out: &mut String) -> Re
         .filter(|(v, d)| v.type_index == 1 && d.is_some())
         .map(|(v, _)| v.value_reference)
         .collect();
+    let source: Source =
+        quick_xml::de::from_str(text).map_err(|e| format!("FMI 3.0 description: {e}"))?;
+    let arrays = array_outputs(source.vendor_annotations, model, &layout)?;
     let mut dependencies = String::new();
     let mut seen = std::collections::BTreeSet::new();
-    for u in model
+    let scalars = model
         .outputs
         .iter()
         .chain(&model.derivatives)
         .chain(&model.initial_unknowns)
-    {
-        let vr = layout.vr[u.index - 1];
+        .map(|u| (layout.vr[u.index - 1], u));
+    for (vr, u) in scalars.chain(arrays.iter().map(|a| (a.vr, a.output))) {
         if !seen.insert(vr) {
             continue;
         }
@@ -412,9 +464,18 @@ pub fn tables(model: &Model, text: &str, xml_path: &str, out: &mut String) -> Re
         };
         let _ = writeln!(dependencies, "        ({vr}, {list}),");
     }
+    let array_table: String = arrays
+        .iter()
+        .map(|a| {
+            format!(
+                "        Fmi3Array {{ name: {:?}, value_reference: {}, size: {} }},\n",
+                a.declaration.name, a.vr, a.declaration.size
+            )
+        })
+        .collect();
     let _ = writeln!(
         out,
-        "pub static {}: Fmi3Model = Fmi3Model {{\n    name: {:?},\n    model_description_xml: include_str!({xml_path:?}),\n    time: {},\n    event_indicators: {},\n    integers: {},\n    booleans: {},\n    enumerations: &{enum_vrs:?},\n    dependencies: &[\n{dependencies}    ],\n}};\n",
+        "pub static {}: Fmi3Model = Fmi3Model {{\n    name: {:?},\n    model_description_xml: include_str!({xml_path:?}),\n    time: {},\n    event_indicators: {},\n    integers: {},\n    booleans: {},\n    enumerations: &{enum_vrs:?},\n    arrays: &[\n{array_table}    ],\n    dependencies: &[\n{dependencies}    ],\n}};\n",
         module.to_uppercase(),
         model.name,
         layout.time,

@@ -34,8 +34,8 @@ pub const RULES: &[&str] = &[
 ];
 
 /// Which form of a description the rules judge. A source names its unknowns, dependencies and
-/// states (build.rs resolves them to indices) and may declare `<Terminals>` in its Tool, which
-/// build.rs moves to the FMI 3.0 FMU; what ships must hold every rule as written.
+/// states (build.rs resolves them to indices) and may declare `<Terminals>` and `<Arrays>` in its
+/// Tool, which build.rs moves to the FMI 3.0 FMU; what ships must hold every rule as written.
 #[derive(Clone, Copy, PartialEq)]
 pub enum Form {
     Source,
@@ -187,7 +187,9 @@ fn check_vendor_annotations(md: &Description, form: Form) -> Result<(), String> 
         let counted = tool
             .elements
             .iter()
-            .filter(|e| form == Form::Shipped || **e != ToolElement::Terminals)
+            .filter(|e| {
+                form == Form::Shipped || !matches!(e, ToolElement::Terminals | ToolElement::Arrays)
+            })
             .count();
         if counted > 1 {
             return Err(format!(

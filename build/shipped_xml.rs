@@ -19,9 +19,10 @@ struct Splices {
     variables: Vec<usize>,
     /// The source's ModelStructure element, start and end.
     model_structure: Option<(usize, usize)>,
-    /// The source's `<Tool><Terminals>` element (the FMI 3.0 flanges, `build/terminals.rs`),
-    /// from the start of its line: FMI 2.0's schema allows a Tool one element, its `<Tests>`.
-    terminals: Option<(usize, usize)>,
+    /// The source's FMI 3.0-only `<Tool>` elements, `<Terminals>` (the flanges,
+    /// `build/terminals.rs`) and `<Arrays>` (`build/fmi3_description.rs`), each from the start of
+    /// its line: FMI 2.0's schema allows a Tool one element, its `<Tests>`.
+    fmi3_only: Vec<(usize, usize)>,
 }
 
 fn find_splices(text: &str) -> Result<Splices, String> {
@@ -49,7 +50,7 @@ fn find_splices(text: &str) -> Result<Splices, String> {
                 }
                 if depth == 3 {
                     if let Some(start) = terminals_start.take() {
-                        splices.terminals = Some((start, after));
+                        splices.fmi3_only.push((start, after));
                     }
                 }
                 continue;
@@ -64,10 +65,10 @@ fn find_splices(text: &str) -> Result<Splices, String> {
             }
             (1, b"ModelStructure") if empty => splices.model_structure = Some((before, after)),
             (1, b"ModelStructure") => structure_start = Some(before),
-            (3, b"Terminals") => {
+            (3, b"Terminals" | b"Arrays") => {
                 let line = text[..before].rfind('\n').unwrap_or(before);
                 if empty {
-                    splices.terminals = Some((line, after));
+                    splices.fmi3_only.push((line, after));
                 } else {
                     terminals_start = Some(line);
                 }
@@ -113,7 +114,7 @@ pub(super) fn shipped(
     log.push_str("  </LogCategories>\n\n  ");
     let at = s.log_categories.ok_or("no ModelVariables element found")?;
     inserts.push((at, at, log));
-    if let Some((start, end)) = s.terminals {
+    for &(start, end) in &s.fmi3_only {
         inserts.push((start, end, String::new()));
     }
     for (i, &at) in s.variables.iter().enumerate() {

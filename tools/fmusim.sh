@@ -38,11 +38,16 @@ fi
 summary() {
   python3 - "$@" <<'PY'
 import csv, math, sys
+def cells(x):
+    # A Boolean, a number, or an FMI 3.0 array: its elements separated by spaces.
+    x = x.strip()
+    return [{"true": 1.0, "false": 0.0}[x.lower()]] if x.lower() in ("true", "false") else [float(v) for v in x.split()]
 def load(path):
     with open(path) as f:
         rows = [r for r in csv.reader(f) if r]
-    value = lambda x: {"true": 1.0, "false": 0.0}.get(x.strip().lower()) if x.strip().lower() in ("true", "false") else float(x)
-    return rows[0], [[value(x) for x in r] for r in rows[1:]]
+    sizes = [len(cells(x)) for x in rows[1]] if len(rows) > 1 else [1] * len(rows[0])
+    header = [name if n == 1 else f"{name}[{k + 1}]" for name, n in zip(rows[0], sizes) for k in range(n)]
+    return header, [[v for x in r for v in cells(x)] for r in rows[1:]]
 stop = sys.argv[1]
 header, rows = load(sys.argv[2])
 end = rows[-1][0] if rows else math.nan
@@ -126,11 +131,21 @@ if [ ${#pairs[@]} -gt 0 ]; then
     name=$(basename "$result" .csv)
     python3 - "$result" "$out/fmi2/$name.csv" "${name%.*}" "${name##*.}" <<'PY' || failed=1
 import csv, math, sys
+def cells(x):
+    # A Boolean, a number, or an FMI 3.0 array (its elements separated by spaces: FMI 2.0 has no
+    # arrays, so they are never among the shared columns).
+    x = x.strip()
+    return [{"true": 1.0, "false": 0.0}[x.lower()]] if x.lower() in ("true", "false") else [float(v) for v in x.split()]
 def load(path):
     with open(path) as f:
         rows = [r for r in csv.reader(f) if r]
-    value = lambda x: {"true": 1.0, "false": 0.0}[x.lower()] if x.lower() in ("true", "false") else float(x)
-    return {name: [value(r[i]) for r in rows[1:]] for i, name in enumerate(rows[0])}
+    table = [[cells(x) for x in r] for r in rows[1:]]
+    columns = {}
+    for i, name in enumerate(rows[0]):
+        n = len(table[0][i]) if table else 1
+        for k in range(n):
+            columns[name if n == 1 else f"{name}[{k + 1}]"] = [r[i][k] for r in table]
+    return columns
 three, two = load(sys.argv[1]), load(sys.argv[2])
 shared = [name for name in three if name in two]
 rows = len(three["time"])

@@ -9,8 +9,7 @@ Writes docs/chapter2-claims.md.
 
 import functools
 
-from fmpy.fmi2 import FMU2Slave
-
+from .fmu import CoSimulation
 from .names import model_description
 from .paths import ROOT, fmu_path
 from .slave import extracted
@@ -32,12 +31,10 @@ class Muscle:
 
     def __init__(self, **parameters):
         self.vr = VR = _value_references()
-        self.fmu = FMU2Slave(guid=model_description("McKibbenMuscle").guid,
-                             unzipDirectory=extracted(fmu_path("McKibbenMuscle")), modelIdentifier="McKibbenMuscle",
-                             instanceName="chapter2")
+        self.fmu = CoSimulation(extracted(fmu_path("McKibbenMuscle")), "chapter2",
+                                model_description("McKibbenMuscle"))
         self.fmu.instantiate()
-        self.fmu.setupExperiment(startTime=0.0)
-        self.fmu.enterInitializationMode()
+        self.fmu.enterInitializationMode(startTime=0.0)
         parameters.setdefault("bladder_layers", 16)
         # The dissertation's strands are inextensible: the largest declared rigidity.
         parameters.setdefault("strand_rigidity", 1e12)

@@ -31,7 +31,7 @@ def main(args):
             if items:
                 what = "one of " + ", ".join(f"{n} ({k})" for n, k in items.items())
             else:
-                unit = checks.unit(v) or ("" if v.type != "Real" else "1")
+                unit = checks.unit(v) or ("" if checks.fmi2_type(v) != "Real" else "1")
                 span = "" if lo is None and hi is None else \
                     f" {'' if lo is None else f'{lo:g}'} .. {'' if hi is None else f'{hi:g}'}"
                 what = f"{v.type}{span} {unit}".rstrip()

@@ -16,9 +16,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from fmpy import extract, read_model_description  # noqa: E402
-from fmpy.fmi2 import FMU2Slave  # noqa: E402
 
-from .paths import FMU_DIR, ROOT, fmu_path
+from .fmu import CoSimulation  # noqa: E402
+from .paths import FMU_DIR, ROOT, fmu_path  # noqa: E402
 
 FMU = FMU_DIR / "McKibbenMuscle.fmu"
 OUT = ROOT / "docs" / "linearized"
@@ -36,12 +36,9 @@ class Muscle:
     def __init__(self, preset):
         md = read_model_description(str(FMU))
         self.vr = {v.name: v.valueReference for v in md.modelVariables}
-        self.fmu = FMU2Slave(
-            guid=md.guid, unzipDirectory=extract(str(FMU)), modelIdentifier="McKibbenMuscle", instanceName="linearized"
-        )
+        self.fmu = CoSimulation(extract(str(FMU)), "linearized", md)
         self.fmu.instantiate()
-        self.fmu.setupExperiment(startTime=0.0)
-        self.fmu.enterInitializationMode()
+        self.fmu.enterInitializationMode(startTime=0.0)
         self.fmu.setInteger([self.vr["preset"], self.vr["bladder_model"]], [preset, 5])
         # The dissertation's muscle: signed force, inextensible strands.
         self.fmu.setBoolean([self.vr["signed_force"]], [True])

@@ -13,8 +13,9 @@ import shutil
 
 import numpy as np
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
 
+from .fmu import CoSimulation
+from .names import fmi2_type
 from .paths import FMU_DIR, ROOT, fmu_path
 
 FMU = str(FMU_DIR / "MultiferroicMotor.fmu")
@@ -31,9 +32,8 @@ class Motor:
     def __init__(self):
         self.md = read_model_description(FMU)
         self.dir = extract(FMU)
-        self.vr = {v.name: (v.valueReference, v.type) for v in self.md.modelVariables}
-        self.fmu = FMU2Slave(guid=self.md.guid, unzipDirectory=self.dir,
-                             modelIdentifier=self.md.coSimulation.modelIdentifier, instanceName="motor")
+        self.vr = {v.name: (v.valueReference, fmi2_type(v)) for v in self.md.modelVariables}
+        self.fmu = CoSimulation(self.dir, "motor", self.md)
 
     def close(self):
         shutil.rmtree(self.dir, ignore_errors=True)
@@ -49,9 +49,8 @@ class Motor:
 
     def start(self, **parameters):
         self.fmu.instantiate(loggingOn=False)
-        self.fmu.setupExperiment(startTime=0.0)
         self.set(**parameters)
-        self.fmu.enterInitializationMode()
+        self.fmu.enterInitializationMode(startTime=0.0)
         self.fmu.exitInitializationMode()
 
     def stop(self):

@@ -13,6 +13,14 @@ import math
 from .paths import UsageError, fmu_path
 
 ENUMERATION = "Enumeration"
+# FMI 3.0 type names under the FMI 2.0 ones the package uses (the variables are the same).
+_FMI2_KIND = {"Float64": "Real", "Int32": "Integer"}
+
+
+def fmi2_type(variable):
+    """The variable's type in FMI 2.0 terms (Real, Integer, Enumeration, Boolean, String), for
+    either version's model description."""
+    return _FMI2_KIND.get(variable.type, variable.type)
 
 
 def nearest_first(name, choices):
@@ -87,7 +95,7 @@ def check_name(model, name, allowed, what):
 def check_value(model, variable, value):
     """`value` converted to what FMPy sets (float, int or bool) after checking its type and the
     declared range; an Enumeration also takes an item's name. UsageError says what is allowed."""
-    name, kind = variable.name, variable.type
+    name, kind = variable.name, fmi2_type(variable)
     lo, hi = declared_range(variable)
     u = f" {unit(variable)}" if unit(variable) else ""
     if kind == ENUMERATION:

@@ -1,5 +1,5 @@
 """Robot joint driven by an antagonistic pair of McKibbenMuscle FMUs, co-simulated with FMPy's
-FMU2Slave API. `tools/examples/robot_joint.rs` runs the same algorithm through the `fmi` crate; both
+slave API (FMI 2.0, or FMI 3.0 with `ACTUATOR_FMUS_FMI=3`). `tools/examples/robot_joint.rs` runs the same algorithm through the `fmi` crate; both
 read `examples/robot_joint.json` and must give the same trajectory.
 
 The joint: a pulley of radius r (`moment_arm`) carries a pendulum (inertia I, viscous damping c,
@@ -52,21 +52,21 @@ def pressures(p, t, q, dq):
 
 
 class Muscle:
-    """One McKibbenMuscle instance through FMU2Slave, addressed by value references."""
+    """One McKibbenMuscle instance through FMPy's slave, addressed by value references."""
 
     def __init__(self, name, parameters, length):
         from fmpy import extract, read_model_description
-        from fmpy.fmi2 import FMU2Slave
+
+        from .fmu import CoSimulation
+        from .names import fmi2_type
 
         path = fmu_path("McKibbenMuscle")
         md = read_model_description(path)
-        self.vr = {v.name: (v.valueReference, v.type) for v in md.modelVariables}
+        self.vr = {v.name: (v.valueReference, fmi2_type(v)) for v in md.modelVariables}
         self.unzipped = extract(path)
-        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=self.unzipped,
-                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=name)
+        self.fmu = CoSimulation(self.unzipped, name, md)
         self.fmu.instantiate()
-        self.fmu.setupExperiment(startTime=0.0)
-        self.fmu.enterInitializationMode()
+        self.fmu.enterInitializationMode(startTime=0.0)
         for key, value in dict(parameters, length=length).items():
             vr, kind = self.vr[key]
             if kind == "Real":
@@ -159,7 +159,7 @@ def plot(rows, path):
     for ax in axes:
         ax.grid(alpha=0.3)
         ax.legend(fontsize=8, loc="upper right")
-    fig.suptitle("Antagonistic McKibbenMuscle pair on a pulley: PD pressure control (FMPy FMU2Slave)")
+    fig.suptitle("Antagonistic McKibbenMuscle pair on a pulley: PD pressure control (FMPy)")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
 

@@ -205,7 +205,7 @@ def run_scene(scene, progress=True, fmu=None, fmi_type=None):
             # be without any input signal.
             held = {name: float(parameters.get(name, v.start))
                     for name, v in checks.variables(scene["fmu"]).items()
-                    if v.causality == "input" and name not in inputs and v.type == "Real"}
+                    if v.causality == "input" and name not in inputs and checks.fmi2_type(v) == "Real"}
             signals = np.zeros(t.size, dtype=[("time", float)] + [(name, float) for name in [*inputs, *held]])
             signals["time"] = t
             for name, signal in inputs.items():

@@ -33,7 +33,7 @@ def _with_held_inputs(model, signals, start_values):
     import numpy as np
 
     held = {name: float(start_values.get(name, v.start)) for name, v in checks.variables(model).items()
-            if v.causality == "input" and v.type == "Real" and name not in signals.dtype.names}
+            if v.causality == "input" and checks.fmi2_type(v) == "Real" and name not in signals.dtype.names}
     if not held:
         return signals
     out = np.zeros(signals.size, dtype=signals.dtype.descr + [(name, float) for name in held])

@@ -7,6 +7,7 @@ item's name or its integer. Names and values are checked before they reach the F
 import functools
 
 from . import names as checks
+from .fmu import CoSimulation
 from .paths import fmu_path
 
 
@@ -19,7 +20,7 @@ def extracted(path):
 
 
 class Slave:
-    """An initialized FMU2Slave addressed by variable names: `at(...)` sets inputs and reads outputs
+    """An initialized FMU (FMI 2.0 or 3.0, see `fmu.CoSimulation`) addressed by variable names: `at(...)` sets inputs and reads outputs
     without a step (outputs follow inputs directly), `step(...)` advances history such as friction.
 
         m = Slave("McKibbenMuscle", preset="DMSP_40", length=0.36)
@@ -30,25 +31,18 @@ class Slave:
     check_values = True
 
     def __init__(self, model, log=None, **parameters):
-        """`model`: FMU name; `log`: an object with FMI `callbacks` (FMPy's printing logger if None);
-        `parameters`: start values set in initialization mode, SI units."""
-        from fmpy.fmi2 import FMU2Slave
-
+        """`model`: FMU name; `log`: an object with FMI 2.0 `callbacks` or an FMI 3.0 `log_message`
+        (FMPy's printing logger if None); `parameters`: start values set in initialization mode, SI
+        units."""
         path = fmu_path(model)
         self.model = model
         self.md = checks.model_description(model)
         self.vars = {v.name: v for v in self.md.modelVariables}
         if self.check_values:
             parameters = checks.check_start_values(model, parameters)
-        self.fmu = FMU2Slave(
-            guid=self.md.guid,
-            unzipDirectory=extracted(path),
-            modelIdentifier=self.md.coSimulation.modelIdentifier,
-            instanceName=model,
-        )
-        self.fmu.instantiate(callbacks=log.callbacks if log else None)
-        self.fmu.setupExperiment(startTime=0.0)
-        self.fmu.enterInitializationMode()
+        self.fmu = CoSimulation(extracted(path), model, self.md)
+        self.fmu.instantiate(log)
+        self.fmu.enterInitializationMode(startTime=0.0)
         self.set(**parameters)
         self.fmu.exitInitializationMode()
         self.time = 0.0  # s
@@ -59,9 +53,10 @@ class Slave:
             v = checks.check_name(self.model, name, checks.SETTABLE, "parameter or input")
             if self.check_values or isinstance(value, str):
                 value = checks.check_value(self.model, v, value)
-            if v.type == "Real":
+            kind = checks.fmi2_type(v)
+            if kind == "Real":
                 self.fmu.setReal([v.valueReference], [float(value)])
-            elif v.type in ("Integer", checks.ENUMERATION):
+            elif kind in ("Integer", checks.ENUMERATION):
                 self.fmu.setInteger([v.valueReference], [int(value)])
             else:
                 self.fmu.setBoolean([v.valueReference], [bool(value)])
@@ -73,7 +68,7 @@ class Slave:
         for name in names:
             v = self.vars[name]
             getter = {"Real": self.fmu.getReal, "Integer": self.fmu.getInteger,
-                      checks.ENUMERATION: self.fmu.getInteger, "Boolean": self.fmu.getBoolean}[v.type]
+                      checks.ENUMERATION: self.fmu.getInteger, "Boolean": self.fmu.getBoolean}[checks.fmi2_type(v)]
             out.append(getter([v.valueReference])[0])
         return out[0] if len(out) == 1 else out
 
@@ -91,4 +86,4 @@ class Slave:
     def close(self):
         """Terminates and frees the instance."""
         self.fmu.terminate()
-        self.fmu.fmi2FreeInstance(self.fmu.component)
+        self.fmu.freeInstance()

@@ -50,8 +50,7 @@ def _fmu_dir(fmu_bytes):
 def net_work(fmu, vr, prestrain, thickness, layers, n_lengths):
     """Net work (J) of one muscle; NaN if the FMU refuses the parameters or the stroke is empty."""
     fmu.reset()
-    fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
+    fmu.enterInitializationMode(startTime=0.0)
     reals = dict(MUSCLE_A, bladder_length=LISTED_LENGTH / (1 + prestrain), bladder_thickness=thickness, length=0.08)
     fmu.setReal([vr[k] for k in reals], list(reals.values()))
     # The dissertation's layers as written (bladder_model 5), as in the README's work table.
@@ -96,14 +95,11 @@ def net_work(fmu, vr, prestrain, thickness, layers, n_lengths):
 
 def run_batch(fmu_bytes, cases, layers, n_lengths):
     """One task: a batch of (prestrain, thickness) cases on one FMU instance, reset between runs."""
-    from fmpy import read_model_description
-    from fmpy.fmi2 import FMU2Slave
+    from actuator_fmus.fmu import CoSimulation
 
     d = _fmu_dir(fmu_bytes)
-    md = read_model_description(d)
-    vr = {v.name: v.valueReference for v in md.modelVariables}
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=d, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName="sweep")
+    fmu = CoSimulation(d, "sweep")
+    vr = {v.name: v.valueReference for v in fmu.md.modelVariables}
     fmu.instantiate()
     out = []
     try:

@@ -58,10 +58,21 @@ pub struct Fmi3Model {
     pub booleans: u32,
     /// The FMI 2.0 Integer value references that are Enumerations (read as Int64).
     pub enumerations: &'static [u32],
+    /// The array outputs (FMI 3.0's own), after the Booleans.
+    pub arrays: &'static [Fmi3Array],
     /// Every ModelStructure unknown: its value reference and its dependencies (value reference,
     /// `fmi3DependencyKind`), `None` where none are declared.
     #[allow(clippy::type_complexity)]
     pub dependencies: &'static [(u32, Option<&'static [(u32, u8)]>)],
+}
+
+/// An array output: a `Float64` with a fixed `<Dimension>`, computed by [`crate::models::Model::array`]
+/// only when read.
+pub struct Fmi3Array {
+    pub name: &'static str,
+    pub value_reference: u32,
+    /// Its elements.
+    pub size: usize,
 }
 
 include!(concat!(env!("OUT_DIR"), "/fmi3_tables.rs"));

@@ -48,6 +48,33 @@ fn value_references_are_unique_and_the_float64_ones_are_the_fmi2_reals() {
         let [reals, integers, booleans, _] = info.counts;
         let indicators = (model.integers - model.event_indicators) as usize;
         assert_eq!(model.time as usize, reals);
-        assert_eq!(seen.len(), reals + 1 + indicators + integers + booleans);
+        assert_eq!(
+            seen.len(),
+            reals + 1 + indicators + integers + booleans + model.arrays.len()
+        );
+        // The array outputs follow the Booleans, one value reference each.
+        for (k, array) in model.arrays.iter().enumerate() {
+            assert_eq!(
+                array.value_reference,
+                model.booleans + (booleans + k) as u32
+            );
+            assert!(array.size >= 1);
+        }
+    }
+}
+
+#[test]
+fn every_declared_array_is_served_by_its_model() {
+    use crate::export::runtime::Runtime;
+    for (model, factory) in FMI3_MODELS.iter().zip(REGISTRY) {
+        let mut runtime: Box<dyn Runtime> = factory.create();
+        runtime.build().unwrap();
+        for array in model.arrays {
+            let mut out = vec![f64::NAN; array.size];
+            runtime.array(array.name, &mut out).unwrap();
+            assert!(out.iter().all(|x| x.is_finite()), "{}", array.name);
+        }
+        let mut out = [0.0];
+        assert!(runtime.array("no_such_array", &mut out).is_err());
     }
 }

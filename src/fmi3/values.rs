@@ -1,7 +1,9 @@
 //! `fmi3Get/Set<Type>` by FMI 3.0 value reference: Float64 (the FMI 2.0 Reals, `time`, the event
-//! indicators), Int32, Int64 (the Enumerations, FMI 3.0 section 2.4.7.3) and Boolean. Each value
-//! reference is translated to FMI 2.0's by the model's [`Fmi3Model`] layout; the shared
-//! `Instance` then applies the same state, range and NaN rules as FMI 2.0.
+//! indicators, the array outputs), Int32, Int64 (the Enumerations, FMI 3.0 section 2.4.7.3) and
+//! Boolean. Each value reference is translated to FMI 2.0's by the model's [`Fmi3Model`] layout;
+//! the shared `Instance` then applies the same state, range and NaN rules as FMI 2.0. An array
+//! takes as many of `values` as it has elements (FMI 3.0 section 2.2.6.2: `nValues` counts the
+//! elements of every variable, arrays serialized in row-major order).
 
 use super::exports::{guarded, Status};
 use super::{fmi3Boolean, fmi3Instance, fmi3Status, fmi3ValueReference, Fmi3Model};
@@ -18,6 +20,8 @@ enum Slot {
     Integer(u32),
     Enumeration(u32),
     Boolean(u32),
+    /// The index of an array output in [`Fmi3Model::arrays`].
+    Array(usize),
     Unknown,
 }
 
@@ -38,6 +42,8 @@ fn classify(model: &Fmi3Model, counts: [usize; 4], vr: u32) -> Slot {
         }
     } else if vr >= model.booleans && vr < model.booleans + booleans {
         Slot::Boolean(vr - model.booleans)
+    } else if let Some(k) = model.arrays.iter().position(|a| a.value_reference == vr) {
+        Slot::Array(k)
     } else {
         Slot::Unknown
     }
@@ -131,26 +137,51 @@ pub unsafe extern "C" fn fmi3GetFloat64(
     const F: &str = "fmi3GetFloat64";
     unsafe {
         guarded(instance, F, |inst| {
-            let (vrs, out) = match arrays_mut(inst, F, vr, nvr, values, n_values) {
-                Ok(a) => a,
-                Err(status) => return status,
-            };
             let reals = inst.info().counts[0] as u32;
+            // SAFETY: the importer passes `nvr` value references (or NULL, refused below).
+            let Some(vrs) = slice(vr, nvr) else {
+                return null_argument(inst, F, "valueReferences and values");
+            };
             // The FMI 2.0 Reals in one call: the common case.
             if vrs.iter().all(|&v| v < reals) {
+                let (vrs, out) = match arrays_mut(inst, F, vr, nvr, values, n_values) {
+                    Ok(a) => a,
+                    Err(status) => return status,
+                };
                 return inst.get_reals(F, vrs, out);
             }
             let Ok(model) = model_of(inst, F) else {
                 return Status::Error;
             };
             let counts = inst.info().counts;
+            let slots: Vec<Slot> = vrs.iter().map(|&v| classify(model, counts, v)).collect();
+            let elements = |s: &Slot| match s {
+                Slot::Array(k) => model.arrays[*k].size,
+                _ => 1,
+            };
+            let total: usize = slots.iter().map(elements).sum();
+            if total != n_values {
+                return inst.error(&format!(
+                    "{F}: nValues ({n_values}) must be {total}, the number of elements of the \
+                     {nvr} variables asked for (arrays count their elements: {})",
+                    array_sizes(model, &slots)
+                ));
+            }
+            // SAFETY: the importer passes `nValues` values (or NULL, refused here).
+            let Some(out) = slice_mut(values, n_values) else {
+                return null_argument(inst, F, "valueReferences and values");
+            };
             let mut status = Status::OK;
-            for (&v, slot) in vrs.iter().zip(out.iter_mut()) {
-                let s = match classify(model, counts, v) {
-                    Slot::Real(r) => inst.get_reals(F, &[r], std::slice::from_mut(slot)),
+            let mut at = 0;
+            for (&v, slot) in vrs.iter().zip(&slots) {
+                let n = elements(slot);
+                let target = &mut out[at..at + n];
+                at += n;
+                let s = match *slot {
+                    Slot::Real(r) => inst.get_reals(F, &[r], target),
                     Slot::Time => {
                         if inst.allowed(F, allowed::GET) {
-                            *slot = inst.time;
+                            target[0] = inst.time;
                             Status::OK
                         } else {
                             Status::Error
@@ -160,10 +191,11 @@ pub unsafe extern "C" fn fmi3GetFloat64(
                         let mut z = vec![0.0; inst.runtime.event_indicator_count()];
                         let s = inst.get_vector(F, Vector::EventIndicators, &mut z);
                         if s < Status::Error {
-                            *slot = z.get(k).copied().unwrap_or(0.0);
+                            target[0] = z.get(k).copied().unwrap_or(0.0);
                         }
                         s
                     }
+                    Slot::Array(k) => inst.get_array(F, model.arrays[k].name, target),
                     _ => inst.error(&format!(
                         "{F}: value reference {v} is not a Float64 variable of {}",
                         model.name
@@ -176,6 +208,25 @@ pub unsafe extern "C" fn fmi3GetFloat64(
             }
             status
         })
+    }
+}
+
+/// "name (size)" of the arrays among `slots`, or "none".
+fn array_sizes(model: &Fmi3Model, slots: &[Slot]) -> String {
+    let listed: Vec<String> = slots
+        .iter()
+        .filter_map(|s| match s {
+            Slot::Array(k) => Some(format!(
+                "{} has {}",
+                model.arrays[*k].name, model.arrays[*k].size
+            )),
+            _ => None,
+        })
+        .collect();
+    if listed.is_empty() {
+        "none here".into()
+    } else {
+        listed.join(", ")
     }
 }
 

@@ -7,7 +7,7 @@
 //! Exchange. Inputs outside the solvable range are evaluated at the nearest valid point and
 //! flagged (`input_clamped`, `out_of_range_policy`), each excursion logged once.
 
-use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::free_bladder::{FreeBladder as Tube, FreeBladderState};
 use crate::variables::free_bladder::{Inputs, Known, Outputs, Parameters, Unknown, Variables};
@@ -154,6 +154,14 @@ impl Model for FreeBladder {
             tube,
             out_of_range: false,
         })
+    }
+
+    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+        // At the point the outputs are computed at (the inputs clamped into the solvable range).
+        let OperatingPoint {
+            pressure, length, ..
+        } = self.operating_point(inputs);
+        wall_arrays::write(name, out, |f| self.tube.wall_field(pressure, length, f))
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {

@@ -8,7 +8,7 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{Bladder, BladderTube};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
@@ -286,6 +286,18 @@ impl Model for KnittedMuscle {
     /// The partials read the friction history besides the inputs.
     fn partials_key(&self) -> Option<HistoryKey> {
         Some(HistoryKey::of([self.history.z, self.history.position]))
+    }
+
+    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+        let Some(bladder) = self.assembly.bladder() else {
+            return wall_arrays::absent(name, out);
+        };
+        // At the length the muscle is evaluated at (the nearer valid one beyond them).
+        let (lo, hi) = self.assembly.valid_lengths();
+        let length = inputs.length.max(lo).min(hi);
+        wall_arrays::write(name, out, |f| {
+            bladder.wall_field(inputs.pressure, length, f)
+        })
     }
 }
 

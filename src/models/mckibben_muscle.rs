@@ -5,7 +5,7 @@
 //! friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
-use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::festo;
@@ -498,6 +498,21 @@ impl Model for McKibbenMuscle {
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
         self.outputs(inputs, outputs, report, false)
+    }
+
+    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+        let Pipeline::Full(muscle) = &self.pipeline else {
+            return wall_arrays::absent(name, out);
+        };
+        let Some(bladder) = muscle.bladder() else {
+            return wall_arrays::absent(name, out);
+        };
+        // The bladder's own length: the input less the connector's stretch, as evaluated.
+        let (p, k_s) = (inputs.pressure, self.strand_stiffness);
+        let (state, _) = muscle.evaluate_with_strands(p, inputs.length, k_s, &self.friction);
+        let state = state.ok_or("no solution at these inputs")?;
+        let length = state.actual_length;
+        wall_arrays::write(name, out, |f| bladder.wall_field(p, length, f))
     }
 
     #[inline]

@@ -18,6 +18,7 @@ pub mod mckibben_muscle;
 pub mod multiferroic_motor;
 pub mod pass_through;
 pub mod pulley_joint;
+mod wall_arrays;
 
 /// Outcome of a model call, in FMI's order of severity.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, PartialOrd, Ord)]
@@ -424,6 +425,14 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// The next time event after the event at `time` (`nextEventTime`), if any.
     fn next_time_event(&self, _time: f64) -> Option<f64> {
         None
+    }
+
+    /// The FMI 3.0 array output `name` (an `<Array>` of the model description's
+    /// VendorAnnotations) at `inputs` and the current history, into `out` (its declared size).
+    /// Computed only when an importer reads it, so an array nobody reads costs nothing. `Err`
+    /// says why there is no value; by default the model has no arrays.
+    fn array(&self, _inputs: &Inputs<Self>, name: &str, _out: &mut [f64]) -> Result<(), String> {
+        Err(format!("no array output named '{name}'"))
     }
 
     /// Exact partial derivatives of the outputs (and, with states, of the derivative variables

@@ -305,6 +305,8 @@ impl FreeBladder {
 
 #[path = "free_bladder_partials.rs"]
 mod partials;
+#[path = "free_bladder_wall.rs"]
+mod wall;
 pub use partials::FreeBladderPartials;
 
 #[cfg(test)]

@@ -98,6 +98,10 @@ impl KnittedAssembly {
         self.bag.as_ref()
     }
 
+    pub fn bladder(&self) -> Option<&Bladder<KnittedCylinder>> {
+        self.bladder.as_ref()
+    }
+
     /// The lengths evaluated (m): inputs beyond them are evaluated at the nearer one.
     pub fn valid_lengths(&self) -> (f64, f64) {
         self.valid

@@ -507,7 +507,8 @@ mod rules {
     }
 
     /// FMI 2.0's schema gives a `<Tool>` one child element at most; the source's `<Terminals>`
-    /// (the FMI 3.0 flanges) beside its `<Tests>` does not ship.
+    /// (the FMI 3.0 flanges) and `<Arrays>` (the FMI 3.0 array outputs) beside its `<Tests>` do
+    /// not ship.
     #[test]
     fn a_tool_holds_one_element() {
         let tests = "<Tests>";
@@ -522,15 +523,17 @@ mod rules {
             "Tool 'actuator-fmus' holds 2 elements",
         );
         assert!(SOURCE.contains("<Terminals>") && !shipped().contains("<Terminals>"));
+        assert!(SOURCE.contains("<Arrays>") && !shipped().contains("<Arrays>"));
         super::refused(
             &SOURCE.replacen(tests, "<Extra/><Tests>", 1),
             "holds 2 elements",
         );
         let source = super::model_description::description::parse(SOURCE).unwrap();
         rules::check_description(&source, rules::Form::Source).unwrap();
+        // Terminals, Arrays and Tests.
         assert!(rules::check_description(&source, rules::Form::Shipped)
             .unwrap_err()
-            .contains("holds 2 elements"));
+            .contains("holds 3 elements"));
     }
 
     #[test]

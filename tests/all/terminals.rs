@@ -15,7 +15,7 @@ const SOURCE: &str = include_str!("../../modelDescription/McKibbenMuscle.xml");
 const FLANGE: &str =
     r#"<Flange name="flange" kind="translational" position="length" force="force" flow="inflow""#;
 
-fn generated(text: &str) -> Result<Option<String>, String> {
+fn generated(text: &str) -> Result<String, String> {
     let model = model_description::check(text, "McKibbenMuscle")?;
     flanges::xml(text, &model)
 }
@@ -38,19 +38,29 @@ fn every_source_passes_and_only_passthrough_has_no_flange() {
         let text = std::fs::read_to_string(&path).unwrap();
         let model = model_description::check(&text, &stem).unwrap();
         let xml = flanges::xml(&text, &model).unwrap();
-        assert_eq!(xml.is_none(), stem == "PassThrough", "{stem}");
+        // Every model has its icon; only PassThrough has no terminal.
+        assert!(xml.contains(r#"<Icon x1="-100" y1="-100" x2="100" y2="100"/>"#));
+        assert_eq!(
+            !xml.contains("<Terminals>"),
+            stem == "PassThrough",
+            "{stem}"
+        );
     }
 }
 
 #[test]
 fn the_muscle_flange_is_length_and_tension() {
-    let xml = generated(SOURCE).unwrap().unwrap();
+    let xml = generated(SOURCE).unwrap();
     assert!(xml.contains(r#"<Terminal name="flange" matchingRule="plug" terminalKind="org.modelica.Mechanics.Translational.Interfaces.Flange""#));
     assert!(xml.contains(
         r#"<TerminalMemberVariable variableName="length" memberName="s" variableKind="signal"/>"#
     ));
     assert!(xml.contains(
         r#"<TerminalMemberVariable variableName="force" memberName="f" variableKind="inflow"/>"#
+    ));
+    // Its icon on the right border of the FMU icon.
+    assert!(xml.contains(
+        r#"<TerminalGraphicalRepresentation iconBaseName="translational_flange" x1="90" y1="-10" x2="110" y2="10"/>"#
     ));
 }
 

@@ -1,8 +1,9 @@
-"""The mechanical flanges of the FMI 3.0 FMUs (terminalsAndIcons/terminalsAndIcons.xml): valid
-against the FMI 3.0 schema FMPy ships, every member an existing variable of the FMU with the
-causality, variability and SI unit of a Modelica flange, terminals only where the source declares a
-flange, the muscle and pulley flanges pairing as the robot-joint system connects them, and the
-force signs the Modelica convention they claim."""
+"""The mechanical flanges and icons of the FMI 3.0 FMUs (terminalsAndIcons/): valid against the FMI
+3.0 schema FMPy ships, every member an existing variable of the FMU with the causality, variability
+and SI unit of a Modelica flange, terminals only where the source declares a flange, the muscle and
+pulley flanges pairing as the robot-joint system connects them, the force signs the Modelica
+convention they claim, and every icon the file names present as PNG (and SVG) of the stated
+extent."""
 
 import pathlib
 import xml.etree.ElementTree as ET
@@ -36,7 +37,7 @@ def fmu(model):
 
 def terminals_xml(model):
     with zipfile.ZipFile(fmu(model)) as z:
-        return z.read(TERMINALS) if TERMINALS in z.namelist() else None
+        return z.read(TERMINALS)
 
 
 def declares_flanges(model):
@@ -62,11 +63,12 @@ def test_terminals_exactly_where_the_source_declares_flanges():
     assert MODELS, "run `make fmus` first"
     assert WITH_FLANGES and len(WITH_FLANGES) < len(MODELS)
     for model in MODELS:
-        assert (terminals_xml(model) is not None) == (model in WITH_FLANGES), model
+        has_terminals = ET.fromstring(terminals_xml(model)).find("Terminals") is not None
+        assert has_terminals == (model in WITH_FLANGES), model
     assert "PassThrough" not in WITH_FLANGES
 
 
-@pytest.mark.parametrize("model", WITH_FLANGES)
+@pytest.mark.parametrize("model", MODELS)
 def test_the_terminals_are_valid_fmi3(model):
     document = etree.fromstring(terminals_xml(model))
     SCHEMA.assertValid(document)
@@ -165,3 +167,35 @@ def test_the_joint_torque_is_the_torque_on_the_outside():
                         for m in ("flexor", "extensor"))
     assert a["jointTorque"] > 0
     assert a["jointTorque"] == pytest.approx(virtual_work, rel=1e-9)
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_every_icon_is_there_as_png_and_svg(model):
+    """The FMU icon (icon.png and icon.svg, FMI 3.0 section 2.4.9.1) over the default coordinate
+    system, and each terminal's icon (iconBaseName.png and .svg) inside the FMU's archive, square
+    images as their extents are."""
+    from PIL import Image
+    import io
+
+    root = ET.fromstring(terminals_xml(model))
+    graphics = root.find("GraphicalRepresentation")
+    system = graphics.find("CoordinateSystem").attrib
+    assert {k: float(v) for k, v in system.items()} == \
+        {"x1": -100, "y1": -100, "x2": 100, "y2": 100, "suggestedScalingFactorTo_mm": 0.1}
+    assert {k: float(v) for k, v in graphics.find("Icon").attrib.items()} == \
+        {"x1": -100, "y1": -100, "x2": 100, "y2": 100}
+    names = ["icon"] + [t.get("iconBaseName") for t in root.iter("TerminalGraphicalRepresentation")]
+    with zipfile.ZipFile(fmu(model)) as z:
+        for name in names:
+            image = Image.open(io.BytesIO(z.read(f"terminalsAndIcons/{name}.png")))
+            assert image.width == image.height >= 64, name
+            # Not blank: more than one colour.
+            assert len(image.getcolors(1 << 16)) > 1, name
+            svg = etree.fromstring(z.read(f"terminalsAndIcons/{name}.svg"))
+            assert svg.get("viewBox") == "-100 -100 200 200", name
+    # Each terminal sits on the icon's border and the terminals do not overlap.
+    boxes = [tuple(float(t.get(k)) for k in ("x1", "y1", "x2", "y2"))
+             for t in root.iter("TerminalGraphicalRepresentation")]
+    assert len(set(boxes)) == len(boxes)
+    for x1, y1, x2, y2 in boxes:
+        assert 100 in (abs((x1 + x2) / 2), abs((y1 + y2) / 2))

@@ -5,6 +5,7 @@
 pub mod calibration;
 pub mod choices;
 pub mod festo_law;
+pub mod icons;
 pub mod package;
 pub mod scene;
 

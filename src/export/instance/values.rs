@@ -321,6 +321,42 @@ impl Instance {
 
     /// `fmi2GetReal`, `fmi3GetFloat64`: as [`Instance::get`], with the value references checked
     /// first and one call into the runtime for all values.
+    /// An FMI 3.0 array output (`Runtime::array`): the model's values once it is built (zeros
+    /// before, as the outputs' start values), every element finite. Where the model has no
+    /// value the elements are 0 and a warning says why.
+    pub fn get_array(&mut self, function: &str, name: &str, out: &mut [f64]) -> Status {
+        if !self.allowed(function, allowed::GET) {
+            return Status::Error;
+        }
+        out.fill(0.0);
+        let refreshing = matches!(
+            self.state(),
+            MachineState::InitializationMode
+                | MachineState::StepComplete
+                | MachineState::EventMode
+                | MachineState::ContinuousTimeMode
+        );
+        let status = if refreshing {
+            self.refresh_outputs(function)
+        } else {
+            Status::OK
+        };
+        if status >= Status::Error || !self.runtime.is_built() {
+            return status;
+        }
+        let why = match self.runtime.array(name, out) {
+            Ok(()) if out.iter().all(|x| x.is_finite()) => return status,
+            Ok(()) => "a value is not finite".to_string(),
+            Err(why) => why,
+        };
+        out.fill(0.0);
+        self.logger.log(
+            Status::Warning,
+            &format!("{function}: {name} is 0 here: {why}"),
+        );
+        status.max(Status::Warning)
+    }
+
     pub fn get_reals(&mut self, function: &str, vrs: &[u32], out: &mut [f64]) -> Status {
         if !self.allowed(function, allowed::GET) {
             return Status::Error;

@@ -171,6 +171,8 @@ pub trait Runtime: Send {
     /// its parameters, with only its checked history taken from the bytes ([`rebuilt`]).
     fn rebuild_model(&mut self) -> Result<(), String>;
     fn as_any(&self) -> &dyn Any;
+    /// The built model's FMI 3.0 array output `name` at the current inputs ([`Model::array`]).
+    fn array(&self, name: &str, out: &mut [f64]) -> Result<(), String>;
 }
 
 #[derive(Serialize, Deserialize)]
@@ -533,6 +535,12 @@ where
     }
     fn as_any(&self) -> &dyn Any {
         self
+    }
+    fn array(&self, name: &str, out: &mut [f64]) -> Result<(), String> {
+        match &self.model {
+            Some(model) => model.array(&self.values.inputs, name, out),
+            None => Err("no model yet: call it in initialization mode or later".into()),
+        }
     }
 }
 

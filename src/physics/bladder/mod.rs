@@ -42,6 +42,9 @@ mod state;
 mod stiffness_partials;
 #[cfg(test)]
 mod tests;
+mod wall_field;
+#[cfg(test)]
+mod wall_field_tests;
 
 use crate::physics::numerics::dual::Dual;
 use continuum::KernelScalar;
@@ -51,6 +54,7 @@ use state::check_state;
 pub use state::BladderState;
 use std::f64::consts::PI;
 pub use stiffness_partials::BladderCurvature;
+pub use wall_field::WallPoint;
 
 /// Mooney-Rivlin `C1` of natural latex used throughout chapter 2 (Fig. 2.9), Pa.
 pub const MOONEY_C1: f64 = 161e3;

@@ -1,9 +1,11 @@
 //! `package_fmi3 <FMI 2.0 FMU dir> <output dir>`: writes `<output dir>/<Model>.fmu`, the FMI 3.0
 //! FMU of every model, from the FMI 2.0 FMU that `package_fmus` wrote: the same binaries (one
 //! library exports both APIs) under FMI 3.0's platform tuples, its documentation page naming FMI 3.0, the
-//! FMI 3.0 model description generated from the same source, and the model's mechanical flanges
-//! as `terminalsAndIcons/terminalsAndIcons.xml` when it declares any.
+//! FMI 3.0 model description generated from the same source, and `terminalsAndIcons/`: the
+//! model's icon and mechanical flanges (`terminalsAndIcons.xml`), with the icon and each flange's
+//! icon as SVG and PNG (`actuator_fmus_tools::icons`).
 
+use actuator_fmus_tools::icons;
 use std::io::{Read, Write};
 use std::path::Path;
 
@@ -15,6 +17,7 @@ const PLATFORMS: [(&str, &str); 3] = [
 ];
 
 fn repackage(
+    model: &str,
     fmi2: &Path,
     out: &Path,
     description: &str,
@@ -39,10 +42,25 @@ fn repackage(
     zip.write_all(documentation.as_bytes())
         .map_err(|e| e.to_string())?;
     if let Some(terminals) = terminals {
-        zip.start_file("terminalsAndIcons/terminalsAndIcons.xml", options)
-            .map_err(|e| e.to_string())?;
-        zip.write_all(terminals.as_bytes())
-            .map_err(|e| e.to_string())?;
+        let mut files = vec![(
+            "terminalsAndIcons.xml".to_string(),
+            terminals.as_bytes().to_vec(),
+        )];
+        let (svg, png) = icons::fmu_icon(model)?;
+        files.push(("icon.svg".into(), svg.into_bytes()));
+        files.push(("icon.png".into(), png));
+        for name in ["translational_flange", "rotational_flange"] {
+            if terminals.contains(&format!("iconBaseName=\"{name}\"")) {
+                let (svg, png) = icons::flange_icon(name)?;
+                files.push((format!("{name}.svg"), svg.into_bytes()));
+                files.push((format!("{name}.png"), png));
+            }
+        }
+        for (name, data) in files {
+            zip.start_file(format!("terminalsAndIcons/{name}"), options)
+                .map_err(|e| e.to_string())?;
+            zip.write_all(&data).map_err(|e| e.to_string())?;
+        }
     }
     for i in 0..archive.len() {
         let mut entry = archive.by_index(i).map_err(|e| e.to_string())?;
@@ -86,7 +104,14 @@ fn main() {
             std::process::exit(1);
         };
         let page = actuator_fmus_tools::package::documentation_page(*factory, "3.0");
-        match repackage(&fmi2, &out, model.model_description_xml, &page, terminals) {
+        match repackage(
+            model.name,
+            &fmi2,
+            &out,
+            model.model_description_xml,
+            &page,
+            terminals,
+        ) {
             Ok(()) => println!("wrote {}", out.display()),
             Err(e) => {
                 eprintln!("package_fmi3: {e}");
