@@ -76,11 +76,13 @@ def harnesses(tmp_path_factory, wineserver):
 
 def script_for(model):
     """Exit initialization, then the description's test input points (Float64 inputs) in turn, three
-    rounds, a step and every Float64 output after each."""
+    rounds, a step and every scalar Float64 output after each."""
     md = read_model_description(str(FMI3_DIR / f"{model}.fmu"))
     vr = {v.name: v.valueReference for v in md.modelVariables if v.type == "Float64"}
     inputs = {v.name for v in md.modelVariables if v.causality == "input" and v.type == "Float64"}
-    outputs = [vr[v.name] for v in md.modelVariables if v.causality == "output" and v.type == "Float64"]
+    # Scalars only: the FMI 2.0 master reads the same script, and FMI 2.0 has no arrays.
+    outputs = [vr[v.name] for v in md.modelVariables
+               if v.causality == "output" and v.type == "Float64" and not v.dimensions]
     source = (ROOT / "modelDescription" / f"{model}.xml").read_text()
     points = [dict(pair.split("=") for pair in values.split())
               for values in re.findall(r'<Inputs values="([^"]*)"', source)]
