@@ -188,14 +188,15 @@ impl McKibben {
                 self.partials_at_transition(&t, pressure, length, k_s, history)?,
             ));
         }
-        let (out, _) = self.evaluate_with_strands(pressure, length, k_s, history);
-        let force = out
-            .ok_or("the muscle cannot be evaluated at this length")?
-            .force;
-        Ok((
-            force,
-            self.partials_with_strands(pressure, length, k_s, history)?,
-        ))
+        // Off the strands, without searching for their transition again: the rigid model at the
+        // inputs, or out of range at the clamped point (`evaluate_with_strands`'s fallback).
+        let at = |p: f64, l: f64| self.partials(p, l, history);
+        let ((out, mut d), by_l, by_p) = self.on_branch(pressure, length, at)?;
+        for y in d.rows_mut() {
+            y[0] *= f64::from(u8::from(by_p));
+            y[1] *= f64::from(u8::from(by_l));
+        }
+        Ok((out.force, d))
     }
 
     /// `[d/dpressure, d/dlength]` of the signed stiffness on the branch
