@@ -137,7 +137,7 @@ def test_rotor_speed_nominal_is_declared_and_returned():
 
 def test_a_unit_speed_nominal_fails_at_the_start(monkeypatch):
     """Why the nominal: with rotor_speed's absolute tolerance at 1e-4 rad/s (nominal 1), resolving
-    the rotor's start (2e13 rad/s^2 to ~5e4 rad/s within ~2 ns) needs steps below OMSimulator's
+    the rotor's start (2.3e13 rad/s^2, 3e4 rad/s within 2 ns) needs steps below OMSimulator's
     minimum, and CVode stops at t = 0."""
 
     class UnitNominals(OMSimulatorCVode):
