@@ -301,6 +301,14 @@ mod tests {
         }
         assert!(m.me_set_states(&[0.0, 0.0, 0.0, f64::NAN]).is_err());
         assert_eq!(m.me_states()[3], -1e9);
+        // A saved Model Exchange state with such a tilt restores; Co-Simulation's bound holds
+        // for an instance that never ran Model Exchange.
+        let mut restored = MultiferroicMotor::new(&p, &inputs).unwrap();
+        assert!(restored.adopt_history(&m).is_ok());
+        assert_eq!(restored.me_states()[3], -1e9);
+        let mut co_simulation = MultiferroicMotor::new(&p, &inputs).unwrap();
+        co_simulation.state.onion_tilt = 20.0;
+        assert!(restored.adopt_history(&co_simulation).is_err());
     }
 
     /// Below the damping CVode's defaults follow, the first event of a Model Exchange run
