@@ -256,7 +256,7 @@ pub enum ToolElement {
 }
 
 /// The name of the `<Tool>` whose elements are this project's own.
-pub const TOOL: &str = "actuator-fmus";
+const TOOL: &str = "actuator-fmus";
 
 impl Description {
     /// The elements of this project's own `<Tool>`s, in order.
