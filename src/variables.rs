@@ -138,6 +138,8 @@ pub trait Interface: 'static {
     type Known: Identifier;
     /// The unknowns of the Jacobian: the Real outputs, then the state derivatives.
     type Unknown: Identifier;
+    /// The FMI 3.0 array outputs.
+    type ArrayOutput: ArrayIdentifier;
     /// `numberOfEventIndicators` of the model description.
     const EVENT_INDICATORS: usize;
     /// Metadata of every variable.
@@ -200,6 +202,29 @@ impl Identifier for () {
     }
     fn from_value_reference(_: u32) -> Option<Self> {
         None
+    }
+}
+
+/// One FMI 3.0 array output of a model (an `<Array>` of its model description's
+/// VendorAnnotations), generated per model description as `crate::variables::<model>::ArrayOutput`:
+/// one variant per array, named after it (`wall_radius` becoming `WallRadius`), so that a renamed
+/// array is a compile error in the model that computes it.
+pub trait ArrayIdentifier: Copy + Eq + std::fmt::Debug + Send + Sync + 'static {
+    /// Every array output, in declaration order.
+    const ALL: &'static [Self];
+    /// The variable name of the array.
+    fn name(self) -> &'static str;
+    /// The array output named `name`, if the model has one.
+    fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.iter().copied().find(|a| a.name() == name)
+    }
+}
+
+/// No array outputs (hand-written interfaces in tests).
+impl ArrayIdentifier for std::convert::Infallible {
+    const ALL: &'static [Self] = &[];
+    fn name(self) -> &'static str {
+        match self {}
     }
 }
 

@@ -7,10 +7,13 @@
 //! Exchange. Inputs outside the solvable range are evaluated at the nearest valid point and
 //! flagged (`input_clamped`, `out_of_range_policy`), each excursion logged once.
 
-use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::wall_arrays::{self, WallQuantity};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::free_bladder::{FreeBladder as Tube, FreeBladderState};
-use crate::variables::free_bladder::{Inputs, Known, Outputs, Parameters, Unknown, Variables};
+use crate::variables::free_bladder::{
+    ArrayOutput, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+};
 use serde::{Deserialize, Serialize};
 
 /// Gauge pressure of an absolute vacuum at standard atmosphere, Pa: nothing lower is physical.
@@ -156,12 +159,18 @@ impl Model for FreeBladder {
         })
     }
 
-    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+    fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
+        let quantity = match array {
+            ArrayOutput::WallRadius => WallQuantity::Radius,
+            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
+            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
+            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
+        };
         // At the point the outputs are computed at (the inputs clamped into the solvable range).
         let OperatingPoint {
             pressure, length, ..
         } = self.operating_point(inputs);
-        wall_arrays::write(name, out, |f| self.tube.wall_field(pressure, length, f))
+        wall_arrays::write(quantity, out, |f| self.tube.wall_field(pressure, length, f))
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {

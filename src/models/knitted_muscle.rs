@@ -8,7 +8,8 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::wall_arrays::{self, WallQuantity};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{Bladder, BladderTube};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
@@ -16,7 +17,7 @@ use crate::physics::knitted_cylinder::{KnittedCylinder, NON_CYLINDRICAL_BLADDER}
 use crate::physics::knitted_muscle::{Friction, KnittedAssembly, KnittedOutput};
 use crate::physics::mckibben::{is_slack, BladderModel};
 use crate::variables::knitted_muscle::{
-    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+    ArrayOutput, CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -296,14 +297,20 @@ impl Model for KnittedMuscle {
         Some(HistoryKey::of([self.history.z, self.history.position]))
     }
 
-    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+    fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
+        let quantity = match array {
+            ArrayOutput::WallRadius => WallQuantity::Radius,
+            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
+            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
+            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
+        };
         let Some(bladder) = self.assembly.bladder() else {
-            return wall_arrays::absent(name, out);
+            return wall_arrays::absent(out);
         };
         // At the length the muscle is evaluated at (the nearer valid one beyond them).
         let (lo, hi) = self.assembly.valid_lengths();
         let length = inputs.length.max(lo).min(hi);
-        wall_arrays::write(name, out, |f| {
+        wall_arrays::write(quantity, out, |f| {
             bladder.wall_field(inputs.pressure, length, f)
         })
     }

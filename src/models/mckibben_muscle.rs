@@ -5,7 +5,8 @@
 //! friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
-use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::wall_arrays::{self, WallQuantity};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::festo;
@@ -17,7 +18,7 @@ use crate::physics::mckibben::{
 };
 use crate::physics::muscle_params::MuscleParams;
 use crate::variables::mckibben_muscle::{
-    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+    ArrayOutput, CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -500,19 +501,25 @@ impl Model for McKibbenMuscle {
         self.outputs(inputs, outputs, report, false)
     }
 
-    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+    fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
+        let quantity = match array {
+            ArrayOutput::WallRadius => WallQuantity::Radius,
+            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
+            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
+            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
+        };
         let Pipeline::Full(muscle) = &self.pipeline else {
-            return wall_arrays::absent(name, out);
+            return wall_arrays::absent(out);
         };
         let Some(bladder) = muscle.bladder() else {
-            return wall_arrays::absent(name, out);
+            return wall_arrays::absent(out);
         };
         // The bladder's own length: the input less the connector's stretch, as evaluated.
         let (p, k_s) = (inputs.pressure, self.strand_stiffness);
         let (state, _) = muscle.evaluate_with_strands(p, inputs.length, k_s, &self.friction);
         let state = state.ok_or("no solution at these inputs")?;
         let length = state.actual_length;
-        wall_arrays::write(name, out, |f| bladder.wall_field(p, length, f))
+        wall_arrays::write(quantity, out, |f| bladder.wall_field(p, length, f))
     }
 
     #[inline]

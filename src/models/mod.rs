@@ -7,7 +7,7 @@
 
 #![forbid(unsafe_code)]
 
-use crate::variables::{Identifier, Interface};
+use crate::variables::{ArrayIdentifier, Identifier, Interface};
 use serde::{de::DeserializeOwned, Serialize};
 use std::marker::PhantomData;
 
@@ -286,6 +286,8 @@ pub type CalculatedParameters<M> = <<M as Model>::Variables as Interface>::Calcu
 /// The continuous states of model `M` (and their derivatives), generated from the variables that
 /// carry a `derivative` attribute; an empty struct for models without states.
 pub type States<M> = <<M as Model>::Variables as Interface>::States;
+/// The FMI 3.0 array outputs of model `M`: an empty enum for models without arrays.
+pub type ArrayOutput<M> = <<M as Model>::Variables as Interface>::ArrayOutput;
 
 /// What an event update (`fmi2NewDiscreteStates`) did, for `fmi2EventInfo`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -427,12 +429,17 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
         None
     }
 
-    /// The FMI 3.0 array output `name` (an `<Array>` of the model description's
+    /// The FMI 3.0 array output `array` (an `<Array>` of the model description's
     /// VendorAnnotations) at `inputs` and the current history, into `out` (its declared size).
     /// Computed only when an importer reads it, so an array nobody reads costs nothing. `Err`
-    /// says why there is no value; by default the model has no arrays.
-    fn array(&self, _inputs: &Inputs<Self>, name: &str, _out: &mut [f64]) -> Result<(), String> {
-        Err(format!("no array output named '{name}'"))
+    /// says why there is no value; by default the model computes none.
+    fn array(
+        &self,
+        _inputs: &Inputs<Self>,
+        array: ArrayOutput<Self>,
+        _out: &mut [f64],
+    ) -> Result<(), String> {
+        Err(format!("this model does not compute {}", array.name()))
     }
 
     /// Exact partial derivatives of the outputs (and, with states, of the derivative variables

@@ -4,8 +4,8 @@
 mod bindings;
 mod directional_derivative;
 
-use crate::models::{EventUpdate, Model, Report};
-use crate::variables::{ContinuousStates, Interface, ModelInfo};
+use crate::models::{ArrayOutput, EventUpdate, Model, Report};
+use crate::variables::{ArrayIdentifier, ContinuousStates, Interface, ModelInfo};
 pub use bindings::Bindings;
 use directional_derivative::PartialsCache;
 use serde::{Deserialize, Serialize};
@@ -537,8 +537,10 @@ where
         self
     }
     fn array(&self, name: &str, out: &mut [f64]) -> Result<(), String> {
+        let array = ArrayOutput::<M>::from_name(name)
+            .ok_or_else(|| format!("no array output named '{name}'"))?;
         match &self.model {
-            Some(model) => model.array(&self.values.inputs, name, out),
+            Some(model) => model.array(&self.values.inputs, array, out),
             None => Err("no model yet: call it in initialization mode or later".into()),
         }
     }
