@@ -46,8 +46,9 @@ pub(crate) unsafe fn guarded(
     let Some(inst) = (unsafe { instance(c) }) else {
         return Status::Error;
     };
-    // One handle table serves both FMI versions: an instance answers only its own version's calls.
-    if inst.api.version != api.version {
+    // One handle table serves both FMI versions: an instance answers only the calls of the `Api`
+    // (a static of its version layer) it was instantiated through.
+    if !std::ptr::eq(inst.api, api) {
         return inst.error(&format!(
             "{function}: the instance was instantiated through the other FMI version's API"
         ));

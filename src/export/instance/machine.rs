@@ -214,6 +214,7 @@ impl Instance {
 
     /// `fmi2DoStep`, `fmi3DoStep`: checks the state and the step, steps the model and forwards
     /// its report.
+    #[inline(always)]
     pub fn do_step(&mut self, function: &str, time: f64, step: f64) -> Status {
         if !self.allowed(function, allowed::DO_STEP) {
             return Status::Error;
@@ -242,6 +243,7 @@ impl Instance {
     }
 
     /// The refusal of a step of `step` from `time`, if any (the caller checked the state).
+    #[inline(always)]
     fn step_refused(&self, function: &str, time: f64, step: f64) -> Option<Status> {
         // Positive and finite; two comparisons (NaN fails both).
         if !(step > 0.0 && step < f64::INFINITY) {

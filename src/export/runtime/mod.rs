@@ -112,8 +112,6 @@ pub trait Runtime: Send {
     fn string(&self, vr: usize) -> &str;
     /// `out[i] = real(vrs[i])`: fmi2GetReal in one dynamic call.
     fn reals(&self, vrs: &[u32], out: &mut [f64]);
-    /// [`Runtime::reals`] if [`Runtime::outputs_current`], else nothing: whether it read them.
-    fn current_reals(&self, vrs: &[u32], out: &mut [f64]) -> bool;
     /// `set_real(vrs[i], values[i])`, then [`Runtime::changed`]: fmi2SetReal in one dynamic call.
     fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool);
     fn set_string(&mut self, vr: usize, value: &str);
@@ -309,14 +307,6 @@ where
         for (&vr, slot) in vrs.iter().zip(out) {
             *slot = M::Variables::real(&self.values, vr as usize);
         }
-    }
-    #[inline]
-    fn current_reals(&self, vrs: &[u32], out: &mut [f64]) -> bool {
-        if !self.outputs_current() {
-            return false;
-        }
-        self.reals(vrs, out);
-        true
     }
     #[inline]
     fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool) {
