@@ -50,7 +50,8 @@ pub(crate) unsafe fn guarded(
     // (a static of its version layer) it was instantiated through.
     if !std::ptr::eq(inst.api, api) {
         return inst.error(&format!(
-            "{function}: the instance was instantiated through the other FMI version's API"
+            "{function}: the instance was instantiated through the {} API",
+            inst.api.version
         ));
     }
     let ptr: *mut Instance = inst;

@@ -38,7 +38,8 @@ pub const MAGIC: u64 = 0x6163_7475_6174_6f72;
 /// What an instance needs to know of the FMI version it was instantiated through: which calls are
 /// its own, and the names its messages use. Each version layer defines one.
 pub struct Api {
-    /// "FMI 2.0" or "FMI 3.0": an instance answers only its own version's calls.
+    /// "FMI 2.0" or "FMI 3.0", for messages. An instance answers only the calls of the `Api` it
+    /// was instantiated through (each version layer has one, a static).
     pub version: &'static str,
     /// The name of [`MachineState::StepComplete`] (FMI 3.0 calls it Step Mode).
     pub step_state: &'static str,
