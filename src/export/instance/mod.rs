@@ -7,6 +7,10 @@
 //! references and is told the name of the function the importer called; the version layers
 //! (`src/fmi2`, `src/fmi3`) turn the importer's C pointers into them. The only `unsafe` here is
 //! in `fmu_state`, on the state pointers this instance handed out itself.
+//!
+//! The three calls of every communication step (`set`, `do_step`, `get_reals`) are
+//! `#[inline(always)]`: each version's export runs its one path as one function, as if it had
+//! been written there.
 
 mod co_simulation_events;
 mod directional_derivative;
@@ -253,7 +257,7 @@ impl Instance {
     }
 
     #[inline(never)]
-    fn recompute_outputs(&mut self, function: &str) -> Status {
+    pub(super) fn recompute_outputs(&mut self, function: &str) -> Status {
         if !self.runtime.is_built() {
             if self.state() != MachineState::InitializationMode {
                 return Status::OK;

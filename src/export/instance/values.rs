@@ -283,15 +283,19 @@ impl Instance {
         }
     }
 
-    /// Before a get reads values: where the state lets inputs change the outputs, brings stale
-    /// outputs up to date (building the model in initialization mode); the status of that.
+    /// Before a get reads values: outputs that inputs made stale are brought up to date (the
+    /// model built in initialization mode) where the state lets inputs change them; the status
+    /// of that.
     #[inline]
     fn outputs_for_get(&mut self, function: &str) -> Status {
+        if self.runtime.outputs_current() {
+            return Status::OK;
+        }
         match self.state() {
             MachineState::InitializationMode
             | MachineState::StepComplete
             | MachineState::EventMode
-            | MachineState::ContinuousTimeMode => self.refresh_outputs(function),
+            | MachineState::ContinuousTimeMode => self.recompute_outputs(function),
             _ => Status::OK,
         }
     }
