@@ -33,22 +33,20 @@ pub enum Status {
 }
 
 /// What a model call has to say: the worst status and the messages that explain it. A report with
-/// nothing to say is a few flags and a null pointer, told by one of them: the per-step path builds
-/// and tests one every step.
+/// nothing to say (fmi2OK, nothing clamped, no message) is a null pointer: the per-step path builds
+/// and tests one every step, and it owns no memory.
 #[derive(Debug, Default)]
 pub struct Report {
-    status: Status,
     /// The model ran (evaluated or stepped): `clamped` describes the outputs it wrote.
     pub evaluated: bool,
-    clamped: bool,
-    /// The status is worse than OK, an input was clamped, or there is a message.
-    loud: bool,
-    /// The messages, allocated with the first.
+    /// Everything else, allocated with the first thing to say.
     notes: Option<Box<Notes>>,
 }
 
 #[derive(Debug, Default)]
 struct Notes {
+    status: Status,
+    clamped: bool,
     messages: Vec<(Status, String)>,
     /// Why an input was clamped, logged once per excursion (the first call that leaves the range).
     clamp_messages: Vec<String>,
@@ -57,17 +55,19 @@ struct Notes {
 impl Report {
     /// The worst status so far.
     pub fn status(&self) -> Status {
-        self.status
+        self.notes.as_ref().map_or(Status::Ok, |n| n.status)
     }
     /// Makes the status at least `status` (without a message: the caller logs why elsewhere).
     pub fn raise(&mut self, status: Status) {
-        self.status = self.status.max(status);
-        self.loud |= status > Status::Ok;
+        if status > Status::Ok {
+            let notes = self.notes_mut();
+            notes.status = notes.status.max(status);
+        }
     }
     pub fn add(&mut self, status: Status, message: impl Into<String>) {
-        self.raise(status);
-        self.loud = true;
-        self.notes_mut().messages.push((status, message.into()));
+        let notes = self.notes_mut();
+        notes.status = notes.status.max(status);
+        notes.messages.push((status, message.into()));
     }
     pub fn warn(&mut self, message: impl Into<String>) {
         self.add(Status::Warning, message)
@@ -75,16 +75,16 @@ impl Report {
     /// Records an input evaluated at the nearest valid point; `message` is built only on the
     /// first call of an excursion (`first`), so that the log gets one line per excursion.
     pub fn clamp(&mut self, first: bool, message: impl FnOnce() -> String) {
-        self.clamped = true;
-        self.loud = true;
+        let notes = self.notes_mut();
+        notes.clamped = true;
         if first {
-            self.notes_mut().clamp_messages.push(message());
+            notes.clamp_messages.push(message());
         }
     }
     /// An input lay outside the model's solvable range and was evaluated at the nearest valid
     /// point. The export layer turns this into a status by the `out_of_range_policy` parameter.
     pub fn clamped(&self) -> bool {
-        self.clamped
+        self.notes.as_ref().is_some_and(|n| n.clamped)
     }
     /// The messages with their statuses, in order.
     pub fn messages(&self) -> &[(Status, String)] {
@@ -101,10 +101,9 @@ impl Report {
             .map(|n| std::mem::take(&mut n.clamp_messages))
             .unwrap_or_default()
     }
-    /// Nothing to say: fmi2OK, nothing clamped, no message. Such a report owns no memory.
-    #[inline(always)]
+    /// Nothing to say: fmi2OK, nothing clamped, no message.
     pub fn is_quiet(&self) -> bool {
-        !self.loud
+        self.notes.is_none()
     }
     fn notes_mut(&mut self) -> &mut Notes {
         self.notes.get_or_insert_with(Default::default)
