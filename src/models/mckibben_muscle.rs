@@ -17,7 +17,10 @@ use crate::physics::mckibben::{
 };
 use crate::physics::muscle_params::MuscleParams;
 use crate::variables::mckibben_muscle::{
-    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+    CalculatedParameters, ContractionBy, EffectivePressureBy, ForceBy, FrictionForceBy, Inputs,
+    Outputs, Parameters, StiffnessBy, StressAxialBy, StressHoopBy, StressRadialBy, StretchAxialBy,
+    StretchHoopBy, StretchRadialBy, TargetPressureBy, ThresholdPressureBy, Unknown, Variables,
+    VolumeBy,
 };
 use serde::{Deserialize, Serialize};
 
@@ -330,21 +333,56 @@ impl McKibbenMuscle {
 
 /// Writes the rows of the physics' partials, by pressure and length.
 fn write_rows(d: &ByPressureLength, p: &mut Partials<Variables>) {
-    for (output, [dp, dl]) in [
-        (Unknown::Force, d.force),
-        (Unknown::EffectivePressure, d.effective_pressure),
-        (Unknown::FrictionForce, d.friction_force),
-        (Unknown::Volume, d.volume),
-        (Unknown::ThresholdPressure, d.threshold_pressure),
-        (Unknown::StretchAxial, d.stretch_axial),
-        (Unknown::StretchHoop, d.stretch_hoop),
-        (Unknown::StretchRadial, d.stretch_radial),
-        (Unknown::StressAxial, d.stress_axial),
-        (Unknown::StressHoop, d.stress_hoop),
-        (Unknown::StressRadial, d.stress_radial),
-    ] {
-        p.row(output, &[(Known::Pressure, dp), (Known::Length, dl)]);
-    }
+    let by = |[pressure, length]: [f64; 2]| (pressure, length);
+    let (force, volume) = (by(d.force), by(d.volume));
+    let (effective, friction) = (by(d.effective_pressure), by(d.friction_force));
+    let threshold = by(d.threshold_pressure);
+    let stretch = [d.stretch_axial, d.stretch_hoop, d.stretch_radial].map(by);
+    let stress = [d.stress_axial, d.stress_hoop].map(by);
+    p.row(ForceBy {
+        pressure: force.0,
+        length: force.1,
+    })
+    .row(EffectivePressureBy {
+        pressure: effective.0,
+        length: effective.1,
+    })
+    .row(FrictionForceBy {
+        pressure: friction.0,
+        length: friction.1,
+    })
+    .row(VolumeBy {
+        pressure: volume.0,
+        length: volume.1,
+    })
+    .row(ThresholdPressureBy {
+        pressure: threshold.0,
+        length: threshold.1,
+    })
+    .row(StretchAxialBy {
+        pressure: stretch[0].0,
+        length: stretch[0].1,
+    })
+    .row(StretchHoopBy {
+        pressure: stretch[1].0,
+        length: stretch[1].1,
+    })
+    .row(StretchRadialBy {
+        pressure: stretch[2].0,
+        length: stretch[2].1,
+    })
+    .row(StressAxialBy {
+        pressure: stress[0].0,
+        length: stress[0].1,
+    })
+    .row(StressHoopBy {
+        pressure: stress[1].0,
+        length: stress[1].1,
+    })
+    // The radial stress at the inner wall is minus the pressure: the length moves it not.
+    .row(StressRadialBy {
+        pressure: d.stress_radial[0],
+    });
 }
 
 impl McKibbenMuscle {
@@ -534,15 +572,12 @@ impl Model for McKibbenMuscle {
     fn partials(&mut self, inputs: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
         write_rows(&self.partials_at(inputs)?, p);
         if p.wants(Unknown::Stiffness) || matches!(self.pipeline, Pipeline::Sleeve(_)) {
-            let [dp, dl] = self.stiffness_row(inputs)?;
-            p.row(
-                Unknown::Stiffness,
-                &[(Known::Pressure, dp), (Known::Length, dl)],
-            );
+            let [pressure, length] = self.stiffness_row(inputs)?;
+            p.row(StiffnessBy { pressure, length });
         }
         // contraction = 1 - length / nominal_length.
         let per_length = -1.0 / self.effective.nominal_length;
-        p.row(Unknown::Contraction, &[(Known::Length, per_length)]);
+        p.row(ContractionBy { length: per_length });
         let target = match &self.solver {
             Some((muscle, max_pressure)) => muscle.target_pressure_partials(
                 *max_pressure,
@@ -552,10 +587,10 @@ impl Model for McKibbenMuscle {
             ),
             None => [0.0; 2],
         };
-        p.row(
-            Unknown::TargetPressure,
-            &[(Known::Length, target[0]), (Known::TargetForce, target[1])],
-        );
+        p.row(TargetPressureBy {
+            length: target[0],
+            target_force: target[1],
+        });
         Ok(())
     }
 
@@ -663,6 +698,7 @@ mod tests {
 mod slack_tests {
     use super::super::all_partials;
     use super::*;
+    use crate::variables::mckibben_muscle::Known;
 
     fn at(m: &mut McKibbenMuscle, pressure: f64, length: f64) -> Outputs {
         let x = Inputs {
