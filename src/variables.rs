@@ -207,7 +207,20 @@ impl Identifier for () {
 /// (`ForceBy { pressure, length }`): one field per known the unknown's `<ModelStructure>` entry
 /// declares. A model writes its partials only through these, so they hold to the declared
 /// dependencies by construction: an undeclared partial does not compile, nor does a missing
-/// declared one.
+/// declared one. McKibbenMuscle's `stress_radial` declares `pressure` alone:
+///
+/// ```
+/// use actuator_fmus::variables::mckibben_muscle::{ForceBy, StressRadialBy};
+/// let _ = (StressRadialBy { pressure: -1.0 }, ForceBy { pressure: 1.0, length: 2.0 });
+/// ```
+/// ```compile_fail
+/// # use actuator_fmus::variables::mckibben_muscle::StressRadialBy;
+/// let _ = StressRadialBy { pressure: -1.0, length: 0.0 }; // undeclared
+/// ```
+/// ```compile_fail
+/// # use actuator_fmus::variables::mckibben_muscle::ForceBy;
+/// let _ = ForceBy { pressure: 1.0 }; // `length` is declared
+/// ```
 pub trait Row: Copy {
     type Variables: Interface;
     /// The unknown whose row this is.
