@@ -83,10 +83,12 @@ def configurations(model, given):
     """The defaults, the description's Parameters sets, every option setting alone, and
     SAMPLED_COMBINATIONS random combinations of the options (seeded by the model's name)."""
     md = read_model_description(fmu_path(model))
-    settings = {v.name: option_values(v) for v in md.modelVariables
-                if v.causality == "parameter" and v.name not in STATUS_ONLY}
-    settings = {name: values for name, values in settings.items() if values}
-    alone = [{name: value} for name, values in settings.items() for value in values]
+    options = [v for v in md.modelVariables
+               if v.causality == "parameter" and v.name not in STATUS_ONLY and option_values(v)]
+    settings = {v.name: option_values(v) for v in options}
+    # Each setting alone; the start value is the defaults'.
+    alone = [{v.name: value} for v in options for value in settings[v.name]
+             if str(value).lower() != str(v.start).lower()]
     rng = random.Random(model)
     sampled = []
     where = extract(fmu_path(model))
