@@ -333,53 +333,47 @@ impl McKibbenMuscle {
 
 /// Writes the rows of the physics' partials, by pressure and length.
 fn write_rows(d: &ByPressureLength, p: &mut Partials<Variables>) {
-    let by = |[pressure, length]: [f64; 2]| (pressure, length);
-    let (force, volume) = (by(d.force), by(d.volume));
-    let (effective, friction) = (by(d.effective_pressure), by(d.friction_force));
-    let threshold = by(d.threshold_pressure);
-    let stretch = [d.stretch_axial, d.stretch_hoop, d.stretch_radial].map(by);
-    let stress = [d.stress_axial, d.stress_hoop].map(by);
     p.row(ForceBy {
-        pressure: force.0,
-        length: force.1,
+        pressure: d.force[0],
+        length: d.force[1],
     })
     .row(EffectivePressureBy {
-        pressure: effective.0,
-        length: effective.1,
+        pressure: d.effective_pressure[0],
+        length: d.effective_pressure[1],
     })
     .row(FrictionForceBy {
-        pressure: friction.0,
-        length: friction.1,
+        pressure: d.friction_force[0],
+        length: d.friction_force[1],
     })
     .row(VolumeBy {
-        pressure: volume.0,
-        length: volume.1,
+        pressure: d.volume[0],
+        length: d.volume[1],
     })
     .row(ThresholdPressureBy {
-        pressure: threshold.0,
-        length: threshold.1,
+        pressure: d.threshold_pressure[0],
+        length: d.threshold_pressure[1],
     })
     .row(StretchAxialBy {
-        pressure: stretch[0].0,
-        length: stretch[0].1,
+        pressure: d.stretch_axial[0],
+        length: d.stretch_axial[1],
     })
     .row(StretchHoopBy {
-        pressure: stretch[1].0,
-        length: stretch[1].1,
+        pressure: d.stretch_hoop[0],
+        length: d.stretch_hoop[1],
     })
     .row(StretchRadialBy {
-        pressure: stretch[2].0,
-        length: stretch[2].1,
+        pressure: d.stretch_radial[0],
+        length: d.stretch_radial[1],
     })
     .row(StressAxialBy {
-        pressure: stress[0].0,
-        length: stress[0].1,
+        pressure: d.stress_axial[0],
+        length: d.stress_axial[1],
     })
     .row(StressHoopBy {
-        pressure: stress[1].0,
-        length: stress[1].1,
+        pressure: d.stress_hoop[0],
+        length: d.stress_hoop[1],
     })
-    // The radial stress at the inner wall is minus the pressure: the length moves it not.
+    // The radial stress at the inner wall is minus the pressure, whatever the length.
     .row(StressRadialBy {
         pressure: d.stress_radial[0],
     });
