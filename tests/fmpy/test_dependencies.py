@@ -39,7 +39,7 @@ def parse_values(text):
 
 def option_values(v):
     """Every setting of an option parameter: each item of an Enumeration, both Booleans, an
-    Integer's bounds; None for a Real."""
+    Integer's bounds and start; None for a Real."""
     if v.type == "Boolean":
         return [False, True]
     if v.type == "Enumeration":
@@ -67,6 +67,8 @@ def initializes(md, where, config):
             v = next(v for v in md.modelVariables if v.name == name)
             if v.type == "Boolean":
                 s.setBoolean([v.valueReference], [bool(value)])
+            elif v.type == "Real":
+                s.setReal([v.valueReference], [float(value)])
             else:
                 s.setInteger([v.valueReference], [int(value)])
         s.enterInitializationMode()
@@ -80,8 +82,9 @@ def initializes(md, where, config):
 
 
 def configurations(model, given):
-    """The defaults, the description's Parameters sets, every option setting alone, and
-    SAMPLED_COMBINATIONS random combinations of the options (seeded by the model's name)."""
+    """The defaults, the description's Parameters sets, every option setting alone, and twice
+    SAMPLED_COMBINATIONS random combinations of the options, alone and on the sets that switch
+    a Real effect on (seeded by the model's name)."""
     md = read_model_description(fmu_path(model))
     options = [v for v in md.modelVariables
                if v.causality == "parameter" and v.name not in STATUS_ONLY and option_values(v)]
@@ -89,17 +92,26 @@ def configurations(model, given):
     # Each setting alone; the start value is the defaults'.
     alone = [{v.name: value} for v in options for value in settings[v.name]
              if str(value).lower() != str(v.start).lower()]
-    rng = random.Random(model)
-    sampled = []
+    # The description's sets that set a Real (a connector spring, a bag) are the bases of half
+    # the combinations on them: the options override the rest of such a set.
+    switches = [{}] + [config for config in given if set(config) - set(settings)]
+    switches += [{}] * (len(switches) - 1)
     where = extract(fmu_path(model))
-    try:
+
+    def combinations(rng, bases):
+        sampled = []
         for _ in range(50 * SAMPLED_COMBINATIONS if settings else 0):
             if len(sampled) == SAMPLED_COMBINATIONS:
                 break
-            combination = {name: rng.choice(values) for name, values in settings.items()}
+            base = rng.choice(bases) if bases else {}
+            combination = dict(base, **{name: rng.choice(values) for name, values in settings.items()})
             # A combination the model refuses, saying why, is no sample.
             if initializes(md, where, combination):
                 sampled.append(combination)
+        return sampled
+
+    try:
+        sampled = combinations(random.Random(model), []) + combinations(random.Random(model), switches)
     finally:
         shutil.rmtree(where, ignore_errors=True)
     unique = []
