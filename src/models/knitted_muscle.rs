@@ -12,7 +12,7 @@ use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{Bladder, BladderTube};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
-use crate::physics::knitted_cylinder::KnittedCylinder;
+use crate::physics::knitted_cylinder::{KnittedCylinder, NON_CYLINDRICAL_BLADDER};
 use crate::physics::knitted_muscle::{Friction, KnittedAssembly, KnittedOutput};
 use crate::physics::mckibben::{is_slack, BladderModel};
 use crate::variables::knitted_muscle::{
@@ -220,7 +220,15 @@ impl Model for KnittedMuscle {
     }
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
-        let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape_kind(p)?)?;
+        let shape = shape_kind(p)?;
+        // Refused before the non-cylindrical table is built (milliseconds) for nothing.
+        let has_bladder = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?
+            .wall()
+            .is_some();
+        if has_bladder && matches!(shape, ShapeKind::NonCylindrical { .. }) {
+            return Err(NON_CYLINDRICAL_BLADDER.to_string().into());
+        }
+        let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape)?;
         let bladder = bladder(p, &sleeve)?;
         let bag = (p.bag_diameter != 0.0).then_some((p.bag_diameter, p.bag_membrane_stiffness));
         let friction = if p.friction {
@@ -412,6 +420,11 @@ mod tests {
         p.bladder_model = 2;
         let e = KnittedMuscle::new(&p, &Inputs::default()).unwrap_err().0;
         assert!(e.contains("cylindrical sleeve"), "{e}");
+        // Before the sleeve's table is built: rows its table refuses still get the bladder's
+        // reason.
+        p.rows = 1000.0;
+        let e = KnittedMuscle::new(&p, &Inputs::default()).unwrap_err().0;
+        assert!(e.contains("no single bladder diameter"), "{e}");
         for shape in [0, 1] {
             let mut p = parameters_with(shape, false);
             p.preset = 2;

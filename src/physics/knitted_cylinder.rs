@@ -23,6 +23,11 @@ pub struct KnittedCylinder {
     sleeve_max_length: f64,
 }
 
+/// Why a bladder is refused in the non-cylindrical sleeve (see [`KnittedCylinder::new`]).
+pub const NON_CYLINDRICAL_BLADDER: &str = "the hyperelastic bladder (section 1.3.6 with eq. \
+     2.6-2.20) needs a cylindrical sleeve: use shape_model 0 (ideal) or 1 (tubular knit); the \
+     non-cylindrical shape has no single bladder diameter";
+
 impl KnittedCylinder {
     /// The cylinder of a built knitted sleeve. `Err` for the non-cylindrical shape (eq. 1.17-1.20):
     /// its rows have different radii (clamped ends, a pocket), so there is no single bladder
@@ -35,14 +40,7 @@ impl KnittedCylinder {
         let quadratic = match sleeve.shape() {
             ShapeModel::Ideal => 4.0 * m * m,
             ShapeModel::Tubular => 4.0 * m * m - 1.0,
-            ShapeModel::NonCylindrical(_) => {
-                return Err(
-                    "the hyperelastic bladder (section 1.3.6 with eq. 2.6-2.20) needs a \
-                            cylindrical sleeve: use shape_model 0 (ideal) or 1 (tubular knit); \
-                            the non-cylindrical shape has no single bladder diameter"
-                        .into(),
-                )
-            }
+            ShapeModel::NonCylindrical(_) => return Err(NON_CYLINDRICAL_BLADDER.into()),
         };
         let d_sq = [
             s * s / pi_sq,

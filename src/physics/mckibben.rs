@@ -9,9 +9,9 @@
 use crate::physics::bladder::{Bladder, BladderState, BladderTube, Wall};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::gaylord::Sleeve;
-use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 
 pub mod bare_sleeve;
+mod connector;
 mod limits;
 mod partials;
 mod strands;
@@ -237,6 +237,12 @@ pub struct McKibbenOutput {
 }
 
 /// Muscle outputs at an actual length, before the connector.
+/// The end of the connector's rising branch from the muscle's shortest length at one pressure
+/// and history ([`McKibben::branch_end`]), found at most once and shared by the evaluations that
+/// need it.
+pub(super) type BranchEnd = std::cell::OnceCell<Option<(f64, Core)>>;
+
+#[derive(Clone, Copy)]
 pub(super) struct Core {
     pub(super) out: McKibbenOutput,
     /// `dF/dL_actual` including the presliding slope in the direction of motion (Newton slope).
@@ -354,6 +360,18 @@ impl McKibben {
         length: f64,
         friction: &HysteresisState,
     ) -> Result<McKibbenOutput, String> {
+        self.evaluate_on(pressure, length, friction, &BranchEnd::new())
+    }
+
+    /// [`Self::evaluate`] sharing `branch` (the connector's rising branch, found once) with
+    /// other evaluations at the same pressure and history.
+    pub(super) fn evaluate_on(
+        &self,
+        pressure: f64,
+        length: f64,
+        friction: &HysteresisState,
+        branch: &BranchEnd,
+    ) -> Result<McKibbenOutput, String> {
         if !pressure.is_finite() {
             return Err(format!("pressure must be finite, got {pressure} Pa"));
         }
@@ -362,7 +380,7 @@ impl McKibben {
         }
         let core = match self.connector_compliance {
             None => self.at_actual_length(pressure, length, friction)?,
-            Some(c) => self.through_connector(pressure, length, friction, c)?,
+            Some(c) => self.through_connector(pressure, length, friction, c, branch)?,
         };
         let mut out = core.out;
         if let Some(c) = self.connector_compliance {
@@ -467,91 +485,6 @@ impl McKibben {
             out.friction_state = next;
         }
         Ok(Core { out, newton_slope })
-    }
-
-    /// Solves `reported = L + c F(L)` for the muscle length `L` (c = 1/k): bracket by doubling
-    /// steps inside the muscle's length range, then safeguarded Newton-bisection. Hand-written,
-    /// capped loops for robustness on the per-step path.
-    fn through_connector(
-        &self,
-        pressure: f64,
-        reported: f64,
-        history: &HysteresisState,
-        c: f64,
-    ) -> Result<Core, String> {
-        let (lo_edge, hi_edge) = match &self.bladder {
-            Some(_) => {
-                let (a, b) = (self.min_length(), self.max_length());
-                let margin = 1e-9 * (b - a);
-                (a + margin, b - margin)
-            }
-            None => (0.0, self.sleeve.strand_length),
-        };
-        let eval = |l: f64| -> Result<(f64, Core), String> {
-            let core = self.at_actual_length(pressure, l, history)?;
-            Ok((l + c * core.out.force - reported, core))
-        };
-        let x0 = super::numerics::bounds::limit(reported, lo_edge, hi_edge);
-        let (h0, core0) = eval(x0)?;
-        if h0 == 0.0 {
-            return Ok(core0);
-        }
-        // Bracket [lo, hi] with h(lo) < 0 < h(hi).
-        let upward = h0 < 0.0;
-        let (mut inner, mut step) = (x0, h0.abs());
-        let mut outer = None;
-        for _ in 0..BRACKET_STEPS {
-            let cand = if upward {
-                (inner + step).min(hi_edge)
-            } else {
-                (inner - step).max(lo_edge)
-            };
-            let (h, core) = eval(cand)?;
-            if h == 0.0 {
-                return Ok(core);
-            }
-            if (h > 0.0) == upward {
-                outer = Some(cand);
-                break;
-            }
-            let at_edge = cand == if upward { hi_edge } else { lo_edge };
-            if at_edge {
-                break;
-            }
-            inner = cand;
-            step *= 2.0;
-        }
-        let Some(outer) = outer else {
-            return Err(format!(
-                "reported length {reported} m cannot be reached through the connector: the \
-                 muscle's length range is ({}, {}) m",
-                self.min_length(),
-                self.max_length()
-            ));
-        };
-        let (lo, hi) = if upward {
-            (inner, outer)
-        } else {
-            (outer, inner)
-        };
-        // h rises with L (slope 1 + c dF/dL > 0 on the stable branch). Converged when the length
-        // moves by less than rounding; F then changes by K times that.
-        let options = RootOptions {
-            absolute: 1e-17,
-            relative: 1e-14,
-            max_iterations: ROOT_ITERATIONS,
-        };
-        let root = newton_bisection(lo, hi, 0.5 * (lo + hi), true, options, |x| {
-            let (value, core) = eval(x)?;
-            let slope = 1.0 + c * core.newton_slope;
-            Ok::<_, String>(Some(Sample {
-                value,
-                slope,
-                payload: core,
-            }))
-        })?;
-        root.payload
-            .ok_or_else(|| "connector solve did not run".to_string())
     }
 }
 

@@ -3,7 +3,7 @@
 //! partials on the branch each takes. Shared by the McKibbenMuscle and McKibbenJoint FMUs.
 
 use super::SURVIVABLE_STRAND_STRAIN;
-use super::{McKibben, McKibbenOutput, StrandTransition};
+use super::{BranchEnd, McKibben, McKibbenOutput, StrandTransition};
 use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::friction::HysteresisState;
 
@@ -58,7 +58,8 @@ impl McKibben {
         k_s: f64,
         history: &HysteresisState,
     ) -> (Option<McKibbenOutput>, Option<OutOfRange>) {
-        let (reason, rigid) = match self.evaluate(pressure, length, history) {
+        let branch = BranchEnd::new();
+        let (reason, rigid) = match self.evaluate_on(pressure, length, history, &branch) {
             Ok(out) if !(out.force > 0.0 && out.stiffness > k_s) => return (Some(out), None),
             Ok(out) => (String::new(), Some(out)),
             Err(reason) => (reason, None),
@@ -67,7 +68,7 @@ impl McKibben {
         // Out of the rigid braid's reach, or stiffer than its strands: the strands stretch.
         let breaking = self.breaking_length();
         let on_strands = length.min(breaking);
-        if let Some(t) = self.strand_transition(pressure, on_strands, k_s, history) {
+        if let Some(t) = self.strand_transition_on(pressure, on_strands, k_s, history, &branch) {
             let clamp = (length > breaking).then(|| OutOfRange {
                 reason: format!(
                     "length {length} m stretches the strands more than {}% of their length past max_length, which no muscle survives",
@@ -117,9 +118,13 @@ impl McKibben {
         k_s: f64,
         history: &HysteresisState,
     ) -> Option<StrandTransition> {
-        match self.evaluate(pressure, length, history) {
+        let branch = BranchEnd::new();
+        match self.evaluate_on(pressure, length, history, &branch) {
             Ok(out) if !(out.force > 0.0 && out.stiffness > k_s) => None,
-            _ => self.strand_transition(pressure, length.min(self.breaking_length()), k_s, history),
+            _ => {
+                let on_strands = length.min(self.breaking_length());
+                self.strand_transition_on(pressure, on_strands, k_s, history, &branch)
+            }
         }
     }
 
@@ -174,14 +179,24 @@ impl McKibben {
                 return Ok((out.force, d));
             }
         }
-        let (out, _) = self.evaluate_with_strands(pressure, length, k_s, history);
-        let force = out
-            .ok_or("the muscle cannot be evaluated at this length")?
-            .force;
-        Ok((
-            force,
-            self.partials_with_strands(pressure, length, k_s, history)?,
-        ))
+        // On the strands: one transition for the force and the partials (as
+        // `evaluate_with_strands` and `strand_partials` find it).
+        if let Some(t) = self.strand_point(pressure, length, k_s, history) {
+            let force = t.rigid.force + k_s * (length.min(self.breaking_length()) - t.length);
+            return Ok((
+                force,
+                self.partials_at_transition(&t, pressure, length, k_s, history)?,
+            ));
+        }
+        // Off the strands, without searching for their transition again: the rigid model at the
+        // inputs, or out of range at the clamped point (`evaluate_with_strands`'s fallback).
+        let at = |p: f64, l: f64| self.partials(p, l, history);
+        let ((out, mut d), by_l, by_p) = self.on_branch(pressure, length, at)?;
+        for y in d.rows_mut() {
+            y[0] *= f64::from(u8::from(by_p));
+            y[1] *= f64::from(u8::from(by_l));
+        }
+        Ok((out.force, d))
     }
 
     /// `[d/dpressure, d/dlength]` of the signed stiffness on the branch
@@ -219,6 +234,19 @@ impl McKibben {
         let Some(t) = self.strand_point(pressure, length, k_s, history) else {
             return Ok(None);
         };
+        self.partials_at_transition(&t, pressure, length, k_s, history)
+            .map(Some)
+    }
+
+    /// [`Self::strand_partials`] on the strands, from their transition `t` at these inputs.
+    fn partials_at_transition(
+        &self,
+        t: &StrandTransition,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> Result<ByPressureLength, String> {
         let (_, mut d) = self.partials(pressure, t.length, history)?;
         let dlt = if t.interior {
             let [kp, kl] = self.stiffness_partials(pressure, t.length, history)?;
@@ -236,7 +264,7 @@ impl McKibben {
         }
         let moves = length <= self.breaking_length();
         d.force = [fp + (fl - k_s) * dlt, if moves { k_s } else { 0.0 }];
-        Ok(Some(d))
+        Ok(d)
     }
 
     /// Runs `at` on the branch [`Self::evaluate_with_strands`] takes below the strands: at the

@@ -9,7 +9,7 @@
 //! slope are continuous; at the braid's reach the force is continuous and its slope rises to
 //! `k_s`.
 
-use super::{McKibben, McKibbenOutput};
+use super::{BranchEnd, McKibben, McKibbenOutput};
 use crate::physics::friction::HysteresisState;
 
 /// Strain of the strands past the braid's reach beyond which no muscle survives: aramid breaks
@@ -74,16 +74,41 @@ impl McKibben {
         strand_stiffness: f64,
         history: &HysteresisState,
     ) -> Option<StrandTransition> {
+        self.strand_transition_on(
+            pressure,
+            length,
+            strand_stiffness,
+            history,
+            &BranchEnd::new(),
+        )
+    }
+
+    /// [`Self::strand_transition`] sharing the connector's rising branch `branch` with the
+    /// other evaluations at this pressure and history.
+    pub(super) fn strand_transition_on(
+        &self,
+        pressure: f64,
+        length: f64,
+        strand_stiffness: f64,
+        history: &HysteresisState,
+        branch: &BranchEnd,
+    ) -> Option<StrandTransition> {
         let rigid = |l: f64| {
-            self.evaluate(pressure, l, history)
+            self.evaluate_on(pressure, l, history, branch)
                 .ok()
                 .map(|o| (o.force, o.stiffness, o))
         };
         let range = (self.min_length(), self.max_length());
-        transition(range, length, strand_stiffness, rigid).map(|t| StrandTransition {
-            length: t.length,
-            rigid: t.rigid,
-            interior: t.interior,
+        let reach = |soft: &McKibbenOutput| {
+            self.connector_reach(pressure, soft.actual_length, history, branch)
+                .map(|(l, o)| (l, (o.force, o.stiffness, o)))
+        };
+        transition_within_reach(range, reach, length, strand_stiffness, rigid).map(|t| {
+            StrandTransition {
+                length: t.length,
+                rigid: t.rigid,
+                interior: t.interior,
+            }
         })
     }
 }
@@ -119,7 +144,24 @@ fn holds<T>(
 /// interpolate, else bisection (at most 30 + 55-odd evaluations; 15-25 instead of bisection's
 /// 50-odd where the rigid model's stiffness or force crosses over; only in this regime).
 pub fn transition<T>(
+    range: (f64, f64),
+    length: f64,
+    k_s: f64,
+    rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+) -> Option<Transition<T>> {
+    transition_within_reach(range, |_: &T| None, length, k_s, rigid)
+}
+
+/// [`transition`] for a rigid model whose solutions end at a reach it can find itself from a
+/// length where it has one (a series connector's, [`McKibben::connector_reach`]): `reach(soft)`
+/// gives the longest length with a solution past the soft end's outputs `soft`, and the rigid
+/// model's value there. Where the search's stiff end has no solution and the reach lies inside
+/// the bracket, the boundary is the reach itself if the rigid model holds there (instead of
+/// bisecting through failed solves, each a whole connector solve), else it lies below and is
+/// found by ITP from the reach.
+pub fn transition_within_reach<T>(
     (lo, hi): (f64, f64),
+    reach: impl Fn(&T) -> Option<(f64, (f64, f64, T))>,
     length: f64,
     k_s: f64,
     rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
@@ -152,6 +194,19 @@ pub fn transition<T>(
         }
     }
     let (mut l, (force, mut slope, mut out)) = soft?;
+    if at_stiff.is_none() {
+        if let Some((at, found)) = reach(&out).filter(|(r, _)| *r > l && *r < stiff) {
+            if !pulls_stiffer(&found) {
+                return Some(Transition {
+                    length: at,
+                    rigid: found.2,
+                    interior: (found.1 - k_s).abs() <= 1e-6 * k_s,
+                });
+            }
+            stiff = at;
+            at_stiff = Some(found);
+        }
+    }
     // ITP (interpolate, truncate, project; Oliveira and Takahashi, ACM TOMS 47, 2020) on the
     // quantity whose sign change ends the rigid model: `g = stiffness - k_s` where the soft end
     // pulls below `k_s`, else its force (it holds because it pushes); bisection where the stiff

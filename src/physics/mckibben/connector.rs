@@ -1,0 +1,295 @@
+//! The series connector of section 2.4: the muscle's own length `L` that a reported length
+//! `L + F(L)/k` gives, and the longest reported length the connector reaches.
+
+use super::{BranchEnd, Core, McKibben, McKibbenOutput, BRACKET_STEPS, ROOT_ITERATIONS};
+use crate::physics::friction::HysteresisState;
+use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
+
+impl McKibben {
+    /// The muscle lengths the connector solve searches: the muscle's range, inset by 1e-9 of
+    /// it where a bladder makes its ends singular.
+    fn connector_edges(&self) -> (f64, f64) {
+        match &self.bladder {
+            Some(_) => {
+                let (a, b) = (self.min_length(), self.max_length());
+                let margin = 1e-9 * (b - a);
+                (a + margin, b - margin)
+            }
+            None => (0.0, self.sleeve.strand_length),
+        }
+    }
+
+    /// The longest reported length the connector reaches at `pressure` on the branch through
+    /// the muscle length `from` (where it has a solution), with the outputs there (series
+    /// stiffness, as [`Self::evaluate`]). `None` without a connector, or where the muscle does not
+    /// rise at `from`. See [`Self::branch_end`]; the branch from the shortest length is taken
+    /// from (or stored in) `branch` when it passes `from`.
+    pub(super) fn connector_reach(
+        &self,
+        pressure: f64,
+        from: f64,
+        history: &HysteresisState,
+        branch: &BranchEnd,
+    ) -> Option<(f64, McKibbenOutput)> {
+        let c = self.connector_compliance?;
+        let (lo_edge, _) = self.connector_edges();
+        let from_shortest = *branch.get_or_init(|| self.branch_end(pressure, lo_edge, history, c));
+        let (l, core) = from_shortest
+            .filter(|(end, _)| *end > from)
+            .or_else(|| self.branch_end(pressure, from, history, c))?;
+        let reported = l + c * core.out.force;
+        let mut out = core.out;
+        let k_m = out.stiffness;
+        out.stiffness = k_m / (1.0 + c * k_m);
+        (reported.is_finite() && out.stiffness.is_finite()).then_some((reported, out))
+    }
+
+    /// The end of the branch on which the reported length `L + c F(L)` rises with the muscle's
+    /// own length `L` (`1 + c dF/dL > 0`), from `from`: at a fold (`dF/dL = -1/c`), where the
+    /// force jumps (a vacuum the free bladder can no longer hold), or at the longest length the
+    /// connector solve searches. Found in `L` by bisection to 1e-9 of the muscle's length range
+    /// (about 30 muscle evaluations, where bisecting the reported length took a whole connector
+    /// solve per step): the end returned always rises, so the connector solve and the strands'
+    /// transition agree on it exactly; short of a fold it moves the reach by second order, short
+    /// of a jump by `1 + c dF/dL` times at most 1e-9 of the range. `None` where the reported
+    /// length does not rise at `from`.
+    fn branch_end(
+        &self,
+        pressure: f64,
+        from: f64,
+        history: &HysteresisState,
+        c: f64,
+    ) -> Option<(f64, Core)> {
+        let (lo_edge, hi_edge) = self.connector_edges();
+        let rising = |l: f64| {
+            self.at_actual_length(pressure, l, history)
+                .ok()
+                .filter(|core| 1.0 + c * core.newton_slope > 0.0)
+        };
+        let mut end = (from, rising(from)?);
+        if let Some(at_edge) = rising(hi_edge) {
+            return Some((hi_edge, at_edge));
+        }
+        let tolerance = 1e-9 * (hi_edge - lo_edge);
+        let mut past = hi_edge;
+        for _ in 0..1100 {
+            let mid = 0.5 * (end.0 + past);
+            if past - end.0 <= tolerance || mid <= end.0 || mid >= past {
+                break;
+            }
+            match rising(mid) {
+                Some(core) => end = (mid, core),
+                None => past = mid,
+            }
+        }
+        Some(end)
+    }
+
+    /// Solves `reported = L + c F(L)` for the muscle length `L` (c = 1/k): bracket by doubling
+    /// steps inside the muscle's length range, then safeguarded Newton-bisection. Hand-written,
+    /// capped loops for robustness on the per-step path. Where that finds no bracket from a first
+    /// guess past a fold or a jump of the force (the reported length falls with `L` there), it
+    /// brackets on the branch rising from the muscle's shortest length (up to its end,
+    /// [`Self::branch_end`], kept in `branch`).
+    pub(super) fn through_connector(
+        &self,
+        pressure: f64,
+        reported: f64,
+        history: &HysteresisState,
+        c: f64,
+        branch: &BranchEnd,
+    ) -> Result<Core, String> {
+        let (lo_edge, hi_edge) = self.connector_edges();
+        let eval = |l: f64| -> Result<(f64, Core), String> {
+            let core = self.at_actual_length(pressure, l, history)?;
+            Ok((l + c * core.out.force - reported, core))
+        };
+        let unreachable = || {
+            format!(
+                "reported length {reported} m cannot be reached through the connector: the \
+                 muscle's length range is ({}, {}) m",
+                self.min_length(),
+                self.max_length()
+            )
+        };
+        let x0 = crate::physics::numerics::bounds::limit(reported, lo_edge, hi_edge);
+        let (h0, core0) = eval(x0)?;
+        if h0 == 0.0 {
+            return Ok(core0);
+        }
+        let (lo, hi) = match self.bracket(x0, h0, &eval)? {
+            Bracket::Root(core) => return Ok(core),
+            Bracket::Between(lo, hi) => (lo, hi),
+            Bracket::None if 1.0 + c * core0.newton_slope > 0.0 => return Err(unreachable()),
+            Bracket::None => {
+                let found = branch.get_or_init(|| self.branch_end(pressure, lo_edge, history, c));
+                let (end, core) = found.ok_or_else(unreachable)?;
+                let h_end = end + c * core.out.force - reported;
+                if h_end == 0.0 {
+                    return Ok(core);
+                }
+                let (h_lo, core_lo) = eval(lo_edge)?;
+                if h_lo == 0.0 {
+                    return Ok(core_lo);
+                }
+                if !(h_lo < 0.0 && h_end > 0.0) {
+                    return Err(unreachable());
+                }
+                (lo_edge, end)
+            }
+        };
+        // h rises with L (slope 1 + c dF/dL > 0 on the stable branch). Converged when the length
+        // moves by less than rounding; F then changes by K times that.
+        let options = RootOptions {
+            absolute: 1e-17,
+            relative: 1e-14,
+            max_iterations: ROOT_ITERATIONS,
+        };
+        let root = newton_bisection(lo, hi, 0.5 * (lo + hi), true, options, |x| {
+            let (value, core) = eval(x)?;
+            let slope = 1.0 + c * core.newton_slope;
+            Ok::<_, String>(Some(Sample {
+                value,
+                slope,
+                payload: core,
+            }))
+        })?;
+        root.payload
+            .ok_or_else(|| "connector solve did not run".to_string())
+    }
+
+    /// Brackets the root of the connector residual `h` from `x0` (where `h = h0 != 0`) by
+    /// doubling steps towards it, inside the connector solve's lengths.
+    fn bracket(
+        &self,
+        x0: f64,
+        h0: f64,
+        eval: &impl Fn(f64) -> Result<(f64, Core), String>,
+    ) -> Result<Bracket, String> {
+        let (lo_edge, hi_edge) = self.connector_edges();
+        let upward = h0 < 0.0;
+        let (mut inner, mut step) = (x0, h0.abs());
+        for _ in 0..BRACKET_STEPS {
+            let cand = if upward {
+                (inner + step).min(hi_edge)
+            } else {
+                (inner - step).max(lo_edge)
+            };
+            let (h, core) = eval(cand)?;
+            if h == 0.0 {
+                return Ok(Bracket::Root(core));
+            }
+            if (h > 0.0) == upward {
+                return Ok(if upward {
+                    Bracket::Between(inner, cand)
+                } else {
+                    Bracket::Between(cand, inner)
+                });
+            }
+            let at_edge = cand == if upward { hi_edge } else { lo_edge };
+            if at_edge {
+                break;
+            }
+            inner = cand;
+            step *= 2.0;
+        }
+        Ok(Bracket::None)
+    }
+}
+
+/// Where the connector solve's bracket search ended.
+enum Bracket {
+    /// On the root itself.
+    Root(Core),
+    /// Between `(lo, hi)` with `h(lo) < 0 < h(hi)`.
+    Between(f64, f64),
+    /// No sign change inside the muscle's lengths.
+    None,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{BladderModel, FrictionParams, MuscleGeometry};
+    use super::*;
+    use crate::physics::bladder::BladderTube;
+
+    /// Table 2.1's muscle C with a soft rubber and friction under a vacuum, its friction
+    /// history far out: near `max_length` the bladder is pressed on the sleeve by a negative
+    /// effective pressure and the force jumps from a small tension to a large push, so the
+    /// reported length `L + F/k` rises, then falls, and the connector reaches no further than
+    /// the top of the rise.
+    fn vacuum_muscle() -> (McKibben, f64, HysteresisState) {
+        let g = MuscleGeometry::muscle_c();
+        let tube = BladderTube {
+            mooney_c1: 1326.9,
+            mooney_c2: 0.0196,
+            ..g.tube()
+        };
+        let model = BladderModel::DissertationContinuum { nodes: 58 };
+        let friction = FrictionParams {
+            coefficient: 0.04,
+            presliding_length: 0.26,
+        };
+        let m = McKibben::new(g.sleeve().unwrap(), tube, model, Some(friction), 923.0).unwrap();
+        (m, -3482.7, HysteresisState::at_rest(9.5))
+    }
+
+    /// The reach is the largest reported length on the rising branch, found independently here
+    /// by scanning the muscle's own length; every reported length below it is solved on that
+    /// branch (`L + F/k` equals it), also where the first guess lies past the jump, and none
+    /// above it.
+    #[test]
+    fn reach_is_the_top_of_the_rising_branch() {
+        let (m, p, rest) = vacuum_muscle();
+        let c = 1.0 / 923.0;
+        let (lo, hi) = m.connector_edges();
+        let reported = |l: f64| {
+            m.at_actual_length(p, l, &rest)
+                .ok()
+                .map(|core| l + c * core.out.force)
+        };
+        // The scan (steps of 2.5e-5 of the range in L, where L + F/k rises by about as much): the
+        // reported length's largest value before it first falls.
+        let mut top = f64::NEG_INFINITY;
+        for i in 0..=40_000 {
+            let l = lo + (hi - lo) * f64::from(i) / 40_000.0;
+            match reported(l) {
+                Some(r) if r >= top => top = r,
+                _ => break,
+            }
+        }
+        let (reach, out) = m.connector_reach(p, lo, &rest, &BranchEnd::new()).unwrap();
+        assert!(
+            reach >= top && reach - top < 5e-5 * (hi - lo),
+            "{reach} vs {top}"
+        );
+        assert!(out.force > 0.0);
+        // The first guess L = reported lands past the jump for these reported lengths.
+        for below in [1e-3, 1e-6, 1e-9] {
+            let r = reach - below * (hi - lo);
+            let o = m.evaluate(p, r, &rest).unwrap();
+            let residual = o.actual_length + c * o.force - r;
+            assert!(residual.abs() < 1e-12 * r, "{below}: {residual}");
+            assert!(o.actual_length < out.actual_length && o.force > 0.0);
+        }
+        assert!(m.evaluate(p, reach * (1.0 + 1e-12), &rest).is_err());
+    }
+
+    /// Past the reach the strands take over at the reach itself: the force is continuous there
+    /// and rises with the strands' stiffness beyond.
+    #[test]
+    fn strands_take_over_at_the_reach() {
+        let (m, p, rest) = vacuum_muscle();
+        let (reach, at) = m
+            .connector_reach(p, m.min_length(), &rest, &BranchEnd::new())
+            .unwrap();
+        let k_s = 1e5;
+        let force = |l: f64| m.evaluate_with_strands(p, l, k_s, &rest).0.unwrap().force;
+        let d = 1e-9;
+        assert!((force(reach - d) - at.force).abs() < 1e-6);
+        assert!((force(reach + d) - at.force - k_s * d).abs() < 1e-6);
+        let t = m.strand_transition(p, reach + 1e-3, k_s, &rest).unwrap();
+        assert_eq!(t.length, reach);
+        assert!(!t.interior);
+    }
+}
