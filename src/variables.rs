@@ -228,6 +228,37 @@ impl ArrayIdentifier for std::convert::Infallible {
     }
 }
 
+/// One row of a model's Jacobian, generated per unknown as `crate::variables::<model>::<Unknown>By`
+/// (`ForceBy { pressure, length }`): one field per known the unknown's `<ModelStructure>` entry
+/// declares. A model writes its partials only through these, so they hold to the declared
+/// dependencies by construction: an undeclared partial does not compile, nor does a missing
+/// declared one. McKibbenMuscle's `stress_radial` declares `pressure` alone:
+///
+/// ```
+/// use actuator_fmus::variables::mckibben_muscle::{ForceBy, StressRadialBy};
+/// let _ = (StressRadialBy { pressure: -1.0 }, ForceBy { pressure: 1.0, length: 2.0 });
+/// ```
+/// ```compile_fail
+/// # use actuator_fmus::variables::mckibben_muscle::StressRadialBy;
+/// let _ = StressRadialBy { pressure: -1.0, length: 0.0 }; // undeclared
+/// ```
+/// ```compile_fail
+/// # use actuator_fmus::variables::mckibben_muscle::ForceBy;
+/// let _ = ForceBy { pressure: 1.0 }; // `length` is declared
+/// ```
+pub trait Row: Copy {
+    type Variables: Interface;
+    /// The unknown whose row this is.
+    const UNKNOWN: <Self::Variables as Interface>::Unknown;
+    /// The knowns it declares, in [`Identifier::index`] order: the row's fields.
+    const KNOWNS: &'static [<Self::Variables as Interface>::Known];
+    /// The row with `by(known)` for each declared known: for a model whose partials come as a
+    /// gradient over every known, of which the row takes the declared ones.
+    fn from_fn(by: impl FnMut(<Self::Variables as Interface>::Known) -> f64) -> Self;
+    /// Calls `into(known, partial)` for each declared known.
+    fn write(&self, into: impl FnMut(<Self::Variables as Interface>::Known, f64));
+}
+
 /// Equality bit for bit (Reals by `f64::to_bits`): the export layer reuses partials only at
 /// exactly the inputs they were taken at. Generated for each model's `Inputs`.
 pub trait Identical {

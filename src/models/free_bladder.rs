@@ -12,7 +12,9 @@ use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::free_bladder::{FreeBladder as Tube, FreeBladderState};
 use crate::variables::free_bladder::{
-    ArrayOutput, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+    ArrayOutput, BallooningPressureBy, ComplianceBy, ForceBy, InnerDiameterBy, Inputs,
+    OuterDiameterBy, Outputs, Parameters, StressAxialBy, StressHoopBy, StretchAxialBy,
+    StretchHoopBy, StretchRadialBy, Variables, VolumeBy,
 };
 use serde::{Deserialize, Serialize};
 
@@ -120,26 +122,6 @@ impl FreeBladder {
     }
 }
 
-/// One field of the physics' state.
-type Field = fn(&FreeBladderState) -> f64;
-
-impl FreeBladder {
-    /// Each Real output with the field of the physics' state it is.
-    const REAL_OUTPUTS: [(Unknown, Field); 11] = [
-        (Unknown::InnerDiameter, |s| s.inner_diameter),
-        (Unknown::OuterDiameter, |s| s.outer_diameter),
-        (Unknown::Volume, |s| s.fluid_volume),
-        (Unknown::Compliance, |s| s.compliance),
-        (Unknown::StretchAxial, |s| s.stretch_axial),
-        (Unknown::StretchHoop, |s| s.stretch_hoop),
-        (Unknown::StretchRadial, |s| s.stretch_radial),
-        (Unknown::StressAxial, |s| s.stress_axial),
-        (Unknown::StressHoop, |s| s.stress_hoop),
-        (Unknown::Force, |s| s.force),
-        (Unknown::BallooningPressure, |s| s.ballooning_pressure),
-    ];
-}
-
 impl Model for FreeBladder {
     type Variables = Variables;
     const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
@@ -200,15 +182,49 @@ impl Model for FreeBladder {
             .evaluate_with_partials(point.pressure, point.length)?;
         let by_pressure = d.along(point.pressure_slope[0], 0.0);
         let by_length = d.along(point.pressure_slope[1], point.length_slope);
-        for (output, field) in Self::REAL_OUTPUTS {
-            p.row(
-                output,
-                &[
-                    (Known::Pressure, field(&by_pressure)),
-                    (Known::Length, field(&by_length)),
-                ],
-            );
-        }
+        let (dp, dl) = (&by_pressure, &by_length);
+        p.row(InnerDiameterBy {
+            pressure: dp.inner_diameter,
+            length: dl.inner_diameter,
+        })
+        .row(OuterDiameterBy {
+            pressure: dp.outer_diameter,
+            length: dl.outer_diameter,
+        })
+        .row(VolumeBy {
+            pressure: dp.fluid_volume,
+            length: dl.fluid_volume,
+        })
+        .row(ComplianceBy {
+            pressure: dp.compliance,
+            length: dl.compliance,
+        })
+        .row(StretchAxialBy {
+            length: dl.stretch_axial,
+        })
+        .row(StretchHoopBy {
+            pressure: dp.stretch_hoop,
+            length: dl.stretch_hoop,
+        })
+        .row(StretchRadialBy {
+            pressure: dp.stretch_radial,
+            length: dl.stretch_radial,
+        })
+        .row(StressAxialBy {
+            pressure: dp.stress_axial,
+            length: dl.stress_axial,
+        })
+        .row(StressHoopBy {
+            pressure: dp.stress_hoop,
+            length: dl.stress_hoop,
+        })
+        .row(ForceBy {
+            pressure: dp.force,
+            length: dl.force,
+        })
+        .row(BallooningPressureBy {
+            length: dl.ballooning_pressure,
+        });
         Ok(())
     }
 
@@ -227,6 +243,7 @@ impl Model for FreeBladder {
 mod tests {
     use super::super::all_partials;
     use super::*;
+    use crate::variables::free_bladder::{Known, Unknown};
 
     fn run(p: &Parameters, pressure: f64, length: f64) -> (Outputs, Report) {
         let mut m = FreeBladder::new(p, &Inputs::default()).unwrap();

@@ -7,7 +7,7 @@
 
 #![forbid(unsafe_code)]
 
-use crate::variables::{ArrayIdentifier, Identifier, Interface};
+use crate::variables::{ArrayIdentifier, Identifier, Interface, Row};
 use serde::{de::DeserializeOwned, Serialize};
 use std::marker::PhantomData;
 
@@ -135,9 +135,10 @@ impl From<&str> for Refusal {
 
 /// Exact partial derivatives of a model's unknowns (outputs, state derivatives) with respect to
 /// its knowns (inputs, continuous states) at one point, written against the identifiers generated
-/// from its model description (`crate::variables::<model>::{Known, Unknown}`): what
+/// from its model description (`crate::variables::<model>::{Known, Unknown}`, and one row type
+/// per unknown, `<Unknown>By`, whose fields are the knowns it declares): what
 /// `fmi2GetDirectionalDerivative` combines with the importer's seed. An unknown without a row is
-/// not provided; a known missing from a row does not affect that unknown.
+/// not provided; a known its `<ModelStructure>` entry does not declare has partial 0.
 pub struct Partials<V: Interface> {
     /// One row per unknown, one column per known (`Identifier::index`), row after row.
     values: Vec<f64>,
@@ -179,19 +180,17 @@ impl<V: Interface> Partials<V> {
         self.wanted.get(unknown.index()).copied().unwrap_or(true)
     }
 
-    /// Writes the row of `unknown`: its partial with respect to each listed known, zero for the
-    /// others.
-    pub fn row(&mut self, unknown: V::Unknown, by_known: &[(V::Known, f64)]) -> &mut Self {
+    /// Writes a row: `p.row(ForceBy { pressure: dp, length: dl })`, the partials of its unknown
+    /// by the knowns its `<ModelStructure>` entry declares (zero by every other known).
+    pub fn row<R: Row<Variables = V>>(&mut self, row: R) -> &mut Self {
         if self.written.is_empty() {
             self.ask_for(std::iter::empty());
         }
-        let start = unknown.index() * Self::COLUMNS;
-        let row = &mut self.values[start..start + Self::COLUMNS];
-        row.fill(0.0);
-        for &(known, d) in by_known {
-            row[known.index()] = d;
-        }
-        self.written[unknown.index()] = true;
+        let unknown = R::UNKNOWN.index();
+        let values = &mut self.values[unknown * Self::COLUMNS..(unknown + 1) * Self::COLUMNS];
+        values.fill(0.0);
+        row.write(|known, d| values[known.index()] = d);
+        self.written[unknown] = true;
         self
     }
 
@@ -444,10 +443,10 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
     /// Exact partial derivatives of the outputs (and, with states, of the derivative variables
     /// `der(x)`) with respect to the inputs (and the states `x`) at `inputs` and the current
     /// history, on the branch [`Model::evaluate`] takes (analytic or forward-mode, never finite
-    /// differences), written as rows of `partials` against the generated identifiers
-    /// (`partials.row(Unknown::Y, &[(Known::U, 2.0)])`). `partials` comes empty; a row the call
-    /// does not read (`!partials.wants(unknown)`) may be left out when it costs more than the
-    /// others (the stiffness's second derivatives). `Err` says why there are none: by default
+    /// differences), written as rows of `partials` through the generated row types, whose fields
+    /// are the declared dependencies (`partials.row(YBy { u: 2.0 })`). `partials` comes empty; a
+    /// row the call does not read (`!partials.wants(unknown)`) may be left out when it costs more
+    /// than the others (the stiffness's second derivatives). `Err` says why there are none: by default
     /// this model does not provide them, and its model description says
     /// `providesDirectionalDerivative="false"`.
     fn partials(
