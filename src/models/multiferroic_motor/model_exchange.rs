@@ -9,28 +9,16 @@
 //! events at the onion's angle at the last event and zero tilt, with zero derivatives. The
 //! description's state count is fixed, hence four in both options.
 
-use super::{gradient_row, partial_rows, write_outputs, MultiferroicMotor};
+use super::{column, partial_rows, write_outputs, MultiferroicMotor};
 use crate::models::{Partials, Report, Status};
-use crate::physics::multiferroic::model_exchange::{by, MeEvaluation, MAX_RINGING_WINDOWS};
+use crate::physics::multiferroic::model_exchange::{MeEvaluation, MAX_RINGING_WINDOWS};
 use crate::physics::multiferroic::{Motor, OnionModel};
-use crate::variables::multiferroic_motor::{Inputs, Known, Outputs, Unknown, Variables};
+use crate::variables::multiferroic_motor::{
+    DerOnionStateAngleBy, DerOnionTiltBy, DerRotorAngleBy, DerRotorSpeedBy, Inputs, Outputs,
+    Variables,
+};
+use crate::variables::Row as _;
 use serde::{Deserialize, Serialize};
-
-/// The continuous states, with their column in the physics' partials.
-pub const STATES: [(Known, usize); 4] = [
-    (Known::RotorAngle, by::ROTOR_ANGLE),
-    (Known::RotorSpeed, by::ROTOR_SPEED),
-    (Known::OnionStateAngle, by::ONION_ANGLE),
-    (Known::OnionTilt, by::ONION_TILT),
-];
-
-/// The states' derivatives, in the order of [`STATES`].
-const DERIVATIVES: [Unknown; 4] = [
-    Unknown::DerRotorAngle,
-    Unknown::DerRotorSpeed,
-    Unknown::DerOnionStateAngle,
-    Unknown::DerOnionTilt,
-];
 
 /// Model Exchange's discrete states, part of the FMU state.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -238,10 +226,13 @@ impl MultiferroicMotor {
         let p = self
             .motor
             .me_partials(&self.state, &inputs, self.me.schedule_time)?;
-        partial_rows(&p, self.strain_drive, &STATES, rows);
-        for (derivative, g) in DERIVATIVES.into_iter().zip(&p.derivatives) {
-            gradient_row(rows, derivative, g, self.strain_drive, &STATES);
-        }
+        partial_rows(&p, self.strain_drive, true, rows);
+        let of = |g| move |known| column(g, known, self.strain_drive, true);
+        let [angle, speed, onion, tilt] = &p.derivatives;
+        rows.row(DerRotorAngleBy::from_fn(of(angle)))
+            .row(DerRotorSpeedBy::from_fn(of(speed)))
+            .row(DerOnionStateAngleBy::from_fn(of(onion)))
+            .row(DerOnionTiltBy::from_fn(of(tilt)));
         Ok(())
     }
 }
@@ -250,7 +241,7 @@ impl MultiferroicMotor {
 mod tests {
     use super::*;
     use crate::models::Model;
-    use crate::variables::multiferroic_motor::Parameters;
+    use crate::variables::multiferroic_motor::{Known, Parameters, Unknown};
     use crate::variables::{ContinuousStates, Interface};
 
     type States = <Variables as Interface>::States;
