@@ -3,31 +3,9 @@
 //! declare (none: an empty enum), so that a model computes its arrays against a type and a
 //! renamed array is a compile error in the model.
 
+use super::jacobian::variant_name;
 use super::Model;
 use std::fmt::Write as _;
-
-/// `wall_stress_hoop` -> `WallStressHoop`.
-fn variant_name(name: &str) -> String {
-    let mut out = String::new();
-    let mut capital = true;
-    for ch in name.chars() {
-        if !ch.is_ascii_alphanumeric() {
-            capital = true;
-        } else if capital {
-            out.extend(ch.to_uppercase());
-            capital = false;
-        } else {
-            out.push(ch);
-        }
-    }
-    if out.is_empty() || out.starts_with(|c: char| c.is_ascii_digit()) {
-        out.insert(0, 'A');
-    }
-    if out == "Self" {
-        out.push('_');
-    }
-    out
-}
 
 /// `ArrayOutput` of `model` and its [`ArrayIdentifier`] implementation (declaration order, which
 /// is the order of the FMI 3.0 value references).

@@ -34,12 +34,12 @@ pub fn identical(model: &Model, code: &mut String) {
     let _ = writeln!(code, "    }}");
 }
 
-/// `der(joint_angle)` -> `DerJointAngle`, `jointTorque` -> `JointTorque`: a variable's name as an
-/// enum variant.
-fn variant_name(v: &Variable) -> String {
+/// `der(joint_angle)` -> `DerJointAngle`, `jointTorque` -> `JointTorque`: a variable's (or an
+/// array's) name as an enum variant.
+pub(super) fn variant_name(name: &str) -> String {
     let mut out = String::new();
     let mut capital = true;
-    for ch in v.name.chars() {
+    for ch in name.chars() {
         if !ch.is_ascii_alphanumeric() {
             capital = true;
         } else if capital {
@@ -120,7 +120,7 @@ fn row_type(
             Some(deps) => deps.iter().any(|&d| std::ptr::eq(&vars[d - 1], *k)),
         })
         .collect();
-    let unknown = variant_name(u);
+    let unknown = variant_name(&u.name);
     let name = format!("{unknown}By");
     let _ = writeln!(
         code,
@@ -140,7 +140,7 @@ fn row_type(
     let _ = writeln!(code, "        const UNKNOWN: Unknown = Unknown::{unknown};");
     let knowns: Vec<String> = declared
         .iter()
-        .map(|k| format!("Known::{}", variant_name(k)))
+        .map(|k| format!("Known::{}", variant_name(&k.name)))
         .collect();
     let _ = writeln!(
         code,
@@ -179,7 +179,7 @@ fn identifier_enum(
     members: &[&Variable],
     code: &mut String,
 ) -> Result<(), String> {
-    let variants: Vec<String> = members.iter().map(|v| variant_name(v)).collect();
+    let variants: Vec<String> = members.iter().map(|v| variant_name(&v.name)).collect();
     for (i, a) in variants.iter().enumerate() {
         if let Some(j) = variants[..i].iter().position(|b| b == a) {
             return Err(format!(
