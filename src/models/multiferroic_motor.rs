@@ -163,7 +163,12 @@ impl Model for MultiferroicMotor {
     const DOCUMENTATION: &'static str = include_str!("multiferroic_motor.html");
 
     fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
-        Motor::validate_state(&saved.state).map_err(|e| format!("motor state: {e}"))?;
+        let validate = if saved.model_exchange_active() {
+            Motor::me_validate_state
+        } else {
+            Motor::validate_state
+        };
+        validate(&saved.state).map_err(|e| format!("motor state: {e}"))?;
         self.state = saved.state;
         self.me = saved.me.validated()?;
         Ok(())
