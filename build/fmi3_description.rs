@@ -330,7 +330,10 @@ fn variable(
     if let Some(u) = &v.unit {
         let _ = write!(a, " unit=\"{}\"", escape(u));
     }
-    for (name, value) in [("min", &v.min), ("max", &v.max), ("nominal", &v.nominal)] {
+    // No `nominal`: FMI 3.0 allows it on a Float64, but the `fmi` crate's reader (fmi-schema 0.8)
+    // refuses the attribute there and so the whole description. The continuous states' nominals
+    // reach importers through fmi3GetNominalsOfContinuousStates, as in FMI 2.0.
+    for (name, value) in [("min", &v.min), ("max", &v.max)] {
         if let Some(value) = value {
             let _ = write!(a, " {name}=\"{}\"", escape(value));
         }
