@@ -445,6 +445,16 @@ fmusim: fmus
 	@test -n "$(FMUSIM)" || { echo "set FMUSIM=path/to/fmusim (docs/compatibility.md: fmusim)"; exit 2; }
 	FMUSIM="$(FMUSIM)" tools/fmusim.sh $(FMUSIM_FMUS)
 
+.PHONY: omsimulator
+## OMSimulator (OpenModelica's FMI simulator, built from source: docs/compatibility.md,
+## "OMSimulator") on every FMU in Co-Simulation and Model Exchange at its default settings, and the
+## motor as Model Exchange (quasi-static and Gilbert onion) against FMPy:
+## `make omsimulator OMSIMULATOR=<prefix>/bin/OMSimulator` (tests/fmpy/test_omsimulator.py, which
+## `make test` skips unless OMSIMULATOR is set or OMSimulator is on PATH).
+omsimulator: fmus $(VENV)/.installed
+	@test -n "$(OMSIMULATOR)" || { echo "set OMSIMULATOR=<prefix>/bin/OMSimulator (docs/compatibility.md: OMSimulator)"; exit 2; }
+	OMSIMULATOR="$(OMSIMULATOR)" $(PY) -m pytest -q -rs tests/fmpy/test_omsimulator.py
+
 ## ---- The documentation site and `make help` ----
 .PHONY: docs help
 
@@ -485,6 +495,7 @@ Measure and check (not part of make test)
   report            docs/accuracy-cost.md and the tables of docs/performance.md
   compliance        the FMU Compliance Checker on every FMU: FMUCHECKER=path/to/fmuCheck.linux64
   fmusim            fmusim validate and simulate (CS, ME) on every FMU, FMI 2.0 and 3.0: FMUSIM=path/to/fmusim
+  omsimulator       OMSimulator on every FMU (CS, ME) and the motor's Model Exchange: OMSIMULATOR=.../bin/OMSimulator
   fuzz              random FMI call sequences (cargo-fuzz): FUZZ_SECONDS= FUZZ_JOBS= SANITIZER=
   fuzz-cmin         the committed fuzz corpus cut to a set cover of its and fuzz/corpus-run's edges
   memcheck          every FMU under valgrind, natively and through FMPy

@@ -75,14 +75,9 @@ fn main() {
         let fmi3_xml = fmi3_description::xml(&text, &model).unwrap_or_else(|e| fail(path, &e));
         let fmi3_path = Path::new(&out_dir).join(format!("{stem}.fmi3.xml"));
         std::fs::write(&fmi3_path, fmi3_xml).unwrap_or_else(|e| fail(path, &e.to_string()));
-        fmi3_description::tables(
-            &model,
-            &text,
-            &fmi3_path.display().to_string(),
-            &mut fmi3_tables,
-        )
-        .unwrap_or_else(|e| fail(path, &e));
-        let xml = terminals::xml(&text, &model).unwrap_or_else(|e| fail(path, &e));
+        fmi3_description::tables(&model, &fmi3_path.display().to_string(), &mut fmi3_tables)
+            .unwrap_or_else(|e| fail(path, &e));
+        let xml = terminals::xml(&model).unwrap_or_else(|e| fail(path, &e));
         let terminals_path = Path::new(&out_dir).join(format!("{stem}.terminalsAndIcons.xml"));
         std::fs::write(&terminals_path, xml).unwrap_or_else(|e| fail(path, &e.to_string()));
         terminal_files.push(format!(

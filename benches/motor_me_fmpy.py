@@ -2,7 +2,8 @@
 200 MPa, 12 periods) under FMPy: Co-Simulation against Model Exchange with CVode, and Euler at
 2 ns over the first two periods, with the rotor angle's largest difference at the period ends.
 Run from the repository root after `make fmus`: `.venv/bin/python benches/motor_me_fmpy.py`; with
-`--defaults`, every configuration of DEFAULT_RUNS as Model Exchange under FMPy's default settings."""
+`--defaults`, every configuration of DEFAULT_RUNS as Model Exchange under FMPy's default settings;
+with `--nominals`, what rotor_speed's nominal does under FMPy's and OMSimulator's CVode settings."""
 
 import pathlib
 import time
@@ -76,11 +77,67 @@ def defaults():
         print(f"| {label} | {counts['rhs']} | {counts['events']} | {wall:.2f} s | {worst:.1e} rad |")
 
 
+def with_speed_nominal(solver, nominal):
+    """`solver` (a CVode class of FMPy's) with rotor_speed's nominal replaced by `nominal`."""
+
+    class Replaced(solver):
+        def __init__(self, *args, **kwargs):
+            get_nominals = kwargs["get_nominals"]
+
+            def replaced(x, nx):
+                get_nominals(x, nx)
+                x[1] = nominal
+
+            kwargs["get_nominals"] = replaced
+            super().__init__(*args, **kwargs)
+
+    return Replaced
+
+
+NOMINAL_RUNS = [("fluid_viscosity", v) for v in (1e-4, 1e-3, 1e-2, 0.1, 1, 2, 4)] + [("density", d) for d in (100, 1e3, 1e5)]
+
+
+def nominals():
+    """For rotor_speed nominals from 1e2 rad/s to the description's: the largest rotor-angle
+    difference at the period ends under FMPy's default CVode, and which parameter sets run (on the
+    schedule, 1.2 ms) under OMSimulator's CVode settings (tests/fmpy/test_motor_omsimulator_settings.py)."""
+    import pathlib
+    import sys
+
+    import fmpy.sundials
+
+    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests" / "fmpy"))
+    from test_motor_omsimulator_settings import OMSimulatorCVode
+
+    default_solver = fmpy.sundials.CVodeSolver
+    cs = simulate_fmu(FMU, start_values=PARAMETERS, output=["rotor_angle"], output_interval=1e-6)
+    ends = np.arange(1, 13) * 1e-4
+    print("| rotor_speed nominal | period ends vs CS, FMPy defaults | " + " | ".join(f"{k} {v:g}" for k, v in NOMINAL_RUNS) + " |")
+    print("|---" * (2 + len(NOMINAL_RUNS)) + "|")
+    try:
+        for nominal in (1e2, 1e3, 1e4, 6.7e4):
+            fmpy.sundials.CVodeSolver = with_speed_nominal(default_solver, nominal)
+            me = simulate_fmu(FMU, fmi_type="ModelExchange", start_values=PARAMETERS, output=["rotor_angle"])
+            row = [f"{nominal:g} rad/s", f"{np.abs(at(me, ends) - at(cs, ends)).max():.1e} rad"]
+            fmpy.sundials.CVodeSolver = with_speed_nominal(OMSimulatorCVode, nominal)
+            for name, value in NOMINAL_RUNS:
+                try:
+                    simulate_fmu(FMU, fmi_type="ModelExchange", start_values={**PARAMETERS, name: value}, output=["rotor_angle"])
+                    row.append("runs")
+                except Exception:
+                    row.append("stops")
+            print("| " + " | ".join(row) + " |", flush=True)
+    finally:
+        fmpy.sundials.CVodeSolver = default_solver
+
+
 def main():
     import sys
 
     if "--defaults" in sys.argv:
         return defaults()
+    if "--nominals" in sys.argv:
+        return nominals()
     print("| run | simulated | wall time | largest rotor-angle difference at period ends |")
     print("|---|---|---|---|")
     for label, stop, kw in [

@@ -10,9 +10,10 @@
 //! when run alone).
 //!
 //! Time on a shared machine moves with the load; instructions do not. When `valgrind` is on the
-//! PATH, the bench also runs itself under callgrind once per FMI-layer case (`PARITY_COUNT=<case>`:
-//! that case alone, its steps inside `counted_steps`, the only function callgrind counts) and
-//! reports instructions per step beside the times. (`perf stat` would count them too, but these
+//! PATH, the bench also runs itself under callgrind for each FMI-layer case (`PARITY_COUNT=<case>`:
+//! that case alone, its steps inside `counted_steps`) and reports instructions per step (counted
+//! inside `counted_steps`) and per call (inside each of the three exported functions) beside
+//! the times. (`perf stat` would count them too, but these
 //! virtual machines expose no hardware counters.)
 //!
 //! Writes `target/parity/parity.json` for `benches/report.py`. `PARITY_ROUNDS` sets the rounds;
@@ -319,9 +320,13 @@ fn counted_steps(case: &mut Case, n: u64) {
 
 /// Steps each `PARITY_COUNT` run counts; the loop's entry and exit are amortized over them.
 const COUNTED_STEPS: u64 = 20_000;
+/// Steps before them (lazy binding, first-call work), counted only in the per-call figures.
+const WARMUP_STEPS: u64 = 1000;
+/// The three calls of a step, counted one by one.
+const CALLS: [&str; 3] = ["fmi2SetReal", "fmi2DoStep", "fmi2GetReal"];
 
-/// `PARITY_COUNT=<case>`: that case alone, warmed up (lazy binding, first-call work), then
-/// [`COUNTED_STEPS`] steps inside [`counted_steps`].
+/// `PARITY_COUNT=<case>`: that case alone, [`WARMUP_STEPS`] steps, then [`COUNTED_STEPS`] steps
+/// inside [`counted_steps`].
 fn count_mode(name: &str) {
     // `cases` builds its cases in the order of COUNTED: up to this one.
     let last = COUNTED
@@ -333,42 +338,60 @@ fn count_mode(name: &str) {
         .iter_mut()
         .find(|c| c.name == name)
         .unwrap_or_else(|| panic!("no case {name}"));
-    (case.run)(1000, &mut []);
+    (case.run)(WARMUP_STEPS, &mut []);
     counted_steps(case, COUNTED_STEPS);
 }
 
-/// Instructions per step of each case in [`COUNTED`], by callgrind (this binary run again in
+/// One case's instructions by callgrind: per step (the harness's loop included) and per call
+/// of [`CALLS`] (the call and everything it calls).
+struct Instructions {
+    case: &'static str,
+    per_step: f64,
+    per_call: [f64; 3],
+}
+
+/// The instructions callgrind collects inside `function` (and what it calls) when this binary
+/// runs `case` in `PARITY_COUNT` mode.
+fn collected(exe: &Path, case: &str, function: &str) -> Option<f64> {
+    let output = std::process::Command::new("valgrind")
+        .args(["--tool=callgrind", "--callgrind-out-file=/dev/null"])
+        .arg(format!("--toggle-collect={function}"))
+        .arg(exe)
+        .env("PARITY_COUNT", case)
+        .output()
+        .ok()?;
+    let log = String::from_utf8_lossy(&output.stderr);
+    // "==pid== Collected : 1234567"
+    let collected = log
+        .lines()
+        .find_map(|l| l.split("Collected :").nth(1))
+        .and_then(|n| n.trim().parse::<f64>().ok());
+    if !output.status.success() || collected.is_none() {
+        eprintln!("callgrind on {case} ({function}) failed:\n{log}");
+    }
+    collected.filter(|_| output.status.success())
+}
+
+/// Instructions of each case in [`COUNTED`], by callgrind (this binary run again in
 /// `PARITY_COUNT` mode); `None` when valgrind is missing or `PARITY_INSTRUCTIONS=0`.
-fn instructions_per_step() -> Option<Vec<(&'static str, f64)>> {
+fn instructions() -> Option<Vec<Instructions>> {
     if std::env::var("PARITY_INSTRUCTIONS").is_ok_and(|v| v == "0") {
         return None;
     }
     let exe = std::env::current_exe().ok()?;
+    let calls = (WARMUP_STEPS + COUNTED_STEPS) as f64;
     let mut counts = Vec::new();
-    for name in COUNTED {
-        let output = std::process::Command::new("valgrind")
-            .args([
-                "--tool=callgrind",
-                "--callgrind-out-file=/dev/null",
-                "--toggle-collect=*counted_steps*",
-            ])
-            .arg(&exe)
-            .env("PARITY_COUNT", name)
-            .output()
-            .ok()?;
-        let log = String::from_utf8_lossy(&output.stderr);
-        // "==pid== Collected : 1234567"
-        let collected = log
-            .lines()
-            .find_map(|l| l.split("Collected :").nth(1))
-            .and_then(|n| n.trim().parse::<f64>().ok());
-        match (output.status.success(), collected) {
-            (true, Some(n)) => counts.push((name, n / COUNTED_STEPS as f64)),
-            _ => {
-                eprintln!("callgrind on {name} failed:\n{log}");
-                return None;
-            }
+    for case in COUNTED {
+        let per_step = collected(&exe, case, "*counted_steps*")? / COUNTED_STEPS as f64;
+        let mut per_call = [0.0; 3];
+        for (n, function) in per_call.iter_mut().zip(CALLS) {
+            *n = collected(&exe, case, function)? / calls;
         }
+        counts.push(Instructions {
+            case,
+            per_step,
+            per_call,
+        });
     }
     Some(counts)
 }
@@ -549,23 +572,47 @@ fn main() {
         &ms,
     );
 
-    let instructions = instructions_per_step();
+    let instructions = instructions();
     match &instructions {
         Some(counts) => {
-            println!("\nInstructions per step (callgrind, {COUNTED_STEPS} steps; independent of the load):");
-            let c = counts[0].1;
-            for (name, n) in counts {
-                println!("{name:<42} {n:>10.1} {:>8.2}x", n / c);
+            println!("\nInstructions (callgrind, {COUNTED_STEPS} steps; independent of the load):");
+            println!(
+                "{:<42} {:>10} {:>9} {:>12} {:>11} {:>12}",
+                "case", "per step", "against C", CALLS[0], CALLS[1], CALLS[2]
+            );
+            let c = counts[0].per_step;
+            for n in counts {
+                println!(
+                    "{:<42} {:>10.1} {:>8.2}x {:>12.1} {:>11.1} {:>12.1}",
+                    n.case,
+                    n.per_step,
+                    n.per_step / c,
+                    n.per_call[0],
+                    n.per_call[1],
+                    n.per_call[2]
+                );
             }
         }
         None => {
-            println!("\nInstructions per step: not counted (no valgrind, or PARITY_INSTRUCTIONS=0)")
+            println!("\nInstructions: not counted (no valgrind, or PARITY_INSTRUCTIONS=0)")
         }
     }
     let instructions_json = instructions.map_or("[]".to_string(), |counts| {
         let rows: Vec<String> = counts
             .iter()
-            .map(|(name, n)| format!("  {{\"case\": \"{name}\", \"per_step\": {n}}}"))
+            .map(|n| {
+                let calls: Vec<String> = CALLS
+                    .iter()
+                    .zip(n.per_call)
+                    .map(|(f, x)| format!("\"{f}\": {x}"))
+                    .collect();
+                format!(
+                    "  {{\"case\": \"{}\", \"per_step\": {}, \"per_call\": {{{}}}}}",
+                    n.case,
+                    n.per_step,
+                    calls.join(", ")
+                )
+            })
             .collect();
         format!("[\n{}\n]", rows.join(",\n"))
     });

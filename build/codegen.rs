@@ -8,6 +8,8 @@
 use super::model_description::{field_name, Model, Variable, TYPES};
 use std::fmt::Write as _;
 
+#[path = "codegen_arrays.rs"]
+mod arrays;
 #[path = "codegen_jacobian.rs"]
 mod jacobian;
 
@@ -223,6 +225,7 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
     states(model, code)?;
     jacobian::identifiers(model, code)?;
     jacobian::identical(model, code);
+    arrays::identifiers(model, code)?;
     let _ = writeln!(
         code,
         "    /// The interface of `{stem}`: its typed variable groups and metadata."
@@ -235,6 +238,7 @@ pub fn tables(model: &Model, xml_path: &str, code: &mut String) -> Result<(), St
     let _ = writeln!(code, "        type States = States;");
     let _ = writeln!(code, "        type Known = Known;");
     let _ = writeln!(code, "        type Unknown = Unknown;");
+    let _ = writeln!(code, "        type ArrayOutput = ArrayOutput;");
     let _ = writeln!(
         code,
         "        const EVENT_INDICATORS: usize = {};",

@@ -1,6 +1,9 @@
 //! The one reader of an FMI 2.0 model description: serde structs over quick-xml. It reads a source
 //! (`modelDescription/<Model>.xml`) and a shipped description alike; the code generator's checks
-//! (`variable_checks.rs`) and the FMI 2.0 rules (`rules.rs`) are checks over this typed data.
+//! (`variable_checks.rs`) and the FMI 2.0 rules (`rules.rs`) are checks over this typed data, and
+//! the FMI 3.0 description (`fmi3_description.rs`, `fmi3_arrays.rs`) and terminals
+//! (`terminals.rs`) are written from it, with what the source's own `<Tool>` declares for FMI 3.0
+//! only (its `<Terminals>` and `<Arrays>`).
 //!
 //! Attribute values the rules judge are kept as text, so that a bad one is refused with a reason
 //! rather than a parse error. A list element (`Unit`, `ScalarVariable`, `Unknown`, ...) must be
@@ -178,6 +181,8 @@ pub struct TypeDefinitions {
 pub struct SimpleType {
     #[serde(rename = "@name")]
     pub name: String,
+    #[serde(rename = "@description")]
+    pub description: Option<String>,
     #[serde(rename = "Real")]
     pub real: Option<TypeAttributes>,
     #[serde(rename = "Enumeration")]
@@ -196,6 +201,8 @@ pub struct Item {
     pub name: String,
     #[serde(rename = "@value")]
     pub value: i32,
+    #[serde(rename = "@description")]
+    pub description: Option<String>,
 }
 
 #[derive(Deserialize)]
@@ -237,14 +244,104 @@ pub struct Tool {
     pub elements: Vec<ToolElement>,
 }
 
-/// A child of a `<Tool>`: the source's `<Terminals>` (the FMI 3.0 flanges) or `<Arrays>` (the FMI
-/// 3.0 array outputs), which build.rs moves out of the FMI 2.0 description, or any other element.
-#[derive(Deserialize, PartialEq)]
+/// A child of a `<Tool>`: the source's `<Terminals>` (the FMI 3.0 flanges, `terminals.rs`) or
+/// `<Arrays>` (the FMI 3.0 array outputs, `fmi3_arrays.rs`), which build.rs moves out of the FMI
+/// 2.0 description, or any other element.
+#[derive(Deserialize)]
 pub enum ToolElement {
-    Terminals,
-    Arrays,
+    Terminals(Terminals),
+    Arrays(Arrays),
     #[serde(other)]
     Other,
+}
+
+/// The name of the `<Tool>` whose elements are this project's own.
+const TOOL: &str = "actuator-fmus";
+
+impl Description {
+    /// The elements of this project's own `<Tool>`s, in order.
+    fn own_elements(&self) -> impl Iterator<Item = &ToolElement> {
+        self.vendor_annotations
+            .iter()
+            .flat_map(|a| &a.tools)
+            .filter(|t| t.name == TOOL)
+            .flat_map(|t| &t.elements)
+    }
+
+    /// The mechanical flanges the source declares (`<Terminals>`), in order.
+    pub fn flanges(&self) -> impl Iterator<Item = &Flange> {
+        self.own_elements()
+            .filter_map(|e| match e {
+                ToolElement::Terminals(t) => Some(&t.flanges),
+                _ => None,
+            })
+            .flatten()
+    }
+
+    /// The FMI 3.0 array outputs the source declares (`<Arrays>`), in order.
+    pub fn arrays(&self) -> impl Iterator<Item = &ArrayDeclaration> {
+        self.own_elements()
+            .filter_map(|e| match e {
+                ToolElement::Arrays(a) => Some(&a.arrays),
+                _ => None,
+            })
+            .flatten()
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Terminals {
+    #[serde(rename = "Flange", default)]
+    pub flanges: Vec<Flange>,
+}
+
+/// `<Flange name kind position|angle force|torque flow description/>`: a mechanical flange of the
+/// FMI 3.0 FMU (`terminals.rs` checks it).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Flange {
+    #[serde(rename = "@name")]
+    pub name: String,
+    #[serde(rename = "@kind")]
+    pub kind: String,
+    #[serde(rename = "@position")]
+    pub position: Option<String>,
+    #[serde(rename = "@force")]
+    pub force: Option<String>,
+    #[serde(rename = "@angle")]
+    pub angle: Option<String>,
+    #[serde(rename = "@torque")]
+    pub torque: Option<String>,
+    #[serde(rename = "@flow")]
+    pub flow: String,
+    #[serde(rename = "@description")]
+    pub description: Option<String>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Arrays {
+    #[serde(rename = "Array", default)]
+    pub arrays: Vec<ArrayDeclaration>,
+}
+
+/// `<Array name size unit description dependenciesOf/>`: an FMI 3.0 array output
+/// (`fmi3_arrays.rs` checks it).
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ArrayDeclaration {
+    #[serde(rename = "@name")]
+    pub name: String,
+    #[serde(rename = "@size")]
+    pub size: u64,
+    #[serde(rename = "@unit")]
+    pub unit: Option<String>,
+    #[serde(rename = "@description")]
+    pub description: Option<String>,
+    /// The scalar output whose dependencies the array has.
+    #[serde(rename = "@dependenciesOf")]
+    pub dependencies_of: String,
 }
 
 #[derive(Deserialize)]

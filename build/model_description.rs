@@ -79,6 +79,9 @@ pub struct Model {
     /// The model description as shipped in the FMU, GUID filled in.
     pub shipped_xml: String,
     pub guid: String,
+    /// The source as read, once: the FMI 3.0 description, its array outputs and its terminals are
+    /// written from it.
+    pub source: description::Description,
 }
 
 /// Checks the model description `text` of file `<stem>.xml`; the error says what is wrong.
@@ -174,7 +177,7 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
     let guid = guid_of(&rendered);
     Ok(Model {
         name: stem.to_string(),
-        description: md.description,
+        description: md.description.clone(),
         variables,
         counts,
         outputs,
@@ -184,6 +187,7 @@ pub fn check(text: &str, stem: &str) -> Result<Model, String> {
         event_indicators,
         shipped_xml: rendered.replacen(GUID_PLACEHOLDER, &guid, 1),
         guid,
+        source: md,
     })
 }
 

@@ -188,7 +188,8 @@ fn check_vendor_annotations(md: &Description, form: Form) -> Result<(), String> 
             .elements
             .iter()
             .filter(|e| {
-                form == Form::Shipped || !matches!(e, ToolElement::Terminals | ToolElement::Arrays)
+                form == Form::Shipped
+                    || !matches!(e, ToolElement::Terminals(_) | ToolElement::Arrays(_))
             })
             .count();
         if counted > 1 {

@@ -138,6 +138,8 @@ pub trait Interface: 'static {
     type Known: Identifier;
     /// The unknowns of the Jacobian: the Real outputs, then the state derivatives.
     type Unknown: Identifier;
+    /// The FMI 3.0 array outputs.
+    type ArrayOutput: ArrayIdentifier;
     /// `numberOfEventIndicators` of the model description.
     const EVENT_INDICATORS: usize;
     /// Metadata of every variable.
@@ -201,6 +203,60 @@ impl Identifier for () {
     fn from_value_reference(_: u32) -> Option<Self> {
         None
     }
+}
+
+/// One FMI 3.0 array output of a model (an `<Array>` of its model description's
+/// VendorAnnotations), generated per model description as `crate::variables::<model>::ArrayOutput`:
+/// one variant per array, named after it (`wall_radius` becoming `WallRadius`), so that a renamed
+/// array is a compile error in the model that computes it.
+pub trait ArrayIdentifier: Copy + Eq + std::fmt::Debug + Send + Sync + 'static {
+    /// Every array output, in declaration order.
+    const ALL: &'static [Self];
+    /// The variable name of the array.
+    fn name(self) -> &'static str;
+    /// The array output named `name`, if the model has one.
+    fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.iter().copied().find(|a| a.name() == name)
+    }
+}
+
+/// No array outputs (hand-written interfaces in tests).
+impl ArrayIdentifier for std::convert::Infallible {
+    const ALL: &'static [Self] = &[];
+    fn name(self) -> &'static str {
+        match self {}
+    }
+}
+
+/// One row of a model's Jacobian, generated per unknown as `crate::variables::<model>::<Unknown>By`
+/// (`ForceBy { pressure, length }`): one field per known the unknown's `<ModelStructure>` entry
+/// declares. A model writes its partials only through these, so they hold to the declared
+/// dependencies by construction: an undeclared partial does not compile, nor does a missing
+/// declared one. McKibbenMuscle's `stress_radial` declares `pressure` alone:
+///
+/// ```
+/// use actuator_fmus::variables::mckibben_muscle::{ForceBy, StressRadialBy};
+/// let _ = (StressRadialBy { pressure: -1.0 }, ForceBy { pressure: 1.0, length: 2.0 });
+/// ```
+/// ```compile_fail
+/// # use actuator_fmus::variables::mckibben_muscle::StressRadialBy;
+/// let _ = StressRadialBy { pressure: -1.0, length: 0.0 }; // undeclared
+/// ```
+/// ```compile_fail
+/// # use actuator_fmus::variables::mckibben_muscle::ForceBy;
+/// let _ = ForceBy { pressure: 1.0 }; // `length` is declared
+/// ```
+pub trait Row: Copy {
+    type Variables: Interface;
+    /// The unknown whose row this is.
+    const UNKNOWN: <Self::Variables as Interface>::Unknown;
+    /// The knowns it declares, in [`Identifier::index`] order: the row's fields.
+    const KNOWNS: &'static [<Self::Variables as Interface>::Known];
+    /// The row with `by(known)` for each declared known: for a model whose partials come as a
+    /// gradient over every known, of which the row takes the declared ones.
+    fn from_fn(by: impl FnMut(<Self::Variables as Interface>::Known) -> f64) -> Self;
+    /// Calls `into(known, partial)` for each declared known.
+    fn write(&self, into: impl FnMut(<Self::Variables as Interface>::Known, f64));
 }
 
 /// Equality bit for bit (Reals by `f64::to_bits`): the export layer reuses partials only at

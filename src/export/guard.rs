@@ -46,27 +46,43 @@ pub(crate) unsafe fn guarded(
     let Some(inst) = (unsafe { instance(c) }) else {
         return Status::Error;
     };
-    // One handle table serves both FMI versions: an instance answers only its own version's calls.
-    if inst.api.version != api.version {
-        return inst.error(&format!(
-            "{function}: the instance was instantiated through the other FMI version's API"
-        ));
+    // One handle table serves both FMI versions: an instance answers only the calls of the `Api`
+    // (a static of its version layer) it was instantiated through.
+    if !std::ptr::eq(inst.api, api) {
+        return wrong_version(inst, function);
     }
     let ptr: *mut Instance = inst;
     // SAFETY: `ptr` is live for the whole call; the closure's borrow ends before the panic arm.
     match catch_unwind(AssertUnwindSafe(|| body(unsafe { &mut *ptr }))) {
         Ok(status) => status,
-        Err(payload) => {
-            // SAFETY: as above; nothing else borrows the instance now.
-            let inst = unsafe { &mut *ptr };
-            inst.set_state(MachineState::Fatal);
-            inst.logger.log(
-                Status::Fatal,
-                &format!("{function}: internal error: {}", panic_text(&*payload)),
-            );
-            Status::Fatal
-        }
+        // SAFETY: as above; nothing else borrows the instance now.
+        Err(payload) => internal_error(unsafe { &mut *ptr }, function, &*payload),
     }
+}
+
+#[cold]
+#[inline(never)]
+fn wrong_version(inst: &Instance, function: &str) -> Status {
+    inst.error(&format!(
+        "{function}: the instance was instantiated through the {} API",
+        inst.api.version
+    ))
+}
+
+/// A panic caught at the C boundary: logged, and the instance becomes fatal.
+#[cold]
+#[inline(never)]
+fn internal_error(
+    inst: &mut Instance,
+    function: &str,
+    payload: &(dyn std::any::Any + Send),
+) -> Status {
+    inst.set_state(MachineState::Fatal);
+    inst.logger.log(
+        Status::Fatal,
+        &format!("{function}: internal error: {}", panic_text(payload)),
+    );
+    Status::Fatal
 }
 
 /// A slice from a C array; NULL is accepted only for an empty array.

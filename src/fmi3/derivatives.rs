@@ -18,49 +18,67 @@ fn check_float64(inst: &Instance, function: &str, vrs: &[u32]) -> Option<fmi3Sta
     })
 }
 
-/// The raw arguments both derivative calls share, with their lengths.
-struct Arguments {
-    unknowns: (*const fmi3ValueReference, usize),
-    knowns: (*const fmi3ValueReference, usize),
-    seed: (*const f64, usize),
-    sensitivity: (*mut f64, usize),
+/// Which side of the Jacobian `J` a derivative call's seed is on.
+#[derive(Clone, Copy)]
+enum Seed {
+    /// `sensitivity = J seed` (`fmi3GetDirectionalDerivative`): a seed value per known.
+    Knowns,
+    /// `sensitivity = seed^T J` (`fmi3GetAdjointDerivative`): a seed value per unknown.
+    Unknowns,
 }
 
-/// The arguments as slices of Float64 value references and values.
+/// A raw array argument and its length.
+type Raw<T> = (T, usize);
+
+/// The arguments both derivative calls share, as slices of Float64 value references and values.
 type Checked<'a> = (&'a [u32], &'a [u32], &'a [f64], &'a mut [f64]);
 
-impl Arguments {
-    /// No NULL array of non-zero length, and every value reference a Float64 variable.
-    ///
-    /// # Safety
-    /// Each non-NULL pointer points to as many values as its length says.
-    unsafe fn checked<'a>(
-        &self,
-        inst: &Instance,
-        function: &str,
-    ) -> Result<Checked<'a>, fmi3Status> {
-        // SAFETY: the caller's contract.
-        let arrays = unsafe {
-            (
-                slice(self.unknowns.0, self.unknowns.1),
-                slice(self.knowns.0, self.knowns.1),
-                slice(self.seed.0, self.seed.1),
-                slice_mut(self.sensitivity.0, self.sensitivity.1),
-            )
-        };
-        let (Some(unknowns), Some(knowns), Some(seed), Some(sensitivity)) = arrays else {
-            return Err(null_argument(
-                inst,
-                function,
-                "unknowns, knowns, seed or sensitivity",
-            ));
-        };
-        match check_float64(inst, function, unknowns)
-            .or_else(|| check_float64(inst, function, knowns))
-        {
-            Some(refused) => Err(refused),
-            None => Ok((unknowns, knowns, seed, sensitivity)),
-        }
+/// The arguments of a derivative call, checked: the seed and the sensitivity as long as the side
+/// `seed_on` says (the variables are scalars), no NULL array of non-zero length, and every value
+/// reference a Float64 variable.
+///
+/// # Safety
+/// Each non-NULL pointer points to as many values as its length says.
+unsafe fn checked<'a>(
+    inst: &Instance,
+    function: &str,
+    seed_on: Seed,
+    unknowns: Raw<*const fmi3ValueReference>,
+    knowns: Raw<*const fmi3ValueReference>,
+    seed: Raw<*const f64>,
+    sensitivity: Raw<*mut f64>,
+) -> Result<Checked<'a>, fmi3Status> {
+    let ((seeded, n_seeded), (sensed, n_sensed)) = match seed_on {
+        Seed::Knowns => (("nKnowns", knowns.1), ("nUnknowns", unknowns.1)),
+        Seed::Unknowns => (("nUnknowns", unknowns.1), ("nKnowns", knowns.1)),
+    };
+    if seed.1 != n_seeded || sensitivity.1 != n_sensed {
+        return Err(inst.error(&format!(
+            "{function}: nSeed ({}) must equal {seeded} ({n_seeded}) and nSensitivity ({}) \
+             {sensed} ({n_sensed}): the variables are scalars",
+            seed.1, sensitivity.1
+        )));
+    }
+    // SAFETY: the caller's contract.
+    let arrays = unsafe {
+        (
+            slice(unknowns.0, unknowns.1),
+            slice(knowns.0, knowns.1),
+            slice(seed.0, seed.1),
+            slice_mut(sensitivity.0, sensitivity.1),
+        )
+    };
+    let (Some(unknowns), Some(knowns), Some(seed), Some(sensitivity)) = arrays else {
+        return Err(null_argument(
+            inst,
+            function,
+            "unknowns, knowns, seed or sensitivity",
+        ));
+    };
+    match check_float64(inst, function, unknowns).or_else(|| check_float64(inst, function, knowns))
+    {
+        Some(refused) => Err(refused),
+        None => Ok((unknowns, knowns, seed, sensitivity)),
     }
 }
 
@@ -80,19 +98,16 @@ pub unsafe extern "C" fn fmi3GetDirectionalDerivative(
     const F: &str = "fmi3GetDirectionalDerivative";
     unsafe {
         guarded(instance, F, |inst| {
-            if n_seed != n_knowns || n_sensitivity != n_unknowns {
-                return inst.error(&format!(
-                    "{F}: nSeed ({n_seed}) must equal nKnowns ({n_knowns}) and nSensitivity \
-                     ({n_sensitivity}) nUnknowns ({n_unknowns}): the variables are scalars"
-                ));
-            }
-            let arguments = Arguments {
-                unknowns: (unknowns, n_unknowns),
-                knowns: (knowns, n_knowns),
-                seed: (seed, n_seed),
-                sensitivity: (sensitivity, n_sensitivity),
-            };
-            let (unknowns, knowns, seed, sensitivity) = match arguments.checked(inst, F) {
+            let arguments = checked(
+                inst,
+                F,
+                Seed::Knowns,
+                (unknowns, n_unknowns),
+                (knowns, n_knowns),
+                (seed, n_seed),
+                (sensitivity, n_sensitivity),
+            );
+            let (unknowns, knowns, seed, sensitivity) = match arguments {
                 Ok(a) => a,
                 Err(refused) => return refused,
             };
@@ -119,19 +134,16 @@ pub unsafe extern "C" fn fmi3GetAdjointDerivative(
     const F: &str = "fmi3GetAdjointDerivative";
     unsafe {
         guarded(instance, F, |inst| {
-            if n_seed != n_unknowns || n_sensitivity != n_knowns {
-                return inst.error(&format!(
-                    "{F}: nSeed ({n_seed}) must equal nUnknowns ({n_unknowns}) and nSensitivity \
-                     ({n_sensitivity}) nKnowns ({n_knowns}): the variables are scalars"
-                ));
-            }
-            let arguments = Arguments {
-                unknowns: (unknowns, n_unknowns),
-                knowns: (knowns, n_knowns),
-                seed: (seed, n_seed),
-                sensitivity: (sensitivity, n_sensitivity),
-            };
-            let (unknowns, knowns, seed, sensitivity) = match arguments.checked(inst, F) {
+            let arguments = checked(
+                inst,
+                F,
+                Seed::Unknowns,
+                (unknowns, n_unknowns),
+                (knowns, n_knowns),
+                (seed, n_seed),
+                (sensitivity, n_sensitivity),
+            );
+            let (unknowns, knowns, seed, sensitivity) = match arguments {
                 Ok(a) => a,
                 Err(refused) => return refused,
             };

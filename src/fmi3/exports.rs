@@ -192,7 +192,7 @@ pub unsafe extern "C" fn fmi3FreeInstance(instance: fmi3Instance) {
     let Some(inst) = handles::release(instance) else {
         return;
     };
-    if inst.api.version != API.version {
+    if !std::ptr::eq(inst.api, &API) {
         // An FMI 2.0 instance freed through FMI 3.0: freed all the same (nothing else can).
         inst.logger.log(
             Status::Warning,

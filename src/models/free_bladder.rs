@@ -7,10 +7,15 @@
 //! Exchange. Inputs outside the solvable range are evaluated at the nearest valid point and
 //! flagged (`input_clamped`, `out_of_range_policy`), each excursion logged once.
 
-use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::wall_arrays::{self, WallQuantity};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::free_bladder::{FreeBladder as Tube, FreeBladderState};
-use crate::variables::free_bladder::{Inputs, Known, Outputs, Parameters, Unknown, Variables};
+use crate::variables::free_bladder::{
+    ArrayOutput, BallooningPressureBy, ComplianceBy, ForceBy, InnerDiameterBy, Inputs,
+    OuterDiameterBy, Outputs, Parameters, StressAxialBy, StressHoopBy, StretchAxialBy,
+    StretchHoopBy, StretchRadialBy, Variables, VolumeBy,
+};
 use serde::{Deserialize, Serialize};
 
 /// Gauge pressure of an absolute vacuum at standard atmosphere, Pa: nothing lower is physical.
@@ -117,26 +122,6 @@ impl FreeBladder {
     }
 }
 
-/// One field of the physics' state.
-type Field = fn(&FreeBladderState) -> f64;
-
-impl FreeBladder {
-    /// Each Real output with the field of the physics' state it is.
-    const REAL_OUTPUTS: [(Unknown, Field); 11] = [
-        (Unknown::InnerDiameter, |s| s.inner_diameter),
-        (Unknown::OuterDiameter, |s| s.outer_diameter),
-        (Unknown::Volume, |s| s.fluid_volume),
-        (Unknown::Compliance, |s| s.compliance),
-        (Unknown::StretchAxial, |s| s.stretch_axial),
-        (Unknown::StretchHoop, |s| s.stretch_hoop),
-        (Unknown::StretchRadial, |s| s.stretch_radial),
-        (Unknown::StressAxial, |s| s.stress_axial),
-        (Unknown::StressHoop, |s| s.stress_hoop),
-        (Unknown::Force, |s| s.force),
-        (Unknown::BallooningPressure, |s| s.ballooning_pressure),
-    ];
-}
-
 impl Model for FreeBladder {
     type Variables = Variables;
     const ALGEBRAIC_MODEL_EXCHANGE: bool = true;
@@ -156,12 +141,18 @@ impl Model for FreeBladder {
         })
     }
 
-    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+    fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
+        let quantity = match array {
+            ArrayOutput::WallRadius => WallQuantity::Radius,
+            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
+            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
+            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
+        };
         // At the point the outputs are computed at (the inputs clamped into the solvable range).
         let OperatingPoint {
             pressure, length, ..
         } = self.operating_point(inputs);
-        wall_arrays::write(name, out, |f| self.tube.wall_field(pressure, length, f))
+        wall_arrays::write(quantity, out, |f| self.tube.wall_field(pressure, length, f))
     }
 
     fn evaluate(&mut self, inputs: &Inputs, outputs: &mut Outputs, report: &mut Report) {
@@ -191,15 +182,49 @@ impl Model for FreeBladder {
             .evaluate_with_partials(point.pressure, point.length)?;
         let by_pressure = d.along(point.pressure_slope[0], 0.0);
         let by_length = d.along(point.pressure_slope[1], point.length_slope);
-        for (output, field) in Self::REAL_OUTPUTS {
-            p.row(
-                output,
-                &[
-                    (Known::Pressure, field(&by_pressure)),
-                    (Known::Length, field(&by_length)),
-                ],
-            );
-        }
+        let (dp, dl) = (&by_pressure, &by_length);
+        p.row(InnerDiameterBy {
+            pressure: dp.inner_diameter,
+            length: dl.inner_diameter,
+        })
+        .row(OuterDiameterBy {
+            pressure: dp.outer_diameter,
+            length: dl.outer_diameter,
+        })
+        .row(VolumeBy {
+            pressure: dp.fluid_volume,
+            length: dl.fluid_volume,
+        })
+        .row(ComplianceBy {
+            pressure: dp.compliance,
+            length: dl.compliance,
+        })
+        .row(StretchAxialBy {
+            length: dl.stretch_axial,
+        })
+        .row(StretchHoopBy {
+            pressure: dp.stretch_hoop,
+            length: dl.stretch_hoop,
+        })
+        .row(StretchRadialBy {
+            pressure: dp.stretch_radial,
+            length: dl.stretch_radial,
+        })
+        .row(StressAxialBy {
+            pressure: dp.stress_axial,
+            length: dl.stress_axial,
+        })
+        .row(StressHoopBy {
+            pressure: dp.stress_hoop,
+            length: dl.stress_hoop,
+        })
+        .row(ForceBy {
+            pressure: dp.force,
+            length: dl.force,
+        })
+        .row(BallooningPressureBy {
+            length: dl.ballooning_pressure,
+        });
         Ok(())
     }
 
@@ -218,6 +243,7 @@ impl Model for FreeBladder {
 mod tests {
     use super::super::all_partials;
     use super::*;
+    use crate::variables::free_bladder::{Known, Unknown};
 
     fn run(p: &Parameters, pressure: f64, length: f64) -> (Outputs, Report) {
         let mut m = FreeBladder::new(p, &Inputs::default()).unwrap();

@@ -8,7 +8,8 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::wall_arrays::{self, WallQuantity};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{Bladder, BladderTube};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
@@ -16,7 +17,8 @@ use crate::physics::knitted_cylinder::{KnittedCylinder, NON_CYLINDRICAL_BLADDER}
 use crate::physics::knitted_muscle::{Friction, KnittedAssembly, KnittedOutput};
 use crate::physics::mckibben::{is_slack, BladderModel};
 use crate::variables::knitted_muscle::{
-    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+    ArrayOutput, CalculatedParameters, EffectivePressureBy, ForceBy, FrictionForceBy, Inputs,
+    MaxRadiusBy, Outputs, Parameters, StiffnessBy, Unknown, Variables, VolumeBy,
 };
 use serde::{Deserialize, Serialize};
 
@@ -177,19 +179,29 @@ impl KnittedMuscle {
             r.force = [0.0; 2];
             r.stiffness = r.stiffness.map(|_| [0.0; 2]);
         }
-        let mut add = |output: Unknown, row: [f64; 2]| {
-            table.row(
-                output,
-                &[(Known::Pressure, row[0]), (Known::Length, row[1])],
-            );
-        };
-        add(Unknown::Force, r.force);
-        add(Unknown::Volume, r.volume);
-        add(Unknown::EffectivePressure, r.effective_pressure);
-        add(Unknown::FrictionForce, r.friction_force);
-        add(Unknown::MaxRadius, r.max_radius);
-        if let Some(stiffness) = r.stiffness {
-            add(Unknown::Stiffness, stiffness);
+        table
+            .row(ForceBy {
+                pressure: r.force[0],
+                length: r.force[1],
+            })
+            .row(VolumeBy {
+                pressure: r.volume[0],
+                length: r.volume[1],
+            })
+            .row(EffectivePressureBy {
+                pressure: r.effective_pressure[0],
+                length: r.effective_pressure[1],
+            })
+            .row(FrictionForceBy {
+                pressure: r.friction_force[0],
+                length: r.friction_force[1],
+            })
+            .row(MaxRadiusBy {
+                pressure: r.max_radius[0],
+                length: r.max_radius[1],
+            });
+        if let Some([pressure, length]) = r.stiffness {
+            table.row(StiffnessBy { pressure, length });
         }
         Ok(())
     }
@@ -296,14 +308,20 @@ impl Model for KnittedMuscle {
         Some(HistoryKey::of([self.history.z, self.history.position]))
     }
 
-    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+    fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
+        let quantity = match array {
+            ArrayOutput::WallRadius => WallQuantity::Radius,
+            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
+            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
+            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
+        };
         let Some(bladder) = self.assembly.bladder() else {
-            return wall_arrays::absent(name, out);
+            return wall_arrays::absent(out);
         };
         // At the length the muscle is evaluated at (the nearer valid one beyond them).
         let (lo, hi) = self.assembly.valid_lengths();
         let length = inputs.length.max(lo).min(hi);
-        wall_arrays::write(name, out, |f| {
+        wall_arrays::write(quantity, out, |f| {
             bladder.wall_field(inputs.pressure, length, f)
         })
     }
@@ -327,6 +345,7 @@ mod tests {
     use super::super::all_partials;
     use super::*;
     use crate::models::Status;
+    use crate::variables::knitted_muscle::Known;
     use std::f64::consts::SQRT_2;
 
     fn parameters_with(shape: i32, friction: bool) -> Parameters {

@@ -20,7 +20,8 @@ use crate::physics::mckibben::{
     MuscleGeometry,
 };
 use crate::variables::mckibben_joint::{
-    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+    CalculatedParameters, ExtensorForceBy, ExtensorLengthBy, ExtensorPressureBy, FlexorForceBy,
+    FlexorLengthBy, FlexorPressureBy, Inputs, JointTorqueBy, Outputs, Parameters, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -401,17 +402,29 @@ impl Model for McKibbenJoint {
         };
         let flexor = [ff_d * dd_du, ff_d * dd_dq + ff_q];
         let extensor = [fe_d * dd_du, fe_d * dd_dq + fe_q];
-        let row = |d: [f64; 2]| [(Known::ActuatorInput, d[0]), (Known::JointPosition, d[1])];
-        p.row(
-            Unknown::JointTorque,
-            &row([r * (flexor[0] - extensor[0]), r * (flexor[1] - extensor[1])]),
-        )
-        .row(Unknown::FlexorForce, &row(flexor))
-        .row(Unknown::ExtensorForce, &row(extensor))
-        .row(Unknown::FlexorPressure, &row([dpf * dd_du, dpf * dd_dq]))
-        .row(Unknown::ExtensorPressure, &row([dpe * dd_du, dpe * dd_dq]))
-        .row(Unknown::FlexorLength, &row([0.0, -r]))
-        .row(Unknown::ExtensorLength, &row([0.0, r]));
+        let torque = [r * (flexor[0] - extensor[0]), r * (flexor[1] - extensor[1])];
+        p.row(JointTorqueBy {
+            actuator_input: torque[0],
+            joint_position: torque[1],
+        })
+        .row(FlexorForceBy {
+            actuator_input: flexor[0],
+            joint_position: flexor[1],
+        })
+        .row(ExtensorForceBy {
+            actuator_input: extensor[0],
+            joint_position: extensor[1],
+        })
+        .row(FlexorPressureBy {
+            actuator_input: dpf * dd_du,
+            joint_position: dpf * dd_dq,
+        })
+        .row(ExtensorPressureBy {
+            actuator_input: dpe * dd_du,
+            joint_position: dpe * dd_dq,
+        })
+        .row(FlexorLengthBy { joint_position: -r })
+        .row(ExtensorLengthBy { joint_position: r });
         Ok(())
     }
 
@@ -449,6 +462,7 @@ impl Model for McKibbenJoint {
 mod tests {
     use super::super::all_partials;
     use super::*;
+    use crate::variables::mckibben_joint::Unknown;
     use std::f64::consts::PI;
 
     fn joint(p: &Parameters) -> McKibbenJoint {

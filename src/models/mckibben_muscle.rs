@@ -5,7 +5,8 @@
 //! friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
-use super::{wall_arrays, HistoryKey, Model, Partials, Refusal, Report, Status};
+use super::wall_arrays::{self, WallQuantity};
+use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::festo;
@@ -17,7 +18,10 @@ use crate::physics::mckibben::{
 };
 use crate::physics::muscle_params::MuscleParams;
 use crate::variables::mckibben_muscle::{
-    CalculatedParameters, Inputs, Known, Outputs, Parameters, Unknown, Variables,
+    ArrayOutput, CalculatedParameters, ContractionBy, EffectivePressureBy, ForceBy,
+    FrictionForceBy, Inputs, Outputs, Parameters, StiffnessBy, StressAxialBy, StressHoopBy,
+    StressRadialBy, StretchAxialBy, StretchHoopBy, StretchRadialBy, TargetPressureBy,
+    ThresholdPressureBy, Unknown, Variables, VolumeBy,
 };
 use serde::{Deserialize, Serialize};
 
@@ -330,21 +334,50 @@ impl McKibbenMuscle {
 
 /// Writes the rows of the physics' partials, by pressure and length.
 fn write_rows(d: &ByPressureLength, p: &mut Partials<Variables>) {
-    for (output, [dp, dl]) in [
-        (Unknown::Force, d.force),
-        (Unknown::EffectivePressure, d.effective_pressure),
-        (Unknown::FrictionForce, d.friction_force),
-        (Unknown::Volume, d.volume),
-        (Unknown::ThresholdPressure, d.threshold_pressure),
-        (Unknown::StretchAxial, d.stretch_axial),
-        (Unknown::StretchHoop, d.stretch_hoop),
-        (Unknown::StretchRadial, d.stretch_radial),
-        (Unknown::StressAxial, d.stress_axial),
-        (Unknown::StressHoop, d.stress_hoop),
-        (Unknown::StressRadial, d.stress_radial),
-    ] {
-        p.row(output, &[(Known::Pressure, dp), (Known::Length, dl)]);
-    }
+    p.row(ForceBy {
+        pressure: d.force[0],
+        length: d.force[1],
+    })
+    .row(EffectivePressureBy {
+        pressure: d.effective_pressure[0],
+        length: d.effective_pressure[1],
+    })
+    .row(FrictionForceBy {
+        pressure: d.friction_force[0],
+        length: d.friction_force[1],
+    })
+    .row(VolumeBy {
+        pressure: d.volume[0],
+        length: d.volume[1],
+    })
+    .row(ThresholdPressureBy {
+        pressure: d.threshold_pressure[0],
+        length: d.threshold_pressure[1],
+    })
+    .row(StretchAxialBy {
+        pressure: d.stretch_axial[0],
+        length: d.stretch_axial[1],
+    })
+    .row(StretchHoopBy {
+        pressure: d.stretch_hoop[0],
+        length: d.stretch_hoop[1],
+    })
+    .row(StretchRadialBy {
+        pressure: d.stretch_radial[0],
+        length: d.stretch_radial[1],
+    })
+    .row(StressAxialBy {
+        pressure: d.stress_axial[0],
+        length: d.stress_axial[1],
+    })
+    .row(StressHoopBy {
+        pressure: d.stress_hoop[0],
+        length: d.stress_hoop[1],
+    })
+    // The radial stress at the inner wall is minus the pressure, whatever the length.
+    .row(StressRadialBy {
+        pressure: d.stress_radial[0],
+    });
 }
 
 impl McKibbenMuscle {
@@ -500,19 +533,25 @@ impl Model for McKibbenMuscle {
         self.outputs(inputs, outputs, report, false)
     }
 
-    fn array(&self, inputs: &Inputs, name: &str, out: &mut [f64]) -> Result<(), String> {
+    fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
+        let quantity = match array {
+            ArrayOutput::WallRadius => WallQuantity::Radius,
+            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
+            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
+            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
+        };
         let Pipeline::Full(muscle) = &self.pipeline else {
-            return wall_arrays::absent(name, out);
+            return wall_arrays::absent(out);
         };
         let Some(bladder) = muscle.bladder() else {
-            return wall_arrays::absent(name, out);
+            return wall_arrays::absent(out);
         };
         // The bladder's own length: the input less the connector's stretch, as evaluated.
         let (p, k_s) = (inputs.pressure, self.strand_stiffness);
         let (state, _) = muscle.evaluate_with_strands(p, inputs.length, k_s, &self.friction);
         let state = state.ok_or("no solution at these inputs")?;
         let length = state.actual_length;
-        wall_arrays::write(name, out, |f| bladder.wall_field(p, length, f))
+        wall_arrays::write(quantity, out, |f| bladder.wall_field(p, length, f))
     }
 
     #[inline]
@@ -534,15 +573,12 @@ impl Model for McKibbenMuscle {
     fn partials(&mut self, inputs: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
         write_rows(&self.partials_at(inputs)?, p);
         if p.wants(Unknown::Stiffness) || matches!(self.pipeline, Pipeline::Sleeve(_)) {
-            let [dp, dl] = self.stiffness_row(inputs)?;
-            p.row(
-                Unknown::Stiffness,
-                &[(Known::Pressure, dp), (Known::Length, dl)],
-            );
+            let [pressure, length] = self.stiffness_row(inputs)?;
+            p.row(StiffnessBy { pressure, length });
         }
         // contraction = 1 - length / nominal_length.
         let per_length = -1.0 / self.effective.nominal_length;
-        p.row(Unknown::Contraction, &[(Known::Length, per_length)]);
+        p.row(ContractionBy { length: per_length });
         let target = match &self.solver {
             Some((muscle, max_pressure)) => muscle.target_pressure_partials(
                 *max_pressure,
@@ -552,10 +588,10 @@ impl Model for McKibbenMuscle {
             ),
             None => [0.0; 2],
         };
-        p.row(
-            Unknown::TargetPressure,
-            &[(Known::Length, target[0]), (Known::TargetForce, target[1])],
-        );
+        p.row(TargetPressureBy {
+            length: target[0],
+            target_force: target[1],
+        });
         Ok(())
     }
 
@@ -663,6 +699,7 @@ mod tests {
 mod slack_tests {
     use super::super::all_partials;
     use super::*;
+    use crate::variables::mckibben_muscle::Known;
 
     fn at(m: &mut McKibbenMuscle, pressure: f64, length: f64) -> Outputs {
         let x = Inputs {

@@ -7,7 +7,7 @@
 
 #![forbid(unsafe_code)]
 
-use crate::variables::{Identifier, Interface};
+use crate::variables::{ArrayIdentifier, Identifier, Interface, Row};
 use serde::{de::DeserializeOwned, Serialize};
 use std::marker::PhantomData;
 
@@ -33,22 +33,20 @@ pub enum Status {
 }
 
 /// What a model call has to say: the worst status and the messages that explain it. A report with
-/// nothing to say is a few flags and a null pointer, told by one of them: the per-step path builds
-/// and tests one every step.
+/// nothing to say (fmi2OK, nothing clamped, no message) is a null pointer: the per-step path builds
+/// and tests one every step, and it owns no memory.
 #[derive(Debug, Default)]
 pub struct Report {
-    status: Status,
     /// The model ran (evaluated or stepped): `clamped` describes the outputs it wrote.
     pub evaluated: bool,
-    clamped: bool,
-    /// The status is worse than OK, an input was clamped, or there is a message.
-    loud: bool,
-    /// The messages, allocated with the first.
+    /// Everything else, allocated with the first thing to say.
     notes: Option<Box<Notes>>,
 }
 
 #[derive(Debug, Default)]
 struct Notes {
+    status: Status,
+    clamped: bool,
     messages: Vec<(Status, String)>,
     /// Why an input was clamped, logged once per excursion (the first call that leaves the range).
     clamp_messages: Vec<String>,
@@ -57,17 +55,19 @@ struct Notes {
 impl Report {
     /// The worst status so far.
     pub fn status(&self) -> Status {
-        self.status
+        self.notes.as_ref().map_or(Status::Ok, |n| n.status)
     }
     /// Makes the status at least `status` (without a message: the caller logs why elsewhere).
     pub fn raise(&mut self, status: Status) {
-        self.status = self.status.max(status);
-        self.loud |= status > Status::Ok;
+        if status > Status::Ok {
+            let notes = self.notes_mut();
+            notes.status = notes.status.max(status);
+        }
     }
     pub fn add(&mut self, status: Status, message: impl Into<String>) {
-        self.raise(status);
-        self.loud = true;
-        self.notes_mut().messages.push((status, message.into()));
+        let notes = self.notes_mut();
+        notes.status = notes.status.max(status);
+        notes.messages.push((status, message.into()));
     }
     pub fn warn(&mut self, message: impl Into<String>) {
         self.add(Status::Warning, message)
@@ -75,16 +75,16 @@ impl Report {
     /// Records an input evaluated at the nearest valid point; `message` is built only on the
     /// first call of an excursion (`first`), so that the log gets one line per excursion.
     pub fn clamp(&mut self, first: bool, message: impl FnOnce() -> String) {
-        self.clamped = true;
-        self.loud = true;
+        let notes = self.notes_mut();
+        notes.clamped = true;
         if first {
-            self.notes_mut().clamp_messages.push(message());
+            notes.clamp_messages.push(message());
         }
     }
     /// An input lay outside the model's solvable range and was evaluated at the nearest valid
     /// point. The export layer turns this into a status by the `out_of_range_policy` parameter.
     pub fn clamped(&self) -> bool {
-        self.clamped
+        self.notes.as_ref().is_some_and(|n| n.clamped)
     }
     /// The messages with their statuses, in order.
     pub fn messages(&self) -> &[(Status, String)] {
@@ -101,10 +101,9 @@ impl Report {
             .map(|n| std::mem::take(&mut n.clamp_messages))
             .unwrap_or_default()
     }
-    /// Nothing to say: fmi2OK, nothing clamped, no message. Such a report owns no memory.
-    #[inline(always)]
+    /// Nothing to say: fmi2OK, nothing clamped, no message.
     pub fn is_quiet(&self) -> bool {
-        !self.loud
+        self.notes.is_none()
     }
     fn notes_mut(&mut self) -> &mut Notes {
         self.notes.get_or_insert_with(Default::default)
@@ -136,9 +135,10 @@ impl From<&str> for Refusal {
 
 /// Exact partial derivatives of a model's unknowns (outputs, state derivatives) with respect to
 /// its knowns (inputs, continuous states) at one point, written against the identifiers generated
-/// from its model description (`crate::variables::<model>::{Known, Unknown}`): what
+/// from its model description (`crate::variables::<model>::{Known, Unknown}`, and one row type
+/// per unknown, `<Unknown>By`, whose fields are the knowns it declares): what
 /// `fmi2GetDirectionalDerivative` combines with the importer's seed. An unknown without a row is
-/// not provided; a known missing from a row does not affect that unknown.
+/// not provided; a known its `<ModelStructure>` entry does not declare has partial 0.
 pub struct Partials<V: Interface> {
     /// One row per unknown, one column per known (`Identifier::index`), row after row.
     values: Vec<f64>,
@@ -180,19 +180,17 @@ impl<V: Interface> Partials<V> {
         self.wanted.get(unknown.index()).copied().unwrap_or(true)
     }
 
-    /// Writes the row of `unknown`: its partial with respect to each listed known, zero for the
-    /// others.
-    pub fn row(&mut self, unknown: V::Unknown, by_known: &[(V::Known, f64)]) -> &mut Self {
+    /// Writes a row: `p.row(ForceBy { pressure: dp, length: dl })`, the partials of its unknown
+    /// by the knowns its `<ModelStructure>` entry declares (zero by every other known).
+    pub fn row<R: Row<Variables = V>>(&mut self, row: R) -> &mut Self {
         if self.written.is_empty() {
             self.ask_for(std::iter::empty());
         }
-        let start = unknown.index() * Self::COLUMNS;
-        let row = &mut self.values[start..start + Self::COLUMNS];
-        row.fill(0.0);
-        for &(known, d) in by_known {
-            row[known.index()] = d;
-        }
-        self.written[unknown.index()] = true;
+        let unknown = R::UNKNOWN.index();
+        let values = &mut self.values[unknown * Self::COLUMNS..(unknown + 1) * Self::COLUMNS];
+        values.fill(0.0);
+        row.write(|known, d| values[known.index()] = d);
+        self.written[unknown] = true;
         self
     }
 
@@ -286,6 +284,8 @@ pub type CalculatedParameters<M> = <<M as Model>::Variables as Interface>::Calcu
 /// The continuous states of model `M` (and their derivatives), generated from the variables that
 /// carry a `derivative` attribute; an empty struct for models without states.
 pub type States<M> = <<M as Model>::Variables as Interface>::States;
+/// The FMI 3.0 array outputs of model `M`: an empty enum for models without arrays.
+pub type ArrayOutput<M> = <<M as Model>::Variables as Interface>::ArrayOutput;
 
 /// What an event update (`fmi2NewDiscreteStates`) did, for `fmi2EventInfo`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -427,21 +427,26 @@ pub trait Model: Clone + Send + Serialize + DeserializeOwned + 'static {
         None
     }
 
-    /// The FMI 3.0 array output `name` (an `<Array>` of the model description's
+    /// The FMI 3.0 array output `array` (an `<Array>` of the model description's
     /// VendorAnnotations) at `inputs` and the current history, into `out` (its declared size).
     /// Computed only when an importer reads it, so an array nobody reads costs nothing. `Err`
-    /// says why there is no value; by default the model has no arrays.
-    fn array(&self, _inputs: &Inputs<Self>, name: &str, _out: &mut [f64]) -> Result<(), String> {
-        Err(format!("no array output named '{name}'"))
+    /// says why there is no value; by default the model computes none.
+    fn array(
+        &self,
+        _inputs: &Inputs<Self>,
+        array: ArrayOutput<Self>,
+        _out: &mut [f64],
+    ) -> Result<(), String> {
+        Err(format!("this model does not compute {}", array.name()))
     }
 
     /// Exact partial derivatives of the outputs (and, with states, of the derivative variables
     /// `der(x)`) with respect to the inputs (and the states `x`) at `inputs` and the current
     /// history, on the branch [`Model::evaluate`] takes (analytic or forward-mode, never finite
-    /// differences), written as rows of `partials` against the generated identifiers
-    /// (`partials.row(Unknown::Y, &[(Known::U, 2.0)])`). `partials` comes empty; a row the call
-    /// does not read (`!partials.wants(unknown)`) may be left out when it costs more than the
-    /// others (the stiffness's second derivatives). `Err` says why there are none: by default
+    /// differences), written as rows of `partials` through the generated row types, whose fields
+    /// are the declared dependencies (`partials.row(YBy { u: 2.0 })`). `partials` comes empty; a
+    /// row the call does not read (`!partials.wants(unknown)`) may be left out when it costs more
+    /// than the others (the stiffness's second derivatives). `Err` says why there are none: by default
     /// this model does not provide them, and its model description says
     /// `providesDirectionalDerivative="false"`.
     fn partials(

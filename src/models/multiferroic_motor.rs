@@ -12,8 +12,11 @@ use crate::physics::multiferroic::{
     SteppingSchedule, GILBERT_SUBSTEP_WEIGHT,
 };
 use crate::variables::multiferroic_motor::{
-    CalculatedParameters, Inputs, Known, Outputs, Parameters, States, Unknown, Variables,
+    AppliedStrainDirectionBy, CalculatedParameters, Inputs, Known, MagnetoelasticEnergyBy,
+    MagnetostaticEnergyBy, OffsetAngleBy, OnionAngleBy, Outputs, Parameters, RotorAngleBy,
+    RotorSpeedBy, States, TorqueBy, Variables,
 };
+use crate::variables::Row as _;
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -106,51 +109,44 @@ fn write_outputs(out: &mut Outputs, o: &MotorOutputs) {
 }
 
 /// The rows of `fmi2GetDirectionalDerivative` from the physics' partials: by each input (and, in
-/// Model Exchange, by each of `states`, with its column in the physics' gradients). With
-/// `strain_drive` the stress comes from the `strain` input.
+/// Model Exchange, `with_states`, by each state), of the outputs. With `strain_drive` the stress
+/// comes from the `strain` input.
 fn partial_rows(
     p: &MePartials,
     strain_modulus: Option<f64>,
-    states: &[(Known, usize)],
+    with_states: bool,
     rows: &mut Partials<Variables>,
 ) {
-    for (output, g) in [
-        (Unknown::Torque, &p.torque),
-        (Unknown::RotorAngle, &p.rotor_angle),
-        (Unknown::RotorSpeed, &p.rotor_speed),
-        (Unknown::OnionAngle, &p.onion_angle),
-        (Unknown::OffsetAngle, &p.offset_angle),
-        (Unknown::MagnetostaticEnergy, &p.magnetostatic_energy),
-        (Unknown::MagnetoelasticEnergy, &p.magnetoelastic_energy),
-        (Unknown::AppliedStrainDirection, &p.applied_strain_direction),
-    ] {
-        gradient_row(rows, output, g, strain_modulus, states);
-    }
+    let of = |g| move |known| column(g, known, strain_modulus, with_states);
+    rows.row(TorqueBy::from_fn(of(&p.torque)))
+        .row(RotorAngleBy::from_fn(of(&p.rotor_angle)))
+        .row(RotorSpeedBy::from_fn(of(&p.rotor_speed)))
+        .row(OnionAngleBy::from_fn(of(&p.onion_angle)))
+        .row(OffsetAngleBy::from_fn(of(&p.offset_angle)))
+        .row(MagnetostaticEnergyBy::from_fn(of(&p.magnetostatic_energy)))
+        .row(MagnetoelasticEnergyBy::from_fn(
+            of(&p.magnetoelastic_energy),
+        ))
+        .row(AppliedStrainDirectionBy::from_fn(of(
+            &p.applied_strain_direction
+        )));
 }
 
-/// The row of `output` from its gradient `g` (see [`partial_rows`]).
-fn gradient_row(
-    rows: &mut Partials<Variables>,
-    output: Unknown,
-    g: &MeGradient,
-    strain_modulus: Option<f64>,
-    states: &[(Known, usize)],
-) {
-    let (stress, strain) = match strain_modulus {
-        Some(modulus) => (0.0, modulus * g[by::STRESS]),
-        None => (g[by::STRESS], 0.0),
-    };
-    let mut row = [(Known::Stress, 0.0); 8];
-    row[..4].copy_from_slice(&[
-        (Known::StrainDirection, g[by::STRAIN_DIRECTION]),
-        (Known::LoadTorque, g[by::LOAD_TORQUE]),
-        (Known::Stress, stress),
-        (Known::Strain, strain),
-    ]);
-    for (slot, &(state, i)) in row[4..].iter_mut().zip(states) {
-        *slot = (state, g[i]);
+/// The partial by `known` in the physics' gradient `g` (see [`partial_rows`]): a row takes those
+/// of the knowns its unknown declares, whose partials are the only ones that may be nonzero.
+fn column(g: &MeGradient, known: Known, strain_modulus: Option<f64>, with_states: bool) -> f64 {
+    let state = |i: usize| if with_states { g[i] } else { 0.0 };
+    match known {
+        Known::StrainDirection => g[by::STRAIN_DIRECTION],
+        Known::LoadTorque => g[by::LOAD_TORQUE],
+        Known::Stress if strain_modulus.is_none() => g[by::STRESS],
+        Known::Stress => 0.0,
+        Known::Strain => strain_modulus.map_or(0.0, |modulus| modulus * g[by::STRESS]),
+        Known::RotorAngle => state(by::ROTOR_ANGLE),
+        Known::RotorSpeed => state(by::ROTOR_SPEED),
+        Known::OnionStateAngle => state(by::ONION_ANGLE),
+        Known::OnionTilt => state(by::ONION_TILT),
     }
-    rows.row(output, &row[..4 + states.len().min(4)]);
 }
 
 /// An Integer switch that must be 0 or 1 (the model description's bounds say so too).
@@ -167,7 +163,12 @@ impl Model for MultiferroicMotor {
     const DOCUMENTATION: &'static str = include_str!("multiferroic_motor.html");
 
     fn adopt_history(&mut self, saved: &Self) -> Result<(), String> {
-        Motor::validate_state(&saved.state).map_err(|e| format!("motor state: {e}"))?;
+        let validate = if saved.model_exchange_active() {
+            Motor::me_validate_state
+        } else {
+            Motor::validate_state
+        };
+        validate(&saved.state).map_err(|e| format!("motor state: {e}"))?;
         self.state = saved.state;
         self.me = saved.me.validated()?;
         Ok(())
@@ -371,7 +372,7 @@ impl Model for MultiferroicMotor {
             ..self.state
         };
         let p = self.motor.me_partials(&settled, &inputs, settled.time)?;
-        partial_rows(&p, self.strain_drive, &[], rows);
+        partial_rows(&p, self.strain_drive, false, rows);
         Ok(())
     }
 

@@ -2,7 +2,7 @@
 //! is the share of any other FMU's step time that is not the model's (docs/accuracy-cost.md).
 
 use super::{HistoryKey, Model, Partials, Refusal, Report};
-use crate::variables::pass_through::{Inputs, Known, Outputs, Parameters, Unknown, Variables};
+use crate::variables::pass_through::{Inputs, Outputs, Parameters, Variables, YBy};
 use serde::{Deserialize, Serialize};
 
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -28,7 +28,7 @@ impl Model for PassThrough {
     }
 
     fn partials(&mut self, _: &Inputs, p: &mut Partials<Variables>) -> Result<(), String> {
-        p.row(Unknown::Y, &[(Known::U, 1.0)]);
+        p.row(YBy { u: 1.0 });
         Ok(())
     }
 

@@ -17,7 +17,9 @@
 
 use super::{EventUpdate, Model, Partials, Refusal, Report, Status};
 use crate::variables::pulley_joint::{
-    Inputs, Known, Outputs, Parameters, States, Unknown, Variables,
+    DerJointAngleBy, DerJointVelocityBy, ExtensorLengthBy, ExtensorPressureBy, FlexorLengthBy,
+    FlexorPressureBy, Inputs, JointAngleBy, JointTorqueBy, JointVelocityBy, Outputs, Parameters,
+    ReferenceAngleBy, States, Variables,
 };
 use serde::{Deserialize, Serialize};
 
@@ -353,61 +355,65 @@ impl Model for PulleyJoint {
     /// respect to the inputs and the states, on the branch `write` takes (saturated pressures
     /// have slope 0, including at the kinks).
     fn partials(&mut self, inputs: &Inputs, d: &mut Partials<Variables>) -> Result<(), String> {
-        use Known::{ExtensorForce, FlexorForce, JointAngle, JointVelocity};
         let p = &self.p;
         let (r, inertia) = (p.moment_arm, p.inertia);
         let (q_ref, dq_ref) = p.reference(self.time);
         let u =
             p.feedforward_gain * q_ref.sin() + p.kp * (q_ref - self.q) + p.kd * (dq_ref - self.dq);
-        d.row(Unknown::FlexorLength, &[(JointAngle, -r)])
-            .row(Unknown::ExtensorLength, &[(JointAngle, r)]);
-        if p.external_pressures {
+        d.row(FlexorLengthBy { joint_angle: -r })
+            .row(ExtensorLengthBy { joint_angle: r });
+        let (flexor, extensor) = if p.external_pressures {
             let flexor = p.saturation_slope(inputs.flexor_pressure_command);
             let extensor = p.saturation_slope(inputs.extensor_pressure_command);
-            d.row(
-                Unknown::FlexorPressure,
-                &[(Known::FlexorPressureCommand, flexor)],
+            (
+                FlexorPressureBy {
+                    flexor_pressure_command: flexor,
+                    joint_angle: 0.0,
+                    joint_velocity: 0.0,
+                },
+                ExtensorPressureBy {
+                    extensor_pressure_command: extensor,
+                    joint_angle: 0.0,
+                    joint_velocity: 0.0,
+                },
             )
-            .row(
-                Unknown::ExtensorPressure,
-                &[(Known::ExtensorPressureCommand, extensor)],
-            );
         } else {
             // p = pc +/- u/2 with du/dq = -kp, du/d(dq) = -kd.
             let flexor = 0.5 * p.saturation_slope(p.common_mode_pressure + 0.5 * u);
             let extensor = -0.5 * p.saturation_slope(p.common_mode_pressure - 0.5 * u);
-            d.row(
-                Unknown::FlexorPressure,
-                &[
-                    (JointAngle, -p.kp * flexor),
-                    (JointVelocity, -p.kd * flexor),
-                ],
+            (
+                FlexorPressureBy {
+                    flexor_pressure_command: 0.0,
+                    joint_angle: -p.kp * flexor,
+                    joint_velocity: -p.kd * flexor,
+                },
+                ExtensorPressureBy {
+                    extensor_pressure_command: 0.0,
+                    joint_angle: -p.kp * extensor,
+                    joint_velocity: -p.kd * extensor,
+                },
             )
-            .row(
-                Unknown::ExtensorPressure,
-                &[
-                    (JointAngle, -p.kp * extensor),
-                    (JointVelocity, -p.kd * extensor),
-                ],
-            );
-        }
-        d.row(Unknown::JointAngle, &[(JointAngle, 1.0)])
-            .row(Unknown::JointVelocity, &[(JointVelocity, 1.0)])
-            .row(Unknown::ReferenceAngle, &[])
-            .row(
-                Unknown::JointTorque,
-                &[(FlexorForce, r), (ExtensorForce, -r)],
-            )
-            .row(Unknown::DerJointAngle, &[(JointVelocity, 1.0)])
-            .row(
-                Unknown::DerJointVelocity,
-                &[
-                    (FlexorForce, r / inertia),
-                    (ExtensorForce, -r / inertia),
-                    (JointAngle, -p.gravity_torque * self.q.cos() / inertia),
-                    (JointVelocity, -p.damping / inertia),
-                ],
-            );
+        };
+        d.row(flexor)
+            .row(extensor)
+            .row(JointAngleBy { joint_angle: 1.0 })
+            .row(JointVelocityBy {
+                joint_velocity: 1.0,
+            })
+            .row(ReferenceAngleBy {})
+            .row(JointTorqueBy {
+                flexor_force: r,
+                extensor_force: -r,
+            })
+            .row(DerJointAngleBy {
+                joint_velocity: 1.0,
+            })
+            .row(DerJointVelocityBy {
+                flexor_force: r / inertia,
+                extensor_force: -r / inertia,
+                joint_angle: -p.gravity_torque * self.q.cos() / inertia,
+                joint_velocity: -p.damping / inertia,
+            });
         Ok(())
     }
 }

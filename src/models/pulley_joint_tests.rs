@@ -2,6 +2,7 @@
 //! are the reference's segment boundaries, and the exact partials agree with central differences.
 
 use super::*;
+use crate::variables::pulley_joint::{Known, Unknown};
 
 fn joint(parameters: &Parameters) -> PulleyJoint {
     PulleyJoint::new(parameters, &Inputs::default()).expect("valid parameters")

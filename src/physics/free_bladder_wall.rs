@@ -44,7 +44,7 @@ impl FreeBladder {
                 stress_axial: radial + mooney(l1),
             };
         }
-        Ok(())
+        WallPoint::check_field(out, length)
     }
 }
 

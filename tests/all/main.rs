@@ -16,6 +16,7 @@ mod common;
 mod bad_input;
 mod c_abi;
 mod declared_ranges;
+mod fmi3_arrays;
 mod fmi3_crate;
 mod fmi_crate;
 mod fuzz_corpus;

@@ -833,3 +833,22 @@ mod continuous_states {
         );
     }
 }
+
+/// The shipped description numbers each variable once, with its index: a number written into the
+/// source would be doubled, and go stale when a variable is added above it.
+#[test]
+fn each_shipped_variable_carries_its_own_index_once() {
+    for (name, source) in sources() {
+        let xml = check(&source, &name).unwrap().shipped_xml;
+        let parts: Vec<&str> = xml.split("<ScalarVariable").collect();
+        for (i, before) in parts[..parts.len() - 1].iter().enumerate() {
+            let line = before.rsplit('\n').next().unwrap_or_default().trim();
+            assert_eq!(
+                line,
+                format!("<!-- {} -->", i + 1),
+                "{name}: variable {} must be preceded on its line by its index alone",
+                i + 1
+            );
+        }
+    }
+}

@@ -17,7 +17,7 @@ const FLANGE: &str =
 
 fn generated(text: &str) -> Result<String, String> {
     let model = model_description::check(text, "McKibbenMuscle")?;
-    flanges::xml(text, &model)
+    flanges::xml(&model)
 }
 
 /// The McKibben description with its flange declaration replaced by `to`.
@@ -37,7 +37,7 @@ fn every_source_passes_and_only_passthrough_has_no_flange() {
         let stem = path.file_stem().unwrap().to_str().unwrap().to_string();
         let text = std::fs::read_to_string(&path).unwrap();
         let model = model_description::check(&text, &stem).unwrap();
-        let xml = flanges::xml(&text, &model).unwrap();
+        let xml = flanges::xml(&model).unwrap();
         // Every model has its icon; only PassThrough has no terminal.
         assert!(xml.contains(r#"<Icon x1="-100" y1="-100" x2="100" y2="100"/>"#));
         assert_eq!(

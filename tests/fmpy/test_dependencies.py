@@ -6,16 +6,25 @@ its output at one tested point at least. Discrete outputs (flags) change only wh
 crosses a threshold: for them each input is also swept across its declared range. Initial unknowns: each input and parameter is perturbed
 before initialization and the initial unknowns compared after fmi2ExitInitializationMode.
 
+The Jacobian: each model writes its partials through row types generated from its
+`<ModelStructure>` (one field per declared known), so its structure is the declared one. On a
+Model Exchange instance at every operating point, every declared (output or state derivative,
+Real input or state) pair must show a nonzero fmi2GetDirectionalDerivative at one point at least,
+and no undeclared known may move an unknown when it is perturbed (fmi2SetReal,
+fmi2SetContinuousStates): the finite difference is the independent truth.
+
 `python tests/fmpy/test_dependencies.py` prints the measured lists."""
 
+import ctypes
+import random
 import shutil
 import sys
-import tempfile
 import xml.etree.ElementTree as ET
 
+import numpy as np
 import pytest
 from fmpy import extract, read_model_description
-from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi2 import FMU2Model, FMU2Slave
 
 from conftest import ROOT, fmu_path  # noqa: E402
 
@@ -28,18 +37,108 @@ def parse_values(text):
     return values
 
 
+def option_values(v):
+    """Every setting of an option parameter: each item of an Enumeration, both Booleans, an
+    Integer's bounds and start; None for a Real."""
+    if v.type == "Boolean":
+        return [False, True]
+    if v.type == "Enumeration":
+        return [int(item.value) for item in v.declaredType.items]
+    if v.type == "Integer":
+        return sorted({int(v.min), int(v.start), int(v.max)})
+    return None
+
+
+SAMPLED_COMBINATIONS = 6
+# Options that set only the status of a call, never a value (test_strict_master.py runs them):
+# the Discard they may ask for would end the measurement at an out-of-range point.
+STATUS_ONLY = {"out_of_range_policy"}
+
+
+def initializes(md, where, config):
+    """Whether the model of description `md`, extracted at `where`, initializes with parameters
+    `config` at its start inputs."""
+    s = FMU2Slave(guid=md.guid, unzipDirectory=where, modelIdentifier=md.coSimulation.modelIdentifier,
+                  instanceName="sample")
+    s.instantiate()
+    try:
+        s.setupExperiment(startTime=0.0)
+        for name, value in config.items():
+            v = next(v for v in md.modelVariables if v.name == name)
+            if v.type == "Boolean":
+                s.setBoolean([v.valueReference], [bool(value)])
+            elif v.type == "Real":
+                s.setReal([v.valueReference], [float(value)])
+            else:
+                s.setInteger([v.valueReference], [int(value)])
+        s.enterInitializationMode()
+        s.exitInitializationMode()
+        s.terminate()
+        return True
+    except Exception:
+        return False
+    finally:
+        s.freeInstance()
+
+
+def configurations(model, given):
+    """The defaults, the description's Parameters sets, every option setting alone, and twice
+    SAMPLED_COMBINATIONS random combinations of the options, alone and on the sets that switch
+    a Real effect on (seeded by the model's name)."""
+    md = read_model_description(fmu_path(model))
+    options = [v for v in md.modelVariables
+               if v.causality == "parameter" and v.name not in STATUS_ONLY and option_values(v)]
+    settings = {v.name: option_values(v) for v in options}
+    # Each setting alone; the start value is the defaults'.
+    alone = [{v.name: value} for v in options for value in settings[v.name]
+             if str(value).lower() != str(v.start).lower()]
+    # The description's sets that set a Real (a connector spring, a bag) are the bases of half
+    # the combinations on them: the options override the rest of such a set.
+    switches = [{}] + [config for config in given if set(config) - set(settings)]
+    switches += [{}] * (len(switches) - 1)
+    where = extract(fmu_path(model))
+
+    def combinations(rng, bases):
+        sampled = []
+        for _ in range(50 * SAMPLED_COMBINATIONS if settings else 0):
+            if len(sampled) == SAMPLED_COMBINATIONS:
+                break
+            base = rng.choice(bases) if bases else {}
+            combination = dict(base, **{name: rng.choice(values) for name, values in settings.items()})
+            # A combination the model refuses, saying why, is no sample.
+            if initializes(md, where, combination):
+                sampled.append(combination)
+        return sampled
+
+    try:
+        sampled = combinations(random.Random(model), []) + combinations(random.Random(model), switches)
+    finally:
+        shutil.rmtree(where, ignore_errors=True)
+    unique = []
+    for config in [{}] + given + alone + sampled:
+        if config not in unique:
+            unique.append(config)
+    return unique
+
+
 def operating_points(model):
-    """The operating points a model's description gives for its tests (VendorAnnotations): the
-    defaults and each Parameters set (the effects on), and the Inputs points (the start values if
-    none)."""
+    """The configurations ([`configurations`]) and the Inputs points the model's description gives
+    for its tests (VendorAnnotations; the start values if none)."""
     root = ET.parse(ROOT / "modelDescription" / f"{model}.xml").getroot()
     tests = root.find("VendorAnnotations/Tool[@name='actuator-fmus']/Tests")
     given = lambda tag: [parse_values(e.get("values")) for e in tests.iter(tag)] if tests is not None else []
-    return [{}] + given("Parameters"), given("Inputs") or [{}]
+    return configurations(model, given("Parameters")), given("Inputs") or [{}]
 
 
 MODELS = sorted(p.stem for p in (ROOT / "modelDescription").glob("*.xml"))
-CONFIGS = {m: operating_points(m) for m in MODELS}
+CONFIGS = {}
+
+
+def configs(model):
+    """([configurations], [Inputs points]) of `model`, built once."""
+    if model not in CONFIGS:
+        CONFIGS[model] = operating_points(model)
+    return CONFIGS[model]
 
 
 class Model:
@@ -116,7 +215,7 @@ def sweep(v, value):
 def measure_outputs(model):
     """{output: {inputs that changed it}} over every operating point."""
     seen = {o.name: set() for o in model.outputs}
-    params, points = CONFIGS[model.name]
+    params, points = configs(model.name)
     for config in params:
         s = model.slave()
         try:
@@ -180,7 +279,7 @@ def measure_initial(model):
     """{initial unknown: {inputs and parameters that changed it}} over every configuration."""
     seen = {u.name: set() for u in model.initial}
     candidates = [v for v in model.vars if v.causality in ("input", "parameter")]
-    params, points = CONFIGS[model.name]
+    params, points = configs(model.name)
     for config, point in ((c, p) for c in params for p in points):
         values = dict(config, **point)
         base = initial_values(model, values)
@@ -207,6 +306,87 @@ def measure_initial(model):
     return seen
 
 
+def jacobian_pairs(model):
+    """{unknown: {known: declared}} of the Jacobian: Real outputs and state derivatives by Real
+    inputs and continuous states."""
+    knowns = [v for v in model.inputs if v.type == "Real"] + [d.variable.derivative for d in model.md.derivatives]
+    unknowns = [u for u in model.md.outputs if u.variable.type == "Real"] + list(model.md.derivatives)
+    names = {k.name for k in knowns}
+    declared = {u.variable.name: {d.name for d in (u.dependencies or []) if d.name in names} for u in unknowns}
+    return knowns, [u.variable for u in unknowns], declared
+
+
+def as_doubles(values):
+    array = np.ascontiguousarray(values, dtype=float)
+    return array, array.ctypes.data_as(ctypes.POINTER(ctypes.c_double))
+
+
+def measure_jacobian(model):
+    """({unknown: {knowns with a nonzero partial}}, {unknown: {knowns that moved it}}) over every
+    operating point of a Model Exchange instance in continuous-time mode, and the points."""
+    knowns, unknowns, _ = jacobian_pairs(model)
+    n = len(model.md.derivatives)
+    inputs = [k for k in knowns if k.causality == "input"]
+    outputs = [u for u in unknowns if u.causality == "output"]
+    nonzero = {u.name: set() for u in unknowns}
+    moved = {u.name: set() for u in unknowns}
+    params, points = configs(model.name)
+    sampled = 0
+    for config in params:
+        m = FMU2Model(guid=model.md.guid, unzipDirectory=model.dir,
+                      modelIdentifier=model.md.modelExchange.modelIdentifier, instanceName="jacobian")
+        m.instantiate()
+        try:
+            m.setupExperiment(startTime=0.0)
+            model.set(m, config)
+            m.enterInitializationMode()
+            m.exitInitializationMode()
+            while m.newDiscreteStates()[0]:
+                pass
+            m.enterContinuousTimeMode()
+            x, x_ptr = as_doubles(np.zeros(n))
+            if n:
+                m.getContinuousStates(x_ptr, n)
+
+            def values(states):
+                _, ptr = as_doubles(states)
+                if n:
+                    m.setContinuousStates(ptr, n)
+                dx, dx_ptr = as_doubles(np.zeros(n))
+                if n:
+                    m.getDerivatives(dx_ptr, n)
+                return list(m.getReal([o.valueReference for o in outputs])) + list(dx)
+
+            for point in points:
+                model.set(m, point)
+                state = x.copy()
+                base = values(state)
+                current = dict(zip((i.name for i in inputs), m.getReal([i.valueReference for i in inputs])))
+                for j, k in enumerate(knowns):
+                    column = m.getDirectionalDerivative([u.valueReference for u in unknowns],
+                                                        [k.valueReference], [1.0])
+                    for u, d in zip(unknowns, column):
+                        if d != 0.0:
+                            nonzero[u.name].add(k.name)
+                    if k.causality == "input":
+                        model.set(m, {k.name: perturbed(k, current[k.name])})
+                        after = values(state)
+                        model.set(m, {k.name: current[k.name]})
+                    else:
+                        shifted = state.copy()
+                        shifted[j - len(inputs)] = perturbed(k, state[j - len(inputs)])
+                        after = values(shifted)
+                    for u, a, b in zip(unknowns, after, base):
+                        if a != b:
+                            moved[u.name].add(k.name)
+                    assert values(state) == base, f"{model.name} {config} {point}: {k.name} not restored"
+                sampled += 1
+        finally:
+            m.terminate()
+            m.freeInstance()
+    return nonzero, moved, sampled
+
+
 def compare(declared, measured, what):
     undeclared = [(o, sorted(measured[o] - declared[o])) for o in declared if measured[o] - declared[o]]
     unshown = [(o, sorted(declared[o] - measured[o])) for o in declared if declared[o] - measured[o]]
@@ -219,7 +399,7 @@ def compare(declared, measured, what):
 def test_the_operating_points_name_the_models_variables(name):
     # A renamed variable must not leave an operating point that sets nothing.
     causality = {v.name: v.causality for v in read_model_description(fmu_path(name)).modelVariables}
-    params, points = CONFIGS[name]
+    params, points = configs(name)
     for values, kind in [(p, "parameter") for p in params] + [(p, "input") for p in points]:
         for variable in values:
             assert causality.get(variable) == kind, f"{name}: {variable} is not a {kind}"
@@ -233,6 +413,24 @@ def test_output_dependencies(name):
     finally:
         model.close()
     print(f"{name}: {pairs} (output, input) pairs verified")
+
+
+@pytest.mark.parametrize("name", MODELS)
+def test_the_jacobian_is_the_declared_dependencies(name):
+    model = Model(name)
+    try:
+        _, _, declared = jacobian_pairs(model)
+        nonzero, moved, sampled = measure_jacobian(model)
+    finally:
+        model.close()
+    undeclared = [(u, sorted(nonzero[u] - declared[u])) for u in declared if nonzero[u] - declared[u]]
+    assert not undeclared, f"{name}: partials by undeclared knowns {undeclared}"
+    moving = [(u, sorted(moved[u] - declared[u])) for u in declared if moved[u] - declared[u]]
+    assert not moving, f"{name}: undeclared knowns that move an unknown {moving}"
+    unshown = [(u, sorted(declared[u] - nonzero[u])) for u in declared if declared[u] - nonzero[u]]
+    assert not unshown, f"{name}: declared dependencies whose partial is 0 at every point {unshown}"
+    pairs = sum(len(d) for d in declared.values())
+    print(f"{name}: {pairs} declared (unknown, known) pairs nonzero, {sampled} Model Exchange points")
 
 
 @pytest.mark.parametrize("name", MODELS)

@@ -228,6 +228,19 @@ def test_directional_and_adjoint_derivatives_match_central_differences(lib):
     bad = (c_uint * 1)(inst.vr["time"])
     assert inst("fmi3GetDirectionalDerivative", unknown, c_size_t(1), bad, c_size_t(1), (c_double * 1)(1.0),
                 c_size_t(1), (c_double * 1)(), c_size_t(1)) == ERROR
+    # Each call's seed and sensitivity sizes are the other's swapped: either call with the
+    # other's sizes, or a NULL seed of non-zero length, is an error.
+    two_in, two_out = (c_double * 2)(1.0, 0.0), (c_double * 2)()
+    assert inst("fmi3GetDirectionalDerivative", unknown, c_size_t(1), known, c_size_t(2), seed, c_size_t(1),
+                two_out, c_size_t(2)) == ERROR
+    assert inst("fmi3GetAdjointDerivative", unknown, c_size_t(1), known, c_size_t(2), two_in, c_size_t(2),
+                (c_double * 1)(), c_size_t(1)) == ERROR
+    assert inst("fmi3GetAdjointDerivative", unknown, c_size_t(1), known, c_size_t(2), None, c_size_t(1),
+                two_out, c_size_t(2)) == ERROR
+    # A refused call leaves the instance usable: the right sizes still give the adjoint.
+    assert inst("fmi3GetAdjointDerivative", unknown, c_size_t(1), known, c_size_t(2), seed, c_size_t(1),
+                two_out, c_size_t(2)) == OK
+    assert list(two_out) == pytest.approx([2.5 * d for d in jacobian], rel=1e-12)
     inst.free()
 
 

@@ -214,6 +214,7 @@ impl Instance {
 
     /// `fmi2DoStep`, `fmi3DoStep`: checks the state and the step, steps the model and forwards
     /// its report.
+    #[inline(always)]
     pub fn do_step(&mut self, function: &str, time: f64, step: f64) -> Status {
         if !self.allowed(function, allowed::DO_STEP) {
             return Status::Error;
@@ -242,16 +243,17 @@ impl Instance {
     }
 
     /// The refusal of a step of `step` from `time`, if any (the caller checked the state).
+    #[inline(always)]
     fn step_refused(&self, function: &str, time: f64, step: f64) -> Option<Status> {
-        // Positive and finite; two comparisons (NaN fails both).
-        if !(step > 0.0 && step < f64::INFINITY) {
+        // Positive and finite (NaN fails both comparisons).
+        if !(0.0 < step && step <= f64::MAX) {
             return Some(self.refuse_step(function, step));
         }
         // The importer's clock and ours may differ by rounding only; adopt the importer's. The
         // allowance scales with the clocks, not the step: a long step must not excuse a wrong
         // communication point. Most masters pass our own time back: then no allowance is needed.
-        let exact = time == self.time;
-        if !time.is_finite() || !(exact || self.within_rounding(time)) {
+        // Our time is finite: equal to it, `time` is too.
+        if !(time == self.time || (time.is_finite() && self.within_rounding(time))) {
             return Some(self.refuse_communication_point(function, time));
         }
         // Both finite, their sum may not be: the clock would become +inf.

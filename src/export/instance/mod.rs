@@ -7,6 +7,10 @@
 //! references and is told the name of the function the importer called; the version layers
 //! (`src/fmi2`, `src/fmi3`) turn the importer's C pointers into them. The only `unsafe` here is
 //! in `fmu_state`, on the state pointers this instance handed out itself.
+//!
+//! The three calls of every communication step (`set`, `do_step`, `get_reals`) are
+//! `#[inline(always)]`: each version's export runs its one path as one function, as if it had
+//! been written there.
 
 mod co_simulation_events;
 mod directional_derivative;
@@ -38,7 +42,8 @@ pub const MAGIC: u64 = 0x6163_7475_6174_6f72;
 /// What an instance needs to know of the FMI version it was instantiated through: which calls are
 /// its own, and the names its messages use. Each version layer defines one.
 pub struct Api {
-    /// "FMI 2.0" or "FMI 3.0": an instance answers only its own version's calls.
+    /// "FMI 2.0" or "FMI 3.0", for messages. An instance answers only the calls of the `Api` it
+    /// was instantiated through (each version layer has one, a static).
     pub version: &'static str,
     /// The name of [`MachineState::StepComplete`] (FMI 3.0 calls it Step Mode).
     pub step_state: &'static str,
@@ -252,7 +257,7 @@ impl Instance {
     }
 
     #[inline(never)]
-    fn recompute_outputs(&mut self, function: &str) -> Status {
+    pub(super) fn recompute_outputs(&mut self, function: &str) -> Status {
         if !self.runtime.is_built() {
             if self.state() != MachineState::InitializationMode {
                 return Status::OK;

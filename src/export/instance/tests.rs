@@ -96,6 +96,7 @@ impl Interface for GainVariables {
     type States = ();
     type Known = ();
     type Unknown = ();
+    type ArrayOutput = std::convert::Infallible;
     const EVENT_INDICATORS: usize = 0;
     const INFO: &'static ModelInfo = &INFO;
 }

@@ -12,7 +12,7 @@ pub trait Value {
     const KIND: VarType;
     /// A reason to refuse the value for this variable, if any.
     fn invalid_for(&self, var: &Variable) -> Option<String>;
-    /// Whether the value passes [`Value::invalid_for`], by the flattened bounds of a [`SetRule`].
+    /// Whether the value passes [`Value::invalid_for`], by the bounds of a [`SetRule`].
     #[inline]
     fn within(&self, _min: f64, _max: f64) -> bool {
         true
@@ -32,9 +32,10 @@ pub trait Value {
 
 impl Value for f64 {
     const KIND: VarType = VarType::Real;
+    /// The bounds are finite: NaN and the infinities fail one of the comparisons.
     #[inline]
     fn within(&self, min: f64, max: f64) -> bool {
-        self.is_finite() && *self >= min && *self <= max
+        *self >= min && *self <= max
     }
     #[inline]
     fn invalid_for(&self, var: &Variable) -> Option<String> {
@@ -149,7 +150,8 @@ fn settable_in(var: &Variable, state: MachineState) -> bool {
 }
 
 /// One variable's checks for fmi2SetXXX, computed once per instance: the states it may be set in
-/// (a mask of [`MachineState::bit`]) and its bounds (infinite where none is declared).
+/// (a mask of [`MachineState::bit`]) and its bounds: the declared ones, else the largest finite
+/// doubles, so that the two comparisons of [`Value::within`] also refuse NaN and the infinities.
 pub struct SetRule {
     var: &'static Variable,
     states: u32,
@@ -164,8 +166,8 @@ impl SetRule {
             .iter()
             .filter(|&&s| settable_in(var, s))
             .fold(0, |mask, s| mask | s.bit());
-        let min = var.min.unwrap_or(f64::NEG_INFINITY);
-        let max = var.max.unwrap_or(f64::INFINITY);
+        let min = var.min.unwrap_or(f64::MIN);
+        let max = var.max.unwrap_or(f64::MAX);
         let parameter = var.causality == Causality::Parameter;
         Self {
             var,
@@ -196,6 +198,7 @@ impl Instance {
     }
 
     /// Sets all values or, if any is refused, none (the old values are kept).
+    #[inline(always)]
     pub fn set<T: Value>(&mut self, function: &str, vrs: &[u32], values: &[T]) -> Status {
         if !self.allowed(function, allowed::SET) {
             return Status::Error;
@@ -280,7 +283,24 @@ impl Instance {
         }
     }
 
-    /// Refreshes stale outputs, then copies `pick(vars, vr)` for each value reference.
+    /// Before a get reads values: outputs that inputs made stale are brought up to date (the
+    /// model built in initialization mode) where the state lets inputs change them; the status
+    /// of that.
+    #[inline]
+    fn outputs_for_get(&mut self, function: &str) -> Status {
+        if self.runtime.outputs_current() {
+            return Status::OK;
+        }
+        match self.state() {
+            MachineState::InitializationMode
+            | MachineState::StepComplete
+            | MachineState::EventMode
+            | MachineState::ContinuousTimeMode => self.recompute_outputs(function),
+            _ => Status::OK,
+        }
+    }
+
+    /// Copies `pick(vars, vr)` for each value reference, outputs brought up to date first.
     pub fn get<T: Copy>(
         &mut self,
         function: &str,
@@ -292,18 +312,9 @@ impl Instance {
         if !self.allowed(function, allowed::GET) {
             return Status::Error;
         }
-        let mut status = Status::OK;
-        if matches!(
-            self.state(),
-            MachineState::InitializationMode
-                | MachineState::StepComplete
-                | MachineState::EventMode
-                | MachineState::ContinuousTimeMode
-        ) {
-            status = self.refresh_outputs(function);
-            if status >= Status::Error {
-                return status;
-            }
+        let status = self.outputs_for_get(function);
+        if status >= Status::Error {
+            return status;
         }
         for (&vr, slot) in vrs.iter().zip(out.iter_mut()) {
             if let Err(s) = self.lookup(function, kind, vr) {
@@ -319,8 +330,6 @@ impl Instance {
         status
     }
 
-    /// `fmi2GetReal`, `fmi3GetFloat64`: as [`Instance::get`], with the value references checked
-    /// first and one call into the runtime for all values.
     /// An FMI 3.0 array output (`Runtime::array`): the model's values once it is built (zeros
     /// before, as the outputs' start values), every element finite. Where the model has no
     /// value the elements are 0 and a warning says why.
@@ -329,18 +338,7 @@ impl Instance {
             return Status::Error;
         }
         out.fill(0.0);
-        let refreshing = matches!(
-            self.state(),
-            MachineState::InitializationMode
-                | MachineState::StepComplete
-                | MachineState::EventMode
-                | MachineState::ContinuousTimeMode
-        );
-        let status = if refreshing {
-            self.refresh_outputs(function)
-        } else {
-            Status::OK
-        };
+        let status = self.outputs_for_get(function);
         if status >= Status::Error || !self.runtime.is_built() {
             return status;
         }
@@ -357,50 +355,37 @@ impl Instance {
         status.max(Status::Warning)
     }
 
+    /// `fmi2GetReal`, `fmi3GetFloat64`: as [`Instance::get`], in one call into the runtime for
+    /// all values. A value reference that is not the model's reads NaN ([`Bindings::real`]), so
+    /// that one test refuses both it and a non-finite output.
+    ///
+    /// [`Bindings::real`]: crate::export::runtime::Bindings::real
+    #[inline(always)]
     pub fn get_reals(&mut self, function: &str, vrs: &[u32], out: &mut [f64]) -> Status {
         if !self.allowed(function, allowed::GET) {
             return Status::Error;
         }
-        let count = self.by_type[type_index(VarType::Real)].len();
-        if let Some(&vr) = vrs.iter().find(|&&vr| vr as usize >= count) {
-            return self.unknown_reference(function, VarType::Real, vr);
+        let status = self.outputs_for_get(function);
+        if status >= Status::Error {
+            return status;
         }
-        let refreshing = matches!(
-            self.state(),
-            MachineState::InitializationMode
-                | MachineState::StepComplete
-                | MachineState::EventMode
-                | MachineState::ContinuousTimeMode
-        );
-        // After a step the outputs are current: one dynamic call reads them.
-        if refreshing && self.runtime.current_reals(vrs, out) {
-            return self.finite_or_refused(function, vrs, out, Status::OK);
-        }
-        let status = if refreshing {
-            self.refresh_outputs(function)
-        } else {
-            Status::OK
-        };
-        if status < Status::Error {
-            self.runtime.reals(vrs, out);
-            return self.finite_or_refused(function, vrs, out, status);
-        }
-        status
-    }
-
-    /// The last guard of "no output is ever NaN" on the fmi2GetReal path: `status` if every
-    /// value is finite, else an error naming the first that is not.
-    #[inline]
-    fn finite_or_refused(
-        &self,
-        function: &str,
-        vrs: &[u32],
-        out: &[f64],
-        status: Status,
-    ) -> Status {
+        self.runtime.reals(vrs, out);
+        // The last guard of "no output is ever NaN": the models check their own results, and a
+        // value that still is not finite is refused here, never handed out.
         match out.iter().position(|x| !x.is_finite()) {
             None => status,
-            Some(k) => self.non_finite(function, vrs[k]),
+            Some(k) => self.refuse_real(function, vrs[k]),
+        }
+    }
+
+    /// The refusal of fmi2GetReal's non-finite value at `vr`: an unknown value reference (the
+    /// importer's error) or a non-finite output (the model's).
+    #[cold]
+    #[inline(never)]
+    fn refuse_real(&self, function: &str, vr: u32) -> Status {
+        match self.by_type[type_index(VarType::Real)].get(vr as usize) {
+            None => self.unknown_reference(function, VarType::Real, vr),
+            Some(_) => self.non_finite(function, vr),
         }
     }
 

@@ -4,8 +4,8 @@
 mod bindings;
 mod directional_derivative;
 
-use crate::models::{EventUpdate, Model, Report};
-use crate::variables::{ContinuousStates, Interface, ModelInfo};
+use crate::models::{ArrayOutput, EventUpdate, Model, Report};
+use crate::variables::{ArrayIdentifier, ContinuousStates, Interface, ModelInfo};
 pub use bindings::Bindings;
 use directional_derivative::PartialsCache;
 use serde::{Deserialize, Serialize};
@@ -112,8 +112,6 @@ pub trait Runtime: Send {
     fn string(&self, vr: usize) -> &str;
     /// `out[i] = real(vrs[i])`: fmi2GetReal in one dynamic call.
     fn reals(&self, vrs: &[u32], out: &mut [f64]);
-    /// [`Runtime::reals`] if [`Runtime::outputs_current`], else nothing: whether it read them.
-    fn current_reals(&self, vrs: &[u32], out: &mut [f64]) -> bool;
     /// `set_real(vrs[i], values[i])`, then [`Runtime::changed`]: fmi2SetReal in one dynamic call.
     fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool);
     fn set_string(&mut self, vr: usize, value: &str);
@@ -311,14 +309,6 @@ where
         }
     }
     #[inline]
-    fn current_reals(&self, vrs: &[u32], out: &mut [f64]) -> bool {
-        if !self.outputs_current() {
-            return false;
-        }
-        self.reals(vrs, out);
-        true
-    }
-    #[inline]
     fn set_reals(&mut self, vrs: &[u32], values: &[f64], parameters: bool) {
         for (&vr, &value) in vrs.iter().zip(values) {
             M::Variables::set_real(&mut self.values, vr as usize, value);
@@ -378,9 +368,8 @@ where
         }
     }
     fn step(&mut self, time: f64, step: f64, report: &mut Report) {
+        // Always built: the state machine lets no step through before initialization.
         let Some(model) = self.model.as_mut() else {
-            // Not built (no step reaches here before initialization): laid out of the way.
-            std::hint::cold_path();
             return;
         };
         report.evaluated = true;
@@ -537,8 +526,10 @@ where
         self
     }
     fn array(&self, name: &str, out: &mut [f64]) -> Result<(), String> {
+        let array = ArrayOutput::<M>::from_name(name)
+            .ok_or_else(|| format!("no array output named '{name}'"))?;
         match &self.model {
-            Some(model) => model.array(&self.values.inputs, name, out),
+            Some(model) => model.array(&self.values.inputs, array, out),
             None => Err("no model yet: call it in initialization mode or later".into()),
         }
     }

@@ -9,28 +9,16 @@
 //! events at the onion's angle at the last event and zero tilt, with zero derivatives. The
 //! description's state count is fixed, hence four in both options.
 
-use super::{gradient_row, partial_rows, write_outputs, MultiferroicMotor};
+use super::{column, partial_rows, write_outputs, MultiferroicMotor};
 use crate::models::{Partials, Report, Status};
-use crate::physics::multiferroic::model_exchange::{by, MeEvaluation, MAX_RINGING_WINDOWS};
+use crate::physics::multiferroic::model_exchange::{MeEvaluation, MAX_RINGING_WINDOWS};
 use crate::physics::multiferroic::{Motor, OnionModel};
-use crate::variables::multiferroic_motor::{Inputs, Known, Outputs, Unknown, Variables};
+use crate::variables::multiferroic_motor::{
+    DerOnionStateAngleBy, DerOnionTiltBy, DerRotorAngleBy, DerRotorSpeedBy, Inputs, Outputs,
+    Variables,
+};
+use crate::variables::Row as _;
 use serde::{Deserialize, Serialize};
-
-/// The continuous states, with their column in the physics' partials.
-pub const STATES: [(Known, usize); 4] = [
-    (Known::RotorAngle, by::ROTOR_ANGLE),
-    (Known::RotorSpeed, by::ROTOR_SPEED),
-    (Known::OnionStateAngle, by::ONION_ANGLE),
-    (Known::OnionTilt, by::ONION_TILT),
-];
-
-/// The states' derivatives, in the order of [`STATES`].
-const DERIVATIVES: [Unknown; 4] = [
-    Unknown::DerRotorAngle,
-    Unknown::DerRotorSpeed,
-    Unknown::DerOnionStateAngle,
-    Unknown::DerOnionTilt,
-];
 
 /// Model Exchange's discrete states, part of the FMU state.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
@@ -131,7 +119,8 @@ impl MultiferroicMotor {
     }
 
     /// Takes the importer's state vector; refuses a non-finite one or one beyond the
-    /// motor's bounds, keeping the old.
+    /// motor's bounds ([`Motor::me_validate_state`]: a trial state's tilt may be large), keeping
+    /// the old.
     pub(super) fn me_set_states(&mut self, x: &[f64; 4]) -> Result<(), String> {
         let mut next = self.state;
         next.rotor_angle = x[0];
@@ -145,7 +134,7 @@ impl MultiferroicMotor {
                 x[2], x[3]
             ));
         }
-        Motor::validate_state(&next)?;
+        Motor::me_validate_state(&next)?;
         self.state = next;
         if !self.gilbert() {
             self.me.held = [x[2], x[3]];
@@ -237,10 +226,13 @@ impl MultiferroicMotor {
         let p = self
             .motor
             .me_partials(&self.state, &inputs, self.me.schedule_time)?;
-        partial_rows(&p, self.strain_drive, &STATES, rows);
-        for (derivative, g) in DERIVATIVES.into_iter().zip(&p.derivatives) {
-            gradient_row(rows, derivative, g, self.strain_drive, &STATES);
-        }
+        partial_rows(&p, self.strain_drive, true, rows);
+        let of = |g| move |known| column(g, known, self.strain_drive, true);
+        let [angle, speed, onion, tilt] = &p.derivatives;
+        rows.row(DerRotorAngleBy::from_fn(of(angle)))
+            .row(DerRotorSpeedBy::from_fn(of(speed)))
+            .row(DerOnionStateAngleBy::from_fn(of(onion)))
+            .row(DerOnionTiltBy::from_fn(of(tilt)));
         Ok(())
     }
 }
@@ -249,7 +241,66 @@ impl MultiferroicMotor {
 mod tests {
     use super::*;
     use crate::models::Model;
-    use crate::variables::multiferroic_motor::Parameters;
+    use crate::variables::multiferroic_motor::{Known, Parameters, Unknown};
+    use crate::variables::{ContinuousStates, Interface};
+
+    type States = <Variables as Interface>::States;
+
+    /// `rotor_speed`'s nominal (abstol = reltol x nominal in CVode under OMSimulator and FMPy) is
+    /// its physical scale, the terminal speed at the ring's peak torque with Table 3.1's motor,
+    /// within a factor of 2: with the default nominal of 1 rad/s, resolving the rotor's 2 ns
+    /// start to 1e-4 rad/s needs steps below OMSimulator's minimum (1e-12 s).
+    #[test]
+    fn rotor_speed_nominal_is_the_terminal_speed_at_peak_torque() {
+        let m = MultiferroicMotor::new(&Parameters::default(), &Inputs::default()).unwrap();
+        let scale = m.motor.terminal_speed();
+        let nominal = States::NOMINALS[1];
+        println!("terminal speed {scale:e} rad/s, nominal {nominal:e} rad/s");
+        assert_eq!(States::NAMES[1], "rotor_speed");
+        assert!(
+            (0.5..=2.0).contains(&(nominal / scale)),
+            "{nominal} vs {scale}"
+        );
+    }
+
+    /// The Gilbert onion takes any finite tilt an integrator tries (CVode's first trial under
+    /// OMSimulator's settings tilts by -800 rad) and gives finite derivatives linear in it; a
+    /// non-finite tilt is still refused, keeping the old state.
+    #[test]
+    fn model_exchange_accepts_far_trial_tilts() {
+        let p = Parameters {
+            onion_model: 1,
+            ..Parameters::default()
+        };
+        let inputs = Inputs::default();
+        let mut m = MultiferroicMotor::new(&p, &inputs).unwrap();
+        m.me_event(&inputs, 0.0).unwrap();
+        let rates = |m: &mut MultiferroicMotor, tilt: f64| {
+            m.me_set_states(&[0.0, 0.0, 0.0, tilt]).unwrap();
+            m.me_derivatives(&inputs).unwrap()
+        };
+        let (at0, at1) = (rates(&mut m, 0.0), rates(&mut m, 1.0));
+        for tilt in [-801.7, 1e3, -1e9] {
+            let d = rates(&mut m, tilt);
+            for i in 2..4 {
+                let linear = at0[i] + tilt * (at1[i] - at0[i]);
+                assert!(
+                    (d[i] - linear).abs() <= 1e-9 * linear.abs(),
+                    "{tilt}: {d:?}"
+                );
+            }
+        }
+        assert!(m.me_set_states(&[0.0, 0.0, 0.0, f64::NAN]).is_err());
+        assert_eq!(m.me_states()[3], -1e9);
+        // A saved Model Exchange state with such a tilt restores; Co-Simulation's bound holds
+        // for an instance that never ran Model Exchange.
+        let mut restored = MultiferroicMotor::new(&p, &inputs).unwrap();
+        assert!(restored.adopt_history(&m).is_ok());
+        assert_eq!(restored.me_states()[3], -1e9);
+        let mut co_simulation = MultiferroicMotor::new(&p, &inputs).unwrap();
+        co_simulation.state.onion_tilt = 20.0;
+        assert!(restored.adopt_history(&co_simulation).is_err());
+    }
 
     /// Below the damping CVode's defaults follow, the first event of a Model Exchange run
     /// warns with the reason (not at later events, not in Co-Simulation, not at the damping it

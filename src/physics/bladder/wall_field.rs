@@ -43,6 +43,31 @@ pub struct WallPoint {
     pub stress_axial: f64,
 }
 
+impl WallPoint {
+    fn is_finite(&self) -> bool {
+        [
+            self.radius,
+            self.stress_radial,
+            self.stress_hoop,
+            self.stress_axial,
+        ]
+        .iter()
+        .all(|v| v.is_finite())
+    }
+
+    /// `Ok` if every point of a field computed at muscle length `length` (m) is finite, else why
+    /// not: near a length limit the stretches, and with them the stresses, overflow.
+    pub fn check_field(field: &[WallPoint], length: f64) -> Result<(), String> {
+        if field.iter().all(WallPoint::is_finite) {
+            Ok(())
+        } else {
+            Err(format!(
+                "the wall's stress field overflows at length {length} m (too close to a length limit)"
+            ))
+        }
+    }
+}
+
 impl<S: SleeveGeometry> Bladder<S> {
     /// The wall's stress field at gauge pressure `pressure` (Pa) and muscle length `length` (m),
     /// written to `out`: its first element is the inner surface, its last the outer one (one
@@ -55,17 +80,7 @@ impl<S: SleeveGeometry> Bladder<S> {
     ) -> Result<(), String> {
         let state = self.evaluate(pressure, length)?;
         self.field_at(pressure, state.stretch_axial, state.outer_diameter, out);
-        if out.iter().all(|p| {
-            [p.radius, p.stress_radial, p.stress_hoop, p.stress_axial]
-                .iter()
-                .all(|v| v.is_finite())
-        }) {
-            Ok(())
-        } else {
-            Err(format!(
-                "the wall's stress field overflows at length {length} m (too close to a length limit)"
-            ))
-        }
+        WallPoint::check_field(out, length)
     }
 
     /// The field at axial stretch `lambda1` and outer diameter `x`.

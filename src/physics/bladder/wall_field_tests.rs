@@ -126,3 +126,28 @@ fn outside_the_fill_range_is_an_error_not_a_number() {
         .is_err());
     assert!(b.wall_field(f64::NAN, 0.1, &mut out).is_err());
 }
+
+#[test]
+fn a_field_with_an_overflowing_point_is_an_error() {
+    let finite = WallPoint {
+        radius: 1e-3,
+        stress_radial: -2e5,
+        stress_hoop: 1e6,
+        stress_axial: 5e5,
+    };
+    assert!(WallPoint::check_field(&[finite; 3], 0.1).is_ok());
+    for overflow in [f64::INFINITY, f64::NEG_INFINITY, f64::NAN] {
+        for k in 0..4 {
+            let mut point = finite;
+            let field = [
+                &mut point.radius,
+                &mut point.stress_radial,
+                &mut point.stress_hoop,
+                &mut point.stress_axial,
+            ];
+            *field[k] = overflow;
+            let e = WallPoint::check_field(&[finite, point], 0.1).unwrap_err();
+            assert!(e.contains("overflows at length 0.1 m"), "{e}");
+        }
+    }
+}

@@ -276,7 +276,10 @@ impl Motor {
     /// rotor's 2 ns inertial time `I/c`). Instead the snap is located by bisection on the substep
     /// length, the rotor advanced on the old branch to just before it (error-controlled as
     /// usual), and the onion put on its new branch; the substep after it starts from the new
-    /// torque. `None` if no snap-free prefix is found.
+    /// torque. The substep ends at the prefix's end, the time of the state it returns: ending it
+    /// at the first snapped length instead left a rotor turning at `omega` behind by `omega`
+    /// times the bracket's width (up to 0.15 rad over a 2 ns step at 1e-11 N m). `None` if no
+    /// snap-free prefix is found.
     fn step_to_onion_snap(
         &self,
         y: &Vector,
@@ -316,7 +319,7 @@ impl Motor {
         u[2] = self
             .landscape(u[0], d.direction, d.stress)
             .settle(snapped[2]);
-        self.sane(&u).then_some((u, err, after))
+        self.sane(&u).then_some((u, err, before))
     }
 
     /// The exponential Rosenbrock pair of order 2(3) of Hochbruck, Ostermann and Schweitzer

@@ -18,7 +18,9 @@
 
 use super::angles::turned_back;
 use super::branch::Branch;
-use super::{Drive, Motor, MotorInputs, MotorOutputs, MotorState, OnionModel};
+use super::{
+    within_limits, Drive, Motor, MotorInputs, MotorOutputs, MotorState, OnionModel, MAX_ANGLE,
+};
 
 /// The Gilbert onion's integration windows after a jump of its drive ([`Motor::me_ringing`]):
 /// precession periods per window (a few hundred CVode steps at its default tolerance, where 500
@@ -101,6 +103,28 @@ impl Motor {
         }
     }
 
+    /// A Model Exchange state: checked as by [`Motor::validate_state`], except that the Gilbert
+    /// onion's tilt may be any angle up to [`MAX_ANGLE`]. An importer's trial states may tilt far
+    /// (CVode's first trial under OMSimulator's settings: -800 rad), and a refusal there stops
+    /// the run (fmi2Error); the LLG rates are linear in the tilt (the film's shape anisotropy is
+    /// quadratic in it, see [`Motor::onion_relaxation_time`]), so any finite tilt has finite
+    /// derivatives, and the solution the integrator accepts stays small.
+    pub fn me_validate_state(state: &MotorState) -> Result<(), String> {
+        Self::validate_state(&MotorState {
+            onion_tilt: 0.0,
+            ..*state
+        })?;
+        within_limits(&[("onion_tilt", state.onion_tilt, MAX_ANGLE, "rad")])
+    }
+
+    /// The rotor's speed scale (rad/s): the terminal speed at the ring's peak torque against the
+    /// rod drag, `max |tau_bar| / c` (Fig. 3.3a, section 3.2.2); infinite without drag. The rotor
+    /// reaches it within a few inertial times `I / c` of a step of the schedule, so it is the
+    /// scale of `rotor_speed` as a continuous state.
+    pub fn terminal_speed(&self) -> f64 {
+        self.ring_bar.max_torque().1.abs() / self.drag
+    }
+
     /// The strain direction and stress in effect at `time` (the inputs', or the schedule's there).
     pub fn me_drive(&self, inputs: &MotorInputs, time: f64) -> [f64; 2] {
         let d = self.drive_at(inputs, time);
@@ -154,7 +178,7 @@ impl Motor {
         schedule_time: f64,
     ) -> Result<Point, String> {
         self.validate_inputs(inputs)?;
-        Self::validate_state(state)?;
+        Self::me_validate_state(state)?;
         let drive = self.drive_at(inputs, schedule_time);
         let speed = if drive.locked { 0.0 } else { state.rotor_speed };
         let mut y = [
@@ -250,7 +274,7 @@ impl Motor {
         inputs: &MotorInputs,
     ) -> Result<bool, String> {
         self.validate_inputs(inputs)?;
-        Self::validate_state(state)?;
+        Self::me_validate_state(state)?;
         let d = self.drive_at(inputs, state.time);
         let mut y = [
             state.rotor_angle,

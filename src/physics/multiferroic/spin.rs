@@ -22,10 +22,15 @@ pub(super) struct OnionCycle {
     /// The ring's torque along one turn of the cycle, in the direction of motion: pairs
     /// `(s, tau_s)` with `s = dir (phi - rotor)` from 0 to 2 pi, both sides of every snap.
     torque: Vec<(f64, f64)>,
+    /// The onion angle at each of those samples (rad), less the turns as `onion`.
+    onion_samples: Vec<f64>,
+    /// The rotor's deviation at its terminal mean speed (with drag and a positive mean force).
+    terminal: Option<Wobble>,
 }
 
 /// The rotor's periodic deviation from its mean motion at one mean speed, sampled where
 /// [`OnionCycle::torque`] is, in the direction of motion.
+#[derive(Clone)]
 struct Wobble {
     /// Angle `delta(s)` (rad, zero mean over a turn) and speed `u(s)` (rad/s) deviations.
     angle: Vec<f64>,
@@ -95,6 +100,42 @@ impl OnionCycle {
     fn phase(s: f64) -> f64 {
         s.rem_euclid(2.0 * PI)
     }
+
+    /// The cycle for a strain direction turned by `angle`: eq. 3.3-3.4 depend only on `psi - phi`
+    /// and `psi - gamma`, so rotor and onion turn with the strain and the torque along the cycle
+    /// is the same. A schedule's segments then share one march.
+    fn rotate(&mut self, angle: f64) {
+        let rotor = self.rotor + angle;
+        let whole = (rotor / (2.0 * PI)).round() * 2.0 * PI;
+        let shift = angle - whole;
+        self.rotor += shift;
+        self.onion += shift;
+        for psi in &mut self.onion_samples {
+            *psi += shift;
+        }
+        self.turns += whole;
+    }
+
+    /// Whether the state's onion is the cycle's at the state's rotor angle (modulo whole turns,
+    /// within 1e-9 rad).
+    fn holds(&self, motor: &Motor, y: &super::Vector, dir: f64, d: &Drive) -> bool {
+        let s = Self::phase(dir * (y[0] - self.turns - self.rotor));
+        let onion = self.onion_at(motor, s, dir, d) + self.turns + self.onion_turns;
+        super::wrap_angle(onion - y[2]).abs() <= 1e-9
+    }
+
+    /// The onion angle on the cycle at `s` (in the direction of motion, from `rotor`) for the
+    /// drive `d`: settled from the sample at or below `s`, with no snap in between.
+    fn onion_at(&self, motor: &Motor, s: f64, dir: f64, d: &Drive) -> f64 {
+        let j = self
+            .torque
+            .partition_point(|&(x, _)| x <= s)
+            .clamp(1, self.torque.len())
+            - 1;
+        motor
+            .landscape(self.rotor + dir * s, d.direction, d.stress)
+            .settle(self.onion_samples[j])
+    }
 }
 
 impl Motor {
@@ -158,25 +199,33 @@ impl Motor {
         if !(resolved_free || corrected) {
             return false;
         }
-        // The cycle is the same for the whole segment (constant drive): marched once.
-        if run
-            .spin_cycle
-            .as_ref()
-            .is_none_or(|(end, _)| *end != segment_end)
-        {
+        // Within a step only the schedule's strain direction changes (the load and the stress
+        // are held): the cycle marched for one segment, turned with the strain, serves the next
+        // when the onion is on it (after a switch it may sit on the other branch of the
+        // bistable stretch until the next fold; then the cycle is marched again from the state).
+        if let Some((direction, cycle)) = &mut run.spin_cycle {
+            if *direction != d.direction {
+                cycle.rotate(d.direction - *direction);
+                *direction = d.direction;
+            }
+            if !cycle.holds(self, &run.y, dir, d) {
+                run.spin_cycle = None;
+            }
+        }
+        if run.spin_cycle.is_none() {
             match self.onion_cycle(&run.y, d, dir) {
-                Some(cycle) => run.spin_cycle = Some((segment_end, cycle)),
+                Some(cycle) => run.spin_cycle = Some((d.direction, cycle)),
                 None => {
                     run.spin_failed = true;
                     return false;
                 }
             }
         }
-        let Some((end, cycle)) = run.spin_cycle.take() else {
+        let Some((direction, cycle)) = run.spin_cycle.take() else {
             return false;
         };
         let spun = self.spin(&run.y, &cycle, d, h, !resolved_free);
-        run.spin_cycle = Some((end, cycle));
+        run.spin_cycle = Some((direction, cycle));
         match spun {
             Spin::NotYet => false,
             Spin::Failed => {
@@ -225,12 +274,27 @@ impl Motor {
                 (omega0 * h + 0.5 * force / i * h * h, omega0 + force / i * h)
             }
         };
+        // The deviation at a mean speed this close to the terminal one is the terminal one's
+        // within tol / 100 (it and its drift scale with the speed's inverse).
+        let near_terminal = |omega: f64| {
+            cycle.terminal.as_ref().filter(|w| {
+                let relative = (1.0 - omega / w.omega).abs();
+                (w.amplitude() + h * w.drift_force.abs() / c) * relative <= 0.01 * tol
+            })
+        };
         let (mut theta, mut speed0) = (y[0], speed);
         if correct_start {
             // The error against resolved integration (see the tests) at the speed it will spin
             // at: the second-order periodic terms left out, `amplitude (epsilon + 1e-3)`, and the
             // third-order drift, `epsilon^3` per radian turned.
-            let terminal = self.wobble(cycle, force / c);
+            let computed;
+            let terminal = match &cycle.terminal {
+                Some(w) => w,
+                None => {
+                    computed = self.wobble(cycle, force / c);
+                    &computed
+                }
+            };
             let amplitude = terminal.amplitude();
             let epsilon = cycle
                 .torque
@@ -243,7 +307,14 @@ impl Motor {
             }
             // The deviation's dependence on the mean speed, neglected while that approaches its
             // terminal value, stays below tol / 10.
-            let start = self.wobble(cycle, speed);
+            let computed;
+            let start = match near_terminal(speed) {
+                Some(w) => w,
+                None => {
+                    computed = self.wobble(cycle, speed);
+                    &computed
+                }
+            };
             let (delta, u) = start.at(cycle, s_of(y[0]), c);
             theta -= dir * delta;
             speed0 -= u;
@@ -254,7 +325,10 @@ impl Motor {
         let (mut advance, mut omega) = mean_motion(speed0, force);
         let mut end_wobble = None;
         if c > 0.0 && omega > 0.0 {
-            let end = self.wobble(cycle, omega);
+            let end = match near_terminal(omega) {
+                Some(w) => std::borrow::Cow::Borrowed(w),
+                None => std::borrow::Cow::Owned(self.wobble(cycle, omega)),
+            };
             (advance, omega) = mean_motion(speed0, force + end.drift_force);
             end_wobble = Some(end);
         }
@@ -269,16 +343,12 @@ impl Motor {
             return Spin::Failed;
         }
         // The onion on its cycle at the end angle: whole turns shift it by the winding, the rest
-        // is marched.
+        // is settled from the cycle's sample below it.
         let from_cycle = phi - cycle.turns - cycle.rotor;
         let whole = (dir * from_cycle / (2.0 * PI)).floor();
         let rest = from_cycle - dir * whole * 2.0 * PI;
-        let Some(onion) = self.march_onion(cycle.rotor, cycle.onion, cycle.rotor + rest, d, None)
-        else {
-            return Spin::Failed;
-        };
-        let psi =
-            onion.0 + cycle.turns + cycle.onion_turns + cycle.winding * dir * whole * 2.0 * PI;
+        let onion = cycle.onion_at(self, dir * rest, dir, d);
+        let psi = onion + cycle.turns + cycle.onion_turns + cycle.winding * dir * whole * 2.0 * PI;
         if !(psi.is_finite() && psi.abs() <= super::MAX_ANGLE) {
             return Spin::Failed;
         }
@@ -358,17 +428,19 @@ impl Motor {
             .settle(y[2] - turns - onion_turns);
         let start = phi0 + dir * 2.0 * PI;
         let (psi1, _) = self.march_onion(phi0, psi0, start, d, None)?;
-        let mut torque = Vec::with_capacity(160);
+        let mut samples = Vec::with_capacity(160);
         let (psi2, work) =
-            self.march_onion(start, psi1, start + dir * 2.0 * PI, d, Some(&mut torque))?;
+            self.march_onion(start, psi1, start + dir * 2.0 * PI, d, Some(&mut samples))?;
         let winding = ((psi2 - psi1) / (2.0 * PI)).round();
         if (psi2 - psi1 - winding * 2.0 * PI).abs() > 1e-6 {
             return None;
         }
-        for sample in &mut torque {
-            *sample = (dir * (sample.0 - start), dir * sample.1);
-        }
-        Some(OnionCycle {
+        let torque = samples
+            .iter()
+            .map(|&(phi, _, tau)| (dir * (phi - start), dir * tau))
+            .collect();
+        let onion_samples = samples.iter().map(|&(_, psi, _)| psi).collect();
+        let mut cycle = OnionCycle {
             turns,
             onion_turns,
             rotor: start,
@@ -376,13 +448,20 @@ impl Motor {
             winding: winding * dir,
             work,
             torque,
-        })
+            onion_samples,
+            terminal: None,
+        };
+        let force = d.load.abs() + work / (2.0 * PI);
+        if self.drag > 0.0 && force > 0.0 {
+            cycle.terminal = Some(self.wobble(&cycle, force / self.drag));
+        }
+        Some(cycle)
     }
 
     /// The quasi-static onion while the rotor turns from `from` to `to` (its memory rule, snaps
     /// included), and the energy the snaps changed `U` by on the way (J). Strides of at most
     /// [`CYCLE_STRIDE`]; a snap is placed by bisection within [`SNAP_PLACEMENT`] rad, where its
-    /// energy change is taken. `samples`, if given, receives the ring's torque `(phi, tau)` at
+    /// energy change is taken. `samples`, if given, receives `(phi, psi, tau)`, the ring's torque at
     /// every stride's end and on both sides of every snap.
     fn march_onion(
         &self,
@@ -390,13 +469,13 @@ impl Motor {
         psi: f64,
         to: f64,
         d: &Drive,
-        mut samples: Option<&mut Vec<(f64, f64)>>,
+        mut samples: Option<&mut Vec<(f64, f64, f64)>>,
     ) -> Option<(f64, f64)> {
         let settle = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).settle(onion);
         let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
         let mut record = |at: f64, onion: f64| {
             if let Some(s) = samples.as_deref_mut() {
-                s.push((at, self.ring_bar.torque_stiffness(onion - at).0));
+                s.push((at, onion, self.ring_bar.torque_stiffness(onion - at).0));
             }
         };
         let strides = ((to - from).abs() / CYCLE_STRIDE).ceil().max(1.0);
