@@ -157,24 +157,13 @@ impl McKibben {
             }
         };
         // h rises with L (slope 1 + c dF/dL > 0 on the stable branch). Converged when the length
-        // moves by less than rounding, or by less than 1e-13 of the muscle's length range: a
-        // wall whose force is a large difference of stresses rounds `F` (and so `h`) far above
-        // `L`'s own rounding, and Newton steps below that floor only bisect through noise.
+        // moves by less than rounding; F then changes by K times that.
         let options = RootOptions {
-            absolute: 1e-13 * (hi_edge - lo_edge),
+            absolute: 1e-17,
             relative: 1e-14,
             max_iterations: ROOT_ITERATIONS,
         };
-        // Start from the first guess's Newton step where it lands inside the bracket (the
-        // residual is nearly linear in `L` where the muscle's stiffness varies slowly, as it
-        // does far from its ends), else from the middle.
-        let newton = x0 - h0 / (1.0 + c * core0.newton_slope);
-        let start = if newton > lo && newton < hi {
-            newton
-        } else {
-            0.5 * (lo + hi)
-        };
-        let root = newton_bisection(lo, hi, start, true, options, |x| {
+        let root = newton_bisection(lo, hi, 0.5 * (lo + hi), true, options, |x| {
             let (value, core) = eval(x)?;
             let slope = 1.0 + c * core.newton_slope;
             Ok::<_, String>(Some(Sample {
