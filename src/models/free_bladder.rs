@@ -7,7 +7,7 @@
 //! Exchange. Inputs outside the solvable range are evaluated at the nearest valid point and
 //! flagged (`input_clamped`, `out_of_range_policy`), each excursion logged once.
 
-use super::wall_arrays::{self, WallQuantity};
+use super::wall_arrays::{self, wall_quantity_of, WallQuantity};
 use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::free_bladder::{FreeBladder as Tube, FreeBladderState};
@@ -142,12 +142,7 @@ impl Model for FreeBladder {
     }
 
     fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
-        let quantity = match array {
-            ArrayOutput::WallRadius => WallQuantity::Radius,
-            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
-            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
-            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
-        };
+        let quantity = wall_quantity_of!(array);
         // At the point the outputs are computed at (the inputs clamped into the solvable range).
         let OperatingPoint {
             pressure, length, ..

@@ -8,7 +8,7 @@
 //! same [`Bladder`] code with the knitted cylinder's diameter; it is refused for the
 //! non-cylindrical shape, which has no single bladder diameter.
 
-use super::wall_arrays::{self, WallQuantity};
+use super::wall_arrays::{self, wall_quantity_of, WallQuantity};
 use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{Bladder, BladderTube};
 use crate::physics::friction::{HysteresisState, StopOperator};
@@ -309,12 +309,7 @@ impl Model for KnittedMuscle {
     }
 
     fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
-        let quantity = match array {
-            ArrayOutput::WallRadius => WallQuantity::Radius,
-            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
-            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
-            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
-        };
+        let quantity = wall_quantity_of!(array);
         let Some(bladder) = self.assembly.bladder() else {
             return wall_arrays::absent(out);
         };

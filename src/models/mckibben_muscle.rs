@@ -5,7 +5,7 @@
 //! friction hysteresis (`friction`) and a series connector (`connector_stiffness` > 0).
 //! With all of them off a step is eq. 2.3 alone.
 
-use super::wall_arrays::{self, WallQuantity};
+use super::wall_arrays::{self, wall_quantity_of, WallQuantity};
 use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::BladderTube;
 use crate::physics::by_pressure_length::ByPressureLength;
@@ -534,12 +534,7 @@ impl Model for McKibbenMuscle {
     }
 
     fn array(&self, inputs: &Inputs, array: ArrayOutput, out: &mut [f64]) -> Result<(), String> {
-        let quantity = match array {
-            ArrayOutput::WallRadius => WallQuantity::Radius,
-            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
-            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
-            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
-        };
+        let quantity = wall_quantity_of!(array);
         let Pipeline::Full(muscle) = &self.pipeline else {
             return wall_arrays::absent(out);
         };

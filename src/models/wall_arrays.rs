@@ -22,6 +22,21 @@ pub(crate) enum WallQuantity {
     StressAxial,
 }
 
+/// The [`WallQuantity`] of the calling model's generated `ArrayOutput`: every model with a bladder
+/// declares the same four arrays, so one mapping serves them all (a renamed array does not
+/// compile).
+macro_rules! wall_quantity_of {
+    ($array:expr) => {
+        match $array {
+            ArrayOutput::WallRadius => WallQuantity::Radius,
+            ArrayOutput::WallStressRadial => WallQuantity::StressRadial,
+            ArrayOutput::WallStressHoop => WallQuantity::StressHoop,
+            ArrayOutput::WallStressAxial => WallQuantity::StressAxial,
+        }
+    };
+}
+pub(crate) use wall_quantity_of;
+
 impl WallQuantity {
     fn of(self, point: &WallPoint) -> f64 {
         match self {
