@@ -34,10 +34,20 @@ impl McKibben {
         let c = self.connector_compliance?;
         let (lo_edge, _) = self.connector_edges();
         let from_shortest = *branch.get_or_init(|| self.branch_end(pressure, lo_edge, history, c));
+        let reported = |(l, core): &(f64, Core)| l + c * core.out.force;
+        // The branch from the shortest length passes `from` only if it ends further in both
+        // lengths: past a jump of the force it may end further in `L` but short of `from`'s
+        // reported length.
+        let passes = |end: &(f64, Core)| {
+            end.0 > from
+                && !self
+                    .at_actual_length(pressure, from, history)
+                    .is_ok_and(|at| reported(end) <= from + c * at.out.force)
+        };
         let (l, core) = from_shortest
-            .filter(|(end, _)| *end > from)
+            .filter(passes)
             .or_else(|| self.branch_end(pressure, from, history, c))?;
-        let reported = l + c * core.out.force;
+        let reported = reported(&(l, core));
         let mut out = core.out;
         let k_m = out.stiffness;
         out.stiffness = k_m / (1.0 + c * k_m);
@@ -66,9 +76,17 @@ impl McKibben {
                 .ok()
                 .filter(|core| 1.0 + c * core.newton_slope > 0.0)
         };
+        let reported = |(l, core): &(f64, Core)| l + c * core.out.force;
+        // On the branch past `end`: rising there, and not below `end`'s reported length (the
+        // force may jump between two rising stretches, where the slope alone does not show it).
+        let on_branch = |l: f64, end: &(f64, Core)| {
+            rising(l)
+                .map(|core| (l, core))
+                .filter(|at| reported(at) >= reported(end))
+        };
         let mut end = (from, rising(from)?);
-        if let Some(at_edge) = rising(hi_edge) {
-            return Some((hi_edge, at_edge));
+        if let Some(at_edge) = on_branch(hi_edge, &end) {
+            return Some(at_edge);
         }
         let tolerance = 1e-9 * (hi_edge - lo_edge);
         let mut past = hi_edge;
@@ -77,8 +95,8 @@ impl McKibben {
             if past - end.0 <= tolerance || mid <= end.0 || mid >= past {
                 break;
             }
-            match rising(mid) {
-                Some(core) => end = (mid, core),
+            match on_branch(mid, &end) {
+                Some(at) => end = at,
                 None => past = mid,
             }
         }
@@ -273,6 +291,47 @@ mod tests {
             assert!(o.actual_length < out.actual_length && o.force > 0.0);
         }
         assert!(m.evaluate(p, reach * (1.0 + 1e-12), &rest).is_err());
+    }
+
+    /// Table 2.1's muscle D with an almost stress-free rubber (`C1` 0.28 Pa) of one quadrature
+    /// node under a vacuum: the free bladder's force jumps between rising stretches of the
+    /// reported length `L + F/k`, where the slope alone does not show the jump. From any muscle
+    /// length on a rising stretch the connector reaches at least that length's own reported
+    /// length (a reach below it belongs to another stretch); and the strands' transition past
+    /// `max_length` is that reach, found without bisecting through connector solves.
+    #[test]
+    fn reach_from_a_length_is_not_below_its_reported_length() {
+        let g = MuscleGeometry::muscle_d();
+        let tube = BladderTube {
+            mooney_c1: 0.2847,
+            mooney_c2: 3.127e-3,
+            ..g.tube()
+        };
+        let model = BladderModel::DissertationContinuum { nodes: 1 };
+        let m = McKibben::new(g.sleeve().unwrap(), tube, model, None, 16553.48).unwrap();
+        let (p, rest, c) = (-36058.86, HysteresisState::at_rest(0.1), 1.0 / 16553.48);
+        let (lo, hi) = m.connector_edges();
+        let mut rising = 0;
+        for i in 1..200 {
+            let l = lo + (hi - lo) * f64::from(i) / 200.0;
+            let Ok(core) = m.at_actual_length(p, l, &rest) else {
+                continue;
+            };
+            if 1.0 + c * core.newton_slope <= 0.0 {
+                continue;
+            }
+            rising += 1;
+            let own = l + c * core.out.force;
+            let (reach, out) = m.connector_reach(p, l, &rest, &BranchEnd::new()).unwrap();
+            assert!(reach >= own, "from {l}: reach {reach} below {own}");
+            assert_eq!(reach, out.actual_length + c * out.force);
+        }
+        assert!(rising > 100, "{rising}");
+        let t = m
+            .strand_transition(p, m.breaking_length(), 327396.4, &rest)
+            .unwrap();
+        assert_eq!(t.length, t.rigid.actual_length + c * t.rigid.force);
+        assert!(!t.interior && t.rigid.force < 0.0 && t.length < m.max_length());
     }
 
     /// Past the reach the strands take over at the reach itself: the force is continuous there
