@@ -101,13 +101,9 @@ def nominals():
     """For rotor_speed nominals from 1e2 rad/s to the description's: the largest rotor-angle
     difference at the period ends under FMPy's default CVode, and which parameter sets run (on the
     schedule, 1.2 ms) under OMSimulator's CVode settings (tests/fmpy/test_motor_omsimulator_settings.py)."""
-    import pathlib
-    import sys
-
     import fmpy.sundials
 
-    sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests" / "fmpy"))
-    from test_motor_omsimulator_settings import OMSimulatorCVode
+    from actuator_fmus.omsimulator_cvode import OMSimulatorCVode
 
     default_solver = fmpy.sundials.CVodeSolver
     cs = simulate_fmu(FMU, start_values=PARAMETERS, output=["rotor_angle"], output_interval=1e-6)
