@@ -446,16 +446,16 @@ impl Motor {
             .saturating_sub(run.attempts.saturating_add(run.extra_cost))
             .max(1);
         let per_segment = (left / SEGMENT_BUDGET_SHARE).max(1);
-        // While more than half the budget is left, the floor is 64 times finer than an even
-        // spread: a short stiff transient at the start of a step (the Gilbert onion's ringing
-        // after a switch) is resolved there, and the even spread of the half left still ends
-        // the step.
+        // While more than half the budget is left, the floor is FINE_FLOOR times finer than an
+        // even spread: the short stiff transients inside a step (the Gilbert onion's ringing
+        // after every switch, ~2 ns at picosecond substeps, at any communication step up to
+        // 1 s) are resolved there, and the even spread of the half left still ends the step.
         let spread = if 2 * u64::from(left) > u64::from(budget) + 1 {
-            64 * left as u64
+            FINE_FLOOR * left as f64
         } else {
-            left as u64
+            left as f64
         };
-        let dt_min = (remaining / spread as f64).min((segment_end - t) / per_segment as f64);
+        let dt_min = (remaining / spread).min((segment_end - t) / per_segment as f64);
         let mut dt_try = run.dt.max(dt_min).min(segment_end - t);
         let clipped = dt_try < run.dt;
         if dt_try < 1e-300 {
@@ -555,6 +555,10 @@ const ONION_SNAP: f64 = 0.05;
 
 /// The snap is located within this fraction of the rotor's inertial time `I/c`.
 const SNAP_RESOLUTION: f64 = 1e-4;
+
+/// While more than half the budget is left, the minimum substep is this fraction of the even
+/// spread of the budget over the rest of the step (see [`Motor::substep`]).
+const FINE_FLOOR: f64 = 1048576.0;
 
 /// A segment of constant drive may use at most 1/this of the substeps left (see [`Motor::step`]).
 const SEGMENT_BUDGET_SHARE: u32 = 16;

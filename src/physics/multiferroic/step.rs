@@ -37,6 +37,9 @@ pub(super) struct StepRun {
     /// Whether `angles` are those of a quasi-static onion settled at `y` for the present drive
     /// (then the next [`Motor::constrain`] has nothing to do).
     pub(super) settled: bool,
+    /// The Gilbert onion's segment (its end) over which the relaxed onion follows the
+    /// quasi-static branch (see [`Motor::relaxed_onion`]).
+    pub(super) following: f64,
 }
 
 impl StepRun {
@@ -68,6 +71,7 @@ impl StepRun {
             period_mismatch: f64::INFINITY,
             angles: None,
             settled: false,
+            following: f64::NAN,
         }
     }
 
@@ -141,6 +145,7 @@ impl Motor {
         }
         let budget = self.params.max_substeps;
         let mut run = StepRun::new(state, h);
+        let twin = self.quasi_static_twin();
         let long_segment = 10.0 * self.rotor_relaxation_time();
         // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
         // repeated periods; the minimum substep reaches the segment's end once the budget is
@@ -155,25 +160,32 @@ impl Motor {
                 }
             }
             let d = self.drive_at(inputs, run.t);
-            if !run.is_settled(&d) {
-                run.angles = Some(self.constrain(&mut run.y, &d, run.angles.as_ref()));
-                run.settled = self.quasi_static();
-            }
             let segment_end = match inputs.schedule.get() {
                 Some(s) => s.next_switch_after(run.t).min(run.t_end),
                 None => run.t_end,
             };
+            let model = match &twin {
+                Some(q) if self.follows_branch(&mut run, &d, segment_end) => q,
+                _ => self,
+            };
+            if !run.is_settled(&d) {
+                run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
+                run.settled = model.quasi_static();
+            }
             run.enter_segment(segment_end, d.direction);
-            if self.advance_spinning(&mut run, &d, segment_end) {
+            if model.advance_spinning(&mut run, &d, segment_end) {
                 continue;
             }
-            if run.settle_tried_for != segment_end && segment_end - run.t > long_segment {
+            if model.quasi_static()
+                && run.settle_tried_for != segment_end
+                && segment_end - run.t > long_segment
+            {
                 run.settle_tried_for = segment_end;
-                if self.advance_overdamped(&mut run, &d, segment_end) {
+                if model.advance_overdamped(&mut run, &d, segment_end) {
                     continue;
                 }
             }
-            self.substep(&mut run, &d, segment_end, budget);
+            model.substep(&mut run, &d, segment_end, budget);
         }
         if run.t < run.t_end {
             return Err(format!(
@@ -204,6 +216,58 @@ impl Motor {
         })
     }
 
+    /// The Gilbert motor's quasi-static twin (`None` for the quasi-static motor): the same motor
+    /// with the onion settled, which follows a relaxed Gilbert onion (see [`Self::relaxed_onion`]).
+    fn quasi_static_twin(&self) -> Option<Motor> {
+        (!self.quasi_static()).then(|| {
+            let mut twin = self.clone();
+            twin.params.onion_model = super::OnionModel::QuasiStatic;
+            twin
+        })
+    }
+
+    /// Whether the Gilbert onion follows its quasi-static branch for the rest of the segment
+    /// ending at `segment_end`: it does from the first pass at which it is relaxed, and then
+    /// starts on the branch (no tilt, the onion settled).
+    fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
+        if run.following == segment_end {
+            return true;
+        }
+        if !self.relaxed_onion(&run.y, d) {
+            return false;
+        }
+        run.following = segment_end;
+        run.y[3] = 0.0;
+        run.angles = None;
+        run.settled = false;
+        run.settle_tried_for = f64::NAN;
+        true
+    }
+
+    /// Whether the Gilbert onion at `y` has relaxed onto its quasi-static branch: its tilt and its
+    /// distance to the minimum of eq. 3.4 it would settle into are within `tolerance` plus its lag
+    /// behind a turning rotor, and that lag is small.
+    ///
+    /// The onion relaxes in `tau_o` ([`Self::onion_relaxation_time`], ~0.4 ns), ~1e4 times faster
+    /// than the rotor (~3 us), so once the ringing after a jump of its drive has decayed it lies
+    /// on the slow manifold: in the minimum, behind it by its lag `tau_o |psi'|` (the tilt is
+    /// smaller, `alpha tau_o |psi'| / 2`), with `|psi'|` a few times the rotor's speed along its
+    /// branch. Following the branch drops that lag: the rotor's path is then the quasi-static one,
+    /// ahead of the Gilbert one by about `tau_o` in time, i.e. by up to `tau_o |omega|` in angle
+    /// while it turns (2e-5 rad at the default schedule's peak 5e4 rad/s) and by nothing once it
+    /// has settled. A rotor that turns so fast that the lag exceeds [`MAX_FOLLOWED_LAG`], or an
+    /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
+    /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
+    pub(super) fn relaxed_onion(&self, y: &Vector, d: &Drive) -> bool {
+        let lag_time = self.onion_relaxation_time();
+        if !(lag_time <= 0.1 * self.rotor_relaxation_time()) {
+            return false;
+        }
+        let rate = if d.locked { 0.0 } else { y[1].abs() };
+        let slack = self.params.tolerance + (4.0 * lag_time * rate).min(MAX_FOLLOWED_LAG);
+        y[3].abs() <= slack && (self.settle(y, d) - y[2]).abs() <= slack
+    }
+
     /// The constraints that hold at every instant: a locked rotor does not turn, and the
     /// quasi-static onion sits settled for the present drive.
     /// Returns the angles at the constrained state (turned from `hint` when close).
@@ -225,3 +289,7 @@ impl Motor {
 /// its two 5x5 exponentials cost about 2.7 us against 0.3-0.9 us (release, x86-64), so the budget
 /// bounds a step's cost alike in both onion models (about 7 ms at the default 20,000).
 pub const GILBERT_SUBSTEP_WEIGHT: u32 = 8;
+
+/// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
+/// drop (see [`Motor::relaxed_onion`]).
+const MAX_FOLLOWED_LAG: f64 = 1e-3;

@@ -1072,3 +1072,87 @@ fn any_budget_ends_the_step() {
         }
     }
 }
+
+/// The Gilbert onion (Table 3.1, damping 0.045) on the motor, `I phi'' = tau_bar(psi - phi) - c
+/// phi'`, `psi' = -g (mu0 Ms^2 V theta + alpha U')`, `theta' = g (U' - alpha mu0 Ms^2 V theta)`
+/// with `U' = tau_bar(psi - phi) + E sin 2 (psi - gamma)` and `g = gamma / (Ms V (1 + alpha^2))`
+/// (the macrospin of `Motor::onion_relaxation_time`), integrated by classical RK4 at 1 ps
+/// through the first 10 ns (the ringing: its ~80 ps precession at 0.08 rad per step) and 10 ps
+/// after (the slow manifold), with the strain from the default schedule's first period.
+fn gilbert_rk4_reference(m: &Motor, until: f64) -> [f64; 4] {
+    let p = &m.params;
+    let (ms, v, alpha) = (p.saturation_magnetization, p.wall_volume, p.gilbert_damping);
+    let g = magnetics::GYROMAGNETIC_RATIO / (ms * v * (1.0 + alpha * alpha));
+    let shape = magnetics::MU0 * ms * ms * v;
+    let e = m.magnetoelastic_per_stress * CALIBRATION_STRESS;
+    let gamma = (-30f64).to_radians();
+    let rate = |y: &[f64; 4]| -> [f64; 4] {
+        let tau = m.ring_bar.torque(y[2] - y[0]);
+        let u = tau + e * (2.0 * (y[2] - gamma)).sin();
+        [
+            y[1],
+            (tau - m.drag * y[1]) / m.inertia,
+            -g * (shape * y[3] + alpha * u),
+            g * (u - alpha * shape * y[3]),
+        ]
+    };
+    let mut y = [0.0; 4];
+    let mut t = 0.0;
+    while t < until {
+        let h: f64 = if t < 10e-9 { 1e-12 } else { 1e-11 };
+        let h = h.min(until - t);
+        let k1 = rate(&y);
+        let k2 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
+        let k3 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
+        let k4 = rate(&std::array::from_fn(|i| y[i] + h * k3[i]));
+        y = std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+        t += h;
+    }
+    y
+}
+
+/// The Gilbert onion on the default schedule (100 us periods) at OMSimulator's 1 ms step: every
+/// step within the budget (no fmi2Warning), the rotor at 1 ms and 1.2 ms that of 1 us steps, and a
+/// 20 us step (the ringing after the start, then the relaxed onion on its branch while the rotor
+/// turns) that of the fine RK4 reference within the onion's dropped lag `tau_o |omega|`.
+#[test]
+fn gilbert_onion_at_millisecond_steps_agrees_with_microsecond_steps_and_a_fine_integration() {
+    let m = motor_with(|p| p.onion_model = OnionModel::Gilbert);
+    let inputs = schedule(100e-6);
+    let (mut long, mut short) = (MotorState::aligned(0.0), MotorState::aligned(0.0));
+    for h in [1e-3, 0.2e-3] {
+        let report = m.step(&mut long, &inputs, h).unwrap();
+        assert!(!report.accuracy_limited, "t = {}: {report:?}", long.time);
+        for _ in 0..(h * 1e6).round() as usize {
+            let report = m.step(&mut short, &inputs, 1e-6).unwrap();
+            assert!(!report.accuracy_limited, "t = {}: {report:?}", short.time);
+        }
+        let difference = (long.rotor_angle - short.rotor_angle).abs();
+        println!(
+            "t = {} s: 1 ms steps {} rad, 1 us steps {difference:e} rad away",
+            long.time, long.rotor_angle
+        );
+        assert!(difference < 1e-6, "t = {}: {difference}", long.time);
+    }
+    // Twelve 60-degree steps, the last one settled.
+    assert!(
+        (long.rotor_angle - 4.0 * PI).abs() < 1e-5,
+        "{}",
+        long.rotor_angle
+    );
+    let until = 20e-6;
+    let mut s = MotorState::aligned(0.0);
+    m.step(&mut s, &inputs, until).unwrap();
+    let reference = gilbert_rk4_reference(&m, until);
+    let lag = m.onion_relaxation_time() * reference[1].abs();
+    assert!(reference[0] > 0.5 && lag > 1e-6, "{reference:?}");
+    println!(
+        "20 us: {} rad, RK4 {} rad, lag {lag:e} rad",
+        s.rotor_angle, reference[0]
+    );
+    assert!(
+        (s.rotor_angle - reference[0]).abs() < lag,
+        "{} against {reference:?} (lag {lag})",
+        s.rotor_angle
+    );
+}
