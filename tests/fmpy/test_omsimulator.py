@@ -106,11 +106,6 @@ def test_the_motor_runs_as_model_exchange_in_omsimulator(tmp_path):
         assert abs(angle - reference) <= tolerance(np.abs(cs["rotor_angle"]).max()), case
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the Gilbert onion's Co-Simulation step of 1 ms exhausts the substep budget (fmi2Warning), "
-    "which stops OMSimulator: docs/compatibility.md, OMSimulator",
-)
 def test_the_gilbert_motor_runs_as_co_simulation_in_omsimulator(tmp_path):
     """The motor on its schedule with the Gilbert onion as Co-Simulation at OMSimulator's 1 ms step:
     OK throughout, the rotor angle at the end that of FMPy's Co-Simulation at 1 us steps."""

@@ -213,6 +213,13 @@ impl Motor {
             }
         }
         if run.spin_cycle.is_none() {
+            // The march costs SPIN_CYCLE_WEIGHT substeps of the budget, or is not started.
+            let spent = run.attempts.saturating_add(run.extra_cost);
+            if spent.saturating_add(SPIN_CYCLE_WEIGHT) > self.params.max_substeps {
+                run.spin_failed = true;
+                return false;
+            }
+            run.extra_cost = run.extra_cost.saturating_add(SPIN_CYCLE_WEIGHT);
             match self.onion_cycle(&run.y, d, dir) {
                 Some(cycle) => run.spin_cycle = Some((d.direction, cycle)),
                 None => {
@@ -523,6 +530,10 @@ const LOAD_DOMINATED: f64 = 0.5;
 /// least this many turns within the segment (fewer cost less resolved than the cycle's march).
 const MAX_SPIN_EPSILON: f64 = 0.05;
 const MIN_SPIN_TURNS: f64 = 2.0;
+/// The onion's cycle ([`Motor::onion_cycle`], two turns of 126 strides with their settles, about
+/// 25 us in release) counts as this many quasi-static substeps (0.3-0.9 us) in `max_substeps`,
+/// so that the budget bounds a step that marches it again at every switch of a fast schedule.
+pub(super) const SPIN_CYCLE_WEIGHT: u32 = 40;
 /// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
 const CYCLE_STRIDE: f64 = 0.05;
 const SNAP_PLACEMENT: f64 = 1e-10;
