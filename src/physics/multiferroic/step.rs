@@ -107,14 +107,16 @@ impl Motor {
     ///   for the default schedule), at the cost of one substep;
     /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
     ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
-    ///   budget`, 64 times less while more than half the budget is left (so that a short stiff
-    ///   transient at the start of a step, such as the Gilbert onion's ringing after a switch, is
+    ///   budget`, 2^20 times less while more than half the budget is left (so that a short stiff
+    ///   transient inside a step, such as the Gilbert onion's ringing after a switch, is
     ///   resolved); a substep at that minimum is accepted even if its error exceeds the tolerance
     ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]). A substep across a snap of
     ///   the quasi-static onion to its other branch is cut at the snap (located by bisection),
     ///   since the torque jumps there and no error estimate shrinks with a substep across it;
     /// - a slipping rotor (no equilibrium ahead) advances by whole overdamped turns
-    ///   ([`Self::slip_turns`], flagged).
+    ///   ([`Self::slip_turns`], flagged);
+    /// - a Gilbert onion, once relaxed after a switch, follows its quasi-static branch to the
+    ///   segment's end by all of the above ([`Self::relaxed_onion`]).
     ///
     /// Each segment may use at most 1/16 of the substeps left. With the stepping schedule, once
     /// three consecutive whole periods have ended in the same state relative to the strain
