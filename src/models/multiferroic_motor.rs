@@ -403,7 +403,8 @@ impl Model for MultiferroicMotor {
                         "the step from t = {time} s by {step} s was completed beyond tolerance \
                          = {} rad (its substep budget max_substeps = {} ran out, a Gilbert \
                          onion substep counting as {GILBERT_SUBSTEP_WEIGHT}, or a slipping rotor \
-                         or the Gilbert onion model was advanced over many periods at once); shorten the step or raise max_substeps where this matters",
+                         was advanced by whole turns); shorten the step or raise max_substeps \
+                         where this matters",
                         self.motor.params.tolerance, self.motor.params.max_substeps
                     ));
                 }

@@ -107,7 +107,7 @@ impl Motor {
     ///   for the default schedule), at the cost of one substep;
     /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
     ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
-    ///   budget`, 2^20 times less while more than half the budget is left (so that a short stiff
+    ///   budget`, 2^30 times less while more than half the budget is left (so that a short stiff
     ///   transient inside a step, such as the Gilbert onion's ringing after a switch, is
     ///   resolved); a substep at that minimum is accepted even if its error exceeds the tolerance
     ///   (flagged), and cannot amplify (see [`Self::rhs_jacobian`]). A substep across a snap of

@@ -1112,7 +1112,8 @@ fn gilbert_rk4_reference(m: &Motor, until: f64) -> [f64; 4] {
 }
 
 /// The Gilbert onion on the default schedule (100 us periods) at OMSimulator's 1 ms step: every
-/// step within the budget (no fmi2Warning), the rotor at 1 ms and 1.2 ms that of 1 us steps, and a
+/// step within the budget (no fmi2Warning), the rotor at 1 ms and 1.2 ms that of 1 us steps (and a
+/// 1 s step's 10,000 steps of 60 degrees within the budget), and a
 /// 20 us step (the ringing after the start, then the relaxed onion on its branch while the rotor
 /// turns) that of the fine RK4 reference within the onion's dropped lag `tau_o |omega|`.
 #[test]
@@ -1134,11 +1135,19 @@ fn gilbert_onion_at_millisecond_steps_agrees_with_microsecond_steps_and_a_fine_i
         );
         assert!(difference < 1e-6, "t = {}: {difference}", long.time);
     }
-    // Twelve 60-degree steps, the last one settled.
+    // Twelve 60-degree steps, the last one settled; and 10,000 in one 1 s step.
     assert!(
         (long.rotor_angle - 4.0 * PI).abs() < 1e-5,
         "{}",
         long.rotor_angle
+    );
+    let mut s = MotorState::aligned(0.0);
+    let report = m.step(&mut s, &inputs, 1.0).unwrap();
+    assert!(!report.accuracy_limited, "{report:?}");
+    assert!(
+        (s.rotor_angle - 1e4 * PI / 3.0).abs() < 1e-5,
+        "{}",
+        s.rotor_angle
     );
     let until = 20e-6;
     let mut s = MotorState::aligned(0.0);
