@@ -247,8 +247,14 @@ impl Motor {
     }
 
     /// Whether the Gilbert onion at `y` has relaxed onto its quasi-static branch: its tilt and its
-    /// distance to the minimum of eq. 3.4 it would settle into are within `tolerance` plus its lag
-    /// behind a turning rotor, and that lag is small.
+    /// distance to the minimum of eq. 3.4 it would settle into are within `tolerance` plus the
+    /// larger of its lag behind a turning rotor and the ringing that no longer matters, and below
+    /// [`MAX_FOLLOWED_LAG`].
+    ///
+    /// Ringing of amplitude `A` left undecayed turns the rotor by at most `A tau_o / tau_rotor`
+    /// (its torque acts over about `tau_o`, the rotor answers over `tau_rotor`; the precession's
+    /// alternating sign makes it less still), so ringing below `tolerance tau_rotor / (10 tau_o)`
+    /// (7.6e-4 rad for Table 3.1) is dropped: the rotor moves by a tenth of the tolerance at most.
     ///
     /// The onion relaxes in `tau_o` ([`Self::onion_relaxation_time`], ~0.4 ns), ~1e4 times faster
     /// than the rotor (~3 us), so once the ringing after a jump of its drive has decayed it lies
@@ -266,7 +272,10 @@ impl Motor {
             return false;
         }
         let rate = if d.locked { 0.0 } else { y[1].abs() };
-        let slack = self.params.tolerance + (4.0 * lag_time * rate).min(MAX_FOLLOWED_LAG);
+        // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
+        let ringing = 0.1 * self.params.tolerance * self.rotor_relaxation_time() / lag_time;
+        let slack =
+            self.params.tolerance + (4.0 * lag_time * rate).max(ringing).min(MAX_FOLLOWED_LAG);
         y[3].abs() <= slack && (self.settle(y, d) - y[2]).abs() <= slack
     }
 

@@ -1123,6 +1123,7 @@ fn gilbert_onion_at_millisecond_steps_agrees_with_microsecond_steps_and_a_fine_i
     let (mut long, mut short) = (MotorState::aligned(0.0), MotorState::aligned(0.0));
     for h in [1e-3, 0.2e-3] {
         let report = m.step(&mut long, &inputs, h).unwrap();
+        println!("t = {} s: {} substeps", long.time, report.substeps);
         assert!(!report.accuracy_limited, "t = {}: {report:?}", long.time);
         for _ in 0..(h * 1e6).round() as usize {
             let report = m.step(&mut short, &inputs, 1e-6).unwrap();
