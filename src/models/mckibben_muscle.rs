@@ -477,7 +477,7 @@ impl Model for McKibbenMuscle {
             )
             .into());
         }
-        if model.wall().is_some() && !(params.bladder_thickness <= params.bladder_length) {
+        if model.wall().is_some() && params.bladder_thickness > params.bladder_length {
             return Err(format!(
                 "bladder_thickness {} m exceeds bladder_length {} m: the bladder models take the \
                  tube as long against its wall (every layer stretched alike along the muscle, \
