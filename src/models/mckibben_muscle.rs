@@ -465,18 +465,6 @@ impl Model for McKibbenMuscle {
             mooney_c2: params.mooney_c2,
         };
         let model = BladderModel::from_switch(params.bladder_model, params.bladder_layers)?;
-        if let BladderModel::Exact { nodes: 1 } | BladderModel::DissertationContinuum { nodes: 1 } =
-            model
-        {
-            return Err(format!(
-                "bladder_model {} needs at least 2 quadrature nodes (bladder_layers), got 1: one \
-                 node samples the wall at a single radius, not through it (2 nodes are within \
-                 29% of the peak force, 16 exact to rounding: docs/bladder-walls.md); for a thin \
-                 wall use bladder_model 1 or 4",
-                params.bladder_model
-            )
-            .into());
-        }
         if model.wall().is_some() && params.bladder_thickness > params.bladder_length {
             return Err(format!(
                 "bladder_thickness {} m exceeds bladder_length {} m: the bladder models take the \
