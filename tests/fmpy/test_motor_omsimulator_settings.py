@@ -43,9 +43,9 @@ RUNS = {
     "quasi-static, schedule, a larger bar": dict(schedule=1, bar_length=4.5e-7, bar_width=2e-7),
     # The rotor's inertial time floored (Motor::me_inertia): a viscous fluid, a light bar.
     "quasi-static, schedule, glycerol": dict(schedule=1, fluid_viscosity=1.4),
-    "quasi-static, schedule, a light bar": dict(schedule=1, density=1000),
+    "quasi-static, schedule, a light bar": dict(schedule=1, density=1000.0),
     "Gilbert, schedule, glycerol": dict(onion_model=1, schedule=1, fluid_viscosity=1.4),
-    "Gilbert, schedule, a light bar": dict(onion_model=1, schedule=1, density=1000),
+    "Gilbert, schedule, a light bar": dict(onion_model=1, schedule=1, density=1000.0),
     "quasi-static, schedule under load": dict(schedule=1, load_torque=5e-19),
     "quasi-static, tension at -40 deg": dict(stress=2e8, strain_direction=-0.7),
     "Gilbert, schedule": dict(onion_model=1, schedule=1),
