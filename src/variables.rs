@@ -214,10 +214,6 @@ pub trait ArrayIdentifier: Copy + Eq + std::fmt::Debug + Send + Sync + 'static {
     const ALL: &'static [Self];
     /// The variable name of the array.
     fn name(self) -> &'static str;
-    /// The array output named `name`, if the model has one.
-    fn from_name(name: &str) -> Option<Self> {
-        Self::ALL.iter().copied().find(|a| a.name() == name)
-    }
 }
 
 /// No array outputs (hand-written interfaces in tests).

@@ -69,12 +69,12 @@ fn every_declared_array_is_served_by_its_model() {
     for (model, factory) in FMI3_MODELS.iter().zip(REGISTRY) {
         let mut runtime: Box<dyn Runtime> = factory.create();
         runtime.build().unwrap();
-        for array in model.arrays {
+        for (k, array) in model.arrays.iter().enumerate() {
             let mut out = vec![f64::NAN; array.size];
-            runtime.array(array.name, &mut out).unwrap();
+            runtime.array(k, &mut out).unwrap();
             assert!(out.iter().all(|x| x.is_finite()), "{}", array.name);
         }
         let mut out = [0.0];
-        assert!(runtime.array("no_such_array", &mut out).is_err());
+        assert!(runtime.array(model.arrays.len(), &mut out).is_err());
     }
 }

@@ -195,7 +195,7 @@ pub unsafe extern "C" fn fmi3GetFloat64(
                         }
                         s
                     }
-                    Slot::Array(k) => inst.get_array(F, model.arrays[k].name, target),
+                    Slot::Array(k) => inst.get_array(F, (k, model.arrays[k].name), target),
                     _ => inst.error(&format!(
                         "{F}: value reference {v} is not a Float64 variable of {}",
                         model.name

@@ -333,7 +333,12 @@ impl Instance {
     /// An FMI 3.0 array output (`Runtime::array`): the model's values once it is built (zeros
     /// before, as the outputs' start values), every element finite. Where the model has no
     /// value the elements are 0 and a warning says why.
-    pub fn get_array(&mut self, function: &str, name: &str, out: &mut [f64]) -> Status {
+    pub fn get_array(
+        &mut self,
+        function: &str,
+        (index, name): (usize, &str),
+        out: &mut [f64],
+    ) -> Status {
         if !self.allowed(function, allowed::GET) {
             return Status::Error;
         }
@@ -342,7 +347,7 @@ impl Instance {
         if status >= Status::Error || !self.runtime.is_built() {
             return status;
         }
-        let why = match self.runtime.array(name, out) {
+        let why = match self.runtime.array(index, out) {
             Ok(()) if out.iter().all(|x| x.is_finite()) => return status,
             Ok(()) => "a value is not finite".to_string(),
             Err(why) => why,

@@ -169,8 +169,10 @@ pub trait Runtime: Send {
     /// its parameters, with only its checked history taken from the bytes ([`rebuilt`]).
     fn rebuild_model(&mut self) -> Result<(), String>;
     fn as_any(&self) -> &dyn Any;
-    /// The built model's FMI 3.0 array output `name` at the current inputs ([`Model::array`]).
-    fn array(&self, name: &str, out: &mut [f64]) -> Result<(), String>;
+    /// The built model's FMI 3.0 array output number `index` (declaration order, that of the
+    /// generated `ArrayOutput::ALL` and of the FMI 3.0 value references) at the current inputs
+    /// ([`Model::array`]).
+    fn array(&self, index: usize, out: &mut [f64]) -> Result<(), String>;
 }
 
 #[derive(Serialize, Deserialize)]
@@ -525,9 +527,10 @@ where
     fn as_any(&self) -> &dyn Any {
         self
     }
-    fn array(&self, name: &str, out: &mut [f64]) -> Result<(), String> {
-        let array = ArrayOutput::<M>::from_name(name)
-            .ok_or_else(|| format!("no array output named '{name}'"))?;
+    fn array(&self, index: usize, out: &mut [f64]) -> Result<(), String> {
+        let array = *ArrayOutput::<M>::ALL
+            .get(index)
+            .ok_or_else(|| format!("no array output number {index}"))?;
         match &self.model {
             Some(model) => model.array(&self.values.inputs, array, out),
             None => Err("no model yet: call it in initialization mode or later".into()),
