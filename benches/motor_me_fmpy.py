@@ -94,7 +94,7 @@ def with_speed_nominal(solver, nominal):
     return Replaced
 
 
-NOMINAL_RUNS = [("fluid_viscosity", v) for v in (1e-4, 1e-3, 1e-2, 0.1, 1, 2, 4)] + [("density", d) for d in (100, 1e3, 1e5)]
+NOMINAL_RUNS = [("fluid_viscosity", v) for v in (5e-6, 1e-4, 1e-3, 1e-2, 0.1, 1, 4, 1e3, 1e9)] + [("density", d) for d in (1e3, 1e5)]
 
 
 def nominals():

@@ -84,14 +84,24 @@ impl BladderModel {
                 Err(format!("bladder_layers must be >= 1, got {layers}"))
             }
         };
+        // One quadrature node samples the wall at a single radius, not through it.
+        let nodes = || match count()? {
+            1 => Err(format!(
+                "bladder_model {model} needs at least 2 quadrature nodes (bladder_layers), got 1: \
+                 one node samples the wall at a single radius, not through it (2 nodes are within \
+                 29% of the peak force, 16 exact to rounding: docs/bladder-walls.md); for a thin \
+                 wall use bladder_model 1 or 4"
+            )),
+            n => Ok(n),
+        };
         match model {
             0 => Ok(Self::None),
             1 => Ok(Self::ThinWall),
             2 => Ok(Self::Layers { layers: count()? }),
-            3 => Ok(Self::Exact { nodes: count()? }),
+            3 => Ok(Self::Exact { nodes: nodes()? }),
             4 => Ok(Self::DissertationThinWall),
             5 => Ok(Self::DissertationLayers { layers: count()? }),
-            6 => Ok(Self::DissertationContinuum { nodes: count()? }),
+            6 => Ok(Self::DissertationContinuum { nodes: nodes()? }),
             _ => Err(format!(
                 "bladder_model must be 0 (none), 1 (thin wall), 2 (layers), 3 (exact wall), \
                  4 (dissertation's thin wall), 5 (dissertation's layers) or 6 (dissertation's \
@@ -577,6 +587,12 @@ mod tests {
             assert!(BladderModel::from_switch(counted, 0).is_err());
         }
         assert!(BladderModel::from_switch(7, 1).is_err());
+        // A quadrature wall needs two nodes; layers may be one.
+        for quadrature in [3, 6] {
+            assert!(BladderModel::from_switch(quadrature, 1).is_err());
+            assert!(BladderModel::from_switch(quadrature, 2).is_ok());
+        }
+        assert!(BladderModel::from_switch(2, 1).is_ok());
     }
 
     #[test]

@@ -254,3 +254,27 @@ def test_exact_wall_matches_the_energy_of_the_same_kinematics():
     assert literal.at("force", pressure=6.9e5, length=0.9 * LISTED[1]) == pytest.approx(102.6, abs=0.05)
     exact.close()
     literal.close()
+
+
+@pytest.mark.parametrize("model", [EXACT, CONTINUUM])
+def test_a_quadrature_wall_of_one_node_is_refused_with_its_reason(model, recording_log):
+    # One Gauss-Legendre node samples the wall at a single radius: muscle D with it is refused at
+    # initialization, saying so; with two nodes the same muscle runs.
+    with pytest.raises(Exception):
+        muscle(log=recording_log, preset=4, bladder_model=model, bladder_layers=1, length=0.1)
+    assert recording_log.contains("at least 2 quadrature nodes")
+    two = muscle(preset=4, bladder_model=model, bladder_layers=2, length=0.1)
+    assert math.isfinite(two.at("force", pressure=3e5, length=0.1))
+    two.close()
+
+
+def test_a_wall_thicker_than_the_tube_is_long_is_refused_with_its_reason(recording_log):
+    # A sleeve of 0.0033 turns round a bladder 40 micrometres long: a 90 mm wall makes it a ring,
+    # not the long tube the wall models assume (refused); a wall as thick as it is long runs.
+    ring = dict(preset=0, strand_length=0.37, turns=0.0033, bladder_length=4e-5, bladder_inner_diameter=5e-4,
+                bladder_model=EXACT, bladder_layers=16)
+    with pytest.raises(Exception):
+        muscle(log=recording_log, bladder_thickness=0.09, **ring)
+    assert recording_log.contains("exceeds bladder_length")
+    tube = muscle(bladder_thickness=4e-5, **ring)
+    tube.close()

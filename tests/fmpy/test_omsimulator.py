@@ -88,12 +88,21 @@ MOTOR_RUNS = {
     "Gilbert, schedule": dict(schedule=1, onion_model=1),
     "Gilbert, schedule, alpha 0.01": dict(schedule=1, onion_model=1, gilbert_damping=0.01),
     "Gilbert, schedule under load": dict(schedule=1, onion_model=1, load_torque=5e-19),
+    # Bounds of the declared space where Model Exchange floors the rotor's inertial time (or,
+    # the thinnest fluid, where the rotor rings longest).
+    "quasi-static, schedule, the lightest bar": dict(schedule=1, density=1000.0),
+    "Gilbert, schedule, the lightest bar": dict(schedule=1, onion_model=1, density=1000.0),
+    "quasi-static, schedule, glycerol": dict(schedule=1, fluid_viscosity=1.4),
+    "Gilbert, schedule, the most viscous fluid": dict(schedule=1, onion_model=1, fluid_viscosity=1e9),
+    "quasi-static, schedule, the thinnest fluid": dict(schedule=1, fluid_viscosity=5e-6),
+    "Gilbert, schedule, the thinnest fluid": dict(schedule=1, onion_model=1, fluid_viscosity=5e-6),
 }
 
 
 def test_the_motor_runs_as_model_exchange_in_omsimulator(tmp_path):
     """The motor on its schedule for 1.2 ms as Model Exchange under OMSimulator's CVode, quasi-static
-    and Gilbert onion: OK throughout, the rotor angle at the end within the tolerance of
+    and Gilbert onion, at defaults and at bounds of the declared space: OK throughout, the rotor
+    angle at the end within the tolerance of
     tests/fmpy/test_motor_omsimulator_settings.py of FMPy's Co-Simulation at 1 us steps."""
     path = fmu_path("MultiferroicMotor")
     stop = stop_time(read_model_description(path))

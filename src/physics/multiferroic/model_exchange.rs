@@ -30,6 +30,13 @@ pub const RINGING_WINDOW_PERIODS: f64 = 4.0;
 pub const RINGING_RELAXATIONS: f64 = 25.0;
 pub const MAX_RINGING_WINDOWS: f64 = 1000.0;
 
+/// The rotor's inertial time in Model Exchange is at least this fraction of its overdamped
+/// relaxation time `c / k` ([`Motor::me_inertia`]) ...
+pub const INERTIAL_TIME_FRACTION: f64 = 1e-4;
+/// ... and at least this long (s) where that fraction is longer: the time below which
+/// `step_period` is not followed either.
+pub const INERTIAL_TIME_FLOOR: f64 = 1e-9;
+
 /// Indices of the independent variables of an [`MeGradient`]: the four states (the last two only
 /// in the Gilbert option) and the three real inputs of [`MotorInputs`].
 pub mod by {
@@ -125,6 +132,34 @@ impl Motor {
         self.ring_bar.max_torque().1.abs() / self.drag
     }
 
+    /// The inertia Model Exchange integrates the rotor with (kg m^2): the bar's `I` where its
+    /// inertial time `I / c` is at least `T = min(INERTIAL_TIME_FLOOR, INERTIAL_TIME_FRACTION c / k)`,
+    /// else `c T`, which gives it that time.
+    ///
+    /// In `I w' = tau - c w` (section 3.2.2) the speed follows the overdamped speed `tau / c`
+    /// with the lag `I / c`; the torque changes on the rotor's relaxation time `c / k` or slower
+    /// (`k` the alignment stiffness, the steepest the rotor sees on a branch), or when the drive
+    /// jumps. Where `I / c` is far below `c / k` (a viscous fluid, a light bar) the rotor is
+    /// overdamped to within that lag, and the lag is far below any time the importer resolves,
+    /// but its integrator must still resolve it at every jump of the drive: CVode under
+    /// OMSimulator's settings (minimum step 1e-12 s) stops for Table 3.1's motor once it is
+    /// below 24 to 48 ps. The floor keeps the overdamped limit and lets the speed relax on `T`
+    /// instead. What it changes: the floored rotor's angle lags the overdamped one by `T w` at
+    /// most, so by `T (tau_max + |load|) / c <= 1e-4 (tau_max + |load|) / k` (2.1e-5 rad for
+    /// Table 3.1's ring and bar without load, whatever the fluid or density), and the lag
+    /// relaxes on `c / k`; the bar's own rotor lags by `I / c < T` in the same way. Table 3.1's
+    /// motor in water (`I / c` 2.2 ns, `c / k` 3.1 us) is not floored.
+    pub fn me_inertia(&self) -> f64 {
+        let relaxation = self.drag / self.alignment_stiffness.abs();
+        let floor = INERTIAL_TIME_FLOOR.min(INERTIAL_TIME_FRACTION * relaxation);
+        let floored = self.drag * floor;
+        if floored.is_finite() {
+            self.inertia.max(floored)
+        } else {
+            self.inertia
+        }
+    }
+
     /// The strain direction and stress in effect at `time` (the inputs', or the schedule's there).
     pub fn me_drive(&self, inputs: &MotorInputs, time: f64) -> [f64; 2] {
         let d = self.drive_at(inputs, time);
@@ -216,7 +251,7 @@ impl Motor {
         if !d.locked {
             derivatives[0] = y[1];
             derivatives[1] =
-                (self.ring_bar.torque(beta) + d.load - self.drag * y[1]) / self.inertia;
+                (self.ring_bar.torque(beta) + d.load - self.drag * y[1]) / self.me_inertia();
         }
         if self.params.onion_model == OnionModel::Gilbert {
             let (g, a, t) = (
@@ -360,7 +395,7 @@ impl Motor {
         let mut derivatives = [[0.0; by::COUNT]; 4];
         if !d.locked {
             derivatives[0] = speed;
-            let (i, c) = (self.inertia, self.drag);
+            let (i, c) = (self.me_inertia(), self.drag);
             let load = unit(by::LOAD_TORQUE);
             derivatives[1] = std::array::from_fn(|j| (torque[j] + load[j] - c * speed[j]) / i);
         }
