@@ -448,7 +448,8 @@ impl Motor {
         let per_segment = (left / SEGMENT_BUDGET_SHARE).max(1);
         // While more than half the budget is left, the floor is FINE_FLOOR times finer than an
         // even spread: the short stiff transients inside a step (the Gilbert onion's ringing
-        // after every switch, ~2 ns at picosecond substeps, at communication steps up to 1 s) are resolved there, and the even spread of the half left still ends the step.
+        // after every switch, ~2 ns at picosecond substeps, at communication steps up to 1 s)
+        // are resolved there, and the even spread of the half left still ends the step.
         let spread = if 2 * u64::from(left) > u64::from(budget) + 1 {
             FINE_FLOOR * left as f64
         } else {
@@ -555,8 +556,8 @@ const ONION_SNAP: f64 = 0.05;
 /// The snap is located within this fraction of the rotor's inertial time `I/c`.
 const SNAP_RESOLUTION: f64 = 1e-4;
 
-/// While more than half the budget is left, the minimum substep is this fraction of the even
-/// spread of the budget over the rest of the step (see [`Motor::substep`]).
+/// While more than half the budget is left, the minimum substep is the even spread of the
+/// budget over the rest of the step divided by this (2^30; see [`Motor::substep`]).
 const FINE_FLOOR: f64 = 1_073_741_824.0;
 
 /// A segment of constant drive may use at most 1/this of the substeps left (see [`Motor::step`]).
