@@ -424,18 +424,6 @@ impl McKibbenMuscle {
         };
         Ok(is_slack(force, false))
     }
-
-    /// Whether [`Model::evaluate`] puts `inputs` on the stretching strands.
-    #[cfg(test)]
-    fn on_strands(&self, inputs: &Inputs) -> bool {
-        let (pressure, length, k_s) = (inputs.pressure, inputs.length, self.strand_stiffness);
-        match &self.pipeline {
-            Pipeline::Sleeve(s) => bare_sleeve::on_the_strands(s, k_s, pressure, length),
-            Pipeline::Full(m) => m
-                .strand_point(pressure, length, k_s, &self.friction)
-                .is_some(),
-        }
-    }
 }
 
 impl Model for McKibbenMuscle {
@@ -862,6 +850,17 @@ mod strand_tests {
     use super::super::all_partials;
     use super::*;
 
+    /// Whether [`Model::evaluate`] puts `inputs` on the stretching strands of `m`.
+    fn on_strands(m: &McKibbenMuscle, inputs: &Inputs) -> bool {
+        let (pressure, length, k_s) = (inputs.pressure, inputs.length, m.strand_stiffness);
+        match &m.pipeline {
+            Pipeline::Sleeve(s) => bare_sleeve::on_the_strands(s, k_s, pressure, length),
+            Pipeline::Full(full) => full
+                .strand_point(pressure, length, k_s, &m.friction)
+                .is_some(),
+        }
+    }
+
     fn step(m: &mut McKibbenMuscle, pressure: f64, length: f64) -> (Outputs, bool) {
         let x = Inputs {
             pressure,
@@ -958,7 +957,7 @@ mod strand_tests {
                 length,
                 ..Default::default()
             };
-            assert!(m.on_strands(&x));
+            assert!(on_strands(&m, &x));
             let d = all_partials(&mut m, &x).unwrap();
             let value = |m: &mut McKibbenMuscle, pressure: f64, length: f64| {
                 let (o, _) = step(m, pressure, length);
