@@ -80,6 +80,8 @@ pub struct Motor {
     pub alignment_stiffness: f64,
     /// Speed scale for the error norm: the undamped natural angular frequency (rad/s).
     speed_scale: f64,
+    /// The inertia Model Exchange integrates the rotor with (see [`Motor::me_inertia`]).
+    me_inertia: f64,
     /// `gamma / (Ms V (1 + alpha^2))` (1/(J s)), the Gilbert option's rate per unit torque.
     llg_rate: f64,
     /// `mu0 Ms^2 V_wall` (J): out-of-plane shape-anisotropy stiffness of the macrospin.
@@ -325,6 +327,7 @@ impl Motor {
             drag,
             alignment_stiffness,
             speed_scale: (alignment_stiffness / inertia).sqrt(),
+            me_inertia: model_exchange::floored_inertia(inertia, drag, alignment_stiffness),
             llg_rate,
             tilt_stiffness,
             ring_bar_slope_bound: onion::curvature_slope_bound(&ring_bar),

@@ -37,6 +37,24 @@ pub const INERTIAL_TIME_FRACTION: f64 = 1e-4;
 /// `step_period` is not followed either.
 pub const INERTIAL_TIME_FLOOR: f64 = 1e-9;
 
+/// The Gilbert onion's fastest rate in Model Exchange is at most the inverse of this time (s)
+/// ([`Motor::me_llg_rate`]), or of [`INERTIAL_TIME_FRACTION`] of the rotor's relaxation time
+/// where that is shorter.
+pub const ONION_TIME_FLOOR: f64 = 1e-10;
+
+/// [`Motor::me_inertia`] from the bar's inertia, the drag and the alignment stiffness, computed
+/// once when the motor is built.
+pub(super) fn floored_inertia(inertia: f64, drag: f64, alignment_stiffness: f64) -> f64 {
+    let relaxation = drag / alignment_stiffness.abs();
+    let floor = INERTIAL_TIME_FLOOR.min(INERTIAL_TIME_FRACTION * relaxation);
+    let floored = drag * floor;
+    if floored.is_finite() {
+        inertia.max(floored)
+    } else {
+        inertia
+    }
+}
+
 /// Indices of the independent variables of an [`MeGradient`]: the four states (the last two only
 /// in the Gilbert option) and the three real inputs of [`MotorInputs`].
 pub mod by {
@@ -150,14 +168,51 @@ impl Motor {
     /// relaxes on `c / k`; the bar's own rotor lags by `I / c < T` in the same way. Table 3.1's
     /// motor in water (`I / c` 2.2 ns, `c / k` 3.1 us) is not floored.
     pub fn me_inertia(&self) -> f64 {
-        let relaxation = self.drag / self.alignment_stiffness.abs();
-        let floor = INERTIAL_TIME_FLOOR.min(INERTIAL_TIME_FRACTION * relaxation);
-        let floored = self.drag * floor;
-        if floored.is_finite() {
-            self.inertia.max(floored)
-        } else {
-            self.inertia
+        self.me_inertia
+    }
+
+    /// The rate per unit torque Model Exchange integrates the Gilbert onion with (1/(J s)), and its
+    /// partial by the stress: the macrospin's `g` of [`Motor::onion_relaxation_time`] where the
+    /// onion's fastest rate is at most `1 / T`, else the rate that makes it `1 / T`, with
+    /// `T = min(ONION_TIME_FLOOR, INERTIAL_TIME_FRACTION c / k)`.
+    ///
+    /// Linearized at a point of in-plane stiffness `K` (tilt stiffness `t`), the macrospin's
+    /// rates are the eigenvalues of `g [[-alpha K, -t], [K, -alpha t]]`, at most
+    /// `g L` with `L = alpha (K + t) + sqrt(K t (1 + alpha^2))`, `K` at most the alignment
+    /// stiffness plus the magnetoelastic one at its steepest (`2 |E|`). After a jump of the drive
+    /// the onion starts `D` (up to pi/2) from its new minimum with a second derivative of about
+    /// `(g L)^2 D`; an integrator's first step (order 1) must then stay below
+    /// `sqrt(2 tol / ((g L)^2 D))`, 1.3 ps for Table 3.1 at 2e8 Pa, and less at a larger stress
+    /// or magnetostriction, a smaller `Ms` or a thicker film: under OMSimulator's settings (minimum
+    /// step 1e-12 s) CVode stops there. Scaling `g` alone rescales the onion's time: its path
+    /// (the precession, which minimum it reaches) is the same whatever `g`, since the rotor
+    /// barely turns within it. What it changes: the ringing lasts `g / g_me` times longer, so the
+    /// torque on the rotor differs within it by at most `k D` over an envelope decay time
+    /// `tau_me` of the floored onion, and the rotor angle by at most `D tau_me / (c / k)` after
+    /// each jump (the impulse over the drag), relaxing on `c / k`. For Table 3.1 at 2e8 Pa the
+    /// onion is slowed 5.2 times (`tau_me` = 2.1 ns): after Fig. 3.3b's jump to -45 degrees at
+    /// most 3.3e-4 rad (measured against the macrospin at its own rate: 2.2e-5 rad).
+    pub fn me_llg_rate(&self, stress: f64) -> (f64, f64) {
+        let alpha = self.params.gilbert_damping;
+        let t = self.tilt_stiffness;
+        let e = self.magnetoelastic_per_stress * stress;
+        let k = self.alignment_stiffness.abs() + 2.0 * e.abs();
+        let root = (k * t * (1.0 + alpha * alpha)).sqrt();
+        let largest = alpha * (k + t) + root;
+        let floor = ONION_TIME_FLOOR
+            .min(INERTIAL_TIME_FRACTION * self.drag / self.alignment_stiffness.abs());
+        let floored = 1.0 / (floor * largest);
+        if !(floored.is_finite() && floored < self.llg_rate) {
+            return (self.llg_rate, 0.0);
         }
+        // d largest / d stress, through K = |k0| + 2 |m sigma| (one-sided at zero stress).
+        let dk = if e == 0.0 {
+            0.0
+        } else {
+            2.0 * e.signum() * self.magnetoelastic_per_stress
+        };
+        let dlargest = (alpha + 0.5 * root / k) * dk;
+        (floored, -floored * dlargest / largest)
     }
 
     /// The strain direction and stress in effect at `time` (the inputs', or the schedule's there).
@@ -189,9 +244,10 @@ impl Motor {
         // one at its steepest (2 |E|).
         let k =
             self.alignment_stiffness.abs() + 2.0 * (self.magnetoelastic_per_stress * stress).abs();
-        let precession = self.llg_rate * (k * self.tilt_stiffness * (1.0 + alpha * alpha)).sqrt();
+        let rate = self.me_llg_rate(stress).0;
+        let precession = rate * (k * self.tilt_stiffness * (1.0 + alpha * alpha)).sqrt();
         let window = RINGING_WINDOW_PERIODS * 2.0 * std::f64::consts::PI / precession;
-        let ringing = RINGING_RELAXATIONS * self.onion_relaxation_time();
+        let ringing = RINGING_RELAXATIONS * self.onion_relaxation_time() * self.llg_rate / rate;
         let window = window.max(ringing / MAX_RINGING_WINDOWS);
         (window.is_finite() && window > 0.0 && ringing.is_finite() && window < ringing)
             .then_some((window, ringing))
@@ -255,7 +311,7 @@ impl Motor {
         }
         if self.params.onion_model == OnionModel::Gilbert {
             let (g, a, t) = (
-                self.llg_rate,
+                self.me_llg_rate(d.stress).0,
                 self.params.gilbert_damping,
                 self.tilt_stiffness,
             );
@@ -400,18 +456,24 @@ impl Motor {
             derivatives[1] = std::array::from_fn(|j| (torque[j] + load[j] - c * speed[j]) / i);
         }
         if self.params.onion_model == OnionModel::Gilbert {
-            let (g, a, t) = (
-                self.llg_rate,
+            let ((g, dg), a, t) = (
+                self.me_llg_rate(d.stress),
                 self.params.gilbert_damping,
                 self.tilt_stiffness,
             );
-            // grad = tau(beta) + E sin(2 (psi - gamma)).
+            // grad = tau(beta) + E sin(2 (psi - gamma)); the rate g depends on the stress.
             let grad: MeGradient = std::array::from_fn(|j| {
                 torque[j] + m * stress[j] * s2 + k_me * (psi[j] - direction[j])
             });
+            let grad_now = self.ring_bar.torque(beta) + e * s2;
+            let (psi_rate, tilt_rate) = (-t * y[3] - a * grad_now, grad_now - a * t * y[3]);
             let tilt = unit(by::ONION_TILT);
-            derivatives[2] = std::array::from_fn(|j| g * (-t * tilt[j] - a * grad[j]));
-            derivatives[3] = std::array::from_fn(|j| g * (grad[j] - a * t * tilt[j]));
+            derivatives[2] = std::array::from_fn(|j| {
+                g * (-t * tilt[j] - a * grad[j]) + dg * stress[j] * psi_rate
+            });
+            derivatives[3] = std::array::from_fn(|j| {
+                g * (grad[j] - a * t * tilt[j]) + dg * stress[j] * tilt_rate
+            });
         }
         let tau = self.ring_bar.torque(beta);
         let sin2 = turned_back(psi_now - d.direction).sin().powi(2);
