@@ -289,3 +289,30 @@ def test_motor_model_exchange_below_the_default_bdf_damping_says_why(recording_l
         pass  # CVode's own failure, after the warning
     assert any("gilbert_damping = 0.002 is below 0.005" in m for m in messages), messages
     assert any("limit the solver's order to 2" in m for m in messages)
+
+
+@pytest.mark.parametrize("onion", [0, 1])
+def test_motor_model_exchange_refuses_a_schedule_below_its_shortest_period(onion, recording_log):
+    """Below step_period 1e-7 s every switch is a time event that restarts the importer's
+    integrator (0.9 to 7 ms each through FMPy): Model Exchange refuses at its first event with the
+    parameter and the limit named. At the limit it runs, fmi2OK throughout."""
+    messages, statuses = [], []
+
+    def logger(_env, _name, _status, _category, message):
+        messages.append(message.decode())
+
+    def calls(message):
+        if message.rpartition(" -> ")[2] in ("WARNING", "DISCARD", "ERROR", "FATAL", "PENDING"):
+            statuses.append(message[:160])
+
+    path = fmu_path("MultiferroicMotor")
+    with pytest.raises(Exception):
+        simulate_fmu(path, fmi_type="ModelExchange", stop_time=1e-7,
+                     start_values=dict(onion_model=onion, schedule=1, step_period=1e-9),
+                     logger=logger)
+    assert any("step_period = 1e-9 s is below 1e-7 s" in m for m in messages), messages
+    me = simulate_fmu(path, fmi_type="ModelExchange", stop_time=2e-6, output=["rotor_angle"],
+                      start_values=dict(onion_model=onion, schedule=1, step_period=1e-7), fmi_call_logger=calls)
+    assert me["time"][-1] == pytest.approx(2e-6, rel=1e-12)
+    assert statuses == []
+    assert np.isfinite(me["rotor_angle"]).all()

@@ -173,7 +173,7 @@ KNOWN_STOPS = {
     ("thickness", "max", 1): THICK_FILM,
     ("gilbert_damping", "min", 1): "below the lightest damping CVode's BDF follows (a documented warning, then mxstep at 0.45 us)",
 }
-# Not run: 1.2e6 switches of the schedule in 1.2 ms, as many time events.
+# Refused in Model Exchange (below its shortest period, 1e-7 s): test_motor_model_exchange.py.
 UNBOUNDED = {("step_period", "min")}
 
 CASES = [

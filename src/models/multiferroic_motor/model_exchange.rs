@@ -176,6 +176,9 @@ impl MultiferroicMotor {
     /// Co-Simulation rule. Returns whether a continuous state's value changed.
     pub(super) fn me_event(&mut self, inputs: &Inputs, time: f64) -> Result<bool, String> {
         let inputs = self.inputs(inputs);
+        if !self.me.active {
+            self.motor.me_check_schedule(&inputs)?;
+        }
         let mut next = self.state;
         next.time = time;
         let mut changed = self.motor.me_event_update(&mut next, &inputs)?;

@@ -795,3 +795,18 @@ fn the_floored_rotor_in_a_viscous_fluid_is_the_overdamped_rotor() {
     assert!(worst <= 1.01 * bound, "{worst} > {bound}");
     assert!(off <= 0.1 * worst, "{off} vs {worst}");
 }
+
+/// A schedule faster than Model Exchange's shortest period is refused with the parameter and the
+/// limit named; at the limit, or without the schedule, it runs.
+#[test]
+fn model_exchange_refuses_a_schedule_faster_than_its_shortest_period() {
+    let m = gilbert();
+    let limit = model_exchange::MIN_SCHEDULE_PERIOD;
+    let why = m.me_check_schedule(&schedule(0.5 * limit)).unwrap_err();
+    assert!(
+        why.contains("step_period = 5e-8 s") && why.contains("1e-7 s"),
+        "{why}"
+    );
+    assert!(m.me_check_schedule(&schedule(limit)).is_ok());
+    assert!(m.me_check_schedule(&MotorInputs::fixed(0.3, 2e8)).is_ok());
+}
