@@ -259,7 +259,7 @@ impl Motor {
     /// Refuses a schedule faster than [`MIN_SCHEDULE_PERIOD`] in Model Exchange, where every
     /// switch is a time event that ends the importer's integrator call and restarts it (measured
     /// through FMPy under OMSimulator's settings: 0.9 ms of wall time per switch with the
-    /// quasi-static onion, 4 to 7 ms with the Gilbert onion's windows, so 18 minutes to 1.5 hours
+    /// quasi-static onion, 4 to 7 ms with the Gilbert onion's windows, so 15 minutes to 2 hours
     /// per simulated millisecond at the declared minimum, 1 ns). Below it the schedule switches
     /// within a hundred of the rotor's inertial-time floor ([`INERTIAL_TIME_FLOOR`]) and within
     /// the Gilbert onion's floored ringing ([`Motor::me_llg_rate`], 53 ns for Table 3.1), which
