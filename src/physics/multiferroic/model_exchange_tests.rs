@@ -810,3 +810,27 @@ fn model_exchange_refuses_a_schedule_faster_than_its_shortest_period() {
     assert!(m.me_check_schedule(&schedule(limit)).is_ok());
     assert!(m.me_check_schedule(&MotorInputs::fixed(0.3, 2e8)).is_ok());
 }
+
+/// Table 3.1's onion is floored: its fastest rate bound `g_me L` (written here from the
+/// linearized macrospin) is exactly 1 / 0.1 ns. In the thinnest fluid the rotor's relaxation is
+/// 15 ns, so the floor (1e-4 of it, 1.6 ps) lies below the onion's own time and `g` is kept.
+#[test]
+fn the_onion_floor_applies_only_where_the_onion_is_faster_than_it() {
+    let m = gilbert();
+    let (alpha, ms, v) = (0.045, 4.85e5, m.params.wall_volume);
+    let t = magnetics::MU0 * ms * ms * v;
+    let g = magnetics::GYROMAGNETIC_RATIO / (ms * v * (1.0 + alpha * alpha));
+    let k = m.alignment_stiffness + 2.0 * (1.5 * m.params.magnetostriction * v * 2e8).abs();
+    let largest = alpha * (k + t) + (k * t * (1.0 + alpha * alpha)).sqrt();
+    println!("fastest rate {:e} /s", g * largest);
+    assert!(g * largest > 4e10);
+    let (g_me, _) = m.me_llg_rate(2e8);
+    assert!((g_me * largest * 1e-10 - 1.0).abs() < 1e-12, "{g_me}");
+    assert_eq!(m.me_llg_rate(-2e8).0, g_me);
+    let thin = motor_with(|p| {
+        p.onion_model = OnionModel::Gilbert;
+        p.fluid_viscosity = 5e-6
+    });
+    assert!(1e-4 * thin.rotor_relaxation_time() < 2e-12);
+    assert_eq!(thin.me_llg_rate(2e8), (thin.llg_rate, 0.0));
+}
