@@ -38,9 +38,12 @@ pub const INERTIAL_TIME_FRACTION: f64 = 1e-4;
 pub const INERTIAL_TIME_FLOOR: f64 = 1e-9;
 
 /// The Gilbert onion's fastest rate in Model Exchange is at most the inverse of this time (s)
-/// ([`Motor::me_llg_rate`]), or of [`INERTIAL_TIME_FRACTION`] of the rotor's relaxation time
-/// where that is shorter.
+/// ([`Motor::me_llg_rate`]), or of [`INERTIAL_TIME_FRACTION`] of the rotor's relaxation time, or
+/// of [`ONION_ROTOR_FRACTION`] of the rotor's (Model Exchange) inertial time, where shorter.
 pub const ONION_TIME_FLOOR: f64 = 1e-10;
+/// The floored onion stays this much faster than the rotor's speed: a slowed precession near the
+/// rotor's inertial time couples to it (a light bar, 0.31 ns, then exceeds FMPy's step budget).
+pub const ONION_ROTOR_FRACTION: f64 = 0.1;
 
 /// [`Motor::me_inertia`] from the bar's inertia, the drag and the alignment stiffness, computed
 /// once when the motor is built.
@@ -177,7 +180,7 @@ impl Motor {
     /// The rate per unit torque Model Exchange integrates the Gilbert onion with (1/(J s)), and its
     /// partial by the stress: the macrospin's `g` of [`Motor::onion_relaxation_time`] where the
     /// onion's fastest rate is at most `1 / T`, else the rate that makes it `1 / T`, with
-    /// `T = min(ONION_TIME_FLOOR, INERTIAL_TIME_FRACTION c / k)`.
+    /// `T = min(ONION_TIME_FLOOR, INERTIAL_TIME_FRACTION c / k, ONION_ROTOR_FRACTION I_me / c)`.
     ///
     /// Linearized at a point of in-plane stiffness `K` (tilt stiffness `t`), the macrospin's
     /// rates are the eigenvalues of `g [[-alpha K, -t], [K, -alpha t]]`, at most
@@ -203,7 +206,8 @@ impl Motor {
         let root = (k * t * (1.0 + alpha * alpha)).sqrt();
         let largest = alpha * (k + t) + root;
         let floor = ONION_TIME_FLOOR
-            .min(INERTIAL_TIME_FRACTION * self.drag / self.alignment_stiffness.abs());
+            .min(INERTIAL_TIME_FRACTION * self.drag / self.alignment_stiffness.abs())
+            .min(ONION_ROTOR_FRACTION * self.me_inertia / self.drag);
         let floored = 1.0 / (floor * largest);
         if !(floored.is_finite() && floored < self.llg_rate) {
             return (self.llg_rate, 0.0);

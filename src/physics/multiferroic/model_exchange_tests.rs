@@ -813,7 +813,8 @@ fn model_exchange_refuses_a_schedule_faster_than_its_shortest_period() {
 
 /// Table 3.1's onion is floored: its fastest rate bound `g_me L` (written here from the
 /// linearized macrospin) is exactly 1 / 0.1 ns. In the thinnest fluid the rotor's relaxation is
-/// 15 ns, so the floor (1e-4 of it, 1.6 ps) lies below the onion's own time and `g` is kept.
+/// 15 ns, so the floor (1e-4 of it, 1.6 ps) lies below the onion's own time and `g` is kept;
+/// with a light bar it is a tenth of the rotor's floored inertial time.
 #[test]
 fn the_onion_floor_applies_only_where_the_onion_is_faster_than_it() {
     let m = gilbert();
@@ -833,4 +834,16 @@ fn the_onion_floor_applies_only_where_the_onion_is_faster_than_it() {
     });
     assert!(1e-4 * thin.rotor_relaxation_time() < 2e-12);
     assert_eq!(thin.me_llg_rate(2e8), (thin.llg_rate, 0.0));
+    // A light bar's rotor (floored inertial time 0.31 ns) keeps the onion ten times faster.
+    let light = motor_with(|p| {
+        p.onion_model = OnionModel::Gilbert;
+        p.density = 1000.0
+    });
+    let rotor = light.me_inertia() / light.drag;
+    assert!((rotor - 1e-4 * light.rotor_relaxation_time()).abs() < 1e-12 * rotor);
+    let (g_light, _) = light.me_llg_rate(2e8);
+    assert!(
+        (g_light * largest * 0.1 * rotor - 1.0).abs() < 1e-12,
+        "{g_light}"
+    );
 }
