@@ -4,12 +4,15 @@ models, the stepping schedule on; each run compared with Co-Simulation (1 us ste
 
     .venv/bin/python tools/motor_omsimulator_bounds.py [--timeout S] [NAME ...]
     .venv/bin/python tools/motor_omsimulator_bounds.py --options
+    .venv/bin/python tools/motor_omsimulator_bounds.py --fmpy-defaults [NAME ...]
 
 Prints one line per run as it finishes: OK or the reason CVode stopped, wall time, the final
 rotor angles of both interfaces and their largest difference at common output points. With
 `--options`: every combination of the options (onion model, schedule, rotor_locked,
 strain_drive) at the defaults and at the bounds of density and fluid_viscosity, Model Exchange
-only, OK only where every FMI call returned fmi2OK."""
+only, OK only where every FMI call returned fmi2OK. With `--fmpy-defaults`: FMPy's own CVode
+settings (relative tolerance 1e-5, at most 500 steps between output points) instead of
+OMSimulator's."""
 
 import itertools
 
@@ -21,13 +24,14 @@ import time
 import numpy as np
 
 
-def run(path, start_values, queue):
+def run(path, start_values, queue, fmpy_defaults=False):
     import fmpy.sundials
     from fmpy import simulate_fmu
 
     from actuator_fmus.omsimulator_cvode import OMSimulatorCVode
 
-    fmpy.sundials.CVodeSolver = OMSimulatorCVode
+    if not fmpy_defaults:
+        fmpy.sundials.CVodeSolver = OMSimulatorCVode
     try:
         t0 = time.perf_counter()
         me = simulate_fmu(path, fmi_type="ModelExchange", solver="CVode", start_values=start_values, output=["rotor_angle"])
@@ -107,6 +111,7 @@ def main():
     parser.add_argument("--options", action="store_true", help="every combination of the options instead")
     parser.add_argument("--fmu", help="the FMU (default: the packaged MultiferroicMotor.fmu)")
     parser.add_argument("--set", action="append", default=[], help="NAME=VALUE for every run")
+    parser.add_argument("--fmpy-defaults", action="store_true", help="FMPy's CVode settings instead of OMSimulator's")
     args = parser.parse_args()
     from actuator_fmus.paths import fmu_path
 
@@ -119,7 +124,7 @@ def main():
     for k, (name, value, onion) in enumerate(todo, 1):
         start = {"schedule": 1, "onion_model": onion, **common, name: value}
         queue = mp.Queue()
-        p = mp.Process(target=run, args=(path, start, queue))
+        p = mp.Process(target=run, args=(path, start, queue, args.fmpy_defaults))
         p.start()
         p.join(args.timeout)
         if p.is_alive():
