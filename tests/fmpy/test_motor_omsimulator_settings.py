@@ -9,8 +9,10 @@ scale (its `nominal`, the terminal speed at the ring's peak torque, 6.7e4 rad/s:
 nominal of 1 the rotor's 2 ns start needs steps below the 1e-12 s minimum), and any finite trial
 state accepted (CVode's first trial tilts the Gilbert onion by hundreds of radians), and a rotor
 inertial time the integrator can resolve (Model Exchange floors it where it is far below the
-rotor's relaxation time: a viscous fluid, a light bar). Every declared bound of every parameter is
-run alone, both onion models, the schedule on. `make omsimulator` runs the real OMSimulator where
+rotor's relaxation time: a viscous fluid, a light bar), and a Gilbert onion whose first steps
+after a jump of the drive stay above the 1e-12 s minimum (Model Exchange floors its fastest rate at
+1/(0.1 ns), see Motor::me_llg_rate). Every declared bound of every parameter is run alone, both
+onion models, the schedule on. `make omsimulator` runs the real OMSimulator where
 it is installed (tests/fmpy/test_omsimulator.py)."""
 
 import xml.etree.ElementTree as ET
