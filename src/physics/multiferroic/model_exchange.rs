@@ -188,14 +188,15 @@ impl Motor {
     /// stiffness plus the magnetoelastic one at its steepest (`2 |E|`). After a jump of the drive
     /// the onion starts `D` (up to pi/2) from its new minimum with a second derivative of about
     /// `(g L)^2 D`; an integrator's first step (order 1) must then stay below
-    /// `sqrt(2 tol / ((g L)^2 D))`, 1.3 ps for Table 3.1 at 2e8 Pa, and less at a larger stress
-    /// or magnetostriction, a smaller `Ms` or a thicker film: under OMSimulator's settings (minimum
-    /// step 1e-12 s) CVode stops there. Scaling `g` alone rescales the onion's time: its path
+    /// `sqrt(2 tol / psi'')`: 0.8 ps for Table 3.1 at the schedule's first jump (`psi''` 3.4e20
+    /// rad/s^2, tolerance 1e-4 rad), less at a larger stress or magnetostriction, a smaller `Ms`
+    /// or a thicker film, where under OMSimulator's settings (minimum step 1e-12 s) CVode stops. Scaling `g` alone rescales the onion's time: its path
     /// (the precession, which minimum it reaches) is the same whatever `g`, since the rotor
     /// barely turns within it. What it changes: the ringing lasts `g / g_me` times longer, so the
     /// torque on the rotor differs within it by at most `k D` over an envelope decay time
-    /// `tau_me` of the floored onion, and the rotor angle by at most `D tau_me / (c / k)` after
-    /// each jump (the impulse over the drag), relaxing on `c / k`. For Table 3.1 at 2e8 Pa the
+    /// `tau_me` of the floored onion (and `tau` of the real one), and the rotor angle by at most
+    /// `D (tau_me + tau) / (c / k)` after each jump (the impulse over the drag), relaxing on
+    /// `c / k`. For Table 3.1 at 2e8 Pa the
     /// onion is slowed 5.2 times (`tau_me` = 2.1 ns): after Fig. 3.3b's jump to -45 degrees at
     /// most 3.3e-4 rad (measured against the macrospin at its own rate: 2.2e-5 rad).
     pub fn me_llg_rate(&self, stress: f64) -> (f64, f64) {
