@@ -246,6 +246,10 @@ DEFAULT_RUNS = {
     "Gilbert, schedule, alpha 0.01": dict(onion_model=1, schedule=1, gilbert_damping=0.01),
     "Gilbert, tension at -40 deg": dict(onion_model=1, stress=2e8, strain_direction=-0.7),
     "Gilbert, onion 1 rad off": dict(onion_model=1, initial_onion_offset=1.0),
+    # The onion's rate floored (Motor::me_llg_rate); with a light bar, to a tenth of the rotor's
+    # floored inertial time (at the plain 0.1 ns floor this run exceeds CVode's step budget).
+    "Gilbert, schedule at 5e8 Pa": dict(onion_model=1, schedule=1, stress_amplitude=5e8),
+    "Gilbert, schedule, a light bar": dict(onion_model=1, schedule=1, density=1000.0),
 }
 # The largest rotor-angle difference allowed at any output point (rad): the transients after the
 # switches differ by up to 2e-4 rad between CVode at its default tolerance and Co-Simulation.
