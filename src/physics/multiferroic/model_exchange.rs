@@ -219,7 +219,9 @@ impl Motor {
         } else {
             2.0 * e.signum() * self.magnetoelastic_per_stress
         };
-        let dlargest = (alpha + 0.5 * root / k) * dk;
+        // d root / dK = root / (2 K); root is 0 where K is (no in-plane stiffness at all).
+        let droot = if k > 0.0 { 0.5 * root / k } else { 0.0 };
+        let dlargest = (alpha + droot) * dk;
         (floored, -floored * dlargest / largest)
     }
 
