@@ -297,9 +297,11 @@ impl Motor {
 }
 
 /// A Gilbert substep's share of the budget `max_substeps`, in substeps of the quasi-static onion:
-/// its two 5x5 exponentials cost about 2.7 us against 0.3-0.9 us (release, x86-64), so the budget
-/// bounds a step's cost alike in both onion models (about 7 ms at the default 20,000).
-pub const GILBERT_SUBSTEP_WEIGHT: u32 = 8;
+/// its embedded pair ([`Motor::gilbert_embedded_step`]: one 5x5 exponential, two Jacobians, a 4x4
+/// solve) costs 0.6-0.8 us per attempt within a step against 0.4-0.5 us for the quasi-static
+/// onion's (release, x86-64, loaded 2-core machine), so the budget bounds a step's cost alike in
+/// both onion models.
+pub const GILBERT_SUBSTEP_WEIGHT: u32 = 2;
 
 /// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
 /// drop (see [`Motor::relaxed_onion`]).
