@@ -147,7 +147,9 @@ impl Motor {
         }
         let budget = self.params.max_substeps;
         let mut run = StepRun::new(state, h);
-        let twin = self.quasi_static_twin();
+        // Built on the first pass that follows the branch: a Gilbert step whose onion never
+        // relaxes does not clone the motor.
+        let twin = std::cell::OnceCell::new();
         let long_segment = 10.0 * self.rotor_relaxation_time();
         // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
         // repeated periods; the minimum substep reaches the segment's end once the budget is
@@ -166,9 +168,10 @@ impl Motor {
                 Some(s) => s.next_switch_after(run.t).min(run.t_end),
                 None => run.t_end,
             };
-            let model = match &twin {
-                Some(q) if self.follows_branch(&mut run, &d, segment_end) => q,
-                _ => self,
+            let model = if !self.quasi_static() && self.follows_branch(&mut run, &d, segment_end) {
+                twin.get_or_init(|| self.quasi_static_twin())
+            } else {
+                self
             };
             if !run.is_settled(&d) {
                 run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
@@ -218,14 +221,12 @@ impl Motor {
         })
     }
 
-    /// The Gilbert motor's quasi-static twin (`None` for the quasi-static motor): the same motor
-    /// with the onion settled, which follows a relaxed Gilbert onion (see [`Self::relaxed_onion`]).
-    fn quasi_static_twin(&self) -> Option<Motor> {
-        (!self.quasi_static()).then(|| {
-            let mut twin = self.clone();
-            twin.params.onion_model = super::OnionModel::QuasiStatic;
-            twin
-        })
+    /// The Gilbert motor's quasi-static twin: the same motor with the onion settled, which
+    /// follows a relaxed Gilbert onion (see [`Self::relaxed_onion`]).
+    fn quasi_static_twin(&self) -> Motor {
+        let mut twin = self.clone();
+        twin.params.onion_model = super::OnionModel::QuasiStatic;
+        twin
     }
 
     /// Whether the Gilbert onion follows its quasi-static branch for the rest of the segment
