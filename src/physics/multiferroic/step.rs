@@ -299,10 +299,10 @@ impl Motor {
 
 /// A Gilbert substep's share of the budget `max_substeps`, in substeps of the quasi-static onion:
 /// its embedded pair ([`Motor::gilbert_embedded_step`]: one 5x5 exponential, two Jacobians, a 4x4
-/// solve) costs 0.6-0.8 us per attempt within a step against 0.4-0.5 us for the quasi-static
-/// onion's (release, x86-64, loaded 2-core machine), so the budget bounds a step's cost alike in
-/// both onion models.
-pub const GILBERT_SUBSTEP_WEIGHT: u32 = 2;
+/// solve) costs up to 1.5 us in the steps that spend their whole budget (0.6-0.8 us for Table
+/// 3.1) against 0.32 us per budget unit of the quasi-static onion's (release, x86-64, loaded
+/// 2-core machine), so the budget bounds a step's cost alike in both onion models.
+pub const GILBERT_SUBSTEP_WEIGHT: u32 = 4;
 
 /// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
 /// drop (see [`Motor::relaxed_onion`]).
