@@ -232,11 +232,21 @@ impl Motor {
     /// Whether the Gilbert onion follows its quasi-static branch for the rest of the segment
     /// ending at `segment_end`: it does from the first pass at which it is relaxed, and then
     /// starts on the branch (no tilt, the onion settled).
+    ///
+    /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance
+    /// at the budget's minimum size): the ringing that the budget cannot resolve is dropped, the
+    /// onion settled into the minimum it rings about. Forced exponential substeps spanning several
+    /// precession periods could otherwise carry a weakly damped onion into the wrong minimum (at
+    /// `gilbert_damping` 1e-4 the rotor then missed its step); the rotor answers the ringing's
+    /// alternating torque by at most `A tau_o / (tau_rotor sqrt(1 + (omega_p tau_o)^2))` to first
+    /// order, far less than the step it would lose. The step stays flagged. (Only for an onion
+    /// that relaxes at all within a tenth of the rotor's time, as in [`Self::relaxed_onion`].)
     fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
         }
-        if !self.relaxed_onion(&run.y, d) {
+        let dropped = run.limited && self.onion_relaxes_fast();
+        if !(dropped || self.relaxed_onion(&run.y, d)) {
             return false;
         }
         run.following = segment_end;
@@ -268,16 +278,22 @@ impl Motor {
     /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
     /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
     pub(super) fn relaxed_onion(&self, y: &Vector, d: &Drive) -> bool {
-        let lag_time = self.onion_relaxation_time();
-        if !(lag_time <= 0.1 * self.rotor_relaxation_time()) {
+        if !self.onion_relaxes_fast() {
             return false;
         }
+        let lag_time = self.onion_relaxation_time();
         let rate = if d.locked { 0.0 } else { y[1].abs() };
         // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
         let ringing = 0.1 * self.params.tolerance * self.rotor_relaxation_time() / lag_time;
         let slack =
             self.params.tolerance + (4.0 * lag_time * rate).max(ringing).min(MAX_FOLLOWED_LAG);
         y[3].abs() <= slack && (self.settle(y, d) - y[2]).abs() <= slack
+    }
+
+    /// Whether the Gilbert onion relaxes within a tenth of the rotor's relaxation time (the
+    /// separation of time scales that following its quasi-static branch rests on).
+    fn onion_relaxes_fast(&self) -> bool {
+        self.onion_relaxation_time() <= 0.1 * self.rotor_relaxation_time()
     }
 
     /// The constraints that hold at every instant: a locked rotor does not turn, and the
