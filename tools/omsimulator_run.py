@@ -2,7 +2,7 @@
 one JSON line per run. Started by tests/fmpy/test_omsimulator.py with OMSimulator's Python package
 on PYTHONPATH; reads the runs as a JSON list on stdin, each
 {"fmu": path, "kind": "cs" | "me", "parameters": {name: value}, "stop": s, "outputs": [names]}
-(a JSON bool sets a Boolean, an int an Integer, a float a Real). Prints for each
+(a JSON bool sets a Boolean, an int an Integer, a float a Real; a refused value stops the run). Prints for each
 {"status": [initialize, simulate], "outputs": {name: value at the end}, "seconds": wall time}."""
 
 import json
@@ -26,7 +26,11 @@ def run(index, fmu, kind, parameters, stop, outputs, results):
     prefix = f"{model}.root.fmu."
     oms.instantiate(model)
     for name, value in parameters.items():
-        SETTERS[type(value)](prefix + name, value)
+        # A setter of the wrong type (an int for a Real) returns an error status and leaves the
+        # start value in place: stop rather than run the wrong scene.
+        status = SETTERS[type(value)](prefix + name, value)
+        if status.value != 0:
+            raise ValueError(f"OMSimulator refused {name} = {value!r} ({type(value).__name__}): status {status}")
     status = [oms.initialize(model).value]
     start = time.perf_counter()
     if status[0] == 0:

@@ -453,16 +453,6 @@ impl Model for McKibbenMuscle {
             mooney_c2: params.mooney_c2,
         };
         let model = BladderModel::from_switch(params.bladder_model, params.bladder_layers)?;
-        if model.wall().is_some() && params.bladder_thickness > params.bladder_length {
-            return Err(format!(
-                "bladder_thickness {} m exceeds bladder_length {} m: the bladder models take the \
-                 tube as long against its wall (every layer stretched alike along the muscle, \
-                 eq. 2.8a, its ends' own deformation neglected), and a wall thicker than the \
-                 tube is long is a ring, not a tube",
-                params.bladder_thickness, params.bladder_length
-            )
-            .into());
-        }
         let notice = (!overridden.is_empty()).then(|| {
             format!(
                 "preset {} replaces the value you set for {} (the effective_* calculated parameters show the values in use)",

@@ -308,6 +308,15 @@ def bisect(f, a, b, iterations=60):
     return 0.5 * (a + b)
 
 
+def test_a_wall_thicker_than_the_bladder_is_long_is_refused_with_its_reason(recording_log):
+    # A 1 mm wall on a bladder 0.5 mm long is a ring, not the long tube eq. 2.8a stretches alike
+    # along the muscle: refused at initialization, naming both parameters.
+    with pytest.raises(Exception):
+        knitted(log=recording_log, preset=2, strand_thickness=0.2e-3, length=0.08,
+                **dict(BLADDER, bladder_length=5e-4, bladder_thickness=1e-3))
+    assert recording_log.contains("bladder_thickness 0.001 m exceeds bladder_length 0.0005 m")
+
+
 def test_bladder_off_is_unchanged():
     # bladder_model 0 ignores every bladder parameter: bit-identical outputs.
     plain = knitted(strand_thickness=0.0)

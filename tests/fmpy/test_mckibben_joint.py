@@ -105,6 +105,14 @@ def test_refuses_a_common_mode_above_the_supply(recording_log):
     assert recording_log.contains("common_mode_pressure")
 
 
+def test_refuses_a_wall_thicker_than_the_bladder_is_long(recording_log):
+    # A ring, not the long tube the bladder models assume (as McKibbenMuscle refuses it).
+    with pytest.raises(Exception):
+        Slave("McKibbenJoint", log=recording_log, preset=0, bladder_model=1, bladder_length=1e-3,
+              bladder_thickness=2e-3)
+    assert recording_log.contains("bladder_thickness 0.002 m exceeds bladder_length 0.001 m")
+
+
 def test_robot_joint_with_the_joint_fmu_reproduces_the_two_muscle_trajectory():
     """The robot-joint example's pendulum with McKibbenJoint in place of two McKibbenMuscle FMUs,
     stepped like a robot simulator: the committed trajectory to 1e-9 rad."""

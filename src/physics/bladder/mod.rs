@@ -178,6 +178,15 @@ impl<S: SleeveGeometry> Bladder<S> {
         positive("bladder inner_diameter (m)", tube.inner_diameter)?;
         positive("bladder thickness (m)", tube.thickness)?;
         positive("bladder unstretched_length (m)", tube.unstretched_length)?;
+        if tube.thickness > tube.unstretched_length {
+            return Err(format!(
+                "bladder_thickness {} m exceeds bladder_length {} m: the bladder models take the \
+                 tube as long against its wall (every layer stretched alike along the muscle, \
+                 eq. 2.8a, its ends' own deformation neglected), and a wall thicker than the \
+                 tube is long is a ring, not a tube",
+                tube.thickness, tube.unstretched_length
+            ));
+        }
         for (name, c) in [("mooney_c1", tube.mooney_c1), ("mooney_c2", tube.mooney_c2)] {
             if !(c.is_finite() && c >= 0.0) {
                 return Err(format!("{name} must be finite and >= 0 Pa, got {c}"));

@@ -429,6 +429,32 @@ fn rejects_bad_parameters() {
     }
 }
 
+/// A wall thicker than the tube is long is a ring, not the long tube eq. 2.8a stretches alike
+/// along the muscle: refused for every wall model (so for every FMU with a bladder), saying which
+/// two parameters clash; a wall exactly as thick as the tube is long is still built.
+#[test]
+fn a_wall_thicker_than_the_tube_is_long_is_refused() {
+    let s = Sleeve::new(0.37, 0.0033).unwrap();
+    let ring = BladderTube::latex(5e-4, 0.09, 4e-5);
+    let tube = BladderTube {
+        thickness: 4e-5,
+        ..ring
+    };
+    for wall in [
+        Wall::Layers(4),
+        Wall::DissertationLayers(1),
+        Wall::Exact(16),
+        Wall::DissertationContinuum(8),
+    ] {
+        let e = Bladder::with_wall(s, ring, wall).unwrap_err();
+        assert!(
+            e.contains("bladder_thickness") && e.contains("exceeds bladder_length"),
+            "{e}"
+        );
+        assert!(Bladder::with_wall(s, tube, wall).is_ok(), "{wall:?}");
+    }
+}
+
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
 
 /// Fig. 1.16 knitted sleeve (110 mm stretched, 14.6 mm at free contraction).
