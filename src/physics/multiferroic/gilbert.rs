@@ -84,10 +84,11 @@ fn pade_phi3_apply(j: &[[f64; 4]; 4], dt: f64, v: &Vector, unit: f64) -> Option<
         if !(p.abs() > 0.0 && p.is_finite()) {
             return None;
         }
-        for r in col + 1..4 {
-            let factor = m[r][col] / p;
-            for k in col..5 {
-                m[r][k] -= factor * m[col][k];
+        let pivot_row = m[col];
+        for row in m.iter_mut().skip(col + 1) {
+            let factor = row[col] / p;
+            for (x, y) in row.iter_mut().zip(&pivot_row).skip(col) {
+                *x -= factor * y;
             }
         }
     }
