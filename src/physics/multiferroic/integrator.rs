@@ -160,7 +160,7 @@ impl Motor {
 
     /// [`Self::exponential_increments`] on the `N - 1` first states: from `exp(dt A / 2)` when
     /// `shared`, else from `exp(dt A)` alone.
-    fn increments_of<const N: usize>(
+    pub(super) fn increments_of<const N: usize>(
         &self,
         f: &Vector,
         j: &[[f64; 4]; 4],
@@ -196,7 +196,7 @@ impl Motor {
 
     /// A power of two near the rotor's undamped angular frequency (rad/s): the speed's unit in
     /// the balanced exponential (1 when that frequency is not a finite positive number).
-    fn speed_unit(&self) -> f64 {
+    pub(super) fn speed_unit(&self) -> f64 {
         let exponent = self.speed_scale.log2().round();
         if exponent.is_finite() && exponent.abs() < 1000.0 {
             2f64.powi(exponent as i32)
@@ -207,7 +207,7 @@ impl Motor {
 
     /// The state after [`Self::exponential_increments`]: a locked rotor stays, the quasi-static
     /// onion is re-settled; `None` when it left the bounds.
-    fn finish_exponential_step(
+    pub(super) fn finish_exponential_step(
         &self,
         y: &Vector,
         increments: &Vector,
@@ -235,7 +235,8 @@ impl Motor {
     /// One error-controlled substep: the new state, its error relative to the tolerance and the
     /// time it advances (`dt`, or less when the quasi-static onion snaps inside it, see
     /// [`Self::step_to_onion_snap`]). The quasi-static rotor uses the embedded pair
-    /// ([`Self::embedded_step`]); the Gilbert onion (a 4x4 system) keeps step doubling.
+    /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`]);
+    /// step doubling remains where either does not apply.
     /// `angles` are those at `y`; the result carries those at the new state when known.
     pub(super) fn controlled_step(
         &self,
@@ -254,6 +255,11 @@ impl Motor {
                 }
                 Some(result) => return result.map(|(u, err, a)| (u, err, dt, Some(a))),
                 None => {}
+            }
+        }
+        if !self.quasi_static() {
+            if let Some((u, err)) = self.gilbert_embedded_step(y, dt, d) {
+                return Some((u, err, dt, None));
             }
         }
         self.doubled_step(y, dt, d)
@@ -406,7 +412,7 @@ impl Motor {
 
     /// The onion half of [`Self::sane`], for a state whose rotor was checked before its settle
     /// (the comparisons are false for NaN, so they also test finiteness).
-    fn onion_sane(y: &Vector) -> bool {
+    pub(super) fn onion_sane(y: &Vector) -> bool {
         y[2].abs() <= MAX_ANGLE && y[3].abs() <= 10.0
     }
 
@@ -414,7 +420,7 @@ impl Motor {
     /// new rotor angle: beyond `MAX_ANGLE` (or at infinity) the offset `psi - phi` has lost the
     /// onion's angle to rounding, the landscape is flat and the settle's march ran to its cap of
     /// 2,000 strides for a substep that was rejected anyway (fuzzing found 4 s steps so).
-    fn rotor_sane(&self, y: &Vector) -> bool {
+    pub(super) fn rotor_sane(&self, y: &Vector) -> bool {
         y[0].is_finite() && y[0].abs() <= MAX_ANGLE && y[1].is_finite()
     }
 

@@ -35,6 +35,7 @@
 pub mod angles;
 pub mod branch;
 pub mod drive;
+mod gilbert;
 mod integrator;
 mod long_steps;
 pub mod magnetics;

@@ -86,7 +86,7 @@ fn spinning_rotor_agrees_with_fine_integration() {
     }
 }
 
-/// A Gilbert substep costs about eight of the quasi-static onion's, and counts so in the budget:
+/// A Gilbert substep costs up to about four of the quasi-static onion's, and counts so in the budget:
 /// a step that needs more than the budget (tolerance 1e-12 through the precession of an undamped
 /// onion, which never relaxes onto its branch) attempts at most `max_substeps / GILBERT_SUBSTEP_WEIGHT` Gilbert substeps (plus the few
 /// that finish it), so `max_substeps` bounds a step's cost alike in both onion models.

@@ -147,7 +147,9 @@ impl Motor {
         }
         let budget = self.params.max_substeps;
         let mut run = StepRun::new(state, h);
-        let twin = self.quasi_static_twin();
+        // Built on the first pass that follows the branch: a Gilbert step whose onion never
+        // relaxes does not clone the motor.
+        let twin = std::cell::OnceCell::new();
         let long_segment = 10.0 * self.rotor_relaxation_time();
         // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
         // repeated periods; the minimum substep reaches the segment's end once the budget is
@@ -166,9 +168,10 @@ impl Motor {
                 Some(s) => s.next_switch_after(run.t).min(run.t_end),
                 None => run.t_end,
             };
-            let model = match &twin {
-                Some(q) if self.follows_branch(&mut run, &d, segment_end) => q,
-                _ => self,
+            let model = if !self.quasi_static() && self.follows_branch(&mut run, &d, segment_end) {
+                twin.get_or_init(|| self.quasi_static_twin())
+            } else {
+                self
             };
             if !run.is_settled(&d) {
                 run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
@@ -218,25 +221,38 @@ impl Motor {
         })
     }
 
-    /// The Gilbert motor's quasi-static twin (`None` for the quasi-static motor): the same motor
-    /// with the onion settled, which follows a relaxed Gilbert onion (see [`Self::relaxed_onion`]).
-    fn quasi_static_twin(&self) -> Option<Motor> {
-        (!self.quasi_static()).then(|| {
-            let mut twin = self.clone();
-            twin.params.onion_model = super::OnionModel::QuasiStatic;
-            twin
-        })
+    /// The Gilbert motor's quasi-static twin: the same motor with the onion settled, which
+    /// follows a relaxed Gilbert onion (see [`Self::relaxed_onion`]).
+    fn quasi_static_twin(&self) -> Motor {
+        let mut twin = self.clone();
+        twin.params.onion_model = super::OnionModel::QuasiStatic;
+        twin
     }
 
     /// Whether the Gilbert onion follows its quasi-static branch for the rest of the segment
     /// ending at `segment_end`: it does from the first pass at which it is relaxed, and then
     /// starts on the branch (no tilt, the onion settled).
+    ///
+    /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance
+    /// at the budget's minimum size): the ringing that the budget cannot resolve is dropped, the
+    /// onion settled into the minimum it rings about. Forced exponential substeps spanning several
+    /// precession periods could otherwise carry a weakly damped onion into the wrong minimum (at
+    /// `gilbert_damping` 1e-4 the rotor then missed its step); the rotor answers the ringing's
+    /// alternating torque by at most `A tau_o / (tau_rotor sqrt(1 + (omega_p tau_o)^2))` to first
+    /// order, far less than the step it would lose. The step stays flagged. (Only for an onion
+    /// that relaxes at all within a tenth of the rotor's time, as in [`Self::relaxed_onion`].)
     fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
         }
-        if !self.relaxed_onion(&run.y, d) {
-            return false;
+        let dropped = run.limited && self.onion_relaxes_fast();
+        if !dropped {
+            // The check settles the onion (a march as in a quasi-static substep): it counts as
+            // one substep in the budget.
+            run.extra_cost = run.extra_cost.saturating_add(1);
+            if !self.relaxed_onion(&run.y, d) {
+                return false;
+            }
         }
         run.following = segment_end;
         run.y[3] = 0.0;
@@ -267,16 +283,22 @@ impl Motor {
     /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
     /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
     pub(super) fn relaxed_onion(&self, y: &Vector, d: &Drive) -> bool {
-        let lag_time = self.onion_relaxation_time();
-        if !(lag_time <= 0.1 * self.rotor_relaxation_time()) {
+        if !self.onion_relaxes_fast() {
             return false;
         }
+        let lag_time = self.onion_relaxation_time();
         let rate = if d.locked { 0.0 } else { y[1].abs() };
         // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
         let ringing = 0.1 * self.params.tolerance * self.rotor_relaxation_time() / lag_time;
         let slack =
             self.params.tolerance + (4.0 * lag_time * rate).max(ringing).min(MAX_FOLLOWED_LAG);
         y[3].abs() <= slack && (self.settle(y, d) - y[2]).abs() <= slack
+    }
+
+    /// Whether the Gilbert onion relaxes within a tenth of the rotor's relaxation time (the
+    /// separation of time scales that following its quasi-static branch rests on).
+    fn onion_relaxes_fast(&self) -> bool {
+        self.onion_relaxation_time() <= 0.1 * self.rotor_relaxation_time()
     }
 
     /// The constraints that hold at every instant: a locked rotor does not turn, and the
@@ -297,9 +319,11 @@ impl Motor {
 }
 
 /// A Gilbert substep's share of the budget `max_substeps`, in substeps of the quasi-static onion:
-/// its two 5x5 exponentials cost about 2.7 us against 0.3-0.9 us (release, x86-64), so the budget
-/// bounds a step's cost alike in both onion models (about 7 ms at the default 20,000).
-pub const GILBERT_SUBSTEP_WEIGHT: u32 = 8;
+/// its embedded pair ([`Motor::gilbert_embedded_step`]: one 5x5 exponential, two Jacobians, a 4x4
+/// solve) costs up to 1.5 us in the steps that spend their whole budget (0.6-0.8 us for Table
+/// 3.1) against 0.32 us per budget unit of the quasi-static onion's (release, x86-64, loaded
+/// 2-core machine), so the budget bounds a step's cost alike in both onion models.
+pub const GILBERT_SUBSTEP_WEIGHT: u32 = 4;
 
 /// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
 /// drop (see [`Motor::relaxed_onion`]).
