@@ -66,7 +66,8 @@ impl Motor {
 /// `(6 I - 1.5 dt J)^-1 v`, the (0,1) Padé approximant of `phi_3(dt J)` applied to `v`, solved
 /// with the speed in units of `unit` (as the exponential is balanced, see
 /// [`Motor::exponential_increments`]) by Gaussian elimination with partial pivoting; `None` if
-/// the matrix is singular or the result not finite.
+/// the matrix is singular or the result not finite. Hand-written: one fixed 4x4 solve per
+/// Gilbert substep, on the hot path, where the library has no linear-algebra dependency.
 fn pade_phi3_apply(j: &[[f64; 4]; 4], dt: f64, v: &Vector, unit: f64) -> Option<Vector> {
     let scale = |i: usize| if i == 1 { unit } else { 1.0 };
     let mut m = [[0.0; 5]; 4];
