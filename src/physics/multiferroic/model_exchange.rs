@@ -203,7 +203,7 @@ impl Motor {
         let alpha = self.params.gilbert_damping;
         let t = self.tilt_stiffness;
         let e = self.magnetoelastic_per_stress * stress;
-        let k = self.alignment_stiffness.abs() + 2.0 * e.abs();
+        let k = self.largest_in_plane_stiffness(stress);
         let root = (k * t * (1.0 + alpha * alpha)).sqrt();
         let largest = alpha * (k + t) + root;
         let floor = ONION_TIME_FLOOR
@@ -250,10 +250,7 @@ impl Motor {
         if self.quasi_static() || alpha <= 0.0 {
             return None;
         }
-        // Largest in-plane stiffness: the ring-bar spring at alignment plus the magnetoelastic
-        // one at its steepest (2 |E|).
-        let k =
-            self.alignment_stiffness.abs() + 2.0 * (self.magnetoelastic_per_stress * stress).abs();
+        let k = self.largest_in_plane_stiffness(stress);
         let rate = self.me_llg_rate(stress).0;
         let precession = rate * (k * self.tilt_stiffness * (1.0 + alpha * alpha)).sqrt();
         let window = RINGING_WINDOW_PERIODS * 2.0 * std::f64::consts::PI / precession;
@@ -261,6 +258,12 @@ impl Motor {
         let window = window.max(ringing / MAX_RINGING_WINDOWS);
         (window.is_finite() && window > 0.0 && ringing.is_finite() && window < ringing)
             .then_some((window, ringing))
+    }
+
+    /// The onion's largest in-plane stiffness (N m/rad) at `stress`: the ring-bar spring at
+    /// alignment plus the magnetoelastic one at its steepest (`2 |E|`).
+    fn largest_in_plane_stiffness(&self, stress: f64) -> f64 {
+        self.alignment_stiffness.abs() + 2.0 * (self.magnetoelastic_per_stress * stress).abs()
     }
 
     /// Refuses a schedule faster than [`MIN_SCHEDULE_PERIOD`] in Model Exchange, where every
