@@ -47,7 +47,8 @@ py-deps:
 
 ## One recipe for both tools (`&:`): under `make -j` it must run once, not once per file.
 ## `+`: cargo shares make's job slots (it also makes `make -n` run these lines).
-target/release/package_fmus target/release/package_fmi3 target/release/calibrate target/release/festo_law &: $(SOURCES)
+## `deps`: the tools link the fmi crate, whose bindgen needs libclang (a fresh `make demo` too).
+target/release/package_fmus target/release/package_fmi3 target/release/calibrate target/release/festo_law &: $(SOURCES) | deps
 	+cargo build --release -p actuator-fmus-tools --bin package_fmus --bin package_fmi3 --bin calibrate --bin festo_law
 
 ## Linux binaries for every maintained distribution: linked against glibc 2.17 (the manylinux2014
