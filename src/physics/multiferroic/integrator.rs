@@ -1,5 +1,5 @@
-//! Exponential Rosenbrock substeps with an embedded error estimate (quasi-static onion) or step
-//! doubling (Gilbert onion); see [`Motor::step`].
+//! Exponential Rosenbrock substeps with an embedded error estimate (each onion model its own pair;
+//! step doubling where neither applies); see [`Motor::step`].
 
 use super::{phi, Angles, Drive, Motor, StepRun, Vector, MAX_ANGLE};
 use crate::physics::numerics::expm;

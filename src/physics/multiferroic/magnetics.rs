@@ -12,6 +12,9 @@ pub const MU0: f64 = 1.256_637_062_12e-6;
 /// Electron gyromagnetic ratio (rad / (s T)), CODATA 2018.
 pub const GYROMAGNETIC_RATIO: f64 = 1.760_859_630_23e11;
 
+/// The shortest length of the ring and the bar (m): a few atoms.
+const MIN_LENGTH: f64 = 1e-9;
+
 /// The four point charges of section 3.2.1, reduced to what eq. 3.3 needs.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct RingBar {
@@ -34,26 +37,25 @@ impl RingBar {
         thickness: f64,
         saturation_magnetization: f64,
     ) -> Result<Self, String> {
-        // The declared ranges' upper ends: 1 m for the lengths, 1e7 A/m (above any known
+        // The declared ranges: 1 nm to 1 m for the lengths (below a few atoms there is no
+        // continuum magnetization for eq. 3.2 to describe), up to 1e7 A/m (above any known
         // material's 2.4e6) for the magnetization.
-        for (name, v, max, unit) in [
-            ("ring_outer_diameter", ring_outer_diameter, 1.0, "m"),
-            ("ring_inner_diameter", ring_inner_diameter, 1.0, "m"),
-            ("bar_length", bar_length, 1.0, "m"),
-            ("bar_width", bar_width, 1.0, "m"),
-            ("thickness", thickness, 1.0, "m"),
-            (
-                "saturation_magnetization",
-                saturation_magnetization,
-                1.0e7,
-                "A/m",
-            ),
+        for (name, v) in [
+            ("ring_outer_diameter", ring_outer_diameter),
+            ("ring_inner_diameter", ring_inner_diameter),
+            ("bar_length", bar_length),
+            ("bar_width", bar_width),
+            ("thickness", thickness),
         ] {
-            if !(v > 0.0 && v <= max) {
-                return Err(format!(
-                    "{name} must be positive and at most {max:e} {unit}, got {v} {unit}"
-                ));
+            if !(MIN_LENGTH..=1.0).contains(&v) {
+                return Err(format!("{name} must be within [{MIN_LENGTH:e}, 1] m, got {v} m"));
             }
+        }
+        let ms = saturation_magnetization;
+        if !(ms > 0.0 && ms <= 1e7) {
+            return Err(format!(
+                "saturation_magnetization must be positive and at most 1e7 A/m, got {ms} A/m"
+            ));
         }
         if ring_inner_diameter >= ring_outer_diameter {
             return Err(format!(
@@ -71,6 +73,24 @@ impl RingBar {
             ));
         }
         let ring_width = 0.5 * (ring_outer_diameter - ring_inner_diameter);
+        // Eq. 3.2's charges are a thin film's (section 3.2.1): shape anisotropy holds the
+        // magnetization in the plane, along the ring's edges (the onion state) and along the
+        // bar's axis, so that the bar's charges sit at its ends. That needs a bar longer than
+        // it is wide, and a film thinner than the bar and the ring are wide.
+        if bar_width >= bar_length {
+            return Err(format!(
+                "bar_width ({bar_width} m) must be less than bar_length ({bar_length} m): the \
+                 model's bar is magnetized along its length, which shape anisotropy holds only \
+                 in a bar longer than it is wide"
+            ));
+        }
+        if thickness > bar_width.min(ring_width) {
+            return Err(format!(
+                "thickness ({thickness} m) must not exceed bar_width ({bar_width} m) or the \
+                 ring's width ({ring_width} m, half of ring_outer_diameter less \
+                 ring_inner_diameter): the model is a thin film's, magnetized in its plane"
+            ));
+        }
         let q_ring = 2.0 * thickness * ring_width * saturation_magnetization;
         let q_bar = thickness * bar_width * saturation_magnetization;
         Ok(Self {

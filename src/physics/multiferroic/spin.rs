@@ -531,9 +531,10 @@ const LOAD_DOMINATED: f64 = 0.5;
 const MAX_SPIN_EPSILON: f64 = 0.05;
 const MIN_SPIN_TURNS: f64 = 2.0;
 /// The onion's cycle ([`Motor::onion_cycle`], two turns of 126 strides with their settles, about
-/// 25 us in release) counts as this many quasi-static substeps (0.3-0.9 us) in `max_substeps`,
-/// so that the budget bounds a step that marches it again at every switch of a fast schedule.
-pub(super) const SPIN_CYCLE_WEIGHT: u32 = 40;
+/// 25 us in release) counts as this many quasi-static substeps (about 0.32 us each) in
+/// `max_substeps`, so that the budget bounds a step that marches it again at every switch of a
+/// fast schedule (at 40, such steps took up to 9.6 ms with the budget at its declared maximum).
+pub(super) const SPIN_CYCLE_WEIGHT: u32 = 80;
 /// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
 const CYCLE_STRIDE: f64 = 0.05;
 const SNAP_PLACEMENT: f64 = 1e-10;

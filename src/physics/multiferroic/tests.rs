@@ -510,12 +510,33 @@ fn schedule_is_a_pure_function_of_time() {
     assert!(SteppingSchedule::new(0.0, 1.0, 1.0, 1e13).is_err());
 }
 
+/// The model is a thin film's (section 3.2.1): a film as thick as the narrower of the bar (100 nm)
+/// and the ring (100 nm) is still accepted, a thicker one or a bar as wide as it is long is
+/// refused with the reason.
+#[test]
+fn refuses_a_film_thicker_than_it_is_wide_and_a_bar_as_wide_as_long() {
+    let mut p = MotorParams::table_3_1();
+    p.thickness = 100e-9;
+    assert!(Motor::new(p.clone()).is_ok());
+    p.ring_outer_diameter = 660e-9;
+    let err = Motor::new(p).unwrap_err();
+    assert!(err.contains("thin film") && err.contains("ring's"), "{err}");
+    let mut p = MotorParams::table_3_1();
+    p.bar_length = 0.999 * p.bar_width;
+    let err = Motor::new(p).unwrap_err();
+    assert!(err.contains("longer than it is wide"), "{err}");
+}
+
 #[test]
 fn rejects_bad_parameters_and_inputs() {
-    let bad: [fn(&mut MotorParams); 9] = [
+    let bad: [fn(&mut MotorParams); 11] = [
         |p| p.ring_inner_diameter = 800e-9,
         |p| p.bar_length = 600e-9,
         |p| p.thickness = 0.0,
+        // Thicker than the bar is wide: not a thin film.
+        |p| p.thickness = 101e-9,
+        // A square bar: no axis along which it is magnetized.
+        |p| p.bar_width = p.bar_length,
         |p| p.saturation_magnetization = f64::NAN,
         |p| p.wall_volume = -1.0,
         |p| p.fluid_viscosity = -1.0,
