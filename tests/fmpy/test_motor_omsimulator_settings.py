@@ -172,6 +172,7 @@ KNOWN_STOPS = {
     ("wall_volume", "min", 1): "refused at initialization: the Gilbert onion's macrospin needs a volume",
     ("bar_length", "min", None): "refused at initialization: a bar shorter than it is wide",
     ("thickness", "max", None): "refused at initialization: a film thicker than the bar is wide",
+    ("bar_width", "min", None): "refused at initialization: a film thicker than the bar is wide",
     ("gilbert_damping", "min", 1): "below the lightest damping CVode's BDF follows (a documented warning, then mxstep at 0.45 us)",
 }
 # Refused in Model Exchange (below its shortest period, 1e-7 s): test_motor_model_exchange.py.
