@@ -379,7 +379,11 @@ fn main() {
                     .collect()
             };
             if slow > report_above {
-                eprintln!("{}: {label}: {slow:.2} s [{}]", info.name, describe(true).join(" "));
+                eprintln!(
+                    "{}: {label}: {slow:.2} s [{}]",
+                    info.name,
+                    describe(true).join(" ")
+                );
             }
             let random = label.starts_with("random");
             // A refusal is normally quick; a slow one is kept as a case, to be re-timed and listed.

@@ -184,6 +184,50 @@ mod tests {
         }
     }
 
+    /// A Gilbert onion whose budget cannot pay for a substep (`max_substeps` below its weight, or
+    /// spent) follows its quasi-static branch, flagged, rather than take a forced substep across
+    /// the step: the rotor never turns faster than drag allows, `max(|omega_0|, (tau_max +
+    /// |load|) / c)` with `tau_max` the ring's largest torque (sampled here), on the schedule's
+    /// first switches at the FMU's 1 us step. (A forced Gilbert substep over the first 1 us
+    /// reached 1.4 times that speed.)
+    #[test]
+    fn gilbert_onion_without_budget_follows_its_branch_within_the_drag_limit() {
+        for budget in [1, 2, 3, 4, 5, 8, 16] {
+            let m = motor_with(|p| {
+                p.onion_model = OnionModel::Gilbert;
+                p.max_substeps = budget;
+            });
+            let tau_max = (0..=20_000)
+                .map(|k| {
+                    m.ring_bar
+                        .torque_stiffness(k as f64 * 1e-4 * std::f64::consts::PI)
+                        .0
+                        .abs()
+                })
+                .fold(0.0, f64::max);
+            let inputs = schedule(20e-6);
+            let mut s = MotorState::aligned(0.0);
+            for _ in 0..60 {
+                let before = s;
+                let report = m.step(&mut s, &inputs, 1e-6).unwrap();
+                let limit = before.rotor_speed.abs().max(tau_max / m.drag);
+                assert!(
+                    s.rotor_speed.abs() <= limit * (1.0 + 1e-9),
+                    "{budget}: {s:?} {limit}"
+                );
+                assert!(
+                    (s.rotor_angle - before.rotor_angle).abs() <= limit * 1e-6 * (1.0 + 1e-9),
+                    "{budget}: {before:?} -> {s:?}"
+                );
+                if budget < 4 {
+                    assert!(report.accuracy_limited, "{budget}: {report:?}");
+                }
+            }
+            // Still a motor: it took its first steps of 60 degrees.
+            assert!(s.rotor_angle > 2.0, "{budget}: {s:?}");
+        }
+    }
+
     /// The pair's substep from a ringing onion on a turning rotor against classical RK4 of the
     /// full nonlinear system at 1e-16 s steps: its error estimate is the exponential Euler
     /// step's true error within a factor of 3, and the corrected result it returns is closer to

@@ -48,7 +48,9 @@ impl RingBar {
             ("thickness", thickness),
         ] {
             if !(MIN_LENGTH..=1.0).contains(&v) {
-                return Err(format!("{name} must be within [{MIN_LENGTH:e}, 1] m, got {v} m"));
+                return Err(format!(
+                    "{name} must be within [{MIN_LENGTH:e}, 1] m, got {v} m"
+                ));
             }
         }
         let ms = saturation_magnetization;

@@ -234,7 +234,8 @@ impl Motor {
     /// starts on the branch (no tilt, the onion settled).
     ///
     /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance
-    /// at the budget's minimum size): the ringing that the budget cannot resolve is dropped, the
+    /// at the budget's minimum size), or is about to be (the budget left cannot pay for another
+    /// Gilbert substep): the ringing that the budget cannot resolve is dropped, the
     /// onion settled into the minimum it rings about. Forced exponential substeps spanning several
     /// precession periods could otherwise carry a weakly damped onion into the wrong minimum (at
     /// `gilbert_damping` 1e-4 the rotor then missed its step); the rotor answers the ringing's
@@ -245,7 +246,14 @@ impl Motor {
         if run.following == segment_end {
             return true;
         }
-        let dropped = run.limited && self.onion_relaxes_fast();
+        // The budget left cannot pay for another Gilbert substep: the next one would be forced
+        // across the rest of the segment, where its linearization (about an onion far from its
+        // minimum after a switch) can drive the rotor past its drag-limited speed. Drop the
+        // ringing now instead, as once forced, and flag the step.
+        let spent = run.attempts.saturating_add(run.extra_cost);
+        let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
+        let dropped = (run.limited || broke) && self.onion_relaxes_fast();
+        run.limited |= dropped;
         if !dropped {
             // The check settles the onion (a march as in a quasi-static substep): it counts as
             // one substep in the budget.
