@@ -14,7 +14,9 @@ use crate::physics::bladder::{Bladder, BladderTube};
 use crate::physics::friction::{HysteresisState, StopOperator};
 use crate::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, StrandFriction};
 use crate::physics::knitted_cylinder::{KnittedCylinder, NON_CYLINDRICAL_BLADDER};
-use crate::physics::knitted_muscle::{Friction, KnittedAssembly, KnittedOutput};
+use crate::physics::knitted_muscle::{
+    Friction, KnittedAssembly, KnittedOutput, BAG_NEEDS_A_CYLINDER,
+};
 use crate::physics::mckibben::{is_slack, BladderModel};
 use crate::variables::knitted_muscle::{
     ArrayOutput, CalculatedParameters, EffectivePressureBy, ForceBy, FrictionForceBy, Inputs,
@@ -222,16 +224,20 @@ impl Model for KnittedMuscle {
 
     fn new(p: &Parameters, start: &Inputs) -> Result<Self, Refusal> {
         let shape = shape_kind(p)?;
-        // Refused before the non-cylindrical table is built (milliseconds) for nothing.
+        // Everything that does not need the sleeve is checked first: the non-cylindrical table
+        // takes milliseconds to build, and a refusal after it would spend them for nothing.
         let has_bladder = BladderModel::from_switch(p.bladder_model, p.bladder_layers)?
             .wall()
             .is_some();
-        if has_bladder && matches!(shape, ShapeKind::NonCylindrical { .. }) {
-            return Err(NON_CYLINDRICAL_BLADDER.to_string().into());
-        }
-        let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape)?;
-        let bladder = bladder(p, &sleeve)?;
         let bag = (p.bag_diameter != 0.0).then_some((p.bag_diameter, p.bag_membrane_stiffness));
+        if matches!(shape, ShapeKind::NonCylindrical { .. }) {
+            if has_bladder {
+                return Err(NON_CYLINDRICAL_BLADDER.to_string().into());
+            }
+            if bag.is_some() {
+                return Err(BAG_NEEDS_A_CYLINDER.to_string().into());
+            }
+        }
         let friction = if p.friction {
             Some(Friction {
                 strand: StrandFriction::new(p.friction_coefficient)?,
@@ -240,13 +246,15 @@ impl Model for KnittedMuscle {
         } else {
             None
         };
-        let assembly = KnittedAssembly::new(sleeve, bladder, bag, friction)?;
         let rigidity = p.strand_rigidity;
         if !(rigidity.is_finite() && rigidity > 0.0) {
             return Err(
                 format!("strand_rigidity must be positive and finite, got {rigidity} N").into(),
             );
         }
+        let sleeve = KnittedSleeve::new(sleeve_params(p)?, shape)?;
+        let bladder = bladder(p, &sleeve)?;
+        let assembly = KnittedAssembly::new(sleeve, bladder, bag, friction)?;
         let yarn_stiffness = assembly.yarn_stiffness(rigidity);
         let valid = assembly.valid_lengths();
         // Friction starts relaxed (z = 0) where the sleeve is at initialization.
@@ -431,6 +439,91 @@ mod tests {
             let mut p = parameters_with(shape, false);
             p.preset = 2;
             p.bladder_model = 1;
+            assert!(KnittedMuscle::new(&p, &Inputs::default()).is_ok());
+        }
+    }
+
+    #[test]
+    fn bag_is_refused_for_the_non_cylindrical_shape_before_its_table() {
+        // A sampled point of the declared space that built its table before this refusal.
+        let p = Parameters {
+            stitches_per_row: 5.154,
+            rows: 154.7,
+            row_strand_length: 44.16,
+            strand_thickness: 9.413e-3,
+            shape_model: 2,
+            shape_segments: 94,
+            friction: true,
+            friction_coefficient: 0.6372,
+            presliding_length: 7.606e-2,
+            bladder_layers: 17,
+            bladder_length: 9.409e-4,
+            bladder_inner_diameter: 4.087e-5,
+            bladder_thickness: 2.477e-7,
+            mooney_c1: 6.536,
+            mooney_c2: 2.921e-4,
+            bag_diameter: 2.977e-3,
+            bag_membrane_stiffness: 9409.0,
+            strand_rigidity: 1.115,
+            ..Parameters::default()
+        };
+        let start = Inputs {
+            pressure: -23.06,
+            length: 8.137,
+        };
+        let e = KnittedMuscle::new(&p, &start).unwrap_err().0;
+        assert_eq!(e, BAG_NEEDS_A_CYLINDER, "{e}");
+        assert!(
+            e.contains("bag_diameter") && e.contains("shape_model"),
+            "{e}"
+        );
+        // Without the bag the same sleeve builds its table.
+        let without = Parameters {
+            bag_diameter: 0.0,
+            ..p.clone()
+        };
+        assert!(KnittedMuscle::new(&without, &start).is_ok());
+        // Before the table: rows the table refuses still get the bag's reason.
+        let e = KnittedMuscle::new(&Parameters { rows: 1000.0, ..p }, &start)
+            .unwrap_err()
+            .0;
+        assert_eq!(e, BAG_NEEDS_A_CYLINDER, "{e}");
+        // The cylinders take the bag.
+        for shape_model in [0, 1] {
+            let p = Parameters {
+                preset: 1,
+                shape_model,
+                bag_diameter: 0.085,
+                ..Parameters::default()
+            };
+            assert!(KnittedMuscle::new(&p, &Inputs::default()).is_ok());
+        }
+    }
+
+    #[test]
+    fn a_sleeve_without_stroke_is_refused_naming_its_variables() {
+        // Full extension n (S - 4 m t) / (2 m) (eq. 1.4 at eq. 1.16's radius) against the
+        // thickness limit 2 n t (section 1.3.4): no stroke for S <= 8 m t, here S = 6 m t.
+        for shape_model in [0, 2] {
+            let p = Parameters {
+                stitches_per_row: 3.0,
+                rows: 10.0,
+                row_strand_length: 6.0 * 3.0 * 1e-3,
+                strand_thickness: 1e-3,
+                shape_model,
+                shape_segments: 10,
+                ..Parameters::default()
+            };
+            let e = KnittedMuscle::new(&p, &Inputs::default()).unwrap_err().0;
+            assert!(e.starts_with("no stroke"), "{e}");
+            for name in ["rows", "strand_thickness", "row_strand_length"] {
+                assert!(e.contains(name), "shape_model {shape_model}: {e}");
+            }
+            // At S = 9 m t it extends past the limit.
+            let p = Parameters {
+                row_strand_length: 9.0 * 3.0 * 1e-3,
+                ..p
+            };
             assert!(KnittedMuscle::new(&p, &Inputs::default()).is_ok());
         }
     }

@@ -107,6 +107,18 @@ impl KnittedParams {
     }
 }
 
+/// `Err` unless full extension `max_length` is above the thickness limit `l_min = 2 n t`
+/// (section 1.3.4).
+fn no_stroke(max_length: f64, l_min: f64) -> Result<(), String> {
+    if max_length > l_min {
+        return Ok(());
+    }
+    Err(format!(
+        "no stroke: full extension {max_length} m (rows, row_strand_length, stitches_per_row) is \
+         not above the thickness limit 2 rows strand_thickness = {l_min} m"
+    ))
+}
+
 /// Which shape model to build.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum ShapeKind {
@@ -168,6 +180,9 @@ impl KnittedSleeve {
                 // Follow the path to a little below the cylinder's free contraction (the
                 // non-cylindrical stroke is shorter, so this passes its zero-force point).
                 let l_max = geom.max_length();
+                // The table starts at this full extension: a sleeve with no stroke is refused
+                // before it is built.
+                no_stroke(l_max, l_min)?;
                 let l_free = n * s / (6.0 * m);
                 let end = (l_free - 0.1 * (l_max - l_free)).max(l_min);
                 let table = ShapeTable::build(geom, end, DEFAULT_TABLE_NODES)?;
@@ -175,12 +190,7 @@ impl KnittedSleeve {
                 (ShapeModel::NonCylindrical(table), lm)
             }
         };
-        if !(max_length > l_min) {
-            return Err(format!(
-                "no stroke: full extension {max_length} m is not above the thickness limit \
-                 2 n t = {l_min} m"
-            ));
-        }
+        no_stroke(max_length, l_min)?;
         let min_length = match &shape {
             ShapeModel::NonCylindrical(t) => t.min_length().max(l_min),
             _ => l_min,

@@ -53,6 +53,13 @@ pub struct KnittedOutput {
     pub history: HysteresisState,
 }
 
+/// Why a bag is refused with the non-cylindrical shape or a rubber bladder (see
+/// [`KnittedAssembly::new`]): the bag caps a single radius, and the rubber bladder already holds
+/// the air.
+pub const BAG_NEEDS_A_CYLINDER: &str = "bag_diameter needs a cylindrical sleeve (shape_model 0 \
+     or 1; the non-cylindrical shape has no single radius the bag could cap) and no rubber \
+     bladder (bladder_model 0)";
+
 impl KnittedAssembly {
     /// The assembly, with a bag of `(diameter (m), membrane stiffness E t (N/m))` if given; a bag
     /// needs a cylindrical sleeve and no rubber bladder.
@@ -65,11 +72,7 @@ impl KnittedAssembly {
         if bag.is_some()
             && (bladder.is_some() || matches!(sleeve.shape(), ShapeModel::NonCylindrical(_)))
         {
-            return Err(
-                "bag_diameter needs a cylindrical sleeve (shape_model 0 or 1) \
-                        and no rubber bladder (bladder_model 0)"
-                    .into(),
-            );
+            return Err(BAG_NEEDS_A_CYLINDER.into());
         }
         let bag = match bag {
             Some((diameter, membrane_stiffness)) => Some(Bag::new(diameter, membrane_stiffness)?),

@@ -20,6 +20,8 @@ use super::solver::{PathPoint, Solver};
 pub(super) const MAX_PATH_ITERATIONS: usize = 40;
 /// Releases of one ring from the floor within a solve before it stays there.
 const MAX_RELEASES: u8 = 3;
+/// Consecutive steps that move no ring beyond roundoff before the fast path gives up.
+const MAX_IDLE_STEPS: usize = 3;
 /// Step halvings when a step leaves a segment unable to close.
 const MAX_BACKTRACKS: usize = 30;
 
@@ -50,6 +52,7 @@ impl Solver {
         let mut backtracks = 0;
         let mut last_residual = f64::INFINITY;
         self.releases.iter_mut().for_each(|n| *n = 0);
+        let mut idle = 0;
         for iteration in 0..max_iterations + MAX_BACKTRACKS {
             let Some((length, volume)) = self.assemble(geom) else {
                 let (alpha, lambda0, dlambda) = step?;
@@ -172,6 +175,21 @@ impl Solver {
             };
             self.base.copy_from_slice(&self.radii);
             self.take_step(alpha, r_min, r_ceiling);
+            // A step the floor clips to roundoff (free rings at `r_min` that Newton moves below
+            // it) leaves the state where it was: after a few such steps the fast path gives up
+            // instead of spending its remaining iterations there. The robust solve restarts from
+            // the same prediction either way, so the table does not change.
+            let moved = (0..rings)
+                .map(|j| (self.radii[j] - self.base[j]).abs())
+                .fold(0.0, f64::max);
+            idle = if moved <= 1e-13 * r_ceiling {
+                idle + 1
+            } else {
+                0
+            };
+            if idle >= MAX_IDLE_STEPS {
+                return None;
+            }
             step = Some((alpha, lambda, dlambda));
             lambda += alpha * dlambda;
         }
