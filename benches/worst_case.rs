@@ -103,6 +103,9 @@ fn draw(rng: &mut Rng, k: &Knob) -> f64 {
     };
     let x = match k.kind {
         VarType::Boolean => (rng.next() & 1) as f64,
+        // A Real whose range starts at 0 is often an effect switched off there (no bag, no
+        // connector): a quarter of the draws take it.
+        VarType::Real if k.lo == 0.0 && k.hi > 0.0 && rng.uniform() < 0.25 => 0.0,
         _ if k.lo > 0.0 && k.hi / k.lo > 10.0 => log_uniform(
             rng,
             k.lo,
