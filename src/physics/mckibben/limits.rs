@@ -222,8 +222,10 @@ impl McKibben {
 
     /// On the strands `F = F(P, L_t(P)) + k_s (L - L_t(P))` and every other output is the
     /// rigid muscle's at `L_t`: by the chain rule with `dL_t/dP = -K_P / K_L` at an interior
-    /// transition (where the rigid stiffness `K` equals `k_s`), 0 at the braid's reach. The
-    /// length moves only the force, by `k_s`, up to the breaking length. `None` off the strands.
+    /// transition (where the rigid stiffness `K` equals `k_s`), `-F_P / F_L` where the rigid
+    /// force turns to a pull (`F(P, L_t) = 0`, so `dF/dP = k_s F_P / F_L`), 0 at the braid's
+    /// reach. The length moves only the force, by `k_s`, up to the breaking length. `None` off
+    /// the strands.
     pub fn strand_partials(
         &self,
         pressure: f64,
@@ -248,6 +250,7 @@ impl McKibben {
         history: &HysteresisState,
     ) -> Result<ByPressureLength, String> {
         let (_, mut d) = self.partials(pressure, t.length, history)?;
+        let [fp, fl] = d.force;
         let dlt = if t.interior {
             let [kp, kl] = self.stiffness_partials(pressure, t.length, history)?;
             if kl != 0.0 {
@@ -255,10 +258,11 @@ impl McKibben {
             } else {
                 0.0
             }
+        } else if t.force_zero && fl != 0.0 {
+            -fp / fl
         } else {
             0.0
         };
-        let [fp, fl] = d.force;
         for y in d.rows_mut() {
             *y = [y[0] + y[1] * dlt, 0.0];
         }
@@ -285,5 +289,72 @@ impl McKibben {
             return Ok((d, false, true));
         }
         at(pressure.max(0.0), clamped).map(|d| (d, false, false))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::mckibben::{BladderModel, MuscleGeometry};
+
+    /// Where the rigid muscle is stiffer than soft strands (`k_s`) even where its force turns
+    /// from a push to a pull, the strands take over at that force's zero `L_0(P)`:
+    /// `F = k_s (L - L_0(P))`. `L_0` is bisected here on the rigid model's sign alone; the
+    /// force and `dF/dP` (a central difference of that closed form) are the strands' branch's.
+    #[test]
+    fn strands_from_the_force_zero_move_with_the_pressure() {
+        let rest = HysteresisState::at_rest(0.09);
+        let mut checked = 0;
+        for g in [MuscleGeometry::muscle_a(), MuscleGeometry::muscle_c()] {
+            for model in [BladderModel::ThinWall, BladderModel::Exact { nodes: 8 }] {
+                let m = McKibben::from_geometry(&g, model, None, 0.0).unwrap();
+                let (lo, hi) = (m.min_length(), m.max_length());
+                for k_s in [1.0, 10.0] {
+                    for p in [2e4, 1e5, 3e5] {
+                        let force = |p: f64, l: f64| m.evaluate(p, l, &rest).unwrap().force;
+                        // The rigid force's zero between mid-stroke and the limit.
+                        let (from, to) = (0.5 * (lo + hi), hi - 1e-9 * (hi - lo));
+                        if !(force(p, from) < 0.0 && force(p, to) > 0.0) {
+                            continue;
+                        }
+                        let zero = |p: f64| {
+                            let (mut a, mut b) = (from, to);
+                            while b - a > 1e-15 * b {
+                                let mid = 0.5 * (a + b);
+                                if force(p, mid) > 0.0 {
+                                    b = mid;
+                                } else {
+                                    a = mid;
+                                }
+                            }
+                            a
+                        };
+                        let l0 = zero(p);
+                        let l = l0 + 1e-3 * (hi - l0);
+                        let t = m.strand_point(p, l, k_s, &rest);
+                        let Some(t) = t.filter(|t| t.force_zero) else {
+                            continue;
+                        };
+                        assert!((t.length - l0).abs() < 1e-12 * l0, "{} vs {l0}", t.length);
+                        let (f, d) = m.force_and_partials_with_strands(p, l, k_s, &rest).unwrap();
+                        // The rigid force at the last float of `L_t` is zero to within its stiffness times
+                        // that float's spacing.
+                        assert!((f - k_s * (l - l0)).abs() < 1e-6 * f, "{f}");
+                        let h = 1e-4 * p;
+                        let closed = k_s * (zero(p - h) - zero(p + h)) / (2.0 * h);
+                        assert!(
+                            (d.force[0] - closed).abs() < 1e-4 * closed.abs(),
+                            "{model:?} P {p} k_s {k_s}: dF/dP {} vs {closed}",
+                            d.force[0]
+                        );
+                        let full = m.partials_with_strands(p, l, k_s, &rest).unwrap();
+                        assert_eq!(full.force, d.force);
+                        assert_eq!(d.force[1], k_s);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked >= 4, "{checked}");
     }
 }
