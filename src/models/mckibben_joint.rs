@@ -277,7 +277,7 @@ impl McKibbenJoint {
         })
     }
 
-    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: 0 while slack.
+    /// `[dF/dP, dF/dL]` of one muscle on the branch `compute` takes: 0 while slack.
     fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
         match self.signed_force_and_partials(pressure, length, history) {
             Some((force, d)) if !self.slack(force) => d,
