@@ -11,13 +11,14 @@
 
 use super::{HistoryKey, Model, Partials, Refusal, Report, Status};
 use crate::physics::bladder::{BladderTube, MOONEY_C1, MOONEY_C2};
+use crate::physics::by_pressure_length::ByPressureLength;
 use crate::physics::festo;
 use crate::physics::friction::HysteresisState;
 use crate::physics::gaylord::Sleeve;
 use crate::physics::inverse::{difference_for_torque, pair_pressures};
 use crate::physics::mckibben::{
     is_slack, strand_rigidity, BladderModel, FrictionParams, McKibben, McKibbenOutput,
-    MuscleGeometry,
+    MuscleGeometry, OutOfRange,
 };
 use crate::variables::mckibben_joint::{
     CalculatedParameters, ExtensorForceBy, ExtensorLengthBy, ExtensorPressureBy, FlexorForceBy,
@@ -49,6 +50,14 @@ pub struct McKibbenJoint {
     /// `strand_rigidity`): past `max_length` the strands stretch, as in McKibbenMuscle.
     strand_stiffness: f64,
 }
+
+/// One muscle at one pressure and length: its outputs, why they are clamped (if so), and its
+/// partials ([`McKibben::evaluate_and_partials_with_strands`]).
+type Evaluated = (
+    Option<McKibbenOutput>,
+    Option<OutOfRange>,
+    Result<ByPressureLength, String>,
+);
 
 /// Both muscles' operating point at the current inputs.
 struct Pair {
@@ -142,26 +151,8 @@ impl McKibbenJoint {
         out
     }
 
-    /// One muscle at (pressure, length), its strands stretching past `max_length`; beyond the
-    /// length no muscle survives, the nearest point evaluated (why, in `clamped`).
-    fn evaluate_muscle(
-        &self,
-        pressure: f64,
-        length: f64,
-        history: &HysteresisState,
-        clamped: &mut Option<String>,
-    ) -> Option<McKibbenOutput> {
-        let (out, excursion) =
-            self.muscle
-                .evaluate_with_strands(pressure, length, self.strand_stiffness, history);
-        if let Some(e) = excursion {
-            clamped.get_or_insert(e.message());
-        }
-        out
-    }
-
-    /// Signed force and `[dF/dP, dF/dL]` of one muscle on the branch [`Self::evaluate_muscle`]
-    /// takes (on the strands, their slope; at a clamped length the length no longer moves it).
+    /// Signed force and `[dF/dP, dF/dL]` of one muscle on the branch
+    /// [`McKibben::evaluate_with_strands`] takes (on the strands, their slope; at a clamped length the length no longer moves it).
     fn signed_force_and_partials(
         &self,
         pressure: f64,
@@ -175,33 +166,34 @@ impl McKibbenJoint {
             .map(|(force, d)| (force, d.force))
     }
 
-    /// Force and dF/dP of one muscle, tension only unless `signed_force`.
-    fn force_and_slope(
-        &self,
-        pressure: f64,
-        length: f64,
-        history: &HysteresisState,
-    ) -> Option<(f64, f64)> {
-        self.signed_force_and_partials(pressure, length, history)
-            .map(|(force, d)| {
-                if self.slack(force) {
-                    (0.0, 0.0)
-                } else {
-                    (force, d[0])
-                }
-            })
+    /// Both muscles at the pressures from `difference`, at the given lengths and histories:
+    /// each one's outputs (with why, if clamped) and partials, from one search for its strands'
+    /// transition.
+    fn pair_at(&self, difference: f64, lengths: [f64; 2]) -> [Evaluated; 2] {
+        let p = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
+        let k_s = self.strand_stiffness;
+        let (f, e) = (&self.flexor_friction, &self.extensor_friction);
+        [
+            self.muscle
+                .evaluate_and_partials_with_strands(p[0], lengths[0], k_s, f),
+            self.muscle
+                .evaluate_and_partials_with_strands(p[1], lengths[1], k_s, e),
+        ]
     }
 
-    /// Torque of the pair at the pressures from `difference`, and its slope in the difference,
-    /// at the given lengths and histories.
-    fn torque_at(&self, difference: f64, lengths: [f64; 2]) -> Result<(f64, f64), String> {
+    /// Torque of the pair evaluated at `difference` ([`Self::pair_at`]), and its slope in the
+    /// difference.
+    fn torque_at(&self, difference: f64, pair: &[Evaluated; 2]) -> Result<(f64, f64), String> {
         let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
-        let p = pair_pressures(pc, difference, pmax);
         // dP/d(difference) is +-1/2 where a pressure is not clipped.
         let unclipped = |x: f64| if x > 0.0 && x < pmax { 0.5 } else { 0.0 };
-        let flexor = self.force_and_slope(p[0], lengths[0], &self.flexor_friction);
-        let extensor = self.force_and_slope(p[1], lengths[1], &self.extensor_friction);
-        match (flexor, extensor) {
+        // Force and dF/dP of one muscle, tension only unless `signed_force`.
+        let force_and_slope = |e: &Evaluated| match e {
+            (Some(out), _, Ok(_)) if self.slack(out.force) => Some((0.0, 0.0)),
+            (Some(out), _, Ok(d)) => Some((out.force, d.force[0])),
+            _ => None,
+        };
+        match (force_and_slope(&pair[0]), force_and_slope(&pair[1])) {
             (Some((f, df)), Some((e, de))) => Ok((
                 self.moment_arm * (f - e),
                 self.moment_arm
@@ -218,9 +210,17 @@ impl McKibbenJoint {
             self.flexor_rest_length - self.moment_arm * q,
             self.extensor_rest_length + self.moment_arm * q,
         ];
+        // The solver's evaluations, whose outputs serve again at the difference it returns.
+        let mut solved_at: Vec<(f64, [Evaluated; 2])> = Vec::new();
         let (difference, saturated) = if self.torque_command {
             // The pressure difference that meets the torque, through the same muscle physics.
-            match difference_for_torque(|d| self.torque_at(d, lengths), u, self.max_pressure) {
+            let torque_of = |d: f64| {
+                let pair = self.pair_at(d, lengths);
+                let torque = self.torque_at(d, &pair);
+                solved_at.push((d, pair));
+                torque
+            };
+            match difference_for_torque(torque_of, u, self.max_pressure) {
                 Ok(solved) => (solved.argument, solved.saturated),
                 Err(reason) => {
                     report.add(
@@ -235,19 +235,28 @@ impl McKibbenJoint {
         };
         // Each pressure clipped to 0 .. max_pressure (a NaN maps to a bound).
         let pressures = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
-        let mut clamped = None;
-        let flexor = self.evaluate_muscle(
-            pressures[0],
-            lengths[0],
-            &self.flexor_friction,
-            &mut clamped,
-        );
-        let extensor = self.evaluate_muscle(
-            pressures[1],
-            lengths[1],
-            &self.extensor_friction,
-            &mut clamped,
-        );
+        // Each muscle with its strands stretching past `max_length`; beyond the length no muscle
+        // survives, the nearest point evaluated (why, in `clamped`).
+        let evaluated = match solved_at
+            .into_iter()
+            .rfind(|(d, _)| d.to_bits() == difference.to_bits())
+        {
+            Some((_, [(f, fc, _), (e, ec, _)])) => [(f, fc), (e, ec)],
+            None => {
+                let k_s = self.strand_stiffness;
+                let (f, e) = (&self.flexor_friction, &self.extensor_friction);
+                [
+                    self.muscle
+                        .evaluate_with_strands(pressures[0], lengths[0], k_s, f),
+                    self.muscle
+                        .evaluate_with_strands(pressures[1], lengths[1], k_s, e),
+                ]
+            }
+        };
+        let clamped = evaluated
+            .iter()
+            .find_map(|(_, clamp)| clamp.as_ref().map(|c| c.message()));
+        let [(flexor, _), (extensor, _)] = evaluated;
         match clamped {
             Some(reason) => {
                 report.clamp(!self.out_of_range, || {
@@ -268,7 +277,7 @@ impl McKibbenJoint {
         })
     }
 
-    /// `[dF/dP, dF/dL]` of one muscle on the branch `evaluate_muscle` takes: 0 while slack.
+    /// `[dF/dP, dF/dL]` of one muscle on the branch `compute` takes: 0 while slack.
     fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
         match self.signed_force_and_partials(pressure, length, history) {
             Some((force, d)) if !self.slack(force) => d,
@@ -645,5 +654,41 @@ mod tests {
             .unwrap()
             .iter()
             .all(|v| *v == 0.0));
+    }
+
+    /// A torque command met on soft strands that take over where the flexor's rigid force turns
+    /// to a pull (the Festo DMSP-10 with `strand_rigidity` 64 N, stretched past its breaking
+    /// length): the delivered torque is the command, not the solver's last iterate short of it.
+    #[test]
+    fn torque_command_is_met_where_the_strands_take_over_at_zero_force() {
+        let p = Parameters {
+            preset: 5,
+            strand_rigidity: 64.12,
+            moment_arm: 0.2813,
+            flexor_rest_length: 0.211,
+            extensor_rest_length: 5.16e-3,
+            common_mode_pressure: 2.035e5,
+            max_pressure: 4.013e7,
+            command_mode: 1,
+            ..Default::default()
+        };
+        let mut j = joint(&p);
+        let flexor = p.flexor_rest_length + p.moment_arm * 2.552;
+        let t = j.muscle.strand_point(
+            2e5,
+            j.muscle.breaking_length(),
+            j.strand_stiffness,
+            &j.flexor_friction,
+        );
+        assert!(flexor > j.muscle.breaking_length() && t.is_some_and(|t| t.force_zero));
+        for command in [2.5, 3.175, 5.0] {
+            let (out, clamped) = at(&mut j, command, -2.552);
+            assert!(clamped && !out.torque_saturated);
+            assert!(
+                (out.joint_torque - command).abs() < 1e-9 * command,
+                "{command}: {}",
+                out.joint_torque
+            );
+        }
     }
 }

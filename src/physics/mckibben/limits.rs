@@ -64,19 +64,11 @@ impl McKibben {
             Ok(out) => (String::new(), Some(out)),
             Err(reason) => (reason, None),
         };
-        let (lo, hi) = (self.min_length(), self.max_length());
         // Out of the rigid braid's reach, or stiffer than its strands: the strands stretch.
         let breaking = self.breaking_length();
         let on_strands = length.min(breaking);
         if let Some(t) = self.strand_transition_on(pressure, on_strands, k_s, history, &branch) {
-            let clamp = (length > breaking).then(|| OutOfRange {
-                reason: format!(
-                    "length {length} m stretches the strands more than {}% of their length past max_length, which no muscle survives",
-                    100.0 * SURVIVABLE_STRAND_STRAIN
-                ),
-                range: (lo, breaking),
-                point: Some((pressure, breaking)),
-            });
+            let clamp = self.past_breaking(pressure, length);
             let mut out = t.rigid;
             out.force += k_s * (on_strands - t.length);
             out.stiffness = k_s;
@@ -85,16 +77,43 @@ impl McKibben {
         if let Some(out) = rigid {
             return (Some(out), None);
         }
+        let (out, clamp) = self.clamped(pressure, length, history, reason);
+        (out, Some(clamp))
+    }
+
+    /// Out of range below the strands (no rigid solution at `length`, for `reason`): the
+    /// outputs at the nearest length with one, under a vacuum the muscle cannot hold there at
+    /// zero pressure.
+    fn clamped(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+        reason: String,
+    ) -> (Option<McKibbenOutput>, OutOfRange) {
         let clamped = self.solvable_length(length);
         let fallback = [(pressure, clamped), (pressure.max(0.0), clamped)]
             .into_iter()
             .find_map(|(p, l)| self.evaluate(p, l, history).ok().map(|o| (p, l, o)));
         let clamp = OutOfRange {
             reason,
-            range: (lo, hi),
+            range: (self.min_length(), self.max_length()),
             point: fallback.as_ref().map(|(p, l, _)| (*p, *l)),
         };
-        (fallback.map(|(_, _, out)| out), Some(clamp))
+        (fallback.map(|(_, _, out)| out), clamp)
+    }
+
+    /// Why a length past the breaking length is evaluated at it, `None` up to it.
+    fn past_breaking(&self, pressure: f64, length: f64) -> Option<OutOfRange> {
+        let breaking = self.breaking_length();
+        (length > breaking).then(|| OutOfRange {
+            reason: format!(
+                "length {length} m stretches the strands more than {}% of their length past max_length, which no muscle survives",
+                100.0 * SURVIVABLE_STRAND_STRAIN
+            ),
+            range: (self.min_length(), breaking),
+            point: Some((pressure, breaking)),
+        })
     }
 
     /// The nearest length the rigid model evaluates: inside the muscle's limits, and by
@@ -155,6 +174,16 @@ impl McKibben {
         if let Some(d) = self.strand_partials(pressure, length, k_s, history)? {
             return Ok(d);
         }
+        self.partials_below_strands(pressure, length, history)
+    }
+
+    /// [`Self::partials_with_strands`] off the strands.
+    fn partials_below_strands(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Result<ByPressureLength, String> {
         let at = |p: f64, l: f64| self.partials(p, l, history).map(|(_, d)| d);
         let (mut d, by_l, by_p) = self.on_branch(pressure, length, at)?;
         for y in d.rows_mut() {
@@ -199,6 +228,57 @@ impl McKibben {
         Ok((out.force, d))
     }
 
+    /// [`Self::evaluate_with_strands`] with the partials of [`Self::partials_with_strands`],
+    /// searching for the strands' transition once (the torque solver evaluates both at every
+    /// iteration).
+    pub fn evaluate_and_partials_with_strands(
+        &self,
+        pressure: f64,
+        length: f64,
+        k_s: f64,
+        history: &HysteresisState,
+    ) -> (
+        Option<McKibbenOutput>,
+        Option<OutOfRange>,
+        Result<ByPressureLength, String>,
+    ) {
+        let rigid = match self.partials(pressure, length, history) {
+            Ok((out, d)) if !(out.force > 0.0 && out.stiffness > k_s) => {
+                return (Some(out), None, Ok(d))
+            }
+            Ok(rigid) => Some(rigid),
+            Err(_) => None,
+        };
+        let reason = if rigid.is_some() {
+            String::new()
+        } else {
+            match self.evaluate(pressure, length, history) {
+                Err(reason) => reason,
+                // Outputs where their partials overflow: each on its own branch.
+                Ok(_) => {
+                    let (out, clamp) = self.evaluate_with_strands(pressure, length, k_s, history);
+                    let d = self.partials_with_strands(pressure, length, k_s, history);
+                    return (out, clamp, d);
+                }
+            }
+        };
+        let on_strands = length.min(self.breaking_length());
+        let branch = BranchEnd::new();
+        if let Some(t) = self.strand_transition_on(pressure, on_strands, k_s, history, &branch) {
+            let d = self.partials_at_transition(&t, pressure, length, k_s, history);
+            let mut out = t.rigid;
+            out.force += k_s * (on_strands - t.length);
+            out.stiffness = k_s;
+            return (Some(out), self.past_breaking(pressure, length), d);
+        }
+        if let Some((out, d)) = rigid {
+            return (Some(out), None, Ok(d));
+        }
+        let (out, clamp) = self.clamped(pressure, length, history, reason);
+        let d = self.partials_below_strands(pressure, length, history);
+        (out, Some(clamp), d)
+    }
+
     /// `[d/dpressure, d/dlength]` of the signed stiffness on the branch
     /// [`Self::evaluate_with_strands`] takes: 0 on the strands (their constant `k_s`), else
     /// [`McKibben::stiffness_partials`] (a second-order pass through the bladder).
@@ -222,8 +302,10 @@ impl McKibben {
 
     /// On the strands `F = F(P, L_t(P)) + k_s (L - L_t(P))` and every other output is the
     /// rigid muscle's at `L_t`: by the chain rule with `dL_t/dP = -K_P / K_L` at an interior
-    /// transition (where the rigid stiffness `K` equals `k_s`), 0 at the braid's reach. The
-    /// length moves only the force, by `k_s`, up to the breaking length. `None` off the strands.
+    /// transition (where the rigid stiffness `K` equals `k_s`), `-F_P / F_L` where the rigid
+    /// force turns to a pull (`F(P, L_t) = 0`, so `dF/dP = k_s F_P / F_L`), 0 at the braid's
+    /// reach. The length moves only the force, by `k_s`, up to the breaking length. `None` off
+    /// the strands.
     pub fn strand_partials(
         &self,
         pressure: f64,
@@ -248,6 +330,7 @@ impl McKibben {
         history: &HysteresisState,
     ) -> Result<ByPressureLength, String> {
         let (_, mut d) = self.partials(pressure, t.length, history)?;
+        let [fp, fl] = d.force;
         let dlt = if t.interior {
             let [kp, kl] = self.stiffness_partials(pressure, t.length, history)?;
             if kl != 0.0 {
@@ -255,10 +338,11 @@ impl McKibben {
             } else {
                 0.0
             }
+        } else if t.force_zero && fl != 0.0 {
+            -fp / fl
         } else {
             0.0
         };
-        let [fp, fl] = d.force;
         for y in d.rows_mut() {
             *y = [y[0] + y[1] * dlt, 0.0];
         }
@@ -285,5 +369,105 @@ impl McKibben {
             return Ok((d, false, true));
         }
         at(pressure.max(0.0), clamped).map(|d| (d, false, false))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::physics::mckibben::{BladderModel, MuscleGeometry};
+
+    /// Where the rigid muscle is stiffer than soft strands (`k_s`) even where its force turns
+    /// from a push to a pull, the strands take over at that force's zero `L_0(P)`:
+    /// `F = k_s (L - L_0(P))`. `L_0` is bisected here on the rigid model's sign alone; the
+    /// force and `dF/dP` (a central difference of that closed form) are the strands' branch's.
+    #[test]
+    fn strands_from_the_force_zero_move_with_the_pressure() {
+        let rest = HysteresisState::at_rest(0.09);
+        let mut checked = 0;
+        for g in [MuscleGeometry::muscle_a(), MuscleGeometry::muscle_c()] {
+            for model in [BladderModel::ThinWall, BladderModel::Exact { nodes: 8 }] {
+                let m = McKibben::from_geometry(&g, model, None, 0.0).unwrap();
+                let (lo, hi) = (m.min_length(), m.max_length());
+                for k_s in [1.0, 10.0] {
+                    for p in [2e4, 1e5, 3e5] {
+                        let force = |p: f64, l: f64| m.evaluate(p, l, &rest).unwrap().force;
+                        // The rigid force's zero between mid-stroke and the limit.
+                        let (from, to) = (0.5 * (lo + hi), hi - 1e-9 * (hi - lo));
+                        if !(force(p, from) < 0.0 && force(p, to) > 0.0) {
+                            continue;
+                        }
+                        let zero = |p: f64| {
+                            let (mut a, mut b) = (from, to);
+                            while b - a > 1e-15 * b {
+                                let mid = 0.5 * (a + b);
+                                if force(p, mid) > 0.0 {
+                                    b = mid;
+                                } else {
+                                    a = mid;
+                                }
+                            }
+                            a
+                        };
+                        let l0 = zero(p);
+                        let l = l0 + 1e-3 * (hi - l0);
+                        let t = m.strand_point(p, l, k_s, &rest);
+                        let Some(t) = t.filter(|t| t.force_zero) else {
+                            continue;
+                        };
+                        assert!((t.length - l0).abs() < 1e-12 * l0, "{} vs {l0}", t.length);
+                        let (f, d) = m.force_and_partials_with_strands(p, l, k_s, &rest).unwrap();
+                        // The rigid force at the last float of `L_t` is zero to within its stiffness times
+                        // that float's spacing.
+                        assert!((f - k_s * (l - l0)).abs() < 1e-6 * f, "{f}");
+                        let h = 1e-4 * p;
+                        let closed = k_s * (zero(p - h) - zero(p + h)) / (2.0 * h);
+                        assert!(
+                            (d.force[0] - closed).abs() < 1e-4 * closed.abs(),
+                            "{model:?} P {p} k_s {k_s}: dF/dP {} vs {closed}",
+                            d.force[0]
+                        );
+                        let full = m.partials_with_strands(p, l, k_s, &rest).unwrap();
+                        assert_eq!(full.force, d.force);
+                        assert_eq!(d.force[1], k_s);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked >= 4, "{checked}");
+    }
+
+    /// The one-search evaluation gives exactly what the two separate ones give, on every
+    /// branch: the rigid model, the strands (interior, at the reach, past breaking) and the
+    /// clamped lengths out of range.
+    #[test]
+    fn evaluation_with_partials_is_the_separate_evaluations() {
+        let rest = HysteresisState::at_rest(0.09);
+        let mut on_strands = 0;
+        for model in [
+            BladderModel::None,
+            BladderModel::ThinWall,
+            BladderModel::Exact { nodes: 8 },
+        ] {
+            let m = McKibben::from_geometry(&MuscleGeometry::muscle_a(), model, None, 0.0).unwrap();
+            let (lo, top) = (m.min_length(), m.breaking_length());
+            for k_s in [1.0, 1e3, 1e5] {
+                for p in [-2e4, 0.0, 1e5, 6e5] {
+                    for i in 0..=60 {
+                        let l = lo - 0.01 + (top + 0.02 - lo) * f64::from(i) / 60.0;
+                        let (out, clamp, d) =
+                            m.evaluate_and_partials_with_strands(p, l, k_s, &rest);
+                        let (out_alone, clamp_alone) = m.evaluate_with_strands(p, l, k_s, &rest);
+                        assert_eq!(out, out_alone, "{model:?} k_s {k_s} P {p} L {l}");
+                        assert_eq!(clamp, clamp_alone, "{model:?} k_s {k_s} P {p} L {l}");
+                        let d_alone = m.partials_with_strands(p, l, k_s, &rest);
+                        assert_eq!(d, d_alone, "{model:?} k_s {k_s} P {p} L {l}");
+                        on_strands += usize::from(m.strand_point(p, l, k_s, &rest).is_some());
+                    }
+                }
+            }
+        }
+        assert!(on_strands > 100, "{on_strands}");
     }
 }

@@ -49,6 +49,9 @@ pub struct StrandTransition {
     pub rigid: McKibbenOutput,
     /// The rigid slope reaches `k_s` at `L_t` (else `L_t` is the braid's reach, fixed).
     pub interior: bool,
+    /// The rigid force turns from a push to a pull at `L_t`, stiffer than the strands on both
+    /// sides: `L_t` is where that force is zero, and moves with the pressure.
+    pub force_zero: bool,
 }
 
 impl McKibben {
@@ -108,6 +111,7 @@ impl McKibben {
                 length: t.length,
                 rigid: t.rigid,
                 interior: t.interior,
+                force_zero: t.force_zero,
             }
         })
     }
@@ -123,6 +127,8 @@ pub struct Transition<T> {
     pub rigid: T,
     /// The rigid slope reaches `k_s` at `L_t` (else `L_t` is the reach, fixed).
     pub interior: bool,
+    /// `L_t` is where the rigid force, stiffer than the strands, turns from a push to a pull.
+    pub force_zero: bool,
 }
 
 /// The rigid model holds at `L` unless it has no solution there or pulls and is stiffer than the
@@ -181,6 +187,7 @@ pub fn transition_within_reach<T>(
                 length: hi,
                 rigid: out,
                 interior: false,
+                force_zero: false,
             });
         }
     }
@@ -201,6 +208,7 @@ pub fn transition_within_reach<T>(
                     length: at,
                     rigid: found.2,
                     interior: (found.1 - k_s).abs() <= 1e-6 * k_s,
+                    force_zero: false,
                 });
             }
             stiff = at;
@@ -275,10 +283,14 @@ pub fn transition_within_reach<T>(
             }
         }
     }
+    let interior = (slope - k_s).abs() <= 1e-6 * k_s;
     Some(Transition {
         length: l,
         rigid: out,
-        interior: (slope - k_s).abs() <= 1e-6 * k_s,
+        interior,
+        // The soft end holds only because it pushes, the stiff end pulls: a sign change of the
+        // force (not the end of the rigid model's solutions).
+        force_zero: !interior && soft_end.1 >= 0.0 && stiff_end.is_some(),
     })
 }
 
