@@ -23,15 +23,17 @@ pub struct Inversion {
     pub argument: f64,
     /// The value the forward model gives there (force, torque).
     pub achieved: f64,
-    /// Whether the target lies outside the reachable range: `argument` is then the nearer end.
+    /// Whether the target cannot be reached: it lies outside the range (`argument` is then the
+    /// nearer end) or inside a jump of the forward model (`argument` is then at the jump).
     pub saturated: bool,
 }
 
 /// Solves `f(x) = target` for `x` in `[lo, hi]` when `f` is monotonic there (either direction;
 /// flat stretches allowed); `f` returns its value and slope. Out of reach, returns the end whose
 /// value is nearer, flagged `saturated`. Inside, the shared safeguarded Newton-bisection
-/// ([`newton_bisection`]): every step stays in the shrinking bracket, so it cannot diverge. `Err`
-/// if `f` fails.
+/// ([`newton_bisection`]): every step stays in the shrinking bracket, so it cannot diverge. A
+/// target inside a jump of `f` (the bracket closes on the jump, the value there still off by more
+/// than its slope over the bracket allows) is flagged `saturated` too. `Err` if `f` fails.
 pub fn invert_monotonic(
     mut f: impl FnMut(f64) -> Result<(f64, f64), String>,
     target: f64,
@@ -65,12 +67,16 @@ pub fn invert_monotonic(
             Some(Sample {
                 value: value - target,
                 slope,
-                payload: value,
+                payload: (value, slope),
             })
         })
     })?;
-    let achieved = root.payload.ok_or("no evaluation inside the bracket")?;
-    Ok(end(root.x, achieved, false))
+    let (achieved, slope) = root.payload.ok_or("no evaluation inside the bracket")?;
+    // Met, the residual is at most the slope times the bracket the finder closed (its stopping
+    // rule); a larger one is a jump of `f` across the target, which no argument meets.
+    let closed = OPTIONS.absolute + OPTIONS.relative * root.x.abs();
+    let met = (achieved - target).abs() <= 4.0 * slope.abs() * closed + 1e-12 * (max - min);
+    Ok(end(root.x, achieved, !met))
 }
 
 /// The gauge pressure in `0 ..= max_pressure` at which `muscle` at input length `length` (from
@@ -192,6 +198,31 @@ mod tests {
         assert!(r.saturated && r.argument == 2.0 && r.achieved == 8.0);
         let r = invert_monotonic(cube, -3.0, -1.0, 2.0).unwrap();
         assert!(r.saturated && r.argument == -1.0);
+    }
+
+    /// A target inside a jump of the forward model is out of reach: flagged, at the jump. Either
+    /// side of the jump, and a steep but continuous stretch, are met.
+    #[test]
+    fn a_target_inside_a_jump_is_flagged_out_of_reach() {
+        let jump = |x: f64| Ok((x + if x > 0.5 { 10.0 } else { 0.0 }, 1.0));
+        let r = invert_monotonic(jump, 5.0, 0.0, 1.0).unwrap();
+        assert!(r.saturated && (r.argument - 0.5).abs() < 1e-8, "{r:?}");
+        for target in [0.3, 10.8] {
+            let r = invert_monotonic(jump, target, 0.0, 1.0).unwrap();
+            assert!(!r.saturated && (r.achieved - target).abs() < 1e-12, "{r:?}");
+        }
+        let steep = |x: f64| {
+            Ok((
+                (1e6 * (x - 0.5)).atan(),
+                1e6 / (1.0 + (1e6 * (x - 0.5)).powi(2)),
+            ))
+        };
+        let r = invert_monotonic(steep, 1.0, 0.0, 1.0).unwrap();
+        // Met to its slope (2.9e5 there) times the finder's 1e-9 in the argument.
+        assert!(!r.saturated && (r.achieved - 1.0).abs() < 3e-4, "{r:?}");
+        let falling_jump = |x: f64| Ok((-x - if x > 0.25 { 3.0 } else { 0.0 }, -1.0));
+        let r = invert_monotonic(falling_jump, -2.0, 0.0, 1.0).unwrap();
+        assert!(r.saturated && (r.argument - 0.25).abs() < 1e-8, "{r:?}");
     }
 
     #[test]
