@@ -481,7 +481,11 @@ impl Motor {
     ) -> Result<MotorOutputs, String> {
         self.validate_inputs(inputs)?;
         Self::validate_state(state)?;
-        let d = self.drive_at(inputs, state.time);
+        Ok(self.outputs_of(state, &self.drive_at(inputs, state.time)))
+    }
+
+    /// [`Self::outputs`] of a valid state under the drive `d`.
+    fn outputs_of(&self, state: &MotorState, d: &Drive) -> MotorOutputs {
         let mut y = [
             state.rotor_angle,
             if d.locked { 0.0 } else { state.rotor_speed },
@@ -489,9 +493,9 @@ impl Motor {
             state.onion_tilt,
         ];
         if self.quasi_static() {
-            y[2] = self.settle(&y, &d);
+            y[2] = self.settle(&y, d);
         }
-        Ok(self.outputs_at(&y, &d))
+        self.outputs_at(&y, d)
     }
 
     fn outputs_at(&self, y: &Vector, d: &Drive) -> MotorOutputs {

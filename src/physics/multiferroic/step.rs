@@ -201,10 +201,9 @@ impl Motor {
             ));
         }
         let d = self.drive_at(inputs, run.t_end);
-        let angles = match run.angles {
-            Some(a) if run.is_settled(&d) => a,
-            _ => self.constrain(&mut run.y, &d, run.angles.as_ref()),
-        };
+        if !run.is_settled(&d) {
+            self.constrain(&mut run.y, &d, run.angles.as_ref());
+        }
         let y = run.y;
         *state = MotorState {
             time: run.t_end,
@@ -215,7 +214,9 @@ impl Motor {
             substep_hint: run.dt.clamp(1e-300, MAX_STEP),
         };
         Ok(StepReport {
-            outputs: self.outputs_with(&y, &d, &angles),
+            // As [`Self::outputs`] gives them at this state, bit for bit (a restored state's
+            // outputs are recomputed so).
+            outputs: self.outputs_of(state, &d),
             substeps: run.attempts,
             accuracy_limited: run.limited,
         })
