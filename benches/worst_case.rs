@@ -392,8 +392,9 @@ fn main() {
             };
             if slow > report_above {
                 eprintln!(
-                    "{}: {label}: {slow:.2} s [{}]",
+                    "{}: {label}: {:.1} us [{}]",
                     info.name,
+                    slow * 1e6,
                     describe(true).join(" ")
                 );
             }
