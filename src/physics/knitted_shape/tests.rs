@@ -148,9 +148,18 @@ fn rejects_bad_geometry() {
     assert!(ShapeGeometry::new(22.0, 49.0, f64::NAN, 0.003, 49).is_err());
     assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, 1).is_err());
     // Beyond the bound, refused with the reason (the clamp segments turn radial first).
-    assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS).is_ok());
-    let why = ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS + 1).unwrap_err();
+    assert!(ShapeGeometry::new(22.0, 200.0, 0.48, 0.003, MAX_SEGMENTS).is_ok());
+    let why = ShapeGeometry::new(22.0, 200.0, 0.48, 0.003, MAX_SEGMENTS + 1).unwrap_err();
     assert!(why.contains("1600") && why.contains("radial"), "{why}");
+    // So is a discretization finer than 32 segments per row (the prototype's 1,568 is the limit).
+    assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, 1568).is_ok());
+    let why = ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, 1569).unwrap_err();
+    assert!(
+        why.contains("radial") && why.contains("shape_segments to at most 1568"),
+        "{why}"
+    );
+    let why = ShapeGeometry::new(22.0, 1.5, 0.48, 0.003, 49).unwrap_err();
+    assert!(why.contains("rows = 1.5"), "{why}");
     // More rows per segment than the table resolves in bounded time: refused, naming the fix.
     let rows = MAX_ROWS_PER_SEGMENT * 20.0;
     assert!(ShapeGeometry::new(22.0, rows, 0.48, 0.003, 20).is_ok());
