@@ -236,7 +236,15 @@ fn follow_path(
                 // Late in the stroke the edge runs out to the clamps faster than predicted
                 // and moves about one ring per iteration; allow for a share of the rings.
                 let iterations = MAX_PATH_ITERATIONS + solver.radii.len() / 16;
-                solve_from(geom, solver, &mut predicted, aim, iterations)
+                // After a failure only the fast paths retry the shorter steps: where they fail
+                // the path has often ended (the clamps' segments turned radial, eq. 1.17), and
+                // a dozen failed robust solves there cost several ms on fine sleeves.
+                if halvings == 0 {
+                    solve_from(geom, solver, &mut predicted, aim, iterations)
+                } else {
+                    predicted.copy_from(solver);
+                    fast_solve(geom, solver, &predicted, aim, iterations).ok_or("fast")
+                }
             } else {
                 nucleate(geom, solver, aim)
             };
