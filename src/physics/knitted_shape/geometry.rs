@@ -9,6 +9,11 @@ use std::f64::consts::PI;
 /// but finer sleeves reach the eq. 1.17 limit at the clamps before free contraction.
 pub const MAX_SEGMENTS: usize = 1600;
 
+/// Most axial segments per row accepted: finer, the segments at the clamps turn radial (eq. 1.17:
+/// the slant is all radius step) before free contraction, so the table ends with tension left
+/// (measured on the prototype at 32 segments per row, and on random sleeves at 50-80).
+pub const MAX_SEGMENTS_PER_ROW: f64 = 32.0;
+
 /// Most rows accepted (see [`ShapeGeometry::new`]).
 pub const MAX_ROWS: f64 = 200.0;
 
@@ -72,6 +77,16 @@ impl ShapeGeometry {
                  segments per row, the segments at the clamps turn radial (eq. 1.17 slant \
                  length all radius step) before free contraction and the table would end \
                  short of zero force"
+            ));
+        }
+        if segments as f64 > MAX_SEGMENTS_PER_ROW * rows {
+            return Err(format!(
+                "shape_segments = {segments} on rows = {rows} is {} segments per row; finer than \
+                 {MAX_SEGMENTS_PER_ROW} per row, the segments at the clamps turn radial (eq. 1.17 \
+                 slant length all radius step) before free contraction and the table would end \
+                 short of zero force: set shape_segments to at most {}",
+                segments as f64 / rows,
+                ((MAX_SEGMENTS_PER_ROW * rows).floor() as usize).max(2)
             ));
         }
         // The table's solver resolves the contraction pocket ring by ring: its cost grows

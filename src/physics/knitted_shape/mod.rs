@@ -34,5 +34,5 @@ mod table;
 mod tests;
 
 pub use baseline::{seed_gradient_volume_curve, SeedAlgorithmOptions};
-pub use geometry::{ShapeGeometry, MAX_ROWS_PER_SEGMENT, MAX_SEGMENTS};
+pub use geometry::{ShapeGeometry, MAX_ROWS_PER_SEGMENT, MAX_SEGMENTS, MAX_SEGMENTS_PER_ROW};
 pub use table::{ShapeTable, DEFAULT_TABLE_NODES};

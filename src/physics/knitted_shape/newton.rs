@@ -35,6 +35,7 @@ impl Solver {
         geom: &ShapeGeometry,
         target: f64,
         max_iterations: usize,
+        shift: bool,
     ) -> Option<PathPoint> {
         let rings = self.radii.len();
         let r_min = geom.min_radius;
@@ -53,6 +54,7 @@ impl Solver {
         let mut last_residual = f64::INFINITY;
         self.releases.iter_mut().for_each(|n| *n = 0);
         let mut idle = 0;
+        let mut last_shift = 0.0;
         for iteration in 0..max_iterations + MAX_BACKTRACKS {
             let Some((length, volume)) = self.assemble(geom) else {
                 let (alpha, lambda0, dlambda) = step?;
@@ -110,13 +112,7 @@ impl Solver {
                 return None;
             }
             let pos = self.shifted_solve(lambda, 0.0)?;
-            let (mut gx, mut gy) = (0.0, 0.0);
-            for j in 0..rings {
-                if !self.held[j] {
-                    gx += self.gl[j] * self.x[j];
-                    gy += self.gl[j] * self.y[j];
-                }
-            }
+            let (mut gx, mut gy) = self.border_products();
             if !(gy.abs() > 0.0) {
                 return None;
             }
@@ -156,6 +152,14 @@ impl Solver {
                     max_radius,
                 });
             }
+            // Away from a maximum the plain step heads for a saddle: a ring just off the floor
+            // of a thin-strand sleeve, where the cone's volume (eq. 1.18) is still convex in its
+            // radius and the slant's concavity (eq. 1.17) small, would be sent back below the
+            // floor. The Hessian is then shifted until the reduced one is negative definite
+            // (bordered inertia one), as in the robust solve, so the step ascends.
+            if shift && pos + usize::from(gy < 0.0) != 1 {
+                (gx, gy) = self.shifted_products(lambda, s_row, &mut last_shift)?;
+            }
             // Newton step on (r, lambda): H dr - g dlambda = -R, g . dr = target - L.
             let dlambda = (target - length + gx) / gy;
             let mut largest = 0.0f64;
@@ -194,6 +198,40 @@ impl Solver {
             lambda += alpha * dlambda;
         }
         None
+    }
+
+    /// `g_L . x` and `g_L . y` of [`Solver::shifted_solve`] at the smallest shift (from
+    /// `1e-8 S_row`, by factors of 4) whose bordered matrix has exactly one positive eigenvalue.
+    fn shifted_products(
+        &mut self,
+        lambda: f64,
+        s_row: f64,
+        last_shift: &mut f64,
+    ) -> Option<(f64, f64)> {
+        let mut mu = (1e-8 * s_row).max(*last_shift / 16.0);
+        for _ in 0..80 {
+            if let Some(pos) = self.shifted_solve(lambda, mu) {
+                let (gx, gy) = self.border_products();
+                if pos + usize::from(gy < 0.0) == 1 && gy != 0.0 {
+                    *last_shift = mu;
+                    return Some((gx, gy));
+                }
+            }
+            mu *= 4.0;
+        }
+        None
+    }
+
+    /// `g_L . x` and `g_L . y` over the free rings.
+    fn border_products(&self) -> (f64, f64) {
+        let (mut gx, mut gy) = (0.0, 0.0);
+        for j in 0..self.radii.len() {
+            if !self.held[j] {
+                gx += self.gl[j] * self.x[j];
+                gy += self.gl[j] * self.y[j];
+            }
+        }
+        (gx, gy)
     }
 
     /// Free rings at `base + alpha x`, kept within `[r_min, r_ceiling]`.

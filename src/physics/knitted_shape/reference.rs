@@ -1,5 +1,7 @@
 //! Reference tables from the one-ring-at-a-time solver, kept as fixtures so
-//! that the faster path is tested against the tables it replaced.
+//! that the faster path is tested against the tables it replaced. The `slow_*` fixtures come from
+//! the path before the shifted Newton step (plain Newton, the robust solve as its fallback), on
+//! sleeves that it built in over 10 ms.
 //!
 //! Regenerate only deliberately: `cargo test --release --lib write_reference_tables --
 //! --ignored` overwrites `reference/*.csv` with the current solver's output.
@@ -58,6 +60,32 @@ pub(super) fn cases() -> Vec<Case> {
             0.08 * 0.3 / (2.0 * PI),
             12,
         ),
+        // Sleeves whose build took over 10 ms before the shifted Newton path (thin strands on
+        // many segments); `S_row` 1 m, `r_min` from `4 m t / S_row`.
+        case(
+            "slow_wide_142",
+            1610.1449364868288,
+            74.90568975501913,
+            1.0,
+            0.0016143462847681193 / (2.0 * PI),
+            142,
+        ),
+        case(
+            "slow_few_stitches_76",
+            3.60314,
+            100.084,
+            1.0,
+            0.00130517 / (2.0 * PI),
+            76,
+        ),
+        case(
+            "slow_long_134",
+            187.83,
+            190.716,
+            1.0,
+            0.00922519 / (2.0 * PI),
+            134,
+        ),
     ]
 }
 
@@ -95,6 +123,9 @@ pub(super) fn fixture(name: &str) -> &'static str {
         "prototype_1568" => include_str!("reference/prototype_1568.csv"),
         "fig_1_16_40" => include_str!("reference/fig_1_16_40.csv"),
         "thick_short_12" => include_str!("reference/thick_short_12.csv"),
+        "slow_wide_142" => include_str!("reference/slow_wide_142.csv"),
+        "slow_few_stitches_76" => include_str!("reference/slow_few_stitches_76.csv"),
+        "slow_long_134" => include_str!("reference/slow_long_134.csv"),
         _ => unreachable!("no fixture {name}"),
     }
 }

@@ -35,6 +35,8 @@ pub(super) struct Solver {
     pub(super) base: Vec<f64>,
     /// Releases of each ring from the floor in the current fast solve.
     pub(super) releases: Vec<u8>,
+    /// Whether the last fast solve needed the inertia-correcting shift (the next tries it first).
+    pub(super) prefer_shift: bool,
 }
 
 /// Converged point on the path.
@@ -69,6 +71,7 @@ impl Solver {
             c: z.clone(),
             base: z,
             releases: vec![0; rings],
+            prefer_shift: false,
         }
     }
 
@@ -76,6 +79,7 @@ impl Solver {
     /// twice per step; fresh allocations were a fifth of the table's time on long sleeves).
     pub(super) fn copy_from(&mut self, other: &Solver) {
         self.lambda = other.lambda;
+        self.prefer_shift = other.prefer_shift;
         for (to, from) in [
             (&mut self.radii, &other.radii),
             (&mut self.gv, &other.gv),

@@ -236,7 +236,15 @@ fn follow_path(
                 // Late in the stroke the edge runs out to the clamps faster than predicted
                 // and moves about one ring per iteration; allow for a share of the rings.
                 let iterations = MAX_PATH_ITERATIONS + solver.radii.len() / 16;
-                solve_from(geom, solver, &mut predicted, aim, iterations)
+                // After a failure only the fast paths retry the shorter steps: where they fail
+                // the path has often ended (the clamps' segments turned radial, eq. 1.17), and
+                // a dozen failed robust solves there cost several ms on fine sleeves.
+                if halvings == 0 {
+                    solve_from(geom, solver, &mut predicted, aim, iterations)
+                } else {
+                    predicted.copy_from(solver);
+                    fast_solve(geom, solver, &predicted, aim, iterations).ok_or("fast")
+                }
             } else {
                 nucleate(geom, solver, aim)
             };
@@ -244,6 +252,10 @@ fn follow_path(
                 Ok(p) => {
                     current = aim;
                     started = true;
+                    // A step that converged lets the next one grow back towards the node
+                    // spacing: a single hard solve would otherwise leave the rest of the node to
+                    // steps up to 2^12 times shorter.
+                    sub = (2.0 * sub).max(-step);
                     last_curvature = p.curvature;
                     edges = [Some((aim, solver.first_free())), edges[0]];
                     if current <= target {
@@ -336,6 +348,26 @@ fn predict(
     }
 }
 
+/// The fast Newton path from `start` (a copy of `solver`): plain Newton and Newton with the
+/// inertia-correcting shift, the one the last solve succeeded with first.
+fn fast_solve(
+    geom: &ShapeGeometry,
+    solver: &mut Solver,
+    start: &Solver,
+    aim: f64,
+    max_iterations: usize,
+) -> Option<PathPoint> {
+    let first = solver.prefer_shift;
+    for shift in [first, !first] {
+        solver.copy_from(start);
+        if let Some(p) = solver.solve_newton(geom, aim, max_iterations, shift) {
+            solver.prefer_shift = shift;
+            return Some(p);
+        }
+    }
+    None
+}
+
 /// One solve on the path: the fast Newton path from the prediction, else the robust solve from
 /// the same start.
 fn solve_from(
@@ -346,7 +378,7 @@ fn solve_from(
     max_iterations: usize,
 ) -> Result<PathPoint, &'static str> {
     start.copy_from(solver);
-    if let Some(p) = solver.solve_newton(geom, aim, max_iterations) {
+    if let Some(p) = fast_solve(geom, solver, start, aim, max_iterations) {
         return Ok(p);
     }
     solver.copy_from(start);
@@ -369,7 +401,14 @@ fn nucleate(
     solver.seed_pocket(geom, geom.max_length() - aim);
     let pocket = solve_from(geom, solver, &mut start, aim, iterations);
     bulge_solver.seed_uniform(geom);
-    let bulge = solve_from(geom, &mut bulge_solver, &mut start, aim, iterations);
+    // Where neither Newton path reaches the bulge but the pocket is found, the pocket is kept:
+    // the robust solve's crawl from the uniform seed takes tens of ms on thin strands.
+    let bulge = if pocket.is_ok() {
+        start.copy_from(&bulge_solver);
+        fast_solve(geom, &mut bulge_solver, &start, aim, iterations).ok_or("bulge")
+    } else {
+        solve_from(geom, &mut bulge_solver, &mut start, aim, iterations)
+    };
     match (pocket, bulge) {
         (Ok(p), Ok(b)) if b.volume > p.volume => {
             *solver = bulge_solver;

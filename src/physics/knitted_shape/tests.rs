@@ -148,9 +148,18 @@ fn rejects_bad_geometry() {
     assert!(ShapeGeometry::new(22.0, 49.0, f64::NAN, 0.003, 49).is_err());
     assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, 1).is_err());
     // Beyond the bound, refused with the reason (the clamp segments turn radial first).
-    assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS).is_ok());
-    let why = ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, MAX_SEGMENTS + 1).unwrap_err();
+    assert!(ShapeGeometry::new(22.0, 200.0, 0.48, 0.003, MAX_SEGMENTS).is_ok());
+    let why = ShapeGeometry::new(22.0, 200.0, 0.48, 0.003, MAX_SEGMENTS + 1).unwrap_err();
     assert!(why.contains("1600") && why.contains("radial"), "{why}");
+    // So is a discretization finer than 32 segments per row (the prototype's 1,568 is the limit).
+    assert!(ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, 1568).is_ok());
+    let why = ShapeGeometry::new(22.0, 49.0, 0.48, 0.003, 1569).unwrap_err();
+    assert!(
+        why.contains("radial") && why.contains("shape_segments to at most 1568"),
+        "{why}"
+    );
+    let why = ShapeGeometry::new(22.0, 1.5, 0.48, 0.003, 49).unwrap_err();
+    assert!(why.contains("rows = 1.5"), "{why}");
     // More rows per segment than the table resolves in bounded time: refused, naming the fix.
     let rows = MAX_ROWS_PER_SEGMENT * 20.0;
     assert!(ShapeGeometry::new(22.0, rows, 0.48, 0.003, 20).is_ok());
@@ -229,5 +238,85 @@ fn table_ends_at_the_first_node_past_zero_force() {
             free >= t.min_length() && free <= t.min_length() + t.spacing,
             "{segments}"
         );
+    }
+}
+
+/// A ring profile's multiplier and KKT residuals: `(lambda, largest |dV/dr - lambda dL/dr|` over
+/// the free rings, largest `dV/dr - lambda dL/dr` over the interior rings on the floor`)`.
+fn kkt(g: &ShapeGeometry, radii: &[f64]) -> (f64, f64, f64) {
+    let n = radii.len();
+    let (mut dl, mut dv) = (vec![0.0; n], vec![0.0; n]);
+    g.gradients(radii, &mut dl, &mut dv).unwrap();
+    let free = |j: usize| radii[j] > g.min_radius;
+    let (mut num, mut den) = (0.0, 0.0);
+    for j in (1..n - 1).filter(|&j| free(j)) {
+        num += dl[j] * dv[j];
+        den += dl[j] * dl[j];
+    }
+    let lambda = num / den;
+    let (mut free_res, mut floor_pull) = (0.0f64, f64::NEG_INFINITY);
+    for j in 1..n - 1 {
+        let z = dv[j] - lambda * dl[j];
+        if free(j) {
+            free_res = free_res.max(z.abs());
+        } else {
+            floor_pull = floor_pull.max(z);
+        }
+    }
+    (lambda, free_res, floor_pull)
+}
+
+#[test]
+fn thin_strand_profiles_are_volume_maxima() {
+    // One stitch per row, a thin strand, a segment per row: plain Newton sends each ring that
+    // leaves the floor back below it (the volume is still convex in its radius there), and the
+    // path follows the maximum with the shifted step. Independently of the solver, each
+    // profile must satisfy the KKT conditions of the maximum (eq. 1.19-1.20 balanced by one
+    // multiplier; no ring on the floor pulled upward) and no move along the length constraint
+    // may gain volume. (The profile re-follows the path in its own steps; on this sleeve, where
+    // several maxima exist at one length, it need not land on the table's.)
+    let g = ShapeGeometry::new(1.0, 60.0, 1.0, 1e-3 / (2.0 * PI), 60).unwrap();
+    let l_free = g.rows / (6.0 * g.stitches_per_row);
+    let t = ShapeTable::build(g, l_free, DEFAULT_TABLE_NODES).unwrap();
+    let scale = g.row_strand_length * g.row_strand_length;
+    let mut rng = 0x2545_f491_4f6c_dd1du64;
+    let mut uniform = || {
+        rng ^= rng << 13;
+        rng ^= rng >> 7;
+        rng ^= rng << 17;
+        (rng >> 11) as f64 / (1u64 << 53) as f64 - 0.5
+    };
+    let lengths: Vec<f64> = t.lengths().collect();
+    for &l in lengths.iter().skip(3).step_by(17) {
+        let radii: Vec<f64> = t.profile(l).unwrap().iter().map(|p| p.1).collect();
+        let (lambda, free_res, floor_pull) = kkt(&g, &radii);
+        assert!(free_res < 1e-8 * scale, "at {l}: residual {free_res:e}");
+        assert!(
+            floor_pull < 1e-8 * scale,
+            "at {l}: a ring on the floor pulls {floor_pull:e}"
+        );
+        // The Lagrangian V - lambda L does not grow along moves of the free rings tangent to
+        // the length constraint (to second order: the reduced Hessian is negative).
+        let n = radii.len();
+        let (mut dl, mut dv) = (vec![0.0; n], vec![0.0; n]);
+        g.gradients(&radii, &mut dl, &mut dv).unwrap();
+        let (l0, v0) = g.length_and_volume(&radii).unwrap();
+        let free: Vec<usize> = (1..n - 1).filter(|&j| radii[j] > g.min_radius).collect();
+        for _ in 0..20 {
+            let mut d = vec![0.0; n];
+            for &j in &free {
+                d[j] = uniform();
+            }
+            let along: f64 = free.iter().map(|&j| dl[j] * d[j]).sum::<f64>()
+                / free.iter().map(|&j| dl[j] * dl[j]).sum::<f64>();
+            for &j in &free {
+                d[j] -= along * dl[j];
+            }
+            let eps = 1e-4 * g.radius_ceiling();
+            let moved: Vec<f64> = (0..n).map(|j| radii[j] + eps * d[j]).collect();
+            let (l1, v1) = g.length_and_volume(&moved).unwrap();
+            let gain = (v1 - lambda * l1) - (v0 - lambda * l0);
+            assert!(gain <= 1e-12 * v0, "at {l}: gain {gain:e} of {v0:e}");
+        }
     }
 }

@@ -1,0 +1,128 @@
+//! The non-cylindrical table's build time over the KnittedMuscle's declared sleeve space
+//! (`cargo bench --bench knitted_table_space`): `stitches_per_row`, `rows`, `row_strand_length`,
+//! `strand_thickness` and `shape_segments` drawn log-uniform over their declared ranges as
+//! `benches/worst_case.rs` draws them (a quarter of the thicknesses zero, the others across 15
+//! decades below the top), until `KNITTED_SLEEVES` (2,000) sleeves build. Times
+//! `KnittedSleeve::new` in thread CPU time, refusals included, and prints the median, p99 and
+//! maximum, the share over 10 ms and the slowest sleeves with their parameters.
+
+#[path = "cpu_clock.rs"]
+mod cpu_clock;
+
+use actuator_fmus::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
+use cpu_clock::thread_cpu;
+
+/// SplitMix64: reproducible draws.
+struct Rng(u64);
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
+        z ^ (z >> 31)
+    }
+    fn uniform(&mut self) -> f64 {
+        (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        (lo.ln() + self.uniform() * (hi.ln() - lo.ln()))
+            .exp()
+            .clamp(lo, hi)
+    }
+}
+
+struct Case {
+    params: KnittedParams,
+    segments: usize,
+    seconds: f64,
+    built: bool,
+}
+
+fn main() {
+    let wanted: usize = std::env::var("KNITTED_SLEEVES")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(2000);
+    let mut rng = Rng(0x6b6e_6974);
+    let mut cases = Vec::new();
+    let mut built = 0;
+    while built < wanted {
+        let params = KnittedParams {
+            stitches_per_row: rng.log_uniform(1.0, 1e6),
+            rows: rng.log_uniform(1.0, 1e7),
+            row_strand_length: rng.log_uniform(1e-6, 1e3),
+            strand_thickness: if rng.uniform() < 0.25 {
+                0.0
+            } else {
+                rng.log_uniform(0.1e-15, 0.1)
+            },
+            bladder_outer_radius: 0.0,
+        };
+        let segments = rng.log_uniform(2.0, 200.5).floor() as usize;
+        let start = thread_cpu();
+        let sleeve = KnittedSleeve::new(params, ShapeKind::NonCylindrical { segments });
+        let seconds = thread_cpu() - start;
+        built += sleeve.is_ok() as usize;
+        cases.push(Case {
+            params,
+            segments,
+            seconds,
+            built: sleeve.is_ok(),
+        });
+    }
+    if let Ok(f) = std::env::var("KNITTED_DUMP") {
+        let mut o = String::new();
+        for c in cases.iter().filter(|c| c.built) {
+            let p = c.params;
+            o += &format!(
+                "{} {} {} {} {}\n",
+                c.seconds,
+                p.stitches_per_row,
+                p.rows,
+                c.segments,
+                4.0 * p.stitches_per_row * p.strand_thickness / p.row_strand_length
+            );
+        }
+        std::fs::write(f, o).unwrap();
+    }
+    let mut times: Vec<f64> = cases
+        .iter()
+        .filter(|c| c.built)
+        .map(|c| c.seconds)
+        .collect();
+    times.sort_by(f64::total_cmp);
+    let at = |q: f64| times[((times.len() - 1) as f64 * q).round() as usize];
+    let slow = times.iter().filter(|&&t| t > 10e-3).count();
+    let refused_max = cases
+        .iter()
+        .filter(|c| !c.built)
+        .map(|c| c.seconds)
+        .fold(0.0, f64::max);
+    println!(
+        "{} sleeves built ({} refused): median {:.3} ms, p99 {:.2} ms, max {:.2} ms; {} ({:.1}%) \
+         over 10 ms; slowest refusal {:.3} ms",
+        times.len(),
+        cases.len() - times.len(),
+        1e3 * at(0.5),
+        1e3 * at(0.99),
+        1e3 * at(1.0),
+        slow,
+        100.0 * slow as f64 / times.len() as f64,
+        1e3 * refused_max
+    );
+    cases.sort_by(|a, b| b.seconds.total_cmp(&a.seconds));
+    println!("slowest (ms, built, m, n, segments, 2 pi r_min / S_row):");
+    for c in cases.iter().take(12) {
+        let p = c.params;
+        println!(
+            "{:8.2} {} m {:.4e} n {:.2} segments {} ratio {:.4e}",
+            1e3 * c.seconds,
+            c.built,
+            p.stitches_per_row,
+            p.rows,
+            c.segments,
+            4.0 * p.stitches_per_row * p.strand_thickness / p.row_strand_length
+        );
+    }
+}
