@@ -229,6 +229,10 @@ pub fn transition_within_reach<T>(
     // (force, stiffness) at each end; the soft end's force is only needed where it pushes.
     let mut soft_end = (force, slope);
     let mut stiff_end = at_stiff.map(|(force, stiffness, _)| (force, stiffness));
+    // Illinois: an end kept twice in a row has its value halved in the interpolation, so that a
+    // secant stuck next to the other end (a value that saturates, as a connector's series
+    // stiffness does towards `max_length`) moves across within a few steps.
+    let (mut weights, mut soft_moved_last) = ((1.0, 1.0), None);
     for taken in 0..120 {
         let mid = 0.5 * (l + stiff);
         if mid <= l || mid >= stiff {
@@ -244,6 +248,7 @@ pub fn transition_within_reach<T>(
         });
         let next = match ends {
             Some((a, b)) if a <= 0.0 && b > 0.0 => {
+                let (a, b) = (a * weights.0, b * weights.1);
                 let falsi = l - a * width / (b - a);
                 let toward_mid = (mid - falsi).signum();
                 // At least a few ulps: else, once one end sits on the boundary, the other
@@ -271,6 +276,10 @@ pub fn transition_within_reach<T>(
             Some((force, stiffness, o)) if !(force > 0.0 && stiffness > k_s) => {
                 (l, slope, out) = (next, stiffness, o);
                 soft_end = (force, stiffness);
+                if soft_moved_last == Some(true) {
+                    weights.1 *= 0.5;
+                }
+                (weights.0, soft_moved_last) = (1.0, Some(true));
             }
             evaluated => {
                 stiff = next;
@@ -280,6 +289,10 @@ pub fn transition_within_reach<T>(
                 stiff_end = evaluated
                     .filter(|_| !probe)
                     .map(|(force, stiffness, _)| (force, stiffness));
+                if soft_moved_last == Some(false) {
+                    weights.0 *= 0.5;
+                }
+                (weights.1, soft_moved_last) = (1.0, Some(false));
             }
         }
     }
@@ -363,7 +376,7 @@ mod tests {
         type Model = fn(f64) -> Option<(f64, f64, f64)>;
         // Bisection to adjacent floats takes 50-odd evaluations; where the stiff end has no
         // stiffness ("ends") the search is bisection.
-        let models: [(&str, Model, f64, usize); 6] = [
+        let models: [(&str, Model, f64, usize); 7] = [
             // Pushes (holds) up to the end of its solutions.
             ("reach", |l| (l < 0.1).then_some((-1.0, 1e9, l)), 1e3, 25),
             // Stiffer than the strands throughout: ends where its force turns to a pull.
@@ -387,6 +400,18 @@ mod tests {
                 25,
             ),
             ("ends", |l| (l < 0.083).then_some((10.0, 1.0, l)), 1e3, 60),
+            // The pole through a connector of 1e4 N/m: the series stiffness saturates at it.
+            (
+                "series",
+                |l| {
+                    (l < 0.1).then(|| {
+                        let k = 2.0 / (0.1 - l).powi(2);
+                        (2.0 / (0.1 - l), k / (1.0 + k / 1e4), l)
+                    })
+                },
+                9e3,
+                25,
+            ),
         ];
         for (name, model, k_s, most) in models {
             let calls = std::cell::Cell::new(0);
