@@ -136,7 +136,7 @@ pub struct Transition<T> {
 /// the rigid model holds there (a closed range, as the knitted sleeve's); otherwise the boundary
 /// between a length where it holds and one where it does not, narrowed until the two are
 /// adjacent floats (the same point bisection reaches): ITP where both ends have a value to
-/// interpolate, else bisection (at most 30 + 55-odd evaluations; 15-25 instead of bisection's
+/// interpolate, else bisection (at most 30 + 60-odd evaluations; 15-25 instead of bisection's
 /// 50-odd where the rigid model's stiffness or force crosses over; only in this regime). No
 /// transition where the rigid model already pulls stiffer than the strands at the first length
 /// below the stiff end where it has a solution.
@@ -222,10 +222,16 @@ pub fn transition_within_reach<T>(
     // than two evaluations beyond bisection's count. It stops only at adjacent floats, not at a
     // tolerance: the boundary must be as exact as bisection's (the partials through it are
     // differentiated against central differences).
-    let width = stiff - l;
     let half_ulp = 0.5 * f64::EPSILON * stiff.abs();
-    let most = (width / half_ulp).log2().ceil() + 2.0;
-    let truncation = 0.2 / width;
+    // ITP's parameters from the bracket it starts on (after any steps towards `end`, below):
+    // its evaluation count, and `0.2 / width` of the truncation.
+    let itp = |width: f64, taken: u32| {
+        (
+            (width / half_ulp).log2().ceil() + 2.0 + f64::from(taken),
+            0.2 / width,
+        )
+    };
+    let (mut most, mut truncation) = itp(stiff - l, 0);
     // (force, stiffness) at each end; the soft end's force is only needed where it pushes.
     let mut soft_end = (force, slope);
     let mut stiff_end = at_stiff.map(|(force, stiffness, _)| (force, stiffness));
@@ -233,6 +239,12 @@ pub fn transition_within_reach<T>(
     // secant stuck next to the other end (a value that saturates, as a connector's series
     // stiffness does towards `max_length`) moves across within a few steps.
     let (mut weights, mut soft_moved_last) = ((1.0, 1.0), None);
+    // A stiff end without solution, `end`, may be where the rigid force diverges (a bladder's
+    // `max_length`), the boundary anywhere from next to it to far below: the search halves the
+    // logarithm of the distance to `end` until the bracket spans less than a factor 2 of it (a
+    // boundary 1e-9 of the range below `end` takes 6-odd probes, not 30 halvings of the way),
+    // unless a probe short of `end` has no solution either (then it bisects).
+    let (end, mut towards_end) = (stiff, stiff_end.is_none());
     for taken in 0..120 {
         let mid = 0.5 * (l + stiff);
         if mid <= l || mid >= stiff {
@@ -246,7 +258,13 @@ pub fn transition_within_reach<T>(
                 (soft_end.0, force)
             }
         });
+        let geometric = towards_end && taken > 0 && end - l > 2.0 * (end - stiff);
+        if towards_end && taken > 0 && !geometric {
+            towards_end = false;
+            (most, truncation) = itp(width, taken);
+        }
         let next = match ends {
+            _ if geometric => end - ((end - l) * (end - stiff)).sqrt(),
             Some((a, b)) if a <= 0.0 && b > 0.0 => {
                 let (a, b) = (a * weights.0, b * weights.1);
                 let falsi = l - a * width / (b - a);
@@ -286,6 +304,7 @@ pub fn transition_within_reach<T>(
                 // Not the probe just below a reach without solution: its values, next to a
                 // singularity, would only slow the interpolation.
                 let probe = taken == 0 && stiff_end.is_none();
+                towards_end &= probe || evaluated.is_some();
                 stiff_end = evaluated
                     .filter(|_| !probe)
                     .map(|(force, stiffness, _)| (force, stiffness));
@@ -376,7 +395,7 @@ mod tests {
         type Model = fn(f64) -> Option<(f64, f64, f64)>;
         // Bisection to adjacent floats takes 50-odd evaluations; where the stiff end has no
         // stiffness ("ends") the search is bisection.
-        let models: [(&str, Model, f64, usize); 7] = [
+        let models: [(&str, Model, f64, usize); 8] = [
             // Pushes (holds) up to the end of its solutions.
             ("reach", |l| (l < 0.1).then_some((-1.0, 1e9, l)), 1e3, 25),
             // Stiffer than the strands throughout: ends where its force turns to a pull.
@@ -385,6 +404,14 @@ mod tests {
                 "pole",
                 |l| (l < 0.1).then(|| (2.0 / (0.1 - l), 2.0 / (0.1 - l).powi(2), l)),
                 1e5,
+                25,
+            ),
+            // Strands as stiff as the pole 3e-8 m short of it: the boundary is found from the
+            // distance to the pole's end, not by halving the way there.
+            (
+                "near pole",
+                |l| (l < 0.1).then(|| (2.0 / (0.1 - l), 2.0 / (0.1 - l).powi(2), l)),
+                2e15,
                 25,
             ),
             (
