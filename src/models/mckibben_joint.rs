@@ -168,17 +168,32 @@ impl McKibbenJoint {
 
     /// Both muscles at the pressures from `difference`, at the given lengths and histories:
     /// each one's outputs (with why, if clamped) and partials, from one search for its strands'
-    /// transition.
-    fn pair_at(&self, difference: f64, lengths: [f64; 2]) -> [Evaluated; 2] {
-        let p = pair_pressures(self.common_mode_pressure, difference, self.max_pressure);
+    /// transition. A muscle whose pressure is one it was evaluated at in `earlier` (the torque
+    /// solver's evaluations, at these lengths and histories) is taken from there: a pressure
+    /// clipped to 0 or `max_pressure` stays so across most of the solver's iterations, and each
+    /// evaluation past `max_length` searches for the strands' transition anew.
+    fn pair_at(
+        &self,
+        difference: f64,
+        lengths: [f64; 2],
+        earlier: &[(f64, [Evaluated; 2])],
+    ) -> [Evaluated; 2] {
+        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
+        let p = pair_pressures(pc, difference, pmax);
         let k_s = self.strand_stiffness;
-        let (f, e) = (&self.flexor_friction, &self.extensor_friction);
-        [
-            self.muscle
-                .evaluate_and_partials_with_strands(p[0], lengths[0], k_s, f),
-            self.muscle
-                .evaluate_and_partials_with_strands(p[1], lengths[1], k_s, e),
-        ]
+        let histories = [&self.flexor_friction, &self.extensor_friction];
+        [0, 1].map(|i| {
+            let same = |d: &f64| pair_pressures(pc, *d, pmax)[i].to_bits() == p[i].to_bits();
+            match earlier.iter().find(|(d, _)| same(d)) {
+                Some((_, pair)) => pair[i].clone(),
+                None => self.muscle.evaluate_and_partials_with_strands(
+                    p[i],
+                    lengths[i],
+                    k_s,
+                    histories[i],
+                ),
+            }
+        })
     }
 
     /// Torque of the pair evaluated at `difference` ([`Self::pair_at`]), and its slope in the
@@ -215,7 +230,7 @@ impl McKibbenJoint {
         let (difference, saturated) = if self.torque_command {
             // The pressure difference that meets the torque, through the same muscle physics.
             let torque_of = |d: f64| {
-                let pair = self.pair_at(d, lengths);
+                let pair = self.pair_at(d, lengths, &solved_at);
                 let torque = self.torque_at(d, &pair);
                 solved_at.push((d, pair));
                 torque
@@ -686,6 +701,55 @@ mod tests {
             assert!(clamped && !out.torque_saturated);
             assert!(
                 (out.joint_torque - command).abs() < 1e-9 * command,
+                "{command}: {}",
+                out.joint_torque
+            );
+        }
+    }
+
+    /// A torque command with no common-mode pressure: the solver keeps one muscle's pressure
+    /// clipped to 0 while it searches, the flexor on its stretching strands (the Festo DMSP-10
+    /// with 324 N strands). The outputs are each muscle's physics at the pressures
+    /// returned, evaluated here on their own, and the torque meets the command.
+    #[test]
+    fn torque_command_outputs_are_each_muscles_physics_at_its_pressure() {
+        let p = Parameters {
+            preset: 5,
+            strand_rigidity: 324.2,
+            moment_arm: 3.421e-3,
+            flexor_rest_length: 0.2581,
+            extensor_rest_length: 0.2665,
+            common_mode_pressure: 0.0,
+            max_pressure: 5.62e7,
+            command_mode: 1,
+            ..Default::default()
+        };
+        let mut j = joint(&p);
+        let q = -4.319;
+        let lengths = [
+            p.flexor_rest_length - p.moment_arm * q,
+            p.extensor_rest_length + p.moment_arm * q,
+        ];
+        let (k_s, rest) = (j.strand_stiffness, j.flexor_friction);
+        assert!(j.muscle.strand_point(0.0, lengths[0], k_s, &rest).is_some());
+        for command in [0.01689, 0.05, -0.01689] {
+            let (out, _) = at(&mut j, command, q);
+            let pressures = [out.flexor_pressure, out.extensor_pressure];
+            assert!(pressures.contains(&0.0), "{command}: {pressures:?}");
+            let forces: Vec<f64> = [&j.flexor_friction, &j.extensor_friction]
+                .iter()
+                .enumerate()
+                .map(|(i, history)| {
+                    let (o, _) =
+                        j.muscle
+                            .evaluate_with_strands(pressures[i], lengths[i], k_s, history);
+                    o.unwrap().force.max(0.0)
+                })
+                .collect();
+            assert_eq!([out.flexor_force, out.extensor_force], forces[..]);
+            assert!(!out.torque_saturated, "{command}");
+            assert!(
+                (out.joint_torque - command).abs() < 1e-9 * command.abs(),
                 "{command}: {}",
                 out.joint_torque
             );

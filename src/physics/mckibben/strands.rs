@@ -131,24 +131,15 @@ pub struct Transition<T> {
     pub force_zero: bool,
 }
 
-/// The rigid model holds at `L` unless it has no solution there or pulls and is stiffer than the
-/// strands (`k_s`, N/m).
-/// Returns its force, stiffness and outputs there.
-fn holds<T>(
-    rigid: &impl Fn(f64) -> Option<(f64, f64, T)>,
-    l: f64,
-    k_s: f64,
-) -> Option<(f64, f64, T)> {
-    rigid(l).filter(|(force, stiffness, _)| !(*force > 0.0 && *stiffness > k_s))
-}
-
 /// The transition for an input `length` in the upper half of the rigid model's `range` where
 /// that model does not hold; `None` where it holds. At or past the reach, the reach itself when
 /// the rigid model holds there (a closed range, as the knitted sleeve's); otherwise the boundary
 /// between a length where it holds and one where it does not, narrowed until the two are
 /// adjacent floats (the same point bisection reaches): ITP where both ends have a value to
-/// interpolate, else bisection (at most 30 + 55-odd evaluations; 15-25 instead of bisection's
-/// 50-odd where the rigid model's stiffness or force crosses over; only in this regime).
+/// interpolate, else bisection (at most 30 + 60-odd evaluations; 15-25 instead of bisection's
+/// 50-odd where the rigid model's stiffness or force crosses over; only in this regime). No
+/// transition where the rigid model already pulls stiffer than the strands at the first length
+/// below the stiff end where it has a solution.
 pub fn transition<T>(
     range: (f64, f64),
     length: f64,
@@ -192,12 +183,21 @@ pub fn transition_within_reach<T>(
         }
     }
     let mut stiff = length.min(hi);
+    // The soft end: the first length, halving the way from `lo` towards the stiff end, where the
+    // rigid model holds. Lengths without a solution are passed over (a connector's reported
+    // lengths below its shortest muscle's); one with a solution that pulls stiffer than the
+    // strands ends the search: the rigid model stiffens towards the stiff end, so the lengths
+    // above it would not hold either (each a whole solve: 30 of them through a connector).
     let mut soft = None;
     for k in 1..=30 {
         let l = stiff - (stiff - lo) * 0.5f64.powi(k);
-        if let Some(out) = holds(&rigid, l, k_s) {
-            soft = Some((l, out));
-            break;
+        match rigid(l) {
+            Some(at) if !pulls_stiffer(&at) => {
+                soft = Some((l, at));
+                break;
+            }
+            Some(_) => return None,
+            None => {}
         }
     }
     let (mut l, (force, mut slope, mut out)) = soft?;
@@ -222,28 +222,51 @@ pub fn transition_within_reach<T>(
     // than two evaluations beyond bisection's count. It stops only at adjacent floats, not at a
     // tolerance: the boundary must be as exact as bisection's (the partials through it are
     // differentiated against central differences).
-    let width = stiff - l;
     let half_ulp = 0.5 * f64::EPSILON * stiff.abs();
-    let most = (width / half_ulp).log2().ceil() + 2.0;
-    let truncation = 0.2 / width;
-    // (force, stiffness - k_s) at each end; the soft end's force is only needed where it pushes.
-    let mut soft_end = (force, slope - k_s);
-    let mut stiff_end = at_stiff.map(|(force, stiffness, _)| (force, stiffness - k_s));
+    // ITP's parameters from the bracket it starts on (after any steps towards `end`, below):
+    // its evaluation count, and `0.2 / width` of the truncation.
+    let itp = |width: f64, taken: u32| {
+        (
+            (width / half_ulp).log2().ceil() + 2.0 + f64::from(taken),
+            0.2 / width,
+        )
+    };
+    let (mut most, mut truncation) = itp(stiff - l, 0);
+    // (force, stiffness) at each end; the soft end's force is only needed where it pushes.
+    let mut soft_end = (force, slope);
+    let mut stiff_end = at_stiff.map(|(force, stiffness, _)| (force, stiffness));
+    // Illinois: an end kept twice in a row has its value halved in the interpolation, so that a
+    // secant stuck next to the other end (a value that saturates, as a connector's series
+    // stiffness does towards `max_length`) moves across within a few steps.
+    let (mut weights, mut soft_moved_last) = ((1.0, 1.0), None);
+    // A stiff end without solution, `end`, may be where the rigid force diverges (a bladder's
+    // `max_length`), the boundary anywhere from next to it to far below: the search halves the
+    // logarithm of the distance to `end` until the bracket spans less than a factor 2 of it (a
+    // boundary 1e-9 of the range below `end` takes 6-odd probes, not 30 halvings of the way),
+    // unless a probe short of `end` has no solution either (then it bisects).
+    let (end, mut towards_end) = (stiff, stiff_end.is_none());
     for taken in 0..120 {
         let mid = 0.5 * (l + stiff);
         if mid <= l || mid >= stiff {
             break;
         }
         let width = stiff - l;
-        let ends = stiff_end.map(|(force, excess)| {
-            if soft_end.1 < 0.0 {
-                (soft_end.1, excess)
+        let ends = stiff_end.map(|(force, stiffness)| {
+            if soft_end.1 < k_s {
+                stiffness_ends(soft_end.1, stiffness, k_s)
             } else {
                 (soft_end.0, force)
             }
         });
+        let geometric = towards_end && taken > 0 && end - l > 2.0 * (end - stiff);
+        if towards_end && taken > 0 && !geometric {
+            towards_end = false;
+            (most, truncation) = itp(width, taken);
+        }
         let next = match ends {
+            _ if geometric => end - ((end - l) * (end - stiff)).sqrt(),
             Some((a, b)) if a <= 0.0 && b > 0.0 => {
+                let (a, b) = (a * weights.0, b * weights.1);
                 let falsi = l - a * width / (b - a);
                 let toward_mid = (mid - falsi).signum();
                 // At least a few ulps: else, once one end sits on the boundary, the other
@@ -270,16 +293,25 @@ pub fn transition_within_reach<T>(
         match rigid(next) {
             Some((force, stiffness, o)) if !(force > 0.0 && stiffness > k_s) => {
                 (l, slope, out) = (next, stiffness, o);
-                soft_end = (force, stiffness - k_s);
+                soft_end = (force, stiffness);
+                if soft_moved_last == Some(true) {
+                    weights.1 *= 0.5;
+                }
+                (weights.0, soft_moved_last) = (1.0, Some(true));
             }
             evaluated => {
                 stiff = next;
                 // Not the probe just below a reach without solution: its values, next to a
                 // singularity, would only slow the interpolation.
                 let probe = taken == 0 && stiff_end.is_none();
+                towards_end &= probe || evaluated.is_some();
                 stiff_end = evaluated
                     .filter(|_| !probe)
-                    .map(|(force, stiffness, _)| (force, stiffness - k_s));
+                    .map(|(force, stiffness, _)| (force, stiffness));
+                if soft_moved_last == Some(false) {
+                    weights.0 *= 0.5;
+                }
+                (weights.1, soft_moved_last) = (1.0, Some(false));
             }
         }
     }
@@ -290,13 +322,38 @@ pub fn transition_within_reach<T>(
         interior,
         // The soft end holds only because it pushes, the stiff end pulls: a sign change of the
         // force (not the end of the rigid model's solutions).
-        force_zero: !interior && soft_end.1 >= 0.0 && stiff_end.is_some(),
+        force_zero: !interior && soft_end.1 >= k_s && stiff_end.is_some(),
     })
+}
+
+/// The values `(soft, stiff)` the interpolation of [`transition_within_reach`] takes from the
+/// rigid stiffness `K` at each end: `ln(K / k_s)` where both are positive, else `K - k_s`. Towards
+/// a bladder's `max_length` the stiffness grows like a pole, `(hi - L)^-m`, on which the secant
+/// through `K - k_s` lands next to the soft end every time (the search then gains little over
+/// bisection); its logarithm is nearly linear in `L` there. Both change sign where `K = k_s`, and
+/// the search stops at adjacent floats whichever it interpolates: the boundary is the same float.
+fn stiffness_ends(soft: f64, stiff: f64, k_s: f64) -> (f64, f64) {
+    if soft > 0.0 && stiff > 0.0 {
+        ((soft / k_s).ln(), (stiff / k_s).ln())
+    } else {
+        (soft - k_s, stiff - k_s)
+    }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The rigid model holds at `L` unless it has no solution there or pulls and is stiffer than the
+    /// strands (`k_s`, N/m).
+    /// Returns its force, stiffness and outputs there.
+    fn holds<T>(
+        rigid: &impl Fn(f64) -> Option<(f64, f64, T)>,
+        l: f64,
+        k_s: f64,
+    ) -> Option<(f64, f64, T)> {
+        rigid(l).filter(|(force, stiffness, _)| !(*force > 0.0 && *stiffness > k_s))
+    }
 
     /// A rigid model singular at its reach, `F = a / (hi - L)`, stiffness `a / (hi - L)^2`:
     /// the strands (`k_s`) take over exactly where that stiffness is `k_s`,
@@ -338,7 +395,7 @@ mod tests {
         type Model = fn(f64) -> Option<(f64, f64, f64)>;
         // Bisection to adjacent floats takes 50-odd evaluations; where the stiff end has no
         // stiffness ("ends") the search is bisection.
-        let models: [(&str, Model, f64, usize); 6] = [
+        let models: [(&str, Model, f64, usize); 8] = [
             // Pushes (holds) up to the end of its solutions.
             ("reach", |l| (l < 0.1).then_some((-1.0, 1e9, l)), 1e3, 25),
             // Stiffer than the strands throughout: ends where its force turns to a pull.
@@ -347,6 +404,14 @@ mod tests {
                 "pole",
                 |l| (l < 0.1).then(|| (2.0 / (0.1 - l), 2.0 / (0.1 - l).powi(2), l)),
                 1e5,
+                25,
+            ),
+            // Strands as stiff as the pole 3e-8 m short of it: the boundary is found from the
+            // distance to the pole's end, not by halving the way there.
+            (
+                "near pole",
+                |l| (l < 0.1).then(|| (2.0 / (0.1 - l), 2.0 / (0.1 - l).powi(2), l)),
+                2e15,
                 25,
             ),
             (
@@ -362,6 +427,18 @@ mod tests {
                 25,
             ),
             ("ends", |l| (l < 0.083).then_some((10.0, 1.0, l)), 1e3, 60),
+            // The pole through a connector of 1e4 N/m: the series stiffness saturates at it.
+            (
+                "series",
+                |l| {
+                    (l < 0.1).then(|| {
+                        let k = 2.0 / (0.1 - l).powi(2);
+                        (2.0 / (0.1 - l), k / (1.0 + k / 1e4), l)
+                    })
+                },
+                9e3,
+                25,
+            ),
         ];
         for (name, model, k_s, most) in models {
             let calls = std::cell::Cell::new(0);
@@ -402,6 +479,32 @@ mod tests {
         assert_eq!(t.length, hi);
         assert!(!t.interior);
         assert!(transition((lo, hi), hi, k_s, rigid).is_none());
+    }
+
+    /// A rigid model that pulls stiffer than the strands from mid-range up to its reach (soft
+    /// strands): no transition in the upper half, found from the first length with a solution
+    /// instead of halving the way to the reach 30 times (each a whole solve). Lengths without a
+    /// solution are passed over: below the first one with a solution, the boundary is found.
+    #[test]
+    fn stiffer_than_the_strands_from_mid_range_has_no_transition() {
+        let (lo, hi, k_s) = (0.05, 0.1, 1e3);
+        let calls = std::cell::Cell::new(0);
+        let stiff = |l: f64| {
+            calls.set(calls.get() + 1);
+            (l < hi).then_some((1e3 * l, 1e9, l))
+        };
+        for length in [0.097, hi, hi + 0.01] {
+            calls.set(0);
+            assert!(transition((lo, hi), length, k_s, stiff).is_none());
+            assert!(calls.get() <= 3, "{length}: {} evaluations", calls.get());
+        }
+        // No solution below 0.09 (as a connector's reported lengths short of its shortest
+        // muscle's), then pushing up to 0.095 and pulling stiffer past it.
+        let gap = |l: f64| (l >= 0.09).then_some((l - 0.095, 1e9, l));
+        let t = transition((lo, hi), hi, k_s, gap).unwrap();
+        let reference = bisected(0.09375, hi, |l| gap(l).is_some_and(|(f, _, _)| f <= 0.0));
+        assert_eq!(t.length, reference);
+        assert!(t.force_zero);
     }
 
     #[test]
