@@ -257,14 +257,19 @@ impl Motor {
             }
         }
         if run.spin_cycle.is_none() {
-            // The march costs SPIN_CYCLE_WEIGHT substeps of the budget, or is not started.
+            // The march costs at least SPIN_CYCLE_WEIGHT substeps of the budget, or is not
+            // started; it is charged by its settles.
             let spent = run.attempts.saturating_add(run.extra_cost);
             if spent.saturating_add(SPIN_CYCLE_WEIGHT) > self.params.max_substeps {
                 run.spin_failed = true;
                 return false;
             }
-            run.extra_cost = run.extra_cost.saturating_add(SPIN_CYCLE_WEIGHT);
-            match self.onion_cycle(&run.y, d, dir) {
+            let mut settles = 0;
+            let cycle = self.onion_cycle(&run.y, d, dir, &mut settles);
+            run.extra_cost = run
+                .extra_cost
+                .saturating_add(settles.div_ceil(SETTLES_PER_SUBSTEP));
+            match cycle {
                 Some(cycle) => run.spin_cycle = Some((d.direction, cycle)),
                 None => {
                     run.spin_failed = true;
@@ -300,7 +305,9 @@ impl Motor {
     /// `|tau| <= tau_max`, moves the rotor from that motion by at most `tau_max g(h)` in angle
     /// and `tau_max s(h)` in speed, with `g(h) = (h - I/c (1 - e^(-h c/I))) / c` and
     /// `s(h) = (1 - e^(-h c/I)) / c` the response to a unit torque (`h^2 / 2I`, `h / I` without
-    /// drag): both are held below `tolerance / 10` (the speed on the error norm's scale).
+    /// drag). The angle's is held below `tolerance / 10`; the speed's, which does not add up
+    /// over segments (the angle's bound includes its effect), below the tolerance on the error
+    /// norm's scale, as an accepted substep's local error.
     ///
     /// This is the rotor of a fast schedule under a load far beyond the ring's torque: it turns
     /// by a fraction of a turn between switches (the onion's cycle, two turns of strides, was
@@ -321,8 +328,8 @@ impl Motor {
             (h, h / i, 0.5 * h * h / i)
         };
         let tau = self.torque_bound();
-        let tol = 0.1 * self.params.tolerance;
-        if !(tau * torque_angle <= tol && tau * torque_speed <= tol * self.speed_scale) {
+        let tol = self.params.tolerance;
+        if !(tau * torque_angle <= 0.1 * tol && tau * torque_speed <= tol * self.speed_scale) {
             return false;
         }
         let turn = run.y[1] * coast + d.load * torque_angle;
@@ -339,7 +346,10 @@ impl Motor {
         run.y = [run.y[0] + turn, speed, psi, 0.0];
         run.t = segment_end;
         run.settled = false;
-        run.attempts = run.attempts.saturating_add(strides as u32);
+        run.attempts = run.attempts.saturating_add(1);
+        run.extra_cost = run
+            .extra_cost
+            .saturating_add((strides as u32).div_ceil(SETTLES_PER_SUBSTEP));
         true
     }
 
@@ -517,7 +527,13 @@ impl Motor {
     /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
     /// `psi0`: one turn to land on it, one to measure it (and sample its torque). `None` if it
     /// does not close.
-    fn onion_cycle(&self, y: &super::Vector, d: &Drive, dir: f64) -> Option<OnionCycle> {
+    fn onion_cycle(
+        &self,
+        y: &super::Vector,
+        d: &Drive,
+        dir: f64,
+        settles: &mut u32,
+    ) -> Option<OnionCycle> {
         // The landscape depends on psi - phi and psi - gamma (mod pi): turn rotor and onion back
         // by whole turns so that the march works near zero (the onion by its own turns too, for
         // a state whose onion is far from its rotor).
@@ -528,10 +544,17 @@ impl Motor {
             .landscape(phi0, d.direction, d.stress)
             .settle(y[2] - turns - onion_turns);
         let start = phi0 + dir * 2.0 * PI;
-        let (psi1, _) = self.march_onion(phi0, psi0, start, d, None)?;
+        *settles += 1;
+        let (psi1, _) = self.march_onion(phi0, psi0, start, d, None, settles)?;
         let mut samples = Vec::with_capacity(160);
-        let (psi2, work) =
-            self.march_onion(start, psi1, start + dir * 2.0 * PI, d, Some(&mut samples))?;
+        let (psi2, work) = self.march_onion(
+            start,
+            psi1,
+            start + dir * 2.0 * PI,
+            d,
+            Some(&mut samples),
+            settles,
+        )?;
         let winding = ((psi2 - psi1) / (2.0 * PI)).round();
         if (psi2 - psi1 - winding * 2.0 * PI).abs() > 1e-6 {
             return None;
@@ -571,8 +594,13 @@ impl Motor {
         to: f64,
         d: &Drive,
         mut samples: Option<&mut Vec<(f64, f64, f64)>>,
+        settles: &mut u32,
     ) -> Option<(f64, f64)> {
-        let settle = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).settle(onion);
+        let count = std::cell::Cell::new(0u32);
+        let settle = |at: f64, onion: f64| {
+            count.set(count.get() + 1);
+            self.landscape(at, d.direction, d.stress).settle(onion)
+        };
         let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
         let mut record = |at: f64, onion: f64| {
             if let Some(s) = samples.as_deref_mut() {
@@ -613,6 +641,7 @@ impl Motor {
             (phi, psi) = (next, settle(next, psi_hi));
             record(phi, psi);
         }
+        *settles = settles.saturating_add(count.get());
         (psi.is_finite() && work.is_finite()).then_some((psi, work))
     }
 }
@@ -630,10 +659,14 @@ const MAX_DRIFT_STRIDE: f64 = 0.05;
 const MAX_SPIN_EPSILON: f64 = 0.05;
 const MIN_SPIN_TURNS: f64 = 2.0;
 /// The onion's cycle ([`Motor::onion_cycle`], two turns of 126 strides with their settles, about
-/// 25 us in release) counts as this many quasi-static substeps (about 0.32 us each) in
+/// 25 us in release) counts as at least this many quasi-static substeps (about 0.32 us each) in
 /// `max_substeps`, so that the budget bounds a step that marches it again at every switch of a
 /// fast schedule (at 40, such steps took up to 9.6 ms with the budget at its declared maximum).
 pub(super) const SPIN_CYCLE_WEIGHT: u32 = 80;
+/// Settles of the quasi-static onion per substep of the budget: the cycle's march of about 320
+/// settles costs about 80 substeps (about 0.08 us a settle against 0.32 us a substep). Marches
+/// (the cycle's, the drifting onion's, the overdamped rotor's) are charged by their settles.
+pub(super) const SETTLES_PER_SUBSTEP: u32 = 4;
 /// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
 const CYCLE_STRIDE: f64 = 0.05;
 const SNAP_PLACEMENT: f64 = 1e-10;
