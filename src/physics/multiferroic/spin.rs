@@ -333,7 +333,7 @@ impl Motor {
             return false;
         }
         let turn = run.y[1] * coast + d.load * torque_angle;
-        if !(turn.abs() <= MAX_DRIFT_TURN) {
+        if turn.is_nan() || turn.abs() > MAX_DRIFT_TURN {
             return false;
         }
         let speed = run.y[1] * (1.0 - c * torque_speed) + d.load * torque_speed;
