@@ -301,3 +301,38 @@ fn a_drifting_rotor_through_a_fast_schedule_agrees_with_fine_integration() {
     assert!((s.rotor_speed - load / m.drag).abs() < 1e-3 * s.rotor_speed);
     assert!(report.substeps <= 500, "{report:?}");
 }
+
+/// The overdamped marches are charged by their settles (one budget substep per
+/// `SETTLES_PER_SUBSTEP`), also when they do not apply: a Table 3.1 rotor settling from 1 rad
+/// off its equilibrium (a march of a few dozen strides), and one under twice the peak torque,
+/// which slips (two turns of about 126 strides each).
+#[test]
+fn overdamped_marches_are_charged_by_their_settles() {
+    let m = motor_with(|p| p.tolerance = 1e-6);
+    let d = |load| super::Drive {
+        direction: 0.3,
+        applied_direction: 0.3,
+        stress: CALIBRATION_STRESS,
+        load,
+        locked: false,
+    };
+    for (load, slips) in [(0.0, false), (4.4e-18, true)] {
+        let d = d(load);
+        let mut state = MotorState::aligned(1.0);
+        state.onion_angle = m
+            .outputs(&state, &MotorInputs::fixed(0.3, CALIBRATION_STRESS))
+            .unwrap()
+            .onion_angle;
+        let mut run = super::StepRun::new(&state, 1.0);
+        run.y[2] = state.onion_angle;
+        assert!(m.advance_overdamped(&mut run, &d, 1.0));
+        assert_eq!(run.attempts, 1);
+        assert_eq!(run.limited, slips);
+        let least = if slips {
+            2 * 126 / super::spin::SETTLES_PER_SUBSTEP
+        } else {
+            2
+        };
+        assert!(run.extra_cost >= least, "{load:e}: {}", run.extra_cost);
+    }
+}
