@@ -244,12 +244,13 @@ impl Motor {
         dt: f64,
         d: &Drive,
         angles: &Angles,
+        bisections: &mut u32,
     ) -> Option<(Vector, f64, f64, Option<Angles>)> {
         if self.quasi_static() && !d.locked {
             match self.embedded_step(y, dt, d, angles) {
                 Some(Some((u, err, _))) if self.onion_snapped(y, &u) => {
                     return self
-                        .step_to_onion_snap(y, dt, d, angles)
+                        .step_to_onion_snap(y, dt, d, angles, bisections)
                         .map(|(u, err, taken)| (u, err, taken, None))
                         .or(Some((u, err, dt, None)));
                 }
@@ -285,13 +286,15 @@ impl Motor {
     /// torque. The substep ends at the prefix's end, the time of the state it returns: ending it
     /// at the first snapped length instead left a rotor turning at `omega` behind by `omega`
     /// times the bracket's width (up to 0.15 rad over a 2 ns step at 1e-11 N m). `None` if no
-    /// snap-free prefix is found.
+    /// snap-free prefix is found. `bisections` counts the embedded steps it takes (each a
+    /// substep's work).
     fn step_to_onion_snap(
         &self,
         y: &Vector,
         dt: f64,
         d: &Drive,
         angles: &Angles,
+        bisections: &mut u32,
     ) -> Option<(Vector, f64, f64)> {
         let (mut before, mut after) = (0.0, dt);
         let mut last_before: Option<(Vector, f64)> = None;
@@ -304,6 +307,7 @@ impl Motor {
                 break;
             }
             let mid = 0.5 * (before + after);
+            *bisections += 1;
             match self.embedded_step(y, mid, d, angles) {
                 Some(Some((u, err, _))) if !self.onion_snapped(y, &u) => {
                     before = mid;
@@ -481,7 +485,11 @@ impl Motor {
         let forced = dt_try <= dt_min * (1.0 + 1e-12);
         let angles = Self::angles_at(&run.y, d, run.angles.as_ref());
         run.angles = Some(angles);
-        match self.controlled_step(&run.y, dt_try, d, &angles) {
+        // A substep across a snap of the onion is charged its bisection's substeps too.
+        let mut bisections = 0;
+        let result = self.controlled_step(&run.y, dt_try, d, &angles, &mut bisections);
+        run.extra_cost = run.extra_cost.saturating_add(bisections);
+        match result {
             Some((y_new, err, taken, new_angles)) if err <= 1.0 || forced => {
                 if err > 1.0 {
                     run.limited = true;

@@ -1,7 +1,9 @@
 //! Long steps in the overdamped limit: settling a rotor and whole slipping turns.
 
 use super::angles::turned_back;
+use super::spin::SETTLES_PER_SUBSTEP;
 use super::{Drive, Motor, StepRun, SteppingSchedule, Vector};
+use std::cell::Cell;
 use std::f64::consts::PI;
 
 impl Motor {
@@ -37,7 +39,17 @@ impl Motor {
     /// end by `residual k delta / c`, below the tolerance for the residuals allowed). A fold that flips the force's sign (the onion jumps) turns the
     /// rotor back and the march goes on from the jumped state. Hand-written for the hot path:
     /// every loop is capped.
-    pub(super) fn settle_rotor(&self, y: &Vector, d: &Drive, available: f64) -> Option<Vector> {
+    pub(super) fn settle_rotor(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        available: f64,
+        settles: &Cell<u32>,
+    ) -> Option<Vector> {
+        let settle = |at: f64, from: f64| {
+            settles.set(settles.get().saturating_add(1));
+            self.landscape(at, d.direction, d.stress).settle(from)
+        };
         let (i, c) = (self.inertia, self.drag);
         if d.locked || !self.quasi_static() || c <= 0.0 {
             return None;
@@ -51,7 +63,7 @@ impl Motor {
         let force_scale = self.alignment_stiffness.abs() + d.load.abs();
         let continuous = 1e-6 * force_scale;
         let mut phi = y[0] + coast;
-        let mut psi = self.landscape(phi, d.direction, d.stress).settle(y[2]);
+        let mut psi = settle(phi, y[2]);
         // The initial layer: the speed has decayed by e^-20 after 20 I/c.
         let mut time = 20.0 * i / c;
         let mut travelled = 0.0;
@@ -75,7 +87,7 @@ impl Motor {
                 MAX_ROTOR_STRIDE
             };
             let next_phi = phi + dir * stride;
-            let next_psi = self.landscape(next_phi, d.direction, d.stress).settle(psi);
+            let next_psi = settle(next_phi, psi);
             let (next_force, _) = self.rotor_force(next_phi, next_psi, d);
             if dir * next_force > 0.0 {
                 time += 0.5 * c * stride * (1.0 / force.abs() + 1.0 / next_force.abs());
@@ -102,7 +114,7 @@ impl Motor {
                 {
                     x = 0.5 * (lo + hi);
                 }
-                let x_psi = self.landscape(x, d.direction, d.stress).settle(psi);
+                let x_psi = settle(x, psi);
                 let (fx, _) = self.rotor_force(x, x_psi, d);
                 root = x;
                 psi_root = x_psi;
@@ -136,7 +148,7 @@ impl Motor {
                     return None;
                 }
                 let end = root + (phi - root).signum() * residual;
-                let end_psi = self.landscape(end, d.direction, d.stress).settle(psi_root);
+                let end_psi = settle(end, psi_root);
                 let speed = (root - end) * rate;
                 return Some([end, speed, end_psi, 0.0]);
             }
@@ -161,7 +173,13 @@ impl Motor {
     /// 1e-7 rad, so the jump costs no accuracy. The first inertial correction to the turn time is
     /// `(I/c) [ln F]` over the turn, which vanishes on a periodic orbit; the next is of order
     /// `(I k / c^2)^2` ~ 1e-6.
-    pub(super) fn slip_turn(&self, phi0: f64, psi0: f64, d: &Drive) -> Option<(f64, f64)> {
+    pub(super) fn slip_turn(
+        &self,
+        phi0: f64,
+        psi0: f64,
+        d: &Drive,
+        settles: &Cell<u32>,
+    ) -> Option<(f64, f64)> {
         let c = self.drag;
         let (f0, _) = self.rotor_force(phi0, psi0, d);
         if f0 == 0.0 {
@@ -172,7 +190,10 @@ impl Motor {
         let (mut phi, mut psi, mut force) = (phi0, psi0, f0);
         let mut stride = MAX_ROTOR_STRIDE;
         let mut time = 0.0;
-        let settle = |at: f64, from: f64| self.landscape(at, d.direction, d.stress).settle(from);
+        let settle = |at: f64, from: f64| {
+            settles.set(settles.get().saturating_add(1));
+            self.landscape(at, d.direction, d.stress).settle(from)
+        };
         for _ in 0..MAX_SLIP_STRIDES {
             let left = dir * (target - phi);
             if left <= 0.0 {
@@ -220,6 +241,7 @@ impl Motor {
         y: &Vector,
         d: &Drive,
         available: f64,
+        settles: &Cell<u32>,
     ) -> Option<(f64, Vector)> {
         let (i, c) = (self.inertia, self.drag);
         if d.locked || !self.quasi_static() || c <= 0.0 {
@@ -230,11 +252,12 @@ impl Motor {
             return None;
         }
         let phi0 = y[0] + coast;
+        settles.set(settles.get().saturating_add(1));
         let psi0 = self.landscape(phi0, d.direction, d.stress).settle(y[2]);
-        let (first, psi1) = self.slip_turn(phi0, psi0, d)?;
+        let (first, psi1) = self.slip_turn(phi0, psi0, d, settles)?;
         let (f0, _) = self.rotor_force(phi0, psi0, d);
         let turn = f0.signum() * 2.0 * PI;
-        let (period, psi2) = self.slip_turn(phi0 + turn, psi1, d)?;
+        let (period, psi2) = self.slip_turn(phi0 + turn, psi1, d, settles)?;
         let onion_turn = psi2 - psi1;
         let winding = (onion_turn / (2.0 * PI)).round() * 2.0 * PI;
         if (onion_turn - winding).abs() > 1e-3 * self.params.tolerance || period <= 0.0 {
@@ -298,13 +321,23 @@ impl Motor {
         d: &Drive,
         segment_end: f64,
     ) -> bool {
-        if let Some(settled) = self.settle_rotor(&run.y, d, segment_end - run.t) {
+        // The marches are charged by their settles, also when they do not apply.
+        let settles = Cell::new(0u32);
+        let charge = |run: &mut StepRun| {
+            run.extra_cost = run
+                .extra_cost
+                .saturating_add(settles.get().div_ceil(SETTLES_PER_SUBSTEP));
+        };
+        if let Some(settled) = self.settle_rotor(&run.y, d, segment_end - run.t, &settles) {
+            charge(run);
             run.attempts = run.attempts.saturating_add(1);
             run.y = settled;
             run.t = segment_end;
             return true;
         }
-        if let Some((advanced, slipped)) = self.slip_turns(&run.y, d, segment_end - run.t) {
+        let slipped = self.slip_turns(&run.y, d, segment_end - run.t, &settles);
+        charge(run);
+        if let Some((advanced, slipped)) = slipped {
             // The turns' phase is only as good as their quadrature and the overdamped limit
             // (~1e-6 relative against resolved steps, see the tests): over thousands of turns
             // that is beyond the tolerance in angle, so flagged.

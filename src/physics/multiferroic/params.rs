@@ -63,12 +63,14 @@ pub struct MotorParams {
     /// natural frequency. Smaller is more accurate and costs more substeps.
     pub tolerance: f64,
     /// Most attempted substeps per call of [`Motor::step`](super::Motor::step) (a settled
-    /// interval counts as one). When a step needs more, the minimum substep grows so that the
+    /// interval counts as one, plus its march). When a step needs more, the minimum substep grows so that the
     /// budget still reaches the end of the step: accuracy degrades (reported in
     /// [`StepReport::accuracy_limited`](super::StepReport::accuracy_limited)) but the cost and
     /// stability do not. Substeps never span a schedule switch, so a step whose switches
     /// outnumber the budget and cannot be settled is refused. A substep of the Gilbert onion
-    /// counts as [`GILBERT_SUBSTEP_WEIGHT`](super::GILBERT_SUBSTEP_WEIGHT) (its cost).
+    /// counts as [`GILBERT_SUBSTEP_WEIGHT`](super::GILBERT_SUBSTEP_WEIGHT) (its cost); the
+    /// quasi-static onion's marches count one per four settles, and a substep cut at an onion
+    /// snap counts its bisection's substeps too.
     pub max_substeps: u32,
 }
 

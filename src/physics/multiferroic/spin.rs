@@ -138,7 +138,48 @@ impl OnionCycle {
     }
 }
 
+/// The tip speed (m/s) above which no material holds a bar spinning about its centre: the
+/// centrifugal stress peaks there at `rho v^2 / 2` for a tip speed `v`, so `v <= sqrt(2 sigma /
+/// rho)`, and the highest specific strength `sigma / rho` of any material (carbon-nanotube
+/// fibres, about 5e7 N m/kg) gives 1e4 m/s (nickel: about 300 m/s).
+pub const BURST_TIP_SPEED: f64 = 1e4;
+
 impl Motor {
+    /// The rotor speed (rad/s) at which the bar's tips reach [`BURST_TIP_SPEED`].
+    pub fn burst_speed(&self) -> f64 {
+        2.0 * BURST_TIP_SPEED / self.params.bar_length
+    }
+
+    /// `Err` when the load drives the rotor past [`Self::burst_speed`] within a step of `h`
+    /// seconds from `speed`, whatever the ring does: with drag `c`, `I w' = load + tau - c w` and
+    /// `|tau| <= tau_max` keep the speed along the load at least
+    /// `w0 e^(-h c/I) + (|load| - tau_max) / c (1 - e^(-h c/I))` (`w0 + (|load| - tau_max) h / I`
+    /// without drag). Such loads (up to 1e-6 N m is accepted, 1e11 times Table 3.1's torque)
+    /// spin a nano-bar at up to 1e17 rad/s, where the rotor leaves its bounds within a step and
+    /// no substep means anything.
+    pub(super) fn check_burst_speed(&self, speed: f64, load: f64, h: f64) -> Result<(), String> {
+        let (i, c) = (self.inertia, self.drag);
+        let force = load.abs() - self.torque_bound();
+        let along = speed * load.signum();
+        let bound = if c > 0.0 {
+            let approach = -(-h * c / i).exp_m1();
+            along * (1.0 - approach) + force / c * approach
+        } else {
+            along + force * h / i
+        };
+        let limit = self.burst_speed();
+        if bound <= limit {
+            return Ok(());
+        }
+        Err(format!(
+            "load_torque = {load:e} N m spins the rotor (now at {speed:e} rad/s) beyond {bound:.3e} \
+             rad/s within this step, past its burst speed {limit:.3e} rad/s (the bar's tips at \
+             {BURST_TIP_SPEED:e} m/s, beyond any material's strength; bar_length = {:e} m, \
+             fluid_viscosity = {:e} Pa s); lower the load or shorten the step",
+            self.params.bar_length, self.params.fluid_viscosity
+        ))
+    }
+
     /// A rotor driven by a load torque far beyond anything the ring can exert, turning many times
     /// within the segment. The ring's torque, periodic in the rotor angle along the onion's
     /// hysteresis cycle, is then a small perturbation `epsilon = tau_max / |load|` of a uniform
@@ -168,6 +209,9 @@ impl Motor {
     /// Resolving every turn took the whole substep budget here (20,000 substeps, 11-40 ms per
     /// 1 us step for loads of 1e-14 to 1e-10 N m on Table 3.1).
     pub(super) fn advance_spinning(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
+        if self.advance_drifting(run, d, segment_end) {
+            return true;
+        }
         let (i, c) = (self.inertia, self.drag);
         let load = d.load;
         if run.spin_failed || d.locked || !self.quasi_static() || load == 0.0 {
@@ -213,14 +257,19 @@ impl Motor {
             }
         }
         if run.spin_cycle.is_none() {
-            // The march costs SPIN_CYCLE_WEIGHT substeps of the budget, or is not started.
+            // The march costs at least SPIN_CYCLE_WEIGHT substeps of the budget, or is not
+            // started; it is charged by its settles.
             let spent = run.attempts.saturating_add(run.extra_cost);
             if spent.saturating_add(SPIN_CYCLE_WEIGHT) > self.params.max_substeps {
                 run.spin_failed = true;
                 return false;
             }
-            run.extra_cost = run.extra_cost.saturating_add(SPIN_CYCLE_WEIGHT);
-            match self.onion_cycle(&run.y, d, dir) {
+            let mut settles = 0;
+            let cycle = self.onion_cycle(&run.y, d, dir, &mut settles);
+            run.extra_cost = run
+                .extra_cost
+                .saturating_add(settles.div_ceil(SETTLES_PER_SUBSTEP));
+            match cycle {
                 Some(cycle) => run.spin_cycle = Some((d.direction, cycle)),
                 None => {
                     run.spin_failed = true;
@@ -247,6 +296,61 @@ impl Motor {
                 true
             }
         }
+    }
+
+    /// A segment over which the ring's torque cannot move the rotor by a tenth of the
+    /// tolerance: the rotor follows load and drag alone, `I phi'' = load - c phi'`, exactly, and
+    /// the quasi-static onion is settled along its path (strides of at most
+    /// [`MAX_DRIFT_STRIDE`], so that its snaps keep their memory rule). The ring's torque,
+    /// `|tau| <= tau_max`, moves the rotor from that motion by at most `tau_max g(h)` in angle
+    /// and `tau_max s(h)` in speed, with `g(h) = (h - I/c (1 - e^(-h c/I))) / c` and
+    /// `s(h) = (1 - e^(-h c/I)) / c` the response to a unit torque (`h^2 / 2I`, `h / I` without
+    /// drag). The angle's is held below `tolerance / 10`; the speed's, which does not add up
+    /// over segments (the angle's bound includes its effect), below the tolerance on the error
+    /// norm's scale, as an accepted substep's local error.
+    ///
+    /// This is the rotor of a fast schedule under a load far beyond the ring's torque: it turns
+    /// by a fraction of a turn between switches (the onion's cycle, two turns of strides, was
+    /// marched again after every switch, 20-30 us each), or barely turns where the ring's torque
+    /// is too weak to move it within the segment. Applies (else `false`) with a quasi-static
+    /// onion and a free rotor turning one way (`omega load >= 0`) by at most
+    /// [`MAX_DRIFT_TURN`].
+    fn advance_drifting(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
+        let (i, c) = (self.inertia, self.drag);
+        if d.locked || !self.quasi_static() || run.y[1] * d.load < 0.0 {
+            return false;
+        }
+        let h = segment_end - run.t;
+        let (coast, torque_speed, torque_angle) = if c > 0.0 {
+            let approach = -(-h * c / i).exp_m1();
+            (i / c * approach, approach / c, (h - i / c * approach) / c)
+        } else {
+            (h, h / i, 0.5 * h * h / i)
+        };
+        let tau = self.torque_bound();
+        let tol = self.params.tolerance;
+        if !(tau * torque_angle <= 0.1 * tol && tau * torque_speed <= tol * self.speed_scale) {
+            return false;
+        }
+        let turn = run.y[1] * coast + d.load * torque_angle;
+        if turn.is_nan() || turn.abs() > MAX_DRIFT_TURN {
+            return false;
+        }
+        let speed = run.y[1] * (1.0 - c * torque_speed) + d.load * torque_speed;
+        let strides = (turn.abs() / MAX_DRIFT_STRIDE).ceil().max(1.0);
+        let mut psi = run.y[2];
+        for k in 1..=strides as usize {
+            let phi = run.y[0] + turn * (k as f64 / strides);
+            psi = self.landscape(phi, d.direction, d.stress).settle(psi);
+        }
+        run.y = [run.y[0] + turn, speed, psi, 0.0];
+        run.t = segment_end;
+        run.settled = false;
+        run.attempts = run.attempts.saturating_add(1);
+        run.extra_cost = run
+            .extra_cost
+            .saturating_add((strides as u32).div_ceil(SETTLES_PER_SUBSTEP));
+        true
     }
 
     /// The state `y` advanced by `h` at constant drive on the averaged spin of `cycle`, with the
@@ -414,7 +518,7 @@ impl Motor {
     }
 
     /// An upper bound of eq. 3.3's torque on the bar (N m): `K a r (1/(r - a)^3 + 1/(r + a)^3)`.
-    fn torque_bound(&self) -> f64 {
+    pub(super) fn torque_bound(&self) -> f64 {
         let rb = &self.ring_bar;
         let (a, r) = (rb.bar_charge_radius, rb.wall_radius);
         (rb.coupling * a * r * ((r - a).powi(-3) + (r + a).powi(-3))).abs()
@@ -423,7 +527,13 @@ impl Motor {
     /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
     /// `psi0`: one turn to land on it, one to measure it (and sample its torque). `None` if it
     /// does not close.
-    fn onion_cycle(&self, y: &super::Vector, d: &Drive, dir: f64) -> Option<OnionCycle> {
+    fn onion_cycle(
+        &self,
+        y: &super::Vector,
+        d: &Drive,
+        dir: f64,
+        settles: &mut u32,
+    ) -> Option<OnionCycle> {
         // The landscape depends on psi - phi and psi - gamma (mod pi): turn rotor and onion back
         // by whole turns so that the march works near zero (the onion by its own turns too, for
         // a state whose onion is far from its rotor).
@@ -434,10 +544,17 @@ impl Motor {
             .landscape(phi0, d.direction, d.stress)
             .settle(y[2] - turns - onion_turns);
         let start = phi0 + dir * 2.0 * PI;
-        let (psi1, _) = self.march_onion(phi0, psi0, start, d, None)?;
+        *settles += 1;
+        let (psi1, _) = self.march_onion(phi0, psi0, start, d, None, settles)?;
         let mut samples = Vec::with_capacity(160);
-        let (psi2, work) =
-            self.march_onion(start, psi1, start + dir * 2.0 * PI, d, Some(&mut samples))?;
+        let (psi2, work) = self.march_onion(
+            start,
+            psi1,
+            start + dir * 2.0 * PI,
+            d,
+            Some(&mut samples),
+            settles,
+        )?;
         let winding = ((psi2 - psi1) / (2.0 * PI)).round();
         if (psi2 - psi1 - winding * 2.0 * PI).abs() > 1e-6 {
             return None;
@@ -477,8 +594,13 @@ impl Motor {
         to: f64,
         d: &Drive,
         mut samples: Option<&mut Vec<(f64, f64, f64)>>,
+        settles: &mut u32,
     ) -> Option<(f64, f64)> {
-        let settle = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).settle(onion);
+        let count = std::cell::Cell::new(0u32);
+        let settle = |at: f64, onion: f64| {
+            count.set(count.get() + 1);
+            self.landscape(at, d.direction, d.stress).settle(onion)
+        };
         let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
         let mut record = |at: f64, onion: f64| {
             if let Some(s) = samples.as_deref_mut() {
@@ -519,6 +641,7 @@ impl Motor {
             (phi, psi) = (next, settle(next, psi_hi));
             record(phi, psi);
         }
+        *settles = settles.saturating_add(count.get());
         (psi.is_finite() && work.is_finite()).then_some((psi, work))
     }
 }
@@ -526,15 +649,24 @@ impl Motor {
 /// The regime of [`Motor::advance_spinning`] from rest: `tau_max / |load|` at most this times the
 /// tolerance.
 const LOAD_DOMINATED: f64 = 0.5;
+/// Largest turn of a drifting rotor within a segment (rad; see [`Motor::advance_drifting`]): a
+/// quarter turn of onion settles, beyond which the averaged spin's cycle is the cheaper.
+const MAX_DRIFT_TURN: f64 = 0.5 * PI;
+/// Largest rotor stride between the drifting onion's settles (rad), as the rotor march's.
+const MAX_DRIFT_STRIDE: f64 = 0.05;
 /// The corrected regime of [`Motor::advance_spinning`]: `tau_max / |load|` at most this, and at
 /// least this many turns within the segment (fewer cost less resolved than the cycle's march).
 const MAX_SPIN_EPSILON: f64 = 0.05;
 const MIN_SPIN_TURNS: f64 = 2.0;
 /// The onion's cycle ([`Motor::onion_cycle`], two turns of 126 strides with their settles, about
-/// 25 us in release) counts as this many quasi-static substeps (about 0.32 us each) in
+/// 25 us in release) counts as at least this many quasi-static substeps (about 0.32 us each) in
 /// `max_substeps`, so that the budget bounds a step that marches it again at every switch of a
 /// fast schedule (at 40, such steps took up to 9.6 ms with the budget at its declared maximum).
 pub(super) const SPIN_CYCLE_WEIGHT: u32 = 80;
+/// Settles of the quasi-static onion per substep of the budget: the cycle's march of about 320
+/// settles costs about 80 substeps (about 0.08 us a settle against 0.32 us a substep). Marches
+/// (the cycle's, the drifting onion's, the overdamped rotor's) are charged by their settles.
+pub(super) const SETTLES_PER_SUBSTEP: u32 = 4;
 /// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
 const CYCLE_STRIDE: f64 = 0.05;
 const SNAP_PLACEMENT: f64 = 1e-10;

@@ -145,6 +145,9 @@ impl Motor {
                 "communication step must be positive and at most {MAX_STEP} s, got {h}"
             ));
         }
+        if !inputs.rotor_locked {
+            self.check_burst_speed(state.rotor_speed, inputs.load_torque, h)?;
+        }
         let budget = self.params.max_substeps;
         let mut run = StepRun::new(state, h);
         // Built on the first pass that follows the branch: a Gilbert step whose onion never
