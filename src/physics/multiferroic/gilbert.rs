@@ -290,8 +290,9 @@ mod tests {
                     };
                     let y: Vector = [0.0, 0.0, start, tilt];
                     let settled = land.settle(y[2]);
+                    let mut rim = f64::INFINITY;
                     let trapped = m
-                        .trapped_ringing(&y, &d, settled)
+                        .trapped_ringing(&y, &d, settled, Some((&mut rim, 0.0)))
                         .map(|t| (t.amplitude, t.rate));
                     let mut reach: f64 = 0.0;
                     let end = rk4(&m, &d, y, span, h, |z| {

@@ -40,6 +40,9 @@ pub(super) struct StepRun {
     /// The Gilbert onion's segment (its end) over which the relaxed onion follows the
     /// quasi-static branch (see [`Motor::relaxed_onion`]).
     pub(super) following: f64,
+    /// The lowest rim of the Gilbert onion's well found in the segment ending at the first value
+    /// (J above its minimum; see [`Motor::trapped_ringing`]).
+    pub(super) rim_barrier: (f64, f64),
 }
 
 impl StepRun {
@@ -72,6 +75,7 @@ impl StepRun {
             angles: None,
             settled: false,
             following: f64::NAN,
+            rim_barrier: (f64::NAN, f64::INFINITY),
         }
     }
 
@@ -259,7 +263,10 @@ impl Motor {
             // The check settles the onion (a march as in a quasi-static substep): it counts as
             // one substep in the budget.
             run.extra_cost = run.extra_cost.saturating_add(1);
-            match self.relaxed_onion(&run.y, d) {
+            if run.rim_barrier.0 != segment_end {
+                run.rim_barrier = (segment_end, f64::INFINITY);
+            }
+            match self.relaxed_onion(&run.y, d, &mut run.rim_barrier.1) {
                 // The averaged ringing's impulse on the rotor.
                 Some(kick) => run.y[1] += kick,
                 None => return false,
@@ -295,7 +302,13 @@ impl Motor {
     /// has settled. A rotor that turns so fast that the lag exceeds [`MAX_FOLLOWED_LAG`], or an
     /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
     /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
-    pub(super) fn relaxed_onion(&self, y: &Vector, d: &Drive) -> Option<f64> {
+    /// `rim_barrier` is the lowest rim found so far in this segment (see [`Self::trapped_ringing`]).
+    pub(super) fn relaxed_onion(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        rim_barrier: &mut f64,
+    ) -> Option<f64> {
         let settled = self.settle(y, d);
         if self.onion_relaxes_fast() {
             let lag_time = self.onion_relaxation_time();
@@ -308,7 +321,7 @@ impl Motor {
                 return Some(0.0);
             }
         }
-        self.averaged_ringing(y, d, settled)
+        self.averaged_ringing(y, d, settled, rim_barrier)
     }
 
     /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
@@ -345,15 +358,24 @@ impl Motor {
     /// This replaces resolving the ringing (about `1/alpha` precession periods per decay time)
     /// once it is trapped, at the cost of the onion's outputs: it is reported at the centre of its
     /// ringing, the minimum, not at the ringing's phase.
-    pub(super) fn averaged_ringing(&self, y: &Vector, d: &Drive, settled: f64) -> Option<f64> {
-        let trap = self.trapped_ringing(y, d, settled)?;
+    pub(super) fn averaged_ringing(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        settled: f64,
+        rim_barrier: &mut f64,
+    ) -> Option<f64> {
+        let limit = 0.1 * self.params.tolerance * self.drag;
+        let k_bar = self.ring_bar.stiffness(settled - y[0]);
+        // The rims are looked for only where ringing anywhere in the turn would pass.
+        let turn = 2.0 * std::f64::consts::PI;
+        let widest = turn * (k_bar.abs() + self.ring_bar_slope_bound * turn) * RIM_SLOWDOWN;
+        let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, limit / widest)))?;
         let (amplitude, rate) = (trap.amplitude, trap.rate);
         let speed = if d.locked { 0.0 } else { y[1].abs() };
-        let limit = 0.1 * self.params.tolerance * self.drag;
         if !(speed * self.drag <= limit * rate) {
             return None;
         }
-        let k_bar = self.ring_bar.stiffness(settled - y[0]);
         if trap.near {
             let (g, alpha, k) = (self.llg_rate, self.params.gilbert_damping, trap.curvature);
             let second = (self.ring_bar_slope_bound + 2.0 * k_bar.abs() * trap.slope_bound / k)
@@ -375,7 +397,19 @@ impl Motor {
 
     /// The Gilbert onion's ringing about `settled` when it is trapped in that minimum's well and
     /// relaxes within a tenth of the rotor's relaxation time (see [`Self::averaged_ringing`]).
-    pub(super) fn trapped_ringing(&self, y: &Vector, d: &Drive, settled: f64) -> Option<Trap> {
+    ///
+    /// Out of the window about the minimum, the rims are looked for when `rims` is given and the
+    /// decay rate at the minimum is at least its second value (1/s): its first is the lowest rim
+    /// found earlier in the segment (J above the minimum; infinite if none), which an onion at or
+    /// above it (less 2%) skips the search for, and which the search updates. (With the rotor
+    /// slow enough for the rim path, the well barely changes within a segment.)
+    pub(super) fn trapped_ringing(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        settled: f64,
+        rims: Option<(&mut f64, f64)>,
+    ) -> Option<Trap> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let k = land.curvature(settled);
         let m = land.third_derivative_bound();
@@ -403,8 +437,13 @@ impl Motor {
         if near < window {
             return Some(trap(near, rate, true));
         }
+        let lowest = match rims {
+            Some((lowest, least_rate)) if rate >= least_rate && excess < 0.98 * *lowest => lowest,
+            _ => return None,
+        };
         let (below, above) = land.well_rims(settled, 0.5 * window);
         let barrier = land.energy(below).min(land.energy(above)) - land.energy(settled);
+        *lowest = barrier;
         (below < y[2] && y[2] < above && excess < 0.99 * barrier).then(|| {
             let reach = (above - settled).max(settled - below);
             trap(reach, rate / RIM_SLOWDOWN, false)
