@@ -41,8 +41,10 @@ pub(super) struct StepRun {
     /// quasi-static branch (see [`Motor::relaxed_onion`]).
     pub(super) following: f64,
     /// The lowest rim of the Gilbert onion's well found in the segment ending at the first value
-    /// (J above its minimum; see [`Motor::trapped_ringing`]).
+    /// (J above its minimum, infinite before the search; see [`Motor::trapped_ringing`]).
     pub(super) rim_barrier: (f64, f64),
+    /// The attempt from which the Gilbert onion's averaged ringing is tried next.
+    pub(super) average_check_at: u32,
 }
 
 impl StepRun {
@@ -76,6 +78,7 @@ impl StepRun {
             settled: false,
             following: f64::NAN,
             rim_barrier: (f64::NAN, f64::INFINITY),
+            average_check_at: 0,
         }
     }
 
@@ -266,7 +269,14 @@ impl Motor {
             if run.rim_barrier.0 != segment_end {
                 run.rim_barrier = (segment_end, f64::INFINITY);
             }
-            match self.relaxed_onion(&run.y, d, &mut run.rim_barrier.1) {
+            // The averaging's check costs about half a Gilbert substep: it is tried at attempts
+            // spaced by an eighth of those made (the ringing decays geometrically in time).
+            let average = run.attempts >= run.average_check_at;
+            if average {
+                run.average_check_at = run.attempts + 1 + run.attempts / 8;
+            }
+            let rims = average.then_some(&mut run.rim_barrier.1);
+            match self.relaxed_onion(&run.y, d, rims) {
                 // The averaged ringing's impulse on the rotor.
                 Some(kick) => run.y[1] += kick,
                 None => return false,
@@ -302,12 +312,13 @@ impl Motor {
     /// has settled. A rotor that turns so fast that the lag exceeds [`MAX_FOLLOWED_LAG`], or an
     /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
     /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
-    /// `rim_barrier` is the lowest rim found so far in this segment (see [`Self::trapped_ringing`]).
+    /// The averaged ringing is tried when `rim_barrier` is given, the lowest rim found in this
+    /// segment (see [`Self::trapped_ringing`]).
     pub(super) fn relaxed_onion(
         &self,
         y: &Vector,
         d: &Drive,
-        rim_barrier: &mut f64,
+        rim_barrier: Option<&mut f64>,
     ) -> Option<f64> {
         let settled = self.settle(y, d);
         if self.onion_relaxes_fast() {
@@ -321,7 +332,7 @@ impl Motor {
                 return Some(0.0);
             }
         }
-        self.averaged_ringing(y, d, settled, rim_barrier)
+        self.averaged_ringing(y, d, settled, rim_barrier?)
     }
 
     /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
@@ -367,13 +378,16 @@ impl Motor {
     ) -> Option<f64> {
         let limit = 0.1 * self.params.tolerance * self.drag;
         let k_bar = self.ring_bar.stiffness(settled - y[0]);
-        // The rims are looked for only where ringing anywhere in the turn would pass.
+        // The rims are looked for only where ringing anywhere in the turn, and the rotor's turn
+        // over its decay, would pass.
         let turn = 2.0 * std::f64::consts::PI;
-        let widest = turn * (k_bar.abs() + self.ring_bar_slope_bound * turn) * RIM_SLOWDOWN;
-        let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, limit / widest)))?;
-        let (amplitude, rate) = (trap.amplitude, trap.rate);
+        let widest = turn * (k_bar.abs() + self.ring_bar_slope_bound * turn);
         let speed = if d.locked { 0.0 } else { y[1].abs() };
-        if !(speed * self.drag <= limit * rate) {
+        let least_rate = (widest / limit).max(speed * self.drag / limit);
+        let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, least_rate)))?;
+        let (amplitude, rate) = (trap.amplitude, trap.rate);
+        // (A NaN fails every bound below.)
+        if speed * self.drag > limit * rate {
             return None;
         }
         if trap.near {
@@ -398,11 +412,11 @@ impl Motor {
     /// The Gilbert onion's ringing about `settled` when it is trapped in that minimum's well and
     /// relaxes within a tenth of the rotor's relaxation time (see [`Self::averaged_ringing`]).
     ///
-    /// Out of the window about the minimum, the rims are looked for when `rims` is given and the
-    /// decay rate at the minimum is at least its second value (1/s): its first is the lowest rim
-    /// found earlier in the segment (J above the minimum; infinite if none), which an onion at or
-    /// above it (less 2%) skips the search for, and which the search updates. (With the rotor
-    /// slow enough for the rim path, the well barely changes within a segment.)
+    /// Out of the window about the minimum, the rims are looked for when `rims` is given, its
+    /// first value is infinite (no search yet in this segment; the search, a march over the well
+    /// both ways, sets it to the lowest rim's height above the minimum) and the decay rate that
+    /// the ringing out to the rims is held to ([`RIM_SLOWDOWN`] times slower than at the minimum)
+    /// is at least its second value (1/s).
     pub(super) fn trapped_ringing(
         &self,
         y: &Vector,
@@ -438,7 +452,11 @@ impl Motor {
             return Some(trap(near, rate, true));
         }
         let lowest = match rims {
-            Some((lowest, least_rate)) if rate >= least_rate && excess < 0.98 * *lowest => lowest,
+            Some((lowest, least_rate))
+                if rate >= least_rate * RIM_SLOWDOWN && lowest.is_infinite() =>
+            {
+                lowest
+            }
             _ => return None,
         };
         let (below, above) = land.well_rims(settled, 0.5 * window);
