@@ -191,6 +191,26 @@ impl Landscape<'_> {
         x
     }
 
+    /// The maxima of eq. 3.4 on either side of the minimum `minimum` (rad), the rims of its well
+    /// (below then above it): the downhill settle of the reversed landscape, started `inside` rad
+    /// from the minimum on either side, where the slope must already rise away from it. With a
+    /// single well per turn both are the same maximum, a turn apart.
+    pub(super) fn well_rims(&self, minimum: f64, inside: f64) -> (f64, f64) {
+        let ring_bar = RingBar {
+            coupling: -self.ring_bar.coupling,
+            ..*self.ring_bar
+        };
+        let reversed = Landscape {
+            ring_bar: &ring_bar,
+            magnetoelastic: -self.magnetoelastic,
+            ..*self
+        };
+        (
+            reversed.settle(minimum - inside),
+            reversed.settle(minimum + inside),
+        )
+    }
+
     /// The minimum between `a` and `b`, where the gradient changes sign from downhill to uphill.
     pub(super) fn refine_minimum(&self, a: f64, b: f64) -> f64 {
         let x = self.angles(0.5 * (a + b));
