@@ -2,7 +2,7 @@
 //! (`cargo bench --bench knitted_table_space`): `stitches_per_row`, `rows`, `row_strand_length`,
 //! `strand_thickness` and `shape_segments` drawn log-uniform over their declared ranges as
 //! `benches/worst_case.rs` draws them (a quarter of the thicknesses zero, the others across 15
-//! decades below the top; `shape_segments` up to `KNITTED_MAX_SEGMENTS`, 200), until
+//! decades below the top; `shape_segments` up to `KNITTED_MAX_SEGMENTS`, the declared 98), until
 //! `KNITTED_SLEEVES` (2,000) sleeves build. Times
 //! `KnittedSleeve::new` in thread CPU time, refusals included, and prints the median, p99 and
 //! maximum, the share over 10 ms and the slowest sleeves with their parameters.
@@ -48,7 +48,7 @@ fn main() {
     let max_segments: f64 = std::env::var("KNITTED_MAX_SEGMENTS")
         .ok()
         .and_then(|s| s.parse().ok())
-        .unwrap_or(200.0);
+        .unwrap_or(98.0);
     let mut rng = Rng(0x6b6e_6974);
     let mut cases = Vec::new();
     let mut built = 0;
