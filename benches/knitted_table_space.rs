@@ -2,7 +2,8 @@
 //! (`cargo bench --bench knitted_table_space`): `stitches_per_row`, `rows`, `row_strand_length`,
 //! `strand_thickness` and `shape_segments` drawn log-uniform over their declared ranges as
 //! `benches/worst_case.rs` draws them (a quarter of the thicknesses zero, the others across 15
-//! decades below the top), until `KNITTED_SLEEVES` (2,000) sleeves build. Times
+//! decades below the top; `shape_segments` up to `KNITTED_MAX_SEGMENTS`, the declared 98), until
+//! `KNITTED_SLEEVES` (2,000) sleeves build. Times
 //! `KnittedSleeve::new` in thread CPU time, refusals included, and prints the median, p99 and
 //! maximum, the share over 10 ms and the slowest sleeves with their parameters.
 
@@ -44,6 +45,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(2000);
+    let max_segments: f64 = std::env::var("KNITTED_MAX_SEGMENTS")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(98.0);
     let mut rng = Rng(0x6b6e_6974);
     let mut cases = Vec::new();
     let mut built = 0;
@@ -59,7 +64,7 @@ fn main() {
             },
             bladder_outer_radius: 0.0,
         };
-        let segments = rng.log_uniform(2.0, 200.5).floor() as usize;
+        let segments = rng.log_uniform(2.0, max_segments + 0.5).floor() as usize;
         let start = thread_cpu();
         let sleeve = KnittedSleeve::new(params, ShapeKind::NonCylindrical { segments });
         let seconds = thread_cpu() - start;
@@ -112,15 +117,17 @@ fn main() {
         1e3 * refused_max
     );
     cases.sort_by(|a, b| b.seconds.total_cmp(&a.seconds));
-    println!("slowest (ms, built, m, n, segments, 2 pi r_min / S_row):");
+    println!("slowest (ms, built, m, n, S_row, thickness, segments, 2 pi r_min / S_row):");
     for c in cases.iter().take(12) {
         let p = c.params;
         println!(
-            "{:8.2} {} m {:.4e} n {:.2} segments {} ratio {:.4e}",
+            "{:8.2} {} m {:e} n {:e} S_row {:e} t {:e} segments {} ratio {:.4e}",
             1e3 * c.seconds,
             c.built,
             p.stitches_per_row,
             p.rows,
+            p.row_strand_length,
+            p.strand_thickness,
             c.segments,
             4.0 * p.stitches_per_row * p.strand_thickness / p.row_strand_length
         );

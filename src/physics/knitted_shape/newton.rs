@@ -157,7 +157,11 @@ impl Solver {
             // radius and the slant's concavity (eq. 1.17) small, would be sent back below the
             // floor. The Hessian is then shifted until the reduced one is negative definite
             // (bordered inertia one), as in the robust solve, so the step ascends.
-            if shift && pos + usize::from(gy < 0.0) != 1 {
+            if shift
+                && pos + usize::from(gy < 0.0) != 1
+                && !(self.is_mirror_symmetric(r_ceiling)
+                    && self.symmetric_ascents(lambda) == Some(1))
+            {
                 (gx, gy) = self.shifted_products(lambda, s_row, &mut last_shift)?;
             }
             // Newton step on (r, lambda): H dr - g dlambda = -R, g . dr = target - L.
