@@ -116,7 +116,7 @@ fn configurations() -> Vec<Config> {
         "tubular",
         &[("shape_model", 1.0)],
     ));
-    for segments in [12, 24, 49, 98, 196] {
+    for segments in [12, 24, 49, 98] {
         c.push(config(
             "KnittedMuscle",
             "shape_segments",
