@@ -319,12 +319,26 @@ impl<S: SleeveGeometry> Bladder<S> {
             return check_state(state, length);
         }
         // Free bladder: solve P_eff(x) = 0 for the outer diameter x below the sleeve's.
-        let x_root = self.free_outer_diameter(pressure, length, x.v)?;
-        let free = self
-            .kernel(pressure, Dual::var_l(length), Dual::var_x(x_root))
-            .ok_or_else(|| self.domain_error(length))?;
+        let free = self.free_kernel(pressure, length, x.v, &contact)?;
         let state = self.free_state(pressure, length, &free, contact.threshold);
         check_state(state, length)
+    }
+
+    /// The wall's kernel at the free bladder's outer diameter (eq. 2.18), seeded in `L` and `x`.
+    fn free_kernel(
+        &self,
+        pressure: f64,
+        length: f64,
+        x_contact: f64,
+        contact: &Kernel,
+    ) -> Result<Kernel, String> {
+        let (x_root, at_root) = self.free_outer_diameter(pressure, length, x_contact, contact)?;
+        match at_root {
+            Some(k) => Ok(k),
+            None => self
+                .kernel(pressure, Dual::var_l(length), Dual::var_x(x_root))
+                .ok_or_else(|| self.domain_error(length)),
+        }
     }
 
     fn check_length(&self, length: f64) -> Result<(), String> {
@@ -377,6 +391,8 @@ impl<S: SleeveGeometry> Bladder<S> {
     /// The wall at muscle length `l` and bladder outer diameter `x`.
     #[inline]
     fn kernel<T: KernelScalar>(&self, pressure: f64, l: T, x: T) -> Option<Kernel<T>> {
+        #[cfg(test)]
+        KERNELS.with(|n| n.set(n.get() + 1));
         match self.wall {
             Wall::Exact(_) => self.exact_kernel(pressure, l, x),
             Wall::Layers(_) => self.layered_kernel(pressure, l, x, false),
@@ -459,6 +475,12 @@ impl<S: SleeveGeometry> Bladder<S> {
             inner,
         })
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Wall evaluations on this thread, for the tests that bound a solve's count.
+    static KERNELS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
 }
 
 fn finite_or(v: f64, what: &str, length: f64) -> Result<f64, String> {

@@ -58,10 +58,7 @@ impl<S: SleeveGeometry> Bladder<S> {
                 },
             ));
         }
-        let x_root = self.free_outer_diameter(pressure, length, x.v)?;
-        let k = self
-            .kernel(pressure, Dual::var_l(length), Dual::var_x(x_root))
-            .ok_or_else(|| self.domain_error(length))?;
+        let k = self.free_kernel(pressure, length, x.v, &contact)?;
         let area = self.fluid_area(k.inner.l2_sq);
         let (dx_dp, dx_dl) = if k.p_eff.dx != 0.0 {
             (-k.a.v / k.p_eff.dx, -k.p_eff.dl / k.p_eff.dx)

@@ -65,7 +65,7 @@ impl<S: SleeveGeometry> Bladder<S> {
                 strand_stiffness: strand,
             }
         } else {
-            let root = self.free_outer_diameter(pressure, length, x.v)?;
+            let (root, _) = self.free_outer_diameter(pressure, length, x.v, &contact)?;
             let x2 = HyperDual::seed(root, [0.0, 1.0], [0.0; 3]);
             let k = self
                 .kernel(pressure, l2, x2)

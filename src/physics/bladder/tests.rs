@@ -703,3 +703,65 @@ proptest! {
         let _ = bl.free_contact_is_stable(l);
     }
 }
+
+/// The free bladder's outer diameter (eq. 2.18 through the wall) is the root a plain bisection
+/// of the sign of `P_eff(x)` finds between collapse and the sleeve, for every wall, from just
+/// below the contact threshold (where the first Newton step from the sleeve's diameter brackets
+/// it) to a deep vacuum; the kernel it returns is the wall's at that diameter, and just below
+/// the threshold that one step is the root (one wall evaluation besides the contact test).
+#[test]
+fn free_root_is_the_bisected_root_of_eq_2_18() {
+    let geometry = muscle(A, 1);
+    let walls = [
+        Wall::Exact(16),
+        Wall::Layers(7),
+        Wall::DissertationLayers(16),
+        Wall::DissertationContinuum(16),
+    ];
+    let kernels = || KERNELS.with(|n| n.get());
+    for wall in walls {
+        let bl = Bladder::with_wall(*geometry.sleeve(), geometry.tube, wall).unwrap();
+        for f in [0.6, 0.75, 0.9] {
+            let l = f * listed_length(A);
+            let threshold = bl.threshold_pressure(l).unwrap();
+            let below = [1e-12, 1e-6, 1e-2, 0.5, 2.0].map(|d| threshold - d * threshold.abs());
+            for p in below.into_iter().chain([0.0, -1e3, -3e4]) {
+                if p >= threshold {
+                    continue;
+                }
+                let (x, contact) = bl.contact_point(p, l).unwrap();
+                let before = kernels();
+                let Ok((root, at_root)) = bl.free_outer_diameter(p, l, x.v, &contact) else {
+                    continue; // a vacuum the bladder cannot hold
+                };
+                let cost = kernels() - before;
+                // Bisection to adjacent floats: collapsed (no kernel) or P_eff >= 0 below.
+                let collapsed_side = |x: f64| {
+                    bl.kernel(p, Dual::var_l(l), Dual::var_x(x))
+                        .is_none_or(|k| k.p_eff.v >= 0.0)
+                };
+                let (mut lo, mut hi) = (0.0, x.v);
+                loop {
+                    let mid = 0.5 * (lo + hi);
+                    if mid <= lo || mid >= hi {
+                        break;
+                    }
+                    if collapsed_side(mid) {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                assert_relative_eq!(root, lo, max_relative = 1e-12);
+                let k = at_root.expect("converged at the root");
+                let fresh = bl.kernel(p, Dual::var_l(l), Dual::var_x(root)).unwrap();
+                let parts =
+                    |k: &Kernel| [k.p_eff.v, k.p_eff.dl, k.p_eff.dx, k.elastic.v, k.elastic.dl];
+                assert_eq!(parts(&k), parts(&fresh));
+                if p > threshold - 1e-6 * threshold.abs() {
+                    assert!(cost <= 1, "{wall:?} {f} {p}: {cost} wall evaluations");
+                }
+            }
+        }
+    }
+}
