@@ -9,29 +9,13 @@
 
 #[path = "cpu_clock.rs"]
 mod cpu_clock;
+#[path = "../tests/common/rng.rs"]
+#[allow(dead_code)]
+mod rng;
 
 use actuator_fmus::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
 use cpu_clock::thread_cpu;
-
-/// SplitMix64: reproducible draws.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn log_uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        (lo.ln() + self.uniform() * (hi.ln() - lo.ln()))
-            .exp()
-            .clamp(lo, hi)
-    }
-}
+use rng::Rng;
 
 struct Case {
     params: KnittedParams,

@@ -22,11 +22,14 @@
 mod common;
 #[path = "cpu_clock.rs"]
 mod cpu_clock;
+#[path = "../tests/common/rng.rs"]
+mod rng;
 
 use actuator_fmus::export::REGISTRY;
 use actuator_fmus::variables::{Causality, ModelInfo, Start, VarType};
 use common::*;
 use cpu_clock::thread_cpu;
+use rng::Rng;
 use std::ffi::c_int;
 use std::time::Instant;
 
@@ -36,21 +39,6 @@ const SLOW_REFUSAL: f64 = 1e-4;
 /// The most random draws per point to initialize (see `main`).
 const MAX_DRAWS_PER_POINT: usize = 200;
 const DECADES: f64 = 15.0;
-
-/// SplitMix64: reproducible draws.
-struct Rng(u64);
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-}
 
 /// A settable variable: (value reference, type, lower and upper bound, start).
 #[derive(Clone, Copy)]
@@ -97,25 +85,19 @@ fn knobs(info: &ModelInfo) -> Vec<Knob> {
 
 /// Log-uniform across decades where the range allows, through zero by magnitude.
 fn draw(rng: &mut Rng, k: &Knob) -> f64 {
-    let log_uniform = |rng: &mut Rng, lo: f64, hi: f64| {
-        (lo.ln() + rng.uniform() * (hi.ln() - lo.ln()))
-            .exp()
-            .clamp(lo, hi)
-    };
     let x = match k.kind {
         VarType::Boolean => (rng.next() & 1) as f64,
         // A Real whose range starts at 0 is often an effect switched off there (no bag, no
         // connector): a quarter of the draws take it.
-        VarType::Real if k.lo == 0.0 && k.hi > 0.0 && rng.uniform() < 0.25 => 0.0,
-        _ if k.lo > 0.0 && k.hi / k.lo > 10.0 => log_uniform(
-            rng,
+        VarType::Real if k.lo == 0.0 && k.hi > 0.0 && rng.chance(0.25) => 0.0,
+        _ if k.lo > 0.0 && k.hi / k.lo > 10.0 => rng.log_uniform(
             k.lo,
             k.hi + 0.5 * (k.kind == VarType::Integer) as i32 as f64,
         ),
         _ if k.lo <= 0.0 && k.hi > 0.0 && k.hi - k.lo > 100.0 => {
-            let negative = k.lo < 0.0 && rng.uniform() < 0.5;
+            let negative = k.lo < 0.0 && rng.chance(0.5);
             let top = if negative { -k.lo } else { k.hi };
-            let m = log_uniform(rng, top * 10f64.powf(-DECADES), top);
+            let m = rng.log_uniform(top * 10f64.powf(-DECADES), top);
             if negative {
                 -m
             } else {

@@ -9,6 +9,9 @@
 //! Prints how many cases ran (docs/compatibility.md quotes the count).
 
 use crate::common;
+#[path = "../common/rng.rs"]
+mod rng;
+use rng::Rng;
 
 use common::*;
 use std::collections::BTreeMap;
@@ -102,35 +105,9 @@ fn parse(xml: &str) -> Description {
     d
 }
 
-/// SplitMix64: reproducible draws without a dependency.
-struct Rng(u64);
-
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn uniform(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn chance(&mut self, p: f64) -> bool {
-        self.uniform() < p
-    }
-}
-
 /// Smallest magnitude drawn from a range that reaches zero: magnitudes are log-uniform over
 /// `DECADES` decades below the largest bound.
 const DECADES: f64 = 15.0;
-
-/// Log-uniform in [lo, hi], 0 < lo < hi.
-fn log_uniform(rng: &mut Rng, lo: f64, hi: f64) -> f64 {
-    (lo.ln() + rng.uniform() * (hi.ln() - lo.ln()))
-        .exp()
-        .clamp(lo, hi)
-}
 
 /// Knobs that buy accuracy with time (table nodes, wall layers, substep budget): random cases draw
 /// them log-uniformly up to these caps; their declared maxima run in the bound-alone cases.
@@ -162,9 +139,9 @@ fn draw(rng: &mut Rng, v: &Var) -> f64 {
             hi
         }
     } else if lo > 0.0 && hi / lo > 100.0 {
-        log_uniform(rng, lo, hi)
+        rng.log_uniform(lo, hi)
     } else if v.kind == Kind::Integer && lo > 0.0 {
-        log_uniform(rng, lo, hi + 0.5)
+        rng.log_uniform(lo, hi + 0.5)
     } else if v.kind == Kind::Integer && hi - lo <= 100.0 {
         (lo + rng.uniform() * (hi - lo + 1.0)).floor()
     } else if lo <= 0.0 && hi > 0.0 {
@@ -175,7 +152,7 @@ fn draw(rng: &mut Rng, v: &Var) -> f64 {
         if rng.chance(0.05) {
             0.0
         } else {
-            let m = log_uniform(rng, top * 10f64.powf(-DECADES), top);
+            let m = rng.log_uniform(top * 10f64.powf(-DECADES), top);
             if negative {
                 -m
             } else {
