@@ -34,6 +34,7 @@
 
 pub mod angles;
 pub mod branch;
+mod drift;
 pub mod drive;
 mod gilbert;
 mod integrator;
