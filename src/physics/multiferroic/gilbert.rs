@@ -104,7 +104,7 @@ fn pade_phi3_apply(j: &[[f64; 4]; 4], dt: f64, v: &Vector, unit: f64) -> Option<
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::{motor_with, schedule};
+    use super::super::tests::{motor_with, rk4_step, schedule};
     use super::super::{Drive, MotorInputs, MotorState, OnionModel, Vector};
     use super::pade_phi3_apply;
 
@@ -241,13 +241,7 @@ mod tests {
         let rate = |z: &Vector| m.rhs_jacobian(z, d, h).0;
         let mut z = y;
         for _ in 0..(span / h).ceil() as usize {
-            let k1 = rate(&z);
-            let k2 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k1[i]));
-            let k3 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k2[i]));
-            let k4 = rate(&std::array::from_fn(|i| z[i] + h * k3[i]));
-            z = std::array::from_fn(|i| {
-                z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            });
+            z = rk4_step(&rate, &z, h);
             visit(&z);
         }
         z
@@ -477,13 +471,7 @@ mod tests {
             let h = dt / n as f64;
             let mut truth = y;
             for _ in 0..n {
-                let k1 = rate(&truth);
-                let k2 = rate(&std::array::from_fn(|i| truth[i] + 0.5 * h * k1[i]));
-                let k3 = rate(&std::array::from_fn(|i| truth[i] + 0.5 * h * k2[i]));
-                let k4 = rate(&std::array::from_fn(|i| truth[i] + h * k3[i]));
-                truth = std::array::from_fn(|i| {
-                    truth[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                });
+                truth = rk4_step(&rate, &truth, h);
             }
             let euler = m.exponential_step(&y, dt, &d).unwrap();
             let (pair, estimate) = m.gilbert_embedded_step(&y, dt, &d).unwrap();

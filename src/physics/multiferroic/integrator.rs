@@ -579,7 +579,7 @@ const SEGMENT_BUDGET_SHARE: u32 = 16;
 
 #[cfg(test)]
 mod tests {
-    use super::super::tests::motor_with;
+    use super::super::tests::{motor_with, rk4_step};
     use super::super::{Drive, OnionModel, Vector};
 
     /// `y' = f + J (y - y0)` over `dt` by RK4 in `n` steps: the substep's linear system,
@@ -591,13 +591,7 @@ mod tests {
         let h = dt / n as f64;
         let mut z = [0.0; 4];
         for _ in 0..n {
-            let k1 = rate(&z);
-            let k2 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k1[i]));
-            let k3 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k2[i]));
-            let k4 = rate(&std::array::from_fn(|i| z[i] + h * k3[i]));
-            z = std::array::from_fn(|i| {
-                z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            });
+            z = rk4_step(&rate, &z, h);
         }
         z
     }

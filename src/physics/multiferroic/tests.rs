@@ -1142,11 +1142,7 @@ fn gilbert_rk4_reference(m: &Motor, until: f64) -> [f64; 4] {
     while t < until {
         let h: f64 = if t < 10e-9 { 1e-12 } else { 1e-11 };
         let h = h.min(until - t);
-        let k1 = rate(&y);
-        let k2 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
-        let k3 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
-        let k4 = rate(&std::array::from_fn(|i| y[i] + h * k3[i]));
-        y = std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+        y = rk4_step(&rate, &y, h);
         t += h;
     }
     y
@@ -1206,4 +1202,14 @@ fn gilbert_onion_at_millisecond_steps_agrees_with_microsecond_steps_and_a_fine_i
         "{} against {reference:?} (lag {lag})",
         s.rotor_angle
     );
+}
+
+/// One classical RK4 step of `y' = rate(y)` from `y` over `h`: the fine reference the tests
+/// integrate against.
+pub(super) fn rk4_step(rate: &impl Fn(&Vector) -> Vector, y: &Vector, h: f64) -> Vector {
+    let k1 = rate(y);
+    let k2 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
+    let k3 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
+    let k4 = rate(&std::array::from_fn(|i| y[i] + h * k3[i]));
+    std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
 }
