@@ -86,7 +86,7 @@ fn configurations() -> Vec<Config> {
             ],
         ));
     }
-    for nodes in [1, 2, 4, 8, 16] {
+    for nodes in [2, 4, 8, 16] {
         c.push(config(
             "McKibbenMuscle",
             "bladder_exact",
