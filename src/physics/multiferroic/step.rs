@@ -45,6 +45,8 @@ pub(super) struct StepRun {
     pub(super) rim_barrier: (f64, f64),
     /// The attempt from which the Gilbert onion's averaged ringing is tried next.
     pub(super) average_check_at: u32,
+    /// The stepping schedule switching inside this step, if any.
+    pub(super) schedule: Option<super::SteppingSchedule>,
 }
 
 impl StepRun {
@@ -79,6 +81,7 @@ impl StepRun {
             following: f64::NAN,
             rim_barrier: (f64::NAN, f64::INFINITY),
             average_check_at: 0,
+            schedule: None,
         }
     }
 
@@ -157,6 +160,7 @@ impl Motor {
         }
         let budget = self.params.max_substeps;
         let mut run = StepRun::new(state, h);
+        run.schedule = inputs.schedule.get().copied();
         // Built on the first pass that follows the branch: a Gilbert step whose onion never
         // relaxes does not clone the motor.
         let twin = std::cell::OnceCell::new();
