@@ -397,7 +397,7 @@ impl Motor {
     /// end of the new axis, so with `|a| + 2 w < pi / 2` it goes downhill to that end's minimum:
     /// the cycle turned by `a`. (`k_max = pi M` with `M` the bound of its slope: the stiffness
     /// has zero mean over a turn.)
-    fn strain_held_turn(&self, d: &Drive, step_angle: f64) -> Option<f64> {
+    pub(super) fn strain_held_turn(&self, d: &Drive, step_angle: f64) -> Option<f64> {
         let e = self
             .landscape(0.0, d.direction, d.stress)
             .magnetoelastic

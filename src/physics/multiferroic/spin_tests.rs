@@ -412,3 +412,79 @@ fn spinning_rotor_over_many_periods_agrees_with_fine_integration() {
         }
     }
 }
+
+/// Table 3.1 with the ring and bar magnetized at `Ms / 1000` (eq. 3.3's torque bound 1e-23 N m)
+/// under a 1 ns schedule of 20 kPa (`E` 30 times that bound: the strain holds the onion at an end
+/// of its axis) and of 200 Pa (it does not): a locked rotor, and a free one in a viscous fluid
+/// (1e3 Pa s) drifting under 1e-9 N m, where the ring cannot move it by a tenth of the tolerance
+/// over the whole step. Held, the step takes its switches at once
+/// ([`Motor::skip_strain_held_periods`]); not held, one by one. Against the onion settled at
+/// every switch from the last (the locked rotor) and the overdamped RK4 with the onion settled
+/// at every evaluation (the drifting one): rotor and onion within the tolerance.
+#[test]
+fn a_strain_held_onion_takes_a_fast_schedule_at_once() {
+    let tol = 1e-6;
+    let period = 1e-9;
+    let switches = 200;
+    for locked in [true, false] {
+        let m = motor_with(|p| {
+            p.saturation_magnetization *= 1e-3;
+            p.fluid_viscosity = 1e3;
+        });
+        let load = if locked { 0.0 } else { 1e-9 };
+        for (stress, step_angle, held) in [(2e4, 2.5, true), (2e4, 1.1, true), (200.0, 1.1, false)]
+        {
+            let schedule =
+                SteppingSchedule::new((-30f64).to_radians(), step_angle, period, stress).unwrap();
+            let inputs = MotorInputs {
+                load_torque: load,
+                rotor_locked: locked,
+                schedule: ScheduleSwitch::on(schedule),
+                ..MotorInputs::fixed(0.0, 0.0)
+            };
+            let mut s = MotorState::aligned(0.0);
+            s.onion_angle = m.outputs(&s, &inputs).unwrap().onion_angle;
+            let (mut phi, mut psi) = (s.rotor_angle, s.onion_angle);
+            let report = m.step(&mut s, &inputs, switches as f64 * period).unwrap();
+            let n = 200;
+            let dt = period / n as f64;
+            for k in 0..switches {
+                let direction = schedule.direction((k as f64 + 0.5) * period);
+                psi = m.landscape(phi, direction, stress).settle(psi);
+                if locked {
+                    continue;
+                }
+                let rate = |phi: f64, psi: &mut f64| {
+                    *psi = m.landscape(phi, direction, stress).settle(*psi);
+                    (m.ring_bar.torque_stiffness(*psi - phi).0 + load) / m.drag
+                };
+                for _ in 0..n {
+                    let mut p = psi;
+                    let k1 = rate(phi, &mut p);
+                    let k2 = rate(phi + 0.5 * dt * k1, &mut p);
+                    let k3 = rate(phi + 0.5 * dt * k2, &mut p);
+                    let k4 = rate(phi + dt * k3, &mut p);
+                    phi += dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0;
+                    psi = m.landscape(phi, direction, stress).settle(psi);
+                }
+            }
+            // The step ends at a switch: the onion there is settled for the next direction.
+            let next = schedule.direction((switches as f64 + 0.5) * period);
+            psi = m.landscape(phi, next, stress).settle(psi);
+            eprintln!(
+                "locked {locked}, {stress} Pa, {step_angle} rad: {} substeps, rotor {} against \
+                 {phi} ({:e}), onion {} against {psi} ({:e})",
+                report.substeps,
+                s.rotor_angle,
+                s.rotor_angle - phi,
+                s.onion_angle,
+                s.onion_angle - psi
+            );
+            assert!(!report.accuracy_limited, "{report:?}");
+            assert_eq!(report.substeps <= 2, held, "{report:?}");
+            assert!(locked || phi > 5.0);
+            assert!((s.rotor_angle - phi).abs() < tol);
+            assert!((s.onion_angle - psi).abs() < tol);
+        }
+    }
+}

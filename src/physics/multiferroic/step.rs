@@ -192,6 +192,9 @@ impl Motor {
                 run.settled = model.quasi_static();
             }
             run.enter_segment(segment_end, d.direction);
+            if self.skip_strain_held_periods(&mut run, &d, segment_end) {
+                continue;
+            }
             if model.advance_spinning(&mut run, &d, segment_end) {
                 continue;
             }
