@@ -190,6 +190,10 @@ impl Motor {
     ///   that (a rotor starting from rest), the error-controlled integrator resolves the few
     ///   turns of its speed's rise.
     ///
+    /// On a schedule, the spin goes on through the following switches while the cycle each
+    /// segment's onion follows is known and the periodic deviation's phase jumps at the switches
+    /// stay within a tenth of the tolerance ([`Self::periods_ahead`]).
+    ///
     /// Resolving every turn took the whole substep budget here (20,000 substeps, 11-40 ms per
     /// 1 us step for loads of 1e-14 to 1e-10 N m on Table 3.1).
     pub(super) fn advance_spinning(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {

@@ -134,7 +134,11 @@ impl Motor {
     /// repeats the last one turned by `step_angle` (the equations are invariant under a common
     /// rotation of rotor, onion and strain), so those periods are advanced at once. This covers
     /// periods that let the rotor settle and faster ones where it turns continuously on a
-    /// periodic orbit. Hence what "accurate" means for a long step: the state at its end, and at
+    /// periodic orbit. Where the strain holds the onion at an end of its axis and the rotor is
+    /// locked or drifts (the ring cannot move it over the rest of the step), the rest of the
+    /// step's periods are taken at once too ([`Self::skip_strain_held_periods`]), and so are a
+    /// spinning rotor's while the onion's cycle turned with the strain is known
+    /// ([`Self::advance_spinning`]). Hence what "accurate" means for a long step: the state at its end, and at
     /// every switch inside it, is the resolved trajectory's within the tolerance; the transients
     /// inside it are not reported.
     ///
