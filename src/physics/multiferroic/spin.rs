@@ -402,6 +402,14 @@ impl Motor {
     /// the cycle turned by `a`. (`k_max = pi M` with `M` the bound of its slope: the stiffness
     /// has zero mean over a turn.)
     pub(super) fn strain_held_turn(&self, d: &Drive, step_angle: f64) -> Option<f64> {
+        let w = self.strain_held_reach(d)?;
+        let turn = step_angle - PI * (step_angle / PI).round();
+        (turn.abs() + 2.0 * w < 0.5 * PI - 1e-6).then_some(turn)
+    }
+
+    /// How far from an end of the strain's axis the onion can be (`w`, rad) when the strain holds
+    /// it there whatever the rotor does (see [`Self::strain_held_turn`]); `None` when it does not.
+    fn strain_held_reach(&self, d: &Drive) -> Option<f64> {
         let e = self
             .landscape(0.0, d.direction, d.stress)
             .magnetoelastic
@@ -411,10 +419,7 @@ impl Motor {
             return None;
         }
         let w = 0.5 * (tau / e).asin();
-        let turn = step_angle - PI * (step_angle / PI).round();
-        let held = 2.0 * e * (2.0 * w).cos() > PI * self.ring_bar_slope_bound
-            && turn.abs() + 2.0 * w < 0.5 * PI - 1e-6;
-        held.then_some(turn)
+        (2.0 * e * (2.0 * w).cos() > PI * self.ring_bar_slope_bound).then_some(w)
     }
 
     /// The state `y` advanced by `h` on the averaged spin of `cycle`, with the periodic deviation
@@ -597,8 +602,8 @@ impl Motor {
     }
 
     /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
-    /// `psi0`: one turn to land on it, one to measure it (and sample its torque). `None` if it
-    /// does not close.
+    /// `psi0`: one turn to land on it (none where the strain holds the onion), one to measure it
+    /// (and sample its torque). `None` if it does not close.
     fn onion_cycle(
         &self,
         y: &super::Vector,
@@ -615,9 +620,18 @@ impl Motor {
         let psi0 = self
             .landscape(phi0, d.direction, d.stress)
             .settle(y[2] - turns - onion_turns);
-        let start = phi0 + dir * 2.0 * PI;
         *settles += 1;
-        let (psi1, _) = self.march_onion(phi0, psi0, start, d, None, settles)?;
+        // A turn to land on the cycle; none where the strain holds the onion, whose minimum then
+        // follows the rotor without a snap (the cycle is where the onion is).
+        let (start, psi1) = if self.strain_held_reach(d).is_some() {
+            (phi0, psi0)
+        } else {
+            let start = phi0 + dir * 2.0 * PI;
+            (
+                start,
+                self.march_onion(phi0, psi0, start, d, None, settles)?.0,
+            )
+        };
         let mut samples = Vec::with_capacity(160);
         let (psi2, work) = self.march_onion(
             start,
