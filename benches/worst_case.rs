@@ -15,7 +15,9 @@
 //!
 //! `WORST_CASE_MODELS=A,B` restricts the FMUs; `WORST_CASE_POINTS=n` the random points;
 //! `WORST_CASE_REPORT_ABOVE=s` lists every case whose step or initialization takes longer than
-//! `s` seconds (default 1).
+//! `s` seconds (default 1), as measured on its first run; `WORST_CASE_REPORT_STEPS_ABOVE=s` lists
+//! after the re-timing every case one of whose steps takes longer than `s` seconds, with each
+//! step's cost and the variables set away from their start values.
 
 #[path = "../tests/common/mod.rs"]
 #[allow(dead_code)]
@@ -310,6 +312,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1.0);
+    let report_steps_above: f64 = std::env::var("WORST_CASE_REPORT_STEPS_ABOVE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(f64::INFINITY);
     let overhead = clock_cost();
     println!(
         "(thread CPU time; the clock's own {:.0} ns subtracted)\n",
@@ -429,6 +435,30 @@ fn main() {
             "{}: {retimed} slowest cases re-timed {RETIMES} more times, their minima kept",
             info.name
         );
+        for c in &cases {
+            if c.steps.iter().any(|&s| s > report_steps_above) {
+                let steps: Vec<String> =
+                    c.steps.iter().map(|s| format!("{:.1}", s * 1e6)).collect();
+                let changed: Vec<String> = knobs
+                    .iter()
+                    .zip(&c.values)
+                    .filter(|(k, x)| **x != k.start)
+                    .map(|(k, x)| format!("{}={x:.3e}", k.name))
+                    .collect();
+                let label = c.label.split(" [").next().unwrap_or(&c.label);
+                eprintln!(
+                    "{}: slow step: {label}: steps [{}] us{} [{}]",
+                    info.name,
+                    steps.join(", "),
+                    if c.step_refused {
+                        " (last refused)"
+                    } else {
+                        ""
+                    },
+                    changed.join(" ")
+                );
+            }
+        }
         let ran = |c: &Case| c.steps.len() - usize::from(c.step_refused);
         let mut steps: Vec<f64> = cases
             .iter()

@@ -103,6 +103,75 @@ impl Motor {
     }
 }
 
+impl Motor {
+    /// The rest of the step's whole periods of the schedule at once when the strain holds the
+    /// onion at an end of its axis ([`Self::strain_held_turn`]) and the rotor is locked or the
+    /// ring's torque cannot move it by a tenth of the tolerance over them (as in
+    /// [`Self::advance_drifting`], over all of them): the rotor follows load and drag alone, and
+    /// the onion, which turns by the same angle at every switch whatever the rotor does, ends at
+    /// the one minimum of eq. 3.4 within `w` of the end of the last period's strain axis, settled
+    /// from the present onion turned by as many of those angles (within `w` of that end). A
+    /// locked rotor or a drifting one otherwise costs a settle or a march at every switch
+    /// (hundreds in a 1 us step of a nanosecond schedule). Returns whether it advanced.
+    pub(super) fn skip_strain_held_periods(
+        &self,
+        run: &mut StepRun,
+        d: &Drive,
+        segment_end: f64,
+    ) -> bool {
+        let Some(s) = run.schedule else {
+            return false;
+        };
+        if !self.quasi_static() || segment_end >= run.t_end {
+            return false;
+        }
+        let first = s.step_index(segment_end);
+        let last = s.step_index(run.t_end);
+        let end = (last * s.step_period).min(run.t_end);
+        if last - first < 1.0 || end <= segment_end {
+            return false;
+        }
+        let Some(turn) = self.strain_held_turn(d, s.step_angle) else {
+            return false;
+        };
+        let h = end - run.t;
+        let [phi, omega] = if d.locked {
+            [run.y[0], 0.0]
+        } else {
+            let (i, c) = (self.inertia, self.drag);
+            let (coast, torque_speed, torque_angle) = if c > 0.0 {
+                let approach = -(-h * c / i).exp_m1();
+                (i / c * approach, approach / c, (h - i / c * approach) / c)
+            } else {
+                (h, h / i, 0.5 * h * h / i)
+            };
+            let tau = self.torque_bound();
+            let tol = self.params.tolerance;
+            if !(tau * torque_angle <= 0.1 * tol && tau * torque_speed <= tol * self.speed_scale) {
+                return false;
+            }
+            [
+                run.y[0] + run.y[1] * coast + d.load * torque_angle,
+                run.y[1] * (1.0 - c * torque_speed) + d.load * torque_speed,
+            ]
+        };
+        let periods = last - first;
+        let applied = s.direction(end - 0.5 * s.step_period);
+        let psi = self
+            .landscape(phi, super::reduced_direction(applied), d.stress)
+            .settle(run.y[2] + periods * turn);
+        if !(phi.is_finite() && phi.abs() <= super::MAX_ANGLE && psi.is_finite()) {
+            return false;
+        }
+        run.y = [phi, omega, psi, 0.0];
+        run.t = end;
+        run.settled = false;
+        run.angles = None;
+        run.attempts = run.attempts.saturating_add(1);
+        true
+    }
+}
+
 /// Largest turn of a drifting rotor within a segment (rad; see [`Motor::advance_drifting`]): a
 /// quarter turn of onion settles, beyond which the averaged spin's cycle is the cheaper.
 const MAX_DRIFT_TURN: f64 = 0.5 * PI;

@@ -192,6 +192,15 @@ pub struct StepReport {
 /// rounding of pi times the turns stays below the direction's own spacing.
 const REDUCED_DIRECTION_ABOVE: f64 = 1e3;
 
+/// The strain direction the physics uses for an applied one (see [`REDUCED_DIRECTION_ABOVE`]).
+fn reduced_direction(applied: f64) -> f64 {
+    if applied.abs() > REDUCED_DIRECTION_ABOVE {
+        applied.rem_euclid(PI)
+    } else {
+        applied
+    }
+}
+
 /// Strain, stress and load held over one substep.
 #[derive(Clone, Copy, Debug)]
 struct Drive {
@@ -436,13 +445,8 @@ impl Motor {
             Some(s) => (s.direction(time), s.stress_amplitude),
             None => (inputs.strain_direction, inputs.stress),
         };
-        let direction = if applied_direction.abs() > REDUCED_DIRECTION_ABOVE {
-            applied_direction.rem_euclid(PI)
-        } else {
-            applied_direction
-        };
         Drive {
-            direction,
+            direction: reduced_direction(applied_direction),
             applied_direction,
             stress,
             load: inputs.load_torque,

@@ -6,6 +6,7 @@ use super::{Drive, Motor, StepRun};
 use std::f64::consts::PI;
 
 /// The quasi-static onion's hysteresis cycle as the rotor turns without end in one direction.
+#[derive(Clone)]
 pub(super) struct OnionCycle {
     /// Whole turns of rotor and onion taken off the state the cycle was found from, so that its
     /// march works near zero (rad).
@@ -26,6 +27,9 @@ pub(super) struct OnionCycle {
     onion_samples: Vec<f64>,
     /// The rotor's deviation at its terminal mean speed (with drag and a positive mean force).
     terminal: Option<Wobble>,
+    /// Whether the cycle is its own turn by half a turn (see [`Self::half_turn_symmetric`]),
+    /// once found.
+    half_turn: std::cell::Cell<Option<bool>>,
 }
 
 /// The rotor's periodic deviation from its mean motion at one mean speed, sampled where
@@ -124,6 +128,27 @@ impl OnionCycle {
         super::wrap_angle(onion - y[2]).abs() <= 1e-9
     }
 
+    /// Whether the cycle turned by half a turn is itself: eq. 3.4 depends on the strain direction
+    /// modulo pi, so rotor and onion turned by pi make a cycle of the same drive, the same one
+    /// when the onion half a turn on is the onion turned by pi (modulo a turn; checked within
+    /// 1e-9 rad at 16 samples of the first half turn). Otherwise the drive may have two cycles,
+    /// and which one the onion lands on after a switch depends on where the rotor is then.
+    fn half_turn_symmetric(&self, motor: &Motor, dir: f64, d: &Drive) -> bool {
+        if let Some(known) = self.half_turn.get() {
+            return known;
+        }
+        let n = self.torque.len();
+        let symmetric = (0..n)
+            .step_by((n / 32).max(1))
+            .filter(|&j| self.torque[j].0 < PI)
+            .all(|j| {
+                let onion = self.onion_at(motor, self.torque[j].0 + PI, dir, d);
+                super::wrap_angle(onion - self.onion_samples[j] - PI).abs() <= 1e-9
+            });
+        self.half_turn.set(Some(symmetric));
+        symmetric
+    }
+
     /// The onion angle on the cycle at `s` (in the direction of motion, from `rotor`) for the
     /// drive `d`: settled from the sample at or below `s`, with no snap in between.
     fn onion_at(&self, motor: &Motor, s: f64, dir: f64, d: &Drive) -> f64 {
@@ -164,6 +189,10 @@ impl Motor {
     ///   and the third-order drift `epsilon^3` times the angle turned below `tol / 10`. Before
     ///   that (a rotor starting from rest), the error-controlled integrator resolves the few
     ///   turns of its speed's rise.
+    ///
+    /// On a schedule, the spin goes on through the following switches while the cycle each
+    /// segment's onion follows is known and the periodic deviation's phase jumps at the switches
+    /// stay within a tenth of the tolerance ([`Self::periods_ahead`]).
     ///
     /// Resolving every turn took the whole substep budget here (20,000 substeps, 11-40 ms per
     /// 1 us step for loads of 1e-14 to 1e-10 N m on Table 3.1).
@@ -239,7 +268,25 @@ impl Motor {
         let Some((direction, cycle)) = run.spin_cycle.take() else {
             return false;
         };
-        let spun = self.spin(&run.y, &cycle, d, h, !resolved_free);
+        if let Some((end, end_drive, end_cycle)) = self.periods_ahead(run, &cycle, d, segment_end) {
+            let y = self.spin(
+                &run.y,
+                &cycle,
+                (&end_cycle, &end_drive),
+                d,
+                end - run.t,
+                !resolved_free,
+            );
+            if let Spin::Ended(y) = y {
+                run.y = y;
+                run.t = end;
+                run.spin_cycle = Some((end_drive.direction, end_cycle));
+                run.settled = false;
+                run.attempts = run.attempts.saturating_add(1);
+                return true;
+            }
+        }
+        let spun = self.spin(&run.y, &cycle, (&cycle, d), d, h, !resolved_free);
         run.spin_cycle = Some((direction, cycle));
         match spun {
             Spin::NotYet => false,
@@ -257,16 +304,138 @@ impl Motor {
         }
     }
 
-    /// The state `y` advanced by `h` at constant drive on the averaged spin of `cycle`, with the
-    /// periodic deviation taken off at the start (`correct_start`) and added back at the end.
+    /// Whole periods of the schedule after the segment ending at `segment_end` that the averaged
+    /// spin takes together with it: the end of the last of them (a switch, within the step), its
+    /// drive, and the cycle turned with its strain; `None` when not even one.
+    ///
+    /// The equations are invariant under a common rotation of rotor, onion and strain, so every
+    /// segment's cycle is this one turned with the strain and has the same mean torque (its snaps
+    /// dissipate the same work per turn): the mean motion goes on through the switches unchanged.
+    /// The strain turns by `step_angle` at a switch, which eq. 3.4 sees modulo pi: the cycle turned
+    /// by it is the one the onion follows when the cycle is its own turn by half a turn
+    /// ([`OnionCycle::half_turn_symmetric`]); when the strain holds the onion at an end of its
+    /// axis, the cycle turned by the onion's own turn at a switch
+    /// ([`Self::strain_held_turn`]); otherwise which of two cycles it lands on may depend on the
+    /// rotor's phase at each switch, and the segments are taken one by one.
+    /// What a switch changes is the phase of the periodic deviation, `delta` and `u`: the mean
+    /// angle and speed jump by at most twice their amplitudes `A` and `U` at the switch, which the
+    /// single spin leaves out; and the onion, settled into the turned landscape, reaches the
+    /// turned cycle within a turn (as the segment-by-segment spin assumes), before which the
+    /// ring's torque differs from the cycle's by at most `2 tau_max` over `2 pi / omega`, an
+    /// impulse of at most `J = 4 pi tau_max / omega`. The deviation's torque `tau - <tau>` is at
+    /// most `2 tau_max`, so `U <= 2 tau_max min(1 / c, 2 pi / (I omega))` (the drag's filter; `u`
+    /// has zero mean and `|u'| <= 4 tau_max / I`) and `A <= pi U / omega` (`delta` has zero mean
+    /// and `|delta'| <= U / omega` per radian). A speed jump `du` moves the rotor by at most
+    /// `I du / c` as it decays, an impulse by `J / c`; so each switch costs at most
+    /// `2 A + 2 U I / c + J / c` in angle, held to a tenth of the tolerance over the switches
+    /// taken, and its speed jumps, decaying by `e = exp(-c T / I)` a period `T`, leave at most
+    /// `(2 U + J / I) e / (1 - e)` at the end, which, as it decays, moves the rotor by a tenth of
+    /// the tolerance at most (its `I / c` times). `A`,
+    /// `U` and `J` are taken at the lower of the present and the terminal mean speed (they fall
+    /// as the speed rises).
+    pub(super) fn periods_ahead(
+        &self,
+        run: &StepRun,
+        cycle: &OnionCycle,
+        d: &Drive,
+        segment_end: f64,
+    ) -> Option<(f64, Drive, OnionCycle)> {
+        let s = run.schedule.as_ref()?;
+        let (i, c) = (self.inertia, self.drag);
+        if segment_end >= run.t_end || c <= 0.0 {
+            return None;
+        }
+        // The segment starting at `segment_end` and the last switch within the step.
+        let first = s.step_index(segment_end);
+        let available = s.step_index(run.t_end) - first;
+        if available < 1.0 {
+            return None;
+        }
+        let dir = d.load.signum();
+        let force = d.load.abs() + cycle.work / (2.0 * PI);
+        let slowest = (dir * run.y[1]).min(force / c);
+        if slowest.is_nan() || slowest <= 0.0 {
+            return None;
+        }
+        let tau = self.torque_bound();
+        let speed_amplitude = 2.0 * tau * (1.0 / c).min(2.0 * PI / (i * slowest));
+        let amplitude = PI * speed_amplitude / slowest;
+        let impulse = 4.0 * PI * tau / slowest;
+        let kick = 2.0 * speed_amplitude + impulse / i;
+        let angle = 2.0 * amplitude + kick * i / c;
+        // What is left at the end of the kicks at the switches before the last period.
+        let decay = (-s.step_period * c / i).exp();
+        let speed = kick * decay / (1.0 - decay);
+        let tol = self.params.tolerance;
+        let periods = (0.1 * tol / angle).floor().min(available);
+        if !(speed * i / c <= 0.1 * tol && periods >= 1.0) {
+            return None;
+        }
+        let turn = match self.strain_held_turn(d, s.step_angle) {
+            Some(turn) => turn,
+            None if cycle.half_turn_symmetric(self, dir, d) => s.step_angle,
+            None => return None,
+        };
+        let end = ((first + periods) * s.step_period).min(run.t_end);
+        let applied = s.direction(end - 0.5 * s.step_period);
+        let end_drive = Drive {
+            direction: super::reduced_direction(applied),
+            applied_direction: applied,
+            ..*d
+        };
+        let mut turned = cycle.clone();
+        turned.rotate(periods * turn);
+        Some((end, end_drive, turned))
+    }
+
+    /// The turn of the onion at every switch of the schedule (`step_angle` brought within a
+    /// quarter turn, modulo pi) when the strain holds it near an end of its axis whatever the
+    /// rotor does; `None` otherwise. With `E sin^2(psi - gamma)` the magnetoelastic energy (eq.
+    /// 3.4), `|tau| <= tau_max` the ring's torque and `k_max` its stiffness's bound, the gradient
+    /// `E sin 2x + tau` (`x = psi - gamma`) has the sign of `E sin 2x` but within
+    /// `w = asin(tau_max / |E|) / 2` of the axis's ends and of its midpoints, and the curvature
+    /// `2 E cos 2x + k` keeps the sign of `E` near the ends and the opposite near the midpoints
+    /// while `2 |E| cos 2w > k_max`: each end (the minima of `E sin^2`) holds one minimum within
+    /// `w`, and no other exists. The onion sits there (two cycles, one at either end, without
+    /// snaps); after a switch by `a` (within a quarter turn modulo pi) it is within `w + |a|` of an
+    /// end of the new axis, so with `|a| + 2 w < pi / 2` it goes downhill to that end's minimum:
+    /// the cycle turned by `a`. (`k_max = pi M` with `M` the bound of its slope: the stiffness
+    /// has zero mean over a turn.)
+    pub(super) fn strain_held_turn(&self, d: &Drive, step_angle: f64) -> Option<f64> {
+        let w = self.strain_held_reach(d)?;
+        let turn = step_angle - PI * (step_angle / PI).round();
+        (turn.abs() + 2.0 * w < 0.5 * PI - 1e-6).then_some(turn)
+    }
+
+    /// How far from an end of the strain's axis the onion can be (`w`, rad) when the strain holds
+    /// it there whatever the rotor does (see [`Self::strain_held_turn`]); `None` when it does not.
+    fn strain_held_reach(&self, d: &Drive) -> Option<f64> {
+        let e = self
+            .landscape(0.0, d.direction, d.stress)
+            .magnetoelastic
+            .abs();
+        let tau = self.torque_bound();
+        if tau.is_nan() || tau >= e {
+            return None;
+        }
+        let w = 0.5 * (tau / e).asin();
+        (2.0 * e * (2.0 * w).cos() > PI * self.ring_bar_slope_bound).then_some(w)
+    }
+
+    /// The state `y` advanced by `h` on the averaged spin of `cycle`, with the periodic deviation
+    /// taken off at the start (`correct_start`) and added back at the end on `end`'s cycle and
+    /// drive (those of the start, or of a later segment of the schedule, see
+    /// [`Self::periods_ahead`]).
     fn spin(
         &self,
         y: &super::Vector,
         cycle: &OnionCycle,
+        end: (&OnionCycle, &Drive),
         d: &Drive,
         h: f64,
         correct_start: bool,
     ) -> Spin {
+        let (end_cycle, end_drive) = end;
         let (i, c) = (self.inertia, self.drag);
         let dir = d.load.signum();
         let tol = self.params.tolerance;
@@ -349,8 +518,9 @@ impl Motor {
         }
         theta += dir * advance;
         let (mut phi, mut omega) = (theta, dir * omega);
+        let s_of_end = |phi: f64| dir * (phi - end_cycle.turns - end_cycle.rotor);
         if let Some(end) = &end_wobble {
-            let (delta, u) = end.at(cycle, s_of(theta), c);
+            let (delta, u) = end.at(end_cycle, s_of_end(theta), c);
             phi += dir * delta;
             omega += dir * u;
         }
@@ -359,11 +529,14 @@ impl Motor {
         }
         // The onion on its cycle at the end angle: whole turns shift it by the winding, the rest
         // is settled from the cycle's sample below it.
-        let from_cycle = phi - cycle.turns - cycle.rotor;
+        let from_cycle = phi - end_cycle.turns - end_cycle.rotor;
         let whole = (dir * from_cycle / (2.0 * PI)).floor();
         let rest = from_cycle - dir * whole * 2.0 * PI;
-        let onion = cycle.onion_at(self, dir * rest, dir, d);
-        let psi = onion + cycle.turns + cycle.onion_turns + cycle.winding * dir * whole * 2.0 * PI;
+        let onion = end_cycle.onion_at(self, dir * rest, dir, end_drive);
+        let psi = onion
+            + end_cycle.turns
+            + end_cycle.onion_turns
+            + end_cycle.winding * dir * whole * 2.0 * PI;
         if !(psi.is_finite() && psi.abs() <= super::MAX_ANGLE) {
             return Spin::Failed;
         }
@@ -429,8 +602,8 @@ impl Motor {
     }
 
     /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
-    /// `psi0`: one turn to land on it, one to measure it (and sample its torque). `None` if it
-    /// does not close.
+    /// `psi0`: one turn to land on it (none where the strain holds the onion), one to measure it
+    /// (and sample its torque). `None` if it does not close.
     fn onion_cycle(
         &self,
         y: &super::Vector,
@@ -447,9 +620,18 @@ impl Motor {
         let psi0 = self
             .landscape(phi0, d.direction, d.stress)
             .settle(y[2] - turns - onion_turns);
-        let start = phi0 + dir * 2.0 * PI;
         *settles += 1;
-        let (psi1, _) = self.march_onion(phi0, psi0, start, d, None, settles)?;
+        // A turn to land on the cycle; none where the strain holds the onion, whose minimum then
+        // follows the rotor without a snap (the cycle is where the onion is).
+        let (start, psi1) = if self.strain_held_reach(d).is_some() {
+            (phi0, psi0)
+        } else {
+            let start = phi0 + dir * 2.0 * PI;
+            (
+                start,
+                self.march_onion(phi0, psi0, start, d, None, settles)?.0,
+            )
+        };
         let mut samples = Vec::with_capacity(160);
         let (psi2, work) = self.march_onion(
             start,
@@ -478,6 +660,7 @@ impl Motor {
             torque,
             onion_samples,
             terminal: None,
+            half_turn: std::cell::Cell::new(None),
         };
         let force = d.load.abs() + work / (2.0 * PI);
         if self.drag > 0.0 && force > 0.0 {

@@ -336,3 +336,155 @@ fn overdamped_marches_are_charged_by_their_settles() {
         assert!(run.extra_cost >= least, "{load:e}: {}", run.extra_cost);
     }
 }
+
+/// A rotor spun by loads of 1e-13 and 2e-13 N m, 1e10 and 2e10 times eq. 3.3's torque bound
+/// (Table 3.1 with the ring and bar magnetized at `Ms / 1000`: 1e-23 N m, under 20 Pa to 20 kPa
+/// of stress), through schedules of 5 and 100 turns a period, the strain turned by 1.1 or 2.5 rad
+/// at each switch. Where the onion follows the bar (20 and 60 Pa) its cycle is its own turn by
+/// half a turn; where the strain holds it at an end of its axis (20 kPa: `E` 30 times the
+/// torque bound) it turns by the step modulo pi, within a quarter turn (1.1 and -0.64 rad). There
+/// the averaged spin takes the periods at once ([`Motor::periods_ahead`]: one or two substeps).
+/// In between (200 Pa) the drive has two cycles, the onion near either end of the strain axis,
+/// and which one it lands on after a switch depends on the rotor's phase: the periods are taken
+/// one by one (turning the cycle through all of them by the step put the onion two turns off).
+/// Rotor angle, speed and onion agree with the fine RK4 through every switch within the
+/// tolerance.
+#[test]
+fn spinning_rotor_over_many_periods_agrees_with_fine_integration() {
+    let m = motor_with(|p| {
+        p.saturation_magnetization *= 1e-3;
+        p.max_substeps = 20_000;
+    });
+    let tol = m.params.tolerance;
+    for (load, period, periods) in [(1e-13, 10e-9, 40.0), (2e-13, 1e-7, 3.0)] {
+        for (stress, step_angle, at_once) in [
+            (20.0, 1.1, true),
+            (60.0, 1.1, true),
+            (200.0, 1.1, false),
+            (2e4, 1.1, true),
+            (2e4, 2.5, true),
+        ] {
+            let schedule =
+                SteppingSchedule::new((-30f64).to_radians(), step_angle, period, stress).unwrap();
+            let inputs = MotorInputs {
+                load_torque: load,
+                schedule: ScheduleSwitch::on(schedule),
+                ..MotorInputs::fixed(0.0, 0.0)
+            };
+            let terminal = load / m.drag;
+            let mut s = MotorState {
+                rotor_speed: terminal,
+                ..MotorState::aligned(0.0)
+            };
+            s.onion_angle = m.outputs(&s, &inputs).unwrap().onion_angle;
+            let mut r = s;
+            let report = m.step(&mut s, &inputs, periods * period).unwrap();
+            for k in 0..periods as usize {
+                let direction = schedule.direction((k as f64 + 0.5) * period);
+                fine_rotor(
+                    &m,
+                    (direction, stress, load),
+                    &mut r,
+                    period,
+                    1e-3 / terminal,
+                );
+            }
+            // The step ends at a switch: the onion there is settled for the next direction.
+            let next = schedule.direction((periods + 0.5) * period);
+            let psi = m
+                .landscape(r.rotor_angle, next, stress)
+                .settle(r.onion_angle);
+            eprintln!(
+                "{load:e} N m, {period:e} s, {stress} Pa, {step_angle} rad: {} substeps, rotor {} against {} \
+                 ({:e}), speed {:e} relative, onion {} against {psi}",
+                report.substeps,
+                s.rotor_angle,
+                r.rotor_angle,
+                s.rotor_angle - r.rotor_angle,
+                (s.rotor_speed - r.rotor_speed) / r.rotor_speed,
+                s.onion_angle
+            );
+            assert!(!report.accuracy_limited, "{report:?}");
+            assert_eq!(f64::from(report.substeps) <= 2.0, at_once, "{report:?}");
+            assert!((s.rotor_angle - r.rotor_angle).abs() < tol);
+            assert!((s.rotor_speed - r.rotor_speed).abs() < 1e-6 * r.rotor_speed);
+            assert!((s.onion_angle - psi).abs() < tol);
+        }
+    }
+}
+
+/// Table 3.1 with the ring and bar magnetized at `Ms / 1000` (eq. 3.3's torque bound 1e-23 N m)
+/// under a 1 ns schedule of 20 kPa (`E` 30 times that bound: the strain holds the onion at an end
+/// of its axis) and of 200 Pa (it does not): a locked rotor, and a free one in a viscous fluid
+/// (1e3 Pa s) drifting under 1e-9 N m, where the ring cannot move it by a tenth of the tolerance
+/// over the whole step. Held, the step takes its switches at once
+/// ([`Motor::skip_strain_held_periods`]); not held, one by one. Against the onion settled at
+/// every switch from the last (the locked rotor) and the overdamped RK4 with the onion settled
+/// at every evaluation (the drifting one): rotor and onion within the tolerance.
+#[test]
+fn a_strain_held_onion_takes_a_fast_schedule_at_once() {
+    let tol = 1e-6;
+    let period = 1e-9;
+    let switches = 200;
+    for locked in [true, false] {
+        let m = motor_with(|p| {
+            p.saturation_magnetization *= 1e-3;
+            p.fluid_viscosity = 1e3;
+        });
+        let load = if locked { 0.0 } else { 1e-9 };
+        for (stress, step_angle, held) in [(2e4, 2.5, true), (2e4, 1.1, true), (200.0, 1.1, false)]
+        {
+            let schedule =
+                SteppingSchedule::new((-30f64).to_radians(), step_angle, period, stress).unwrap();
+            let inputs = MotorInputs {
+                load_torque: load,
+                rotor_locked: locked,
+                schedule: ScheduleSwitch::on(schedule),
+                ..MotorInputs::fixed(0.0, 0.0)
+            };
+            let mut s = MotorState::aligned(0.0);
+            s.onion_angle = m.outputs(&s, &inputs).unwrap().onion_angle;
+            let (mut phi, mut psi) = (s.rotor_angle, s.onion_angle);
+            let report = m.step(&mut s, &inputs, switches as f64 * period).unwrap();
+            let n = 200;
+            let dt = period / n as f64;
+            for k in 0..switches {
+                let direction = schedule.direction((k as f64 + 0.5) * period);
+                psi = m.landscape(phi, direction, stress).settle(psi);
+                if locked {
+                    continue;
+                }
+                let rate = |phi: f64, psi: &mut f64| {
+                    *psi = m.landscape(phi, direction, stress).settle(*psi);
+                    (m.ring_bar.torque_stiffness(*psi - phi).0 + load) / m.drag
+                };
+                for _ in 0..n {
+                    let mut p = psi;
+                    let k1 = rate(phi, &mut p);
+                    let k2 = rate(phi + 0.5 * dt * k1, &mut p);
+                    let k3 = rate(phi + 0.5 * dt * k2, &mut p);
+                    let k4 = rate(phi + dt * k3, &mut p);
+                    phi += dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0;
+                    psi = m.landscape(phi, direction, stress).settle(psi);
+                }
+            }
+            // The step ends at a switch: the onion there is settled for the next direction.
+            let next = schedule.direction((switches as f64 + 0.5) * period);
+            psi = m.landscape(phi, next, stress).settle(psi);
+            eprintln!(
+                "locked {locked}, {stress} Pa, {step_angle} rad: {} substeps, rotor {} against \
+                 {phi} ({:e}), onion {} against {psi} ({:e})",
+                report.substeps,
+                s.rotor_angle,
+                s.rotor_angle - phi,
+                s.onion_angle,
+                s.onion_angle - psi
+            );
+            assert!(!report.accuracy_limited, "{report:?}");
+            assert_eq!(report.substeps <= 2, held, "{report:?}");
+            assert!(locked || phi > 5.0);
+            assert!((s.rotor_angle - phi).abs() < tol);
+            assert!((s.onion_angle - psi).abs() < tol);
+        }
+    }
+}

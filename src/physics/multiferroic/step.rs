@@ -45,6 +45,8 @@ pub(super) struct StepRun {
     pub(super) rim_barrier: (f64, f64),
     /// The attempt from which the Gilbert onion's averaged ringing is tried next.
     pub(super) average_check_at: u32,
+    /// The stepping schedule switching inside this step, if any.
+    pub(super) schedule: Option<super::SteppingSchedule>,
 }
 
 impl StepRun {
@@ -79,6 +81,7 @@ impl StepRun {
             following: f64::NAN,
             rim_barrier: (f64::NAN, f64::INFINITY),
             average_check_at: 0,
+            schedule: None,
         }
     }
 
@@ -131,7 +134,11 @@ impl Motor {
     /// repeats the last one turned by `step_angle` (the equations are invariant under a common
     /// rotation of rotor, onion and strain), so those periods are advanced at once. This covers
     /// periods that let the rotor settle and faster ones where it turns continuously on a
-    /// periodic orbit. Hence what "accurate" means for a long step: the state at its end, and at
+    /// periodic orbit. Where the strain holds the onion at an end of its axis and the rotor is
+    /// locked or drifts (the ring cannot move it over the rest of the step), the rest of the
+    /// step's periods are taken at once too ([`Self::skip_strain_held_periods`]), and so are a
+    /// spinning rotor's while the onion's cycle turned with the strain is known
+    /// ([`Self::advance_spinning`]). Hence what "accurate" means for a long step: the state at its end, and at
     /// every switch inside it, is the resolved trajectory's within the tolerance; the transients
     /// inside it are not reported.
     ///
@@ -157,6 +164,7 @@ impl Motor {
         }
         let budget = self.params.max_substeps;
         let mut run = StepRun::new(state, h);
+        run.schedule = inputs.schedule.get().copied();
         // Built on the first pass that follows the branch: a Gilbert step whose onion never
         // relaxes does not clone the motor.
         let twin = std::cell::OnceCell::new();
@@ -188,6 +196,9 @@ impl Motor {
                 run.settled = model.quasi_static();
             }
             run.enter_segment(segment_end, d.direction);
+            if self.skip_strain_held_periods(&mut run, &d, segment_end) {
+                continue;
+            }
             if model.advance_spinning(&mut run, &d, segment_end) {
                 continue;
             }
