@@ -20,7 +20,6 @@
 //! step's cost and the variables set away from their start values.
 
 #[path = "../tests/common/mod.rs"]
-#[allow(dead_code)]
 mod common;
 #[path = "cpu_clock.rs"]
 mod cpu_clock;
