@@ -1,6 +1,7 @@
 //! The series connector of section 2.4: the muscle's own length `L` that a reported length
 //! `L + F(L)/k` gives, and the longest reported length the connector reaches.
 
+use super::LIMIT_MARGIN;
 use super::{BranchEnd, Core, McKibben, McKibbenOutput, BRACKET_STEPS, ROOT_ITERATIONS};
 use crate::physics::friction::HysteresisState;
 use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
@@ -111,7 +112,8 @@ impl McKibben {
     /// [`Self::branch_end`], kept in `branch`), and so it does where the bracket holds a jump of
     /// the force instead of a root (the reported length falls in the jump's gap); where that
     /// branch does not reach it either, the length is out of reach. What it returns solves the
-    /// relation, to 1e-6 of the muscle's length range at worst (a wall's rounding noise).
+    /// relation, to [`LIMIT_MARGIN`] of the muscle's length range at worst (a wall's rounding
+    /// noise).
     pub(super) fn through_connector(
         &self,
         pressure: f64,
@@ -188,10 +190,11 @@ impl McKibben {
             let core = root
                 .payload
                 .ok_or_else(|| "connector solve did not run".to_string())?;
-            // A root, or a gap within 1e-6 of the range: the rounding noise of a nearly
-            // stress-free wall's force. The finder may also narrow onto a jump whose ends'
+            // A root, or a gap within LIMIT_MARGIN of the range: the rounding noise of a nearly
+            // stress-free wall's force (1e-8 to 1e-4 of the range), which the solve's first
+            // guess may have landed across. The finder may also narrow onto a jump whose ends'
             // slopes are noise: its residual tells.
-            let noise = 1e3 * options.jump_width;
+            let noise = LIMIT_MARGIN * (hi_edge - lo_edge);
             let (h, slope) = (
                 root.x + c * core.out.force - reported,
                 1.0 + c * core.newton_slope,
@@ -372,8 +375,8 @@ mod tests {
     /// Table 2.1's muscle A with an almost stress-free rubber under a vacuum, through a soft
     /// connector: the free bladder's force is rounding noise of about a newton that jumps between
     /// adjacent lengths, so the connector residual `L + F/k - reported` jumps across zero
-    /// at many lengths. A solve returns a root of the connector relation (within 1e-6 of the
-    /// range, that noise's scale) or an error, never the length next to a jump it narrowed onto.
+    /// at many lengths, by up to metres. A solve returns a root of the connector relation (to
+    /// `LIMIT_MARGIN` of the range at worst) or an error, never the length next to such a jump.
     #[test]
     fn a_solve_returns_a_root_or_nothing_where_the_force_jumps() {
         let g = MuscleGeometry::muscle_a();
@@ -398,7 +401,10 @@ mod tests {
             match m.evaluate(p, reported, &rest) {
                 Ok(out) => {
                     let h = out.actual_length + out.force / k - reported;
-                    assert!(h.abs() <= 1e-6 * (hi - lo), "{reported} m: residual {h} m");
+                    assert!(
+                        h.abs() <= LIMIT_MARGIN * (hi - lo),
+                        "{reported}: residual {h} m"
+                    );
                     roots += 1;
                 }
                 Err(_) => gaps += 1,
