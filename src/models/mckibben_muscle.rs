@@ -60,6 +60,9 @@ pub struct McKibbenMuscle {
     signed_force: bool,
     /// The straight strands' axial stiffness `k_s = E A / b`, N/m (from `strand_rigidity`).
     strand_stiffness: f64,
+    /// `out_of_range_policy` 2: a step whose input is out of range is refused, so a step past
+    /// the breaking length is not evaluated where one rigid evaluation shows it out of range.
+    refuse_out_of_range: bool,
 }
 
 /// The muscle the parameters (or the preset) describe, with the parameters the user set that
@@ -290,6 +293,14 @@ impl McKibbenMuscle {
                 }
             }
             Pipeline::Full(muscle) => {
+                if commit && self.refuse_out_of_range {
+                    // The step is refused (fmi2Discard): its outputs and history stay.
+                    let (p, l) = (inputs.pressure, inputs.length);
+                    if let Some(e) = muscle.refused_past_breaking(p, l, &self.friction) {
+                        log_excursion(&mut self.out_of_range, report, Some(e));
+                        return;
+                    }
+                }
                 let (out, excursion) = muscle.evaluate_with_strands(
                     inputs.pressure,
                     inputs.length,
@@ -491,6 +502,7 @@ impl Model for McKibbenMuscle {
             solver,
             signed_force: p.signed_force,
             strand_stiffness: rigidity(p)? / params.strand_length,
+            refuse_out_of_range: p.out_of_range_policy == 2,
         })
     }
 
@@ -622,6 +634,52 @@ mod tests {
         );
         assert!(exact.iter().all(|d| *d != 0.0));
         assert_eq!(with.get(Unknown::Force), first.get(Unknown::Force));
+    }
+
+    /// Under `out_of_range_policy` 2 a step past the breaking length is refused before it is
+    /// evaluated: the outputs and the friction history stay as the last accepted step left them,
+    /// and the report flags the excursion with the breaking length's reason; under policy 0 the
+    /// same step is evaluated (the strands at the breaking length).
+    #[test]
+    fn a_refused_step_past_breaking_is_not_evaluated() {
+        let base = Parameters {
+            preset: 1,
+            bladder_model: 1,
+            friction: true,
+            ..Default::default()
+        };
+        let x = Inputs {
+            pressure: 3e5,
+            length: 0.1,
+            ..Default::default()
+        };
+        let far = Inputs {
+            length: 0.2,
+            ..x.clone()
+        };
+        for policy in [0, 2] {
+            let p = Parameters {
+                out_of_range_policy: policy,
+                ..base.clone()
+            };
+            let mut m = McKibbenMuscle::new(&p, &x).unwrap();
+            let mut out = Outputs::default();
+            m.step(&x, &mut out, 0.0, 1e-3, &mut Report::default());
+            let (before, history) = (out.clone(), m.friction);
+            let mut report = Report::default();
+            m.step(&far, &mut out, 1e-3, 1e-3, &mut report);
+            assert!(report.clamped());
+            let why = report.clamp_messages().join("");
+            assert!(why.contains("past max_length"), "{why}");
+            if policy == 2 {
+                assert_eq!(out.force, before.force);
+                assert_eq!(m.friction, history);
+                assert!(why.contains("holding the previous outputs"), "{why}");
+            } else {
+                // The strands stretched to the breaking length.
+                assert!(out.force > before.force, "{} {}", out.force, before.force);
+            }
+        }
     }
 
     /// The bare sleeve writes the neutral outputs of the absent effects once per model, and every

@@ -212,6 +212,7 @@ impl FreeBladder {
             absolute: 0.0,
             relative: 1e-15,
             max_iterations: ROOT_ITERATIONS,
+            jump_width: 0.0,
         };
         let root = newton_bisection(lo, hi, 1.0, true, options, |w| {
             let (f, slope, _) = self.shape(w);

@@ -14,6 +14,7 @@ const OPTIONS: RootOptions = RootOptions {
     absolute: 1e-9,
     relative: 1e-13,
     max_iterations: 200,
+    jump_width: 0.0,
 };
 
 /// The result of an inversion.

@@ -55,6 +55,7 @@ impl<S: SleeveGeometry> Bladder<S> {
             absolute: 0.0,
             relative: 1e-14,
             max_iterations: ROOT_ITERATIONS,
+            jump_width: 0.0,
         };
         // Converged where the Newton correction is within the tolerance, as in newton_bisection.
         let converged = |x: f64, k: &Kernel| {

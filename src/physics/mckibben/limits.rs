@@ -116,6 +116,29 @@ impl McKibben {
         })
     }
 
+    /// For a caller that refuses an out-of-range input instead of evaluating it: why
+    /// [`Self::evaluate_with_strands`] would evaluate `length` at another point, decided without
+    /// the strands' transition where one rigid evaluation decides it. Past the breaking length
+    /// with no rigid solution at `length` (always so without a connector, whose reported length
+    /// never exceeds the muscle's), that evaluation is at the breaking length, or at the nearest
+    /// solvable length where the strands do not take over: out of range either way. `None` where
+    /// this does not decide it (the whole evaluation does). The point is `None`: nothing is
+    /// evaluated.
+    pub fn refused_past_breaking(
+        &self,
+        pressure: f64,
+        length: f64,
+        history: &HysteresisState,
+    ) -> Option<OutOfRange> {
+        let out_of_range = self.past_breaking(pressure, length)?;
+        self.evaluate(pressure, length, history)
+            .is_err()
+            .then_some(OutOfRange {
+                point: None,
+                ..out_of_range
+            })
+    }
+
     /// The nearest length the rigid model evaluates: inside the muscle's limits, and by
     /// [`LIMIT_MARGIN`] of the stroke inside them when a bladder makes the limits singular.
     pub fn solvable_length(&self, length: f64) -> f64 {
@@ -376,6 +399,49 @@ impl McKibben {
 mod tests {
     use super::*;
     use crate::physics::mckibben::{BladderModel, MuscleGeometry};
+
+    /// A length past the breaking length that the rigid model cannot reach is refused without
+    /// the strands' transition, and the whole evaluation puts it out of range too; one that a
+    /// soft connector reaches on the rigid branch (a long reported length, a short muscle) is
+    /// left to the whole evaluation, which evaluates it there. Up to the breaking length nothing
+    /// is refused.
+    #[test]
+    fn refusal_past_breaking_agrees_with_the_evaluation() {
+        let rest = HysteresisState::at_rest(0.1);
+        let g = MuscleGeometry::muscle_a();
+        let k_s = 1e6;
+        for (stiffness, pressure) in [(0.0, 3e5), (923.0, 3e5), (923.0, -5e3), (1.0, 3e5)] {
+            let m = McKibben::from_geometry(&g, BladderModel::ThinWall, None, stiffness).unwrap();
+            let breaking = m.breaking_length();
+            for l in [
+                0.5 * breaking,
+                breaking,
+                1.001 * breaking,
+                2.0 * breaking,
+                30.0,
+            ] {
+                let refused = m.refused_past_breaking(pressure, l, &rest);
+                let (out, clamp) = m.evaluate_with_strands(pressure, l, k_s, &rest);
+                if l <= breaking {
+                    assert!(refused.is_none(), "{stiffness} N/m, {l} m");
+                    continue;
+                }
+                match refused {
+                    Some(why) => {
+                        assert!(clamp.is_some(), "{stiffness} N/m, {l} m: {out:?}");
+                        assert!(why.point.is_none() && why.reason.contains("past max_length"));
+                    }
+                    // Only the connector of 1 N/m reaches these lengths at 3e5 Pa.
+                    None => {
+                        assert_eq!(stiffness, 1.0, "{l} m");
+                        let out = out.unwrap();
+                        assert!(clamp.is_none() && out.actual_length < m.max_length());
+                        assert!((out.actual_length + out.force - l).abs() < 1e-9 * l);
+                    }
+                }
+            }
+        }
+    }
 
     /// Where the rigid muscle is stiffer than soft strands (`k_s`) even where its force turns
     /// from a push to a pull, the strands take over at that force's zero `L_0(P)`:

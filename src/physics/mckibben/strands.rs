@@ -102,8 +102,9 @@ impl McKibben {
                 .map(|o| (o.force, o.stiffness, o))
         };
         let range = (self.min_length(), self.max_length());
-        let reach = |soft: &McKibbenOutput| {
-            self.connector_reach(pressure, soft.actual_length, history, branch)
+        let reach = |soft: Option<&McKibbenOutput>| {
+            let from = soft.map_or(self.min_length(), |s| s.actual_length);
+            self.connector_reach(pressure, from, history, branch)
                 .map(|(l, o)| (l, (o.force, o.stiffness, o)))
         };
         transition_within_reach(range, reach, length, strand_stiffness, rigid).map(|t| {
@@ -146,19 +147,21 @@ pub fn transition<T>(
     k_s: f64,
     rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
 ) -> Option<Transition<T>> {
-    transition_within_reach(range, |_: &T| None, length, k_s, rigid)
+    transition_within_reach(range, |_: Option<&T>| None, length, k_s, rigid)
 }
 
 /// [`transition`] for a rigid model whose solutions end at a reach it can find itself from a
 /// length where it has one (a series connector's, [`McKibben::connector_reach`]): `reach(soft)`
-/// gives the longest length with a solution past the soft end's outputs `soft`, and the rigid
-/// model's value there. Where the search's stiff end has no solution and the reach lies inside
-/// the bracket, the boundary is the reach itself if the rigid model holds there (instead of
-/// bisecting through failed solves, each a whole connector solve), else it lies below and is
-/// found by ITP from the reach.
+/// gives the longest length with a solution past the soft end's outputs `soft` (`None`: from
+/// the shortest length), and the rigid model's value there. Where the search's stiff end has no
+/// solution and the reach lies inside the bracket, the boundary is the reach itself if the
+/// rigid model holds there (instead of bisecting through failed solves, each a whole connector
+/// solve), else it lies below and is found by ITP from the reach. Where no halving below the
+/// stiff end has a solution (they fall in gaps where the force jumps), the boundary is the reach
+/// from the shortest length, if the rigid model holds there.
 pub fn transition_within_reach<T>(
     (lo, hi): (f64, f64),
-    reach: impl Fn(&T) -> Option<(f64, (f64, f64, T))>,
+    reach: impl Fn(Option<&T>) -> Option<(f64, (f64, f64, T))>,
     length: f64,
     k_s: f64,
     rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
@@ -200,9 +203,17 @@ pub fn transition_within_reach<T>(
             None => {}
         }
     }
-    let (mut l, (force, mut slope, mut out)) = soft?;
+    let Some((mut l, (force, mut slope, mut out))) = soft else {
+        let (at, found) = reach(None).filter(|(r, _)| at_stiff.is_none() && *r < stiff)?;
+        return (!pulls_stiffer(&found)).then_some(Transition {
+            length: at,
+            rigid: found.2,
+            interior: (found.1 - k_s).abs() <= 1e-6 * k_s,
+            force_zero: false,
+        });
+    };
     if at_stiff.is_none() {
-        if let Some((at, found)) = reach(&out).filter(|(r, _)| *r > l && *r < stiff) {
+        if let Some((at, found)) = reach(Some(&out)).filter(|(r, _)| *r > l && *r < stiff) {
             if !pulls_stiffer(&found) {
                 return Some(Transition {
                     length: at,

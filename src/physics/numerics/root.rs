@@ -16,6 +16,11 @@ pub struct RootOptions {
     pub relative: f64,
     /// Iteration cap (each iteration is one evaluation).
     pub max_iterations: usize,
+    /// Below this bracket width (0: never) a sign change that the slopes cannot explain is a
+    /// jump of `f`, not a root: where the values at the bracket's ends differ by more than 4
+    /// times the steeper end's slope times the width, the finder stops (`Root::jump`). Across
+    /// a root, even at a kink, they differ by at most about that slope times the width.
+    pub jump_width: f64,
 }
 
 /// One evaluation of the function: its value, slope and whatever the caller wants back at the
@@ -35,6 +40,9 @@ pub struct Root<T> {
     pub payload: Option<T>,
     /// False when the iteration cap was reached before the stopping rule held.
     pub converged: bool,
+    /// The sign change is a jump of `f` (see [`RootOptions::jump_width`]): `x` is next to it,
+    /// not a root.
+    pub jump: bool,
 }
 
 /// Root of `f` in the bracket between `lo` and `hi` (either order), starting from `start`
@@ -57,6 +65,8 @@ pub fn newton_bisection<T, E>(
     };
     let orientation = if rising { 1.0 } else { -1.0 };
     let mut payload = None;
+    // (value, slope) evaluated at `lo` and `hi`, once they are.
+    let (mut at_lo, mut at_hi) = (None, None);
     for _ in 0..options.max_iterations {
         let Some(s) = eval(x)? else {
             x = 0.5 * (lo + hi);
@@ -70,12 +80,13 @@ pub fn newton_bisection<T, E>(
                 x,
                 payload,
                 converged: true,
+                jump: false,
             });
         }
         if orientation * value < 0.0 {
-            lo = x;
+            (lo, at_lo) = (x, Some((value, slope)));
         } else {
-            hi = x;
+            (hi, at_hi) = (x, Some((value, slope)));
         }
         let newton = x - value / slope;
         let newton_ok = newton.is_finite() && orientation * slope > 0.0;
@@ -84,7 +95,21 @@ pub fn newton_bisection<T, E>(
                 x,
                 payload,
                 converged: true,
+                jump: false,
             });
+        }
+        if let (true, Some((v_lo, s_lo)), Some((v_hi, s_hi))) =
+            (hi - lo <= options.jump_width, at_lo, at_hi)
+        {
+            let steeper = f64::max(s_lo.abs(), s_hi.abs());
+            if (v_hi - v_lo).abs() > 4.0 * steeper * (hi - lo) {
+                return Ok(Root {
+                    x,
+                    payload,
+                    converged: false,
+                    jump: true,
+                });
+            }
         }
         x = if newton_ok && newton > lo && newton < hi {
             newton
@@ -96,6 +121,7 @@ pub fn newton_bisection<T, E>(
         x,
         payload,
         converged: false,
+        jump: false,
     })
 }
 
@@ -108,6 +134,7 @@ mod tests {
             absolute: 0.0,
             relative: 1e-15,
             max_iterations: 100,
+            jump_width: 0.0,
         }
     }
 
@@ -176,6 +203,33 @@ mod tests {
         .unwrap();
         assert!(r.converged && (r.x - 0.3).abs() < 1e-15, "{}", r.x);
         assert_eq!(r.payload, Some(r.x));
+    }
+
+    /// A sign change at a jump is reported as one once the bracket is narrower than
+    /// `jump_width`, a root at a kink (the slope steps from 1 to 1e6) is not, and without
+    /// `jump_width` the finder narrows onto the jump as onto a root.
+    #[test]
+    fn a_jump_is_told_from_a_kink() {
+        let jump = |x: f64| (if x < 0.3 { x - 0.5 } else { x + 0.5 }, 1.0);
+        let kink = |x: f64| {
+            if x < 0.3 {
+                (x - 0.3, 1.0)
+            } else {
+                (1e6 * (x - 0.3), 1e6)
+            }
+        };
+        let with = RootOptions {
+            jump_width: 1e-9,
+            ..options()
+        };
+        let r = newton_bisection(0.0, 1.0, 0.9, true, with, plain(jump)).unwrap();
+        assert!(r.jump && !r.converged && (r.x - 0.3).abs() < 1e-9, "{r:?}");
+        let r = newton_bisection(0.0, 1.0, 0.9, true, options(), plain(jump)).unwrap();
+        assert!(!r.jump && r.converged && (r.x - 0.3).abs() < 1e-15, "{r:?}");
+        for start in [0.0, 0.29, 0.31, 1.0] {
+            let r = newton_bisection(0.0, 1.0, start, true, with, plain(kink)).unwrap();
+            assert!(!r.jump && r.converged && (r.x - 0.3).abs() < 1e-15, "{r:?}");
+        }
     }
 
     #[test]
