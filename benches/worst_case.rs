@@ -15,7 +15,7 @@
 //!
 //! `WORST_CASE_MODELS=A,B` restricts the FMUs; `WORST_CASE_POINTS=n` the random points;
 //! `WORST_CASE_REPORT_ABOVE=s` lists every case whose step or initialization takes longer than
-//! `s` seconds (default 1).
+//! `s` seconds (default 1); `WORST_CASE_STEP_ABOVE=s` lists those whose slowest step does.
 
 #[path = "../tests/common/mod.rs"]
 #[allow(dead_code)]
@@ -310,6 +310,10 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(1.0);
+    let step_above: f64 = std::env::var("WORST_CASE_STEP_ABOVE")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or(f64::INFINITY);
     let overhead = clock_cost();
     println!(
         "(thread CPU time; the clock's own {:.0} ns subtracted)\n",
@@ -368,7 +372,8 @@ fn main() {
         let mut measure = |label: String, values: Vec<f64>, cases: &mut Vec<Case>| {
             let (init, steps, refused, step_refused) =
                 run(&api, info, &knobs, &values, h, overhead);
-            let slow = steps.iter().copied().fold(init, f64::max);
+            let slowest_step = steps.iter().copied().fold(0.0, f64::max);
+            let slow = slowest_step.max(init);
             let describe = |only_changed: bool| -> Vec<String> {
                 knobs
                     .iter()
@@ -377,11 +382,12 @@ fn main() {
                     .map(|(k, x)| format!("{}={x:.3e}", k.name))
                     .collect()
             };
-            if slow > report_above {
+            if slow > report_above || slowest_step > step_above {
                 eprintln!(
-                    "{}: {label}: {:.1} us [{}]",
+                    "{}: {label}: {:.1} us (step {:.1} us) [{}]",
                     info.name,
                     slow * 1e6,
+                    slowest_step * 1e6,
                     describe(true).join(" ")
                 );
             }

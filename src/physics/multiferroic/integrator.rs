@@ -259,7 +259,10 @@ impl Motor {
             }
         }
         if !self.quasi_static() {
-            if let Some((u, err)) = self.gilbert_embedded_step(y, dt, d) {
+            if let Some((u, err)) = self
+                .gilbert_explicit_step(y, dt, d)
+                .or_else(|| self.gilbert_embedded_step(y, dt, d))
+            {
                 return Some((u, err, dt, None));
             }
         }
