@@ -324,6 +324,11 @@ impl Motor {
         rim_barrier: Option<&mut Rims>,
         remaining: f64,
     ) -> Option<f64> {
+        // Without the averaged ringing only the first test can pass, and its slack is at most
+        // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle.
+        if rim_barrier.is_none() && !(y[3].abs() <= self.params.tolerance + MAX_FOLLOWED_LAG) {
+            return None;
+        }
         let settled = self.settle(y, d);
         if self.onion_relaxes_fast() {
             let lag_time = self.onion_relaxation_time();
@@ -374,10 +379,10 @@ impl Motor {
     /// once it is trapped, at the cost of the onion's outputs: it is reported at the centre of its
     /// ringing, the minimum, not at the ringing's phase.
     ///
-    /// A locked rotor feels no ringing: trapped ringing is dropped there when it decays to within
-    /// the tolerance of the minimum in the `remaining` time of its segment (s), at its bound on
-    /// the decay rate, so that the onion meets the segment's end, and the next switch, where the
-    /// resolved one does.
+    /// A locked rotor feels no ringing: trapped ringing is also dropped there when it decays to
+    /// within the tolerance of the minimum in the `remaining` time of its segment (s), at its
+    /// bound on the decay rate, so that the onion meets the segment's end (the step's end or the
+    /// next switch) where the resolved one does.
     pub(super) fn averaged_ringing(
         &self,
         y: &Vector,
@@ -386,11 +391,6 @@ impl Motor {
         rim_barrier: &mut Rims,
         remaining: f64,
     ) -> Option<f64> {
-        if d.locked {
-            let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, 0.0)))?;
-            let decayed = trap.amplitude * (-trap.rate * remaining).exp();
-            return (decayed <= self.params.tolerance).then_some(0.0);
-        }
         let limit = 0.1 * self.params.tolerance * self.drag;
         let k_bar = self.ring_bar.stiffness(settled - y[0]);
         // The rims are looked for only where ringing anywhere in the turn, and the rotor's turn
@@ -398,9 +398,16 @@ impl Motor {
         let turn = 2.0 * std::f64::consts::PI;
         let widest = turn * (k_bar.abs() + self.ring_bar_slope_bound * turn);
         let speed = if d.locked { 0.0 } else { y[1].abs() };
-        let least_rate = (widest / limit).max(speed * self.drag / limit);
+        let least_rate = if d.locked {
+            0.0
+        } else {
+            (widest / limit).max(speed * self.drag / limit)
+        };
         let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, least_rate)))?;
         let (amplitude, rate) = (trap.amplitude, trap.rate);
+        if d.locked && amplitude * (-rate * remaining).exp() <= self.params.tolerance {
+            return Some(0.0);
+        }
         // (A NaN fails every bound below.)
         if speed * self.drag > limit * rate {
             return None;
