@@ -326,7 +326,8 @@ impl Motor {
     ) -> Option<f64> {
         // Without the averaged ringing only the first test can pass, and its slack is at most
         // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle.
-        if rim_barrier.is_none() && !(y[3].abs() <= self.params.tolerance + MAX_FOLLOWED_LAG) {
+        let small_tilt = y[3].abs() <= self.params.tolerance + MAX_FOLLOWED_LAG;
+        if rim_barrier.is_none() && !small_tilt {
             return None;
         }
         let settled = self.settle(y, d);
