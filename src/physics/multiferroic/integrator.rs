@@ -235,7 +235,8 @@ impl Motor {
     /// One error-controlled substep: the new state, its error relative to the tolerance and the
     /// time it advances (`dt`, or less when the quasi-static onion snaps inside it, see
     /// [`Self::step_to_onion_snap`]). The quasi-static rotor uses the embedded pair
-    /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`]);
+    /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`],
+    /// or within its reach and unless `forced` the explicit [`Self::gilbert_explicit_step`]);
     /// step doubling remains where either does not apply.
     /// `angles` are those at `y`; the result carries those at the new state when known.
     pub(super) fn controlled_step(
@@ -244,6 +245,7 @@ impl Motor {
         dt: f64,
         d: &Drive,
         angles: &Angles,
+        forced: bool,
         bisections: &mut u32,
     ) -> Option<(Vector, f64, f64, Option<Angles>)> {
         if self.quasi_static() && !d.locked {
@@ -259,7 +261,12 @@ impl Motor {
             }
         }
         if !self.quasi_static() {
-            if let Some((u, err)) = self.gilbert_embedded_step(y, dt, d) {
+            // A forced substep takes the exponential pair, which cannot amplify.
+            if let Some((u, err)) = (!forced)
+                .then(|| self.gilbert_explicit_step(y, dt, d))
+                .flatten()
+                .or_else(|| self.gilbert_embedded_step(y, dt, d))
+            {
                 return Some((u, err, dt, None));
             }
         }
@@ -487,7 +494,7 @@ impl Motor {
         run.angles = Some(angles);
         // A substep across a snap of the onion is charged its bisection's substeps too.
         let mut bisections = 0;
-        let result = self.controlled_step(&run.y, dt_try, d, &angles, &mut bisections);
+        let result = self.controlled_step(&run.y, dt_try, d, &angles, forced, &mut bisections);
         run.extra_cost = run.extra_cost.saturating_add(bisections);
         match result {
             Some((y_new, err, taken, new_angles)) if err <= 1.0 || forced => {

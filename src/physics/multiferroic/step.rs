@@ -42,7 +42,7 @@ pub(super) struct StepRun {
     pub(super) following: f64,
     /// The lowest rim of the Gilbert onion's well found in the segment ending at the first value
     /// (J above its minimum, infinite before the search; see [`Motor::trapped_ringing`]).
-    pub(super) rim_barrier: (f64, f64),
+    pub(super) rim_barrier: (f64, Rims),
     /// The attempt from which the Gilbert onion's averaged ringing is tried next.
     pub(super) average_check_at: u32,
     /// The stepping schedule switching inside this step, if any.
@@ -79,7 +79,7 @@ impl StepRun {
             angles: None,
             settled: false,
             following: f64::NAN,
-            rim_barrier: (f64::NAN, f64::INFINITY),
+            rim_barrier: (f64::NAN, Rims::NONE),
             average_check_at: 0,
             schedule: None,
         }
@@ -281,7 +281,7 @@ impl Motor {
             // one substep in the budget.
             run.extra_cost = run.extra_cost.saturating_add(1);
             if run.rim_barrier.0 != segment_end {
-                run.rim_barrier = (segment_end, f64::INFINITY);
+                run.rim_barrier = (segment_end, Rims::NONE);
             }
             // The averaging's check costs about half a Gilbert substep: it is tried at attempts
             // spaced by an eighth of those made (the ringing decays geometrically in time).
@@ -290,7 +290,7 @@ impl Motor {
                 run.average_check_at = run.attempts + 1 + run.attempts / 8;
             }
             let rims = average.then_some(&mut run.rim_barrier.1);
-            match self.relaxed_onion(&run.y, d, rims) {
+            match self.relaxed_onion(&run.y, d, rims, segment_end - run.t) {
                 // The averaged ringing's impulse on the rotor.
                 Some(kick) => run.y[1] += kick,
                 None => return false,
@@ -327,13 +327,20 @@ impl Motor {
     /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
     /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
     /// The averaged ringing is tried when `rim_barrier` is given, the lowest rim found in this
-    /// segment (see [`Self::trapped_ringing`]).
+    /// segment (see [`Self::trapped_ringing`]); `remaining` is the time left in the segment (s).
     pub(super) fn relaxed_onion(
         &self,
         y: &Vector,
         d: &Drive,
-        rim_barrier: Option<&mut f64>,
+        rim_barrier: Option<&mut Rims>,
+        remaining: f64,
     ) -> Option<f64> {
+        // Without the averaged ringing only the first test can pass, and its slack is at most
+        // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle.
+        let small_tilt = y[3].abs() <= self.params.tolerance + MAX_FOLLOWED_LAG;
+        if rim_barrier.is_none() && !small_tilt {
+            return None;
+        }
         let settled = self.settle(y, d);
         if self.onion_relaxes_fast() {
             let lag_time = self.onion_relaxation_time();
@@ -346,7 +353,7 @@ impl Motor {
                 return Some(0.0);
             }
         }
-        self.averaged_ringing(y, d, settled, rim_barrier?)
+        self.averaged_ringing(y, d, settled, rim_barrier?, remaining)
     }
 
     /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
@@ -383,12 +390,18 @@ impl Motor {
     /// This replaces resolving the ringing (about `1/alpha` precession periods per decay time)
     /// once it is trapped, at the cost of the onion's outputs: it is reported at the centre of its
     /// ringing, the minimum, not at the ringing's phase.
+    ///
+    /// A locked rotor feels no ringing: trapped ringing is also dropped there when it decays to
+    /// within the tolerance of the minimum in the `remaining` time of its segment (s), at its
+    /// bound on the decay rate, so that the onion meets the segment's end (the step's end or the
+    /// next switch) where the resolved one does.
     pub(super) fn averaged_ringing(
         &self,
         y: &Vector,
         d: &Drive,
         settled: f64,
-        rim_barrier: &mut f64,
+        rim_barrier: &mut Rims,
+        remaining: f64,
     ) -> Option<f64> {
         let limit = 0.1 * self.params.tolerance * self.drag;
         let k_bar = self.ring_bar.stiffness(settled - y[0]);
@@ -397,9 +410,16 @@ impl Motor {
         let turn = 2.0 * std::f64::consts::PI;
         let widest = turn * (k_bar.abs() + self.ring_bar_slope_bound * turn);
         let speed = if d.locked { 0.0 } else { y[1].abs() };
-        let least_rate = (widest / limit).max(speed * self.drag / limit);
+        let least_rate = if d.locked {
+            0.0
+        } else {
+            (widest / limit).max(speed * self.drag / limit)
+        };
         let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, least_rate)))?;
         let (amplitude, rate) = (trap.amplitude, trap.rate);
+        if d.locked && amplitude * (-rate * remaining).exp() <= self.params.tolerance {
+            return Some(0.0);
+        }
         // (A NaN fails every bound below.)
         if speed * self.drag > limit * rate {
             return None;
@@ -426,17 +446,18 @@ impl Motor {
     /// The Gilbert onion's ringing about `settled` when it is trapped in that minimum's well and
     /// relaxes within a tenth of the rotor's relaxation time (see [`Self::averaged_ringing`]).
     ///
-    /// Out of the window about the minimum, the rims are looked for when `rims` is given, its
-    /// first value is infinite (no search yet in this segment; the search, a march over the well
-    /// both ways, sets it to the lowest rim's height above the minimum) and the decay rate that
-    /// the ringing out to the rims is held to ([`RIM_SLOWDOWN`] times slower than at the minimum)
-    /// is at least its second value (1/s).
+    /// Out of the window about the minimum, the rims are looked for when `rims` is given, none
+    /// were found yet in this segment (the search, a march over the well both ways, records
+    /// them) or, for a locked rotor, they were found for another minimum, and the decay rate
+    /// that the ringing out to the rims is held to ([`RIM_SLOWDOWN`] times slower than at the
+    /// minimum) is at least its second value (1/s). A locked rotor's rims found for this minimum
+    /// are used again (its landscape is frozen).
     pub(super) fn trapped_ringing(
         &self,
         y: &Vector,
         d: &Drive,
         settled: f64,
-        rims: Option<(&mut f64, f64)>,
+        rims: Option<(&mut Rims, f64)>,
     ) -> Option<Trap> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let k = land.curvature(settled);
@@ -465,17 +486,31 @@ impl Motor {
         if near < window {
             return Some(trap(near, rate, true));
         }
-        let lowest = match rims {
-            Some((lowest, least_rate))
-                if rate >= least_rate * RIM_SLOWDOWN && lowest.is_infinite() =>
-            {
-                lowest
-            }
+        let found = match rims {
+            Some((found, least_rate)) if rate >= least_rate * RIM_SLOWDOWN => found,
             _ => return None,
         };
-        let (below, above) = land.well_rims(settled, 0.5 * window);
-        let barrier = land.energy(below).min(land.energy(above)) - land.energy(settled);
-        *lowest = barrier;
+        // A locked rotor's landscape is frozen: the well found in this segment stays the same
+        // as long as the onion settles into the same minimum.
+        let same_well = d.locked && (found.minimum - settled).abs() <= 1e-9;
+        if !same_well {
+            if found.barrier.is_finite() && !d.locked {
+                return None;
+            }
+            let (below, above) = land.well_rims(settled, 0.5 * window);
+            *found = Rims {
+                barrier: land.energy(below).min(land.energy(above)) - land.energy(settled),
+                minimum: settled,
+                below,
+                above,
+            };
+        }
+        let Rims {
+            barrier,
+            below,
+            above,
+            ..
+        } = *found;
         (below < y[2] && y[2] < above && excess < 0.99 * barrier).then(|| {
             let reach = (above - settled).max(settled - below);
             trap(reach, rate / RIM_SLOWDOWN, false)
@@ -532,6 +567,26 @@ impl Motor {
 /// 3.1) against 0.32 us per budget unit of the quasi-static onion's (release, x86-64, loaded
 /// 2-core machine), so the budget bounds a step's cost alike in both onion models.
 pub const GILBERT_SUBSTEP_WEIGHT: u32 = 4;
+
+/// The rims of the Gilbert onion's well found in a segment (see [`Motor::trapped_ringing`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Rims {
+    /// The lowest rim's height above the minimum (J); infinite before the search.
+    pub(super) barrier: f64,
+    /// The minimum whose well it is, and the well's rims (rad).
+    pub(super) minimum: f64,
+    pub(super) below: f64,
+    pub(super) above: f64,
+}
+
+impl Rims {
+    pub(super) const NONE: Rims = Rims {
+        barrier: f64::INFINITY,
+        minimum: f64::NAN,
+        below: f64::NAN,
+        above: f64::NAN,
+    };
+}
 
 /// A Gilbert onion's ringing trapped in the well of a minimum (see [`Motor::averaged_ringing`]).
 pub(super) struct Trap {
