@@ -4,12 +4,7 @@
 //! array of no size, named like a variable or another array, depending on what is not an output,
 //! or with an unknown attribute is refused with the reason.
 
-#[allow(dead_code)]
-#[path = "../../build/fmi3_description.rs"]
-mod fmi3_description;
-#[allow(dead_code)]
-#[path = "../../build/model_description.rs"]
-mod model_description;
+use crate::build_script::{fmi3_description, model_description};
 
 const SOURCE: &str = include_str!("../../modelDescription/McKibbenMuscle.xml");
 const ARRAY: &str = r#"<Array name="wall_radius" size="9" unit="m" dependenciesOf="stress_hoop""#;

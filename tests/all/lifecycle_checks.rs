@@ -3,8 +3,7 @@
 //! clocks or outputs no run produces.
 
 use crate::common;
-#[path = "../common/exercise.rs"]
-mod exercise;
+use crate::exercise;
 
 use common::*;
 use exercise::*;

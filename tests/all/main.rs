@@ -12,8 +12,12 @@
 /// One copy of the shared helpers for every module (`use crate::common`).
 #[path = "../common/mod.rs"]
 mod common;
+/// The call sequences that exercise every model, shared by the lifecycle and restore checks.
+#[path = "../common/exercise.rs"]
+mod exercise;
 
 mod bad_input;
+mod build_script;
 mod c_abi;
 mod declared_ranges;
 mod fmi3_arrays;

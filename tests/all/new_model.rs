@@ -11,12 +11,7 @@
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-#[allow(dead_code)]
-#[path = "../../build/codegen.rs"]
-mod codegen;
-#[allow(dead_code)]
-#[path = "../../build/model_description.rs"]
-mod model_description;
+use crate::build_script::{codegen, model_description};
 
 fn documented_files() -> Vec<(String, String)> {
     let doc = Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/adding-a-model.md");

@@ -6,8 +6,7 @@
 //! `f64::clamp` and returned fmi2Fatal (found by `make fuzz SANITIZER=none`).
 
 use crate::common;
-#[path = "../common/exercise.rs"]
-mod exercise;
+use crate::exercise;
 
 use common::*;
 use exercise::*;

@@ -2,12 +2,7 @@
 //! description gets the export layer's part and the ModelStructure indices; the GUID follows every
 //! change to the variables.
 
-#[allow(dead_code)]
-#[path = "../../build/codegen.rs"]
-mod codegen;
-#[allow(dead_code)]
-#[path = "../../build/model_description.rs"]
-mod model_description;
+use crate::build_script::{codegen, model_description};
 
 use model_description::{check, guid_of, ResolvedUnknown};
 
