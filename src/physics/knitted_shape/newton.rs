@@ -22,6 +22,8 @@ pub(super) const MAX_PATH_ITERATIONS: usize = 40;
 const MAX_RELEASES: u8 = 3;
 /// Consecutive steps that move no ring beyond roundoff before the fast path gives up.
 const MAX_IDLE_STEPS: usize = 3;
+/// Pocket edges put back on the floor in one solve after converging to a saddle.
+const MAX_EDGE_HOLDS: usize = 2;
 /// Step halvings when a step leaves a segment unable to close.
 const MAX_BACKTRACKS: usize = 30;
 
@@ -54,7 +56,8 @@ impl Solver {
         let mut last_residual = f64::INFINITY;
         self.releases.iter_mut().for_each(|n| *n = 0);
         let mut idle = 0;
-        let mut last_shift = 0.0;
+        let mut last_shift = self.shift_hint;
+        let mut edge_holds = 0;
         for iteration in 0..max_iterations + MAX_BACKTRACKS {
             let Some((length, volume)) = self.assemble(geom) else {
                 let (alpha, lambda0, dlambda) = step?;
@@ -135,6 +138,21 @@ impl Solver {
                 let maximum = pos + usize::from(gy < 0.0) == 1
                     || (self.is_mirror_symmetric(r_ceiling)
                         && self.symmetric_ascents(lambda) == Some(1));
+                if !maximum && edge_holds < MAX_EDGE_HOLDS {
+                    if let Some(j) = self.lowest_edge_ring() {
+                        edge_holds += 1;
+                        // A mirror-symmetric profile stays symmetric: the twin goes down too.
+                        let twin = rings - 1 - j;
+                        if self.is_mirror_symmetric(r_ceiling) {
+                            self.held[twin] = true;
+                            self.radii[twin] = r_min;
+                        }
+                        self.held[j] = true;
+                        self.radii[j] = r_min;
+                        last_residual = f64::INFINITY;
+                        continue;
+                    }
+                }
                 if !maximum {
                     return None;
                 }
@@ -212,12 +230,13 @@ impl Solver {
         s_row: f64,
         last_shift: &mut f64,
     ) -> Option<(f64, f64)> {
-        let mut mu = (1e-8 * s_row).max(*last_shift / 16.0);
+        let mut mu = (1e-8 * s_row).max(*last_shift / 4.0);
         for _ in 0..80 {
             if let Some(pos) = self.shifted_solve(lambda, mu) {
                 let (gx, gy) = self.border_products();
                 if pos + usize::from(gy < 0.0) == 1 && gy != 0.0 {
                     *last_shift = mu;
+                    self.shift_hint = mu;
                     return Some((gx, gy));
                 }
             }
@@ -246,6 +265,17 @@ impl Solver {
                 self.radii[j] = crate::physics::numerics::bounds::limit(r, r_min, r_ceiling);
             }
         }
+    }
+
+    /// The free ring next to a held one (a pocket's edge) with the smallest radius.
+    fn lowest_edge_ring(&self) -> Option<usize> {
+        let rings = self.radii.len();
+        (1..rings - 1)
+            .filter(|&j| {
+                !self.held[j]
+                    && ((j > 1 && self.held[j - 1]) || (j + 2 < rings && self.held[j + 1]))
+            })
+            .min_by(|&a, &b| self.radii[a].total_cmp(&self.radii[b]))
     }
 
     /// First ring off the floor from the left clamp (the pocket's edge); the last ring if none.
