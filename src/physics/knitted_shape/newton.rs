@@ -24,6 +24,8 @@ const MAX_RELEASES: u8 = 3;
 const MAX_IDLE_STEPS: usize = 3;
 /// Pocket edges put back on the floor in one solve after converging to a saddle.
 const MAX_EDGE_HOLDS: usize = 2;
+/// Steps towards a saddle (one ascent, active set unchanged) before its edge is put down.
+const SADDLE_STEPS: usize = 2;
 /// Step halvings when a step leaves a segment unable to close.
 const MAX_BACKTRACKS: usize = 30;
 
@@ -58,6 +60,7 @@ impl Solver {
         let mut idle = 0;
         let mut last_shift = self.shift_hint;
         let mut edge_holds = 0;
+        let mut saddle_run = 0;
         for iteration in 0..max_iterations + MAX_BACKTRACKS {
             let Some((length, volume)) = self.assemble(geom) else {
                 let (alpha, lambda0, dlambda) = step?;
@@ -125,17 +128,25 @@ impl Solver {
             let floor = grad_tol.max(1e-9 * largest_term);
             let stalled = residual <= 1e3 * floor && residual > 0.5 * last_residual;
             last_residual = residual;
-            if !set_changed
+            let converged = !set_changed
                 && (residual <= grad_tol || stalled)
-                && (length - target).abs() <= length_tol
-            {
+                && (length - target).abs() <= length_tol;
+            // Steps that keep one ascent with the set unchanged are converging on a saddle:
+            // its edge is put down (below) without converging there first.
+            let bordered = pos + usize::from(gy < 0.0);
+            saddle_run = if !set_changed && bordered == 2 {
+                saddle_run + 1
+            } else {
+                0
+            };
+            if converged || saddle_run >= SADDLE_STEPS {
                 // Converged. A maximum has a negative definite reduced Hessian: the bordered
                 // matrix has exactly one positive eigenvalue. The pocket centred on the lattice
                 // can instead be a saddle whose one ascent is antisymmetric (a shift by part of a
                 // segment, worth far less volume than the table's accuracy); the robust solve,
                 // which releases rings in mirror pairs, stays on it too, so a symmetric profile
                 // is accepted if it is a maximum among symmetric profiles.
-                let maximum = pos + usize::from(gy < 0.0) == 1
+                let maximum = bordered == 1
                     || (self.is_mirror_symmetric(r_ceiling)
                         && self.symmetric_ascents(lambda) == Some(1));
                 if !maximum && edge_holds < MAX_EDGE_HOLDS {
@@ -150,9 +161,15 @@ impl Solver {
                         self.held[j] = true;
                         self.radii[j] = r_min;
                         last_residual = f64::INFINITY;
+                        saddle_run = 0;
                         continue;
                     }
                 }
+            }
+            if converged {
+                let maximum = bordered == 1
+                    || (self.is_mirror_symmetric(r_ceiling)
+                        && self.symmetric_ascents(lambda) == Some(1));
                 if !maximum {
                     return None;
                 }
