@@ -22,7 +22,7 @@ pub(super) const MAX_PATH_ITERATIONS: usize = 40;
 const MAX_RELEASES: u8 = 3;
 /// Consecutive steps that move no ring beyond roundoff before the fast path gives up.
 const MAX_IDLE_STEPS: usize = 3;
-/// Pocket edges put back on the floor in one solve after converging to a saddle.
+/// Pocket edges put back on the floor in one solve when Newton heads for a saddle.
 const MAX_EDGE_HOLDS: usize = 2;
 /// Steps towards a saddle (one ascent, active set unchanged) before its edge is put down.
 const SADDLE_STEPS: usize = 2;
@@ -131,45 +131,45 @@ impl Solver {
             let converged = !set_changed
                 && (residual <= grad_tol || stalled)
                 && (length - target).abs() <= length_tol;
-            // Steps that keep one ascent with the set unchanged are converging on a saddle:
-            // its edge is put down (below) without converging there first.
+            // Steps that keep one ascent with the set unchanged are converging on a saddle.
             let bordered = pos + usize::from(gy < 0.0);
             saddle_run = if !set_changed && bordered == 2 {
                 saddle_run + 1
             } else {
                 0
             };
-            if converged || saddle_run >= SADDLE_STEPS {
-                // Converged. A maximum has a negative definite reduced Hessian: the bordered
-                // matrix has exactly one positive eigenvalue. The pocket centred on the lattice
-                // can instead be a saddle whose one ascent is antisymmetric (a shift by part of a
-                // segment, worth far less volume than the table's accuracy); the robust solve,
-                // which releases rings in mirror pairs, stays on it too, so a symmetric profile
-                // is accepted if it is a maximum among symmetric profiles.
-                let maximum = bordered == 1
+            let checked = converged || saddle_run >= SADDLE_STEPS;
+            // A maximum has a negative definite reduced Hessian: the bordered matrix has exactly
+            // one positive eigenvalue. The pocket centred on the lattice can instead be a saddle
+            // whose one ascent is antisymmetric (a shift by part of a segment, worth far less
+            // volume than the table's accuracy); the robust solve, which releases rings in
+            // mirror pairs, stays on it too, so a symmetric profile is accepted if it is a
+            // maximum among symmetric profiles.
+            let maximum = checked
+                && (bordered == 1
                     || (self.is_mirror_symmetric(r_ceiling)
-                        && self.symmetric_ascents(lambda) == Some(1));
-                if !maximum && edge_holds < MAX_EDGE_HOLDS {
-                    if let Some(j) = self.lowest_edge_ring() {
-                        edge_holds += 1;
-                        // A mirror-symmetric profile stays symmetric: the twin goes down too.
-                        let twin = rings - 1 - j;
-                        if self.is_mirror_symmetric(r_ceiling) {
-                            self.held[twin] = true;
-                            self.radii[twin] = r_min;
-                        }
-                        self.held[j] = true;
-                        self.radii[j] = r_min;
-                        last_residual = f64::INFINITY;
-                        saddle_run = 0;
-                        continue;
+                        && self.symmetric_ascents(lambda) == Some(1)));
+            // On a thin strand the saddle is often a pocket one ring too wide: its edge ring
+            // sits just off the floor, where the cone's volume (eq. 1.18) is still convex in its
+            // radius, and the ascent puts it down. That ring goes back on the floor and Newton
+            // goes on from there (the robust solve would start over from the prediction).
+            if checked && !maximum && edge_holds < MAX_EDGE_HOLDS {
+                if let Some(j) = self.lowest_edge_ring() {
+                    edge_holds += 1;
+                    // A mirror-symmetric profile stays symmetric: the twin goes down too.
+                    let twin = rings - 1 - j;
+                    if self.is_mirror_symmetric(r_ceiling) {
+                        self.held[twin] = true;
+                        self.radii[twin] = r_min;
                     }
+                    self.held[j] = true;
+                    self.radii[j] = r_min;
+                    last_residual = f64::INFINITY;
+                    saddle_run = 0;
+                    continue;
                 }
             }
             if converged {
-                let maximum = bordered == 1
-                    || (self.is_mirror_symmetric(r_ceiling)
-                        && self.symmetric_ascents(lambda) == Some(1));
                 if !maximum {
                     return None;
                 }
@@ -284,7 +284,7 @@ impl Solver {
         }
     }
 
-    /// The free ring next to a held one (a pocket's edge) with the smallest radius.
+    /// The lowest free ring next to a held interior ring (a pocket's edge, not a clamp's).
     fn lowest_edge_ring(&self) -> Option<usize> {
         let rings = self.radii.len();
         (1..rings - 1)
