@@ -22,6 +22,10 @@ pub(super) const MAX_PATH_ITERATIONS: usize = 40;
 const MAX_RELEASES: u8 = 3;
 /// Consecutive steps that move no ring beyond roundoff before the fast path gives up.
 const MAX_IDLE_STEPS: usize = 3;
+/// Pocket edges put back on the floor in one solve when Newton heads for a saddle.
+const MAX_EDGE_HOLDS: usize = 2;
+/// Steps towards a saddle (one ascent, active set unchanged) before its edge is put down.
+const SADDLE_STEPS: usize = 2;
 /// Step halvings when a step leaves a segment unable to close.
 const MAX_BACKTRACKS: usize = 30;
 
@@ -54,7 +58,9 @@ impl Solver {
         let mut last_residual = f64::INFINITY;
         self.releases.iter_mut().for_each(|n| *n = 0);
         let mut idle = 0;
-        let mut last_shift = 0.0;
+        let mut last_shift = self.shift_hint;
+        let mut edge_holds = 0;
+        let mut saddle_run = 0;
         for iteration in 0..max_iterations + MAX_BACKTRACKS {
             let Some((length, volume)) = self.assemble(geom) else {
                 let (alpha, lambda0, dlambda) = step?;
@@ -122,19 +128,48 @@ impl Solver {
             let floor = grad_tol.max(1e-9 * largest_term);
             let stalled = residual <= 1e3 * floor && residual > 0.5 * last_residual;
             last_residual = residual;
-            if !set_changed
+            let converged = !set_changed
                 && (residual <= grad_tol || stalled)
-                && (length - target).abs() <= length_tol
-            {
-                // Converged. A maximum has a negative definite reduced Hessian: the bordered
-                // matrix has exactly one positive eigenvalue. The pocket centred on the lattice
-                // can instead be a saddle whose one ascent is antisymmetric (a shift by part of a
-                // segment, worth far less volume than the table's accuracy); the robust solve,
-                // which releases rings in mirror pairs, stays on it too, so a symmetric profile
-                // is accepted if it is a maximum among symmetric profiles.
-                let maximum = pos + usize::from(gy < 0.0) == 1
+                && (length - target).abs() <= length_tol;
+            // Steps that keep one ascent with the set unchanged are converging on a saddle.
+            let bordered = pos + usize::from(gy < 0.0);
+            saddle_run = if !set_changed && bordered == 2 {
+                saddle_run + 1
+            } else {
+                0
+            };
+            let checked = converged || saddle_run >= SADDLE_STEPS;
+            // A maximum has a negative definite reduced Hessian: the bordered matrix has exactly
+            // one positive eigenvalue. The pocket centred on the lattice can instead be a saddle
+            // whose one ascent is antisymmetric (a shift by part of a segment, worth far less
+            // volume than the table's accuracy); the robust solve, which releases rings in
+            // mirror pairs, stays on it too, so a symmetric profile is accepted if it is a
+            // maximum among symmetric profiles.
+            let maximum = checked
+                && (bordered == 1
                     || (self.is_mirror_symmetric(r_ceiling)
-                        && self.symmetric_ascents(lambda) == Some(1));
+                        && self.symmetric_ascents(lambda) == Some(1)));
+            // On a thin strand the saddle is often a pocket one ring too wide: its edge ring
+            // sits just off the floor, where the cone's volume (eq. 1.18) is still convex in its
+            // radius, and the ascent puts it down. That ring goes back on the floor and Newton
+            // goes on from there (the robust solve would start over from the prediction).
+            if checked && !maximum && edge_holds < MAX_EDGE_HOLDS {
+                if let Some(j) = self.lowest_edge_ring() {
+                    edge_holds += 1;
+                    // A mirror-symmetric profile stays symmetric: the twin goes down too.
+                    let twin = rings - 1 - j;
+                    if self.is_mirror_symmetric(r_ceiling) {
+                        self.held[twin] = true;
+                        self.radii[twin] = r_min;
+                    }
+                    self.held[j] = true;
+                    self.radii[j] = r_min;
+                    last_residual = f64::INFINITY;
+                    saddle_run = 0;
+                    continue;
+                }
+            }
+            if converged {
                 if !maximum {
                     return None;
                 }
@@ -212,12 +247,13 @@ impl Solver {
         s_row: f64,
         last_shift: &mut f64,
     ) -> Option<(f64, f64)> {
-        let mut mu = (1e-8 * s_row).max(*last_shift / 16.0);
+        let mut mu = (1e-8 * s_row).max(*last_shift / 4.0);
         for _ in 0..80 {
             if let Some(pos) = self.shifted_solve(lambda, mu) {
                 let (gx, gy) = self.border_products();
                 if pos + usize::from(gy < 0.0) == 1 && gy != 0.0 {
                     *last_shift = mu;
+                    self.shift_hint = mu;
                     return Some((gx, gy));
                 }
             }
@@ -246,6 +282,17 @@ impl Solver {
                 self.radii[j] = crate::physics::numerics::bounds::limit(r, r_min, r_ceiling);
             }
         }
+    }
+
+    /// The lowest free ring next to a held interior ring (a pocket's edge, not a clamp's).
+    fn lowest_edge_ring(&self) -> Option<usize> {
+        let rings = self.radii.len();
+        (1..rings - 1)
+            .filter(|&j| {
+                !self.held[j]
+                    && ((j > 1 && self.held[j - 1]) || (j + 2 < rings && self.held[j + 1]))
+            })
+            .min_by(|&a, &b| self.radii[a].total_cmp(&self.radii[b]))
     }
 
     /// First ring off the floor from the left clamp (the pocket's edge); the last ring if none.

@@ -37,6 +37,9 @@ pub(super) struct Solver {
     pub(super) releases: Vec<u8>,
     /// Whether the last fast solve needed the inertia-correcting shift (the next tries it first).
     pub(super) prefer_shift: bool,
+    /// The last inertia-correcting shift the fast path used: the next solve's search for one
+    /// starts a little below it (it changes slowly along the path).
+    pub(super) shift_hint: f64,
 }
 
 /// Converged point on the path.
@@ -72,6 +75,7 @@ impl Solver {
             base: z,
             releases: vec![0; rings],
             prefer_shift: false,
+            shift_hint: 0.0,
         }
     }
 
@@ -80,6 +84,7 @@ impl Solver {
     pub(super) fn copy_from(&mut self, other: &Solver) {
         self.lambda = other.lambda;
         self.prefer_shift = other.prefer_shift;
+        self.shift_hint = other.shift_hint;
         for (to, from) in [
             (&mut self.radii, &other.radii),
             (&mut self.gv, &other.gv),
@@ -188,9 +193,10 @@ impl Solver {
             if !held && denom > 0.0 {
                 positive += 1;
             }
-            self.c[j] = off_here / denom;
-            self.x[j] = (rx - prev_off * xp) / denom;
-            self.y[j] = (ry - prev_off * yp) / denom;
+            let inv = 1.0 / denom;
+            self.c[j] = off_here * inv;
+            self.x[j] = (rx - prev_off * xp) * inv;
+            self.y[j] = (ry - prev_off * yp) * inv;
             prev_off = off_here;
         }
         for j in (0..rings - 1).rev() {
@@ -358,8 +364,10 @@ impl Solver {
                         break;
                     }
                 }
+                // After the plain step, the search resumes a little below the last step's
+                // shift: the shift needed changes slowly from step to step.
                 mu = if mu == 0.0 {
-                    1e-8 * s_row.max(1e-300)
+                    (1e-8 * s_row.max(1e-300)).max(last_mu / 16.0)
                 } else {
                     mu * 4.0
                 };
@@ -462,21 +470,30 @@ impl Solver {
         } else {
             n
         };
-        let period =
+        let mut period =
             crate::physics::numerics::bounds::limit(period, 2.0 * geom.rows_per_segment(), n);
-        let amplitude = deficit * m / (PI * period);
         let k = geom.rows_per_segment();
         let rings = self.radii.len();
         let centre = 0.5 * n;
-        for j in 0..rings {
-            let pos = j as f64 * k - centre;
-            let inside = pos.abs() < 0.5 * period && j > 0 && j < rings - 1;
-            self.radii[j] = if inside {
-                r + amplitude * (1.0 + (2.0 * PI * pos / period).cos())
-            } else {
-                r
-            };
-            self.held[j] = !inside;
+        // On a thin strand the period is a ring or two, and the amplitude that takes up the
+        // deficit there would tilt a segment past radial (eq. 1.17): the pocket is widened
+        // until every segment closes.
+        loop {
+            let amplitude = deficit * m / (PI * period);
+            for j in 0..rings {
+                let pos = j as f64 * k - centre;
+                let inside = pos.abs() < 0.5 * period && j > 0 && j < rings - 1;
+                self.radii[j] = if inside {
+                    r + amplitude * (1.0 + (2.0 * PI * pos / period).cos())
+                } else {
+                    r
+                };
+                self.held[j] = !inside;
+            }
+            if period >= n || geom.length_and_volume(&self.radii).is_some() {
+                break;
+            }
+            period = (2.0 * period).min(n);
         }
         self.lambda = 3.0 * PI * r * r - r * s;
     }

@@ -278,6 +278,112 @@ fn thin_strand_profiles_are_volume_maxima() {
     let g = ShapeGeometry::new(1.0, 60.0, 1.0, 1e-3 / (2.0 * PI), 60).unwrap();
     let l_free = g.rows / (6.0 * g.stitches_per_row);
     let t = ShapeTable::build(g, l_free, DEFAULT_TABLE_NODES).unwrap();
+    assert_profiles_are_maxima(&g, &t, 17);
+}
+
+#[test]
+fn saddle_edges_put_down_leave_volume_maxima() {
+    // A thin strand (2 pi r_min / S_row = 5e-11) on 11 segments per row with 1.2 stitches: the
+    // pocket sits off centre, and at about one node in two Newton heads for a saddle with the
+    // pocket one ring too wide, its edge ring barely off the floor; the fast path puts that
+    // ring down and goes on (its build took 12 ms when the robust solve started over from
+    // the prediction there). The profiles it ends on must be volume maxima by the same
+    // independent checks.
+    let m = 1.2305893906736984;
+    let r_min = 4.0 * m * 1.469079187257612e-11 / (2.0 * PI);
+    let g = ShapeGeometry::new(m, 7.088766356975538, 1.4920880080525771, r_min, 77).unwrap();
+    let l_free = g.rows * g.row_strand_length / (6.0 * m);
+    let t = ShapeTable::build(g, l_free, DEFAULT_TABLE_NODES).unwrap();
+    // The table reaches zero force.
+    assert!(t.free_contraction_length().is_some());
+    assert_profiles_are_maxima(&g, &t, 4);
+}
+
+/// Whether the Lagrangian `V - lambda L` is concave on the moves of the free rings that keep the
+/// length (the second-order condition of a maximum): its Hessian, by central differences of the
+/// gradients (eq. 1.19-1.20), projected on the length constraint's tangent, with the
+/// constraint's own direction added back with a negative weight, must be negative definite
+/// (Cholesky). On a mirror-symmetric profile only symmetric moves count: the pocket centred on
+/// the lattice may be a saddle for a shift by part of a segment, which the table accepts (worth
+/// far less volume than its accuracy).
+fn reduced_hessian_is_negative(g: &ShapeGeometry, radii: &[f64], lambda: f64) -> bool {
+    let n = radii.len();
+    let free: Vec<usize> = (1..n - 1).filter(|&j| radii[j] > g.min_radius).collect();
+    let symmetric =
+        (0..n).all(|j| (radii[j] - radii[n - 1 - j]).abs() <= 1e-9 * g.radius_ceiling());
+    // Moves: one ring each, or a ring with its mirror image.
+    let moves: Vec<Vec<usize>> = free
+        .iter()
+        .filter(|&&j| !symmetric || j <= n - 1 - j)
+        .map(|&j| {
+            if symmetric && j != n - 1 - j {
+                vec![j, n - 1 - j]
+            } else {
+                vec![j]
+            }
+        })
+        .collect();
+    let k = moves.len();
+    let gradient = |r: &[f64]| {
+        let (mut dl, mut dv) = (vec![0.0; n], vec![0.0; n]);
+        g.gradients(r, &mut dl, &mut dv).unwrap();
+        (dl, dv)
+    };
+    let along = |x: &[f64], mv: &[usize]| mv.iter().map(|&j| x[j]).sum::<f64>();
+    let (dl0, _) = gradient(radii);
+    let mut h = vec![vec![0.0; k]; k];
+    for (b, mv) in moves.iter().enumerate() {
+        let step = 1e-6 * radii[mv[0]].max(1e-3 * g.radius_ceiling());
+        let (mut up, mut down) = (radii.to_vec(), radii.to_vec());
+        for &j in mv {
+            up[j] += step;
+            down[j] -= step;
+        }
+        let ((lu, vu), (ld, vd)) = (gradient(&up), gradient(&down));
+        for (a, ma) in moves.iter().enumerate() {
+            let plus = along(&vu, ma) - lambda * along(&lu, ma);
+            let minus = along(&vd, ma) - lambda * along(&ld, ma);
+            h[a][b] = (plus - minus) / (2.0 * step);
+        }
+    }
+    // -(P H P) + c u u^T with u the unit constraint gradient and P = I - u u^T.
+    let gl: Vec<f64> = moves.iter().map(|mv| along(&dl0, mv)).collect();
+    let norm = gl.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let u: Vec<f64> = gl.iter().map(|x| x / norm).collect();
+    let sym = |a: usize, b: usize| 0.5 * (h[a][b] + h[b][a]);
+    let hu: Vec<f64> = (0..k)
+        .map(|a| (0..k).map(|b| sym(a, b) * u[b]).sum())
+        .collect();
+    let uhu: f64 = (0..k).map(|a| u[a] * hu[a]).sum();
+    let size = (0..k).map(|a| h[a][a].abs()).fold(0.0, f64::max);
+    let mut m = vec![vec![0.0; k]; k];
+    for a in 0..k {
+        for b in 0..k {
+            let php = sym(a, b) - u[a] * hu[b] - hu[a] * u[b] + uhu * u[a] * u[b];
+            m[a][b] = -php + size * u[a] * u[b];
+        }
+    }
+    // Cholesky: every pivot positive (and not lost in the differences' noise).
+    for c in 0..k {
+        let d = m[c][c] - m[c][..c].iter().map(|x| x * x).sum::<f64>();
+        if d.is_nan() || d <= 1e-9 * size {
+            return false;
+        }
+        let d = d.sqrt();
+        m[c][c] = d;
+        for r in c + 1..k {
+            let dot: f64 = m[r][..c].iter().zip(&m[c][..c]).map(|(a, b)| a * b).sum();
+            m[r][c] = (m[r][c] - dot) / d;
+        }
+    }
+    true
+}
+
+/// Every `stride`-th node's profile, re-followed by [`ShapeTable::profile`], satisfies the KKT
+/// conditions of a volume maximum (eq. 1.19-1.20 balanced by one multiplier; no ring on the
+/// floor pulled upward) and no move of its free rings along the length constraint gains volume.
+fn assert_profiles_are_maxima(g: &ShapeGeometry, t: &ShapeTable, stride: usize) {
+    let g = *g;
     let scale = g.row_strand_length * g.row_strand_length;
     let mut rng = 0x2545_f491_4f6c_dd1du64;
     let mut uniform = || {
@@ -287,13 +393,17 @@ fn thin_strand_profiles_are_volume_maxima() {
         (rng >> 11) as f64 / (1u64 << 53) as f64 - 0.5
     };
     let lengths: Vec<f64> = t.lengths().collect();
-    for &l in lengths.iter().skip(3).step_by(17) {
+    for &l in lengths.iter().skip(3).step_by(stride) {
         let radii: Vec<f64> = t.profile(l).unwrap().iter().map(|p| p.1).collect();
         let (lambda, free_res, floor_pull) = kkt(&g, &radii);
         assert!(free_res < 1e-8 * scale, "at {l}: residual {free_res:e}");
         assert!(
             floor_pull < 1e-8 * scale,
             "at {l}: a ring on the floor pulls {floor_pull:e}"
+        );
+        assert!(
+            reduced_hessian_is_negative(&g, &radii, lambda),
+            "at {l}: not a maximum on the length constraint"
         );
         // The Lagrangian V - lambda L does not grow along moves of the free rings tangent to
         // the length constraint (to second order: the reduced Hessian is negative).
