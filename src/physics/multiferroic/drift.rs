@@ -65,20 +65,13 @@ impl Motor {
     /// onion and a free rotor turning one way (`omega load >= 0`) by at most
     /// [`MAX_DRIFT_TURN`].
     pub(super) fn advance_drifting(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
-        let (i, c) = (self.inertia, self.drag);
+        let c = self.drag;
         if d.locked || !self.quasi_static() || run.y[1] * d.load < 0.0 {
             return false;
         }
         let h = segment_end - run.t;
-        let (coast, torque_speed, torque_angle) = if c > 0.0 {
-            let approach = -(-h * c / i).exp_m1();
-            (i / c * approach, approach / c, (h - i / c * approach) / c)
-        } else {
-            (h, h / i, 0.5 * h * h / i)
-        };
-        let tau = self.torque_bound();
-        let tol = self.params.tolerance;
-        if !(tau * torque_angle <= 0.1 * tol && tau * torque_speed <= tol * self.speed_scale) {
+        let (coast, torque_speed, torque_angle) = self.drift_response(h);
+        if !self.ring_is_negligible(torque_speed, torque_angle) {
             return false;
         }
         let turn = run.y[1] * coast + d.load * torque_angle;
@@ -100,6 +93,27 @@ impl Motor {
             .extra_cost
             .saturating_add((strides as u32).div_ceil(SETTLES_PER_SUBSTEP));
         true
+    }
+
+    /// The rotor's response over `h` to its initial speed and to a unit torque, under drag `c`
+    /// and inertia `I`: `(I/c (1 - e^(-h c/I)), s(h), g(h))` with `s` and `g` as above (the angle
+    /// a unit speed coasts, the speed and the angle a unit torque gives).
+    fn drift_response(&self, h: f64) -> (f64, f64, f64) {
+        let (i, c) = (self.inertia, self.drag);
+        if c > 0.0 {
+            let approach = -(-h * c / i).exp_m1();
+            (i / c * approach, approach / c, (h - i / c * approach) / c)
+        } else {
+            (h, h / i, 0.5 * h * h / i)
+        }
+    }
+
+    /// Whether the ring's largest torque moves the rotor by at most a tenth of the tolerance in
+    /// angle and the tolerance in speed, given the unit-torque responses of [`Self::drift_response`].
+    fn ring_is_negligible(&self, torque_speed: f64, torque_angle: f64) -> bool {
+        let tau = self.torque_bound();
+        let tol = self.params.tolerance;
+        tau * torque_angle <= 0.1 * tol && tau * torque_speed <= tol * self.speed_scale
     }
 }
 
@@ -138,16 +152,9 @@ impl Motor {
         let [phi, omega] = if d.locked {
             [run.y[0], 0.0]
         } else {
-            let (i, c) = (self.inertia, self.drag);
-            let (coast, torque_speed, torque_angle) = if c > 0.0 {
-                let approach = -(-h * c / i).exp_m1();
-                (i / c * approach, approach / c, (h - i / c * approach) / c)
-            } else {
-                (h, h / i, 0.5 * h * h / i)
-            };
-            let tau = self.torque_bound();
-            let tol = self.params.tolerance;
-            if !(tau * torque_angle <= 0.1 * tol && tau * torque_speed <= tol * self.speed_scale) {
+            let c = self.drag;
+            let (coast, torque_speed, torque_angle) = self.drift_response(h);
+            if !self.ring_is_negligible(torque_speed, torque_angle) {
                 return false;
             }
             [
