@@ -40,18 +40,8 @@ impl Motor {
         for (x, c) in u3.iter_mut().zip(correction) {
             *x += c;
         }
-        if d.locked {
-            u3[0] = y[0];
-            u3[1] = 0.0;
-        }
-        if !(self.rotor_sane(&u3) && Self::onion_sane(&u3)) {
-            return None;
-        }
-        let tol = self.params.tolerance;
-        let scales = [tol, tol * self.speed_scale, tol, tol];
-        let err = (0..4)
-            .map(|i| correction[i].abs() / scales[i])
-            .fold(0.0, f64::max);
+        let u3 = self.checked_end(u3, y, d.locked)?;
+        let err = self.error_norm(|i| correction[i]);
         // Beyond the tolerance the correction is no longer small and the substep, if taken at
         // all (forced at the budget's minimum size), is the exponential Euler step, which is
         // exact for the linear part and cannot amplify (see [`Self::rhs_jacobian`]).
@@ -118,7 +108,7 @@ impl Motor {
                 -5103.0 / 18656.0,
             ],
         ));
-        let mut u = at(
+        let u = at(
             &[&k1, &k3, &k4, &k5, &k6],
             &[
                 35.0 / 384.0,
@@ -139,22 +129,33 @@ impl Motor {
             -1.0 / 40.0,
         ];
         let stages = [&k1, &k3, &k4, &k5, &k6, &k7];
-        if d.locked {
+        let u = self.checked_end(u, y, d.locked)?;
+        let err = self.error_norm(|i| {
+            dt * stages
+                .iter()
+                .zip(&weights)
+                .map(|(k, w)| w * k[i])
+                .sum::<f64>()
+        });
+        err.is_finite().then(|| (u, err.powf(0.6)))
+    }
+
+    /// A substep's end `u` with a locked rotor put back where it was (`y`'s angle, at rest);
+    /// `None` if the rotor or the onion is not sane there.
+    fn checked_end(&self, mut u: Vector, y: &Vector, locked: bool) -> Option<Vector> {
+        if locked {
             u[0] = y[0];
             u[1] = 0.0;
         }
-        if !(self.rotor_sane(&u) && Self::onion_sane(&u)) {
-            return None;
-        }
+        (self.rotor_sane(&u) && Self::onion_sane(&u)).then_some(u)
+    }
+
+    /// The error estimate `e` in units of the tolerance: the largest `|e_i|` over the angles'
+    /// tolerance and the speed's on its scale.
+    fn error_norm(&self, e: impl Fn(usize) -> f64) -> f64 {
         let tol = self.params.tolerance;
         let scales = [tol, tol * self.speed_scale, tol, tol];
-        let err = (0..4)
-            .map(|i| {
-                let e: f64 = stages.iter().zip(&weights).map(|(k, w)| w * k[i]).sum();
-                (dt * e).abs() / scales[i]
-            })
-            .fold(0.0, f64::max);
-        err.is_finite().then(|| (u, err.powf(0.6)))
+        (0..4).map(|i| e(i).abs() / scales[i]).fold(0.0, f64::max)
     }
 
     /// The right-hand side of [`Self::rhs_jacobian`] alone, for the Gilbert onion, from the

@@ -242,6 +242,34 @@ fn spinning_rotor_through_a_fast_schedule_agrees_with_fine_integration() {
     assert!((s.rotor_speed - r.rotor_speed).abs() < 1e-6 * r.rotor_speed);
 }
 
+/// `n` RK4 steps of `dt` of the overdamped rotor `c phi' = tau + load` under a fixed strain,
+/// the quasi-static onion settled at every evaluation: the fine reference of the drifting-rotor
+/// tests. Returns the rotor and onion angles.
+fn overdamped_rk4(
+    m: &Motor,
+    direction: f64,
+    stress: f64,
+    load: f64,
+    (mut phi, mut psi): (f64, f64),
+    dt: f64,
+    n: usize,
+) -> (f64, f64) {
+    let rate = |phi: f64, psi: &mut f64| {
+        *psi = m.landscape(phi, direction, stress).settle(*psi);
+        (m.ring_bar.torque_stiffness(*psi - phi).0 + load) / m.drag
+    };
+    for _ in 0..n {
+        let mut p = psi;
+        let k1 = rate(phi, &mut p);
+        let k2 = rate(phi + 0.5 * dt * k1, &mut p);
+        let k3 = rate(phi + 0.5 * dt * k2, &mut p);
+        let k4 = rate(phi + dt * k3, &mut p);
+        phi += dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0;
+        psi = m.landscape(phi, direction, stress).settle(psi);
+    }
+    (phi, psi)
+}
+
 /// A rotor in a viscous fluid (1e3 Pa s: relaxation time 3 s) driven by 1e-9 N m through a
 /// 2 ns schedule: between switches the ring's torque moves it by at most 3e-10 rad, so each
 /// segment is the load's motion with the onion settled along the path
@@ -267,20 +295,8 @@ fn a_drifting_rotor_through_a_fast_schedule_agrees_with_fine_integration() {
     for k in 0..100 {
         let direction = schedule.direction((k as f64 + 0.5) * period);
         let stress = schedule.stress_amplitude;
-        let rate = |phi: f64, psi: &mut f64| {
-            *psi = m.landscape(phi, direction, stress).settle(*psi);
-            (m.ring_bar.torque_stiffness(*psi - phi).0 + load) / m.drag
-        };
         psi = m.landscape(phi, direction, stress).settle(psi);
-        for _ in 0..n {
-            let mut p = psi;
-            let k1 = rate(phi, &mut p);
-            let k2 = rate(phi + 0.5 * dt * k1, &mut p);
-            let k3 = rate(phi + 0.5 * dt * k2, &mut p);
-            let k4 = rate(phi + dt * k3, &mut p);
-            phi += dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0;
-            psi = m.landscape(phi, direction, stress).settle(psi);
-        }
+        (phi, psi) = overdamped_rk4(&m, direction, stress, load, (phi, psi), dt, n);
     }
     // The step ends at a switch: the onion there is settled for the next direction.
     let next = schedule.direction(100.5 * period);
@@ -454,19 +470,7 @@ fn a_strain_held_onion_takes_a_fast_schedule_at_once() {
                 if locked {
                     continue;
                 }
-                let rate = |phi: f64, psi: &mut f64| {
-                    *psi = m.landscape(phi, direction, stress).settle(*psi);
-                    (m.ring_bar.torque_stiffness(*psi - phi).0 + load) / m.drag
-                };
-                for _ in 0..n {
-                    let mut p = psi;
-                    let k1 = rate(phi, &mut p);
-                    let k2 = rate(phi + 0.5 * dt * k1, &mut p);
-                    let k3 = rate(phi + 0.5 * dt * k2, &mut p);
-                    let k4 = rate(phi + dt * k3, &mut p);
-                    phi += dt * (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0;
-                    psi = m.landscape(phi, direction, stress).settle(psi);
-                }
+                (phi, psi) = overdamped_rk4(&m, direction, stress, load, (phi, psi), dt, n);
             }
             // The step ends at a switch: the onion there is settled for the next direction.
             let next = schedule.direction((switches as f64 + 0.5) * period);
