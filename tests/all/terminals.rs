@@ -2,8 +2,8 @@
 //! every model's source passes, and a flange naming a missing variable, the wrong unit or
 //! causality, or an unknown attribute is refused with the reason.
 
-use crate::build_script::terminals as flanges;
 use crate::build_script::model_description;
+use crate::build_script::terminals as flanges;
 
 const SOURCE: &str = include_str!("../../modelDescription/McKibbenMuscle.xml");
 const FLANGE: &str =

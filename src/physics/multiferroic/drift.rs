@@ -98,7 +98,7 @@ impl Motor {
     /// The rotor's response over `h` to its initial speed and to a unit torque, under drag `c`
     /// and inertia `I`: `(I/c (1 - e^(-h c/I)), s(h), g(h))` with `s` and `g` as above (the angle
     /// a unit speed coasts, the speed and the angle a unit torque gives).
-    fn drift_response(&self, h: f64) -> (f64, f64, f64) {
+    pub(super) fn drift_response(&self, h: f64) -> (f64, f64, f64) {
         let (i, c) = (self.inertia, self.drag);
         if c > 0.0 {
             let approach = -(-h * c / i).exp_m1();
@@ -110,72 +110,10 @@ impl Motor {
 
     /// Whether the ring's largest torque moves the rotor by at most a tenth of the tolerance in
     /// angle and the tolerance in speed, given the unit-torque responses of [`Self::drift_response`].
-    fn ring_is_negligible(&self, torque_speed: f64, torque_angle: f64) -> bool {
+    pub(super) fn ring_is_negligible(&self, torque_speed: f64, torque_angle: f64) -> bool {
         let tau = self.torque_bound();
         let tol = self.params.tolerance;
         tau * torque_angle <= 0.1 * tol && tau * torque_speed <= tol * self.speed_scale
-    }
-}
-
-impl Motor {
-    /// The rest of the step's whole periods of the schedule at once when the strain holds the
-    /// onion at an end of its axis ([`Self::strain_held_turn`]) and the rotor is locked or the
-    /// ring's torque cannot move it by a tenth of the tolerance over them (as in
-    /// [`Self::advance_drifting`], over all of them): the rotor follows load and drag alone, and
-    /// the onion, which turns by the same angle at every switch whatever the rotor does, ends at
-    /// the one minimum of eq. 3.4 within `w` of the end of the last period's strain axis, settled
-    /// from the present onion turned by as many of those angles (within `w` of that end). A
-    /// locked rotor or a drifting one otherwise costs a settle or a march at every switch
-    /// (hundreds in a 1 us step of a nanosecond schedule). Returns whether it advanced.
-    pub(super) fn skip_strain_held_periods(
-        &self,
-        run: &mut StepRun,
-        d: &Drive,
-        segment_end: f64,
-    ) -> bool {
-        let Some(s) = run.schedule else {
-            return false;
-        };
-        if !self.quasi_static() || segment_end >= run.t_end {
-            return false;
-        }
-        let first = s.step_index(segment_end);
-        let last = s.step_index(run.t_end);
-        let end = (last * s.step_period).min(run.t_end);
-        if last - first < 1.0 || end <= segment_end {
-            return false;
-        }
-        let Some(turn) = self.strain_held_turn(d, s.step_angle) else {
-            return false;
-        };
-        let h = end - run.t;
-        let [phi, omega] = if d.locked {
-            [run.y[0], 0.0]
-        } else {
-            let c = self.drag;
-            let (coast, torque_speed, torque_angle) = self.drift_response(h);
-            if !self.ring_is_negligible(torque_speed, torque_angle) {
-                return false;
-            }
-            [
-                run.y[0] + run.y[1] * coast + d.load * torque_angle,
-                run.y[1] * (1.0 - c * torque_speed) + d.load * torque_speed,
-            ]
-        };
-        let periods = last - first;
-        let applied = s.direction(end - 0.5 * s.step_period);
-        let psi = self
-            .landscape(phi, super::reduced_direction(applied), d.stress)
-            .settle(run.y[2] + periods * turn);
-        if !(phi.is_finite() && phi.abs() <= super::MAX_ANGLE && psi.is_finite()) {
-            return false;
-        }
-        run.y = [phi, omega, psi, 0.0];
-        run.t = end;
-        run.settled = false;
-        run.angles = None;
-        run.attempts = run.attempts.saturating_add(1);
-        true
     }
 }
 

@@ -243,7 +243,7 @@ fn pade_phi3_apply(j: &[[f64; 4]; 4], dt: f64, v: &Vector, unit: f64) -> Option<
 
 #[cfg(test)]
 mod tests {
-    use super::super::step::Rims;
+    use super::super::ringing::Rims;
     use super::super::tests::{motor_with, rk4_step, schedule};
     use super::super::{Drive, MotorInputs, MotorState, OnionModel, Vector};
     use super::pade_phi3_apply;

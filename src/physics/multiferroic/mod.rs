@@ -34,6 +34,7 @@
 
 pub mod angles;
 pub mod branch;
+mod cycle;
 mod drift;
 pub mod drive;
 mod gilbert;
@@ -47,7 +48,9 @@ pub mod onion;
 #[cfg(test)]
 mod onion_tests;
 mod params;
+mod periods;
 pub mod phi;
+mod ringing;
 pub mod schedule;
 mod spin;
 #[cfg(test)]

@@ -2,40 +2,14 @@
 //! hysteresis cycle, with the periodic deviation from the mean motion added back (the method of
 //! averaging to first order in `tau_max / |load|`, its secular drift to second order).
 
+use super::cycle::OnionCycle;
 use super::{Drive, Motor, StepRun};
 use std::f64::consts::PI;
-
-/// The quasi-static onion's hysteresis cycle as the rotor turns without end in one direction.
-#[derive(Clone)]
-pub(super) struct OnionCycle {
-    /// Whole turns of rotor and onion taken off the state the cycle was found from, so that its
-    /// march works near zero (rad).
-    turns: f64,
-    onion_turns: f64,
-    /// A rotor angle on the cycle and the onion angle there (rad), less `turns` and
-    /// `turns + onion_turns`.
-    rotor: f64,
-    onion: f64,
-    /// Onion turns per rotor turn (0 when the onion swings back and forth, +-1 when it follows).
-    winding: f64,
-    /// `int tau dphi` over one turn (J): the energy the onion's snaps dissipate, `<= 0`.
-    work: f64,
-    /// The ring's torque along one turn of the cycle, in the direction of motion: pairs
-    /// `(s, tau_s)` with `s = dir (phi - rotor)` from 0 to 2 pi, both sides of every snap.
-    torque: Vec<(f64, f64)>,
-    /// The onion angle at each of those samples (rad), less the turns as `onion`.
-    onion_samples: Vec<f64>,
-    /// The rotor's deviation at its terminal mean speed (with drag and a positive mean force).
-    terminal: Option<Wobble>,
-    /// Whether the cycle is its own turn by half a turn (see [`Self::half_turn_symmetric`]),
-    /// once found.
-    half_turn: std::cell::Cell<Option<bool>>,
-}
 
 /// The rotor's periodic deviation from its mean motion at one mean speed, sampled where
 /// [`OnionCycle::torque`] is, in the direction of motion.
 #[derive(Clone)]
-struct Wobble {
+pub(super) struct Wobble {
     /// Angle `delta(s)` (rad, zero mean over a turn) and speed `u(s)` (rad/s) deviations.
     angle: Vec<f64>,
     speed: Vec<f64>,
@@ -97,70 +71,6 @@ enum Spin {
     /// The averaged spin does not apply in this step.
     Failed,
     Ended(super::Vector),
-}
-
-impl OnionCycle {
-    /// Turn `s` modulo one turn.
-    fn phase(s: f64) -> f64 {
-        s.rem_euclid(2.0 * PI)
-    }
-
-    /// The cycle for a strain direction turned by `angle`: eq. 3.3-3.4 depend only on `psi - phi`
-    /// and `psi - gamma`, so rotor and onion turn with the strain and the torque along the cycle
-    /// is the same. A schedule's segments then share one march.
-    fn rotate(&mut self, angle: f64) {
-        let rotor = self.rotor + angle;
-        let whole = (rotor / (2.0 * PI)).round() * 2.0 * PI;
-        let shift = angle - whole;
-        self.rotor += shift;
-        self.onion += shift;
-        for psi in &mut self.onion_samples {
-            *psi += shift;
-        }
-        self.turns += whole;
-    }
-
-    /// Whether the state's onion is the cycle's at the state's rotor angle (modulo whole turns,
-    /// within 1e-9 rad).
-    fn holds(&self, motor: &Motor, y: &super::Vector, dir: f64, d: &Drive) -> bool {
-        let s = Self::phase(dir * (y[0] - self.turns - self.rotor));
-        let onion = self.onion_at(motor, s, dir, d) + self.turns + self.onion_turns;
-        super::wrap_angle(onion - y[2]).abs() <= 1e-9
-    }
-
-    /// Whether the cycle turned by half a turn is itself: eq. 3.4 depends on the strain direction
-    /// modulo pi, so rotor and onion turned by pi make a cycle of the same drive, the same one
-    /// when the onion half a turn on is the onion turned by pi (modulo a turn; checked within
-    /// 1e-9 rad at 16 samples of the first half turn). Otherwise the drive may have two cycles,
-    /// and which one the onion lands on after a switch depends on where the rotor is then.
-    fn half_turn_symmetric(&self, motor: &Motor, dir: f64, d: &Drive) -> bool {
-        if let Some(known) = self.half_turn.get() {
-            return known;
-        }
-        let n = self.torque.len();
-        let symmetric = (0..n)
-            .step_by((n / 32).max(1))
-            .filter(|&j| self.torque[j].0 < PI)
-            .all(|j| {
-                let onion = self.onion_at(motor, self.torque[j].0 + PI, dir, d);
-                super::wrap_angle(onion - self.onion_samples[j] - PI).abs() <= 1e-9
-            });
-        self.half_turn.set(Some(symmetric));
-        symmetric
-    }
-
-    /// The onion angle on the cycle at `s` (in the direction of motion, from `rotor`) for the
-    /// drive `d`: settled from the sample at or below `s`, with no snap in between.
-    fn onion_at(&self, motor: &Motor, s: f64, dir: f64, d: &Drive) -> f64 {
-        let j = self
-            .torque
-            .partition_point(|&(x, _)| x <= s)
-            .clamp(1, self.torque.len())
-            - 1;
-        motor
-            .landscape(self.rotor + dir * s, d.direction, d.stress)
-            .settle(self.onion_samples[j])
-    }
 }
 
 impl Motor {
@@ -304,124 +214,6 @@ impl Motor {
         }
     }
 
-    /// Whole periods of the schedule after the segment ending at `segment_end` that the averaged
-    /// spin takes together with it: the end of the last of them (a switch, within the step), its
-    /// drive, and the cycle turned with its strain; `None` when not even one.
-    ///
-    /// The equations are invariant under a common rotation of rotor, onion and strain, so every
-    /// segment's cycle is this one turned with the strain and has the same mean torque (its snaps
-    /// dissipate the same work per turn): the mean motion goes on through the switches unchanged.
-    /// The strain turns by `step_angle` at a switch, which eq. 3.4 sees modulo pi: the cycle turned
-    /// by it is the one the onion follows when the cycle is its own turn by half a turn
-    /// ([`OnionCycle::half_turn_symmetric`]); when the strain holds the onion at an end of its
-    /// axis, the cycle turned by the onion's own turn at a switch
-    /// ([`Self::strain_held_turn`]); otherwise which of two cycles it lands on may depend on the
-    /// rotor's phase at each switch, and the segments are taken one by one.
-    /// What a switch changes is the phase of the periodic deviation, `delta` and `u`: the mean
-    /// angle and speed jump by at most twice their amplitudes `A` and `U` at the switch, which the
-    /// single spin leaves out; and the onion, settled into the turned landscape, reaches the
-    /// turned cycle within a turn (as the segment-by-segment spin assumes), before which the
-    /// ring's torque differs from the cycle's by at most `2 tau_max` over `2 pi / omega`, an
-    /// impulse of at most `J = 4 pi tau_max / omega`. The deviation's torque `tau - <tau>` is at
-    /// most `2 tau_max`, so `U <= 2 tau_max min(1 / c, 2 pi / (I omega))` (the drag's filter; `u`
-    /// has zero mean and `|u'| <= 4 tau_max / I`) and `A <= pi U / omega` (`delta` has zero mean
-    /// and `|delta'| <= U / omega` per radian). A speed jump `du` moves the rotor by at most
-    /// `I du / c` as it decays, an impulse by `J / c`; so each switch costs at most
-    /// `2 A + 2 U I / c + J / c` in angle, held to a tenth of the tolerance over the switches
-    /// taken, and its speed jumps, decaying by `e = exp(-c T / I)` a period `T`, leave at most
-    /// `(2 U + J / I) e / (1 - e)` at the end, which, as it decays, moves the rotor by a tenth of
-    /// the tolerance at most (its `I / c` times). `A`,
-    /// `U` and `J` are taken at the lower of the present and the terminal mean speed (they fall
-    /// as the speed rises).
-    pub(super) fn periods_ahead(
-        &self,
-        run: &StepRun,
-        cycle: &OnionCycle,
-        d: &Drive,
-        segment_end: f64,
-    ) -> Option<(f64, Drive, OnionCycle)> {
-        let s = run.schedule.as_ref()?;
-        let (i, c) = (self.inertia, self.drag);
-        if segment_end >= run.t_end || c <= 0.0 {
-            return None;
-        }
-        // The segment starting at `segment_end` and the last switch within the step.
-        let first = s.step_index(segment_end);
-        let available = s.step_index(run.t_end) - first;
-        if available < 1.0 {
-            return None;
-        }
-        let dir = d.load.signum();
-        let force = d.load.abs() + cycle.work / (2.0 * PI);
-        let slowest = (dir * run.y[1]).min(force / c);
-        if slowest.is_nan() || slowest <= 0.0 {
-            return None;
-        }
-        let tau = self.torque_bound();
-        let speed_amplitude = 2.0 * tau * (1.0 / c).min(2.0 * PI / (i * slowest));
-        let amplitude = PI * speed_amplitude / slowest;
-        let impulse = 4.0 * PI * tau / slowest;
-        let kick = 2.0 * speed_amplitude + impulse / i;
-        let angle = 2.0 * amplitude + kick * i / c;
-        // What is left at the end of the kicks at the switches before the last period.
-        let decay = (-s.step_period * c / i).exp();
-        let speed = kick * decay / (1.0 - decay);
-        let tol = self.params.tolerance;
-        let periods = (0.1 * tol / angle).floor().min(available);
-        if !(speed * i / c <= 0.1 * tol && periods >= 1.0) {
-            return None;
-        }
-        let turn = match self.strain_held_turn(d, s.step_angle) {
-            Some(turn) => turn,
-            None if cycle.half_turn_symmetric(self, dir, d) => s.step_angle,
-            None => return None,
-        };
-        let end = ((first + periods) * s.step_period).min(run.t_end);
-        let applied = s.direction(end - 0.5 * s.step_period);
-        let end_drive = Drive {
-            direction: super::reduced_direction(applied),
-            applied_direction: applied,
-            ..*d
-        };
-        let mut turned = cycle.clone();
-        turned.rotate(periods * turn);
-        Some((end, end_drive, turned))
-    }
-
-    /// The turn of the onion at every switch of the schedule (`step_angle` brought within a
-    /// quarter turn, modulo pi) when the strain holds it near an end of its axis whatever the
-    /// rotor does; `None` otherwise. With `E sin^2(psi - gamma)` the magnetoelastic energy (eq.
-    /// 3.4), `|tau| <= tau_max` the ring's torque and `k_max` its stiffness's bound, the gradient
-    /// `E sin 2x + tau` (`x = psi - gamma`) has the sign of `E sin 2x` but within
-    /// `w = asin(tau_max / |E|) / 2` of the axis's ends and of its midpoints, and the curvature
-    /// `2 E cos 2x + k` keeps the sign of `E` near the ends and the opposite near the midpoints
-    /// while `2 |E| cos 2w > k_max`: each end (the minima of `E sin^2`) holds one minimum within
-    /// `w`, and no other exists. The onion sits there (two cycles, one at either end, without
-    /// snaps); after a switch by `a` (within a quarter turn modulo pi) it is within `w + |a|` of an
-    /// end of the new axis, so with `|a| + 2 w < pi / 2` it goes downhill to that end's minimum:
-    /// the cycle turned by `a`. (`k_max = pi M` with `M` the bound of its slope: the stiffness
-    /// has zero mean over a turn.)
-    pub(super) fn strain_held_turn(&self, d: &Drive, step_angle: f64) -> Option<f64> {
-        let w = self.strain_held_reach(d)?;
-        let turn = step_angle - PI * (step_angle / PI).round();
-        (turn.abs() + 2.0 * w < 0.5 * PI - 1e-6).then_some(turn)
-    }
-
-    /// How far from an end of the strain's axis the onion can be (`w`, rad) when the strain holds
-    /// it there whatever the rotor does (see [`Self::strain_held_turn`]); `None` when it does not.
-    fn strain_held_reach(&self, d: &Drive) -> Option<f64> {
-        let e = self
-            .landscape(0.0, d.direction, d.stress)
-            .magnetoelastic
-            .abs();
-        let tau = self.torque_bound();
-        if tau.is_nan() || tau >= e {
-            return None;
-        }
-        let w = 0.5 * (tau / e).asin();
-        (2.0 * e * (2.0 * w).cos() > PI * self.ring_bar_slope_bound).then_some(w)
-    }
-
     /// The state `y` advanced by `h` on the averaged spin of `cycle`, with the periodic deviation
     /// taken off at the start (`correct_start`) and added back at the end on `end`'s cycle and
     /// drive (those of the start, or of a later segment of the schedule, see
@@ -549,7 +341,7 @@ impl Motor {
     /// integrator over the phase, decay `kappa = c / (I omega)` per radian) and made periodic by
     /// `u(0) = u_1(2 pi) / (1 - exp(-2 pi kappa))` (`u_1` started from 0). `delta` integrates
     /// `u / omega` (trapezoid) less its mean.
-    fn wobble(&self, cycle: &OnionCycle, omega: f64) -> Wobble {
+    pub(super) fn wobble(&self, cycle: &OnionCycle, omega: f64) -> Wobble {
         let (i, c) = (self.inertia, self.drag);
         let tau = &cycle.torque;
         let n = tau.len();
@@ -600,137 +392,6 @@ impl Motor {
         let (a, r) = (rb.bar_charge_radius, rb.wall_radius);
         (rb.coupling * a * r * ((r - a).powi(-3) + (r + a).powi(-3))).abs()
     }
-
-    /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
-    /// `psi0`: one turn to land on it (none where the strain holds the onion), one to measure it
-    /// (and sample its torque). `None` if it does not close.
-    fn onion_cycle(
-        &self,
-        y: &super::Vector,
-        d: &Drive,
-        dir: f64,
-        settles: &mut u32,
-    ) -> Option<OnionCycle> {
-        // The landscape depends on psi - phi and psi - gamma (mod pi): turn rotor and onion back
-        // by whole turns so that the march works near zero (the onion by its own turns too, for
-        // a state whose onion is far from its rotor).
-        let turns = (y[0] / (2.0 * PI)).round() * 2.0 * PI;
-        let onion_turns = ((y[2] - y[0]) / (2.0 * PI)).round() * 2.0 * PI;
-        let phi0 = y[0] - turns;
-        let psi0 = self
-            .landscape(phi0, d.direction, d.stress)
-            .settle(y[2] - turns - onion_turns);
-        *settles += 1;
-        // A turn to land on the cycle; none where the strain holds the onion, whose minimum then
-        // follows the rotor without a snap (the cycle is where the onion is).
-        let (start, psi1) = if self.strain_held_reach(d).is_some() {
-            (phi0, psi0)
-        } else {
-            let start = phi0 + dir * 2.0 * PI;
-            (
-                start,
-                self.march_onion(phi0, psi0, start, d, None, settles)?.0,
-            )
-        };
-        let mut samples = Vec::with_capacity(160);
-        let (psi2, work) = self.march_onion(
-            start,
-            psi1,
-            start + dir * 2.0 * PI,
-            d,
-            Some(&mut samples),
-            settles,
-        )?;
-        let winding = ((psi2 - psi1) / (2.0 * PI)).round();
-        if (psi2 - psi1 - winding * 2.0 * PI).abs() > 1e-6 {
-            return None;
-        }
-        let torque = samples
-            .iter()
-            .map(|&(phi, _, tau)| (dir * (phi - start), dir * tau))
-            .collect();
-        let onion_samples = samples.iter().map(|&(_, psi, _)| psi).collect();
-        let mut cycle = OnionCycle {
-            turns,
-            onion_turns,
-            rotor: start,
-            onion: psi1,
-            winding: winding * dir,
-            work,
-            torque,
-            onion_samples,
-            terminal: None,
-            half_turn: std::cell::Cell::new(None),
-        };
-        let force = d.load.abs() + work / (2.0 * PI);
-        if self.drag > 0.0 && force > 0.0 {
-            cycle.terminal = Some(self.wobble(&cycle, force / self.drag));
-        }
-        Some(cycle)
-    }
-
-    /// The quasi-static onion while the rotor turns from `from` to `to` (its memory rule, snaps
-    /// included), and the energy the snaps changed `U` by on the way (J). Strides of at most
-    /// [`CYCLE_STRIDE`]; a snap is placed by bisection within [`SNAP_PLACEMENT`] rad, where its
-    /// energy change is taken. `samples`, if given, receives `(phi, psi, tau)`, the ring's torque at
-    /// every stride's end and on both sides of every snap.
-    fn march_onion(
-        &self,
-        from: f64,
-        psi: f64,
-        to: f64,
-        d: &Drive,
-        mut samples: Option<&mut Vec<(f64, f64, f64)>>,
-        settles: &mut u32,
-    ) -> Option<(f64, f64)> {
-        let count = std::cell::Cell::new(0u32);
-        let settle = |at: f64, onion: f64| {
-            count.set(count.get() + 1);
-            self.landscape(at, d.direction, d.stress).settle(onion)
-        };
-        let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
-        let mut record = |at: f64, onion: f64| {
-            if let Some(s) = samples.as_deref_mut() {
-                s.push((at, onion, self.ring_bar.torque_stiffness(onion - at).0));
-            }
-        };
-        let strides = ((to - from).abs() / CYCLE_STRIDE).ceil().max(1.0);
-        if strides > 1e6 {
-            return None;
-        }
-        let (mut phi, mut psi, mut work) = (from, psi, 0.0);
-        record(phi, psi);
-        for k in 1..=strides as usize {
-            let next = from + (to - from) * k as f64 / strides;
-            let psi_next = settle(next, psi);
-            if (psi_next - psi).abs() <= ONION_JUMP + 4.0 * (next - phi).abs() {
-                (phi, psi) = (next, psi_next);
-                record(phi, psi);
-                continue;
-            }
-            // A snap inside the stride: bisect for it on the rotor angle.
-            let (mut lo, mut psi_lo, mut hi, mut psi_hi) = (phi, psi, next, psi_next);
-            for _ in 0..64 {
-                if (hi - lo).abs() <= SNAP_PLACEMENT {
-                    break;
-                }
-                let mid = 0.5 * (lo + hi);
-                let psi_mid = settle(mid, psi_lo);
-                if (psi_mid - psi_lo).abs() <= ONION_JUMP + 4.0 * (mid - lo).abs() {
-                    (lo, psi_lo) = (mid, psi_mid);
-                } else {
-                    (hi, psi_hi) = (mid, psi_mid);
-                }
-            }
-            work += energy(hi, psi_hi) - energy(lo, psi_lo);
-            record(lo, psi_lo);
-            record(hi, psi_hi);
-            (phi, psi) = (next, settle(next, psi_hi));
-            record(phi, psi);
-        }
-        *settles = settles.saturating_add(count.get());
-        (psi.is_finite() && work.is_finite()).then_some((psi, work))
-    }
 }
 
 /// The regime of [`Motor::advance_spinning`] from rest: `tau_max / |load|` at most this times the
@@ -749,8 +410,3 @@ pub(super) const SPIN_CYCLE_WEIGHT: u32 = 80;
 /// settles costs about 80 substeps (about 0.08 us a settle against 0.32 us a substep). Marches
 /// (the cycle's, the drifting onion's, the overdamped rotor's) are charged by their settles.
 pub(super) const SETTLES_PER_SUBSTEP: u32 = 4;
-/// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
-const CYCLE_STRIDE: f64 = 0.05;
-const SNAP_PLACEMENT: f64 = 1e-10;
-/// An onion turn beyond its branch's that marks a snap (rad), as in the integrator.
-const ONION_JUMP: f64 = 0.05;

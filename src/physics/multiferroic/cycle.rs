@@ -1,0 +1,236 @@
+//! The quasi-static onion's hysteresis cycle as a rotor turns under a fixed strain: marched
+//! once, round the turn, with its snaps located (see [`Motor::onion_cycle`]).
+
+use super::spin::Wobble;
+use super::{Drive, Motor};
+use std::f64::consts::PI;
+
+/// The quasi-static onion's hysteresis cycle as the rotor turns without end in one direction.
+#[derive(Clone)]
+pub(super) struct OnionCycle {
+    /// Whole turns of rotor and onion taken off the state the cycle was found from, so that its
+    /// march works near zero (rad).
+    pub(super) turns: f64,
+    pub(super) onion_turns: f64,
+    /// A rotor angle on the cycle and the onion angle there (rad), less `turns` and
+    /// `turns + onion_turns`.
+    pub(super) rotor: f64,
+    pub(super) onion: f64,
+    /// Onion turns per rotor turn (0 when the onion swings back and forth, +-1 when it follows).
+    pub(super) winding: f64,
+    /// `int tau dphi` over one turn (J): the energy the onion's snaps dissipate, `<= 0`.
+    pub(super) work: f64,
+    /// The ring's torque along one turn of the cycle, in the direction of motion: pairs
+    /// `(s, tau_s)` with `s = dir (phi - rotor)` from 0 to 2 pi, both sides of every snap.
+    pub(super) torque: Vec<(f64, f64)>,
+    /// The onion angle at each of those samples (rad), less the turns as `onion`.
+    pub(super) onion_samples: Vec<f64>,
+    /// The rotor's deviation at its terminal mean speed (with drag and a positive mean force).
+    pub(super) terminal: Option<Wobble>,
+    /// Whether the cycle is its own turn by half a turn (see [`Self::half_turn_symmetric`]),
+    /// once found.
+    pub(super) half_turn: std::cell::Cell<Option<bool>>,
+}
+
+impl OnionCycle {
+    /// Turn `s` modulo one turn.
+    pub(super) fn phase(s: f64) -> f64 {
+        s.rem_euclid(2.0 * PI)
+    }
+
+    /// The cycle for a strain direction turned by `angle`: eq. 3.3-3.4 depend only on `psi - phi`
+    /// and `psi - gamma`, so rotor and onion turn with the strain and the torque along the cycle
+    /// is the same. A schedule's segments then share one march.
+    pub(super) fn rotate(&mut self, angle: f64) {
+        let rotor = self.rotor + angle;
+        let whole = (rotor / (2.0 * PI)).round() * 2.0 * PI;
+        let shift = angle - whole;
+        self.rotor += shift;
+        self.onion += shift;
+        for psi in &mut self.onion_samples {
+            *psi += shift;
+        }
+        self.turns += whole;
+    }
+
+    /// Whether the state's onion is the cycle's at the state's rotor angle (modulo whole turns,
+    /// within 1e-9 rad).
+    pub(super) fn holds(&self, motor: &Motor, y: &super::Vector, dir: f64, d: &Drive) -> bool {
+        let s = Self::phase(dir * (y[0] - self.turns - self.rotor));
+        let onion = self.onion_at(motor, s, dir, d) + self.turns + self.onion_turns;
+        super::wrap_angle(onion - y[2]).abs() <= 1e-9
+    }
+
+    /// Whether the cycle turned by half a turn is itself: eq. 3.4 depends on the strain direction
+    /// modulo pi, so rotor and onion turned by pi make a cycle of the same drive, the same one
+    /// when the onion half a turn on is the onion turned by pi (modulo a turn; checked within
+    /// 1e-9 rad at 16 samples of the first half turn). Otherwise the drive may have two cycles,
+    /// and which one the onion lands on after a switch depends on where the rotor is then.
+    pub(super) fn half_turn_symmetric(&self, motor: &Motor, dir: f64, d: &Drive) -> bool {
+        if let Some(known) = self.half_turn.get() {
+            return known;
+        }
+        let n = self.torque.len();
+        let symmetric = (0..n)
+            .step_by((n / 32).max(1))
+            .filter(|&j| self.torque[j].0 < PI)
+            .all(|j| {
+                let onion = self.onion_at(motor, self.torque[j].0 + PI, dir, d);
+                super::wrap_angle(onion - self.onion_samples[j] - PI).abs() <= 1e-9
+            });
+        self.half_turn.set(Some(symmetric));
+        symmetric
+    }
+
+    /// The onion angle on the cycle at `s` (in the direction of motion, from `rotor`) for the
+    /// drive `d`: settled from the sample at or below `s`, with no snap in between.
+    pub(super) fn onion_at(&self, motor: &Motor, s: f64, dir: f64, d: &Drive) -> f64 {
+        let j = self
+            .torque
+            .partition_point(|&(x, _)| x <= s)
+            .clamp(1, self.torque.len())
+            - 1;
+        motor
+            .landscape(self.rotor + dir * s, d.direction, d.stress)
+            .settle(self.onion_samples[j])
+    }
+}
+
+impl Motor {
+    /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
+    /// `psi0`: one turn to land on it (none where the strain holds the onion), one to measure it
+    /// (and sample its torque). `None` if it does not close.
+    pub(super) fn onion_cycle(
+        &self,
+        y: &super::Vector,
+        d: &Drive,
+        dir: f64,
+        settles: &mut u32,
+    ) -> Option<OnionCycle> {
+        // The landscape depends on psi - phi and psi - gamma (mod pi): turn rotor and onion back
+        // by whole turns so that the march works near zero (the onion by its own turns too, for
+        // a state whose onion is far from its rotor).
+        let turns = (y[0] / (2.0 * PI)).round() * 2.0 * PI;
+        let onion_turns = ((y[2] - y[0]) / (2.0 * PI)).round() * 2.0 * PI;
+        let phi0 = y[0] - turns;
+        let psi0 = self
+            .landscape(phi0, d.direction, d.stress)
+            .settle(y[2] - turns - onion_turns);
+        *settles += 1;
+        // A turn to land on the cycle; none where the strain holds the onion, whose minimum then
+        // follows the rotor without a snap (the cycle is where the onion is).
+        let (start, psi1) = if self.strain_held_reach(d).is_some() {
+            (phi0, psi0)
+        } else {
+            let start = phi0 + dir * 2.0 * PI;
+            (
+                start,
+                self.march_onion(phi0, psi0, start, d, None, settles)?.0,
+            )
+        };
+        let mut samples = Vec::with_capacity(160);
+        let (psi2, work) = self.march_onion(
+            start,
+            psi1,
+            start + dir * 2.0 * PI,
+            d,
+            Some(&mut samples),
+            settles,
+        )?;
+        let winding = ((psi2 - psi1) / (2.0 * PI)).round();
+        if (psi2 - psi1 - winding * 2.0 * PI).abs() > 1e-6 {
+            return None;
+        }
+        let torque = samples
+            .iter()
+            .map(|&(phi, _, tau)| (dir * (phi - start), dir * tau))
+            .collect();
+        let onion_samples = samples.iter().map(|&(_, psi, _)| psi).collect();
+        let mut cycle = OnionCycle {
+            turns,
+            onion_turns,
+            rotor: start,
+            onion: psi1,
+            winding: winding * dir,
+            work,
+            torque,
+            onion_samples,
+            terminal: None,
+            half_turn: std::cell::Cell::new(None),
+        };
+        let force = d.load.abs() + work / (2.0 * PI);
+        if self.drag > 0.0 && force > 0.0 {
+            cycle.terminal = Some(self.wobble(&cycle, force / self.drag));
+        }
+        Some(cycle)
+    }
+
+    /// The quasi-static onion while the rotor turns from `from` to `to` (its memory rule, snaps
+    /// included), and the energy the snaps changed `U` by on the way (J). Strides of at most
+    /// [`CYCLE_STRIDE`]; a snap is placed by bisection within [`SNAP_PLACEMENT`] rad, where its
+    /// energy change is taken. `samples`, if given, receives `(phi, psi, tau)`, the ring's torque at
+    /// every stride's end and on both sides of every snap.
+    pub(super) fn march_onion(
+        &self,
+        from: f64,
+        psi: f64,
+        to: f64,
+        d: &Drive,
+        mut samples: Option<&mut Vec<(f64, f64, f64)>>,
+        settles: &mut u32,
+    ) -> Option<(f64, f64)> {
+        let count = std::cell::Cell::new(0u32);
+        let settle = |at: f64, onion: f64| {
+            count.set(count.get() + 1);
+            self.landscape(at, d.direction, d.stress).settle(onion)
+        };
+        let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
+        let mut record = |at: f64, onion: f64| {
+            if let Some(s) = samples.as_deref_mut() {
+                s.push((at, onion, self.ring_bar.torque_stiffness(onion - at).0));
+            }
+        };
+        let strides = ((to - from).abs() / CYCLE_STRIDE).ceil().max(1.0);
+        if strides > 1e6 {
+            return None;
+        }
+        let (mut phi, mut psi, mut work) = (from, psi, 0.0);
+        record(phi, psi);
+        for k in 1..=strides as usize {
+            let next = from + (to - from) * k as f64 / strides;
+            let psi_next = settle(next, psi);
+            if (psi_next - psi).abs() <= ONION_JUMP + 4.0 * (next - phi).abs() {
+                (phi, psi) = (next, psi_next);
+                record(phi, psi);
+                continue;
+            }
+            // A snap inside the stride: bisect for it on the rotor angle.
+            let (mut lo, mut psi_lo, mut hi, mut psi_hi) = (phi, psi, next, psi_next);
+            for _ in 0..64 {
+                if (hi - lo).abs() <= SNAP_PLACEMENT {
+                    break;
+                }
+                let mid = 0.5 * (lo + hi);
+                let psi_mid = settle(mid, psi_lo);
+                if (psi_mid - psi_lo).abs() <= ONION_JUMP + 4.0 * (mid - lo).abs() {
+                    (lo, psi_lo) = (mid, psi_mid);
+                } else {
+                    (hi, psi_hi) = (mid, psi_mid);
+                }
+            }
+            work += energy(hi, psi_hi) - energy(lo, psi_lo);
+            record(lo, psi_lo);
+            record(hi, psi_hi);
+            (phi, psi) = (next, settle(next, psi_hi));
+            record(phi, psi);
+        }
+        *settles = settles.saturating_add(count.get());
+        (psi.is_finite() && work.is_finite()).then_some((psi, work))
+    }
+}
+
+/// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
+const CYCLE_STRIDE: f64 = 0.05;
+const SNAP_PLACEMENT: f64 = 1e-10;
+/// An onion turn beyond its branch's that marks a snap (rad), as in the integrator.
+const ONION_JUMP: f64 = 0.05;

@@ -1,0 +1,290 @@
+//! The Gilbert onion's ringing after a jump of its drive: when it has relaxed onto its
+//! quasi-static branch, when it is trapped in its well and can be averaged out, and how fast it
+//! decays (see [`Motor::relaxed_onion`], [`Motor::averaged_ringing`]).
+
+use super::{Drive, Motor, Vector};
+
+impl Motor {
+    /// Whether the Gilbert onion at `y` has relaxed onto its quasi-static branch, with the speed
+    /// kick (rad/s) that its averaged ringing gives the rotor: either its tilt and its distance to
+    /// the minimum of eq. 3.4 it would settle into are within `tolerance` plus the larger of its
+    /// lag behind a turning rotor and the ringing that no longer matters, and below
+    /// [`MAX_FOLLOWED_LAG`] (no kick), or its ringing is trapped about that minimum and averages
+    /// out ([`Self::averaged_ringing`]).
+    ///
+    /// Ringing of amplitude `A` left undecayed turns the rotor by at most `A tau_o / tau_rotor`
+    /// (its torque acts over about `tau_o`, the rotor answers over `tau_rotor`; the precession's
+    /// alternating sign makes it less still), so ringing below `tolerance tau_rotor / (10 tau_o)`
+    /// (7.6e-4 rad for Table 3.1) is dropped: the rotor moves by a tenth of the tolerance at most.
+    ///
+    /// The onion relaxes in `tau_o` ([`Self::onion_relaxation_time`], ~0.4 ns), ~1e4 times faster
+    /// than the rotor (~3 us), so once the ringing after a jump of its drive has decayed it lies
+    /// on the slow manifold: in the minimum, behind it by its lag `tau_o |psi'|` (the tilt is
+    /// smaller, `alpha tau_o |psi'| / 2`), with `|psi'|` a few times the rotor's speed along its
+    /// branch. Following the branch drops that lag: the rotor's path is then the quasi-static one,
+    /// ahead of the Gilbert one by about `tau_o` in time, i.e. by up to `tau_o |omega|` in angle
+    /// while it turns (2e-5 rad at the default schedule's peak 5e4 rad/s) and by nothing once it
+    /// has settled. A rotor that turns so fast that the lag exceeds [`MAX_FOLLOWED_LAG`], or an
+    /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
+    /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
+    /// The averaged ringing is tried when `rim_barrier` is given, the lowest rim found in this
+    /// segment (see [`Self::trapped_ringing`]); `remaining` is the time left in the segment (s).
+    pub(super) fn relaxed_onion(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        rim_barrier: Option<&mut Rims>,
+        remaining: f64,
+    ) -> Option<f64> {
+        // Without the averaged ringing only the first test can pass, and its slack is at most
+        // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle.
+        let small_tilt = y[3].abs() <= self.params.tolerance + MAX_FOLLOWED_LAG;
+        if rim_barrier.is_none() && !small_tilt {
+            return None;
+        }
+        let settled = self.settle(y, d);
+        if self.onion_relaxes_fast() {
+            let lag_time = self.onion_relaxation_time();
+            let rate = if d.locked { 0.0 } else { y[1].abs() };
+            // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
+            let ringing = 0.1 * self.params.tolerance * self.rotor_relaxation_time() / lag_time;
+            let slack =
+                self.params.tolerance + (4.0 * lag_time * rate).max(ringing).min(MAX_FOLLOWED_LAG);
+            if y[3].abs() <= slack && (settled - y[2]).abs() <= slack {
+                return Some(0.0);
+            }
+        }
+        self.averaged_ringing(y, d, settled, rim_barrier?, remaining)
+    }
+
+    /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
+    /// `settled` of eq. 3.4 when that ringing is trapped in the minimum's well and, averaged out,
+    /// moves the rotor by less than a tenth of the tolerance beyond that kick; `None` otherwise.
+    /// The rotor then sees the ringing through its cycle average: the branch itself, plus the
+    /// kick to first order in the amplitude, plus what is bounded below.
+    ///
+    /// Trapped: with the landscape frozen, Gilbert damping only lowers the macrospin's energy
+    /// `U(psi) + T theta^2 / 2` (`dE/dt = -g alpha (U'^2 + T^2 theta^2)`), so an onion whose
+    /// energy is below both rims of its well (the maxima of `U` either side) never leaves it.
+    /// Near the minimum a cheaper bound does: with `k = U''(psi*)` and `M` a bound on `|U'''|`,
+    /// `U(psi* + s) - U(psi*) >= k s^2/2 - M |s|^3/6 >= 5 k s^2/12` for `|s| <= w = k / (2M)`,
+    /// where the curvature stays within `[k/2, 3k/2]`; an onion in that window with less energy
+    /// than `5 k w^2/12` above the minimum rings within `sqrt(12 dE / (5 k))` of it. (The rotor's
+    /// own motion is slow against the onion's, at least ten times, so the well moves
+    /// adiabatically.)
+    ///
+    /// Negligible: ringing of amplitude `A` decays at least at the slowest rate `r` of the onion's
+    /// linearization in the window (the damped precession's `g alpha (k + T)/2` or, overdamped,
+    /// its slow creep; [`RIM_SLOWDOWN`] times slower for ringing out to the rims). Near the
+    /// minimum the ringing is the onion's linear mode `x' = J x` (`x = (psi - psi*, theta)`,
+    /// `J = g [[-alpha k, -T], [k, -alpha T]]`), whose offset integrates to
+    /// `(-J^-1 x0)_psi = (alpha x0_psi - theta0) / (g k (1 + alpha^2))`: times the ring-bar
+    /// stiffness `k_bar` that is the impulse on the rotor, given to it as a kick of its speed
+    /// (a locked rotor takes none). What is left is second order: the torque's curvature
+    /// (`|tau_bar''| <= M_bar`) and the onion's own (its centre shifts by `M A^2 / k`) add at most
+    /// `(M_bar + 2 |k_bar| M / k) A^2 / (4 r)` to the impulse. Out to the rims no first order
+    /// is taken: the whole ringing's torque integrates to at most `k_bar A / r` there. Either
+    /// bound, divided by the drag `c` (the rotor's eventual turn, with or without inertia), is
+    /// held below a tenth of the tolerance, as is the rotor's turn `|omega| / r` over the decay
+    /// (the onion's lag behind a turning rotor, dropped with the ringing).
+    ///
+    /// This replaces resolving the ringing (about `1/alpha` precession periods per decay time)
+    /// once it is trapped, at the cost of the onion's outputs: it is reported at the centre of its
+    /// ringing, the minimum, not at the ringing's phase.
+    ///
+    /// A locked rotor feels no ringing: trapped ringing is also dropped there when it decays to
+    /// within the tolerance of the minimum in the `remaining` time of its segment (s), at its
+    /// bound on the decay rate, so that the onion meets the segment's end (the step's end or the
+    /// next switch) where the resolved one does.
+    pub(super) fn averaged_ringing(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        settled: f64,
+        rim_barrier: &mut Rims,
+        remaining: f64,
+    ) -> Option<f64> {
+        let limit = 0.1 * self.params.tolerance * self.drag;
+        let k_bar = self.ring_bar.stiffness(settled - y[0]);
+        // The rims are looked for only where ringing anywhere in the turn, and the rotor's turn
+        // over its decay, would pass.
+        let turn = 2.0 * std::f64::consts::PI;
+        let widest = turn * (k_bar.abs() + self.ring_bar_slope_bound * turn);
+        let speed = if d.locked { 0.0 } else { y[1].abs() };
+        let least_rate = if d.locked {
+            0.0
+        } else {
+            (widest / limit).max(speed * self.drag / limit)
+        };
+        let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, least_rate)))?;
+        let (amplitude, rate) = (trap.amplitude, trap.rate);
+        if d.locked && amplitude * (-rate * remaining).exp() <= self.params.tolerance {
+            return Some(0.0);
+        }
+        // (A NaN fails every bound below.)
+        if speed * self.drag > limit * rate {
+            return None;
+        }
+        if trap.near {
+            let (g, alpha, k) = (self.llg_rate, self.params.gilbert_damping, trap.curvature);
+            let second = (self.ring_bar_slope_bound + 2.0 * k_bar.abs() * trap.slope_bound / k)
+                * amplitude
+                * amplitude
+                / (4.0 * rate);
+            if second <= limit {
+                if d.locked {
+                    return Some(0.0);
+                }
+                let offset = (alpha * (y[2] - settled) - y[3]) / (g * k * (1.0 + alpha * alpha));
+                return Some(k_bar * offset / self.inertia);
+            }
+        }
+        // The ring-bar stiffness anywhere the ringing reaches (its slope is bounded).
+        let stiffness = k_bar.abs() + self.ring_bar_slope_bound * amplitude;
+        (amplitude * stiffness <= limit * rate).then_some(0.0)
+    }
+
+    /// The Gilbert onion's ringing about `settled` when it is trapped in that minimum's well and
+    /// relaxes within a tenth of the rotor's relaxation time (see [`Self::averaged_ringing`]).
+    ///
+    /// Out of the window about the minimum, the rims are looked for when `rims` is given, none
+    /// were found yet in this segment (the search, a march over the well both ways, records
+    /// them) or, for a locked rotor, they were found for another minimum, and the decay rate
+    /// that the ringing out to the rims is held to ([`RIM_SLOWDOWN`] times slower than at the
+    /// minimum) is at least its second value (1/s). A locked rotor's rims found for this minimum
+    /// are used again (its landscape is frozen).
+    pub(super) fn trapped_ringing(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        settled: f64,
+        rims: Option<(&mut Rims, f64)>,
+    ) -> Option<Trap> {
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let k = land.curvature(settled);
+        let m = land.third_derivative_bound();
+        if !(k > 0.0 && k.is_finite() && m.is_finite() && m > 0.0) {
+            return None;
+        }
+        let rate = self
+            .onion_decay_rate(0.5 * k)
+            .min(self.onion_decay_rate(1.5 * k));
+        if !(rate > 0.0 && rate * self.rotor_relaxation_time() >= 10.0) {
+            return None;
+        }
+        let window = 0.5 * k / m;
+        let offset = y[2] - settled;
+        let excess =
+            land.energy(y[2]) - land.energy(settled) + 0.5 * self.tilt_stiffness * y[3] * y[3];
+        let near = (2.4 * excess.max(0.0) / k).sqrt().max(offset.abs());
+        let trap = |amplitude, rate, near| Trap {
+            amplitude,
+            rate,
+            near,
+            curvature: k,
+            slope_bound: m,
+        };
+        if near < window {
+            return Some(trap(near, rate, true));
+        }
+        let found = match rims {
+            Some((found, least_rate)) if rate >= least_rate * RIM_SLOWDOWN => found,
+            _ => return None,
+        };
+        // A locked rotor's landscape is frozen: the well found in this segment stays the same
+        // as long as the onion settles into the same minimum.
+        let same_well = d.locked && (found.minimum - settled).abs() <= 1e-9;
+        if !same_well {
+            if found.barrier.is_finite() && !d.locked {
+                return None;
+            }
+            let (below, above) = land.well_rims(settled, 0.5 * window);
+            *found = Rims {
+                barrier: land.energy(below).min(land.energy(above)) - land.energy(settled),
+                minimum: settled,
+                below,
+                above,
+            };
+        }
+        let Rims {
+            barrier,
+            below,
+            above,
+            ..
+        } = *found;
+        (below < y[2] && y[2] < above && excess < 0.99 * barrier).then(|| {
+            let reach = (above - settled).max(settled - below);
+            trap(reach, rate / RIM_SLOWDOWN, false)
+        })
+    }
+
+    /// The slowest decay rate (1/s) of the Gilbert onion's linearization about a minimum of
+    /// curvature `k` with the rotor held: the eigenvalues of
+    /// `g [[-alpha k, -T], [k, -alpha T]]` (see [`Self::onion_relaxation_time`]), whose trace is
+    /// `-g alpha (k + T)` and determinant `g^2 k T (1 + alpha^2)`. 0 without damping.
+    pub(super) fn onion_decay_rate(&self, k: f64) -> f64 {
+        let (g, alpha, t) = (
+            self.llg_rate,
+            self.params.gilbert_damping,
+            self.tilt_stiffness,
+        );
+        let trace = g * alpha * (k + t);
+        let det = g * g * k * t * (1.0 + alpha * alpha);
+        let discriminant = trace * trace - 4.0 * det;
+        if discriminant <= 0.0 {
+            0.5 * trace
+        } else {
+            // The smaller root, (trace - sqrt(disc)) / 2, without cancellation.
+            2.0 * det / (trace + discriminant.sqrt())
+        }
+    }
+
+    /// Whether the Gilbert onion relaxes within a tenth of the rotor's relaxation time (the
+    /// separation of time scales that following its quasi-static branch rests on).
+    pub(super) fn onion_relaxes_fast(&self) -> bool {
+        self.onion_relaxation_time() <= 0.1 * self.rotor_relaxation_time()
+    }
+}
+
+/// The rims of the Gilbert onion's well found in a segment (see [`Motor::trapped_ringing`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Rims {
+    /// The lowest rim's height above the minimum (J); infinite before the search.
+    pub(super) barrier: f64,
+    /// The minimum whose well it is, and the well's rims (rad).
+    pub(super) minimum: f64,
+    pub(super) below: f64,
+    pub(super) above: f64,
+}
+
+impl Rims {
+    pub(super) const NONE: Rims = Rims {
+        barrier: f64::INFINITY,
+        minimum: f64::NAN,
+        below: f64::NAN,
+        above: f64::NAN,
+    };
+}
+
+/// A Gilbert onion's ringing trapped in the well of a minimum (see [`Motor::averaged_ringing`]).
+pub(super) struct Trap {
+    /// Bound on its distance from the minimum (rad).
+    pub(super) amplitude: f64,
+    /// Bound below its decay rate (1/s).
+    pub(super) rate: f64,
+    /// Within the window about the minimum where the curvature stays within half of its value.
+    pub(super) near: bool,
+    /// The curvature of eq. 3.4 at the minimum (J/rad^2).
+    pub(super) curvature: f64,
+    /// The bound on the third derivative of eq. 3.4 (J/rad^3).
+    pub(super) slope_bound: f64,
+}
+
+/// How much slower than its linearization's at the minimum ringing that reaches out to the rims of
+/// its well may decay (see [`Motor::averaged_ringing`]): the curvature falls to zero on the way
+/// and the orbit lingers near the rims.
+const RIM_SLOWDOWN: f64 = 100.0;
+
+/// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
+/// drop (see [`Motor::relaxed_onion`]).
+const MAX_FOLLOWED_LAG: f64 = 1e-3;
