@@ -586,8 +586,9 @@ def main():
              "time (so that they reproduce on a loaded machine), of one set-inputs + `fmi2DoStep` + get-output",
              "through the packaged FMU's C ABI; errors are the largest deviation from a converged",
              "reference over the scenario, relative to the reference's largest force (muscles) or in rad (motor).",
-             "The McKibben scenario keeps the bladder on the sleeve; below the contact threshold the free",
-             "bladder's root costs more (`make bench` measures muscle A at 400 kPa, mostly free).",
+             "The McKibben scenario keeps the layered and exact walls on the sleeve; the thin wall's threshold",
+             "pressure for muscle A is 0.93 MPa, so below it that wall's bladder is free and each step solves",
+             "its free bladder's root, which costs more (`make bench` measures muscle A at 400 kPa, mostly free).",
              ""]
     for family in (mckibben_rows(), knitted_rows(), motor_rows()):
         if family is None:
@@ -688,7 +689,7 @@ def main():
 COST_ROWS = [
     ("PassThrough/baseline/y = u", "PassThrough (y = u): the FMI layer alone"),
     ("McKibbenMuscle/bladder_model/none", "McKibbenMuscle, ideal sleeve (eq. 2.3)"),
-    ("McKibbenMuscle/bladder_model/thin", "McKibbenMuscle, thin-walled bladder (muscle A, 690 kPa, in contact)"),
+    ("McKibbenMuscle/bladder_model/thin", "McKibbenMuscle, thin-walled bladder (muscle A, 690 kPa, below its 0.93 MPa threshold: free)"),
     ("McKibbenMuscle/bladder_layers/16", "McKibbenMuscle, layered wall, 16 layers"),
     ("McKibbenMuscle/bladder_exact/16", "McKibbenMuscle, exact wall, 16 nodes"),
     ("McKibbenMuscle/friction/on (thin)", "McKibbenMuscle, thin wall + friction"),
