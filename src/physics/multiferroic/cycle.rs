@@ -1,7 +1,7 @@
-//! The quasi-static onion's hysteresis cycle as a rotor turns under a fixed strain: marched
-//! once, round the turn, with its snaps located (see [`Motor::onion_cycle`]).
+//! The quasi-static onion's hysteresis cycle as a rotor turns under a fixed strain, marched once
+//! round the turn with its snaps located (see [`Motor::onion_cycle`]), and the rotor's periodic
+//! deviation from its mean motion along it.
 
-use super::spin::Wobble;
 use super::{Drive, Motor};
 use std::f64::consts::PI;
 
@@ -93,6 +93,64 @@ impl OnionCycle {
         motor
             .landscape(self.rotor + dir * s, d.direction, d.stress)
             .settle(self.onion_samples[j])
+    }
+}
+
+/// The rotor's periodic deviation from its mean motion at one mean speed, sampled where
+/// [`OnionCycle::torque`] is, in the direction of motion.
+#[derive(Clone)]
+pub(super) struct Wobble {
+    /// Angle `delta(s)` (rad, zero mean over a turn) and speed `u(s)` (rad/s) deviations.
+    pub(super) angle: Vec<f64>,
+    pub(super) speed: Vec<f64>,
+    /// The second-order mean force `<tau'(s) delta(s)> = -<tau(s) u(s)> / Omega` (N m).
+    pub(super) drift_force: f64,
+    /// The mean speed (rad/s), the decay per radian `kappa` and the cycle's mean torque (N m).
+    pub(super) omega: f64,
+    pub(super) kappa: f64,
+    pub(super) mean: f64,
+}
+
+impl Wobble {
+    pub(super) fn amplitude(&self) -> f64 {
+        self.angle.iter().fold(0.0, |a: f64, x| a.max(x.abs()))
+    }
+
+    /// One stride `h` (rad) of `I omega du/ds + c u = tau~(s)` for `tau~` linear over it:
+    /// `u_end = e u_0 + a tau~_0 + b tau~_end`.
+    pub(super) fn stride(&self, h: f64, c: f64) -> (f64, f64, f64) {
+        let x = self.kappa * h;
+        let one_minus_e = -(-x).exp_m1();
+        // 1 - (1 - e^-x) / x, by its series where it cancels.
+        let ramp = if x < 1e-3 {
+            x / 2.0 - x * x / 6.0 + x * x * x / 24.0
+        } else {
+            1.0 - one_minus_e / x
+        };
+        (1.0 - one_minus_e, (one_minus_e - ramp) / c, ramp / c)
+    }
+
+    /// Angle and speed deviation at phase `s`: from the sample below it, the same exact stride
+    /// (so no interpolation error between samples).
+    pub(super) fn at(&self, cycle: &OnionCycle, s: f64, c: f64) -> (f64, f64) {
+        let tau = &cycle.torque;
+        let s = OnionCycle::phase(s);
+        let j = tau
+            .partition_point(|&(x, _)| x <= s)
+            .clamp(1, tau.len() - 1)
+            - 1;
+        let (s0, t0) = tau[j];
+        let (s1, t1) = tau[j + 1];
+        let h = (s - s0).max(0.0);
+        let t_s = if s1 > s0 {
+            t0 + (t1 - t0) * (h / (s1 - s0)).min(1.0)
+        } else {
+            t1
+        };
+        let (e, a, b) = self.stride(h, c);
+        let u = e * self.speed[j] + a * (t0 - self.mean) + b * (t_s - self.mean);
+        let delta = self.angle[j] + 0.5 * h * (self.speed[j] + u) / self.omega;
+        (delta, u)
     }
 }
 
