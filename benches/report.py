@@ -450,8 +450,8 @@ KNOB_LABELS = {
     "bladder_exact": "bladder_model 3: exact wall (value = nodes)",
     "shape_model": "shape_model (cylindrical)",
     "shape_segments": "shape_model 2: non-cylindrical (value = segments)",
-    "tolerance": "tolerance (value)",
-    "onion_model": "onion_model",
+    "tolerance": "tolerance (value, rad)",
+    "onion_model": "onion_model 1: Gilbert onion (tolerance 1e-6 rad)",
     "friction": "friction on: size of the effect, not an error",
 }
 
@@ -480,7 +480,9 @@ def _place_labels(ax, labelled):
                                arrowprops=dict(arrowstyle="-", lw=0.4, color="0.4") if abs(dy) > 12 else None)
             box = note.get_window_extent(renderer).expanded(1.05, 1.1)
             near = box.padded(7)  # keeps a label off other markers, so that it names its own
-            clear = not any(box.overlaps(t) for t in taken) and not any(
+            axes = ax.get_window_extent(renderer)
+            inside = axes.contains(box.x0, box.y0) and axes.contains(box.x1, box.y1)
+            clear = inside and not any(box.overlaps(t) for t in taken) and not any(
                 near.contains(*p) for p in points if p is not own)
             if clear or (dx, dy) == candidates[-1]:
                 taken.append(box)
