@@ -166,22 +166,13 @@ impl Motor {
             .ring_bar
             .torque_stiffness_of(a.sin_offset, a.cos_offset);
         let grad = tau + self.magnetoelastic_per_stress * d.stress * a.sin_double;
-        let (g, alpha, t) = (
-            self.llg_rate,
-            self.params.gilbert_damping,
-            self.tilt_stiffness,
-        );
         let rotor = if d.locked {
             [0.0, 0.0]
         } else {
             [y[1], (tau + d.load - self.drag * y[1]) / self.inertia]
         };
-        [
-            rotor[0],
-            rotor[1],
-            g * (-t * y[3] - alpha * grad),
-            g * (grad - alpha * t * y[3]),
-        ]
+        let [onion, tilt] = self.onion_rate(grad, y[3]);
+        [rotor[0], rotor[1], onion, tilt]
     }
 
     /// A bound on the moduli of the eigenvalues of the Jacobian `j` (1/s): the onion block's

@@ -81,10 +81,8 @@ impl Motor {
                 self.params.gilbert_damping,
                 self.tilt_stiffness,
             );
-            let grad = tau + e * s2;
             let (d_psi, d_phi) = (k_bar + k_me, -k_bar);
-            f[2] = g * (-t * y[3] - a * grad);
-            f[3] = g * (grad - a * t * y[3]);
+            [f[2], f[3]] = self.onion_rate(tau + e * s2, y[3]);
             j[2][2] = -g * a * d_psi;
             j[2][3] = -g * t;
             j[3][2] = g * d_psi;
@@ -95,6 +93,19 @@ impl Motor {
             }
         }
         (f, j)
+    }
+
+    /// The Gilbert onion's in-plane and tilt rates (the macrospin's Landau-Lifshitz-Gilbert rates,
+    /// linear in the tilt) for the energy's gradient `grad` along the onion angle and the tilt
+    /// `theta`, shared by the exponential pair's right-hand side and the explicit pair's.
+    #[inline(always)]
+    pub(super) fn onion_rate(&self, grad: f64, theta: f64) -> [f64; 2] {
+        let (g, a, t) = (
+            self.llg_rate,
+            self.params.gilbert_damping,
+            self.tilt_stiffness,
+        );
+        [g * (-t * theta - a * grad), g * (grad - a * t * theta)]
     }
 
     /// The rotor stiffness `k` for the linearization over `dt`: unchanged unless it is negative
