@@ -191,6 +191,16 @@ TEST_JOBS ?= 3
 test:
 	@$(MAKE) --no-print-directory deps cross-deps interop-deps py-deps
 	+@$(MAKE) --no-print-directory -j$(TEST_JOBS) test-rust test-fmpy
+	+@$(MAKE) --no-print-directory test-report
+
+## Every configuration `make report` measures, run once each and nothing written (criterion's test
+## mode, the motor and wall CPU-time bench, `benches/report.py --smoke`): a configuration an FMU
+## refuses fails here, not in the next report.
+.PHONY: test-report
+test-report: fmus $(VENV)/.installed
+	cargo bench --bench accuracy_cost -- --test
+	cargo bench --bench cpu_time
+	$(PY) benches/report.py --smoke
 
 ## The C pass-through FMU (FMI 2.0 Co-Simulation) that benches/parity.rs holds our FMI layer against.
 C_PASSTHROUGH := target/c_passthrough/PassThroughC.so

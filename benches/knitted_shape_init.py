@@ -60,15 +60,16 @@ def measure(paths, segments, repeats):
 SEGMENTS = (49, 98)
 
 
-def rows(paths):
-    """Markdown rows over SEGMENTS, and the best CPU times of the first FMU by segments."""
+def rows(paths, repeats=None):
+    """Markdown rows over SEGMENTS, and the best CPU times of the first FMU by segments (over
+    `repeats` builds each, by default 20 below 200 segments and 5 from there)."""
     header = "| segments | CPU time | wall time | goal (CPU) |"
     if len(paths) > 1:
         header += " other FMU, CPU | ratio |"
     out = [header, "|---" * (header.count("|") - 1) + "|"]
     times = {}
     for segments in SEGMENTS:
-        best = measure(paths, segments, 20 if segments < 200 else 5)
+        best = measure(paths, segments, repeats or (20 if segments < 200 else 5))
         (cpu, wall) = best[0]
         times[segments] = cpu
         goal = GOALS.get(segments)
