@@ -2,11 +2,33 @@
 
 use super::{Angles, Drive, Motor, Vector};
 
+/// The full system's right-hand side `f` and Jacobian `j` at a substep's start for its length,
+/// with the angles there: evaluated once and shared by the explicit pair and the exponential
+/// one ([`Motor::linearized`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Linearized {
+    pub(super) f: Vector,
+    pub(super) j: [[f64; 4]; 4],
+    pub(super) angles: Angles,
+}
+
+impl Motor {
+    /// [`Linearized`] at `y` (whose angles are `angles`) for a substep `dt`.
+    pub(super) fn linearized(&self, y: &Vector, d: &Drive, dt: f64, angles: &Angles) -> Linearized {
+        let (f, j) = self.rhs_jacobian_at(y, d, dt, angles);
+        Linearized {
+            f,
+            j,
+            angles: *angles,
+        }
+    }
+}
+
 impl Motor {
     /// The exponential Rosenbrock pair 2(3) of Hochbruck, Ostermann and Schweitzer (exprb32, SIAM
     /// J. Numer. Anal. 47, 2009) on the full system `(phi, omega, psi, theta)` of the Gilbert
-    /// onion: the exponential Euler step `u1 = y + h phi_1(hJ) F(y)` (one 5x5 augmented
-    /// exponential, as [`Self::exponential_step`]), then with the linearization's defect
+    /// onion: the exponential Euler step `u1 = y + h phi_1(hJ) F(y)` (one 4x4 exponential with
+    /// its `phi_1` column, as [`Self::exponential_step`]), then with the linearization's defect
     /// `D = F(u1) - F(y) - J (u1 - y)` the correction `2 h phi_3(hJ) D`, which is the error
     /// estimate of `u1` and, within the tolerance, is added to it (as in the quasi-static
     /// rotor's [`Self::embedded_step`]).
@@ -24,12 +46,13 @@ impl Motor {
         y: &Vector,
         dt: f64,
         d: &Drive,
+        start: &Linearized,
     ) -> Option<(Vector, f64)> {
-        let (f0, j) = self.rhs_jacobian(y, d, dt);
+        let (f0, j) = (start.f, start.j);
         let unit = self.speed_unit();
-        let (_, increments) = self.increments_of::<5>(&f0, &j, dt, false, unit)?;
+        let (_, increments) = self.increments_of::<4>(&f0, &j, dt, false, unit)?;
         let u1 = self.finish_exponential_step(y, &increments, d)?;
-        let (f1, _) = self.rhs_jacobian(&u1, d, dt);
+        let f1 = self.gilbert_rate(&u1, d, &start.angles.moved(u1[2], u1[0], d.direction));
         let step: Vector = std::array::from_fn(|i| u1[i] - y[i]);
         let rhs: Vector = std::array::from_fn(|i| {
             let linear: f64 = (0..4).map(|k| j[i][k] * step[k]).sum();
@@ -70,16 +93,17 @@ impl Motor {
         y: &Vector,
         dt: f64,
         d: &Drive,
+        start: &Linearized,
     ) -> Option<(Vector, f64)> {
-        let (k1, j) = self.rhs_jacobian(y, d, dt);
+        let k1 = start.f;
         // (False for a NaN rate too.)
-        let within_reach = dt * self.fastest_rate(&j) <= EXPLICIT_REACH;
+        let within_reach = dt * self.fastest_rate(&start.j) <= EXPLICIT_REACH;
         if !within_reach {
             return None;
         }
         // Each stage's angles turned from the start's (see [`Angles::moved`]).
-        let start = Angles::exact(y[2], y[0], d.direction);
-        let rate = |z: &Vector| self.gilbert_rate(z, d, &start.moved(z[2], z[0], d.direction));
+        let rate =
+            |z: &Vector| self.gilbert_rate(z, d, &start.angles.moved(z[2], z[0], d.direction));
         let at = |k: &[&Vector], a: &[f64]| -> Vector {
             std::array::from_fn(|i| y[i] + dt * k.iter().zip(a).map(|(k, a)| a * k[i]).sum::<f64>())
         };
@@ -236,7 +260,7 @@ fn pade_phi3_apply(j: &[[f64; 4]; 4], dt: f64, v: &Vector, unit: f64) -> Option<
 mod tests {
     use super::super::ringing::Rims;
     use super::super::tests::{motor_with, rk4_step, schedule};
-    use super::super::{Drive, MotorInputs, MotorState, OnionModel, Vector};
+    use super::super::{Angles, Drive, MotorInputs, MotorState, OnionModel, Vector};
     use super::pade_phi3_apply;
 
     /// The Gilbert onion across its declared damping from 0.003 up, on the stepping schedule (20
@@ -693,7 +717,8 @@ mod tests {
                 truth = rk4_step(&rate, &truth, h);
             }
             let euler = m.exponential_step(&y, dt, &d).unwrap();
-            let (pair, estimate) = m.gilbert_embedded_step(&y, dt, &d).unwrap();
+            let start = m.linearized(&y, &d, dt, &Angles::exact(y[2], y[0], d.direction));
+            let (pair, estimate) = m.gilbert_embedded_step(&y, dt, &d, &start).unwrap();
             let (euler_error, pair_error) = (scaled(&euler, &truth), scaled(&pair, &truth));
             println!(
                 "dt {dt:e}: estimate {estimate:e}, Euler {euler_error:e}, pair {pair_error:e}"
@@ -739,7 +764,8 @@ mod tests {
                 locked,
             };
             for dt in [1e-13, 3e-13, 1e-12, 3e-12, 1e-11, 3e-11, 1e-10] {
-                let (u, estimate) = match m.gilbert_explicit_step(&y, dt, &d) {
+                let start = m.linearized(&y, &d, dt, &Angles::exact(y[2], y[0], d.direction));
+                let (u, estimate) = match m.gilbert_explicit_step(&y, dt, &d, &start) {
                     Some((u, estimate)) if estimate <= 1.0 => (u, estimate),
                     _ => {
                         declined += 1;
