@@ -243,9 +243,10 @@ impl Motor {
     /// One error-controlled substep: the new state, its error relative to the tolerance and the
     /// time it advances (`dt`, or less when the quasi-static onion snaps inside it, see
     /// [`Self::step_to_onion_snap`]). The quasi-static rotor uses the embedded pair
-    /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`],
-    /// or within its reach and unless `forced` the explicit [`Self::gilbert_explicit_step`]);
-    /// step doubling remains where either does not apply.
+    /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`];
+    /// unless `forced`, first the explicit [`Self::gilbert_explicit_step`] within its reach, else
+    /// the exponential RK4 [`Self::gilbert_exponential_rk4_step`] within its own, where the
+    /// exponential pair takes over what it rejects); step doubling remains where none applies.
     /// `angles` are those at `y`; the result carries those at the new state when known.
     pub(super) fn controlled_step(
         &self,
@@ -269,14 +270,29 @@ impl Motor {
             }
         }
         if !self.quasi_static() {
-            // A forced substep takes the exponential pair, which cannot amplify. Both start
+            // A forced substep takes the exponential pair, which cannot amplify. All three start
             // from the same right-hand side and Jacobian.
             let start = self.linearized(y, d, dt, angles);
-            if let Some((u, err)) = (!forced)
+            let explicit = (!forced)
                 .then(|| self.gilbert_explicit_step(y, dt, d, &start))
-                .flatten()
-                .or_else(|| self.gilbert_embedded_step(y, dt, d, &start))
-            {
+                .flatten();
+            if let Some((u, err)) = explicit {
+                return Some((u, err, dt, None));
+            }
+            // Where the exponential RK4 substep rejects, the exponential pair may still take it:
+            // near its minimum the onion's ringing is nearly linear, which the exponential pair
+            // follows exactly over many precession periods.
+            let rk4 = (!forced)
+                .then(|| self.gilbert_exponential_rk4_step(y, dt, d, &start))
+                .flatten();
+            if let Some((u, err)) = rk4.filter(|(_, err)| *err <= 1.0) {
+                return Some((u, err, dt, None));
+            }
+            match self.gilbert_embedded_step(y, dt, d, &start) {
+                Some((u, err)) if err <= 1.0 || rk4.is_none() => return Some((u, err, dt, None)),
+                _ => {}
+            }
+            if let Some((u, err)) = rk4 {
                 return Some((u, err, dt, None));
             }
         }

@@ -105,8 +105,7 @@ pub fn expm_affine<const M: usize>(a: &Mat<M>, b: &[f64; M]) -> Option<(Mat<M>, 
         x = std::array::from_fn(|i| ex[i] + x[i]);
         e = mul(&e, &e);
     }
-    (e.iter().flatten().all(|v| v.is_finite()) && x.iter().all(|v| v.is_finite()))
-        .then_some((e, x))
+    (e.iter().flatten().all(|v| v.is_finite()) && x.iter().all(|v| v.is_finite())).then_some((e, x))
 }
 
 /// `a v`.
@@ -239,7 +238,10 @@ mod tests {
         }
         // An overflowing forcing column is refused, never returned as infinity.
         let huge = [[0.0, 1.0], [-4.0, -3.0]];
-        assert!(expm_affine(&huge, &[1e308, 1e308])
-            .is_none_or(|(e, x)| e.iter().flatten().chain(&x).all(|v| v.is_finite())));
+        assert!(expm_affine(&huge, &[1e308, 1e308]).is_none_or(|(e, x)| e
+            .iter()
+            .flatten()
+            .chain(&x)
+            .all(|v| v.is_finite())));
     }
 }
