@@ -65,7 +65,7 @@ impl Motor {
             *x += c;
         }
         let u3 = self.checked_end(u3, y, d.locked)?;
-        let err = self.error_norm(|i| correction[i]);
+        let err = self.error_norm(|i| correction[i], y, &u3);
         // Beyond the tolerance the correction is no longer small and the substep, if taken at
         // all (forced at the budget's minimum size), is the exponential Euler step, which is
         // exact for the linear part and cannot amplify (see [`Self::rhs_jacobian`]).
@@ -155,13 +155,17 @@ impl Motor {
         ];
         let stages = [&k1, &k3, &k4, &k5, &k6, &k7];
         let u = self.checked_end(u, y, d.locked)?;
-        let err = self.error_norm(|i| {
-            dt * stages
-                .iter()
-                .zip(&weights)
-                .map(|(k, w)| w * k[i])
-                .sum::<f64>()
-        });
+        let err = self.error_norm(
+            |i| {
+                dt * stages
+                    .iter()
+                    .zip(&weights)
+                    .map(|(k, w)| w * k[i])
+                    .sum::<f64>()
+            },
+            y,
+            &u,
+        );
         err.is_finite().then(|| (u, fifth_order_error(err)))
     }
 
@@ -175,11 +179,16 @@ impl Motor {
         (self.rotor_sane(&u) && Self::onion_sane(&u)).then_some(u)
     }
 
-    /// The error estimate `e` in units of the tolerance: the largest `|e_i|` over the angles'
-    /// tolerance and the speed's on its scale.
-    fn error_norm(&self, e: impl Fn(usize) -> f64) -> f64 {
+    /// The error estimate `e` of a substep from `y` to `u` in units of the tolerance: the
+    /// largest `|e_i|` over the angles' tolerance and the speed's on its scale, the latter no
+    /// finer than [`SPEED_ROUNDING`] of the speed. (A motor whose ring barely holds its bar has an
+    /// undamped frequency, the speed's scale, of 1e-4 rad/s and less: at a load's 500 rad/s its
+    /// speed's tolerance fell below the speed's own rounding, and the error estimates, then
+    /// rounding noise, held the substeps to picoseconds.)
+    fn error_norm(&self, e: impl Fn(usize) -> f64, y: &Vector, u: &Vector) -> f64 {
         let tol = self.params.tolerance;
-        let scales = [tol, tol * self.speed_scale, tol, tol];
+        let speed = (tol * self.speed_scale).max(SPEED_ROUNDING * y[1].abs().max(u[1].abs()));
+        let scales = [tol, speed, tol, tol];
         (0..4).map(|i| e(i).abs() / scales[i]).fold(0.0, f64::max)
     }
 
@@ -276,7 +285,7 @@ impl Motor {
             rate,
         );
         let u = self.checked_end(two, y, false)?;
-        let err = self.error_norm(|i| two[i] - whole[i]);
+        let err = self.error_norm(|i| two[i] - whole[i], y, &u);
         err.is_finite().then(|| (u, fifth_order_error(err)))
     }
 
@@ -361,6 +370,10 @@ fn fifth_order_error(err: f64) -> f64 {
     let root = err.sqrt();
     root * root.sqrt().sqrt()
 }
+
+/// The finest speed error (relative to the speed) that the Gilbert substeps' error norm asks
+/// for: 64 ulp, about the rounding that a substep's sums of stages leave in the speed.
+const SPEED_ROUNDING: f64 = 64.0 * f64::EPSILON;
 
 /// The longest exponential RK4 substep relative to the onion's rates (see
 /// [`Motor::gilbert_exponential_rk4_step`]): classical RK4's stability region reaches about 2.8
@@ -1040,6 +1053,60 @@ mod tests {
             assert!(rotor <= 10.0 * tol && onion <= 10.0 * tol, "{alpha}");
             assert!(rotor <= 1e-3 * truth[0].abs(), "{alpha}");
         }
+    }
+
+    /// A motor whose ring barely holds its bar (magnetization 7.4 A/m, a millimetre bar in a
+    /// 28 cm ring: undamped frequency, the speed's error scale, 5e-5 rad/s) spun by a load to
+    /// 500 rad/s, at `tolerance` 1.5e-10, its onion creeping off the maximum it starts at: the
+    /// speed's tolerance alone would be below the speed's rounding. The 1 us step is not
+    /// accuracy-limited and ends within the tolerance of classical RK4 of the full system at
+    /// 1 ps steps (the step that spent its budget on rounding noise dropped the onion into its
+    /// minimum, 1.5 rad away, flagged).
+    #[test]
+    fn a_tiny_speed_scale_does_not_hold_the_substeps_to_rounding() {
+        use super::super::{Motor, MotorParams, ScheduleSwitch, SteppingSchedule};
+        let m = Motor::new(MotorParams {
+            ring_outer_diameter: 2.769e-1,
+            ring_inner_diameter: 4.122e-3,
+            bar_length: 9.822e-4,
+            bar_width: 2.873e-4,
+            thickness: 1.252e-8,
+            saturation_magnetization: 7.393,
+            magnetostriction: -4.109e-3,
+            wall_volume: 8.62e-11,
+            density: 3.235e4,
+            fluid_viscosity: 4.195,
+            gilbert_damping: 0.3482,
+            onion_model: OnionModel::Gilbert,
+            tolerance: 1.504e-10,
+            max_substeps: 12730,
+        })
+        .unwrap();
+        assert!(m.speed_scale < 1e-4, "{}", m.speed_scale);
+        let schedule = SteppingSchedule::new(8.259e-3, 5.249, 4.575e-6, 1.282e-2).unwrap();
+        let inputs = MotorInputs {
+            load_torque: 3.911e-7,
+            schedule: ScheduleSwitch::new(true, schedule),
+            ..MotorInputs::fixed(0.0, 0.0)
+        };
+        let mut s = MotorState::aligned(0.0);
+        let y0 = [0.0; 4];
+        let report = m.step(&mut s, &inputs, 1e-6).unwrap();
+        let truth = rk4(&m, &m.drive_at(&inputs, 0.0), y0, 1e-6, 1e-12, |_| {});
+        let got = [s.rotor_angle, s.rotor_speed, s.onion_angle, s.onion_tilt];
+        println!("{} substeps: {got:?} against {truth:?}", report.substeps);
+        assert!(!report.accuracy_limited);
+        let tol = m.params.tolerance;
+        for i in [0, 2, 3] {
+            assert!(
+                (got[i] - truth[i]).abs() <= 2.0 * tol,
+                "{i}: {got:?} {truth:?}"
+            );
+        }
+        assert!(
+            (got[1] - truth[1]).abs() <= 1e-9 * truth[1].abs(),
+            "{got:?} {truth:?}"
+        );
     }
 
     #[test]
