@@ -1,4 +1,5 @@
-//! The Gilbert onion's error-controlled substep: one exponential per substep.
+//! The Gilbert onion's error-controlled substeps: the exponential pair, the explicit
+//! Dormand-Prince pair while the onion rings, and an exponential RK4 on a stiff rotor.
 
 use super::phi::Phi2x2;
 use super::{Angles, Drive, Motor, Vector};
@@ -236,8 +237,9 @@ impl Motor {
     /// doubling's (one full step against two halves, which share the start's stage), taken
     /// whole rather than divided by `2^4 - 1`, so that an order lost to stiffness cannot hide;
     /// the two halves are the result. Returned as `err^(5/8)`, as the explicit pair's (about the
-    /// fourth order's `err^(-1/5)` step rule). `None` for a locked rotor (the explicit pair reaches it),
-    /// out of reach, for an underdamped rotor block (complex eigenvalues) or when the step fails.
+    /// fourth order's `err^(-1/5)` step rule). `None` for a locked rotor (the explicit pair
+    /// reaches it), out of reach, for an underdamped rotor block (complex eigenvalues) or when
+    /// the step fails.
     pub(super) fn gilbert_exponential_rk4_step(
         &self,
         y: &Vector,
@@ -294,8 +296,9 @@ impl Motor {
     /// those matrices. With `u` the deviation from `y0` and `N(u) = F(y0 + u) - L u`:
     /// `a = h/2 phi_1(z/2) N(0)`, `b = h/2 phi_1(z/2) N(a)`,
     /// `c = e^(z/2) a + h/2 phi_1(z/2) (2 N(b) - N(0))` and the end
-    /// `h [phi_1 N(0) + phi_2 (2 N(a) + 2 N(b) - N(c) - 3 N(0)) + 4 phi_3 (N(0) - N(a) - N(b) + N(c))]`
-    /// (`phi_k` at `z = h L`; at `L = 0`, on the onion, this is classical RK4).
+    /// `h [phi_1 N(0) + phi_2 (2 N(a) + 2 N(b) - N(c) - 3 N(0)) + 4 phi_3 D]` with
+    /// `D = N(0) - N(a) - N(b) + N(c)` (`phi_k` at `z = h L`; at `L = 0`, on the onion, this is
+    /// classical RK4).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
     fn etd_rk4(
