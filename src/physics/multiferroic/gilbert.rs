@@ -249,7 +249,8 @@ impl Motor {
     ) -> Option<(Vector, f64)> {
         let j = &start.j;
         // (False for a NaN rate too.)
-        if d.locked || !(dt * self.onion_rate_bound(j) <= ETD_REACH) {
+        let within_reach = dt * self.onion_rate_bound(j) <= ETD_REACH;
+        if d.locked || !within_reach {
             return None;
         }
         let block = |h: f64| [[h * j[0][0], h * j[0][1]], [h * j[1][0], h * j[1][1]]];
