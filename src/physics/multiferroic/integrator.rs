@@ -4,9 +4,6 @@
 use super::{phi, Angles, Drive, Motor, StepRun, Vector, MAX_ANGLE};
 use crate::physics::numerics::expm;
 
-/// The size of the full augmented system: rotor angle and speed, onion angle and tilt, forcing.
-const AUGMENTED: usize = 5;
-
 impl Motor {
     /// Right-hand side and Jacobian of the ODE in `(phi, omega, psi, theta)`, for a substep `dt`.
     ///
@@ -124,8 +121,8 @@ impl Motor {
         }
     }
 
-    /// One exponential Rosenbrock-Euler substep: `y + dt phi1(dt J) f(y)`, computed as the last
-    /// column of the exponential of the augmented matrix `dt [[J, f], [0, 0]]`. Exact for linear
+    /// One exponential Rosenbrock-Euler substep: `y + dt phi1(dt J) f(y)`, the last column of the
+    /// exponential of the augmented matrix `dt [[J, f], [0, 0]]`. Exact for linear
     /// dynamics; the quasi-static onion is re-settled at the new rotor angle.
     pub(super) fn exponential_step(&self, y: &Vector, dt: f64, d: &Drive) -> Option<Vector> {
         let (_, increments) = self.exponential_increments(y, dt, d, false)?;
@@ -137,7 +134,7 @@ impl Motor {
     /// drops a negative stiffness for `dt` only), so `exp(dt A) = exp(dt A / 2)^2` and the pair
     /// costs one exponential and one product instead of two.
     ///
-    /// The augmented matrix is balanced first by a power of two `s` near the rotor's undamped
+    /// The matrix is balanced first by a power of two `s` near the rotor's undamped
     /// frequency, with the speed measured in units of `s` (`D^-1 A D`, `D = diag(1, s, 1, ...)`,
     /// exact in binary): the rotor row `k / I` (~1e14 1/s^2 for Table 3.1) otherwise sets the
     /// matrix norm, and with it ten more squarings than the onion's and the rotor's own rates
@@ -153,12 +150,12 @@ impl Motor {
         let shared = half && self.rhs_jacobian(y, d, 0.5 * dt).1 == j;
         let speed_unit = self.speed_unit();
         // The onion rows are zero in the quasi-static option (it is re-settled afterwards), so
-        // the rotor block evolves alone: a 3x3 exponential of (angle, speed, forcing) gives the
-        // same increments as the 5x5 one at a fifth of the cost.
+        // the rotor block evolves alone: its 2x2 exponential gives the same increments as the
+        // full 4x4 one at a fraction of the cost.
         if self.quasi_static() {
-            self.increments_of::<3>(&f, &j, dt, shared, speed_unit)
+            self.increments_of::<2>(&f, &j, dt, shared, speed_unit)
         } else {
-            self.increments_of::<AUGMENTED>(&f, &j, dt, shared, speed_unit)
+            self.increments_of::<4>(&f, &j, dt, shared, speed_unit)
         }
         .and_then(|(halved, full)| match (half, halved) {
             (true, None) => {
@@ -169,9 +166,10 @@ impl Motor {
         })
     }
 
-    /// [`Self::exponential_increments`] on the `N - 1` first states: from `exp(dt A / 2)` when
-    /// `shared`, else from `exp(dt A)` alone.
-    pub(super) fn increments_of<const N: usize>(
+    /// [`Self::exponential_increments`] on the `M` first states: from `exp(dt A / 2)` when
+    /// `shared`, else from `exp(dt A)` alone ([`expm::expm_affine`]: the augmented matrix's
+    /// blocks).
+    pub(super) fn increments_of<const M: usize>(
         &self,
         f: &Vector,
         j: &[[f64; 4]; 4],
@@ -181,27 +179,26 @@ impl Motor {
     ) -> Option<(Option<Vector>, Vector)> {
         let unit = |i: usize| if i == 1 { speed_unit } else { 1.0 };
         let h = if shared { 0.5 * dt } else { dt };
-        let mut m = [[0.0; N]; N];
-        for i in 0..N - 1 {
-            for k in 0..N - 1 {
-                m[i][k] = h * j[i][k] * unit(k) / unit(i);
-            }
-            m[i][N - 1] = h * f[i] / unit(i);
-        }
-        let column = |e: &expm::Mat<N>| {
+        let a: expm::Mat<M> =
+            std::array::from_fn(|i| std::array::from_fn(|k| h * j[i][k] * unit(k) / unit(i)));
+        let b: [f64; M] = std::array::from_fn(|i| h * f[i] / unit(i));
+        let column = |x: &[f64; M]| {
             let mut increments = [0.0; 4];
-            for (i, x) in increments.iter_mut().enumerate().take(N - 1) {
-                *x = e[i][N - 1] * unit(i);
+            for (i, v) in increments.iter_mut().enumerate().take(M) {
+                *v = x[i] * unit(i);
             }
             increments
         };
-        let e = expm::expm_augmented(&m)?;
+        let (e, x) = expm::expm_affine(&a, &b)?;
         if shared {
-            let full = expm::square(&e);
-            let finite = full[..N - 1].iter().all(|row| row[N - 1].is_finite());
-            finite.then(|| (Some(column(&e)), column(&full)))
+            // [[E, x], [0, 1]]^2 = [[E^2, E x + x], [0, 1]].
+            let full: [f64; M] =
+                std::array::from_fn(|i| x[i] + (0..M).map(|k| e[i][k] * x[k]).sum::<f64>());
+            full.iter()
+                .all(|v| v.is_finite())
+                .then(|| (Some(column(&x)), column(&full)))
         } else {
-            Some((None, column(&e)))
+            Some((None, column(&x)))
         }
     }
 
@@ -246,9 +243,10 @@ impl Motor {
     /// One error-controlled substep: the new state, its error relative to the tolerance and the
     /// time it advances (`dt`, or less when the quasi-static onion snaps inside it, see
     /// [`Self::step_to_onion_snap`]). The quasi-static rotor uses the embedded pair
-    /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`],
-    /// or within its reach and unless `forced` the explicit [`Self::gilbert_explicit_step`]);
-    /// step doubling remains where either does not apply.
+    /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`];
+    /// unless `forced`, first the explicit [`Self::gilbert_explicit_step`] within its reach, else
+    /// the exponential RK4 [`Self::gilbert_exponential_rk4_step`] within its own, where the
+    /// exponential pair takes over what it rejects); step doubling remains where none applies.
     /// `angles` are those at `y`; the result carries those at the new state when known.
     pub(super) fn controlled_step(
         &self,
@@ -272,12 +270,29 @@ impl Motor {
             }
         }
         if !self.quasi_static() {
-            // A forced substep takes the exponential pair, which cannot amplify.
-            if let Some((u, err)) = (!forced)
-                .then(|| self.gilbert_explicit_step(y, dt, d))
-                .flatten()
-                .or_else(|| self.gilbert_embedded_step(y, dt, d))
-            {
+            // A forced substep takes the exponential pair, which cannot amplify. All three start
+            // from the same right-hand side and Jacobian.
+            let start = self.linearized(y, d, dt, angles);
+            let explicit = (!forced)
+                .then(|| self.gilbert_explicit_step(y, dt, d, &start))
+                .flatten();
+            if let Some((u, err)) = explicit {
+                return Some((u, err, dt, None));
+            }
+            // Where the exponential RK4 substep rejects, the exponential pair may still take it:
+            // near its minimum the onion's ringing is nearly linear, which the exponential pair
+            // follows exactly over many precession periods.
+            let rk4 = (!forced)
+                .then(|| self.gilbert_exponential_rk4_step(y, dt, d, &start))
+                .flatten();
+            if let Some((u, err)) = rk4.filter(|(_, err)| *err <= 1.0) {
+                return Some((u, err, dt, None));
+            }
+            match self.gilbert_embedded_step(y, dt, d, &start) {
+                Some((u, err)) if err <= 1.0 || rk4.is_none() => return Some((u, err, dt, None)),
+                _ => {}
+            }
+            if let Some((u, err)) = rk4 {
                 return Some((u, err, dt, None));
             }
         }

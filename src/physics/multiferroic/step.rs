@@ -323,7 +323,7 @@ impl Motor {
 }
 
 /// A Gilbert substep's share of the budget `max_substeps`, in substeps of the quasi-static onion:
-/// its embedded pair ([`Motor::gilbert_embedded_step`]: one 5x5 exponential, two Jacobians, a 4x4
+/// its embedded pair ([`Motor::gilbert_embedded_step`]: one 4x4 exponential, two Jacobians, a 4x4
 /// solve) costs up to 1.5 us in the steps that spend their whole budget (0.6-0.8 us for Table
 /// 3.1) against 0.32 us per budget unit of the quasi-static onion's (release, x86-64, loaded
 /// 2-core machine), so the budget bounds a step's cost alike in both onion models.
