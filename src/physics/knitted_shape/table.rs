@@ -248,6 +248,21 @@ fn follow_path(
             } else {
                 nucleate(geom, solver, aim)
             };
+            // Where the pockets cannot take up more length (a thin strand's top ring at the
+            // ceiling, or past its own volume maximum), another pocket shares the contraction.
+            let outcome = match outcome {
+                Err(why) if started => {
+                    solver.copy_from(&backup);
+                    if solver.add_pocket() {
+                        predicted.copy_from(solver);
+                        let iterations = MAX_PATH_ITERATIONS + solver.radii.len() / 16;
+                        fast_solve(geom, solver, &predicted, aim, iterations).ok_or(why)
+                    } else {
+                        Err(why)
+                    }
+                }
+                other => other,
+            };
             match outcome {
                 Ok(p) => {
                     current = aim;
@@ -326,7 +341,8 @@ fn predict(
     for _ in 0..8 {
         for j in 0..rings {
             if !solver.held[j] {
-                solver.radii[j] = (last.radii[j] + last.y[j] * dl_taken).max(geom.min_radius);
+                solver.radii[j] = (last.radii[j] + last.y[j] * dl_taken)
+                    .clamp(geom.min_radius, geom.radius_ceiling());
             }
         }
         if geom.length_and_volume(&solver.radii).is_some() {
@@ -340,9 +356,10 @@ fn predict(
         if e1 < e0 && l0 > l1 && e1 > 1 {
             let crossed = (e0 - e1) as f64 * (-dl_taken) / (l0 - l1);
             let edge = e1.saturating_sub(crossed.floor() as usize).max(1);
-            for j in edge..e1 {
-                solver.held[j] = false;
-                solver.held[rings - 1 - j] = false;
+            for j in (edge..e1).flat_map(|j| [j, rings - 1 - j]) {
+                if solver.on_floor(j) {
+                    solver.held[j] = false;
+                }
             }
         }
     }
