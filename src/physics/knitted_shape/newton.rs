@@ -6,7 +6,8 @@
 //! re-convergence per ring: quadratic in `segments` overall. Here the active set is updated in
 //! every Newton step from the complementarity of `r_j >= r_min` and `z_j = dV/dr_j - lambda
 //! dL/dr_j <= 0` (a ring is held when `(r_j - r_min) + z_j / |H_jj| < 0`: its Newton move would
-//! take it below the floor), and the length constraint enters the step itself, so a warm start
+//! take it below the floor; one the step takes to the ceiling `S_row / (2 pi)` stays there while
+//! `z_j >= 0`), and the length constraint enters the step itself, so a warm start
 //! from the tangent predictor converges in a few O(segments) iterations wherever the pocket's
 //! edge is. Anything unusual (no convergence, a saddle, a non-finite value) returns `None`, and
 //! the caller falls back to the robust solve from the same start.

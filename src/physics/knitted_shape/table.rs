@@ -181,7 +181,8 @@ impl ShapeTable {
 /// solve, and the pocket's edge, which the tangent cannot move (held rings stay held), moves on
 /// by the rings it crossed per metre over the last step. The fast Newton path
 /// ([`Solver::solve_newton`]) then converges in a few O(segments) sweeps; the robust solve is
-/// the fallback, then shorter steps.
+/// the fallback, then a copy of the highest pocket beside the others ([`Solver::add_pocket`]),
+/// then shorter steps.
 fn follow_path(
     geom: &ShapeGeometry,
     solver: &mut Solver,
@@ -251,7 +252,7 @@ fn follow_path(
             // Where the pockets cannot take up more length (a thin strand's top ring at the
             // ceiling, or past its own volume maximum), another pocket shares the contraction.
             let outcome = match outcome {
-                Err(why) if started => {
+                Err(why) if started && halvings == 0 => {
                     solver.copy_from(&backup);
                     if solver.add_pocket() {
                         predicted.copy_from(solver);
