@@ -5,8 +5,10 @@
 //! decades below the top; `shape_segments` up to `KNITTED_MAX_SEGMENTS`, the declared 98), until
 //! `KNITTED_SLEEVES` (2,000) sleeves build. Times
 //! `KnittedSleeve::new` in thread CPU time, refusals included, and prints the median, p99 and
-//! maximum, the share over 10 ms and the slowest sleeves with their parameters, each timed again
-//! `KNITTED_REPEAT` (5) times.
+//! maximum, the share over 10 ms, the tables that end with tension left above the strands'
+//! shortest length (`dV/dL < 0` at their last node) and the slowest sleeves with their
+//! parameters, each timed again `KNITTED_REPEAT` (5) times. `KNITTED_DUMP=<file>` writes every
+//! built sleeve: seconds, m, n, S_row, thickness, segments, table nodes, whether it ends early.
 
 #[path = "cpu_clock.rs"]
 mod cpu_clock;

@@ -294,6 +294,16 @@ impl Solver {
         geom: &ShapeGeometry,
         target: f64,
     ) -> Result<PathPoint, &'static str> {
+        self.solve_within(geom, target, MAX_NEWTON * MAX_ACTIVE_PASSES)
+    }
+
+    /// [`Solver::solve`] within `max_iterations` iterations.
+    pub(super) fn solve_within(
+        &mut self,
+        geom: &ShapeGeometry,
+        target: f64,
+        max_iterations: usize,
+    ) -> Result<PathPoint, &'static str> {
         let rings = self.radii.len();
         let r_min = geom.min_radius;
         let r_ceiling = geom.radius_ceiling();
@@ -304,7 +314,7 @@ impl Solver {
         let mut stalled = false;
         let mut releases = vec![0u8; rings];
         let mut last_mu = 0.0;
-        for _it in 0..MAX_NEWTON * MAX_ACTIVE_PASSES {
+        for _it in 0..max_iterations {
             self.assemble(geom).ok_or("assemble")?;
             let lambda = self.multiplier().ok_or("multiplier")?;
             self.lambda = lambda;
