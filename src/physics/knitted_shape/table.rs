@@ -284,7 +284,8 @@ fn follow_path(
                     if halvings > MAX_SUBSTEP_HALVINGS {
                         break 'nodes;
                     }
-                    sub *= 0.5;
+                    // Half of what failed: the regrown step may have been cut to the node.
+                    sub = 0.5 * sub.max(target - current);
                 }
             }
         }
