@@ -5,8 +5,10 @@
 //! decades below the top; `shape_segments` up to `KNITTED_MAX_SEGMENTS`, the declared 98), until
 //! `KNITTED_SLEEVES` (2,000) sleeves build. Times
 //! `KnittedSleeve::new` in thread CPU time, refusals included, and prints the median, p99 and
-//! maximum, the share over 10 ms and the slowest sleeves with their parameters, each timed again
-//! `KNITTED_REPEAT` (5) times.
+//! maximum, the share over 10 ms, the tables that end with tension left above the strands'
+//! shortest length (`dV/dL < 0` at their last node) and the slowest sleeves with their
+//! parameters, each timed again `KNITTED_REPEAT` (5) times. `KNITTED_DUMP=<file>` writes every
+//! built sleeve: seconds, m, n, S_row, thickness, segments, table nodes, whether it ends early.
 
 #[path = "cpu_clock.rs"]
 mod cpu_clock;
@@ -14,7 +16,7 @@ mod cpu_clock;
 #[allow(dead_code)]
 mod rng;
 
-use actuator_fmus::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind};
+use actuator_fmus::physics::knitted::{KnittedParams, KnittedSleeve, ShapeKind, ShapeModel};
 use cpu_clock::thread_cpu;
 use rng::Rng;
 
@@ -23,6 +25,24 @@ struct Case {
     segments: usize,
     seconds: f64,
     built: bool,
+    /// Table nodes, and whether the table ends with tension left (`dV/dL < 0` at its last node)
+    /// above the sleeve's shortest length.
+    nodes: usize,
+    early: bool,
+}
+
+/// Nodes of a non-cylindrical sleeve's table and whether it ends early: with tension left at its
+/// last node, above the strands' shortest length.
+fn table_end(sleeve: &KnittedSleeve) -> (usize, bool) {
+    match sleeve.shape() {
+        ShapeModel::NonCylindrical(t) => {
+            let nodes = t.lengths().count();
+            let tension = t.evaluate(t.min_length()).1 < 0.0;
+            let above = t.min_length() > sleeve.params().min_length_thickness() * (1.0 + 1e-12);
+            (nodes, tension && above)
+        }
+        _ => (0, false),
+    }
 }
 
 fn main() {
@@ -59,11 +79,14 @@ fn main() {
         let sleeve = KnittedSleeve::new(params, ShapeKind::NonCylindrical { segments });
         let seconds = thread_cpu() - start;
         built += sleeve.is_ok() as usize;
+        let (nodes, early) = sleeve.as_ref().map(table_end).unwrap_or((0, false));
         cases.push(Case {
             params,
             segments,
             seconds,
             built: sleeve.is_ok(),
+            nodes,
+            early,
         });
     }
     if let Ok(f) = std::env::var("KNITTED_DUMP") {
@@ -71,12 +94,15 @@ fn main() {
         for c in cases.iter().filter(|c| c.built) {
             let p = c.params;
             o += &format!(
-                "{} {} {} {} {}\n",
+                "{} {:e} {:e} {:e} {:e} {} {} {}\n",
                 c.seconds,
                 p.stitches_per_row,
                 p.rows,
+                p.row_strand_length,
+                p.strand_thickness,
                 c.segments,
-                4.0 * p.stitches_per_row * p.strand_thickness / p.row_strand_length
+                c.nodes,
+                c.early
             );
         }
         std::fs::write(f, o).unwrap();
@@ -106,6 +132,23 @@ fn main() {
         100.0 * slow as f64 / times.len() as f64,
         1e3 * refused_max
     );
+    let early: Vec<&Case> = cases.iter().filter(|c| c.early).collect();
+    println!(
+        "{} tables end with tension left above the shortest length",
+        early.len()
+    );
+    for c in &early {
+        let p = c.params;
+        println!(
+            "  {} nodes: m {:e} n {:e} S_row {:e} t {:e} segments {}",
+            c.nodes,
+            p.stitches_per_row,
+            p.rows,
+            p.row_strand_length,
+            p.strand_thickness,
+            c.segments
+        );
+    }
     cases.sort_by(|a, b| b.seconds.total_cmp(&a.seconds));
     // The slowest sleeves again, each timed `KNITTED_REPEAT` (5) more times: the least of the
     // times excludes preemption and a busy sibling core.

@@ -11,11 +11,12 @@
 //! - eq. 1.18: its volume is the truncated cone `pi/3 L (a^2 + ab + b^2)` (the dissertation's form
 //!   divided through by `b - a`, which is singular for a cylinder).
 //!
-//! At every length the shape maximizes the volume under the strand constraint with `r >= r_min`
-//! (eq. 1.1: the fluid's potential energy is least). [`ShapeTable::build`] follows that maximum from
-//! full extension down past free contraction with Newton steps on the Karush-Kuhn-Tucker system,
+//! At every length the shape maximizes the volume under the strand constraint with
+//! `r_min <= r <= S_row / (2 pi)` (eq. 1.1: the fluid's potential energy is least; at the
+//! ceiling a row's whole strand is its circumference, eq. 1.4 with `h = 0`).
+//! [`ShapeTable::build`] follows that maximum from full extension down past free contraction with Newton steps on the Karush-Kuhn-Tucker system,
 //! whose Hessian is tridiagonal (eq. 1.19-1.20: a radius touches only its two segments), so a
-//! step costs O(segments); the rings held at `r_min` are updated within each step (`newton.rs`,
+//! step costs O(segments); the rings held at a bound are updated within each step (`newton.rs`,
 //! with the slower line-searched solve of `solver.rs` as its fallback). The
 //! multiplier is `dV/dL` itself, and the sensitivity of the same system gives `d2V/dL2`, so the
 //! table holds exact `V`, `V'`, `V''` and is read through a quintic Hermite interpolant (C2).

@@ -6,7 +6,8 @@
 //! re-convergence per ring: quadratic in `segments` overall. Here the active set is updated in
 //! every Newton step from the complementarity of `r_j >= r_min` and `z_j = dV/dr_j - lambda
 //! dL/dr_j <= 0` (a ring is held when `(r_j - r_min) + z_j / |H_jj| < 0`: its Newton move would
-//! take it below the floor), and the length constraint enters the step itself, so a warm start
+//! take it below the floor; one the step takes to the ceiling `S_row / (2 pi)` stays there while
+//! `z_j >= 0`), and the length constraint enters the step itself, so a warm start
 //! from the tangent predictor converges in a few O(segments) iterations wherever the pocket's
 //! edge is. Anything unusual (no convergence, a saddle, a non-finite value) returns `None`, and
 //! the caller falls back to the robust solve from the same start.
@@ -85,15 +86,23 @@ impl Solver {
             for j in 1..rings - 1 {
                 let z = self.gv[j] - lambda * self.gl[j];
                 let curvature = (self.dv[j] - lambda * self.dl[j]).abs();
-                let hold = if first {
-                    self.held[j]
+                // The bound a ring is held at: the floor, or the ceiling where a bead's ring on a
+                // thin strand would take more than the row's strand as circumference.
+                let stuck = self.held[j] && self.releases[j] >= MAX_RELEASES;
+                let bound = if first {
+                    self.held[j].then_some(self.radii[j])
                 } else if self.radii[j] <= r_min {
                     // A ring that keeps falling back to the floor (its pull is at roundoff) is
                     // left there, as in the robust solve.
-                    z <= grad_tol || (self.held[j] && self.releases[j] >= MAX_RELEASES)
+                    (z <= grad_tol || stuck).then_some(r_min)
+                } else if self.radii[j] >= r_ceiling {
+                    (z >= -grad_tol || stuck).then_some(r_ceiling)
+                } else if (self.radii[j] - r_min) * curvature + z < 0.0 {
+                    Some(r_min)
                 } else {
-                    (self.radii[j] - r_min) * curvature + z < 0.0
+                    None
                 };
+                let hold = bound.is_some();
                 if hold != self.held[j] {
                     set_changed = true;
                     self.held[j] = hold;
@@ -101,9 +110,11 @@ impl Solver {
                         self.releases[j] = self.releases[j].saturating_add(1);
                     }
                 }
-                if hold && self.radii[j] > r_min {
-                    self.radii[j] = r_min;
-                    projected = true;
+                if let Some(r) = bound {
+                    if self.radii[j] != r {
+                        self.radii[j] = r;
+                        projected = true;
+                    }
                 }
                 if !hold {
                     residual = residual.max(z.abs());
@@ -113,6 +124,25 @@ impl Solver {
             step = None;
             if projected {
                 continue;
+            }
+            if self.held.iter().all(|&h| h) && (1..rings - 1).any(|j| self.at_ceiling(j)) {
+                // Every ring at a bound (a thin strand's one-ring beads capped at the ceiling):
+                // the rings no longer fix the multiplier. A shorter length is reached by raising
+                // the floor ring that gains the most volume per length lost (the exchange of
+                // section 1.3.5); its ratio is the multiplier.
+                if !(target < length) {
+                    return None;
+                }
+                let ratio = |j: usize| self.gv[j] / self.gl[j];
+                let j = (1..rings - 1)
+                    .filter(|&j| {
+                        self.on_floor(j) && self.gl[j] < 0.0 && self.releases[j] < MAX_RELEASES
+                    })
+                    .min_by(|&a, &b| ratio(a).total_cmp(&ratio(b)))?;
+                lambda = ratio(j);
+                self.held[j] = false;
+                self.releases[j] += 1;
+                set_changed = true;
             }
             if !residual.is_finite() {
                 return None;
@@ -284,13 +314,14 @@ impl Solver {
         }
     }
 
-    /// The lowest free ring next to a held interior ring (a pocket's edge, not a clamp's).
+    /// The lowest free ring next to an interior ring on the floor (a pocket's edge, not a
+    /// clamp's).
     fn lowest_edge_ring(&self) -> Option<usize> {
         let rings = self.radii.len();
         (1..rings - 1)
             .filter(|&j| {
                 !self.held[j]
-                    && ((j > 1 && self.held[j - 1]) || (j + 2 < rings && self.held[j + 1]))
+                    && ((j > 1 && self.on_floor(j - 1)) || (j + 2 < rings && self.on_floor(j + 1)))
             })
             .min_by(|&a, &b| self.radii[a].total_cmp(&self.radii[b]))
     }
@@ -298,7 +329,9 @@ impl Solver {
     /// First ring off the floor from the left clamp (the pocket's edge); the last ring if none.
     pub(super) fn first_free(&self) -> usize {
         let rings = self.radii.len();
-        (1..rings - 1).find(|&j| !self.held[j]).unwrap_or(rings - 1)
+        (1..rings - 1)
+            .find(|&j| !self.on_floor(j))
+            .unwrap_or(rings - 1)
     }
 
     /// Whether the profile equals its mirror image to roundoff.

@@ -18,8 +18,12 @@ pub(super) struct Solver {
     pub(super) radii: Vec<f64>,
     /// `lambda = dV/dL` at the optimum (negative in the stroke: tension).
     pub(super) lambda: f64,
-    /// `true` for rings held at the minimum radius (and the two clamped ends).
+    /// `true` for rings held at a bound: the minimum radius (and the two clamped ends) or the
+    /// ceiling `S_row / (2 pi)`, where a row's whole strand is its circumference (eq. 1.4 with
+    /// `h = 0`). A held ring's radius says which.
     pub(super) held: Vec<bool>,
+    /// The ceiling `S_row / (2 pi)` (m).
+    pub(super) ceiling: f64,
     // Gradients and tridiagonal Hessians of V and L over the rings.
     pub(super) gv: Vec<f64>,
     pub(super) gl: Vec<f64>,
@@ -63,6 +67,7 @@ impl Solver {
             radii: vec![geom.min_radius; rings],
             lambda: 0.0,
             held,
+            ceiling: geom.radius_ceiling(),
             gv: z.clone(),
             gl: z.clone(),
             dv: z.clone(),
@@ -83,6 +88,7 @@ impl Solver {
     /// twice per step; fresh allocations were a fifth of the table's time on long sleeves).
     pub(super) fn copy_from(&mut self, other: &Solver) {
         self.lambda = other.lambda;
+        self.ceiling = other.ceiling;
         self.prefer_shift = other.prefer_shift;
         self.shift_hint = other.shift_hint;
         for (to, from) in [
@@ -102,6 +108,18 @@ impl Solver {
         }
         self.held.clone_from(&other.held);
         self.releases.clone_from(&other.releases);
+    }
+
+    /// Whether ring `j` is held at the ceiling (else, if held, at the floor).
+    #[inline]
+    pub(super) fn at_ceiling(&self, j: usize) -> bool {
+        self.held[j] && self.radii[j] >= self.ceiling
+    }
+
+    /// Whether ring `j` is held at the minimum radius (a clamp or a ring outside the pockets).
+    #[inline]
+    pub(super) fn on_floor(&self, j: usize) -> bool {
+        self.held[j] && self.radii[j] < self.ceiling
     }
 
     /// Gradients and tridiagonal Hessians of `V` and `L` (eq. 1.19-1.20 and their second
@@ -207,7 +225,7 @@ impl Solver {
     }
 
     /// Moves the free rings along the length gradient until `L = target` (1-D Newton, capped),
-    /// holding any ring that reaches the minimum radius. Returns `(L, V)`.
+    /// holding any ring that reaches the minimum radius or the ceiling. Returns `(L, V)`.
     pub(super) fn restore_length(
         &mut self,
         geom: &ShapeGeometry,
@@ -233,7 +251,7 @@ impl Solver {
             for _ in 0..40 {
                 for j in 0..self.radii.len() {
                     if !self.held[j] {
-                        self.radii[j] = (base[j] + beta * self.gl[j]).max(r_min);
+                        self.radii[j] = (base[j] + beta * self.gl[j]).clamp(r_min, self.ceiling);
                     }
                 }
                 if let Some(x) = geom.length_and_volume(&self.radii) {
@@ -252,11 +270,15 @@ impl Solver {
         ((lv.0 - target).abs() <= 1e-10 * geom.max_length()).then_some(lv)
     }
 
+    /// Holds the free rings that reached a bound, at that bound.
     pub(super) fn hold_touching(&mut self, r_min: f64) {
         let rings = self.radii.len();
         for j in 1..rings - 1 {
             if !self.held[j] && self.radii[j] <= r_min {
                 self.radii[j] = r_min;
+                self.held[j] = true;
+            } else if !self.held[j] && self.radii[j] >= self.ceiling {
+                self.radii[j] = self.ceiling;
                 self.held[j] = true;
             }
         }
@@ -272,6 +294,16 @@ impl Solver {
         geom: &ShapeGeometry,
         target: f64,
     ) -> Result<PathPoint, &'static str> {
+        self.solve_within(geom, target, MAX_NEWTON * MAX_ACTIVE_PASSES)
+    }
+
+    /// [`Solver::solve`] within `max_iterations` iterations.
+    pub(super) fn solve_within(
+        &mut self,
+        geom: &ShapeGeometry,
+        target: f64,
+        max_iterations: usize,
+    ) -> Result<PathPoint, &'static str> {
         let rings = self.radii.len();
         let r_min = geom.min_radius;
         let r_ceiling = geom.radius_ceiling();
@@ -282,7 +314,7 @@ impl Solver {
         let mut stalled = false;
         let mut releases = vec![0u8; rings];
         let mut last_mu = 0.0;
-        for _it in 0..MAX_NEWTON * MAX_ACTIVE_PASSES {
+        for _it in 0..max_iterations {
             self.assemble(geom).ok_or("assemble")?;
             let lambda = self.multiplier().ok_or("multiplier")?;
             self.lambda = lambda;
@@ -292,8 +324,8 @@ impl Solver {
                     res = res.max((self.gv[j] - lambda * self.gl[j]).abs());
                 }
             }
-            // Held rings that want to grow (KKT sign) are released one at a time, once the free
-            // rings are converged or the ascent has stalled.
+            // Held rings that pull away from their bound (KKT sign) are released one at a time,
+            // once the free rings are converged or the ascent has stalled.
             let grad_tol = 1e-10 * s_row * s_row;
             // Near a symmetric saddle of the pocket's lattice position the shifted steps crawl;
             // a residual this small changes the volume by far less than roundoff of the table.
@@ -307,10 +339,13 @@ impl Solver {
                 let mut release = None;
                 let mut worst = grad_tol;
                 for j in 1..rings - 1 {
-                    let grow = self.gv[j] - lambda * self.gl[j];
-                    // A ring that keeps falling back to the floor is left there (bounded work).
-                    if self.held[j] && grow > worst && releases[j] < 3 {
-                        worst = grow;
+                    // A ring on the floor is released if it wants to grow, one at the ceiling if
+                    // it wants to shrink (KKT sign of `z = dV/dr - lambda dL/dr`).
+                    let z = self.gv[j] - lambda * self.gl[j];
+                    let pull = if self.at_ceiling(j) { -z } else { z };
+                    // A ring that keeps falling back to its bound is left there (bounded work).
+                    if self.held[j] && pull > worst && releases[j] < 3 {
+                        worst = pull;
                         release = Some(j);
                     }
                 }
@@ -444,6 +479,60 @@ impl Solver {
             *yj *= dlam;
         }
         dlam.is_finite().then_some(dlam)
+    }
+
+    /// Places a copy of the highest pocket (a run of rings off the floor) in the middle of the
+    /// longest run of interior rings on the floor, leaving a floor ring on each side of it.
+    /// `false` if there is no room. On a thin strand a pocket gains volume convexly at first and
+    /// its top ring meets the ceiling soon after: past that, the maximum shares the contraction
+    /// among more pockets, which Newton cannot reach from one pocket (a ring on the floor has no
+    /// pull until the new pocket is already large).
+    pub(super) fn add_pocket(&mut self) -> bool {
+        let rings = self.radii.len();
+        let runs = |floor: bool| {
+            let mut out: Vec<(usize, usize)> = Vec::new();
+            let mut j = 1;
+            while j < rings - 1 {
+                if self.on_floor(j) == floor {
+                    let start = j;
+                    while j < rings - 1 && self.on_floor(j) == floor {
+                        j += 1;
+                    }
+                    out.push((start, j - 1));
+                } else {
+                    j += 1;
+                }
+            }
+            out
+        };
+        let peak = |&(a, b): &(usize, usize)| self.radii[a..=b].iter().cloned().fold(0.0, f64::max);
+        let Some((a, b)) = runs(false)
+            .into_iter()
+            .max_by(|x, y| peak(x).total_cmp(&peak(y)))
+        else {
+            return false;
+        };
+        let width = b - a + 1;
+        // The rings a new pocket may take in a floor run: all but the ends that border another
+        // pocket (a clamp needs no floor ring beside it).
+        let usable = |&(lo, hi): &(usize, usize)| {
+            let first = if lo == 1 { lo } else { lo + 1 };
+            let last = if hi == rings - 2 { hi } else { hi - 1 };
+            (first, (last + 1).saturating_sub(first))
+        };
+        let Some((first, room)) = runs(true).iter().map(usable).max_by_key(|&(_, room)| room)
+        else {
+            return false;
+        };
+        if room < width {
+            return false;
+        }
+        let first = first + (room - width) / 2;
+        for i in 0..width {
+            self.radii[first + i] = self.radii[a + i];
+            self.held[first + i] = self.held[a + i];
+        }
+        true
     }
 
     /// Frees every interior ring just above the minimum radius (the dissertation's uniform raise).

@@ -241,13 +241,20 @@ fn table_ends_at_the_first_node_past_zero_force() {
     }
 }
 
+/// Whether a ring is off both bounds: above the floor `r_min` and below the ceiling
+/// `S_row / (2 pi)`, where a row's whole strand is its circumference (eq. 1.4 at `h = 0`).
+fn free_ring(g: &ShapeGeometry, r: f64) -> bool {
+    r > g.min_radius && r < g.row_strand_length / (2.0 * PI)
+}
+
 /// A ring profile's multiplier and KKT residuals: `(lambda, largest |dV/dr - lambda dL/dr|` over
-/// the free rings, largest `dV/dr - lambda dL/dr` over the interior rings on the floor`)`.
+/// the free rings, largest pull away from its bound over the interior rings at a bound: `dV/dr -
+/// lambda dL/dr` on the floor, its negative at the ceiling`)`.
 fn kkt(g: &ShapeGeometry, radii: &[f64]) -> (f64, f64, f64) {
     let n = radii.len();
     let (mut dl, mut dv) = (vec![0.0; n], vec![0.0; n]);
     g.gradients(radii, &mut dl, &mut dv).unwrap();
-    let free = |j: usize| radii[j] > g.min_radius;
+    let free = |j: usize| free_ring(g, radii[j]);
     let (mut num, mut den) = (0.0, 0.0);
     for j in (1..n - 1).filter(|&j| free(j)) {
         num += dl[j] * dv[j];
@@ -259,8 +266,10 @@ fn kkt(g: &ShapeGeometry, radii: &[f64]) -> (f64, f64, f64) {
         let z = dv[j] - lambda * dl[j];
         if free(j) {
             free_res = free_res.max(z.abs());
-        } else {
+        } else if radii[j] <= g.min_radius {
             floor_pull = floor_pull.max(z);
+        } else {
+            floor_pull = floor_pull.max(-z);
         }
     }
     (lambda, free_res, floor_pull)
@@ -308,7 +317,7 @@ fn saddle_edges_put_down_leave_volume_maxima() {
 /// far less volume than its accuracy).
 fn reduced_hessian_is_negative(g: &ShapeGeometry, radii: &[f64], lambda: f64) -> bool {
     let n = radii.len();
-    let free: Vec<usize> = (1..n - 1).filter(|&j| radii[j] > g.min_radius).collect();
+    let free: Vec<usize> = (1..n - 1).filter(|&j| free_ring(g, radii[j])).collect();
     let symmetric =
         (0..n).all(|j| (radii[j] - radii[n - 1 - j]).abs() <= 1e-9 * g.radius_ceiling());
     // Moves: one ring each, or a ring with its mirror image.
@@ -381,7 +390,8 @@ fn reduced_hessian_is_negative(g: &ShapeGeometry, radii: &[f64], lambda: f64) ->
 
 /// Every `stride`-th node's profile, re-followed by [`ShapeTable::profile`], satisfies the KKT
 /// conditions of a volume maximum (eq. 1.19-1.20 balanced by one multiplier; no ring on the
-/// floor pulled upward) and no move of its free rings along the length constraint gains volume.
+/// floor pulled upward, none at the ceiling pulled downward) and no move of its free rings along
+/// the length constraint gains volume.
 fn assert_profiles_are_maxima(g: &ShapeGeometry, t: &ShapeTable, stride: usize) {
     let g = *g;
     let scale = g.row_strand_length * g.row_strand_length;
@@ -399,7 +409,7 @@ fn assert_profiles_are_maxima(g: &ShapeGeometry, t: &ShapeTable, stride: usize) 
         assert!(free_res < 1e-8 * scale, "at {l}: residual {free_res:e}");
         assert!(
             floor_pull < 1e-8 * scale,
-            "at {l}: a ring on the floor pulls {floor_pull:e}"
+            "at {l}: a ring at a bound pulls away from it by {floor_pull:e}"
         );
         assert!(
             reduced_hessian_is_negative(&g, &radii, lambda),
@@ -411,7 +421,7 @@ fn assert_profiles_are_maxima(g: &ShapeGeometry, t: &ShapeTable, stride: usize) 
         let (mut dl, mut dv) = (vec![0.0; n], vec![0.0; n]);
         g.gradients(&radii, &mut dl, &mut dv).unwrap();
         let (l0, v0) = g.length_and_volume(&radii).unwrap();
-        let free: Vec<usize> = (1..n - 1).filter(|&j| radii[j] > g.min_radius).collect();
+        let free: Vec<usize> = (1..n - 1).filter(|&j| free_ring(&g, radii[j])).collect();
         for _ in 0..20 {
             let mut d = vec![0.0; n];
             for &j in &free {
@@ -428,5 +438,58 @@ fn assert_profiles_are_maxima(g: &ShapeGeometry, t: &ShapeTable, stride: usize) 
             let gain = (v1 - lambda * l1) - (v0 - lambda * l0);
             assert!(gain <= 1e-12 * v0, "at {l}: gain {gain:e} of {v0:e}");
         }
+    }
+}
+
+#[test]
+fn thin_strand_beads_stop_at_the_ceiling_and_reach_free_contraction() {
+    // Two sleeves of the declared space with about two rows per segment and a very thin strand
+    // (`4 m t / S_row` 1.3e-7 and 1.1e-10): the pockets are single-ring beads, each of which
+    // grows until its ring's circumference takes the row's whole strand (eq. 1.4 at `h = 0`,
+    // the ceiling `S_row / (2 pi)`); past that the contraction is shared by more beads. The
+    // volume maximum exists at every length down to free contraction (the feasible rings are a
+    // closed bounded set and the uniform cylinder of eq. 1.4 is one of them), so each table must
+    // reach zero force with every ring within the ceiling, and its profiles must be maxima: KKT
+    // with both bounds (eq. 1.19-1.20) and second order.
+    let sleeves = [
+        // (m, n, S_row, strand thickness, segments)
+        (
+            1.2810257107066474,
+            151.94540631829753,
+            6.262554205172668e-6,
+            1.587157605345259e-13,
+            76,
+        ),
+        (
+            1.3964296007078456,
+            161.09922407098475,
+            57.34547729625463,
+            1.1308097620664532e-9,
+            80,
+        ),
+    ];
+    for (m, n, s, t, segments) in sleeves {
+        let g = ShapeGeometry::new(m, n, s, 4.0 * m * t / (2.0 * PI), segments).unwrap();
+        // `KnittedSleeve::new`'s end: a little below the cylinder's free contraction.
+        let l_free = n * s / (6.0 * m);
+        let end = l_free - 0.1 * (g.max_length() - l_free);
+        let table = ShapeTable::build(g, end, DEFAULT_TABLE_NODES).unwrap();
+        let last = table.slope.len() - 1;
+        assert!(
+            table.slope[last] >= 0.0 && table.slope[last - 1] < 0.0,
+            "m {m}: the table ends with dV/dL {:e} after {} nodes",
+            table.slope[last],
+            last + 1
+        );
+        assert!(table.free_contraction_length().is_some());
+        let ceiling = g.radius_ceiling();
+        let widest = table.max_radius.iter().cloned().fold(0.0, f64::max);
+        assert!(
+            widest <= ceiling,
+            "m {m}: a ring at {widest:e} above {ceiling:e}"
+        );
+        // The beads meet the ceiling: the bound is exercised.
+        assert!(widest > 0.999 * ceiling, "m {m}: {widest:e} of {ceiling:e}");
+        assert_profiles_are_maxima(&g, &table, 9);
     }
 }
