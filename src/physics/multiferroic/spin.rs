@@ -49,6 +49,9 @@ impl Motor {
     /// Resolving every turn took the whole substep budget here (20,000 substeps, 11-40 ms per
     /// 1 us step for loads of 1e-14 to 1e-10 N m on Table 3.1).
     pub(super) fn advance_spinning(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
+        if self.advance_unstrained(run, d) {
+            return true;
+        }
         if self.advance_drifting(run, d, segment_end) {
             return true;
         }

@@ -492,3 +492,77 @@ fn a_strain_held_onion_takes_a_fast_schedule_at_once() {
         }
     }
 }
+
+/// Without eq. 3.4's term (no wall volume, so the schedule's stress does nothing) the onion sits
+/// at the bar and the rotor follows load and drag alone ([`Motor::advance_unstrained`]): a Table
+/// 3.1 rotor from rest with the onion started 3.2 rad off (it settles a turn ahead of the bar)
+/// through 50 switches of a 2 ns schedule, at rest, drifting (1e-16 N m) and spinning (1e-13 N m,
+/// 3.3e9 rad/s), and locked. One step over all 50 switches and steps switch by switch (their
+/// ends, the state at every switch) against the fine RK4 here, run period by period with each
+/// period's strain direction; the long step takes one substep where the integrator took at least
+/// one per switch.
+#[test]
+fn an_unstrained_rotor_takes_a_fast_schedule_at_once() {
+    let m = motor_with(|p| p.wall_volume = 0.0);
+    let period = 2e-9;
+    let periods = 50;
+    for (load, locked) in [(0.0, false), (1e-16, false), (-1e-13, false), (1e-13, true)] {
+        let inputs = MotorInputs {
+            load_torque: load,
+            rotor_locked: locked,
+            ..super::tests::schedule(period)
+        };
+        let schedule = *inputs.schedule.get().unwrap();
+        let mut start = MotorState {
+            onion_angle: 3.2,
+            ..MotorState::aligned(0.0)
+        };
+        start.onion_angle = m.outputs(&start, &inputs).unwrap().onion_angle;
+        assert!((start.onion_angle - 2.0 * PI).abs() < 1e-9);
+        let terminal = load / m.drag;
+        let dt = (1e-3 / terminal.abs()).min(0.005 * m.inertial_time());
+        let (mut long, mut short, mut r) = (start, start, start);
+        let report = m.step(&mut long, &inputs, periods as f64 * period).unwrap();
+        assert_eq!(report.substeps, 1, "{report:?}");
+        for k in 0..periods {
+            let t = k as f64 * period;
+            let report = m.step(&mut short, &inputs, period).unwrap();
+            assert_eq!(report.substeps, 1, "{report:?}");
+            if locked {
+                r.time += period;
+            } else {
+                let direction = schedule.direction(t + 0.5 * period);
+                fine_rotor(
+                    &m,
+                    (direction, schedule.stress_amplitude, load),
+                    &mut r,
+                    period,
+                    dt,
+                );
+            }
+            let tol = m.params.tolerance;
+            let ends = if k + 1 == periods { 2 } else { 1 };
+            for s in [&short, &long].into_iter().take(ends) {
+                assert!(
+                    (s.rotor_angle - r.rotor_angle).abs() < tol,
+                    "{load:e} {k}: {s:?} {r:?}"
+                );
+                assert!(
+                    (s.onion_angle - r.onion_angle).abs() < tol,
+                    "{load:e} {k}: {s:?} {r:?}"
+                );
+                assert!(
+                    (s.rotor_speed - r.rotor_speed).abs() <= 1e-9 * terminal.abs() + 1e-3,
+                    "{load:e} {k}: {s:?} {r:?}"
+                );
+            }
+        }
+        eprintln!(
+            "{load:e}: rotor {} against {}",
+            long.rotor_angle, r.rotor_angle
+        );
+        if load.abs() > 1e-14 && !locked {
+            assert!(r.rotor_angle.abs() > 100.0, "{r:?}");
+        }
+    }
+}
