@@ -417,7 +417,10 @@ impl Motor {
                     break;
                 }
                 // The curvature no longer falls: the fold is within rounding of `lo`.
-                let at_fold = previous.is_some_and(|(_, g_p)| !(g_p > 1.5 * g_lo));
+                let at_fold = previous.is_some_and(|(_, g_p)| {
+                    let falling = g_p > 1.5 * g_lo;
+                    !falling
+                });
                 let secant = previous.and_then(|(p, g_p)| {
                     let x = lo + g_lo * (lo - p) / (g_p - g_lo);
                     let t = (x - lo) / width;

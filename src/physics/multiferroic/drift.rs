@@ -116,7 +116,8 @@ impl Motor {
         }
         let (phi, psi) = (run.y[0], run.y[2]);
         let offset = psi - phi;
-        if !(super::angles::turned_back(offset).cos() > 0.0) {
+        let at_minimum = super::angles::turned_back(offset).cos() > 0.0;
+        if !at_minimum {
             return false;
         }
         let y = if d.locked {
