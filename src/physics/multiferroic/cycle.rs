@@ -286,8 +286,9 @@ impl Motor {
     }
 
     /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
-    /// `psi0`: one turn to land on it (none where the strain holds the onion), one to measure it
-    /// (and sample its torque). `None` if it does not close.
+    /// `psi0`: a landing march up to the onion's first snap or over one turn (none where the
+    /// strain holds the onion), then one turn to measure it (and sample its torque) from there.
+    /// `None` if that turn does not close (the onion not back where it started, modulo turns).
     pub(super) fn onion_cycle(
         &self,
         y: &super::Vector,
@@ -310,14 +311,12 @@ impl Motor {
         let (start, psi1) = if self.strain_held_reach(d).is_some() {
             (phi0, psi0)
         } else {
-            let start = phi0 + dir * 2.0 * PI;
-            (
-                start,
-                self.march_onion(phi0, psi0, start, d, None, settles)?.0,
-            )
+            let (start, psi1, _) =
+                self.march_onion(phi0, psi0, phi0 + dir * 2.0 * PI, d, None, settles)?;
+            (start, psi1)
         };
         let mut samples = Vec::with_capacity(160);
-        let (psi2, work) = self.march_onion(
+        let (_, psi2, work) = self.march_onion(
             start,
             psi1,
             start + dir * 2.0 * PI,
@@ -354,10 +353,12 @@ impl Motor {
     }
 
     /// The quasi-static onion while the rotor turns from `from` to `to` (its memory rule, snaps
-    /// included), and the energy the snaps changed `U` by on the way (J). Strides of at most
-    /// [`CYCLE_STRIDE`]; a snap is placed by bisection within [`SNAP_PLACEMENT`] rad, where its
-    /// energy change is taken. `samples`, if given, receives `(phi, psi, tau)`, the ring's torque at
-    /// every stride's end and on both sides of every snap.
+    /// included): the rotor and onion angles at the end and the energy the snaps changed `U` by
+    /// on the way (J). Strides of at most [`CYCLE_STRIDE`]; a snap is placed within
+    /// [`SNAP_PLACEMENT`] rad, where its energy change is taken. `samples`, if given, receives
+    /// `(phi, psi, tau)`, the ring's torque at every stride's end and on both sides of every
+    /// snap; without it (a landing march) the march ends just past the first snap, placed within
+    /// [`LANDING_SNAP_PLACEMENT`].
     pub(super) fn march_onion(
         &self,
         from: f64,
@@ -366,17 +367,18 @@ impl Motor {
         d: &Drive,
         mut samples: Option<&mut Vec<(f64, f64, f64)>>,
         settles: &mut u32,
-    ) -> Option<(f64, f64)> {
+    ) -> Option<(f64, f64, f64)> {
         let count = std::cell::Cell::new(0u32);
         let settle = |at: f64, onion: f64| {
             count.set(count.get() + 1);
             self.landscape(at, d.direction, d.stress).settle(onion)
         };
         let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
-        let placement = if samples.is_some() {
-            SNAP_PLACEMENT
-        } else {
+        let landing = samples.is_none();
+        let placement = if landing {
             LANDING_SNAP_PLACEMENT
+        } else {
+            SNAP_PLACEMENT
         };
         let mut record = |at: f64, onion: f64| {
             if let Some(s) = samples.as_deref_mut() {
@@ -445,11 +447,16 @@ impl Motor {
             work += energy(hi, psi_hi) - energy(lo, psi_lo);
             record(lo, psi_lo);
             record(hi, psi_hi);
+            if landing {
+                // The snap has set the onion on the branch it jumped to.
+                (phi, psi) = (hi, psi_hi);
+                break;
+            }
             (phi, psi) = (next, settle(next, psi_hi));
             record(phi, psi);
         }
         *settles = settles.saturating_add(count.get());
-        (psi.is_finite() && work.is_finite()).then_some((psi, work))
+        (psi.is_finite() && work.is_finite()).then_some((phi, psi, work))
     }
 }
 
