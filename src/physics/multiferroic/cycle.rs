@@ -154,10 +154,141 @@ impl Wobble {
     }
 }
 
+/// The drive of a canonical cycle ([`Motor::canonical_cycle`]): stress and load (their bits), the
+/// direction of motion, and the end of the strain axis the onion starts at.
+#[derive(Clone, Copy, PartialEq)]
+struct CycleKey {
+    stress: u64,
+    load: u64,
+    forward: bool,
+    far_end: bool,
+}
+
+/// Canonical cycles already marched ([`Motor::canonical_cycle`]), with the settles each march
+/// took (charged again at every use, so that the budget, and with it the result, does not depend
+/// on what is memoized). A clone starts empty.
+#[derive(Default)]
+pub(super) struct CycleCache(std::sync::Mutex<Vec<(CycleKey, Option<OnionCycle>, u32)>>);
+
+/// Canonical cycles kept: both ends of the axis in both directions of motion.
+const CACHED_CYCLES: usize = 4;
+
+impl Clone for CycleCache {
+    fn clone(&self) -> Self {
+        Self::default()
+    }
+}
+
+impl std::fmt::Debug for CycleCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str("CycleCache")
+    }
+}
+
 impl Motor {
+    /// The onion's cycle through the state `y` taken from a canonical march: rotor from 0 with
+    /// the onion at the end of the strain's axis (direction 0; the minima of eq. 3.4's term)
+    /// nearest the state's, its
+    /// landing turn and its measured turn as in [`Self::onion_cycle`], then turned with the
+    /// strain (eq. 3.3-3.4 depend on `psi - phi` and `psi - gamma` only, see
+    /// [`OnionCycle::rotate`]) and given the state's whole turns; `None` when the state's onion
+    /// is not on it (then the caller marches from the state). The march is a function of the
+    /// drive alone, so it is memoized across steps (a spinning rotor without switches within a
+    /// step marched its cycle again at every step, 40-120 us) while a step's result stays a
+    /// function of its state and inputs (restoring a saved state repeats a step bit for bit).
+    /// `settles` receives the march's settles whether memoized or not.
+    pub(super) fn canonical_cycle(
+        &self,
+        y: &super::Vector,
+        d: &Drive,
+        dir: f64,
+        settles: &mut u32,
+    ) -> Option<OnionCycle> {
+        // The ends of the axis, the minima of eq. 3.4's `E sin^2(psi - gamma)`: along the strain
+        // for `E > 0`, across it for `E < 0`.
+        let axis = if self.magnetoelastic_per_stress * d.stress < 0.0 {
+            0.5 * PI
+        } else {
+            0.0
+        };
+        // Where the strain holds the onion at an end, its cycle is the one from that end (it
+        // never reaches the other); otherwise the cycle from the near end, then the far one, so
+        // that a cycle which winds (passing both ends) is found from the first at any phase.
+        let nearer = ((y[2] - d.direction - axis) / PI).round().rem_euclid(2.0) == 1.0;
+        let ends: &[bool] = if self.strain_held_reach(d).is_some() {
+            &[nearer]
+        } else {
+            &[false, true]
+        };
+        ends.iter()
+            .find_map(|&far_end| self.canonical_cycle_from(y, d, dir, axis, far_end, settles))
+    }
+
+    /// [`Self::canonical_cycle`] from the end `far_end` of the axis (`axis` from the strain).
+    fn canonical_cycle_from(
+        &self,
+        y: &super::Vector,
+        d: &Drive,
+        dir: f64,
+        axis: f64,
+        far_end: bool,
+        settles: &mut u32,
+    ) -> Option<OnionCycle> {
+        let key = CycleKey {
+            stress: d.stress.to_bits(),
+            load: d.load.to_bits(),
+            forward: dir > 0.0,
+            far_end,
+        };
+        let memo = |cache: &mut Vec<(CycleKey, Option<OnionCycle>, u32)>| {
+            cache
+                .iter()
+                .find(|entry| entry.0 == key)
+                .map(|entry| (entry.1.clone(), entry.2))
+        };
+        let known = match self.cycles.0.lock() {
+            Ok(mut cache) => memo(&mut cache),
+            Err(_) => None,
+        };
+        let (cycle, marched) = match known {
+            Some(found) => found,
+            None => {
+                let canonical = Drive {
+                    direction: 0.0,
+                    applied_direction: 0.0,
+                    ..*d
+                };
+                let start = [0.0, 0.0, axis + if far_end { PI } else { 0.0 }, 0.0];
+                let mut marched = 0;
+                let cycle = self.onion_cycle(&start, &canonical, dir, &mut marched);
+                if let Ok(mut cache) = self.cycles.0.lock() {
+                    if cache.len() >= CACHED_CYCLES {
+                        cache.remove(0);
+                    }
+                    cache.push((key, cycle.clone(), marched));
+                }
+                (cycle, marched)
+            }
+        };
+        *settles = settles.saturating_add(marched);
+        let mut cycle = cycle?;
+        cycle.rotate(d.direction);
+        cycle.turns += ((y[0] - cycle.turns - cycle.rotor) / (2.0 * PI)).round() * 2.0 * PI;
+        *settles = settles.saturating_add(1);
+        let s = OnionCycle::phase(dir * (y[0] - cycle.turns - cycle.rotor));
+        let onion = cycle.onion_at(self, s, dir, d) + cycle.turns + cycle.onion_turns;
+        let whole = ((y[2] - onion) / (2.0 * PI)).round() * 2.0 * PI;
+        if !((y[2] - onion - whole).abs() <= 1e-9 && whole.is_finite()) {
+            return None;
+        }
+        cycle.onion_turns += whole;
+        Some(cycle)
+    }
+
     /// The onion's cycle for a rotor turning in direction `dir` from `phi0` with the onion at
-    /// `psi0`: one turn to land on it (none where the strain holds the onion), one to measure it
-    /// (and sample its torque). `None` if it does not close.
+    /// `psi0`: a landing march up to the onion's first snap or over one turn (none where the
+    /// strain holds the onion), then one turn to measure it (and sample its torque) from there.
+    /// `None` if that turn does not close (the onion not back where it started, modulo turns).
     pub(super) fn onion_cycle(
         &self,
         y: &super::Vector,
@@ -180,14 +311,12 @@ impl Motor {
         let (start, psi1) = if self.strain_held_reach(d).is_some() {
             (phi0, psi0)
         } else {
-            let start = phi0 + dir * 2.0 * PI;
-            (
-                start,
-                self.march_onion(phi0, psi0, start, d, None, settles)?.0,
-            )
+            let (start, psi1, _) =
+                self.march_onion(phi0, psi0, phi0 + dir * 2.0 * PI, d, None, settles)?;
+            (start, psi1)
         };
         let mut samples = Vec::with_capacity(160);
-        let (psi2, work) = self.march_onion(
+        let (_, psi2, work) = self.march_onion(
             start,
             psi1,
             start + dir * 2.0 * PI,
@@ -224,10 +353,12 @@ impl Motor {
     }
 
     /// The quasi-static onion while the rotor turns from `from` to `to` (its memory rule, snaps
-    /// included), and the energy the snaps changed `U` by on the way (J). Strides of at most
-    /// [`CYCLE_STRIDE`]; a snap is placed by bisection within [`SNAP_PLACEMENT`] rad, where its
-    /// energy change is taken. `samples`, if given, receives `(phi, psi, tau)`, the ring's torque at
-    /// every stride's end and on both sides of every snap.
+    /// included): the rotor and onion angles at the end and the energy the snaps changed `U` by
+    /// on the way (J). Strides of at most [`CYCLE_STRIDE`]; a snap is placed within
+    /// [`SNAP_PLACEMENT`] rad, where its energy change is taken. `samples`, if given, receives
+    /// `(phi, psi, tau)`, the ring's torque at every stride's end and on both sides of every
+    /// snap; without it (a landing march) the march ends just past the first snap, placed within
+    /// [`LANDING_SNAP_PLACEMENT`].
     pub(super) fn march_onion(
         &self,
         from: f64,
@@ -236,13 +367,19 @@ impl Motor {
         d: &Drive,
         mut samples: Option<&mut Vec<(f64, f64, f64)>>,
         settles: &mut u32,
-    ) -> Option<(f64, f64)> {
+    ) -> Option<(f64, f64, f64)> {
         let count = std::cell::Cell::new(0u32);
         let settle = |at: f64, onion: f64| {
             count.set(count.get() + 1);
             self.landscape(at, d.direction, d.stress).settle(onion)
         };
         let energy = |at: f64, onion: f64| self.landscape(at, d.direction, d.stress).energy(onion);
+        let landing = samples.is_none();
+        let placement = if landing {
+            LANDING_SNAP_PLACEMENT
+        } else {
+            SNAP_PLACEMENT
+        };
         let mut record = |at: f64, onion: f64| {
             if let Some(s) = samples.as_deref_mut() {
                 s.push((at, onion, self.ring_bar.torque_stiffness(onion - at).0));
@@ -262,16 +399,47 @@ impl Motor {
                 record(phi, psi);
                 continue;
             }
-            // A snap inside the stride: bisect for it on the rotor angle.
+            // A snap inside the stride: the fold where the branch's minimum vanishes, bracketed
+            // on the rotor angle. Its curvature there falls like the square root of the
+            // distance to the fold, so the squared curvature at the last two angles on the
+            // branch extrapolates linearly to it (secant steps, a bisection when they leave the
+            // bracket); once the step is within the placement, the angle just past it is tried.
             let (mut lo, mut psi_lo, mut hi, mut psi_hi) = (phi, psi, next, psi_next);
+            let squared_curvature = |at: f64, onion: f64| {
+                self.landscape(at, d.direction, d.stress)
+                    .curvature(onion)
+                    .max(0.0)
+                    .powi(2)
+            };
+            let mut g_lo = squared_curvature(lo, psi_lo);
+            let mut previous: Option<(f64, f64)> = None;
             for _ in 0..64 {
-                if (hi - lo).abs() <= SNAP_PLACEMENT {
+                let width = hi - lo;
+                if width.abs() <= placement {
                     break;
                 }
-                let mid = 0.5 * (lo + hi);
+                // The curvature no longer falls: the fold is within rounding of `lo`.
+                let at_fold = previous.is_some_and(|(_, g_p)| {
+                    let falling = g_p > 1.5 * g_lo;
+                    !falling
+                });
+                let secant = previous.and_then(|(p, g_p)| {
+                    let x = lo + g_lo * (lo - p) / (g_p - g_lo);
+                    let t = (x - lo) / width;
+                    (t.is_finite() && t > 0.0 && t < 0.9).then_some(x)
+                });
+                let just_past = lo + 0.9 * placement * width.signum();
+                let mid = match secant {
+                    _ if at_fold => just_past,
+                    Some(x) if (x - lo).abs() < 0.5 * placement => just_past,
+                    Some(x) => x,
+                    None => 0.5 * (lo + hi),
+                };
                 let psi_mid = settle(mid, psi_lo);
                 if (psi_mid - psi_lo).abs() <= ONION_JUMP + 4.0 * (mid - lo).abs() {
+                    previous = Some((lo, g_lo));
                     (lo, psi_lo) = (mid, psi_mid);
+                    g_lo = squared_curvature(lo, psi_lo);
                 } else {
                     (hi, psi_hi) = (mid, psi_mid);
                 }
@@ -279,16 +447,24 @@ impl Motor {
             work += energy(hi, psi_hi) - energy(lo, psi_lo);
             record(lo, psi_lo);
             record(hi, psi_hi);
+            if landing {
+                // The snap has set the onion on the branch it jumped to.
+                (phi, psi) = (hi, psi_hi);
+                break;
+            }
             (phi, psi) = (next, settle(next, psi_hi));
             record(phi, psi);
         }
         *settles = settles.saturating_add(count.get());
-        (psi.is_finite() && work.is_finite()).then_some((psi, work))
+        (psi.is_finite() && work.is_finite()).then_some((phi, psi, work))
     }
 }
 
 /// Rotor stride of the onion's cycle march (rad), and the placement of its snaps.
 const CYCLE_STRIDE: f64 = 0.05;
 const SNAP_PLACEMENT: f64 = 1e-10;
+/// The placement of a snap on the landing turn of [`Motor::onion_cycle`], which only needs the
+/// branch the onion lands on.
+const LANDING_SNAP_PLACEMENT: f64 = 1e-4;
 /// An onion turn beyond its branch's that marks a snap (rad), as in the integrator.
 const ONION_JUMP: f64 = 0.05;

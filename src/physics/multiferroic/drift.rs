@@ -95,6 +95,52 @@ impl Motor {
         true
     }
 
+    /// Without eq. 3.4's term (no stress, or no wall volume: `E = 0` for every segment of the
+    /// step, since the schedule holds its stress), the onion's landscape is eq. 3.3 alone, whose
+    /// one minimum per turn is at the bar (`beta = 0`): the settled onion turns rigidly with the
+    /// rotor, its torque on the bar stays what it is now (zero but for the settle's rounding), and
+    /// the rotor follows `I phi'' = load + tau - c phi'` exactly over the rest of the step,
+    /// through every switch of the schedule (the strain direction it changes does not enter).
+    /// A locked rotor stays as it is. Applies (else `false`) with a quasi-static onion settled
+    /// on that minimum (not a Gilbert onion following its branch, which does so one segment at a
+    /// time).
+    ///
+    /// Without it, the step was cut at every switch of a nanosecond schedule (a drift or a settle
+    /// each, hundreds per 1 us step) or the onion's cycle (zero torque) was marched every step.
+    pub(super) fn advance_unstrained(&self, run: &mut StepRun, d: &Drive) -> bool {
+        if !self.quasi_static()
+            || !run.following.is_nan()
+            || self.magnetoelastic_per_stress * d.stress != 0.0
+        {
+            return false;
+        }
+        let (phi, psi) = (run.y[0], run.y[2]);
+        let offset = psi - phi;
+        let at_minimum = super::angles::turned_back(offset).cos() > 0.0;
+        if !at_minimum {
+            return false;
+        }
+        let y = if d.locked {
+            [phi, 0.0, psi, 0.0]
+        } else {
+            let c = self.drag;
+            let force = d.load + self.ring_bar.torque(offset);
+            let (coast, torque_speed, torque_angle) = self.drift_response(run.t_end - run.t);
+            let turn = run.y[1] * coast + force * torque_angle;
+            let speed = run.y[1] * (1.0 - c * torque_speed) + force * torque_speed;
+            [phi + turn, speed, psi + turn, 0.0]
+        };
+        if !(y.iter().all(|v| v.is_finite()) && y[0].abs().max(y[2].abs()) <= super::MAX_ANGLE) {
+            return false;
+        }
+        run.y = y;
+        run.t = run.t_end;
+        run.settled = false;
+        run.angles = None;
+        run.attempts = run.attempts.saturating_add(1);
+        true
+    }
+
     /// The rotor's response over `h` to its initial speed and to a unit torque, under drag `c`
     /// and inertia `I`: `(I/c (1 - e^(-h c/I)), s(h), g(h))` with `s` and `g` as above (the angle
     /// a unit speed coasts, the speed and the angle a unit torque gives).

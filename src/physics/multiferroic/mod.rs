@@ -93,6 +93,10 @@ pub struct Motor {
     tilt_stiffness: f64,
     /// Bound on the third derivative of eq. 3.3 (J/rad^3), for the onion's safe march.
     ring_bar_slope_bound: f64,
+    /// The onion's cycles marched from their canonical start (a memo of pure functions of the
+    /// drive: not part of the state; see [`Motor::canonical_cycle`]).
+    #[serde(skip)]
+    cycles: cycle::CycleCache,
 }
 
 /// Inputs held over a communication step.
@@ -345,6 +349,7 @@ impl Motor {
             llg_rate,
             tilt_stiffness,
             ring_bar_slope_bound: onion::curvature_slope_bound(&ring_bar),
+            cycles: Default::default(),
             ring_bar,
             params,
         })

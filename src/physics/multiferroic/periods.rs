@@ -3,6 +3,7 @@
 //! state after the remaining periods follows without a march or settle at each switch.
 
 use super::cycle::OnionCycle;
+use super::spin::SETTLES_PER_SUBSTEP;
 use super::{Drive, Motor, StepRun};
 use std::f64::consts::PI;
 
@@ -155,7 +156,7 @@ impl Motor {
             return false;
         }
         let Some(turn) = self.strain_held_turn(d, s.step_angle) else {
-            return false;
+            return d.locked && self.settle_locked_periods(run, d, &s, first, last);
         };
         let h = end - run.t;
         let [phi, omega] = if d.locked {
@@ -184,6 +185,49 @@ impl Motor {
         run.settled = false;
         run.angles = None;
         run.attempts = run.attempts.saturating_add(1);
+        true
+    }
+
+    /// A locked rotor through the rest of the step's whole periods (segments `first` to
+    /// `last - 1`) where the strain does not hold the onion: nothing moves but the onion, which
+    /// settles into each period's landscape from where the last one left it (its memory rule,
+    /// section 3.2.2), one settle a switch and nothing else (each pass of [`Motor::step`]'s loop
+    /// added its checks and a substep's bookkeeping, a third of the cost). Charged by its
+    /// settles as the other marches; `false` when the budget left does not cover them (the loop
+    /// then goes on, and refuses the step when the switches outnumber its passes).
+    fn settle_locked_periods(
+        &self,
+        run: &mut StepRun,
+        d: &Drive,
+        s: &super::SteppingSchedule,
+        first: f64,
+        last: f64,
+    ) -> bool {
+        let periods = last - first;
+        let spent = run.attempts.saturating_add(run.extra_cost);
+        let left = self.params.max_substeps.saturating_sub(spent);
+        if !(periods >= 1.0 && periods <= f64::from(left) * f64::from(SETTLES_PER_SUBSTEP)) {
+            return false;
+        }
+        let phi = run.y[0];
+        let mut psi = run.y[2];
+        for k in 0..periods as u32 {
+            let applied = s.direction((first + f64::from(k) + 0.5) * s.step_period);
+            psi = self
+                .landscape(phi, super::reduced_direction(applied), d.stress)
+                .settle(psi);
+        }
+        if !psi.is_finite() {
+            return false;
+        }
+        run.y = [phi, 0.0, psi, 0.0];
+        run.t = (last * s.step_period).min(run.t_end);
+        run.settled = false;
+        run.angles = None;
+        run.attempts = run.attempts.saturating_add(1);
+        run.extra_cost = run
+            .extra_cost
+            .saturating_add((periods as u32).div_ceil(SETTLES_PER_SUBSTEP));
         true
     }
 }

@@ -49,6 +49,9 @@ impl Motor {
     /// Resolving every turn took the whole substep budget here (20,000 substeps, 11-40 ms per
     /// 1 us step for loads of 1e-14 to 1e-10 N m on Table 3.1).
     pub(super) fn advance_spinning(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
+        if self.advance_unstrained(run, d) {
+            return true;
+        }
         if self.advance_drifting(run, d, segment_end) {
             return true;
         }
@@ -105,7 +108,10 @@ impl Motor {
                 return false;
             }
             let mut settles = 0;
-            let cycle = self.onion_cycle(&run.y, d, dir, &mut settles);
+            let cycle = match self.canonical_cycle(&run.y, d, dir, &mut settles) {
+                Some(cycle) => Some(cycle),
+                None => self.onion_cycle(&run.y, d, dir, &mut settles),
+            };
             run.extra_cost = run
                 .extra_cost
                 .saturating_add(settles.div_ceil(SETTLES_PER_SUBSTEP));
@@ -151,8 +157,64 @@ impl Motor {
                 run.t = segment_end;
                 run.settled = false;
                 run.attempts = run.attempts.saturating_add(1);
+                self.spin_held_periods(run, d, !resolved_free);
                 true
             }
+        }
+    }
+
+    /// After a segment of the averaged spin, the step's following segments of the schedule, one
+    /// by one, where the strain holds the onion at an end of its axis
+    /// ([`Self::strain_held_turn`]): the onion then lands at every switch on the cycle turned by
+    /// its own turn there, so each segment is the spin on that cycle
+    /// ([`Self::spin_rotor`], the periodic deviation taken off and added back at the switches as
+    /// the segment-by-segment spin does) without the settles that checked the onion was on it and
+    /// placed it at every switch: the onion is placed once, at the end. Stops where a segment's
+    /// spin does not apply (the loop of [`Motor::step`] goes on from there) or the budget, a
+    /// substep a segment as before, is spent.
+    fn spin_held_periods(&self, run: &mut StepRun, d: &Drive, correct_start: bool) {
+        let Some(s) = run.schedule else {
+            return;
+        };
+        let Some(turn) = self.strain_held_turn(d, s.step_angle) else {
+            return;
+        };
+        let Some((_, mut cycle)) = run.spin_cycle.take() else {
+            return;
+        };
+        let (t0, attempts0) = (run.t, run.attempts);
+        let mut drive = *d;
+        let mut rotor = [run.y[0], run.y[1]];
+        while run.t < run.t_end
+            && run.attempts.saturating_add(run.extra_cost) < self.params.max_substeps
+        {
+            let applied = s.direction(run.t);
+            drive = Drive {
+                direction: super::reduced_direction(applied),
+                applied_direction: applied,
+                ..drive
+            };
+            cycle.rotate(turn);
+            let end = s.next_switch_after(run.t).min(run.t_end);
+            let y = [rotor[0], rotor[1], 0.0, 0.0];
+            match self.spin_rotor(&y, &cycle, &cycle, &drive, end - run.t, correct_start) {
+                Ok(r) => rotor = r,
+                Err(_) => break,
+            }
+            run.t = end;
+            run.attempts = run.attempts.saturating_add(1);
+        }
+        if run.t == t0 {
+            run.spin_cycle = Some((drive.direction, cycle));
+            return;
+        }
+        match self.onion_on_cycle(&cycle, &drive, rotor[0], d.load.signum()) {
+            Some(psi) => {
+                run.y = [rotor[0], rotor[1], psi, 0.0];
+                run.spin_cycle = Some((drive.direction, cycle));
+                run.angles = None;
+            }
+            None => (run.t, run.attempts) = (t0, attempts0),
         }
     }
 
@@ -170,6 +232,26 @@ impl Motor {
         correct_start: bool,
     ) -> Spin {
         let (end_cycle, end_drive) = end;
+        let dir = d.load.signum();
+        match self.spin_rotor(y, cycle, end_cycle, d, h, correct_start) {
+            Ok([phi, omega]) => match self.onion_on_cycle(end_cycle, end_drive, phi, dir) {
+                Some(psi) => Spin::Ended([phi, omega, psi, 0.0]),
+                None => Spin::Failed,
+            },
+            Err(spin) => spin,
+        }
+    }
+
+    /// The rotor's angle and speed of [`Self::spin`], without the onion.
+    fn spin_rotor(
+        &self,
+        y: &super::Vector,
+        cycle: &OnionCycle,
+        end_cycle: &OnionCycle,
+        d: &Drive,
+        h: f64,
+        correct_start: bool,
+    ) -> Result<[f64; 2], Spin> {
         let (i, c) = (self.inertia, self.drag);
         let dir = d.load.signum();
         let tol = self.params.tolerance;
@@ -221,7 +303,7 @@ impl Motor {
                 / force;
             let turned = h * force / c;
             if amplitude * (epsilon + 1e-3) + epsilon.powi(3) * turned > tol {
-                return Spin::Failed;
+                return Err(Spin::Failed);
             }
             // The deviation's dependence on the mean speed, neglected while that approaches its
             // terminal value, stays below tol / 10.
@@ -237,7 +319,7 @@ impl Motor {
             theta -= dir * delta;
             speed0 -= u;
             if start.amplitude() * (1.0 - force / (c * speed0)).abs() > 0.1 * tol {
-                return Spin::NotYet;
+                return Err(Spin::NotYet);
             }
         }
         let (mut advance, mut omega) = mean_motion(speed0, force);
@@ -259,22 +341,20 @@ impl Motor {
             omega += dir * u;
         }
         if !(phi.is_finite() && phi.abs() <= super::MAX_ANGLE && omega.is_finite()) {
-            return Spin::Failed;
+            return Err(Spin::Failed);
         }
-        // The onion on its cycle at the end angle: whole turns shift it by the winding, the rest
-        // is settled from the cycle's sample below it.
-        let from_cycle = phi - end_cycle.turns - end_cycle.rotor;
+        Ok([phi, omega])
+    }
+
+    /// The onion on `cycle` (of the drive `d`) at the rotor angle `phi`: whole turns shift it by
+    /// the winding, the rest is settled from the cycle's sample below it.
+    fn onion_on_cycle(&self, cycle: &OnionCycle, d: &Drive, phi: f64, dir: f64) -> Option<f64> {
+        let from_cycle = phi - cycle.turns - cycle.rotor;
         let whole = (dir * from_cycle / (2.0 * PI)).floor();
         let rest = from_cycle - dir * whole * 2.0 * PI;
-        let onion = end_cycle.onion_at(self, dir * rest, dir, end_drive);
-        let psi = onion
-            + end_cycle.turns
-            + end_cycle.onion_turns
-            + end_cycle.winding * dir * whole * 2.0 * PI;
-        if !(psi.is_finite() && psi.abs() <= super::MAX_ANGLE) {
-            return Spin::Failed;
-        }
-        Spin::Ended([phi, omega, psi, 0.0])
+        let onion = cycle.onion_at(self, dir * rest, dir, d);
+        let psi = onion + cycle.turns + cycle.onion_turns + cycle.winding * dir * whole * 2.0 * PI;
+        (psi.is_finite() && psi.abs() <= super::MAX_ANGLE).then_some(psi)
     }
 
     /// The periodic deviation from the mean motion at mean speed `omega` (> 0, in the direction
