@@ -47,6 +47,8 @@ mod model_exchange_tests;
 pub mod onion;
 #[cfg(test)]
 mod onion_tests;
+#[cfg(test)]
+mod orbit_proto_tests;
 mod params;
 mod periods;
 pub mod phi;
