@@ -624,8 +624,18 @@ impl Motor {
     /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]).
     fn averageable(&self, y: &Vector, d: &Drive, remaining: f64) -> Option<(Well, Orbit)> {
         let land = self.landscape(y[0], d.direction, d.stress);
-        let well = self.onion_well(&land, y[2])?;
         let t = self.tilt_stiffness;
+        // First from the linearization at the minimum (no search for the rims): its period
+        // `2 pi / (g sqrt(k T))` and energy loss per orbit `g alpha (k + T) P` (the orbit's are
+        // within a factor of two of them in the wells met), against the checks below.
+        let k = land.curvature(land.settle(y[2]));
+        let period = 2.0 * PI / (self.llg_rate * (k * t).sqrt());
+        let loss = self.llg_rate * self.params.gilbert_damping * (k + t) * period;
+        let stiff = !d.locked && self.inertia < self.drag * period;
+        if !(loss <= 2.0 * MAX_LOSS_PER_ORBIT && remaining >= 0.5 * MIN_ORBITS * period) || stiff {
+            return None;
+        }
+        let well = self.onion_well(&land, y[2])?;
         let omega = if d.locked { 0.0 } else { y[1] };
         // The tilt about the orbit's centre.
         let tilt = y[3] - self.tilt_centre(&land, &well, omega);
