@@ -59,6 +59,9 @@ const MIN_ORBITS: f64 = 8.0;
 pub(super) const ORBIT_EVALUATION_WEIGHT: u32 = 6;
 /// A Dormand-Prince step of the averaged equations (six evaluations) in the budget's units.
 const AVERAGED_STEP_WEIGHT: u32 = 6 * ORBIT_EVALUATION_WEIGHT;
+/// A free rotor whose speed relaxes within this fraction of an orbit (`I / c`) is taken as
+/// overdamped over the averaged advance: it turns at `(<tau> + load) / c`.
+const OVERDAMPED: f64 = 0.01;
 /// The most RK4 steps of the march to the first turning point (two orbits), one unit each.
 const MARCH_STEPS: u32 = 256;
 
@@ -359,6 +362,8 @@ struct Averager<'a> {
     orbit: Orbit,
     /// Evaluations of the right-hand side.
     evaluations: u32,
+    /// The rotor is overdamped (see [`OVERDAMPED`]).
+    overdamped: bool,
 }
 
 impl Averager<'_> {
@@ -409,6 +414,8 @@ impl Averager<'_> {
         self.orbit = o;
         let rotor = if self.d.locked {
             [0.0, 0.0]
+        } else if self.overdamped {
+            [(o.torque + self.d.load) / m.drag, 0.0]
         } else {
             [s[1], (o.torque + self.d.load - m.drag * s[1]) / m.inertia]
         };
@@ -515,23 +522,27 @@ impl Motor {
         let start = run.t + marched;
         let (well, o) = self.averageable(&y, d, segment_end - start)?;
         let land = self.landscape(y[0], d.direction, d.stress);
-        let omega = if d.locked { 0.0 } else { y[1] };
+        let overdamped = !d.locked && self.overdamped(o.period);
+        let omega = self.rotor_speed(&y, d, overdamped);
         let tilt = y[3] - self.tilt_centre(&land, &well, omega);
         let (phase, impulse, damped) = self.phase_on_orbit(&land, &well, &o, y[2], tilt);
         // Within a rounding of the turning point: the phase within [-1/2, 1/2).
         let phase = phase - phase.round();
-        let mut s: Slow = [
-            y[0],
-            omega - impulse / self.inertia,
-            o.energy - damped,
-            phase,
-        ];
+        // (An overdamped rotor's speed is not a variable; its angle's oscillating part
+        // `P~ / c` vanishes with `P~` at the turning point.)
+        let speed = if overdamped {
+            0.0
+        } else {
+            omega - impulse / self.inertia
+        };
+        let mut s: Slow = [y[0], speed, o.energy - damped, phase];
         let mut avg = Averager {
             m: self,
             d,
             well,
             orbit: o,
             evaluations: 0,
+            overdamped,
         };
         let mut k1 = avg.rate(&s)?;
         let tol = self.params.tolerance;
@@ -601,7 +612,13 @@ impl Motor {
         // The onion back at its lower turning point.
         let land = self.landscape(s[0], d.direction, d.stress);
         let (well, o) = avg.orbit_at(&s)?;
-        let omega = if d.locked { 0.0 } else { s[1] };
+        let omega = if overdamped {
+            self.rotor_speed(&[s[0], 0.0, o.below, 0.0], d, true)
+        } else if d.locked {
+            0.0
+        } else {
+            s[1]
+        };
         run.y = [s[0], omega, o.below, self.tilt_centre(&land, &well, omega)];
         run.t = time;
         run.angles = None;
@@ -611,6 +628,24 @@ impl Motor {
             evaluations: avg.evaluations,
             resolved,
         })
+    }
+
+    /// Whether a free rotor is taken as overdamped over orbits of `period` (see [`OVERDAMPED`]).
+    fn overdamped(&self, period: f64) -> bool {
+        self.inertia <= OVERDAMPED * self.drag * period
+    }
+
+    /// The rotor's speed at `y`: its own, or an overdamped rotor's `(tau + load) / c`, or 0
+    /// locked.
+    fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
+        if d.locked {
+            0.0
+        } else if overdamped {
+            let land = self.landscape(y[0], d.direction, d.stress);
+            (point(&land, y[2]).2 + d.load) / self.drag
+        } else {
+            y[1]
+        }
     }
 
     /// Ringing narrower than this (rad) is within the relaxed onion's slack (see
@@ -631,12 +666,14 @@ impl Motor {
         let k = land.curvature(land.settle(y[2]));
         let period = 2.0 * PI / (self.llg_rate * (k * t).sqrt());
         let loss = self.llg_rate * self.params.gilbert_damping * (k + t) * period;
-        let stiff = !d.locked && self.inertia < self.drag * period;
+        let stiff = !d.locked
+            && self.inertia < self.drag * period
+            && self.inertia > 2.0 * OVERDAMPED * self.drag * period;
         if !(loss <= 2.0 * MAX_LOSS_PER_ORBIT && remaining >= 0.5 * MIN_ORBITS * period) || stiff {
             return None;
         }
         let well = self.onion_well(&land, y[2])?;
-        let omega = if d.locked { 0.0 } else { y[1] };
+        let omega = self.rotor_speed(y, d, self.overdamped(period));
         // The tilt about the orbit's centre.
         let tilt = y[3] - self.tilt_centre(&land, &well, omega);
         let e = point(&land, y[2]).0 - well.floor + 0.5 * t * tilt * tilt;
@@ -655,9 +692,16 @@ impl Motor {
         // `max |tau - <tau>| P^2 / (4 pi^2 I)` (the torque's harmonics add less).
         let wobble = o.swing * o.period * o.period / (4.0 * PI * PI * self.inertia);
         // A free rotor whose speed relaxes within a few orbits holds the explicit steps to a few
-        // orbits (Dormand-Prince's stability reaches 3.3 relaxation times).
+        // orbits (Dormand-Prince's stability reaches 3.3 relaxation times), unless it is
+        // overdamped: then its angle oscillates by `max |tau - <tau>| P / (2 pi c)` with the
+        // precession, and lags its drag-limited turn by `I / c` times its speed's change,
+        // `2 max |tau - <tau>| / c` at most, both held within a tenth of the tolerance.
+        let c = self.drag;
+        let overdamped = self.overdamped(o.period)
+            && o.swing * o.period / (2.0 * PI * c) <= 0.1 * tol
+            && self.inertia / c * 2.0 * o.swing / c <= 0.1 * tol;
         let stiff = self.inertia < 2.0 * self.drag * o.period;
-        if !(d.locked || (wobble <= 0.1 * tol && !stiff)) {
+        if !(d.locked || overdamped || (wobble <= 0.1 * tol && !stiff)) {
             return None;
         }
         // The phase's drift: the damped orbit's frequency is that of the averaged equations
@@ -691,10 +735,15 @@ impl Motor {
         period: f64,
     ) -> Option<(Vector, f64, u32)> {
         let h = period / 128.0;
+        let overdamped = !d.locked && self.overdamped(period);
         let rate = |z: &Vector| {
             let mut f = self.rhs_jacobian(z, d, h).0;
             if d.locked {
                 f[0] = 0.0;
+                f[1] = 0.0;
+            } else if overdamped {
+                // (tau + load) / c, the speed left out.
+                f[0] = z[1] + f[1] * self.inertia / self.drag;
                 f[1] = 0.0;
             }
             f

@@ -32,27 +32,35 @@ fn gilbert(alpha: f64) -> Motor {
 
 /// Table 3.1's onion rings after the schedule's first switch (released from its settled state,
 /// 0.3 of its well's lowest rim above the new minimum) or is entered mid-orbit (at the minimum,
-/// either tilt): the orbit-averaged advance over 1 us (300 ns mid-orbit) against a fine RK4 of
-/// the full macrospin and rotor, free and locked. The averaged path is taken (its steps counted,
-/// a few hundred against the ~1e5 substeps of the resolved ringing); the rotor ends within a
-/// tenth of the tolerance (1.4e-8 rad at most, where the ringing moves it by 5.5e-4 rad at
-/// damping 1e-4) and its speed within the tolerance on its scale; the onion's angle and tilt
-/// within the tolerance (1.1e-6 rad at damping 1e-4 on a free rotor, where the ringing is still
-/// 2.5e-3 rad wide after 1 us). At damping 1e-2 the action drops by a third per orbit: the
-/// averaged path is not taken.
+/// either tilt): the orbit-averaged advance over 1 us or 300 ns against a fine RK4 of the full
+/// macrospin and rotor, free, locked, and in a fluid 1e4 times as viscous as water (the rotor
+/// overdamped). The averaged path is taken (its steps counted, at most 162, against the ~1e5
+/// substeps of the resolved ringing) and ends at the last lower turning point (or where the
+/// ringing is within the relaxed onion's slack); the rotor ends within a tenth of the tolerance
+/// (2.1e-8 rad at most, where the ringing moves it by 5.5e-4 rad at damping 1e-4) and its speed
+/// within the tolerance on its scale; the onion's angle within 4.1e-8 rad and its tilt within
+/// 3.4e-7 rad. At damping 1e-2 the energy drops by a third per orbit: the averaged path is not
+/// taken.
 #[test]
 fn orbit_averaged_ringing_matches_a_fine_rk4_of_the_full_system() {
-    for (alpha, entry, locked, span) in [
-        (1e-4, 0.0, false, 1e-6),
-        (1e-4, 0.0, true, 1e-6),
-        (1e-3, 0.0, false, 1e-6),
-        (1e-3, 0.0, true, 1e-6),
-        (1e-4, 1.0, false, 1e-6),
-        (1e-3, -1.0, false, 3e-7),
-        (3e-4, 0.5, true, 3e-7),
-        (1e-2, 0.0, false, 1e-6),
+    for (alpha, entry, locked, span, viscosity) in [
+        (1e-4, 0.0, false, 1e-6, 1e-3),
+        (1e-4, 0.0, true, 1e-6, 1e-3),
+        (1e-3, 0.0, false, 1e-6, 1e-3),
+        (1e-3, 0.0, true, 1e-6, 1e-3),
+        (1e-4, 1.0, false, 1e-6, 1e-3),
+        (1e-3, -1.0, false, 3e-7, 1e-3),
+        (3e-4, 0.5, true, 3e-7, 1e-3),
+        (1e-2, 0.0, false, 1e-6, 1e-3),
+        // An overdamped rotor (its speed relaxes in 2.2e-13 s, against 2.9e-10 s orbits).
+        (1e-4, 0.0, false, 1e-6, 10.0),
+        (1e-3, 1.0, false, 1e-6, 10.0),
     ] {
-        let m = gilbert(alpha);
+        let m = motor_with(|p| {
+            p.onion_model = OnionModel::Gilbert;
+            p.gilbert_damping = alpha;
+            p.fluid_viscosity = viscosity;
+        });
         let inputs = MotorInputs {
             rotor_locked: locked,
             ..schedule(20e-6)
@@ -84,8 +92,8 @@ fn orbit_averaged_ringing_matches_a_fine_rk4_of_the_full_system() {
         let tol = m.params.tolerance;
         let error: Vec<f64> = (0..4).map(|i| (run.y[i] - truth[i]).abs()).collect();
         println!(
-            "damping {alpha}, entry {entry}, locked {locked}: {taken:?} to {:e} s: error {error:?}",
-            run.t
+            "damping {alpha}, entry {entry}, locked {locked}, viscosity {viscosity}: {taken:?} to {:e} s: error {error:?} (rotor {})",
+            run.t, truth[0]
         );
         assert!(taken.steps <= 400, "{alpha}: {taken:?}");
         // At the last lower turning point before the span's end (an orbit is 0.29 ns), or
