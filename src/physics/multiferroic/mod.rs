@@ -47,6 +47,11 @@ mod model_exchange_tests;
 pub mod onion;
 #[cfg(test)]
 mod onion_tests;
+mod orbit;
+#[cfg(test)]
+mod orbit_proto_tests;
+#[cfg(test)]
+mod orbit_tests;
 mod params;
 mod periods;
 pub mod phi;

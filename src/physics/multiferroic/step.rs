@@ -46,6 +46,8 @@ pub(super) struct StepRun {
     pub(super) rim_barrier: (f64, Rims),
     /// The attempt from which the Gilbert onion's averaged ringing is tried next.
     pub(super) average_check_at: u32,
+    /// The attempt from which the orbit-averaged ringing is tried next.
+    pub(super) orbit_check_at: u32,
     /// The stepping schedule switching inside this step, if any.
     pub(super) schedule: Option<super::SteppingSchedule>,
 }
@@ -82,6 +84,7 @@ impl StepRun {
             following: f64::NAN,
             rim_barrier: (f64::NAN, Rims::NONE),
             average_check_at: 0,
+            orbit_check_at: 0,
             schedule: None,
         }
     }
@@ -209,6 +212,22 @@ impl Motor {
             {
                 run.settle_tried_for = segment_end;
                 if model.advance_overdamped(&mut run, &d, segment_end) {
+                    continue;
+                }
+            }
+            if !model.quasi_static() && run.attempts >= run.orbit_check_at {
+                // Tried at attempts spaced by an eighth of those made, as the averaged ringing.
+                let advance = self.advance_orbits(&mut run, &d, segment_end);
+                run.orbit_check_at = run.attempts + 1 + run.attempts / 8;
+                if let Some(a) = advance {
+                    run.attempts = run.attempts.saturating_add(a.steps);
+                    run.extra_cost = run
+                        .extra_cost
+                        .saturating_add(
+                            a.evaluations
+                                .saturating_mul(super::orbit::ORBIT_EVALUATION_WEIGHT),
+                        )
+                        .saturating_add(a.resolved);
                     continue;
                 }
             }
