@@ -20,8 +20,11 @@
 //! comes out by itself), while the quasi-static onion is re-solved at the end of every substep.
 //! The method is second order. With the quasi-static onion the rotor block is 2x2, its `phi`
 //! functions come in closed form and the third-order member of an embedded exponential Rosenbrock
-//! pair (exprb32) estimates the local error; the Gilbert onion keeps step doubling. The estimate
-//! sizes the next substep.
+//! pair (exprb32) estimates the local error. The Gilbert onion's ringing takes an explicit
+//! Dormand-Prince 5(4) pair within its stability reach, an exponential RK4 where only the rotor's
+//! drag keeps that pair out of reach, else an exponential Rosenbrock pair (`gilbert.rs`); weakly
+//! damped ringing trapped in its well advances orbit-averaged (`orbit.rs`). The estimate sizes
+//! the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see [`MotorParams::max_substeps`]).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
@@ -49,7 +52,7 @@ pub mod onion;
 mod onion_tests;
 mod orbit;
 #[cfg(test)]
-mod orbit_proto_tests;
+mod orbit_theory_tests;
 #[cfg(test)]
 mod orbit_tests;
 mod params;

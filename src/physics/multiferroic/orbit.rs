@@ -56,7 +56,7 @@ const MIN_ORBITS: f64 = 8.0;
 /// An evaluation of the averaged equations' right-hand side (an orbit's quadrature and the
 /// well's minimum, about 2 us) in the budget's units, substeps of the quasi-static onion
 /// (0.32 us, see [`super::GILBERT_SUBSTEP_WEIGHT`]).
-pub(super) const ORBIT_EVALUATION_WEIGHT: u32 = 6;
+const ORBIT_EVALUATION_WEIGHT: u32 = 6;
 /// A Dormand-Prince step of the averaged equations (six evaluations) in the budget's units.
 const AVERAGED_STEP_WEIGHT: u32 = 6 * ORBIT_EVALUATION_WEIGHT;
 /// A free rotor whose speed relaxes within this fraction of an orbit (`I / c`) is taken as
@@ -475,6 +475,15 @@ pub(super) struct OrbitAdvance {
     pub(super) evaluations: u32,
     /// RK4 steps of the full system to the first turning point.
     pub(super) resolved: u32,
+}
+
+impl OrbitAdvance {
+    /// The budget units beyond `steps`: each evaluation by its measured cost, each RK4 step one.
+    pub(super) fn extra_cost(&self) -> u32 {
+        self.evaluations
+            .saturating_mul(ORBIT_EVALUATION_WEIGHT)
+            .saturating_add(self.resolved)
+    }
 }
 
 impl Motor {

@@ -221,13 +221,7 @@ impl Motor {
                 run.orbit_check_at = run.attempts + 1 + run.attempts / 8;
                 if let Some(a) = advance {
                     run.attempts = run.attempts.saturating_add(a.steps);
-                    run.extra_cost = run
-                        .extra_cost
-                        .saturating_add(
-                            a.evaluations
-                                .saturating_mul(super::orbit::ORBIT_EVALUATION_WEIGHT),
-                        )
-                        .saturating_add(a.resolved);
+                    run.extra_cost = run.extra_cost.saturating_add(a.extra_cost());
                     continue;
                 }
             }

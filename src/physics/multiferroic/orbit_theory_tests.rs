@@ -1,6 +1,6 @@
-//! The orbit-averaged Gilbert ringing, as a test-side model against RK4 of the full macrospin and
-//! rotor: the groundwork for averaging the large-amplitude ringing in the motor's step (not wired
-//! into it).
+//! The orbit-averaged Gilbert ringing as an independent test-side model (bisected turning points,
+//! frozen landscape, entry mid-orbit) against RK4 of the full macrospin and rotor: the theory that
+//! `orbit.rs` implements, checked apart from its implementation.
 //!
 //! With the landscape `U(psi)` of eq. 3.4 frozen, the undamped macrospin is Hamiltonian in
 //! `(psi, -theta/g)` with energy `E = U + T theta^2 / 2`: `psi' = -g T theta`, `theta' = g U'`.
