@@ -52,9 +52,9 @@ pub mod onion;
 mod onion_tests;
 mod orbit;
 #[cfg(test)]
-mod orbit_theory_tests;
-#[cfg(test)]
 mod orbit_tests;
+#[cfg(test)]
+mod orbit_theory_tests;
 mod params;
 mod periods;
 pub mod phi;
