@@ -8,7 +8,7 @@ use super::{Drive, Motor, MotorInputs, MotorState, OnionModel, Vector};
 
 /// Fine RK4 of the full macrospin and rotor from `y0` over `span` (a fiftieth of the onion's
 /// fastest rate per step).
-fn resolved(m: &Motor, d: &Drive, y0: Vector, span: f64) -> Vector {
+pub(super) fn resolved(m: &Motor, d: &Drive, y0: Vector, span: f64) -> Vector {
     let (_, j) = m.rhs_jacobian(&y0, d, 1e-12);
     let norm = (2..4)
         .map(|i| (2..4).map(|k| j[i][k].abs()).sum::<f64>())

@@ -17,6 +17,7 @@
 //! Quadrature: `psi = c + h sin u` between the turning points `c -+ h` makes `dpsi / |theta|`
 //! smooth and periodic in `u` over the whole orbit, so the midpoint rule converges spectrally.
 
+use super::orbit_tests::resolved;
 use super::tests::{motor_with, rk4_step, schedule};
 use super::{Drive, Motor, OnionModel, Vector};
 
@@ -165,18 +166,6 @@ fn averaged(m: &Motor, d: &Drive, y0: Vector, span: f64, h: f64) -> ([f64; 3], (
         s[2] = s[2].max(0.0);
     }
     (s, boundary)
-}
-
-/// Fine RK4 of the full macrospin and rotor from `y0` over `span`.
-fn resolved(m: &Motor, d: &Drive, y0: Vector, span: f64) -> Vector {
-    let (_, j) = m.rhs_jacobian(&y0, d, 1e-12);
-    let norm = (2..4)
-        .map(|i| (2..4).map(|k| j[i][k].abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    let n = (span * norm / 0.02).ceil() as usize;
-    let h = span / n as f64;
-    let rate = |z: &Vector| m.rhs_jacobian(z, d, h).0;
-    (0..n).fold(y0, |z, _| rk4_step(&rate, &z, h))
 }
 
 /// The quadrature of a trapped orbit of Table 3.1's onion after the first switch of the

@@ -3,7 +3,8 @@
 //!
 //! Hand-written on plain arrays for speed on the per-substep hot path (two calls per substep)
 //! and so that a hopeless argument returns `None` instead of panicking or producing NaN. Generic
-//! over the size: the quasi-static motor needs 3x3 (rotor and forcing), the Gilbert one 5x5.
+//! over the size: the quasi-static motor needs 3x3 (rotor and forcing), the Gilbert one 4x4 with
+//! its forcing's `phi_1` column ([`expm_affine`]).
 
 pub type Mat<const N: usize> = [[f64; N]; N];
 
@@ -24,29 +25,7 @@ fn mul<const N: usize>(a: &Mat<N>, b: &Mat<N>) -> Mat<N> {
 /// `exp(m)`, or `None` if `m` is not finite, too large to scale (norm above 2^200), or the
 /// result overflows.
 pub fn expm<const N: usize>(m: &Mat<N>) -> Option<Mat<N>> {
-    let norm = m
-        .iter()
-        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    if !norm.is_finite() {
-        return None;
-    }
-    // Scale to norm <= 1/4: 12 Taylor terms then leave a remainder below 0.25^13/13! ~ 2e-18.
-    let mut squarings = 0u32;
-    let mut scale = 1.0;
-    while norm * scale > 0.25 {
-        scale *= 0.5;
-        squarings += 1;
-        if squarings > 200 {
-            return None;
-        }
-    }
-    let mut a = *m;
-    for row in a.iter_mut() {
-        for x in row.iter_mut() {
-            *x *= scale;
-        }
-    }
+    let (a, squarings, _) = scaled_to_a_quarter(m)?;
     let mut e = taylor_12(&a);
     for _ in 0..squarings {
         e = mul(&e, &e);
@@ -67,30 +46,12 @@ pub fn expm<const N: usize>(m: &Mat<N>) -> Option<Mat<N>> {
 /// relative to `b`, at the rate of `a`'s). `None` if an input is not finite, `a` is too large to
 /// scale (norm above 2^200) or the result overflows.
 pub fn expm_affine<const M: usize>(a: &Mat<M>, b: &[f64; M]) -> Option<(Mat<M>, [f64; M])> {
-    let norm = a
-        .iter()
-        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
-        .fold(0.0, f64::max);
-    if !(norm.is_finite() && b.iter().all(|x| x.is_finite())) {
+    if !b.iter().all(|x| x.is_finite()) {
         return None;
     }
-    // Scale to norm <= 1/4: 12 Taylor terms then leave remainders below 0.25^13/13! ~ 2e-18 of
-    // exp and 0.25^12/13! ~ 1e-17 of phi_1 (relative to b).
-    let mut squarings = 0u32;
-    let mut scale = 1.0;
-    while norm * scale > 0.25 {
-        scale *= 0.5;
-        squarings += 1;
-        if squarings > 200 {
-            return None;
-        }
-    }
-    let mut s = *a;
-    for row in s.iter_mut() {
-        for x in row.iter_mut() {
-            *x *= scale;
-        }
-    }
+    // 12 Taylor terms leave remainders below 0.25^13/13! ~ 2e-18 of exp and 0.25^12/13! ~ 1e-17
+    // of phi_1 (relative to b).
+    let (s, squarings, scale) = scaled_to_a_quarter(a)?;
     let mut e = taylor_12(&s);
     // phi_1(s) (scale b) by Horner: b + s (b + s (b + ...) / 3) / 2, to s^11 b / 12!.
     let scaled_b: [f64; M] = std::array::from_fn(|i| b[i] * scale);
@@ -106,6 +67,35 @@ pub fn expm_affine<const M: usize>(a: &Mat<M>, b: &[f64; M]) -> Option<(Mat<M>, 
         e = mul(&e, &e);
     }
     (e.iter().flatten().all(|v| v.is_finite()) && x.iter().all(|v| v.is_finite())).then_some((e, x))
+}
+
+/// `m` scaled by a power of two to a norm of at most 1/4, where 12 Taylor terms leave a
+/// remainder below 0.25^13/13! ~ 2e-18: the scaled matrix, the squarings that undo it and the
+/// scale. `None` if `m` is not finite or its norm exceeds 2^200.
+fn scaled_to_a_quarter<const N: usize>(m: &Mat<N>) -> Option<(Mat<N>, u32, f64)> {
+    let norm = m
+        .iter()
+        .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
+        .fold(0.0, f64::max);
+    if !norm.is_finite() {
+        return None;
+    }
+    let mut squarings = 0u32;
+    let mut scale = 1.0;
+    while norm * scale > 0.25 {
+        scale *= 0.5;
+        squarings += 1;
+        if squarings > 200 {
+            return None;
+        }
+    }
+    let mut a = *m;
+    for row in a.iter_mut() {
+        for x in row.iter_mut() {
+            *x *= scale;
+        }
+    }
+    Some((a, squarings, scale))
 }
 
 /// `a v`.
