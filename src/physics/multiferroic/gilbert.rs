@@ -3,6 +3,7 @@
 
 use super::phi::Phi2x2;
 use super::{Angles, Drive, Motor, Vector};
+use crate::physics::numerics::dormand_prince;
 
 /// The full system's right-hand side `f` and Jacobian `j` at a substep's start for its length,
 /// with the angles there: evaluated once and shared by the explicit pair and the exponential
@@ -104,69 +105,12 @@ impl Motor {
             return None;
         }
         // Each stage's angles turned from the start's (see [`Angles::moved`]).
-        let rate =
-            |z: &Vector| self.gilbert_rate(z, d, &start.angles.moved(z[2], z[0], d.direction));
-        let at = |k: &[&Vector], a: &[f64]| -> Vector {
-            std::array::from_fn(|i| y[i] + dt * k.iter().zip(a).map(|(k, a)| a * k[i]).sum::<f64>())
+        let rate = |z: &Vector| {
+            Some(self.gilbert_rate(z, d, &start.angles.moved(z[2], z[0], d.direction)))
         };
-        let k2 = rate(&at(&[&k1], &[0.2]));
-        let k3 = rate(&at(&[&k1, &k2], &[3.0 / 40.0, 9.0 / 40.0]));
-        let k4 = rate(&at(
-            &[&k1, &k2, &k3],
-            &[44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0],
-        ));
-        let k5 = rate(&at(
-            &[&k1, &k2, &k3, &k4],
-            &[
-                19372.0 / 6561.0,
-                -25360.0 / 2187.0,
-                64448.0 / 6561.0,
-                -212.0 / 729.0,
-            ],
-        ));
-        let k6 = rate(&at(
-            &[&k1, &k2, &k3, &k4, &k5],
-            &[
-                9017.0 / 3168.0,
-                -355.0 / 33.0,
-                46732.0 / 5247.0,
-                49.0 / 176.0,
-                -5103.0 / 18656.0,
-            ],
-        ));
-        let u = at(
-            &[&k1, &k3, &k4, &k5, &k6],
-            &[
-                35.0 / 384.0,
-                500.0 / 1113.0,
-                125.0 / 192.0,
-                -2187.0 / 6784.0,
-                11.0 / 84.0,
-            ],
-        );
-        let k7 = rate(&u);
-        // The fifth-order result less the embedded fourth-order one.
-        let weights = [
-            71.0 / 57600.0,
-            -71.0 / 16695.0,
-            71.0 / 1920.0,
-            -17253.0 / 339200.0,
-            22.0 / 525.0,
-            -1.0 / 40.0,
-        ];
-        let stages = [&k1, &k3, &k4, &k5, &k6, &k7];
+        let (u, k) = dormand_prince::step(y, &k1, dt, rate)?;
         let u = self.checked_end(u, y, d.locked)?;
-        let err = self.error_norm(
-            |i| {
-                dt * stages
-                    .iter()
-                    .zip(&weights)
-                    .map(|(k, w)| w * k[i])
-                    .sum::<f64>()
-            },
-            y,
-            &u,
-        );
+        let err = self.error_norm(|i| dormand_prince::error(dt, &k, i), y, &u);
         err.is_finite().then(|| (u, fifth_order_error(err)))
     }
 

@@ -39,6 +39,7 @@ use std::sync::OnceLock;
 use super::onion::Landscape;
 use super::step::StepRun;
 use super::{Angles, Drive, Motor, Vector};
+use crate::physics::numerics::dormand_prince;
 
 /// Midpoint nodes on a half orbit.
 const NODES: usize = 32;
@@ -428,44 +429,6 @@ impl Averager<'_> {
     }
 }
 
-/// Dormand-Prince 5(4) (Dormand and Prince, J. Comput. Appl. Math. 6, 1980): the stages'
-/// coefficients, the fifth-order weights and the difference of the embedded fourth-order ones.
-const DP_A: [&[f64]; 6] = [
-    &[0.2],
-    &[3.0 / 40.0, 9.0 / 40.0],
-    &[44.0 / 45.0, -56.0 / 15.0, 32.0 / 9.0],
-    &[
-        19372.0 / 6561.0,
-        -25360.0 / 2187.0,
-        64448.0 / 6561.0,
-        -212.0 / 729.0,
-    ],
-    &[
-        9017.0 / 3168.0,
-        -355.0 / 33.0,
-        46732.0 / 5247.0,
-        49.0 / 176.0,
-        -5103.0 / 18656.0,
-    ],
-    &[
-        35.0 / 384.0,
-        0.0,
-        500.0 / 1113.0,
-        125.0 / 192.0,
-        -2187.0 / 6784.0,
-        11.0 / 84.0,
-    ],
-];
-const DP_E: [f64; 7] = [
-    71.0 / 57600.0,
-    0.0,
-    -71.0 / 16695.0,
-    71.0 / 1920.0,
-    -17253.0 / 339200.0,
-    22.0 / 525.0,
-    -1.0 / 40.0,
-];
-
 /// What [`Motor::advance_orbits`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(super) struct OrbitAdvance {
@@ -797,27 +760,10 @@ fn dormand_prince(
     h: f64,
     scales: impl Fn(&Slow, f64) -> [f64; 4],
 ) -> Option<(Slow, Slow, f64)> {
-    let mut k: [Slow; 7] = [*k1; 7];
-    for stage in 0..6 {
-        let z: Slow = std::array::from_fn(|i| {
-            s[i] + h * DP_A[stage]
-                .iter()
-                .zip(&k)
-                .map(|(a, k)| a * k[i])
-                .sum::<f64>()
-        });
-        k[stage + 1] = avg.rate(&z)?;
-    }
-    // The last stage is at the fifth-order result.
-    let next: Slow = std::array::from_fn(|i| {
-        s[i] + h * DP_A[5].iter().zip(&k).map(|(a, k)| a * k[i]).sum::<f64>()
-    });
+    let (next, k) = dormand_prince::step(s, k1, h, |z| avg.rate(z))?;
     let scale = scales(&next, avg.orbit.half_width().max(f64::MIN_POSITIVE));
     let err = (0..4)
-        .map(|i| {
-            let e: f64 = DP_E.iter().zip(&k).map(|(w, k)| w * k[i]).sum();
-            (h * e).abs() / scale[i]
-        })
+        .map(|i| dormand_prince::error(h, &k, i).abs() / scale[i])
         .fold(0.0, f64::max);
     err.is_finite().then_some((next, k[6], err))
 }
