@@ -1,0 +1,449 @@
+//! The orbit-averaged advance of the Gilbert onion's weakly damped ringing
+//! ([`Motor::advance_orbits`]): the orbit's energy and phase and the rotor, integrated between
+//! lower turning points of the orbits that `orbit.rs` evaluates (the method is described there).
+
+use super::onion::Landscape;
+use super::orbit::{point, Orbit, Well};
+use super::step::StepRun;
+use super::{Drive, Motor, Vector};
+use crate::physics::numerics::dormand_prince;
+use std::f64::consts::PI;
+
+/// The orbit's energy at most this fraction of the lowest rim's height above the minimum: the
+/// quadrature stays converged and the averaged orbit's energy off by its oscillating part
+/// cannot leave the well.
+const RIM_MARGIN: f64 = 0.9;
+/// At most this fraction of the energy lost per orbit (the averaging's small parameter).
+const MAX_LOSS_PER_ORBIT: f64 = 0.05;
+/// The averaged advance is tried when the segment has at least this many orbits left (fewer
+/// are resolved at about the cost of the averaged advance's entry and exit).
+const MIN_ORBITS: f64 = 8.0;
+/// An evaluation of the averaged equations' right-hand side (an orbit's quadrature and the
+/// well's minimum, about 2 us) in the budget's units, substeps of the quasi-static onion
+/// (0.32 us, see [`super::GILBERT_SUBSTEP_WEIGHT`]).
+const ORBIT_EVALUATION_WEIGHT: u32 = 6;
+/// A Dormand-Prince step of the averaged equations (six evaluations) in the budget's units.
+const AVERAGED_STEP_WEIGHT: u32 = 6 * ORBIT_EVALUATION_WEIGHT;
+/// A free rotor whose speed relaxes within this fraction of an orbit (`I / c`) is taken as
+/// overdamped over the averaged advance: it turns at `(<tau> + load) / c`.
+const OVERDAMPED: f64 = 0.01;
+/// The most RK4 steps of the march to the first turning point (two orbits), one unit each.
+const MARCH_STEPS: u32 = 256;
+
+/// The averaged ringing's state: rotor angle and speed (rad, rad/s), the orbit's energy above
+/// the minimum (J) and its phase (cycles).
+type Slow = [f64; 4];
+
+/// The averaged equations' right-hand side at one rotor angle after another, each well and orbit
+/// found from the last (the landscape moves little between calls).
+struct Averager<'a> {
+    m: &'a Motor,
+    d: &'a Drive,
+    well: Well,
+    orbit: Orbit,
+    /// Evaluations of the right-hand side.
+    evaluations: u32,
+    /// The rotor is overdamped (see [`OVERDAMPED`]).
+    overdamped: bool,
+}
+
+impl Averager<'_> {
+    /// The well at rotor angle `phi`: the last one's rims moved with its minimum (they bracket
+    /// the turning points; [`turning_point`] checks that they still do).
+    fn well_at(&self, land: &Landscape) -> Option<Well> {
+        let minimum = land.settle(self.well.minimum);
+        let shift = minimum - self.well.minimum;
+        let k = land.curvature(minimum);
+        let floor = point(land, minimum).0;
+        let (below, above) = (self.well.below + shift, self.well.above + shift);
+        let barrier = point(land, below).0.min(point(land, above).0) - floor;
+        (k > 0.0 && barrier > 0.0).then_some(Well {
+            minimum,
+            below,
+            above,
+            barrier,
+            floor,
+            curvature: k,
+        })
+    }
+
+    /// The well and orbit at the slow state `s`, the turning points' iterations started from the
+    /// last orbit's moved with its minimum.
+    fn orbit_at(&self, s: &Slow) -> Option<(Well, Orbit)> {
+        let land = self.m.landscape(s[0], self.d.direction, self.d.stress);
+        let well = self.well_at(&land)?;
+        let shift = well.minimum - self.well.minimum;
+        let guess = (self.orbit.below + shift, self.orbit.above + shift);
+        let o = self.m.orbit(&land, &well, s[2], guess)?;
+        Some((well, o))
+    }
+
+    /// The averaged equations: the rotor driven by the orbit's mean torque, the energy lowered by
+    /// the damping and by the landscape turning under the orbit (the orbit's mean of
+    /// `dU/dphi omega` less the minimum's), the phase at the damped orbit's frequency.
+    fn rate(&mut self, s: &Slow) -> Option<Slow> {
+        self.evaluations += 1;
+        let m = self.m;
+        let (well, o) = self.orbit_at(s)?;
+        let (alpha, t) = (m.params.gilbert_damping, m.tilt_stiffness);
+        let k = well.curvature;
+        let shift = 1.0 - alpha * alpha * (t - k) * (t - k) / (4.0 * k * t);
+        if shift.is_nan() || shift <= 0.0 {
+            return None;
+        }
+        self.well = well;
+        self.orbit = o;
+        let rotor = if self.d.locked {
+            [0.0, 0.0]
+        } else if self.overdamped {
+            [(o.torque + self.d.load) / m.drag, 0.0]
+        } else {
+            [s[1], (o.torque + self.d.load - m.drag * s[1]) / m.inertia]
+        };
+        Some([
+            rotor[0],
+            rotor[1],
+            o.damping_rate(alpha) - rotor[0] * (o.torque - o.torque_at_minimum),
+            shift.sqrt() / o.period,
+        ])
+    }
+}
+
+/// What [`Motor::advance_orbits`] did.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub(super) struct OrbitAdvance {
+    /// Accepted and rejected steps of the averaged equations.
+    pub(super) steps: u32,
+    /// Their right-hand sides' evaluations.
+    pub(super) evaluations: u32,
+    /// RK4 steps of the full system to the first turning point.
+    pub(super) resolved: u32,
+}
+
+impl OrbitAdvance {
+    /// The budget units beyond `steps`: each evaluation by its measured cost, each RK4 step one.
+    pub(super) fn extra_cost(&self) -> u32 {
+        self.evaluations
+            .saturating_mul(ORBIT_EVALUATION_WEIGHT)
+            .saturating_add(self.resolved)
+    }
+}
+
+impl Motor {
+    /// The tilt about which the onion rings while the rotor turns at `omega`: the minimum moves
+    /// at `m' = omega k_bar / k` (the ring-bar stiffness over the well's curvature), and
+    /// `psi' = -g T theta` follows it about `theta = -m' / (g T)`.
+    fn tilt_centre(&self, land: &Landscape, well: &Well, omega: f64) -> f64 {
+        let k_bar = land.ring_bar.stiffness(well.minimum - land.bar_angle);
+        -omega * k_bar / (well.curvature * self.llg_rate * self.tilt_stiffness)
+    }
+
+    /// Advances the Gilbert onion's ringing and the rotor by the orbit-averaged equations (see
+    /// the module documentation) from `run`'s state towards `segment_end`, when the onion is
+    /// trapped in its well (at most [`RIM_MARGIN`] of the lowest rim's height above the
+    /// minimum), loses at most [`MAX_LOSS_PER_ORBIT`] of its energy per orbit, the segment has
+    /// at least [`MIN_ORBITS`] orbits left and the rotor angle's oscillating part `Q~ / I`
+    /// (left out) is within a tenth of the tolerance.
+    ///
+    /// The averaged advance starts and ends at the orbit's lower turning point: there the
+    /// oscillating parts of the rotor's impulse and of the damping's energy loss vanish, and the
+    /// phase's (the damping's first-order pull along the orbit) is the same at both ends. The
+    /// onion is first resolved to that point (classical RK4 at 1/128 of a period); the averaged
+    /// equations are integrated by Dormand-Prince 5(4), each step's error within a tenth of the
+    /// tolerance on the rotor and on the onion's place (through the energy and the phase, at
+    /// the orbit's width); the advance ends at the last whole orbit before `segment_end`, or
+    /// earlier once the ringing is within the relaxed onion's slack (the branch then takes over,
+    /// see [`Self::relaxed_onion`]). The onion is put back at its turning point, and the rest of
+    /// the segment (less than an orbit) is left to the resolved substeps. `None` (and `run`
+    /// untouched) where it does not apply.
+    pub(super) fn advance_orbits(
+        &self,
+        run: &mut StepRun,
+        d: &Drive,
+        segment_end: f64,
+    ) -> Option<OrbitAdvance> {
+        // At most half the budget left: the resolved substeps still end the step.
+        let spent = run.attempts.saturating_add(run.extra_cost);
+        let allowance = self.params.max_substeps.saturating_sub(spent) / 2;
+        if allowance < MARCH_STEPS + 4 + 4 * AVERAGED_STEP_WEIGHT {
+            return None;
+        }
+        let max_steps = (allowance - MARCH_STEPS - 4) / AVERAGED_STEP_WEIGHT;
+        let (well, o) = self.averageable(&run.y, d, segment_end - run.t)?;
+        let (y, marched, resolved) = self.march_to_turning_point(&run.y, d, &well, o.period)?;
+        let start = run.t + marched;
+        let (well, o) = self.averageable(&y, d, segment_end - start)?;
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let overdamped = !d.locked && self.overdamped(o.period);
+        let omega = self.rotor_speed(&y, d, overdamped);
+        let tilt = y[3] - self.tilt_centre(&land, &well, omega);
+        let (phase, impulse, damped) = self.phase_on_orbit(&land, &well, &o, y[2], tilt);
+        // Within a rounding of the turning point: the phase within [-1/2, 1/2).
+        let phase = phase - phase.round();
+        // (An overdamped rotor's speed is not a variable; its angle's oscillating part
+        // `P~ / c` vanishes with `P~` at the turning point.)
+        let speed = if overdamped {
+            0.0
+        } else {
+            omega - impulse / self.inertia
+        };
+        let mut s: Slow = [y[0], speed, o.energy - damped, phase];
+        let mut avg = Averager {
+            m: self,
+            d,
+            well,
+            orbit: o,
+            evaluations: 0,
+            overdamped,
+        };
+        let mut k1 = avg.rate(&s)?;
+        let tol = self.params.tolerance;
+        let speed_scale = tol * self.speed_scale;
+        let slack = self.relaxed_slack();
+        // A first step of a tenth of the energy's decay time.
+        let mut h = (0.1 * s[2] / k1[2].abs()).min(segment_end - start);
+        let mut time = start;
+        let mut steps = 0u32;
+        // The accepted steps' starts: the last whole orbit is found from one of them.
+        let mut history: Vec<(f64, Slow, Slow)> = Vec::new();
+        while time < segment_end && steps < max_steps {
+            let h_try = h.min(segment_end - time);
+            steps += 1;
+            let Some((next, k7, err)) = dormand_prince(&mut avg, &s, &k1, h_try, |next, width| {
+                [
+                    0.1 * tol,
+                    0.1 * speed_scale,
+                    0.1 * tol * 2.0 * next[2].abs() / width,
+                    0.1 * tol / (2.0 * PI * width),
+                ]
+            }) else {
+                h = 0.25 * h_try;
+                if h < 4.0 * o.period {
+                    break;
+                }
+                continue;
+            };
+            if err <= 1.0 {
+                history.push((time, s, k1));
+                time = if segment_end - (time + h_try) < 1e-15 * segment_end {
+                    segment_end
+                } else {
+                    time + h_try
+                };
+                s = next;
+                k1 = k7;
+                if self.onion_relaxes_fast() && avg.orbit.half_width() <= slack {
+                    break;
+                }
+            }
+            h = h_try * (0.9 * err.powf(-0.2)).clamp(0.2, 5.0);
+            // Where the first steps cannot reach beyond a few orbits the averaging gains nothing
+            // over resolving them.
+            if steps < 8 && h < 2.0 * avg.orbit.period && time < segment_end {
+                break;
+            }
+        }
+        // Back to the last lower turning point: the step from the last accepted start before it
+        // that ends there, by the secant method on its length.
+        let whole = s[3].floor();
+        let (t0, s0, k0) = *history.iter().rev().find(|(_, z, _)| z[3] <= whole)?;
+        let mut length = (whole - s0[3]) / k0[3];
+        for _ in 0..4 {
+            let (z, _, _) = dormand_prince(&mut avg, &s0, &k0, length, |_, _| [1.0; 4])?;
+            let miss = whole - z[3];
+            s = z;
+            if miss.abs() <= 1e-12 {
+                break;
+            }
+            length += miss / k0[3];
+        }
+        let time = t0 + length;
+        if !(time > run.t && time <= segment_end) {
+            return None;
+        }
+        // The onion back at its lower turning point.
+        let land = self.landscape(s[0], d.direction, d.stress);
+        let (well, o) = avg.orbit_at(&s)?;
+        let omega = if overdamped {
+            self.rotor_speed(&[s[0], 0.0, o.below, 0.0], d, true)
+        } else if d.locked {
+            0.0
+        } else {
+            s[1]
+        };
+        run.y = [s[0], omega, o.below, self.tilt_centre(&land, &well, omega)];
+        run.t = time;
+        run.angles = None;
+        run.settled = false;
+        Some(OrbitAdvance {
+            steps,
+            evaluations: avg.evaluations,
+            resolved,
+        })
+    }
+
+    /// Whether a free rotor is taken as overdamped over orbits of `period` (see [`OVERDAMPED`]).
+    fn overdamped(&self, period: f64) -> bool {
+        self.inertia <= OVERDAMPED * self.drag * period
+    }
+
+    /// The rotor's speed at `y`: its own, or an overdamped rotor's `(tau + load) / c`, or 0
+    /// locked.
+    fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
+        if d.locked {
+            0.0
+        } else if overdamped {
+            let land = self.landscape(y[0], d.direction, d.stress);
+            (point(&land, y[2]).2 + d.load) / self.drag
+        } else {
+            y[1]
+        }
+    }
+
+    /// Ringing narrower than this (rad) is within the relaxed onion's slack (see
+    /// [`Self::relaxed_onion`]): the averaged advance stops there and the branch takes over.
+    fn relaxed_slack(&self) -> f64 {
+        let tol = self.params.tolerance;
+        0.5 * (0.1 * tol * self.rotor_relaxation_time() / self.onion_relaxation_time()).min(1e-3)
+    }
+
+    /// The well and orbit of the onion at `y` when the averaged advance applies to it with
+    /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]).
+    fn averageable(&self, y: &Vector, d: &Drive, remaining: f64) -> Option<(Well, Orbit)> {
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let t = self.tilt_stiffness;
+        // First from the linearization at the minimum (no search for the rims): its period
+        // `2 pi / (g sqrt(k T))` and energy loss per orbit `g alpha (k + T) P` (the orbit's are
+        // within a factor of two of them in the wells met), against the checks below.
+        let k = land.curvature(land.settle(y[2]));
+        let period = 2.0 * PI / (self.llg_rate * (k * t).sqrt());
+        let loss = self.llg_rate * self.params.gilbert_damping * (k + t) * period;
+        let stiff = !d.locked
+            && self.inertia < self.drag * period
+            && self.inertia > 2.0 * OVERDAMPED * self.drag * period;
+        if !(loss <= 2.0 * MAX_LOSS_PER_ORBIT && remaining >= 0.5 * MIN_ORBITS * period) || stiff {
+            return None;
+        }
+        let well = self.onion_well(&land, y[2])?;
+        let omega = self.rotor_speed(y, d, self.overdamped(period));
+        // The tilt about the orbit's centre.
+        let tilt = y[3] - self.tilt_centre(&land, &well, omega);
+        let e = point(&land, y[2]).0 - well.floor + 0.5 * t * tilt * tilt;
+        if !(well.below < y[2] && y[2] < well.above && e <= RIM_MARGIN * well.barrier) {
+            return None;
+        }
+        let guess = (well.minimum - 1e-3, well.minimum + 1e-3);
+        let o = self.orbit(&land, &well, e, guess)?;
+        let alpha = self.params.gilbert_damping;
+        let loss = -o.damping_rate(alpha) * o.period / e;
+        if !(loss <= MAX_LOSS_PER_ORBIT && remaining >= MIN_ORBITS * o.period) {
+            return None;
+        }
+        let tol = self.params.tolerance;
+        // The rotor angle's oscillating part, left out: its fundamental's amplitude
+        // `max |tau - <tau>| P^2 / (4 pi^2 I)` (the torque's harmonics add less).
+        let wobble = o.swing * o.period * o.period / (4.0 * PI * PI * self.inertia);
+        // A free rotor whose speed relaxes within a few orbits holds the explicit steps to a few
+        // orbits (Dormand-Prince's stability reaches 3.3 relaxation times), unless it is
+        // overdamped: then its angle oscillates by `max |tau - <tau>| P / (2 pi c)` with the
+        // precession, and lags its drag-limited turn by `I / c` times its speed's change,
+        // `2 max |tau - <tau>| / c` at most, both held within a tenth of the tolerance.
+        let c = self.drag;
+        let overdamped = self.overdamped(o.period)
+            && o.swing * o.period / (2.0 * PI * c) <= 0.1 * tol
+            && self.inertia / c * 2.0 * o.swing / c <= 0.1 * tol;
+        let stiff = self.inertia < 2.0 * self.drag * o.period;
+        if !(d.locked || overdamped || (wobble <= 0.1 * tol && !stiff)) {
+            return None;
+        }
+        // The phase's drift: the damped orbit's frequency is that of the averaged equations
+        // within the linearization's shift `alpha^2 (T - k)^2 / (8 k T)` (measured: 0.6 of it at
+        // 0.3 of the rim, exact near the minimum). Over `N` orbits it misplaces the onion at the
+        // advance's end by `2 pi N` times that shift times the tilt's amplitude
+        // `A sqrt(k / T)` there, `A` the ringing's width then (decaying by `e^(-loss N / 2)`, to
+        // the relaxed onion's slack at most).
+        let k = well.curvature;
+        let shift = alpha * alpha * (t - k) * (t - k) / (8.0 * k * t);
+        let width = o.half_width();
+        let mut orbits = remaining / o.period;
+        let slack = self.relaxed_slack();
+        if self.onion_relaxes_fast() && slack < width {
+            orbits = orbits.min(2.0 * (width / slack).ln() / loss);
+        }
+        let end_width = width * (-0.5 * loss * orbits).exp();
+        let drift = 2.0 * PI * shift * orbits * end_width * (k / t).sqrt();
+        (drift <= tol).then_some((well, o))
+    }
+
+    /// The full macrospin and rotor from `y` to the onion's next lower turning point (its tilt
+    /// through zero from above, below the minimum), by classical RK4 at 1/128 of the orbit's
+    /// `period`, the crossing refined by Newton steps in time: the state there, the time taken
+    /// and the RK4 steps. `None` if it is not met within two periods.
+    fn march_to_turning_point(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        well: &Well,
+        period: f64,
+    ) -> Option<(Vector, f64, u32)> {
+        let h = period / 128.0;
+        let overdamped = !d.locked && self.overdamped(period);
+        let rate = |z: &Vector| {
+            let mut f = self.rhs_jacobian(z, d, h).0;
+            if d.locked {
+                f[0] = 0.0;
+                f[1] = 0.0;
+            } else if overdamped {
+                // (tau + load) / c, the speed left out.
+                f[0] = z[1] + f[1] * self.inertia / self.drag;
+                f[1] = 0.0;
+            }
+            f
+        };
+        let step = |z: &Vector, h: f64| {
+            let k1 = rate(z);
+            let k2 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k1[i]));
+            let k3 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k2[i]));
+            let k4 = rate(&std::array::from_fn(|i| z[i] + h * k3[i]));
+            let out: Vector = std::array::from_fn(|i| {
+                z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
+            });
+            out
+        };
+        let below = |z: &Vector| z[2] < well.minimum;
+        let (mut z, mut time) = (*y, 0.0);
+        for n in 0..MARCH_STEPS {
+            let next = step(&z, h);
+            if z[3] > 0.0 && next[3] <= 0.0 && below(&next) {
+                // The tilt's zero: Newton in time from the nearer end.
+                let (mut w, mut t) = (next, time + h);
+                for _ in 0..3 {
+                    let dt = -w[3] / rate(&w)[3];
+                    w = step(&w, dt);
+                    t += dt;
+                }
+                return Some((w, t, n + 4));
+            }
+            z = next;
+            time += h;
+        }
+        None
+    }
+}
+
+/// One Dormand-Prince 5(4) step of the averaged equations from `s` (rates `k1` there) over `h`:
+/// the result, the rates at it and the error against the scales `scales(result, orbit width)`.
+fn dormand_prince(
+    avg: &mut Averager,
+    s: &Slow,
+    k1: &Slow,
+    h: f64,
+    scales: impl Fn(&Slow, f64) -> [f64; 4],
+) -> Option<(Slow, Slow, f64)> {
+    let (next, k) = dormand_prince::step(s, k1, h, |z| avg.rate(z))?;
+    let scale = scales(&next, avg.orbit.half_width().max(f64::MIN_POSITIVE));
+    let err = (0..4)
+        .map(|i| dormand_prince::error(h, &k, i).abs() / scale[i])
+        .fold(0.0, f64::max);
+    err.is_finite().then_some((next, k[6], err))
+}
