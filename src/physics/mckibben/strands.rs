@@ -160,11 +160,39 @@ pub fn transition<T>(
 /// stiff end has a solution (they fall in gaps where the force jumps), the boundary is the reach
 /// from the shortest length, if the rigid model holds there.
 pub fn transition_within_reach<T>(
+    range: (f64, f64),
+    reach: impl Fn(Option<&T>) -> Option<(f64, (f64, f64, T))>,
+    length: f64,
+    k_s: f64,
+    rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+) -> Option<Transition<T>> {
+    search(range, reach, length, k_s, rigid, |_, _| None)
+}
+
+/// [`transition`] for a rigid model with a switch that a cheaper, smooth quantity locates (a
+/// bladder's contact, where the rigid stiffness jumps): `locate(soft, stiff)` gives, for the
+/// bracket the search starts from (both ends with a solution), the length `x` such that the
+/// switch lies between `x` and the next float up, or `None` where the bracket holds no switch.
+/// The rigid model is evaluated at the next float up, then at `x`: where the switch is the
+/// boundary (it fails above, holds at `x`) that ends the search in two evaluations instead of
+/// 50-odd; otherwise the search goes on exactly as [`transition`]'s.
+pub fn transition_located<T>(
+    range: (f64, f64),
+    length: f64,
+    k_s: f64,
+    rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+    locate: impl FnOnce(f64, f64) -> Option<f64>,
+) -> Option<Transition<T>> {
+    search(range, |_: Option<&T>| None, length, k_s, rigid, locate)
+}
+
+fn search<T>(
     (lo, hi): (f64, f64),
     reach: impl Fn(Option<&T>) -> Option<(f64, (f64, f64, T))>,
     length: f64,
     k_s: f64,
     rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+    locate: impl FnOnce(f64, f64) -> Option<f64>,
 ) -> Option<Transition<T>> {
     if length <= 0.5 * (lo + hi) {
         return None;
@@ -255,6 +283,24 @@ pub fn transition_within_reach<T>(
     // logarithm of the distance to `end` until the bracket spans less than a factor 2 of it (a
     // boundary 1e-9 of the range below `end` takes 6-odd probes, not 30 halvings of the way),
     // unless a probe short of `end` has no solution either (then it bisects).
+    // A located switch `x` is the boundary where the rigid model fails at the next float up and
+    // holds at `x`: the bracket is then closed. Otherwise both evaluations are set aside (the
+    // first, past the switch, fails early where it is not the boundary) and the search goes on
+    // as without it.
+    let located = stiff_end
+        .is_some()
+        .then(|| locate(l, stiff))
+        .flatten()
+        .filter(|x| *x > l && x.next_up() < stiff);
+    if let Some(x) = located {
+        if let Some(above) = rigid(x.next_up()).filter(pulls_stiffer) {
+            if let Some(below) = rigid(x).filter(|o| !pulls_stiffer(o)) {
+                (l, slope, out) = (x, below.1, below.2);
+                soft_end = (below.0, below.1);
+                (stiff, stiff_end) = (x.next_up(), Some((above.0, above.1)));
+            }
+        }
+    }
     let (end, mut towards_end) = (stiff, stiff_end.is_none());
     for taken in 0..120 {
         let mid = 0.5 * (l + stiff);
