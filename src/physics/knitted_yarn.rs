@@ -47,7 +47,7 @@ impl KnittedAssembly {
 
     /// Where the yarn takes over at `pressure` for an input `length`; `None` where the rigid
     /// knit holds. The rigid stiffness jumps where the bladder meets the sleeve: a bracket
-    /// across that switch is narrowed on the smooth threshold pressure, not the rigid knit.
+    /// across that switch is narrowed on the smooth contact pressure, not the rigid knit.
     fn yarn_transition(
         &self,
         pressure: f64,
@@ -82,17 +82,19 @@ impl KnittedAssembly {
         }
     }
 
-    /// The length `x` between `a < b` such that the bladder's contact at `pressure`
-    /// (`P >= threshold(L)`, eq. 2.18 at the sleeve's diameter) differs between `x` and the next
-    /// float up; `None` without a bladder, where `a` and `b` are on the same side, or where the
-    /// threshold has no value. Regula falsi (Illinois) on `threshold(L) - P`, smooth in `L`,
-    /// bisecting whenever two steps have not halved the bracket, down to adjacent floats.
+    /// The length `x` between `a < b` such that the bladder's contact at `pressure` differs
+    /// between `x` and the next float up; `None` without a bladder, where `a` and `b` are on the
+    /// same side, or where the contact test has no value. Regula falsi (Illinois) on the contact
+    /// pressure `P_eff` at the sleeve's diameter (the sign
+    /// [`crate::physics::bladder::Bladder::evaluate`] tests, smooth in
+    /// `L`), bisecting whenever two steps have not halved the bracket, down to adjacent floats.
     fn contact_switch(&self, pressure: f64, a: f64, b: f64) -> Option<f64> {
         let bladder = self.bladder()?;
         if !pressure.is_finite() {
             return None;
         }
-        let excess = |l: f64| bladder.threshold_pressure(l).ok().map(|t| t - pressure);
+        // Negative in contact (`P_eff >= 0`, the test's `-0.0` included).
+        let excess = |l: f64| bladder.contact_pressure(pressure, l).ok().map(|p| -p);
         let (mut a, mut b) = (a, b);
         let (mut fa, mut fb) = (excess(a)?, excess(b)?);
         let contact_a = fa <= 0.0;
@@ -261,7 +263,7 @@ mod tests {
 
     /// Past the breaking length at low pressures the yarn's transition lies where the bladder
     /// meets the sleeve (the rigid stiffness jumps there); at higher ones the rigid stiffness
-    /// reaches the yarn's in contact. Located from the threshold pressure, the first is a
+    /// reaches the yarn's in contact. Located from the contact pressure, the first is a
     /// boundary of the rigid knit next to the plain search's, in 2 rigid evaluations after the
     /// bracket instead of 50-odd; the second is the plain search's own, bit for bit.
     #[test]
@@ -277,7 +279,7 @@ mod tests {
             let k_s = a.yarn_stiffness(8.069);
             let history = HysteresisState::at_rest(a.valid_lengths().1);
             let length = a.breaking_length();
-            let excess = |x: f64, p: f64| a.bladder().unwrap().threshold_pressure(x).unwrap() - p;
+            let contact = |x: f64, p: f64| a.bladder().unwrap().evaluate(p, x).unwrap().contact;
             for pressure in (0..40).map(|i| 10f64.powf(0.1 * f64::from(i))) {
                 let count = Cell::new(0);
                 let rigid = a.rigid(pressure, &history);
@@ -305,9 +307,7 @@ mod tests {
                     taken += 1;
                     let x = switch.get().unwrap();
                     assert!(
-                        l == x
-                            && (excess(x, pressure) <= 0.0)
-                                != (excess(x.next_up(), pressure) <= 0.0),
+                        l == x && contact(x, pressure) != contact(x.next_up(), pressure),
                         "{case}"
                     );
                     assert!(located_count <= plain_count - 40, "{case}");
@@ -315,14 +315,12 @@ mod tests {
                     let holds = |x: f64| rigid(x).is_some_and(|(f, k, _)| !(f > 0.0 && k > k_s));
                     assert!(holds(l) && !holds(l.next_up()), "{case}: {l}");
                     // The plain search's, or another within a few floats only because the contact
-                    // flickers there: the threshold pressure, smooth to rounding, crosses the
-                    // pressure more than once between them.
+                    // flickers there (rounding in `P_eff`): the bladder meets the sleeve, and
+                    // leaves it, more than once between them.
                     let (mut x, mut crossings) = (p.min(l), 0);
                     while x < p.max(l) {
                         let next = x.next_up();
-                        crossings += usize::from(
-                            (excess(x, pressure) <= 0.0) != (excess(next, pressure) <= 0.0),
-                        );
+                        crossings += usize::from(contact(x, pressure) != contact(next, pressure));
                         x = next;
                     }
                     assert!(

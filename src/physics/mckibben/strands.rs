@@ -174,8 +174,8 @@ pub fn transition_within_reach<T>(
 /// bracket the search starts from (both ends with a solution), the length `x` such that the
 /// switch lies between `x` and the next float up, or `None` where the bracket holds no switch.
 /// The rigid model is evaluated at the next float up, then at `x`: where the switch is the
-/// boundary (it fails above, holds at `x`) that ends the search in two evaluations instead of
-/// 50-odd; otherwise the search goes on exactly as [`transition`]'s.
+/// boundary (the model fails above it and holds at `x`) the search ends there, in two
+/// evaluations instead of 50-odd; otherwise it goes on exactly as [`transition`]'s.
 pub fn transition_located<T>(
     range: (f64, f64),
     length: f64,
@@ -278,15 +278,9 @@ fn search<T>(
     // secant stuck next to the other end (a value that saturates, as a connector's series
     // stiffness does towards `max_length`) moves across within a few steps.
     let (mut weights, mut soft_moved_last) = ((1.0, 1.0), None);
-    // A stiff end without solution, `end`, may be where the rigid force diverges (a bladder's
-    // `max_length`), the boundary anywhere from next to it to far below: the search halves the
-    // logarithm of the distance to `end` until the bracket spans less than a factor 2 of it (a
-    // boundary 1e-9 of the range below `end` takes 6-odd probes, not 30 halvings of the way),
-    // unless a probe short of `end` has no solution either (then it bisects).
     // A located switch `x` is the boundary where the rigid model fails at the next float up and
-    // holds at `x`: the bracket is then closed. Otherwise both evaluations are set aside (the
-    // first, past the switch, fails early where it is not the boundary) and the search goes on
-    // as without it.
+    // holds at `x`: the bracket is then closed. Otherwise the evaluations are set aside (only
+    // the first where the model holds past the switch) and the search goes on as without them.
     let located = stiff_end
         .is_some()
         .then(|| locate(l, stiff))
@@ -301,6 +295,11 @@ fn search<T>(
             }
         }
     }
+    // A stiff end without solution, `end`, may be where the rigid force diverges (a bladder's
+    // `max_length`), the boundary anywhere from next to it to far below: the search halves the
+    // logarithm of the distance to `end` until the bracket spans less than a factor 2 of it (a
+    // boundary 1e-9 of the range below `end` takes 6-odd probes, not 30 halvings of the way),
+    // unless a probe short of `end` has no solution either (then it bisects).
     let (end, mut towards_end) = (stiff, stiff_end.is_none());
     for taken in 0..120 {
         let mid = 0.5 * (l + stiff);
