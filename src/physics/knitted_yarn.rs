@@ -88,13 +88,13 @@ impl KnittedAssembly {
 
     /// The length `x` between `a < b` such that the bladder's contact at `pressure` differs
     /// between `x` and the next float up; `None` without a bladder, where `a` and `b` are on the
-    /// same side, or where the contact test has no value. Regula falsi (Illinois) on the contact
+    /// same side, where the contact test has no value, or under vacuum. Regula falsi (Illinois) on the contact
     /// pressure `P_eff` at the sleeve's diameter (the sign
     /// [`crate::physics::bladder::Bladder::evaluate`] tests, smooth in
     /// `L`), bisecting whenever two steps have not halved the bracket, down to adjacent floats.
     ///
     /// `None` as well where the switch is not where the rigid knit stops holding: where it
-    /// holds on the contact side of a bracket narrowed to a millionth of the length
+    /// holds on the contact side of a bracket narrowed to 1e-4 of the length
     /// (`holds_not(L)` false), its stiffness meets the yarn's in contact, not at the jump.
     fn contact_switch(
         &self,
@@ -104,7 +104,8 @@ impl KnittedAssembly {
         holds_not: impl Fn(f64) -> bool,
     ) -> Option<f64> {
         let bladder = self.bladder()?;
-        if !pressure.is_finite() {
+        // Under vacuum the rigid knit may evaluate a collapsing bladder at zero pressure instead.
+        if !(pressure > 0.0 && pressure.is_finite()) {
             return None;
         }
         // Negative in contact (`P_eff >= 0`, the test's `-0.0` included).
@@ -122,7 +123,7 @@ impl KnittedAssembly {
             if mid <= a || mid >= b {
                 return Some(a);
             }
-            if !checked && b - a <= 1e-6 * b {
+            if !checked && b - a <= 1e-4 * b {
                 checked = true;
                 if !holds_not(if contact_a { a } else { b }) {
                     return None;
