@@ -88,14 +88,14 @@ impl KnittedAssembly {
 
     /// The length `x` between `a < b` such that the bladder's contact at `pressure` differs
     /// between `x` and the next float up; `None` without a bladder, where `a` and `b` are on the
-    /// same side, where the contact test has no value, or under vacuum. Regula falsi (Illinois) on the contact
-    /// pressure `P_eff` at the sleeve's diameter (the sign
-    /// [`crate::physics::bladder::Bladder::evaluate`] tests, smooth in
-    /// `L`), bisecting whenever two steps have not halved the bracket, down to adjacent floats.
+    /// same side, where the contact test has no value, or under vacuum. Regula falsi (Illinois)
+    /// on the contact pressure `P_eff` at the sleeve's diameter (the sign
+    /// [`crate::physics::bladder::Bladder::evaluate`] tests, smooth in `L`), bisecting whenever
+    /// two steps have not halved the bracket, down to adjacent floats.
     ///
-    /// `None` as well where the switch is not where the rigid knit stops holding: where it
-    /// holds on the contact side of a bracket narrowed to 1e-4 of the length
-    /// (`holds_not(L)` false), its stiffness meets the yarn's in contact, not at the jump.
+    /// `None` as well where the switch is not where the rigid knit stops holding: where it holds
+    /// on the contact side of a bracket narrowed to 1e-4 of the length (`holds_not(L)` false),
+    /// its stiffness meets the yarn's in contact, not at the jump.
     fn contact_switch(
         &self,
         pressure: f64,
