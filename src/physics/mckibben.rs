@@ -17,7 +17,8 @@ mod partials;
 mod strands;
 pub use limits::{is_slack, OutOfRange, LIMIT_MARGIN};
 pub use strands::{
-    strand_rigidity, transition, StrandTransition, Transition, SURVIVABLE_STRAND_STRAIN,
+    strand_rigidity, transition, transition_located, StrandTransition, Transition,
+    SURVIVABLE_STRAND_STRAIN,
 };
 
 /// Iteration caps of the connector solve (bracket search doubles its step; root is Newton-bisection).

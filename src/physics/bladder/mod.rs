@@ -300,6 +300,13 @@ impl<S: SleeveGeometry> Bladder<S> {
         finite_or(k.threshold, "threshold pressure", length)
     }
 
+    /// `P_eff` (eq. 2.12 / 2.19) of the bladder held at the sleeve's diameter at `length`, Pa:
+    /// [`Bladder::evaluate`] is in contact exactly where it is not negative. A positive multiple
+    /// of `pressure - threshold` (see [`Bladder::threshold_pressure`]), smooth in the length.
+    pub fn contact_pressure(&self, pressure: f64, length: f64) -> Result<f64, String> {
+        Ok(self.contact_point(pressure, length)?.1.p_eff.v)
+    }
+
     /// The bladder's state at gauge pressure `pressure` (Pa) and muscle length `length` (m).
     ///
     /// In contact (`P >= threshold`) the outer diameter is the sleeve's (eq. 2.7, 2.20); otherwise

@@ -160,11 +160,39 @@ pub fn transition<T>(
 /// stiff end has a solution (they fall in gaps where the force jumps), the boundary is the reach
 /// from the shortest length, if the rigid model holds there.
 pub fn transition_within_reach<T>(
+    range: (f64, f64),
+    reach: impl Fn(Option<&T>) -> Option<(f64, (f64, f64, T))>,
+    length: f64,
+    k_s: f64,
+    rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+) -> Option<Transition<T>> {
+    search(range, reach, length, k_s, rigid, |_, _| None)
+}
+
+/// [`transition`] for a rigid model with a switch that a cheaper, smooth quantity locates (a
+/// bladder's contact, where the rigid stiffness jumps): `locate(soft, stiff)` gives, for the
+/// bracket the search starts from (both ends with a solution), the length `x` such that the
+/// switch lies between `x` and the next float up, or `None` where the bracket holds no switch.
+/// The rigid model is evaluated at the next float up, then at `x`: where the switch is the
+/// boundary (the model fails above it and holds at `x`) the search ends there, in two
+/// evaluations instead of 50-odd; otherwise it goes on exactly as [`transition`]'s.
+pub fn transition_located<T>(
+    range: (f64, f64),
+    length: f64,
+    k_s: f64,
+    rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+    locate: impl FnOnce(f64, f64) -> Option<f64>,
+) -> Option<Transition<T>> {
+    search(range, |_: Option<&T>| None, length, k_s, rigid, locate)
+}
+
+fn search<T>(
     (lo, hi): (f64, f64),
     reach: impl Fn(Option<&T>) -> Option<(f64, (f64, f64, T))>,
     length: f64,
     k_s: f64,
     rigid: impl Fn(f64) -> Option<(f64, f64, T)>,
+    locate: impl FnOnce(f64, f64) -> Option<f64>,
 ) -> Option<Transition<T>> {
     if length <= 0.5 * (lo + hi) {
         return None;
@@ -250,6 +278,23 @@ pub fn transition_within_reach<T>(
     // secant stuck next to the other end (a value that saturates, as a connector's series
     // stiffness does towards `max_length`) moves across within a few steps.
     let (mut weights, mut soft_moved_last) = ((1.0, 1.0), None);
+    // A located switch `x` is the boundary where the rigid model fails at the next float up and
+    // holds at `x`: the bracket is then closed. Otherwise the evaluations are set aside (only
+    // the first where the model holds past the switch) and the search goes on as without them.
+    let located = stiff_end
+        .is_some()
+        .then(|| locate(l, stiff))
+        .flatten()
+        .filter(|x| *x > l && x.next_up() < stiff);
+    if let Some(x) = located {
+        if let Some(above) = rigid(x.next_up()).filter(pulls_stiffer) {
+            if let Some(below) = rigid(x).filter(|o| !pulls_stiffer(o)) {
+                (l, slope, out) = (x, below.1, below.2);
+                soft_end = (below.0, below.1);
+                (stiff, stiff_end) = (x.next_up(), Some((above.0, above.1)));
+            }
+        }
+    }
     // A stiff end without solution, `end`, may be where the rigid force diverges (a bladder's
     // `max_length`), the boundary anywhere from next to it to far below: the search halves the
     // logarithm of the distance to `end` until the bracket spans less than a factor 2 of it (a
