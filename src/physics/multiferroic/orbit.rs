@@ -59,6 +59,28 @@ pub(super) struct Well {
     pub(super) curvature: f64,
 }
 
+impl Well {
+    /// The well with minimum `minimum` (curvature `curvature`) between the rims `(below, above)`
+    /// of the landscape `land`, its floor and barrier evaluated there (not checked).
+    pub(super) fn between(
+        land: &Landscape,
+        minimum: f64,
+        (below, above): (f64, f64),
+        curvature: f64,
+    ) -> Well {
+        let floor = point(land, minimum).0;
+        let barrier = point(land, below).0.min(point(land, above).0) - floor;
+        Well {
+            minimum,
+            below,
+            above,
+            barrier,
+            floor,
+            curvature,
+        }
+    }
+}
+
 /// An orbit of the frozen, undamped macrospin in a well.
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Orbit {
@@ -207,16 +229,8 @@ impl Motor {
             return None;
         }
         let (below, above) = land.well_rims(minimum, 0.25 * k / m);
-        let floor = point(land, minimum).0;
-        let barrier = point(land, below).0.min(point(land, above).0) - floor;
-        (below < minimum && minimum < above && barrier > 0.0).then_some(Well {
-            minimum,
-            below,
-            above,
-            barrier,
-            floor,
-            curvature: k,
-        })
+        Some(Well::between(land, minimum, (below, above), k))
+            .filter(|w| below < minimum && minimum < above && w.barrier > 0.0)
     }
 
     /// The orbit `e` (J) above the minimum of `well` (the rims bracket its turning points),

@@ -54,17 +54,8 @@ impl Averager<'_> {
         let minimum = land.settle(self.well.minimum);
         let shift = minimum - self.well.minimum;
         let k = land.curvature(minimum);
-        let floor = point(land, minimum).0;
-        let (below, above) = (self.well.below + shift, self.well.above + shift);
-        let barrier = point(land, below).0.min(point(land, above).0) - floor;
-        (k > 0.0 && barrier > 0.0).then_some(Well {
-            minimum,
-            below,
-            above,
-            barrier,
-            floor,
-            curvature: k,
-        })
+        let rims = (self.well.below + shift, self.well.above + shift);
+        Some(Well::between(land, minimum, rims, k)).filter(|w| k > 0.0 && w.barrier > 0.0)
     }
 
     /// The well and orbit at the slow state `s`, the turning points' iterations started from the
