@@ -59,6 +59,7 @@ mod orbit_theory_tests;
 mod params;
 mod periods;
 pub mod phi;
+mod rhs;
 mod ringing;
 pub mod schedule;
 mod spin;
