@@ -24,7 +24,9 @@ impl Motor {
     /// `I phi'' = load - c phi'`, exactly solved ([`Self::drift_response`]). So once three
     /// consecutive whole periods have ended with the same onion offset from their strain and
     /// the same tilt (within `tolerance / 100`, then `tolerance / 1000`), every later period
-    /// repeats the last one turned by `step_angle`. This is where a schedule turns the strain
+    /// repeats the last one turned by `step_angle`; two, within `tolerance / 1000`, where the
+    /// onion ended both on its quasi-static branch (relaxed: the period that follows depends
+    /// on that offset alone). This is where a schedule turns the strain
     /// faster than the rotor can follow (by angles that never repeat, so the rotor never
     /// comes back to the same place relative to the strain, as
     /// [`Self::skip_repeated_periods`] needs) while the onion settles or rings down within a
@@ -53,7 +55,15 @@ impl Motor {
             return false;
         }
         let tol = self.params.tolerance;
-        let relative = [run.y[2] - run.segment_direction, run.y[3], run.y[2]];
+        // Whether the onion followed its quasi-static branch to the period's end (settled,
+        // no tilt): the next period then depends on its offset from the strain alone.
+        let relaxed = run.following == run.segment_end;
+        let relative = [
+            run.y[2] - run.segment_direction,
+            run.y[3],
+            run.y[2],
+            f64::from(u8::from(relaxed)),
+        ];
         if run.whole_period {
             // Eq. 3.4 repeats every half turn of the offset: the onion may settle a half turn
             // away from the strain's own turn, and the reduced strain direction (see
@@ -72,8 +82,11 @@ impl Motor {
                 let half_turns = ((relative[2] - p[2] - s.step_angle) / PI).round();
                 s.step_angle + half_turns * PI
             });
+            // Two periods from the branch with the same offset repeat for good; otherwise the
+            // one before must have converged too.
+            let from_branch = relaxed && run.onion_period_end.is_some_and(|p| p[3] == 1.0);
             if mismatch <= 1e-3 * tol + rounding
-                && run.onion_period_mismatch <= 1e-2 * tol + rounding
+                && (from_branch || run.onion_period_mismatch <= 1e-2 * tol + rounding)
                 && periods >= 1.0
                 && self.advance_onion_periods(run, s, inputs, periods, turn)
             {

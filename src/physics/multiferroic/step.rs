@@ -33,9 +33,9 @@ pub(super) struct StepRun {
     pub(super) period_end: Option<[f64; 3]>,
     pub(super) period_mismatch: f64,
     /// As `period_end` and `period_mismatch` for the Gilbert onion alone (offset from the strain,
-    /// tilt, angle), and whether the ring-bar torque is negligible over the step (see
+    /// tilt, angle, 1 if on its branch), and whether the ring-bar torque is negligible over the step (see
     /// [`Motor::skip_onion_periods`]).
-    pub(super) onion_period_end: Option<[f64; 3]>,
+    pub(super) onion_period_end: Option<[f64; 4]>,
     pub(super) onion_period_mismatch: f64,
     pub(super) onion_decoupled: Option<bool>,
     /// The eq. 3.3-3.4 angles' sines and cosines at the last evaluated state, the starting point
