@@ -141,7 +141,7 @@ impl Motor {
     /// rotor (unless `locked`) and for the onion (see [`Self::skip_onion_periods`]).
     pub(super) fn ring_decoupled(&self, s: &SteppingSchedule, locked: bool, h: f64) -> bool {
         let curvature = 2.0 * (self.magnetoelastic_per_stress * s.stress_amplitude).abs();
-        if !(curvature > 0.0) {
+        if curvature.is_nan() || curvature <= 0.0 {
             return false;
         }
         if !locked {
