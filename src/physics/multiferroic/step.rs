@@ -32,6 +32,12 @@ pub(super) struct StepRun {
     /// onion, speed) and how far it was from the one before (rad).
     pub(super) period_end: Option<[f64; 3]>,
     pub(super) period_mismatch: f64,
+    /// As `period_end` and `period_mismatch` for the Gilbert onion alone (offset from the strain,
+    /// tilt, angle, 1 if on its branch), and whether the ring-bar torque is negligible over the step (see
+    /// [`Motor::skip_onion_periods`]).
+    pub(super) onion_period_end: Option<[f64; 4]>,
+    pub(super) onion_period_mismatch: f64,
+    pub(super) onion_decoupled: Option<bool>,
     /// The eq. 3.3-3.4 angles' sines and cosines at the last evaluated state, the starting point
     /// of the next evaluation's (see [`angles`](super::angles)).
     pub(super) angles: Option<Angles>,
@@ -79,6 +85,9 @@ impl StepRun {
             whole_period: false,
             period_end: None,
             period_mismatch: f64::INFINITY,
+            onion_period_end: None,
+            onion_period_mismatch: f64::INFINITY,
+            onion_decoupled: None,
             angles: None,
             settled: false,
             following: f64::NAN,
@@ -181,7 +190,9 @@ impl Motor {
                 break;
             }
             if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
-                if self.skip_repeated_periods(&mut run, s) {
+                if self.skip_repeated_periods(&mut run, s)
+                    || self.skip_onion_periods(&mut run, s, inputs)
+                {
                     continue;
                 }
             }
