@@ -126,33 +126,28 @@ impl Solver {
     /// derivatives). Returns `(L, V)`, `None` if a segment cannot close.
     pub(super) fn assemble(&mut self, geom: &ShapeGeometry) -> Option<(f64, f64)> {
         let rings = self.radii.len();
-        for v in [
-            &mut self.gv,
-            &mut self.gl,
-            &mut self.dv,
-            &mut self.dl,
-            &mut self.ov,
-            &mut self.ol,
-        ] {
-            v.iter_mut().for_each(|x| *x = 0.0);
-        }
+        let k = geom.segment_constants();
         let (mut l, mut v) = (0.0, 0.0);
+        // Ring `j` sums its share of segment `j` (ending at it) and of segment `j + 1` (starting
+        // at it), in that order; the end rings have one segment each.
+        let (mut gv, mut gl, mut dv, mut dl) = (0.0, 0.0, 0.0, 0.0);
         for i in 1..rings {
-            let seg = geom.segment(self.radii[i - 1], self.radii[i])?;
+            let seg = k.segment(self.radii[i - 1], self.radii[i])?;
             l += seg.l;
             v += seg.v;
-            let (a, b) = (i - 1, i);
-            self.gv[a] += seg.va;
-            self.gl[a] += seg.la;
-            self.dv[a] += seg.vaa;
-            self.dl[a] += seg.laa;
-            self.gv[b] += seg.vb;
-            self.gl[b] += seg.lb;
-            self.dv[b] += seg.vbb;
-            self.dl[b] += seg.lbb;
+            let a = i - 1;
+            self.gv[a] = gv + seg.va;
+            self.gl[a] = gl + seg.la;
+            self.dv[a] = dv + seg.vaa;
+            self.dl[a] = dl + seg.laa;
             self.ov[a] = seg.vab;
             self.ol[a] = seg.lab;
+            (gv, gl, dv, dl) = (seg.vb, seg.lb, seg.vbb, seg.lbb);
         }
+        let last = rings - 1;
+        (self.gv[last], self.gl[last], self.dv[last], self.dl[last]) = (gv, gl, dv, dl);
+        self.ov[last] = 0.0;
+        self.ol[last] = 0.0;
         Some((l, v))
     }
 
@@ -174,11 +169,28 @@ impl Solver {
     /// Returns the number of positive pivots (Sylvester inertia of `H - mu I`), `None` on a
     /// vanishing pivot.
     pub(super) fn shifted_solve(&mut self, lambda: f64, mu: f64) -> Option<usize> {
-        let rings = self.radii.len();
+        let scale = self.pivot_scale(lambda);
+        self.shifted_solve_scaled(lambda, mu, scale)
+    }
+
+    /// The largest `|Hess V - lambda Hess L|` on the diagonal, the scale of a vanishing pivot.
+    pub(super) fn pivot_scale(&self, lambda: f64) -> f64 {
         let mut scale = 0.0f64;
-        for j in 0..rings {
+        for j in 0..self.radii.len() {
             scale = scale.max((self.dv[j] - lambda * self.dl[j]).abs());
         }
+        scale
+    }
+
+    /// [`Solver::shifted_solve`] with the [`Solver::pivot_scale`] of `lambda` (the same for every
+    /// shift tried at one iterate).
+    pub(super) fn shifted_solve_scaled(
+        &mut self,
+        lambda: f64,
+        mu: f64,
+        scale: f64,
+    ) -> Option<usize> {
+        let rings = self.radii.len();
         let tiny = 1e-14 * scale.max(f64::MIN_POSITIVE) + mu * 1e-14;
         let mut positive = 0;
         let mut prev_off = 0.0;
@@ -211,7 +223,8 @@ impl Solver {
             if !held && denom > 0.0 {
                 positive += 1;
             }
-            let inv = 1.0 / denom;
+            // A held ring's row is the identity (no coupling reaches it): its pivot is exactly 1.
+            let inv = if held { 1.0 } else { 1.0 / denom };
             self.c[j] = off_here * inv;
             self.x[j] = (rx - prev_off * xp) * inv;
             self.y[j] = (ry - prev_off * yp) * inv;
