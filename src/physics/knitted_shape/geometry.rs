@@ -167,10 +167,16 @@ impl ShapeGeometry {
     /// Total axial length and volume of a ring profile.
     pub fn length_and_volume(&self, radii: &[f64]) -> Option<(f64, f64)> {
         let k = self.segment_constants();
+        // Every segment between two rings on the floor is the same one.
+        let r_min = self.min_radius;
+        let floor = k.segment(r_min, r_min);
         let mut l = 0.0;
         let mut v = 0.0;
         for pair in radii.windows(2) {
-            let seg = k.segment(pair[0], pair[1])?;
+            let seg = match floor {
+                Some(floor) if pair[0] == r_min && pair[1] == r_min => floor,
+                _ => k.segment(pair[0], pair[1])?,
+            };
             l += seg.l;
             v += seg.v;
         }

@@ -2,7 +2,7 @@
 
 // `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
-use super::geometry::ShapeGeometry;
+use super::geometry::{Segment, ShapeGeometry};
 use std::f64::consts::PI;
 
 /// Newton iterations per solve; the warm start usually converges in 3-5.
@@ -44,6 +44,9 @@ pub(super) struct Solver {
     /// The last inertia-correcting shift the fast path used: the next solve's search for one
     /// starts a little below it (it changes slowly along the path).
     pub(super) shift_hint: f64,
+    /// The segment between two rings on the floor (`None` if it cannot close): the same for
+    /// every such pair, and most segments of a pocket's early stroke.
+    floor_segment: Option<Segment>,
 }
 
 /// Converged point on the path.
@@ -81,6 +84,7 @@ impl Solver {
             releases: vec![0; rings],
             prefer_shift: false,
             shift_hint: 0.0,
+            floor_segment: geom.segment(geom.min_radius, geom.min_radius),
         }
     }
 
@@ -91,6 +95,7 @@ impl Solver {
         self.ceiling = other.ceiling;
         self.prefer_shift = other.prefer_shift;
         self.shift_hint = other.shift_hint;
+        self.floor_segment = other.floor_segment;
         for (to, from) in [
             (&mut self.radii, &other.radii),
             (&mut self.gv, &other.gv),
@@ -131,8 +136,13 @@ impl Solver {
         // Ring `j` sums its share of segment `j` (ending at it) and of segment `j + 1` (starting
         // at it), in that order; the end rings have one segment each.
         let (mut gv, mut gl, mut dv, mut dl) = (0.0, 0.0, 0.0, 0.0);
+        let r_min = geom.min_radius;
         for i in 1..rings {
-            let seg = k.segment(self.radii[i - 1], self.radii[i])?;
+            let (ra, rb) = (self.radii[i - 1], self.radii[i]);
+            let seg = match self.floor_segment {
+                Some(floor) if ra == r_min && rb == r_min => floor,
+                _ => k.segment(ra, rb)?,
+            };
             l += seg.l;
             v += seg.v;
             let a = i - 1;
