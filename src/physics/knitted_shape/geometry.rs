@@ -150,8 +150,107 @@ impl ShapeGeometry {
     /// `None` if the segment cannot close (slant shorter than the radius step).
     #[inline]
     pub(super) fn segment(&self, a: f64, b: f64) -> Option<Segment> {
-        let sig = self.slant_slope();
-        let s = self.rows_per_segment() * self.stitch_height(0.5 * (a + b));
+        self.segment_constants().segment(a, b)
+    }
+
+    /// The sleeve's constants of [`ShapeGeometry::segment`], for the loops over all rings.
+    #[inline]
+    pub(super) fn segment_constants(&self) -> SegmentConstants {
+        SegmentConstants {
+            rows_per_segment: self.rows_per_segment(),
+            slant_slope: self.slant_slope(),
+            row_strand_length: self.row_strand_length,
+            two_m: 2.0 * self.stitches_per_row,
+        }
+    }
+
+    /// Total axial length and volume of a ring profile.
+    pub fn length_and_volume(&self, radii: &[f64]) -> Option<(f64, f64)> {
+        let k = self.segment_constants();
+        // Every segment between two rings on the floor is the same one.
+        let r_min = self.min_radius;
+        let floor = k.segment(r_min, r_min);
+        let mut l = 0.0;
+        let mut v = 0.0;
+        for pair in radii.windows(2) {
+            let seg = match floor {
+                Some(floor) if pair[0] == r_min && pair[1] == r_min => floor,
+                _ => k.segment(pair[0], pair[1])?,
+            };
+            l += seg.l;
+            v += seg.v;
+        }
+        Some((l, v))
+    }
+
+    /// Gradients of length and volume with each interior ring (eq. 1.19 and 1.20: a ring's
+    /// segment and the following one). Entries for the clamped end rings are zero.
+    pub(super) fn gradients(
+        &self,
+        radii: &[f64],
+        dl: &mut [f64],
+        dv: &mut [f64],
+    ) -> Option<(f64, f64)> {
+        let rings = radii.len();
+        dl.iter_mut().for_each(|x| *x = 0.0);
+        dv.iter_mut().for_each(|x| *x = 0.0);
+        let k = self.segment_constants();
+        let (mut l, mut v) = (0.0, 0.0);
+        for i in 1..rings {
+            let seg = k.segment(radii[i - 1], radii[i])?;
+            l += seg.l;
+            v += seg.v;
+            if i - 1 > 0 {
+                dl[i - 1] += seg.la;
+                dv[i - 1] += seg.va;
+            }
+            if i < rings - 1 {
+                dl[i] += seg.lb;
+                dv[i] += seg.vb;
+            }
+        }
+        Some((l, v))
+    }
+}
+
+/// Axial length `l` and volume `v` of one segment with derivatives in its end radii `a`, `b`.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Segment {
+    pub(super) l: f64,
+    pub(super) la: f64,
+    pub(super) lb: f64,
+    pub(super) laa: f64,
+    pub(super) lbb: f64,
+    pub(super) lab: f64,
+    pub(super) v: f64,
+    pub(super) va: f64,
+    pub(super) vb: f64,
+    pub(super) vaa: f64,
+    pub(super) vbb: f64,
+    pub(super) vab: f64,
+}
+
+/// What [`ShapeGeometry::segment`] needs of the sleeve, computed once per sweep over the rings:
+/// the segment is evaluated per ring in every Newton iteration, and these divisions were a large
+/// share of its cost.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SegmentConstants {
+    rows_per_segment: f64,
+    slant_slope: f64,
+    row_strand_length: f64,
+    two_m: f64,
+}
+
+impl SegmentConstants {
+    /// [`ShapeGeometry::segment`].
+    #[inline(always)]
+    pub(super) fn segment(&self, a: f64, b: f64) -> Option<Segment> {
+        let sig = self.slant_slope;
+        // `k h(r)` at the mean radius, eq. 1.4, operation for operation as
+        // `ShapeGeometry::stitch_height` computes it: on thin strands the path's choice among
+        // nearly equal maxima follows the last bits of these values.
+        let s = self.rows_per_segment
+            * ((self.row_strand_length - 2.0 * PI * (0.5 * (a + b))) / self.two_m);
         let d = b - a;
         let w = s * s - d * d;
         if !(s > 0.0 && w > 1e-300 * s * s + f64::MIN_POSITIVE) {
@@ -194,61 +293,4 @@ impl ShapeGeometry {
             vab: qab * l + qa * lb + qb * la + q * lab,
         })
     }
-
-    /// Total axial length and volume of a ring profile.
-    pub fn length_and_volume(&self, radii: &[f64]) -> Option<(f64, f64)> {
-        let mut l = 0.0;
-        let mut v = 0.0;
-        for pair in radii.windows(2) {
-            let seg = self.segment(pair[0], pair[1])?;
-            l += seg.l;
-            v += seg.v;
-        }
-        Some((l, v))
-    }
-
-    /// Gradients of length and volume with each interior ring (eq. 1.19 and 1.20: a ring's
-    /// segment and the following one). Entries for the clamped end rings are zero.
-    pub(super) fn gradients(
-        &self,
-        radii: &[f64],
-        dl: &mut [f64],
-        dv: &mut [f64],
-    ) -> Option<(f64, f64)> {
-        let rings = radii.len();
-        dl.iter_mut().for_each(|x| *x = 0.0);
-        dv.iter_mut().for_each(|x| *x = 0.0);
-        let (mut l, mut v) = (0.0, 0.0);
-        for i in 1..rings {
-            let seg = self.segment(radii[i - 1], radii[i])?;
-            l += seg.l;
-            v += seg.v;
-            if i - 1 > 0 {
-                dl[i - 1] += seg.la;
-                dv[i - 1] += seg.va;
-            }
-            if i < rings - 1 {
-                dl[i] += seg.lb;
-                dv[i] += seg.vb;
-            }
-        }
-        Some((l, v))
-    }
-}
-
-/// Axial length `l` and volume `v` of one segment with derivatives in its end radii `a`, `b`.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Segment {
-    pub(super) l: f64,
-    pub(super) la: f64,
-    pub(super) lb: f64,
-    pub(super) laa: f64,
-    pub(super) lbb: f64,
-    pub(super) lab: f64,
-    pub(super) v: f64,
-    pub(super) va: f64,
-    pub(super) vb: f64,
-    pub(super) vaa: f64,
-    pub(super) vbb: f64,
-    pub(super) vab: f64,
 }

@@ -278,8 +278,9 @@ impl Solver {
         last_shift: &mut f64,
     ) -> Option<(f64, f64)> {
         let mut mu = (1e-8 * s_row).max(*last_shift / 4.0);
+        let scale = self.pivot_scale(lambda);
         for _ in 0..80 {
-            if let Some(pos) = self.shifted_solve(lambda, mu) {
+            if let Some(pos) = self.shifted_solve_scaled(lambda, mu, scale) {
                 let (gx, gy) = self.border_products();
                 if pos + usize::from(gy < 0.0) == 1 && gy != 0.0 {
                     *last_shift = mu;

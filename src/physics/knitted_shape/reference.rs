@@ -89,6 +89,35 @@ pub(super) fn cases() -> Vec<Case> {
     ]
 }
 
+/// The two slowest table builds among 2,000 sleeves drawn over the KnittedMuscle's declared space
+/// (`benches/knitted_table_space.rs`, `KNITTED_SEED=8`), `r_min = 4 m t / (2 pi)` from their
+/// strand thickness `t`: a short wide sleeve (full extension 1.6 mm, ceiling radius 1.9 mm) whose
+/// path ends where the clamps' segments turn radial (eq. 1.17), and a thin strand on 90 segments
+/// whose pocket sits against one clamp and reaches zero force.
+pub(super) fn slowest_sampled() -> Vec<Case> {
+    let sleeve = |name, m: f64, n, s, t: f64, segments| {
+        case(name, m, n, s, 4.0 * m * t / (2.0 * PI), segments)
+    };
+    vec![
+        sleeve(
+            "sampled_radial_end_88",
+            7.232877696854794e2,
+            1.8574609855364474e2,
+            1.2165512223995123e-2,
+            6.221929277575029e-9,
+            88,
+        ),
+        sleeve(
+            "sampled_thin_90",
+            2.0919603768608237e1,
+            1.0608952247092475e2,
+            6.854262142174964e-4,
+            8.871632718064084e-15,
+            90,
+        ),
+    ]
+}
+
 pub(super) struct Row {
     pub(super) length: f64,
     pub(super) volume: f64,
@@ -126,6 +155,8 @@ pub(super) fn fixture(name: &str) -> &'static str {
         "slow_wide_142" => include_str!("reference/slow_wide_142.csv"),
         "slow_few_stitches_76" => include_str!("reference/slow_few_stitches_76.csv"),
         "slow_long_134" => include_str!("reference/slow_long_134.csv"),
+        "sampled_radial_end_88" => include_str!("reference/sampled_radial_end_88.csv"),
+        "sampled_thin_90" => include_str!("reference/sampled_thin_90.csv"),
         _ => unreachable!("no fixture {name}"),
     }
 }
@@ -136,7 +167,7 @@ fn write_reference_tables() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("src/physics/knitted_shape/reference");
     std::fs::create_dir_all(&dir).unwrap();
-    for c in cases() {
+    for c in cases().into_iter().chain(slowest_sampled()) {
         let t = ShapeTable::build(c.geometry, c.end, c.nodes).unwrap();
         let mut out = format!(
             "# {}: m {}, n {}, S_row {:e} m, r_min {:e} m, {} segments, end {:e} m, {} nodes\n\

@@ -2,7 +2,7 @@
 
 // `!(x > y)` is deliberate: it also rejects NaN. Index loops walk several coupled arrays.
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
-use super::geometry::ShapeGeometry;
+use super::geometry::{Segment, ShapeGeometry};
 use std::f64::consts::PI;
 
 /// Newton iterations per solve; the warm start usually converges in 3-5.
@@ -44,6 +44,9 @@ pub(super) struct Solver {
     /// The last inertia-correcting shift the fast path used: the next solve's search for one
     /// starts a little below it (it changes slowly along the path).
     pub(super) shift_hint: f64,
+    /// The segment between two rings on the floor (`None` if it cannot close): the same for
+    /// every such pair, and most segments of a pocket's early stroke.
+    floor_segment: Option<Segment>,
 }
 
 /// Converged point on the path.
@@ -81,6 +84,7 @@ impl Solver {
             releases: vec![0; rings],
             prefer_shift: false,
             shift_hint: 0.0,
+            floor_segment: geom.segment(geom.min_radius, geom.min_radius),
         }
     }
 
@@ -91,6 +95,7 @@ impl Solver {
         self.ceiling = other.ceiling;
         self.prefer_shift = other.prefer_shift;
         self.shift_hint = other.shift_hint;
+        self.floor_segment = other.floor_segment;
         for (to, from) in [
             (&mut self.radii, &other.radii),
             (&mut self.gv, &other.gv),
@@ -126,33 +131,33 @@ impl Solver {
     /// derivatives). Returns `(L, V)`, `None` if a segment cannot close.
     pub(super) fn assemble(&mut self, geom: &ShapeGeometry) -> Option<(f64, f64)> {
         let rings = self.radii.len();
-        for v in [
-            &mut self.gv,
-            &mut self.gl,
-            &mut self.dv,
-            &mut self.dl,
-            &mut self.ov,
-            &mut self.ol,
-        ] {
-            v.iter_mut().for_each(|x| *x = 0.0);
-        }
+        let k = geom.segment_constants();
         let (mut l, mut v) = (0.0, 0.0);
+        // Ring `j` sums its share of segment `j` (ending at it) and of segment `j + 1` (starting
+        // at it), in that order; the end rings have one segment each.
+        let (mut gv, mut gl, mut dv, mut dl) = (0.0, 0.0, 0.0, 0.0);
+        let r_min = geom.min_radius;
         for i in 1..rings {
-            let seg = geom.segment(self.radii[i - 1], self.radii[i])?;
+            let (ra, rb) = (self.radii[i - 1], self.radii[i]);
+            let seg = match self.floor_segment {
+                Some(floor) if ra == r_min && rb == r_min => floor,
+                _ => k.segment(ra, rb)?,
+            };
             l += seg.l;
             v += seg.v;
-            let (a, b) = (i - 1, i);
-            self.gv[a] += seg.va;
-            self.gl[a] += seg.la;
-            self.dv[a] += seg.vaa;
-            self.dl[a] += seg.laa;
-            self.gv[b] += seg.vb;
-            self.gl[b] += seg.lb;
-            self.dv[b] += seg.vbb;
-            self.dl[b] += seg.lbb;
+            let a = i - 1;
+            self.gv[a] = gv + seg.va;
+            self.gl[a] = gl + seg.la;
+            self.dv[a] = dv + seg.vaa;
+            self.dl[a] = dl + seg.laa;
             self.ov[a] = seg.vab;
             self.ol[a] = seg.lab;
+            (gv, gl, dv, dl) = (seg.vb, seg.lb, seg.vbb, seg.lbb);
         }
+        let last = rings - 1;
+        (self.gv[last], self.gl[last], self.dv[last], self.dl[last]) = (gv, gl, dv, dl);
+        self.ov[last] = 0.0;
+        self.ol[last] = 0.0;
         Some((l, v))
     }
 
@@ -174,11 +179,28 @@ impl Solver {
     /// Returns the number of positive pivots (Sylvester inertia of `H - mu I`), `None` on a
     /// vanishing pivot.
     pub(super) fn shifted_solve(&mut self, lambda: f64, mu: f64) -> Option<usize> {
-        let rings = self.radii.len();
+        let scale = self.pivot_scale(lambda);
+        self.shifted_solve_scaled(lambda, mu, scale)
+    }
+
+    /// The largest `|Hess V - lambda Hess L|` on the diagonal, the scale of a vanishing pivot.
+    pub(super) fn pivot_scale(&self, lambda: f64) -> f64 {
         let mut scale = 0.0f64;
-        for j in 0..rings {
+        for j in 0..self.radii.len() {
             scale = scale.max((self.dv[j] - lambda * self.dl[j]).abs());
         }
+        scale
+    }
+
+    /// [`Solver::shifted_solve`] with the [`Solver::pivot_scale`] of `lambda` (the same for every
+    /// shift tried at one iterate).
+    pub(super) fn shifted_solve_scaled(
+        &mut self,
+        lambda: f64,
+        mu: f64,
+        scale: f64,
+    ) -> Option<usize> {
+        let rings = self.radii.len();
         let tiny = 1e-14 * scale.max(f64::MIN_POSITIVE) + mu * 1e-14;
         let mut positive = 0;
         let mut prev_off = 0.0;
@@ -211,7 +233,8 @@ impl Solver {
             if !held && denom > 0.0 {
                 positive += 1;
             }
-            let inv = 1.0 / denom;
+            // A held ring's row is the identity (no coupling reaches it): its pivot is exactly 1.
+            let inv = if held { 1.0 } else { 1.0 / denom };
             self.c[j] = off_here * inv;
             self.x[j] = (rx - prev_off * xp) * inv;
             self.y[j] = (ry - prev_off * yp) * inv;

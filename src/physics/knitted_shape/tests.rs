@@ -493,3 +493,64 @@ fn thin_strand_beads_stop_at_the_ceiling_and_reach_free_contraction() {
         assert_profiles_are_maxima(&g, &table, 9);
     }
 }
+
+#[test]
+fn slowest_sampled_sleeves_reach_their_end_as_volume_maxima() {
+    // The two slowest builds of 2,000 sleeves drawn over the declared space (reference.rs
+    // `slowest_sampled`). Each table must reach its end condition, its profiles must be volume
+    // maxima (KKT with both bounds, eq. 1.19-1.20, and second order), and it must agree node by
+    // node with its fixture to the tolerances of `tables_agree_with_the_reference_solver`.
+    use super::reference::{differences, fixture, parse, slowest_sampled};
+    for c in slowest_sampled() {
+        let g = c.geometry;
+        let t = ShapeTable::build(g, c.end, c.nodes).unwrap();
+        let last = t.slope.len() - 1;
+        let l_end = t.min_length();
+        assert!(
+            l_end > c.end && last > 100,
+            "{}: {} nodes to {l_end:e}",
+            c.name,
+            last + 1
+        );
+        if t.slope[last] >= 0.0 {
+            // Zero force reached: the table ends at the first node past it.
+            assert!(t.slope[last - 1] < 0.0, "{}", c.name);
+            assert!(t.free_contraction_length().is_some(), "{}", c.name);
+        } else {
+            // Ended with tension left: past the last node a clamp's segment would have to be
+            // steeper than radial (eq. 1.17, the slant all radius step).
+            let radii: Vec<f64> = t.profile(l_end).unwrap().iter().map(|p| p.1).collect();
+            let k = g.rows / g.segments as f64;
+            let steepest = radii
+                .windows(2)
+                .map(|w| (w[1] - w[0]).abs() / (k * g.stitch_height(0.5 * (w[0] + w[1]))))
+                .fold(0.0, f64::max);
+            assert!(steepest > 0.999, "{}: steepest segment {steepest}", c.name);
+        }
+        if t.slope[last] >= 0.0 {
+            assert_profiles_are_maxima(&g, &t, 11);
+        } else {
+            // The random moves of `assert_profiles_are_maxima` would tilt the near-radial clamp
+            // segments past closing; KKT and the reduced Hessian's sign are checked directly.
+            let scale = g.row_strand_length * g.row_strand_length;
+            for l in t.lengths().skip(3).step_by(11) {
+                let radii: Vec<f64> = t.profile(l).unwrap().iter().map(|p| p.1).collect();
+                let (lambda, free_res, floor_pull) = kkt(&g, &radii);
+                assert!(free_res < 1e-8 * scale, "at {l}: residual {free_res:e}");
+                assert!(floor_pull < 1e-8 * scale, "at {l}: pull {floor_pull:e}");
+                assert!(
+                    reduced_hessian_is_negative(&g, &radii, lambda),
+                    "at {l}: not a maximum on the length constraint"
+                );
+            }
+        }
+        let reference = parse(fixture(c.name));
+        assert_eq!(t.volume.len(), reference.len(), "{}", c.name);
+        let d = differences(&c);
+        assert!(
+            d[0] < 1e-9 && d[1] < 3e-5 && d[2] < 1e-4 && d[3] < 3e-5,
+            "{}: {d:?}",
+            c.name
+        );
+    }
+}
