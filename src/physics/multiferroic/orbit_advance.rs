@@ -377,9 +377,12 @@ impl Motor {
         // Ringing that decays to the relaxed onion's slack within the segment, at half its
         // slowest loss per orbit (its own or its linearization's at the minimum), ends the
         // advance there and is dropped at whatever phase it has (see [`Self::relaxed_onion`]):
-        // its phase never reaches an output.
+        // its phase never reaches an output. (Not under an overdamped rotor: its angle, held to
+        // a tenth of the tolerance, takes the averaged steps there, dozens per segment on
+        // schedules of tens of nanoseconds, where resolving the ringing costs less.)
         let least_loss = loss.min(2.0 * PI * alpha * (k + t) / (k * t).sqrt());
         let dropped = self.onion_relaxes_fast()
+            && (d.locked || !self.overdamped(o.period))
             && 4.0 * (width / slack).max(1.0).ln() / least_loss <= remaining / o.period;
         if dropped {
             return Some((well, o, true));
