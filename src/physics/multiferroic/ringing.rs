@@ -118,6 +118,37 @@ impl Motor {
             (widest / limit).max(speed * self.drag / limit)
         };
         let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, least_rate)))?;
+        if let Some((level, rims)) = trap.sublevel {
+            // Out to the rims: the ringing dies out within the segment (a locked rotor), or its
+            // whole torque moves the rotor too little. (A NaN fails every bound.)
+            let tol = self.params.tolerance;
+            let passes = |amplitude: f64, rate: f64| {
+                (d.locked && amplitude * (-rate * remaining).exp() <= tol)
+                    || (speed * self.drag <= limit * rate
+                        && amplitude * (k_bar.abs() + self.ring_bar_slope_bound * amplitude)
+                            <= limit * rate)
+            };
+            if passes(trap.amplitude, trap.rate) {
+                return Some(0.0);
+            }
+            // Else at the decay that the energy's sublevel gradient bound guarantees, sampled
+            // only where it can pass: that bound is below the curvature at the minimum.
+            let (g, alpha, t) = (
+                self.llg_rate,
+                self.params.gilbert_damping,
+                self.tilt_stiffness,
+            );
+            let k = trap.curvature;
+            let fastest = g * alpha * k.min(t);
+            if !passes(trap.amplitude.min((2.0 * level / k).sqrt()), fastest) {
+                return None;
+            }
+            let land = self.landscape(y[0], d.direction, d.stress);
+            let floor = land.energy(settled);
+            let kappa = sublevel_gradient_bound(&land, settled, floor, level, rims);
+            let amplitude = trap.amplitude.min((2.0 * level / kappa).sqrt());
+            return (kappa > 0.0 && passes(amplitude, g * alpha * kappa.min(t))).then_some(0.0);
+        }
         let (amplitude, rate) = (trap.amplitude, trap.rate);
         if d.locked && amplitude * (-rate * remaining).exp() <= self.params.tolerance {
             return Some(0.0);
@@ -154,9 +185,10 @@ impl Motor {
     /// rate at the minimum is at least its second value (1/s; the ringing out to the rims decays
     /// no faster). A locked rotor's rims found for this minimum are used again (its landscape is
     /// frozen); a well that moved by less than half the window is the one found, its rims moved
-    /// with it. The ringing out to the rims decays at least at the faster of [`RIM_SLOWDOWN`]
-    /// times slower than at the minimum and the rate that [`sublevel_gradient_bound`] guarantees
-    /// for its energy, `g alpha min(kappa, T)` in amplitude, from within `sqrt(2 E / kappa)`.
+    /// with it. The ringing out to the rims decays at least [`RIM_SLOWDOWN`] times slower than at
+    /// the minimum; [`Self::averaged_ringing`] may also take the rate that
+    /// [`sublevel_gradient_bound`] guarantees for its energy, `g alpha min(kappa, T)` in
+    /// amplitude, from within `sqrt(2 E / kappa)`.
     pub(super) fn trapped_ringing(
         &self,
         y: &Vector,
@@ -187,6 +219,7 @@ impl Motor {
             near,
             curvature: k,
             slope_bound: m,
+            sublevel: None,
         };
         if near < window {
             return Some(trap(near, rate, true));
@@ -234,17 +267,9 @@ impl Motor {
             return None;
         }
         let reach = (above - settled).max(settled - below);
-        let heuristic = rate / RIM_SLOWDOWN;
-        // The decay that the gradient's bound over the energy's sublevel set guarantees, where
-        // it beats the heuristic slowdown.
-        let floor = land.energy(settled);
-        let kappa = sublevel_gradient_bound(&land, settled, floor, excess, (below, above));
-        let guaranteed =
-            self.llg_rate * self.params.gilbert_damping * kappa.min(self.tilt_stiffness);
-        Some(if guaranteed > heuristic {
-            trap(reach.min((2.0 * excess / kappa).sqrt()), guaranteed, false)
-        } else {
-            trap(reach, heuristic, false)
+        Some(Trap {
+            sublevel: Some((excess, (below, above))),
+            ..trap(reach, rate / RIM_SLOWDOWN, false)
         })
     }
 
@@ -358,6 +383,9 @@ pub(super) struct Trap {
     pub(super) curvature: f64,
     /// The bound on the third derivative of eq. 3.4 (J/rad^3).
     pub(super) slope_bound: f64,
+    /// Out to the rims: its energy above the minimum (J) and the rims (rad), the sublevel set
+    /// of [`sublevel_gradient_bound`].
+    pub(super) sublevel: Option<(f64, (f64, f64))>,
 }
 
 /// How much slower than its linearization's at the minimum ringing that reaches out to the rims of
