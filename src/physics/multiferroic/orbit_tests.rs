@@ -210,7 +210,7 @@ fn weakly_damped_gilbert_onion_averages_its_ringing_at_one_microsecond() {
 /// are counted (the averaged advance's steps and the relaxed onion's settles included): at
 /// damping 1e-3 the ringing that decays within the step is averaged without its phase (88 and
 /// 72 substeps free and locked, where resolving it took 616 and 602), at 1e-2 the locked onion's
-/// ringing is dropped once its energy's guaranteed decay ends it within the step (282, against
+/// ringing is dropped once its energy's guaranteed decay ends it within the step (318, against
 /// 575).
 #[test]
 fn ringing_after_a_release_keeps_to_a_fine_rk4_over_a_step() {

@@ -140,11 +140,16 @@ impl Motor {
             );
             let k = trap.curvature;
             let fastest = g * alpha * k.min(t);
-            if !passes(trap.amplitude.min((2.0 * level / k).sqrt()), fastest) {
+            // Sampled again only once the energy has halved since (the bound grows as the set
+            // shrinks).
+            if !passes(trap.amplitude.min((2.0 * level / k).sqrt()), fastest)
+                || level > 0.5 * rim_barrier.sampled_level
+            {
                 return None;
             }
+            rim_barrier.sampled_level = level;
             let land = self.landscape(y[0], d.direction, d.stress);
-            let floor = land.energy(settled);
+            let floor = super::orbit::point(&land, settled).0;
             let kappa = sublevel_gradient_bound(&land, settled, floor, level, rims);
             let amplitude = trap.amplitude.min((2.0 * level / kappa).sqrt());
             return (kappa > 0.0 && passes(amplitude, g * alpha * kappa.min(t))).then_some(0.0);
@@ -181,9 +186,9 @@ impl Motor {
     ///
     /// Out of the window about the minimum, the rims are looked for when `rims` is given, none
     /// were found yet in this segment (the search, a march over the well both ways, records
-    /// them) or, for a locked rotor, they were found for another minimum, and twice the decay
-    /// rate at the minimum is at least its second value (1/s; the ringing out to the rims decays
-    /// no faster). A locked rotor's rims found for this minimum are used again (its landscape is
+    /// them) or, for a locked rotor, they were found for another minimum, and the decay rate
+    /// that the ringing out to the rims is held to ([`RIM_SLOWDOWN`] times slower than at the
+    /// minimum) is at least its second value (1/s). A locked rotor's rims found for this minimum are used again (its landscape is
     /// frozen); a well that moved by less than half the window is the one found, its rims moved
     /// with it. The ringing out to the rims decays at least [`RIM_SLOWDOWN`] times slower than at
     /// the minimum; [`Self::averaged_ringing`] may also take the rate that
@@ -225,7 +230,7 @@ impl Motor {
             return Some(trap(near, rate, true));
         }
         let found = match rims {
-            Some((found, least_rate)) if 2.0 * rate >= least_rate => found,
+            Some((found, least_rate)) if rate >= least_rate * RIM_SLOWDOWN => found,
             _ => return None,
         };
         // A locked rotor's landscape is frozen: the well found in this segment stays the same
@@ -244,6 +249,7 @@ impl Motor {
                 minimum: settled,
                 below,
                 above,
+                ..*found
             };
         } else if !same_well {
             if found.barrier.is_finite() && !d.locked {
@@ -255,6 +261,7 @@ impl Motor {
                 minimum: settled,
                 below,
                 above,
+                sampled_level: f64::INFINITY,
             };
         }
         let Rims {
@@ -325,8 +332,8 @@ pub(super) fn sublevel_gradient_bound(
         let mut beyond = false;
         for i in 1..=SUBLEVEL_NODES {
             let x = minimum + (rim - minimum) * i as f64 / SUBLEVEL_NODES as f64;
-            let rise = land.energy(x) - floor;
-            let gradient = land.gradient(x);
+            let (energy, gradient, _) = super::orbit::point(land, x);
+            let rise = energy - floor;
             // Within rounding of the minimum the ratio is the curvature there, sampled further out.
             if rise <= 1e-9 * level {
                 continue;
@@ -360,6 +367,9 @@ pub(super) struct Rims {
     pub(super) minimum: f64,
     pub(super) below: f64,
     pub(super) above: f64,
+    /// The energy above the minimum (J) at which [`sublevel_gradient_bound`] was last sampled in
+    /// this segment; infinite before.
+    pub(super) sampled_level: f64,
 }
 
 impl Rims {
@@ -368,6 +378,7 @@ impl Rims {
         minimum: f64::NAN,
         below: f64::NAN,
         above: f64::NAN,
+        sampled_level: f64::INFINITY,
     };
 }
 
