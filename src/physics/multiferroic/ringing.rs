@@ -188,12 +188,11 @@ impl Motor {
     /// were found yet in this segment (the search, a march over the well both ways, records
     /// them) or, for a locked rotor, they were found for another minimum, and the decay rate
     /// that the ringing out to the rims is held to ([`RIM_SLOWDOWN`] times slower than at the
-    /// minimum) is at least its second value (1/s). A locked rotor's rims found for this minimum are used again (its landscape is
-    /// frozen); a well that moved by less than half the window is the one found, its rims moved
-    /// with it. The ringing out to the rims decays at least [`RIM_SLOWDOWN`] times slower than at
-    /// the minimum; [`Self::averaged_ringing`] may also take the rate that
-    /// [`sublevel_gradient_bound`] guarantees for its energy, `g alpha min(kappa, T)` in
-    /// amplitude, from within `sqrt(2 E / kappa)`.
+    /// minimum) is at least its second value (1/s). A locked rotor's rims found for this minimum
+    /// are used again (its landscape is frozen); a well that moved by less than half the window
+    /// is the one found, its rims moved with it. [`Self::averaged_ringing`] may also take the
+    /// rate that [`sublevel_gradient_bound`] guarantees for the ringing's energy,
+    /// `g alpha min(kappa, T)` in amplitude, from within `sqrt(2 E / kappa)`.
     pub(super) fn trapped_ringing(
         &self,
         y: &Vector,
