@@ -160,10 +160,10 @@ impl Motor {
             return None;
         }
         let max_steps = (allowance - MARCH_STEPS - 4) / AVERAGED_STEP_WEIGHT;
-        let (well, o) = self.averageable(&run.y, d, segment_end - run.t)?;
+        let (well, o, _) = self.averageable(&run.y, d, segment_end - run.t)?;
         let (y, marched, resolved) = self.march_to_turning_point(&run.y, d, &well, o.period)?;
         let start = run.t + marched;
-        let (well, o) = self.averageable(&y, d, segment_end - start)?;
+        let (well, o, dropped) = self.averageable(&y, d, segment_end - start)?;
         let land = self.landscape(y[0], d.direction, d.stress);
         let overdamped = !d.locked && self.overdamped(o.period);
         let omega = self.rotor_speed(&y, d, overdamped);
@@ -191,6 +191,14 @@ impl Motor {
         let tol = self.params.tolerance;
         let speed_scale = tol * self.speed_scale;
         let slack = self.relaxed_slack();
+        // Ringing that the branch drops once it is within the slack (see [`Self::averageable`]):
+        // its phase only places the advance's end on a turning point, and its width only
+        // matters against the slack.
+        let (width_error, phase_error) = if dropped {
+            (0.1 * tol.max(slack), 0.01)
+        } else {
+            (0.1 * tol, 0.1 * tol)
+        };
         // A first step of a tenth of the energy's decay time.
         let mut h = (0.1 * s[2] / k1[2].abs()).min(segment_end - start);
         let mut time = start;
@@ -204,8 +212,12 @@ impl Motor {
                 [
                     0.1 * tol,
                     0.1 * speed_scale,
-                    0.1 * tol * 2.0 * next[2].abs() / width,
-                    0.1 * tol / (2.0 * PI * width),
+                    width_error * 2.0 * next[2].abs() / width,
+                    if dropped {
+                        phase_error
+                    } else {
+                        phase_error / (2.0 * PI * width)
+                    },
                 ]
             }) else {
                 h = 0.25 * h_try;
@@ -293,14 +305,14 @@ impl Motor {
 
     /// Ringing narrower than this (rad) is within the relaxed onion's slack (see
     /// [`Self::relaxed_onion`]): the averaged advance stops there and the branch takes over.
-    fn relaxed_slack(&self) -> f64 {
+    pub(super) fn relaxed_slack(&self) -> f64 {
         let tol = self.params.tolerance;
         0.5 * (0.1 * tol * self.rotor_relaxation_time() / self.onion_relaxation_time()).min(1e-3)
     }
 
     /// The well and orbit of the onion at `y` when the averaged advance applies to it with
     /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]).
-    fn averageable(&self, y: &Vector, d: &Drive, remaining: f64) -> Option<(Well, Orbit)> {
+    fn averageable(&self, y: &Vector, d: &Drive, remaining: f64) -> Option<(Well, Orbit, bool)> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;
         // First from the linearization at the minimum (no search for the rims): its period
@@ -362,8 +374,21 @@ impl Motor {
             orbits = orbits.min(2.0 * (width / slack).ln() / loss);
         }
         let end_width = width * (-0.5 * loss * orbits).exp();
+        // Ringing that decays to the relaxed onion's slack within the segment, at half its
+        // slowest loss per orbit (its own or its linearization's at the minimum), ends the
+        // advance there and is dropped at whatever phase it has (see [`Self::relaxed_onion`]):
+        // its phase never reaches an output. (Not under an overdamped rotor: its angle, held to
+        // a tenth of the tolerance, takes the averaged steps there, dozens per segment on
+        // schedules of tens of nanoseconds, where resolving the ringing costs less.)
+        let least_loss = loss.min(2.0 * PI * alpha * (k + t) / (k * t).sqrt());
+        let dropped = self.onion_relaxes_fast()
+            && (d.locked || !self.overdamped(o.period))
+            && 4.0 * (width / slack).max(1.0).ln() / least_loss <= remaining / o.period;
+        if dropped {
+            return Some((well, o, true));
+        }
         let drift = 2.0 * PI * shift * orbits * end_width * (k / t).sqrt();
-        (drift <= tol).then_some((well, o))
+        (drift <= tol).then_some((well, o, false))
     }
 
     /// The full macrospin and rotor from `y` to the onion's next lower turning point (its tilt

@@ -75,7 +75,8 @@ impl Motor {
     ///
     /// Negligible: ringing of amplitude `A` decays at least at the slowest rate `r` of the onion's
     /// linearization in the window (the damped precession's `g alpha (k + T)/2` or, overdamped,
-    /// its slow creep; [`RIM_SLOWDOWN`] times slower for ringing out to the rims). Near the
+    /// its slow creep; for ringing out to the rims, the faster of [`RIM_SLOWDOWN`] times slower
+    /// and the decay that [`sublevel_gradient_bound`] guarantees). Near the
     /// minimum the ringing is the onion's linear mode `x' = J x` (`x = (psi - psi*, theta)`,
     /// `J = g [[-alpha k, -T], [k, -alpha T]]`), whose offset integrates to
     /// `(-J^-1 x0)_psi = (alpha x0_psi - theta0) / (g k (1 + alpha^2))`: times the ring-bar
@@ -117,6 +118,42 @@ impl Motor {
             (widest / limit).max(speed * self.drag / limit)
         };
         let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, least_rate)))?;
+        if let Some((level, rims)) = trap.sublevel {
+            // Out to the rims: the ringing dies out within the segment (a locked rotor), or its
+            // whole torque moves the rotor too little. (A NaN fails every bound.)
+            let tol = self.params.tolerance;
+            let passes = |amplitude: f64, rate: f64| {
+                (d.locked && amplitude * (-rate * remaining).exp() <= tol)
+                    || (speed * self.drag <= limit * rate
+                        && amplitude * (k_bar.abs() + self.ring_bar_slope_bound * amplitude)
+                            <= limit * rate)
+            };
+            if passes(trap.amplitude, trap.rate) {
+                return Some(0.0);
+            }
+            // Else at the decay that the energy's sublevel gradient bound guarantees, sampled
+            // only where it can pass: that bound is below the curvature at the minimum.
+            let (g, alpha, t) = (
+                self.llg_rate,
+                self.params.gilbert_damping,
+                self.tilt_stiffness,
+            );
+            let k = trap.curvature;
+            let fastest = g * alpha * k.min(t);
+            // Sampled again only once the energy has halved since (the bound grows as the set
+            // shrinks).
+            if !passes(trap.amplitude.min((2.0 * level / k).sqrt()), fastest)
+                || level > 0.5 * rim_barrier.sampled_level
+            {
+                return None;
+            }
+            rim_barrier.sampled_level = level;
+            let land = self.landscape(y[0], d.direction, d.stress);
+            let floor = super::orbit::point(&land, settled).0;
+            let kappa = sublevel_gradient_bound(&land, settled, floor, level, rims);
+            let amplitude = trap.amplitude.min((2.0 * level / kappa).sqrt());
+            return (kappa > 0.0 && passes(amplitude, g * alpha * kappa.min(t))).then_some(0.0);
+        }
         let (amplitude, rate) = (trap.amplitude, trap.rate);
         if d.locked && amplitude * (-rate * remaining).exp() <= self.params.tolerance {
             return Some(0.0);
@@ -152,7 +189,10 @@ impl Motor {
     /// them) or, for a locked rotor, they were found for another minimum, and the decay rate
     /// that the ringing out to the rims is held to ([`RIM_SLOWDOWN`] times slower than at the
     /// minimum) is at least its second value (1/s). A locked rotor's rims found for this minimum
-    /// are used again (its landscape is frozen).
+    /// are used again (its landscape is frozen); a well that moved by less than half the window
+    /// is the one found, its rims moved with it. [`Self::averaged_ringing`] may also take the
+    /// rate that [`sublevel_gradient_bound`] guarantees for the ringing's energy,
+    /// `g alpha min(kappa, T)` in amplitude, from within `sqrt(2 E / kappa)`.
     pub(super) fn trapped_ringing(
         &self,
         y: &Vector,
@@ -183,6 +223,7 @@ impl Motor {
             near,
             curvature: k,
             slope_bound: m,
+            sublevel: None,
         };
         if near < window {
             return Some(trap(near, rate, true));
@@ -194,7 +235,22 @@ impl Motor {
         // A locked rotor's landscape is frozen: the well found in this segment stays the same
         // as long as the onion settles into the same minimum.
         let same_well = d.locked && (found.minimum - settled).abs() <= 1e-9;
-        if !same_well {
+        // A well that moved by less than half the window with a turning rotor (or settling
+        // onion) is the same one: its rims are moved with its minimum, and its barrier taken
+        // there, where the energy is at most the rims' own (the moved points bracket the orbit
+        // all the same).
+        let shift = settled - found.minimum;
+        if !same_well && found.barrier.is_finite() && shift.abs() <= 0.5 * window {
+            let (below, above) = (found.below + shift, found.above + shift);
+            let floor = land.energy(settled);
+            *found = Rims {
+                barrier: land.energy(below).min(land.energy(above)) - floor,
+                minimum: settled,
+                below,
+                above,
+                ..*found
+            };
+        } else if !same_well {
             if found.barrier.is_finite() && !d.locked {
                 return None;
             }
@@ -204,6 +260,7 @@ impl Motor {
                 minimum: settled,
                 below,
                 above,
+                sampled_level: f64::INFINITY,
             };
         }
         let Rims {
@@ -212,9 +269,13 @@ impl Motor {
             above,
             ..
         } = *found;
-        (below < y[2] && y[2] < above && excess < 0.99 * barrier).then(|| {
-            let reach = (above - settled).max(settled - below);
-            trap(reach, rate / RIM_SLOWDOWN, false)
+        if !(below < y[2] && y[2] < above && excess < 0.99 * barrier) {
+            return None;
+        }
+        let reach = (above - settled).max(settled - below);
+        Some(Trap {
+            sublevel: Some((excess, (below, above))),
+            ..trap(reach, rate / RIM_SLOWDOWN, false)
         })
     }
 
@@ -246,6 +307,56 @@ impl Motor {
     }
 }
 
+/// A lower bound `kappa` (J/rad^2) on `U'^2 / (2 (U - U(minimum)))` over the sublevel set
+/// `U - U(minimum) <= level` of the well between `rims` of the landscape `land` (`floor` its
+/// energy at the minimum): with the landscape frozen, Gilbert damping then lowers the macrospin's
+/// energy `E = U - U(minimum) + T theta^2 / 2` at least at the rate
+/// `dE/dt = -g alpha (U'^2 + T^2 theta^2) <= -2 g alpha min(kappa, T) E` (a Polyak-Lojasiewicz
+/// inequality), and the onion stays within `sqrt(2 E / kappa)` of the minimum (the quadratic
+/// growth that the inequality implies). Sampled on [`SUBLEVEL_NODES`] points out to the rim on
+/// either side, the ratio at the first point beyond the level taken at the level, and halved for
+/// the samples' spacing; 0 where the set reaches a rim (the gradient vanishes there).
+pub(super) fn sublevel_gradient_bound(
+    land: &super::onion::Landscape,
+    minimum: f64,
+    floor: f64,
+    level: f64,
+    rims: (f64, f64),
+) -> f64 {
+    if level.is_nan() || level <= 0.0 {
+        return 0.0;
+    }
+    let mut least = f64::INFINITY;
+    for rim in [rims.0, rims.1] {
+        let mut beyond = false;
+        for i in 1..=SUBLEVEL_NODES {
+            let x = minimum + (rim - minimum) * i as f64 / SUBLEVEL_NODES as f64;
+            let (energy, gradient, _) = super::orbit::point(land, x);
+            let rise = energy - floor;
+            // Within rounding of the minimum the ratio is the curvature there, sampled further out.
+            if rise <= 1e-9 * level {
+                continue;
+            }
+            least = least.min(gradient * gradient / (2.0 * rise.min(level)));
+            if rise > level {
+                beyond = true;
+                break;
+            }
+        }
+        if !beyond {
+            return 0.0;
+        }
+    }
+    if least.is_finite() {
+        0.5 * least
+    } else {
+        0.0
+    }
+}
+
+/// Samples per side of [`sublevel_gradient_bound`].
+const SUBLEVEL_NODES: usize = 48;
+
 /// The rims of the Gilbert onion's well found in a segment (see [`Motor::trapped_ringing`]).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct Rims {
@@ -255,6 +366,9 @@ pub(super) struct Rims {
     pub(super) minimum: f64,
     pub(super) below: f64,
     pub(super) above: f64,
+    /// The energy above the minimum (J) at which [`sublevel_gradient_bound`] was last sampled in
+    /// this segment; infinite before.
+    pub(super) sampled_level: f64,
 }
 
 impl Rims {
@@ -263,6 +377,7 @@ impl Rims {
         minimum: f64::NAN,
         below: f64::NAN,
         above: f64::NAN,
+        sampled_level: f64::INFINITY,
     };
 }
 
@@ -278,6 +393,9 @@ pub(super) struct Trap {
     pub(super) curvature: f64,
     /// The bound on the third derivative of eq. 3.4 (J/rad^3).
     pub(super) slope_bound: f64,
+    /// Out to the rims: its energy above the minimum (J) and the rims (rad), the sublevel set
+    /// of [`sublevel_gradient_bound`].
+    pub(super) sublevel: Option<(f64, (f64, f64))>,
 }
 
 /// How much slower than its linearization's at the minimum ringing that reaches out to the rims of
@@ -288,3 +406,131 @@ const RIM_SLOWDOWN: f64 = 100.0;
 /// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
 /// drop (see [`Motor::relaxed_onion`]).
 const MAX_FOLLOWED_LAG: f64 = 1e-3;
+
+#[cfg(test)]
+mod tests {
+    use super::super::tests::{motor_with, rk4_step, schedule};
+    use super::super::{OnionModel, Vector};
+    use super::sublevel_gradient_bound;
+
+    /// The bound on `U'^2 / (2 (U - U*))` over a sublevel set of Table 3.1's well after the
+    /// schedule's first switch against the least ratio on 200,000 points of the same set: below
+    /// it and within a factor of 4 of it, from a tenth of the lowest rim's height to 0.99 of
+    /// it; 0 at the rim (the gradient vanishes there) and above it.
+    #[test]
+    fn sublevel_gradient_bound_is_below_a_dense_minimum() {
+        let m = motor_with(|p| p.onion_model = OnionModel::Gilbert);
+        let d = m.drive_at(&schedule(20e-6), 0.0);
+        let land = m.landscape(0.0, d.direction, d.stress);
+        let well = m.onion_well(&land, 0.0).unwrap();
+        let floor = land.energy(well.minimum);
+        let rims = (well.below, well.above);
+        for fraction in [0.1, 0.5, 0.9, 0.99, 1.0, 1.5] {
+            let level = fraction * well.barrier;
+            let kappa = sublevel_gradient_bound(&land, well.minimum, floor, level, rims);
+            // The dense minimum over the connected set about the minimum, walked out both ways.
+            let mut least = f64::INFINITY;
+            for rim in [well.below, well.above] {
+                let n = 100_000;
+                for i in 1..=n {
+                    let x = well.minimum + (rim - well.minimum) * i as f64 / n as f64;
+                    let rise = land.energy(x) - floor;
+                    if rise > level {
+                        break;
+                    }
+                    if rise > 1e-9 * level {
+                        let g = land.gradient(x);
+                        least = least.min(g * g / (2.0 * rise));
+                    }
+                }
+            }
+            println!("{fraction} of the rim: bound {kappa:e}, dense {least:e}");
+            if fraction >= 1.0 {
+                assert_eq!(kappa, 0.0, "{fraction}");
+                continue;
+            }
+            assert!(
+                kappa <= least && kappa >= least / 4.0,
+                "{fraction}: {kappa} {least}"
+            );
+        }
+    }
+
+    /// With the rotor locked (the landscape frozen), Table 3.1's onion released from rest at 0.9
+    /// and 0.98 of its well's lowest rim above the minimum, at dampings 1e-4 to 0.1: along a
+    /// fine RK4 of the full macrospin its energy stays below `E0 exp(-2 r t)` and its distance
+    /// to the minimum below `sqrt(2 E0 / kappa) exp(-r t)`, `r = g alpha min(kappa, T)` from
+    /// [`sublevel_gradient_bound`]; at 0.1 it has decayed by more than half of that bound's
+    /// decay over the span (the bound is not empty).
+    #[test]
+    fn locked_onion_decays_within_the_sublevel_bound() {
+        for alpha in [1e-4, 1e-3, 1e-2, 0.1] {
+            let m = motor_with(|p| {
+                p.onion_model = OnionModel::Gilbert;
+                p.gilbert_damping = alpha;
+            });
+            let inputs = super::super::MotorInputs {
+                rotor_locked: true,
+                ..schedule(20e-6)
+            };
+            let d = m.drive_at(&inputs, 0.0);
+            let land = m.landscape(0.0, d.direction, d.stress);
+            let well = m.onion_well(&land, 0.0).unwrap();
+            let floor = land.energy(well.minimum);
+            for fraction in [0.9, 0.98] {
+                // The point below the minimum at that height.
+                let (mut lo, mut hi) = (well.below, well.minimum);
+                for _ in 0..200 {
+                    let mid = 0.5 * (lo + hi);
+                    if land.energy(mid) - floor > fraction * well.barrier {
+                        lo = mid;
+                    } else {
+                        hi = mid;
+                    }
+                }
+                let e0 = land.energy(hi) - floor;
+                let kappa = sublevel_gradient_bound(
+                    &land,
+                    well.minimum,
+                    floor,
+                    e0,
+                    (well.below, well.above),
+                );
+                assert!(kappa > 0.0, "{alpha} {fraction}");
+                let rate = m.llg_rate * alpha * kappa.min(m.tilt_stiffness);
+                let energy =
+                    |y: &Vector| land.energy(y[2]) - floor + 0.5 * m.tilt_stiffness * y[3] * y[3];
+                let (_, j) = m.rhs_jacobian(&[0.0, 0.0, hi, 0.0], &d, 1e-12);
+                let h = 0.02 / (j[2][2].abs() + j[3][3].abs() + (j[2][3] * j[3][2]).abs().sqrt());
+                // A few of the bound's decay times, at most 2e5 steps.
+                let steps = ((3.0 / rate / h).ceil() as usize).min(200_000);
+                let rate_fn = |z: &Vector| m.rhs_jacobian(z, &d, h).0;
+                let mut y: Vector = [0.0, 0.0, hi, 0.0];
+                let mut worst = 0.0f64;
+                for n in 1..=steps {
+                    y = rk4_step(&rate_fn, &y, h);
+                    y[0] = 0.0;
+                    y[1] = 0.0;
+                    let t = n as f64 * h;
+                    let bound = e0 * (-2.0 * rate * t).exp();
+                    worst = worst.max(energy(&y) / bound);
+                    let reach = (2.0 * e0 / kappa).sqrt() * (-rate * t).exp();
+                    assert!(
+                        (y[2] - well.minimum).abs() <= reach * (1.0 + 1e-9),
+                        "{alpha} {fraction} t {t:e}: {} beyond {reach}",
+                        y[2] - well.minimum
+                    );
+                }
+                let span = steps as f64 * h;
+                println!(
+                    "damping {alpha}, {fraction} of the rim: kappa {kappa:e}, rate {rate:e} 1/s over {span:e} s: energy at most {worst} of the bound, ends at {} of E0",
+                    energy(&y) / e0
+                );
+                assert!(worst <= 1.0 + 1e-9, "{alpha} {fraction}: {worst}");
+                if alpha == 0.1 {
+                    assert!(energy(&y) / e0 < (-rate * span).exp(), "{alpha} {fraction}");
+                }
+            }
+        }
+    }
+}
