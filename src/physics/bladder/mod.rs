@@ -351,6 +351,17 @@ impl<S: SleeveGeometry> Bladder<S> {
             k.elastic = elastic;
             // Only the innermost layer's `-P V_1 / L` moves with `P` at fixed `(L, x)`.
             k.elastic_dp = [Dual::constant(innermost_volume), l.recip()];
+        } else {
+            let at_root = match self.wall {
+                Wall::DissertationContinuum(_) => self.continuum_free_elastic(l, x),
+                Wall::Exact(_) => self.exact_free_elastic(l, x),
+                Wall::Layers(_) | Wall::DissertationLayers(_) => None,
+            };
+            if let Some(elastic) = at_root {
+                k.elastic = elastic;
+                // The pressure enters through the root only.
+                k.elastic_dp = [Dual::constant(0.0); 2];
+            }
         }
         Ok(k)
     }

@@ -825,3 +825,50 @@ fn collapsed_layers_carry_the_vacuum_in_the_innermost_layer() {
         }
     }
 }
+
+/// Where a vacuum has pulled the free bore of a nearly stress-free rubber (`C2` 1.7e-4 Pa, no
+/// `C1`) nearly closed, every wall's force is a smooth function of the length: its change over
+/// 1e-6 of the length is the analytic stiffness times that step (the implicit function theorem
+/// through the root, computed apart from the force), to 1e-3 of it. Written with the gas
+/// pressure from the inside out, the force scattered by up to newtons between such lengths.
+#[test]
+fn collapsed_free_force_is_smooth_in_every_wall() {
+    let (_, lr0, d_ri, t, b, n) = TABLE_2_1[A];
+    let tube = BladderTube {
+        mooney_c1: 0.0,
+        mooney_c2: 1.716e-4,
+        ..BladderTube::latex(d_ri, t, lr0)
+    };
+    let walls = [
+        Wall::DissertationLayers(14),
+        Wall::Layers(14),
+        Wall::DissertationContinuum(16),
+        Wall::Exact(16),
+    ];
+    for wall in walls {
+        let bl = Bladder::with_wall(Sleeve::new(b, n).unwrap(), tube, wall).unwrap();
+        let (lo, hi) = (bl.min_length(), bl.max_length());
+        for p in [-1e3, -1.371e4, -1e5] {
+            let mut free = 0;
+            for i in 1..100 {
+                let l = lo + (hi - lo) * f64::from(i) / 100.0;
+                let (Ok(s), Ok(next)) = (bl.evaluate(p, l), bl.evaluate(p, l * (1.0 + 1e-6)))
+                else {
+                    continue;
+                };
+                if s.contact || next.contact {
+                    continue;
+                }
+                free += 1;
+                assert!(s.stretch_hoop < 0.1, "{wall:?} {p} {l}: {}", s.stretch_hoop);
+                let step = s.stiffness * l * 1e-6;
+                let change = next.force - s.force;
+                assert!(
+                    (change - step).abs() <= 1e-3 * step.abs(),
+                    "{wall:?} {p} Pa {l} m: {change} N against {step} N"
+                );
+            }
+            assert!(free > 50, "{wall:?} {p}: {free} free lengths");
+        }
+    }
+}
