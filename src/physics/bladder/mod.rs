@@ -62,6 +62,11 @@ pub const MOONEY_C1: f64 = 161e3;
 pub const MOONEY_C2: f64 = 39e3;
 /// Largest accepted number of layers: far past convergence, and it bounds the per-call work.
 pub const MAX_LAYERS: usize = 4096;
+/// The bore's squared hoop stretch below which a free bladder's axial force is taken from the
+/// outside in (see `free_kernel`). The outward form's rounding grows as its inverse (a vacuum on
+/// a nearly stress-free rubber pulls it to 1e-8 and below); above it both forms agree to
+/// rounding, and the outward one, which the kernel has already computed, is kept.
+const PULLED_IN_BORE: f64 = 1e-2;
 
 /// The relaxed bladder tube before it is clamped into the sleeve (Table 2.1 columns).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -331,7 +336,9 @@ impl<S: SleeveGeometry> Bladder<S> {
         check_state(state, length)
     }
 
-    /// The wall's kernel at the free bladder's outer diameter (eq. 2.18), seeded in `L` and `x`.
+    /// The wall's kernel at the free bladder's outer diameter (eq. 2.18), seeded in `L` and `x`;
+    /// where the bore is pulled in below [`PULLED_IN_BORE`], with the axial force taken from the
+    /// outside in.
     fn free_kernel(
         &self,
         pressure: f64,
@@ -347,6 +354,9 @@ impl<S: SleeveGeometry> Bladder<S> {
                 .kernel(pressure, l, x)
                 .ok_or_else(|| self.domain_error(length))?,
         };
+        if k.inner.l2_sq.v >= PULLED_IN_BORE {
+            return Ok(k);
+        }
         if let Some((elastic, innermost_volume)) = self.free_layers_elastic(pressure, l, x, &k) {
             k.elastic = elastic;
             // Only the innermost layer's `-P V_1 / L` moves with `P` at fixed `(L, x)`.
