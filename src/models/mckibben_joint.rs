@@ -49,6 +49,9 @@ pub struct McKibbenJoint {
     /// The straight strands' axial stiffness `k_s = E A / b` of each muscle, N/m (from
     /// `strand_rigidity`): past `max_length` the strands stretch, as in McKibbenMuscle.
     strand_stiffness: f64,
+    /// `out_of_range_policy` 2: a step whose input is out of range is refused, so a step that
+    /// takes a muscle past its breaking length is refused before either muscle is evaluated.
+    refuse_out_of_range: bool,
 }
 
 /// One muscle at one pressure and length: its outputs, why they are clamped (if so), and its
@@ -292,6 +295,31 @@ impl McKibbenJoint {
         })
     }
 
+    /// Why a step at `inputs` is refused under `out_of_range_policy` 2 without evaluating it: a
+    /// muscle past its breaking length (McKibbenMuscle's reason; without a connector its range
+    /// test decides, whatever the pressure). The flexor's reason if both are.
+    fn refused_past_breaking(&self, inputs: &Inputs) -> Option<OutOfRange> {
+        let q = inputs.joint_position;
+        let lengths = [
+            self.flexor_rest_length - self.moment_arm * q,
+            self.extensor_rest_length + self.moment_arm * q,
+        ];
+        let (pc, pmax) = (self.common_mode_pressure, self.max_pressure);
+        // With a torque command the pressures are not known before the solve; the range test
+        // does not need them.
+        let difference = if self.torque_command {
+            0.0
+        } else {
+            inputs.actuator_input
+        };
+        let pressures = pair_pressures(pc, difference, pmax);
+        let histories = [&self.flexor_friction, &self.extensor_friction];
+        (0..2).find_map(|i| {
+            self.muscle
+                .refused_past_breaking(pressures[i], lengths[i], histories[i])
+        })
+    }
+
     /// `[dF/dP, dF/dL]` of one muscle on the branch `compute` takes: 0 while slack.
     fn muscle_partials(&self, pressure: f64, length: f64, history: &HysteresisState) -> [f64; 2] {
         match self.signed_force_and_partials(pressure, length, history) {
@@ -380,6 +408,7 @@ impl Model for McKibbenJoint {
             torque_command,
             signed_force: p.signed_force,
             strand_stiffness,
+            refuse_out_of_range: p.out_of_range_policy == 2,
         })
     }
 
@@ -472,6 +501,17 @@ impl Model for McKibbenJoint {
         _step: f64,
         report: &mut Report,
     ) {
+        if self.refuse_out_of_range {
+            // The step is refused (fmi2Discard): its outputs and histories stay.
+            if let Some(e) = self.refused_past_breaking(inputs) {
+                let q = inputs.joint_position;
+                report.clamp(!self.out_of_range, || {
+                    format!("jointPosition {q} rad: {}", e.message())
+                });
+                self.out_of_range = true;
+                return;
+            }
+        }
         // Quasi-static, as McKibbenMuscle: the held inputs fix the outputs at the end of the step
         // and each friction history follows its muscle's length at the communication points.
         if let Some(pair) = self.compute(inputs, report) {
@@ -578,6 +618,54 @@ mod tests {
                 assert!((rise - k_s * dl).abs() < 1e-5 * k_s * dl, "{l}: {rise}");
             }
             previous = out.extensor_force;
+        }
+    }
+
+    /// Under `out_of_range_policy` 2 a step that takes the extensor past its breaking length is
+    /// refused before either muscle is evaluated (no wall evaluation, in either command mode):
+    /// the outputs and both friction histories stay as the last accepted step left them, and the
+    /// report flags the excursion with McKibbenMuscle's reason. Under policy 0 the same step is
+    /// evaluated, the extensor's strands held at the breaking length.
+    #[test]
+    fn a_refused_step_past_breaking_is_not_evaluated() {
+        let kernels = crate::physics::bladder::kernel_count;
+        for (policy, mode) in [(0, 0), (2, 0), (0, 1), (2, 1)] {
+            let p = Parameters {
+                preset: 1,
+                bladder_model: 1,
+                friction: true,
+                command_mode: mode,
+                out_of_range_policy: policy,
+                ..Default::default()
+            };
+            let mut j = joint(&p);
+            let u = if mode == 1 { 0.1 } else { 1e5 };
+            let (before, clamped) = at(&mut j, u, 0.0);
+            assert!(!clamped);
+            let histories = (j.flexor_friction, j.extensor_friction);
+            let far = (1.2 * j.muscle.breaking_length() - p.extensor_rest_length) / p.moment_arm;
+            let x = Inputs {
+                actuator_input: u,
+                joint_position: far,
+                joint_velocity: 0.0,
+            };
+            let mut out = before.clone();
+            let mut report = Report::default();
+            let evaluations = kernels();
+            j.step(&x, &mut out, 1e-3, 1e-3, &mut report);
+            let evaluations = kernels() - evaluations;
+            assert!(report.clamped());
+            let why = report.clamp_messages().join("");
+            assert!(why.contains("past max_length"), "{why}");
+            if policy == 2 {
+                assert_eq!(evaluations, 0, "mode {mode}");
+                assert_eq!(out.joint_torque, before.joint_torque);
+                assert_eq!((j.flexor_friction, j.extensor_friction), histories);
+                assert!(why.contains("holding the previous outputs"), "{why}");
+            } else {
+                assert!(evaluations > 0);
+                assert!(out.extensor_force > before.extensor_force, "mode {mode}");
+            }
         }
     }
 

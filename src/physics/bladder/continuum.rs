@@ -190,6 +190,30 @@ impl<S: SleeveGeometry> Bladder<S> {
         l: T,
         x: T,
     ) -> Option<Kernel<T>> {
+        self.continuum_parts::<T, false>(pressure, l, x)
+            .map(|(k, _)| k)
+    }
+
+    /// The continuum wall's elastic force at a free root, `P_eff = 0` (eq. 2.17 through the
+    /// wall): with `P / d_in = G(D_RO)` there, the pressure through the wall is taken from the
+    /// outside in, `p(s) = d(s) (G(D_RO) - G(s))`, and `int p w ds = G(D_RO) Phi(D_RI) - int g Phi ds`
+    /// loses the `x^3 G(D_RO)` both of its terms carry. Written with `P / d_in`, as the kernel
+    /// does for any `x`, those terms cancel to the root's residual: where a vacuum has pulled
+    /// the bore nearly closed, `G(D_RO)` is huge and a root known to rounding leaves the force
+    /// wrong by newtons. A function of `(L, x)` only. `None` outside the geometry.
+    pub(super) fn continuum_free_elastic(&self, l: Dual, x: Dual) -> Option<Dual> {
+        self.continuum_parts::<Dual, true>(0.0, l, x)?.1
+    }
+
+    /// [`Self::continuum_kernel`], with [`Self::continuum_free_elastic`] at `(L, x)` if `AT_ROOT`
+    /// (decided at compile time: the kernel's own calls compute nothing more).
+    #[inline(always)]
+    fn continuum_parts<T: KernelScalar, const AT_ROOT: bool>(
+        &self,
+        pressure: f64,
+        l: T,
+        x: T,
+    ) -> Option<(Kernel<T>, Option<T>)> {
         let c1x2 = 2.0 * self.tube.mooney_c1;
         let c2x2 = 2.0 * self.tube.mooney_c2;
         let lambda1 = l * (1.0 / self.tube.unstretched_length);
@@ -247,7 +271,10 @@ impl<S: SleeveGeometry> Bladder<S> {
         let phi_in = (x_cu - d_in_sq * d_in) * (PI / 6.0);
         let elastic =
             (axial_sum * (PI / 2.0) + h_phi_sum * (PI / 6.0)) * span - phi_in * inv_d_in * pressure;
-        Some(Kernel {
+        let at_root = AT_ROOT.then(|| {
+            (axial_sum * (PI / 2.0) + (d_in_sq * d_in * h_sum - hoop_sum) * (PI / 6.0)) * span
+        });
+        let kernel = Kernel {
             a,
             c,
             p_eff,
@@ -260,7 +287,8 @@ impl<S: SleeveGeometry> Bladder<S> {
                 axial: axial_in,
                 hoop: hoop_in,
             },
-        })
+        };
+        Some((kernel, at_root))
     }
 }
 

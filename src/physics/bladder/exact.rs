@@ -29,6 +29,7 @@
 use super::continuum::KernelScalar;
 use super::continuum::{WallCall, WallWeight};
 use super::{Bladder, InnerLayer, Kernel, SleeveGeometry};
+use crate::physics::numerics::dual::Dual;
 use std::f64::consts::PI;
 
 impl<S: SleeveGeometry> Bladder<S> {
@@ -41,6 +42,26 @@ impl<S: SleeveGeometry> Bladder<S> {
         l: T,
         x: T,
     ) -> Option<Kernel<T>> {
+        self.exact_parts::<T, false>(pressure, l, x).map(|(k, _)| k)
+    }
+
+    /// The exact wall's axial force at a free root, `P_eff = 0`: with `P = int h dr / r` there,
+    /// `N = int g 2 pi r dr - int h pi r dr + P pi r_in^2` (the pressure through the wall taken
+    /// from the outside in), without the `x^2 P` that both of the kernel's terms carry and that
+    /// cancel to the root's residual. A function of `(L, x)` only. `None` outside the geometry.
+    pub(super) fn exact_free_elastic(&self, l: Dual, x: Dual) -> Option<Dual> {
+        self.exact_parts::<Dual, true>(0.0, l, x)?.1
+    }
+
+    /// [`Self::exact_kernel`], with [`Self::exact_free_elastic`] at `(L, x)` if `AT_ROOT`
+    /// (decided at compile time: the kernel's own calls compute nothing more).
+    #[inline(always)]
+    fn exact_parts<T: KernelScalar, const AT_ROOT: bool>(
+        &self,
+        pressure: f64,
+        l: T,
+        x: T,
+    ) -> Option<(Kernel<T>, Option<T>)> {
         let c1x2 = 2.0 * self.tube.mooney_c1;
         let c2x2 = 2.0 * self.tube.mooney_c2;
         let lambda1 = l * (1.0 / self.tube.unstretched_length);
@@ -80,7 +101,9 @@ impl<S: SleeveGeometry> Bladder<S> {
         // pi/4 int g du + pi/8 (x^2 int h du / u - int h du) - P V_R / L.
         let elastic = (axial_sum * (PI / 2.0) + (x_sq * h_per_u - hoop_sum) * (PI / 4.0)) * span
             - rubber_area * pressure;
-        Some(Kernel {
+        let at_root = AT_ROOT
+            .then(|| (axial_sum * (PI / 2.0) + (d_in_sq * h_per_u - hoop_sum) * (PI / 4.0)) * span);
+        let kernel = Kernel {
             a: T::constant(1.0),
             c,
             p_eff,
@@ -93,6 +116,7 @@ impl<S: SleeveGeometry> Bladder<S> {
                 axial: axial_in,
                 hoop: hoop_in,
             },
-        })
+        };
+        Some((kernel, at_root))
     }
 }

@@ -62,6 +62,11 @@ pub const MOONEY_C1: f64 = 161e3;
 pub const MOONEY_C2: f64 = 39e3;
 /// Largest accepted number of layers: far past convergence, and it bounds the per-call work.
 pub const MAX_LAYERS: usize = 4096;
+/// The bore's squared hoop stretch below which a free bladder's axial force is taken from the
+/// outside in (see `free_kernel`). The outward form's rounding grows as its inverse (a vacuum on
+/// a nearly stress-free rubber pulls it to 1e-8 and below); above it both forms agree to
+/// rounding, and the outward one, which the kernel has already computed, is kept.
+const PULLED_IN_BORE: f64 = 1e-2;
 
 /// The relaxed bladder tube before it is clamped into the sleeve (Table 2.1 columns).
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -331,7 +336,9 @@ impl<S: SleeveGeometry> Bladder<S> {
         check_state(state, length)
     }
 
-    /// The wall's kernel at the free bladder's outer diameter (eq. 2.18), seeded in `L` and `x`.
+    /// The wall's kernel at the free bladder's outer diameter (eq. 2.18), seeded in `L` and `x`;
+    /// where the bore is pulled in below [`PULLED_IN_BORE`], with the axial force taken from the
+    /// outside in.
     fn free_kernel(
         &self,
         pressure: f64,
@@ -340,12 +347,91 @@ impl<S: SleeveGeometry> Bladder<S> {
         contact: &Kernel,
     ) -> Result<Kernel, String> {
         let (x_root, at_root) = self.free_outer_diameter(pressure, length, x_contact, contact)?;
-        match at_root {
-            Some(k) => Ok(k),
+        let (l, x) = (Dual::var_l(length), Dual::var_x(x_root));
+        let mut k = match at_root {
+            Some(k) => k,
             None => self
-                .kernel(pressure, Dual::var_l(length), Dual::var_x(x_root))
-                .ok_or_else(|| self.domain_error(length)),
+                .kernel(pressure, l, x)
+                .ok_or_else(|| self.domain_error(length))?,
+        };
+        if k.inner.l2_sq.v >= PULLED_IN_BORE {
+            return Ok(k);
         }
+        if let Some((elastic, innermost_volume)) = self.free_layers_elastic(pressure, l, x, &k) {
+            k.elastic = elastic;
+            // Only the innermost layer's `-P V_1 / L` moves with `P` at fixed `(L, x)`.
+            k.elastic_dp = [Dual::constant(innermost_volume), l.recip()];
+        } else {
+            let at_root = match self.wall {
+                Wall::DissertationContinuum(_) => self.continuum_free_elastic(l, x),
+                Wall::Exact(_) => self.exact_free_elastic(l, x),
+                Wall::Layers(_) | Wall::DissertationLayers(_) => None,
+            };
+            if let Some(elastic) = at_root {
+                k.elastic = elastic;
+                // The pressure enters through the root only.
+                k.elastic_dp = [Dual::constant(0.0); 2];
+            }
+        }
+        Ok(k)
+    }
+
+    /// The layered walls' elastic force at a free root `k` (eq. 2.17 summed over the layers),
+    /// with the outer layers' pressures taken from the outside in, from the free bladder's
+    /// `P_eff = 0`: `p_in = (p_out + hoop k) / (1 + k)` of eq. 2.19 (`p_in = p_out + hoop k` for
+    /// the balanced layers), and the innermost layer's the gas's `P`. At the exact root the
+    /// outward recursion gives the same pressures; but a bore pulled nearly closed by a vacuum
+    /// multiplies them by the innermost layer's `1 + k` (millions), so a root known to rounding
+    /// leaves them, and the force, wrong by newtons, where inwards each step divides by it.
+    /// With the innermost layer's rubber volume (its `-P V_1 / L` is the only term moving with
+    /// `P` at fixed `(L, x)`). `None` for the quadrature walls, or outside the geometry.
+    fn free_layers_elastic(
+        &self,
+        pressure: f64,
+        l: Dual,
+        x: Dual,
+        k: &Kernel,
+    ) -> Option<(Dual, f64)> {
+        let as_written = match self.wall {
+            Wall::Layers(_) => false,
+            Wall::DissertationLayers(_) => true,
+            Wall::Exact(_) | Wall::DissertationContinuum(_) => return None,
+        };
+        let c1x2 = 2.0 * self.tube.mooney_c1;
+        let c2x2 = 2.0 * self.tube.mooney_c2;
+        let lambda1 = l * (1.0 / self.tube.unstretched_length);
+        let inv_lambda1 = lambda1.recip();
+        let lambda1_sq = lambda1 * lambda1;
+        let inv_lambda1_sq = inv_lambda1 * inv_lambda1;
+        let x_sq = x * x;
+        let (innermost, outer) = self.layers.split_first()?;
+        let mut sum = (k.inner.axial + (-pressure)) * innermost.rubber_volume;
+        let mut p_out = Dual::constant(0.0);
+        for layer in outer.iter().rev() {
+            // As in `layered_kernel`: eq. 2.20, 2.9a-b and eq. 2.19's k of the layer.
+            let l2_sq = (x_sq - inv_lambda1 * layer.excess_sq) * layer.inv_d0_sq;
+            if !(l2_sq.v > 0.0 && l2_sq.v.is_finite()) {
+                return None;
+            }
+            let inv_l2_sq = l2_sq.recip();
+            let l3_sq = inv_lambda1_sq * inv_l2_sq;
+            let inv_l3_sq = lambda1_sq * l2_sq;
+            let hoop = (l2_sq - l3_sq) * c1x2 - (inv_l2_sq - inv_l3_sq) * c2x2;
+            let axial = (lambda1_sq - l3_sq) * c1x2 - (inv_lambda1_sq - inv_l3_sq) * c2x2;
+            let k = inv_lambda1 * inv_l2_sq * layer.wall_ratio;
+            let p_in = if as_written {
+                (p_out + hoop * k) * (k + 1.0).recip()
+            } else {
+                p_out + hoop * k
+            };
+            sum = sum + (axial - p_in) * layer.rubber_volume;
+            p_out = p_in;
+        }
+        let elastic = sum * l.recip();
+        elastic
+            .v
+            .is_finite()
+            .then_some((elastic, innermost.rubber_volume))
     }
 
     fn check_length(&self, length: f64) -> Result<(), String> {
@@ -482,6 +568,12 @@ impl<S: SleeveGeometry> Bladder<S> {
             inner,
         })
     }
+}
+
+/// Wall evaluations on this thread so far (tests only).
+#[cfg(test)]
+pub(crate) fn kernel_count() -> usize {
+    KERNELS.with(|n| n.get())
 }
 
 #[cfg(test)]

@@ -765,3 +765,110 @@ fn free_root_is_the_bisected_root_of_eq_2_18() {
         }
     }
 }
+
+/// A nearly stress-free rubber (`C2` 1.7e-4 Pa, no `C1`) under a vacuum pulls the free bore in
+/// to about 1e-4 of its diameter. In that limit the dissertation's layers (eq. 2.19) carry the
+/// whole vacuum in their innermost layer (its own pressure is `P`; the outer layers', like the rubber's own
+/// stresses, are of order `C2 / lambda_1^2`), so the force is `-P V_1 / L`, `V_1` that layer's
+/// rubber volume, and the stiffness its slope `P V_1 / L^2`, within the rubber's stresses over
+/// its whole volume. Evaluated from the inside out, the outer layers' pressures take the
+/// innermost layer's factor `1 + k` (millions) times the root's rounding: the force scattered by
+/// newtons between adjacent lengths.
+#[test]
+fn collapsed_layers_carry_the_vacuum_in_the_innermost_layer() {
+    let (_, lr0, d_ri, t, b, n) = TABLE_2_1[A];
+    let c2 = 1.716e-4;
+    let tube = BladderTube {
+        mooney_c1: 0.0,
+        mooney_c2: c2,
+        ..BladderTube::latex(d_ri, t, lr0)
+    };
+    let layers = 14;
+    let step = 2.0 * t / layers as f64;
+    let inner_volume = PI / 4.0 * ((d_ri + step).powi(2) - d_ri * d_ri) * lr0;
+    let wall = Wall::DissertationLayers(layers);
+    let bl = Bladder::with_wall(Sleeve::new(b, n).unwrap(), tube, wall).unwrap();
+    let (lo, hi) = (bl.min_length(), bl.max_length());
+    {
+        for p in [-1e3, -1.371e4, -1e5] {
+            let mut free = 0;
+            for i in 1..400 {
+                let l = lo + (hi - lo) * f64::from(i) / 400.0;
+                let Ok(s) = bl.evaluate(p, l) else { continue };
+                if s.contact {
+                    continue;
+                }
+                free += 1;
+                assert!(
+                    s.stretch_hoop < 1e-3,
+                    "{wall:?} {p} {l}: {}",
+                    s.stretch_hoop
+                );
+                let force = -p * inner_volume / l;
+                // The rubber's stresses, 2 C2 (1/lambda_1^2 + 1) at most, over its volume.
+                let lambda1 = l / lr0;
+                let rubber = 2.0 * c2 * (lambda1.powi(-2) + 1.0) * bl.rubber_volume() / l;
+                let what = format!("{wall:?} {p} Pa {l} m");
+                assert!(
+                    (s.force - force).abs() <= 5.0 * rubber,
+                    "{what}: {}",
+                    s.force
+                );
+                let slope = -force / l;
+                assert!(
+                    (s.stiffness - slope).abs() <= 15.0 * rubber / l,
+                    "{what}: {}",
+                    s.stiffness
+                );
+            }
+            assert!(free > 200, "{wall:?} {p}: {free} free lengths");
+        }
+    }
+}
+
+/// Where a vacuum has pulled the free bore of a nearly stress-free rubber (`C2` 1.7e-4 Pa, no
+/// `C1`) nearly closed, every wall's force is a smooth function of the length: its change over
+/// 1e-6 of the length is the analytic stiffness times that step (the implicit function theorem
+/// through the root, computed apart from the force), to 1e-3 of it. Written with the gas
+/// pressure from the inside out, the force scattered by up to newtons between such lengths.
+#[test]
+fn collapsed_free_force_is_smooth_in_every_wall() {
+    let (_, lr0, d_ri, t, b, n) = TABLE_2_1[A];
+    let tube = BladderTube {
+        mooney_c1: 0.0,
+        mooney_c2: 1.716e-4,
+        ..BladderTube::latex(d_ri, t, lr0)
+    };
+    let walls = [
+        Wall::DissertationLayers(14),
+        Wall::Layers(14),
+        Wall::DissertationContinuum(16),
+        Wall::Exact(16),
+    ];
+    for wall in walls {
+        let bl = Bladder::with_wall(Sleeve::new(b, n).unwrap(), tube, wall).unwrap();
+        let (lo, hi) = (bl.min_length(), bl.max_length());
+        for p in [-1e3, -1.371e4, -1e5] {
+            let mut free = 0;
+            for i in 1..100 {
+                let l = lo + (hi - lo) * f64::from(i) / 100.0;
+                let (Ok(s), Ok(next)) = (bl.evaluate(p, l), bl.evaluate(p, l * (1.0 + 1e-6)))
+                else {
+                    continue;
+                };
+                if s.contact || next.contact {
+                    continue;
+                }
+                free += 1;
+                assert!(s.stretch_hoop < 0.1, "{wall:?} {p} {l}: {}", s.stretch_hoop);
+                let step = s.stiffness * l * 1e-6;
+                let change = next.force - s.force;
+                assert!(
+                    (change - step).abs() <= 1e-3 * step.abs(),
+                    "{wall:?} {p} Pa {l} m: {change} N against {step} N"
+                );
+            }
+            assert!(free > 50, "{wall:?} {p}: {free} free lengths");
+        }
+    }
+}
