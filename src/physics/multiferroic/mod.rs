@@ -52,6 +52,8 @@ mod onion_periods;
 #[cfg(test)]
 mod onion_periods_tests;
 #[cfg(test)]
+mod resolved_tests;
+#[cfg(test)]
 mod onion_tests;
 mod orbit;
 mod orbit_advance;
