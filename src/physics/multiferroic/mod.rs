@@ -52,8 +52,6 @@ mod onion_periods;
 #[cfg(test)]
 mod onion_periods_tests;
 #[cfg(test)]
-mod resolved_tests;
-#[cfg(test)]
 mod onion_tests;
 mod orbit;
 mod orbit_advance;
@@ -64,6 +62,8 @@ mod orbit_theory_tests;
 mod params;
 mod periods;
 pub mod phi;
+#[cfg(test)]
+mod resolved_tests;
 mod rhs;
 mod ringing;
 pub mod schedule;
