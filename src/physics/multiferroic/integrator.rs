@@ -434,6 +434,15 @@ impl Motor {
                 };
             }
             Some((_, err, _, _)) => run.dt = (dt_try * step_factor(err)).max(dt_min),
+            None if forced && !self.quasi_static() && self.onion_relaxes_fast() => {
+                // The Gilbert onion left its bounds (its tilt beyond 10 rad on a steep landscape)
+                // even at the smallest allowed substep: flagged, the next pass drops its ringing
+                // and follows its branch from here ([`Motor::follows_branch`]), the rotor's speed
+                // kept (zeroing it would lose its coasting distance `omega I / c` each time).
+                run.limited = true;
+                run.settled = false;
+                run.dt = dt_try;
+            }
             None if forced => {
                 // The linearization overflowed (or the rotor left `MAX_ANGLE`) even at the
                 // smallest allowed substep: hold the state over it rather than produce garbage.

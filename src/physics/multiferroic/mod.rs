@@ -62,6 +62,8 @@ mod orbit_theory_tests;
 mod params;
 mod periods;
 pub mod phi;
+#[cfg(test)]
+mod resolved_tests;
 mod rhs;
 mod ringing;
 pub mod schedule;

@@ -6,7 +6,7 @@ use super::*;
 use std::collections::HashMap;
 
 /// `name=value` pairs as the worst-case benchmark prints a case (the FMU's variable names).
-fn values(text: &str) -> HashMap<String, f64> {
+pub(super) fn values(text: &str) -> HashMap<String, f64> {
     text.split_whitespace()
         .filter_map(|p| {
             let (k, v) = p.split_once('=')?;
@@ -18,7 +18,7 @@ fn values(text: &str) -> HashMap<String, f64> {
 /// The motor, its start (rotor at rest at 0, the onion `initial_onion_offset` from it) and its
 /// inputs for a case's values, the FMU's start values elsewhere; `Err` if the motor refuses
 /// them (the printed digits can make two diameters equal).
-fn case(kv: &HashMap<String, f64>) -> Result<(Motor, MotorState, MotorInputs), String> {
+pub(super) fn case(kv: &HashMap<String, f64>) -> Result<(Motor, MotorState, MotorInputs), String> {
     let mut p = MotorParams::table_3_1();
     let g = |k: &str, d: f64| kv.get(k).copied().unwrap_or(d);
     p.ring_outer_diameter = g("ring_outer_diameter", p.ring_outer_diameter);

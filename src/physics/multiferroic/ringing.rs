@@ -93,10 +93,10 @@ impl Motor {
     /// once it is trapped, at the cost of the onion's outputs: it is reported at the centre of its
     /// ringing, the minimum, not at the ringing's phase.
     ///
-    /// A locked rotor feels no ringing: trapped ringing is also dropped there when it decays to
-    /// within the tolerance of the minimum in the `remaining` time of its segment (s), at its
-    /// bound on the decay rate, so that the onion meets the segment's end (the step's end or the
-    /// next switch) where the resolved one does.
+    /// A locked rotor takes no impulse, so those bounds decide nothing for it: trapped ringing is
+    /// dropped there only when it decays to within the tolerance of the minimum in the `remaining`
+    /// time of its segment (s), at its bound on the decay rate, so that the onion meets the
+    /// segment's end (the step's end or the next switch) where the resolved one does.
     pub(super) fn averaged_ringing(
         &self,
         y: &Vector,
@@ -119,14 +119,18 @@ impl Motor {
         };
         let trap = self.trapped_ringing(y, d, settled, Some((rim_barrier, least_rate)))?;
         if let Some((level, rims)) = trap.sublevel {
-            // Out to the rims: the ringing dies out within the segment (a locked rotor), or its
-            // whole torque moves the rotor too little. (A NaN fails every bound.)
+            // Out to the rims: the ringing dies out within the segment (a locked rotor: it takes
+            // no impulse, so only that counts), or its whole torque moves the rotor too little.
+            // (A NaN fails every bound.)
             let tol = self.params.tolerance;
             let passes = |amplitude: f64, rate: f64| {
-                (d.locked && amplitude * (-rate * remaining).exp() <= tol)
-                    || (speed * self.drag <= limit * rate
+                if d.locked {
+                    amplitude * (-rate * remaining).exp() <= tol
+                } else {
+                    speed * self.drag <= limit * rate
                         && amplitude * (k_bar.abs() + self.ring_bar_slope_bound * amplitude)
-                            <= limit * rate)
+                            <= limit * rate
+                }
             };
             if passes(trap.amplitude, trap.rate) {
                 return Some(0.0);
@@ -155,8 +159,10 @@ impl Motor {
             return (kappa > 0.0 && passes(amplitude, g * alpha * kappa.min(t))).then_some(0.0);
         }
         let (amplitude, rate) = (trap.amplitude, trap.rate);
-        if d.locked && amplitude * (-rate * remaining).exp() <= self.params.tolerance {
-            return Some(0.0);
+        // A locked rotor takes no impulse, so the bounds below on it decide nothing: its onion's
+        // ringing is dropped only once it has decayed by the segment's end.
+        if d.locked {
+            return (amplitude * (-rate * remaining).exp() <= self.params.tolerance).then_some(0.0);
         }
         // (A NaN fails every bound below.)
         if speed * self.drag > limit * rate {
@@ -169,9 +175,6 @@ impl Motor {
                 * amplitude
                 / (4.0 * rate);
             if second <= limit {
-                if d.locked {
-                    return Some(0.0);
-                }
                 let offset = (alpha * (y[2] - settled) - y[3]) / (g * k * (1.0 + alpha * alpha));
                 return Some(k_bar * offset / self.inertia);
             }

@@ -1,0 +1,126 @@
+//! The resolved Gilbert path against independent truths: a locked rotor's onion against an RK4
+//! of the macrospin, a free rotor under load and drag against its exact solution.
+
+use super::onion_periods_tests::{case, values};
+use super::*;
+
+/// A benchmark case: a weakly damped Gilbert onion (damping 1.26e-2) on a 12 ns schedule, the
+/// ring's torque on the rotor negligible.
+const PRECESSING: &str = "load_torque=-2.671e-7 ring_outer_diameter=2.661e-6 \
+    ring_inner_diameter=6.941e-7 bar_length=3.855e-7 bar_width=3.392e-8 thickness=1.165e-8 \
+    saturation_magnetization=1.712e4 magnetostriction=-7.157e-3 wall_volume=6.328e-11 \
+    density=3.751e4 fluid_viscosity=7.833e4 gilbert_damping=1.257e-2 tolerance=7.966e-6 \
+    step_angle=-3.418e0 step_period=1.226e-8 stress_amplitude=2.279e0 \
+    schedule_initial_direction=-7.294e-5 onion_model=1 max_substeps=5.930e2 schedule=1 \
+    initial_onion_offset=-5.832e-5";
+
+/// Classical RK4 of the motor's ODE (its right-hand side alone, at `per_ns` equal substeps per
+/// nanosecond of each segment of constant drive) from `state` to `t_end`.
+fn rk4(m: &Motor, state: &MotorState, inputs: &MotorInputs, t_end: f64, per_ns: f64) -> Vector {
+    let mut y = [
+        state.rotor_angle,
+        state.rotor_speed,
+        state.onion_angle,
+        state.onion_tilt,
+    ];
+    let mut t = state.time;
+    let s = inputs.schedule.get().unwrap();
+    while t < t_end {
+        let next = s.next_switch_after(t).min(t_end);
+        let d = m.drive_at(inputs, t);
+        let n = ((next - t) * 1e9 * per_ns).ceil().max(1.0) as usize;
+        let h = (next - t) / n as f64;
+        let f = |y: &Vector| m.rhs_jacobian(y, &d, 1e-300).0;
+        for _ in 0..n {
+            let k1 = f(&y);
+            let y2: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]);
+            let k2 = f(&y2);
+            let y3: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]);
+            let k3 = f(&y3);
+            let y4: Vector = std::array::from_fn(|i| y[i] + h * k3[i]);
+            let k4 = f(&y4);
+            for i in 0..4 {
+                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+            }
+        }
+        t = next;
+    }
+    y
+}
+
+/// The same motor with `tolerance / 100` and a budget of 1e8 substeps.
+fn fine(m: &Motor) -> Motor {
+    let mut p = m.params.clone();
+    p.tolerance *= 0.01;
+    p.max_substeps = 100_000_000;
+    Motor::new(p).unwrap()
+}
+
+/// A locked rotor's onion, ringing through every switch of a 12 ns schedule (its decay rate
+/// bound lets it fall by only a fraction per period), against an RK4 of the macrospin: the
+/// averaged ringing may drop it only once it has decayed within its segment. Dropping it at
+/// every switch (by bounds meant for the impulse on a free rotor) ends 14 rad away.
+#[test]
+fn locked_onion_rings_as_the_macrospin() {
+    let mut kv = values(PRECESSING);
+    kv.insert("rotor_locked".into(), 1.0);
+    let (m, start, inputs) = case(&kv).unwrap();
+    let t_end = 1e-6;
+    let reference = rk4(&m, &start, &inputs, t_end, 200.0);
+    let finer = rk4(&m, &start, &inputs, t_end, 400.0);
+    let tol = m.params.tolerance;
+    assert!(
+        (reference[2] - finer[2]).abs() <= 1e-3 * tol,
+        "{reference:?} {finer:?}"
+    );
+    let mut st = start;
+    let report = fine(&m).step(&mut st, &inputs, t_end).unwrap();
+    println!("{st:?} against {reference:?}");
+    assert!(!report.accuracy_limited);
+    assert!(
+        (st.onion_angle - reference[2]).abs() <= tol && (st.onion_tilt - reference[3]).abs() <= tol,
+        "{st:?} against {reference:?}"
+    );
+}
+
+/// The repeated periods' free-rotor case: onion relaxed within each 2.16 ns switch, the ring's
+/// torque negligible, the rotor under load and drag.
+const SETTLED_FREE: &str =
+    "load_torque=1e-6 ring_outer_diameter=3.253e-1 ring_inner_diameter=1.279e-1 \
+         bar_length=4e-5 bar_width=1e-5 thickness=1e-6 saturation_magnetization=7.248e4 \
+         magnetostriction=6.666e-3 wall_volume=3.307e-11 density=6.435e3 fluid_viscosity=1e3 \
+         gilbert_damping=3.089e-3 tolerance=6.272e-4 step_angle=2.677e0 step_period=2.160e-9 \
+         stress_amplitude=-2.300e9 schedule_initial_direction=8.853e2 onion_model=1 \
+         max_substeps=1.795e4 initial_onion_offset=-3.639e-3 schedule=1";
+
+/// The onion's excursion after each switch (its tilt runs past the bound of 10 rad on this steep
+/// landscape, also in an RK4 of its equations) fails the Gilbert substeps at their smallest
+/// size; the rotor, which the ring cannot move, must keep its speed through it. Stepped one
+/// period at a time for 1 us (463 switches) with the resolved substeps at a hundredth of the
+/// tolerance, it stays on the exact load-and-drag solution `phi = L/c (t - tau (1 - e^(-t/tau)))`,
+/// `tau = I/c`; a speed reset at each switch loses `omega tau` a period, 1.26e-4 rad in all.
+#[test]
+fn free_rotor_keeps_its_speed_through_the_switches() {
+    let (m, start, inputs) = case(&values(SETTLED_FREE)).unwrap();
+    let fine = fine(&m);
+    let s = inputs.schedule.get().unwrap();
+    let (c, tau) = (m.drag, m.inertia / m.drag);
+    let mut st = start;
+    while st.time < 1e-6 {
+        let h = s.next_switch_after(st.time).min(1e-6) - st.time;
+        fine.step(&mut st, &inputs, h).unwrap();
+    }
+    let t = st.time;
+    let exact = inputs.load_torque / c * (t + tau * (-t / tau).exp_m1());
+    let speed = -inputs.load_torque / c * (-t / tau).exp_m1();
+    println!(
+        "rotor {} exact {exact}; speed {} exact {speed}",
+        st.rotor_angle, st.rotor_speed
+    );
+    assert!(
+        (st.rotor_angle - exact).abs() <= 1e-3 * m.params.tolerance,
+        "rotor {} against {exact}",
+        st.rotor_angle
+    );
+    assert!((st.rotor_speed - speed).abs() <= 1e-9 * speed.abs());
+}
