@@ -397,28 +397,12 @@ impl<S: SleeveGeometry> Bladder<S> {
             Wall::DissertationLayers(_) => true,
             Wall::Exact(_) | Wall::DissertationContinuum(_) => return None,
         };
-        let c1x2 = 2.0 * self.tube.mooney_c1;
-        let c2x2 = 2.0 * self.tube.mooney_c2;
-        let lambda1 = l * (1.0 / self.tube.unstretched_length);
-        let inv_lambda1 = lambda1.recip();
-        let lambda1_sq = lambda1 * lambda1;
-        let inv_lambda1_sq = inv_lambda1 * inv_lambda1;
-        let x_sq = x * x;
+        let stretch = self.stretch(l, x);
         let (innermost, outer) = self.layers.split_first()?;
         let mut sum = (k.inner.axial + (-pressure)) * innermost.rubber_volume;
         let mut p_out = Dual::constant(0.0);
         for layer in outer.iter().rev() {
-            // As in `layered_kernel`: eq. 2.20, 2.9a-b and eq. 2.19's k of the layer.
-            let l2_sq = (x_sq - inv_lambda1 * layer.excess_sq) * layer.inv_d0_sq;
-            if !(l2_sq.v > 0.0 && l2_sq.v.is_finite()) {
-                return None;
-            }
-            let inv_l2_sq = l2_sq.recip();
-            let l3_sq = inv_lambda1_sq * inv_l2_sq;
-            let inv_l3_sq = lambda1_sq * l2_sq;
-            let hoop = (l2_sq - l3_sq) * c1x2 - (inv_l2_sq - inv_l3_sq) * c2x2;
-            let axial = (lambda1_sq - l3_sq) * c1x2 - (inv_lambda1_sq - inv_l3_sq) * c2x2;
-            let k = inv_lambda1 * inv_l2_sq * layer.wall_ratio;
+            let LayerStress { hoop, axial, k, .. } = stretch.layer(layer)?;
             let p_in = if as_written {
                 (p_out + hoop * k) * (k + 1.0).recip()
             } else {
@@ -506,14 +490,8 @@ impl<S: SleeveGeometry> Bladder<S> {
         x: T,
         as_written: bool,
     ) -> Option<Kernel<T>> {
-        let c1x2 = 2.0 * self.tube.mooney_c1;
-        let c2x2 = 2.0 * self.tube.mooney_c2;
-        let lambda1 = l * (1.0 / self.tube.unstretched_length);
-        let inv_lambda1 = lambda1.recip();
-        let lambda1_sq = lambda1 * lambda1;
-        let inv_lambda1_sq = inv_lambda1 * inv_lambda1;
+        let stretch = self.stretch(l, x);
         let inv_l = l.recip();
-        let x_sq = x * x;
         // Pressure inside the current layer is a P - c (linear in P, a > 0), so the threshold
         // pressure c/a of the whole stack falls out of the same pass.
         let mut a = T::constant(1.0);
@@ -524,19 +502,12 @@ impl<S: SleeveGeometry> Bladder<S> {
         let mut a_sum = T::constant(0.0);
         let mut inner: Option<InnerLayer<T>> = None;
         for layer in &self.layers {
-            // Eq. 2.20 in squared form: lambda_2i^2 = (x^2 - (D_RO^2 - D_0i^2)/lambda_1) / D_0i^2.
-            let l2_sq = (x_sq - inv_lambda1 * layer.excess_sq) * layer.inv_d0_sq;
-            if !(l2_sq.value() > 0.0 && l2_sq.value().is_finite()) {
-                return None;
-            }
-            let inv_l2_sq = l2_sq.recip();
-            let l3_sq = inv_lambda1_sq * inv_l2_sq;
-            let inv_l3_sq = lambda1_sq * l2_sq;
-            // Eq. 2.9b and 2.9a without the radial stress.
-            let hoop = (l2_sq - l3_sq) * c1x2 - (inv_l2_sq - inv_l3_sq) * c2x2;
-            let axial = (lambda1_sq - l3_sq) * c1x2 - (inv_lambda1_sq - inv_l3_sq) * c2x2;
-            // lambda_3 / lambda_2 * Delta D / D_0i of eq. 2.19.
-            let k = inv_lambda1 * inv_l2_sq * layer.wall_ratio;
+            let LayerStress {
+                l2_sq,
+                hoop,
+                axial,
+                k,
+            } = stretch.layer(layer)?;
             // sigma_33 = -p_in; sigma_11 = sigma_33 + axial (eq. 2.17 for the layer).
             axial_sum = axial_sum + (axial + c) * layer.rubber_volume;
             a_sum = a_sum + a * layer.rubber_volume;
@@ -566,6 +537,68 @@ impl<S: SleeveGeometry> Bladder<S> {
             elastic,
             elastic_dp: [a_sum, inv_l],
             inner,
+        })
+    }
+}
+
+/// The axial stretch's powers, the Mooney-Rivlin constants and the squared outer diameter at
+/// `(L, x)`, from which every layer's stresses follow ([`Stretch::layer`]).
+struct Stretch<T> {
+    c1x2: f64,
+    c2x2: f64,
+    inv_lambda1: T,
+    lambda1_sq: T,
+    inv_lambda1_sq: T,
+    x_sq: T,
+}
+
+/// One layer's squared hoop stretch, its hoop and axial stress differences and eq. 2.19's `k`.
+struct LayerStress<T> {
+    l2_sq: T,
+    hoop: T,
+    axial: T,
+    k: T,
+}
+
+impl<S: SleeveGeometry> Bladder<S> {
+    #[inline(always)]
+    fn stretch<T: KernelScalar>(&self, l: T, x: T) -> Stretch<T> {
+        let lambda1 = l * (1.0 / self.tube.unstretched_length);
+        let inv_lambda1 = lambda1.recip();
+        Stretch {
+            c1x2: 2.0 * self.tube.mooney_c1,
+            c2x2: 2.0 * self.tube.mooney_c2,
+            inv_lambda1,
+            lambda1_sq: lambda1 * lambda1,
+            inv_lambda1_sq: inv_lambda1 * inv_lambda1,
+            x_sq: x * x,
+        }
+    }
+}
+
+impl<T: KernelScalar> Stretch<T> {
+    /// The layer's stresses; `None` if its squared hoop stretch is not positive (outside the
+    /// geometry) or not finite.
+    #[inline(always)]
+    fn layer(&self, layer: &Layer) -> Option<LayerStress<T>> {
+        // Eq. 2.20 in squared form: lambda_2i^2 = (x^2 - (D_RO^2 - D_0i^2)/lambda_1) / D_0i^2.
+        let l2_sq = (self.x_sq - self.inv_lambda1 * layer.excess_sq) * layer.inv_d0_sq;
+        if !(l2_sq.value() > 0.0 && l2_sq.value().is_finite()) {
+            return None;
+        }
+        let inv_l2_sq = l2_sq.recip();
+        let l3_sq = self.inv_lambda1_sq * inv_l2_sq;
+        let inv_l3_sq = self.lambda1_sq * l2_sq;
+        // Eq. 2.9b and 2.9a without the radial stress.
+        let hoop = (l2_sq - l3_sq) * self.c1x2 - (inv_l2_sq - inv_l3_sq) * self.c2x2;
+        let axial =
+            (self.lambda1_sq - l3_sq) * self.c1x2 - (self.inv_lambda1_sq - inv_l3_sq) * self.c2x2;
+        Some(LayerStress {
+            l2_sq,
+            hoop,
+            axial,
+            // lambda_3 / lambda_2 * Delta D / D_0i of eq. 2.19.
+            k: self.inv_lambda1 * inv_l2_sq * layer.wall_ratio,
         })
     }
 }
