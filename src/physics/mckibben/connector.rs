@@ -372,13 +372,9 @@ mod tests {
         assert!(!t.interior && t.rigid.force < 0.0 && t.length < m.max_length());
     }
 
-    /// Table 2.1's muscle A with an almost stress-free rubber under a vacuum, through a soft
-    /// connector: the free bladder's force is rounding noise of about a newton that jumps between
-    /// adjacent lengths, so the connector residual `L + F/k - reported` jumps across zero
-    /// at many lengths, by up to metres. A solve returns a root of the connector relation (to
-    /// `LIMIT_MARGIN` of the range at worst) or an error, never the length next to such a jump.
-    #[test]
-    fn a_solve_returns_a_root_or_nothing_where_the_force_jumps() {
+    /// Table 2.1's muscle A with an almost stress-free rubber (`mooney_c2` 1.7e-4 Pa, no
+    /// `mooney_c1`, 14 layers as written) and friction, through a soft connector of `k` N/m.
+    fn soft_rubber_muscle_a(k: f64) -> McKibben {
         let g = MuscleGeometry::muscle_a();
         let tube = BladderTube {
             mooney_c1: 0.0,
@@ -390,8 +386,16 @@ mod tests {
             coefficient: 6.289e-3,
             presliding_length: 2.683e-8,
         };
+        McKibben::new(g.sleeve().unwrap(), tube, model, Some(friction), k).unwrap()
+    }
+
+    /// That muscle under a vacuum that pulls its bladder's bore nearly closed: near the top of
+    /// its range a solve returns a root of the connector relation `L + F/k = reported` (to
+    /// `LIMIT_MARGIN` of the range at worst) or an error, never a length off it.
+    #[test]
+    fn a_solve_returns_a_root_or_nothing_where_the_bore_is_pulled_in() {
         let k = 0.1609;
-        let m = McKibben::new(g.sleeve().unwrap(), tube, model, Some(friction), k).unwrap();
+        let m = soft_rubber_muscle_a(k);
         let (p, rest) = (-1.371e4, HysteresisState::at_rest(3.094));
         let (lo, hi) = (m.min_length(), m.max_length());
         let (mut roots, mut gaps) = (0, 0);
@@ -415,24 +419,14 @@ mod tests {
 
     /// The same muscle's evaluation anywhere from a 1 kPa to a 100 kPa vacuum, at lengths up to
     /// 30 times past the breaking length, with the friction history at either end: with the free
-    /// bladder's force smooth where its bore has collapsed (the layers' pressures taken from the
+    /// bladder's force smooth where its bore is pulled in (the layers' pressures taken from the
     /// outside in), every connector solve converges or ends out of reach on a smooth residual,
-    /// at most 2,000 wall evaluations in all (up to 27,700 while that force was rounding noise
-    /// of newtons, each transition probe a connector solve bisecting through it).
+    /// at most 2,000 wall evaluations in all (a force left to the root's rounding, newtons there,
+    /// makes each transition probe a connector solve that bisects through its jumps: 27,700).
     #[test]
     fn a_collapsed_bladder_through_a_soft_connector_is_evaluated_in_bounded_work() {
         let g = MuscleGeometry::muscle_a();
-        let tube = BladderTube {
-            mooney_c1: 0.0,
-            mooney_c2: 1.716e-4,
-            ..g.tube()
-        };
-        let model = BladderModel::DissertationLayers { layers: 14 };
-        let friction = FrictionParams {
-            coefficient: 6.289e-3,
-            presliding_length: 2.683e-8,
-        };
-        let m = McKibben::new(g.sleeve().unwrap(), tube, model, Some(friction), 0.1609).unwrap();
+        let m = soft_rubber_muscle_a(0.1609);
         let k_s = 2.359e11 / g.strand_length;
         let kernels = crate::physics::bladder::kernel_count;
         for p in [-1e3, -1e4, -1.371e4, -2e4, -1e5] {
