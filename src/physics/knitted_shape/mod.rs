@@ -29,6 +29,7 @@ mod newton;
 mod partials;
 #[cfg(test)]
 mod reference;
+mod seeds;
 mod solver;
 mod table;
 #[cfg(test)]
