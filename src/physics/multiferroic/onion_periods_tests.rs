@@ -65,6 +65,22 @@ pub(super) fn case(kv: &HashMap<String, f64>) -> Result<(Motor, MotorState, Moto
     Ok((m, state, inputs))
 }
 
+/// Eq. 3.4's curvature `k = 2 |E|` at a minimum under the stress and the onion block's slowest
+/// decay rate there, from the eigenvalues in complex form:
+/// `lambda^2 + g a (k + t) lambda + g^2 (1 + a^2) k t = 0`.
+fn curvature_and_slowest_decay(m: &Motor, stress: f64) -> (f64, f64) {
+    let k = 2.0 * (m.magnetoelastic_per_stress * stress).abs();
+    let (g, a, t) = (m.llg_rate, m.params.gilbert_damping, m.tilt_stiffness);
+    let (b, c) = (g * a * (k + t), g * g * (1.0 + a * a) * k * t);
+    let disc = b * b - 4.0 * c;
+    let slowest = if disc >= 0.0 {
+        0.5 * (b - disc.sqrt())
+    } else {
+        0.5 * b
+    };
+    (k, slowest)
+}
+
 fn skips() -> u32 {
     SKIPS.with(|c| c.get())
 }
@@ -224,21 +240,7 @@ fn the_regime_ends_where_the_ring_can_shift_the_onion() {
     .unwrap();
     let s = *inputs.schedule.get().unwrap();
     let bound = |stress: f64| {
-        let e = (m.magnetoelastic_per_stress * stress).abs();
-        let (g, a, t, k) = (
-            m.llg_rate,
-            m.params.gilbert_damping,
-            m.tilt_stiffness,
-            2.0 * e,
-        );
-        // lambda^2 + g a (k + t) lambda + g^2 (1 + a^2) k t = 0.
-        let (b, c) = (g * a * (k + t), g * g * (1.0 + a * a) * k * t);
-        let disc = b * b - 4.0 * c;
-        let slowest = if disc >= 0.0 {
-            0.5 * (b - disc.sqrt())
-        } else {
-            0.5 * b
-        };
+        let (k, slowest) = curvature_and_slowest_decay(&m, stress);
         m.torque_bound() / k * (1.0 + 1.0 / (slowest * s.step_period)) / m.params.tolerance
     };
     let mut flips = 0;
@@ -293,20 +295,8 @@ fn classify_fast_schedules() {
         if m.params.onion_model != OnionModel::Gilbert || !(1e-9..1e-6).contains(&s.step_period) {
             continue;
         }
-        let e = (m.magnetoelastic_per_stress * s.stress_amplitude).abs();
-        let (g, a, t, k) = (
-            m.llg_rate,
-            m.params.gilbert_damping,
-            m.tilt_stiffness,
-            2.0 * e,
-        );
-        let (b, c) = (g * a * (k + t), g * g * (1.0 + a * a) * k * t);
-        let disc = b * b - 4.0 * c;
-        let slowest = if disc >= 0.0 {
-            0.5 * (b - disc.sqrt())
-        } else {
-            0.5 * b
-        };
+        let (k, slowest) = curvature_and_slowest_decay(&m, s.stress_amplitude);
+        let a = m.params.gilbert_damping;
         let tol = m.params.tolerance;
         let tau = m.torque_bound();
         let (_, speed, angle) = m.drift_response(1e-6);
