@@ -17,7 +17,9 @@
 //! `WORST_CASE_REPORT_ABOVE=s` lists every case whose step or initialization takes longer than
 //! `s` seconds (default 1), as measured on its first run; `WORST_CASE_REPORT_STEPS_ABOVE=s` lists
 //! after the re-timing every case one of whose steps takes longer than `s` seconds, with each
-//! step's cost and the variables set away from their start values.
+//! step's cost and the variables set away from their start values. `WORST_CASE_CASES=i,j` runs
+//! only the random draws `random i`, `random j` (the same draws as a full run), each five times,
+//! printing every value at full precision and each run's step costs.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -197,6 +199,40 @@ const RETIMES: usize = 4;
 const RETIME_SHARE: f64 = 0.001;
 
 /// Re-times the slowest cases (see [`RETIMES`]); returns how many were re-timed.
+/// Replays the random draws up to the last chosen one and runs only the chosen ones.
+fn run_chosen(
+    api: &Api,
+    info: &ModelInfo,
+    knobs: &[Knob],
+    rng: &mut Rng,
+    chosen: &[usize],
+    h: f64,
+    overhead: f64,
+) {
+    let last = chosen.iter().copied().max().unwrap_or(0);
+    for drawn in 0..=last {
+        let values: Vec<f64> = knobs.iter().map(|k| draw(rng, k)).collect();
+        if !chosen.contains(&drawn) {
+            continue;
+        }
+        println!("{}: random {drawn}:", info.name);
+        for (k, x) in knobs.iter().zip(&values) {
+            println!("  {} = {x:e}", k.name);
+        }
+        for _ in 0..5 {
+            let (init, steps, refused, step_refused) = run(api, info, knobs, &values, h, overhead);
+            let steps: Vec<String> = steps.iter().map(|s| format!("{:.1}", s * 1e6)).collect();
+            println!(
+                "  init {:.1} us{}, steps [{}] us{}",
+                init * 1e6,
+                if refused { " (refused)" } else { "" },
+                steps.join(", "),
+                if step_refused { " (last refused)" } else { "" }
+            );
+        }
+    }
+}
+
 fn retime_slowest(
     api: &Api,
     info: &ModelInfo,
@@ -307,6 +343,9 @@ fn main() {
         .and_then(|s| s.parse().ok())
         .unwrap_or(10_000);
     let only = std::env::var("WORST_CASE_MODELS").ok();
+    let chosen: Option<Vec<usize>> = std::env::var("WORST_CASE_CASES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|i| i.trim().parse().ok()).collect());
     let report_above: f64 = std::env::var("WORST_CASE_REPORT_ABOVE")
         .ok()
         .and_then(|s| s.parse().ok())
@@ -365,6 +404,10 @@ fn main() {
             plans.push((label, v));
         }
         let mut rng = Rng(0x5eed ^ info.name.len() as u64);
+        if let Some(chosen) = &chosen {
+            run_chosen(&api, info, &knobs, &mut rng, chosen, h, overhead);
+            continue;
+        }
         let mut cases = Vec::with_capacity(plans.len() + points);
         // Initializations refused at the random points: their cost counts, their labels are not
         // kept (a model refusing most of its box draws hundreds of thousands of them).
