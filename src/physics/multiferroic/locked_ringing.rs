@@ -50,7 +50,7 @@ impl Motor {
         remaining: f64,
         checked: &mut f64,
     ) -> bool {
-        if !d.locked || !(remaining > 0.0) {
+        if !d.locked || remaining.is_nan() || remaining <= 0.0 {
             return false;
         }
         let land = self.landscape(y[0], d.direction, d.stress);
