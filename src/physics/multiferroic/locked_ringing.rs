@@ -40,15 +40,17 @@ impl Motor {
     /// onion lies within `sqrt(12 E / (5 k))` of the minimum, inside the window of half the
     /// curvature, and its tilt within `sqrt(2 E / T)`) is at most [`TIME_MARGIN`] of
     /// `remaining`. Only from at most [`RIM_MARGIN`] of the lowest rim, losing at most
-    /// [`MAX_LOSS_PER_ORBIT`] of the energy per orbit along the way. `checked` is the energy
-    /// above the minimum (J) at which it last failed in this segment: it is tried again once the
-    /// energy has halved since (the decay time only shrinks as the energy falls).
+    /// [`MAX_LOSS_PER_ORBIT`] of the energy per orbit along the way. `settled` is the minimum the
+    /// onion settles into; `retry` the energy above it (J) below which the check is tried again in
+    /// this segment, set on each failure: half the energy where the decay time was too long (it
+    /// only shrinks as the energy falls), just below it where the onion was too close to a rim.
     pub(super) fn locked_ringing_decays(
         &self,
         y: &Vector,
         d: &Drive,
+        settled: f64,
         remaining: f64,
-        checked: &mut f64,
+        retry: &mut f64,
     ) -> bool {
         if !d.locked || remaining.is_nan() || remaining <= 0.0 {
             return false;
@@ -63,7 +65,7 @@ impl Motor {
         // The linearization at the minimum first (no rims): its averaged energy decay rate
         // `g alpha (k + T)` bounds the decay time from below, its loss per orbit
         // `2 pi alpha (k + T) / sqrt(k T)` must be small.
-        let minimum = land.settle(y[2]);
+        let minimum = settled;
         let k = land.curvature(minimum);
         let m = land.third_derivative_bound();
         if !(k > 0.0 && k.is_finite() && m > 0.0 && m.is_finite()) {
@@ -85,11 +87,13 @@ impl Motor {
         if e0 <= e1 {
             return true;
         }
-        // (The averaged rate is within a factor of two of the linearization's in the wells met:
-        // beyond that the quadrature below cannot pass.)
-        if (e0 / e1).ln() > 2.0 * TIME_MARGIN * remaining * linear_rate || e0 > 0.5 * *checked {
+        // A cheap refusal first, at twice the linearization's rate (the averaged rate falls below
+        // it towards the rims of eq. 3.4's softening wells: 0.2 of it at 0.99 of the rim at
+        // `k / T = 16`).
+        if (e0 / e1).ln() > 2.0 * TIME_MARGIN * remaining * linear_rate || e0 > *retry {
             return false;
         }
+        *retry = RIM_MARGIN * e0;
         let Some(well) = self.onion_well(&land, y[2]) else {
             return false;
         };
@@ -100,7 +104,7 @@ impl Motor {
         {
             return false;
         }
-        *checked = e0;
+        *retry = 0.5 * e0;
         // The averaged rate `|<E'>| / E` (1/s) of the orbit at `e`, `None` where the orbit is
         // not found or loses too much per orbit.
         let mut guess = (well.minimum - 1e-3, well.minimum + 1e-3);

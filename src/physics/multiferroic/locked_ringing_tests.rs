@@ -88,8 +88,9 @@ fn locked_decay_time_is_not_shorter_than_the_resolved_one() {
         let y: Vector = [0.0, 0.0, st.onion_angle, 0.0];
         let (decayed, _) = resolved(&m, &d, st.onion_angle, 1e-6);
         let decays = |remaining: f64| {
-            let mut checked = f64::INFINITY;
-            m.locked_ringing_decays(&y, &d, remaining, &mut checked)
+            let mut retry = f64::INFINITY;
+            let settled = m.landscape(0.0, d.direction, d.stress).settle(y[2]);
+            m.locked_ringing_decays(&y, &d, settled, remaining, &mut retry)
         };
         // Released at or beyond 0.999 of the rim: refused whatever the time left.
         let land = m.landscape(0.0, d.direction, d.stress);

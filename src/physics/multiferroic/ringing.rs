@@ -59,8 +59,8 @@ impl Motor {
             return Some(kick);
         }
         // A locked rotor's ringing that its orbit-averaged loss ends within the segment.
-        let checked = &mut rims.decay_checked_level;
-        self.locked_ringing_decays(y, d, remaining, checked)
+        let retry = &mut rims.decay_retry_level;
+        self.locked_ringing_decays(y, d, settled, remaining, retry)
             .then_some(0.0)
     }
 
@@ -271,7 +271,7 @@ impl Motor {
                 below,
                 above,
                 sampled_level: f64::INFINITY,
-                decay_checked_level: f64::INFINITY,
+                decay_retry_level: f64::INFINITY,
             };
         }
         let Rims {
@@ -380,9 +380,9 @@ pub(super) struct Rims {
     /// The energy above the minimum (J) at which [`sublevel_gradient_bound`] was last sampled in
     /// this segment; infinite before.
     pub(super) sampled_level: f64,
-    /// The energy above the minimum (J) at which [`Motor::locked_ringing_decays`] last failed in
-    /// this segment; infinite before.
-    pub(super) decay_checked_level: f64,
+    /// The energy above the minimum (J) below which [`Motor::locked_ringing_decays`] is tried
+    /// again in this segment; infinite before.
+    pub(super) decay_retry_level: f64,
 }
 
 impl Rims {
@@ -392,7 +392,7 @@ impl Rims {
         below: f64::NAN,
         above: f64::NAN,
         sampled_level: f64::INFINITY,
-        decay_checked_level: f64::INFINITY,
+        decay_retry_level: f64::INFINITY,
     };
 }
 
