@@ -42,6 +42,9 @@ mod drift;
 pub mod drive;
 mod gilbert;
 mod integrator;
+mod locked_ringing;
+#[cfg(test)]
+mod locked_ringing_tests;
 mod long_steps;
 pub mod magnetics;
 pub mod model_exchange;

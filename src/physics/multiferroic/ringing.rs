@@ -54,7 +54,14 @@ impl Motor {
                 return Some(0.0);
             }
         }
-        self.averaged_ringing(y, d, settled, rim_barrier?, remaining)
+        let rims = rim_barrier?;
+        if let Some(kick) = self.averaged_ringing(y, d, settled, rims, remaining) {
+            return Some(kick);
+        }
+        // A locked rotor's ringing that its orbit-averaged loss ends within the segment.
+        let retry = &mut rims.decay_retry_level;
+        self.locked_ringing_decays(y, d, settled, remaining, retry)
+            .then_some(0.0)
     }
 
     /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
@@ -264,6 +271,7 @@ impl Motor {
                 below,
                 above,
                 sampled_level: f64::INFINITY,
+                decay_retry_level: f64::INFINITY,
             };
         }
         let Rims {
@@ -372,6 +380,9 @@ pub(super) struct Rims {
     /// The energy above the minimum (J) at which [`sublevel_gradient_bound`] was last sampled in
     /// this segment; infinite before.
     pub(super) sampled_level: f64,
+    /// The energy above the minimum (J) below which [`Motor::locked_ringing_decays`] is tried
+    /// again in this segment; infinite before.
+    pub(super) decay_retry_level: f64,
 }
 
 impl Rims {
@@ -381,6 +392,7 @@ impl Rims {
         below: f64::NAN,
         above: f64::NAN,
         sampled_level: f64::INFINITY,
+        decay_retry_level: f64::INFINITY,
     };
 }
 
