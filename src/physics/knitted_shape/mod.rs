@@ -24,6 +24,8 @@
 //! the baseline that the benchmarks and a test compare against.
 
 mod baseline;
+#[cfg(test)]
+mod choice_tests;
 mod geometry;
 mod newton;
 mod partials;
