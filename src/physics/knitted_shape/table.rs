@@ -442,7 +442,8 @@ fn full_step(
 }
 
 /// Nucleation just below full extension: a centred pocket and a near-uniform bulge are solved
-/// from their seeds and the larger volume is kept (both are local maxima). Leaves the winner in
+/// from their seeds and the larger volume is kept; where that is a mirror-symmetric pair of
+/// pockets (a saddle), one pocket of the pair alone where it holds more. Leaves the winner in
 /// `solver`.
 fn nucleate(
     geom: &ShapeGeometry,
