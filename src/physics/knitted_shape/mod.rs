@@ -20,10 +20,29 @@
 //! with the slower line-searched solve of `solver.rs` as its fallback). The
 //! multiplier is `dV/dL` itself, and the sensitivity of the same system gives `d2V/dL2`, so the
 //! table holds exact `V`, `V'`, `V''` and is read through a quintic Hermite interpolant (C2).
+//!
+//! Which maximum, where several exist: the table follows one by continuation. With `lambda =
+//! dV/dL` the KKT conditions are `dV/dr_j = lambda dL/dr_j` on the free rings (eq. 1.19-1.20),
+//! and a maximum also has a negative definite Hessian of `V - lambda L` on the moves that keep
+//! `L` (the bordered KKT matrix has exactly one positive eigenvalue). A maximum is a stable
+//! shape of the quasi-static muscle (section 1.3.5: the fluid leads it to the least potential
+//! energy at the given length), so as the length shortens the sleeve stays on it while it
+//! exists; the path does the same from the tangent predictor. The start decides the branch:
+//! just below full extension the pocket and uniform-raise seeds are each solved (the latter by
+//! the fast path only, where the pocket is found), and the path starts on the one of greater
+//! volume (the pocket on a tie); where that is a mirror-symmetric pair of pockets, a
+//! saddle (moving length from one pocket to the other gains volume, the pocket's cone of eq.
+//! 1.18 being convex in the length it takes up at first), one pocket of the pair is solved alone
+//! and taken where it holds more (its mirror image holds the same volume and gives the same
+//! table). Where the followed maximum ends before zero force (a fold, or a ring reaching the
+//! ceiling), the path takes the maximum its fallbacks reach (the robust solve, an added pocket).
+//!
 //! [`seed_gradient_volume_curve`] is the dissertation's slow one-row-at-a-time gradient exchange, kept as
 //! the baseline that the benchmarks and a test compare against.
 
 mod baseline;
+#[cfg(test)]
+mod choice_tests;
 mod geometry;
 mod newton;
 mod partials;

@@ -17,6 +17,12 @@
 use super::geometry::ShapeGeometry;
 use super::solver::{PathPoint, Solver};
 
+#[cfg(test)]
+thread_local! {
+    /// Iterations of both solves on this thread: the tests bound a table's work with it.
+    pub(super) static ITERATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
 /// Newton iterations on the path before giving up to the robust solve; a warm start needs 2-5.
 pub(super) const MAX_PATH_ITERATIONS: usize = 40;
 /// Releases of one ring from the floor within a solve before it stays there.
@@ -63,6 +69,8 @@ impl Solver {
         let mut edge_holds = 0;
         let mut saddle_run = 0;
         for iteration in 0..max_iterations + MAX_BACKTRACKS {
+            #[cfg(test)]
+            ITERATIONS.with(|c| c.set(c.get() + 1));
             let Some((length, volume)) = self.assemble(geom) else {
                 let (alpha, lambda0, dlambda) = step?;
                 backtracks += 1;
@@ -291,6 +299,17 @@ impl Solver {
             mu *= 4.0;
         }
         None
+    }
+
+    /// Positive eigenvalues of the bordered KKT matrix at the current rings, over all moves of
+    /// the free rings (one at a maximum: the reduced Hessian is negative definite). Overwrites
+    /// the solve's scratch (`x`, `y`).
+    pub(super) fn bordered_ascents(&mut self, geom: &ShapeGeometry) -> Option<usize> {
+        self.assemble(geom)?;
+        let lambda = self.multiplier()?;
+        let pos = self.shifted_solve(lambda, 0.0)?;
+        let (_, gy) = self.border_products();
+        Some(pos + usize::from(gy < 0.0))
     }
 
     /// `g_L . x` and `g_L . y` over the free rings.

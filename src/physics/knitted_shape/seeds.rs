@@ -61,6 +61,22 @@ impl Solver {
         true
     }
 
+    /// Puts the rings of the right half on the floor: of two mirror-image pockets, the left one
+    /// alone. `false` (unchanged) unless a floor ring in the middle parts two pockets.
+    pub(super) fn keep_left_half(&mut self, r_min: f64) -> bool {
+        let rings = self.radii.len();
+        let mid = rings / 2;
+        let parted = (1..mid).any(|j| !self.on_floor(j)) && self.on_floor(mid);
+        if !parted {
+            return false;
+        }
+        for j in mid..rings - 1 {
+            self.radii[j] = r_min;
+            self.held[j] = true;
+        }
+        true
+    }
+
     /// Frees every interior ring just above the minimum radius (the dissertation's uniform raise).
     pub(super) fn seed_uniform(&mut self, geom: &ShapeGeometry) {
         let rings = self.radii.len();

@@ -337,6 +337,8 @@ impl Solver {
         let mut releases = vec![0u8; rings];
         let mut last_mu = 0.0;
         for _it in 0..max_iterations {
+            #[cfg(test)]
+            super::newton::ITERATIONS.with(|c| c.set(c.get() + 1));
             self.assemble(geom).ok_or("assemble")?;
             let lambda = self.multiplier().ok_or("multiplier")?;
             self.lambda = lambda;

@@ -442,7 +442,8 @@ fn full_step(
 }
 
 /// Nucleation just below full extension: a centred pocket and a near-uniform bulge are solved
-/// from their seeds and the larger volume is kept (both are local maxima). Leaves the winner in
+/// from their seeds and the larger volume is kept; where that is a mirror-symmetric pair of
+/// pockets (a saddle), one pocket of the pair alone where it holds more. Leaves the winner in
 /// `solver`.
 fn nucleate(
     geom: &ShapeGeometry,
@@ -465,7 +466,7 @@ fn nucleate(
     } else {
         solve_from(geom, &mut bulge_solver, &mut start, aim, iterations)
     };
-    match (pocket, bulge) {
+    let found = match (pocket, bulge) {
         (Ok(p), Ok(b)) if b.volume > p.volume => {
             *solver = bulge_solver;
             Ok(b)
@@ -475,5 +476,25 @@ fn nucleate(
             Ok(b)
         }
         (p, _) => p,
+    }?;
+    // Both seeds can end on a mirror-symmetric saddle, two pockets of which the fast path
+    // accepts the pair (a maximum among symmetric profiles): its ascent moves length from one
+    // pocket to the other. The path must start on a maximum, so one pocket of the pair is
+    // solved alone and taken where it holds more volume (its mirror image has the same).
+    let mut check = solver.clone();
+    if check.bordered_ascents(geom) == Some(1) {
+        return Ok(found);
+    }
+    check.copy_from(solver);
+    if !check.keep_left_half(geom.min_radius) {
+        return Ok(found);
+    }
+    start.copy_from(&check);
+    match fast_solve(geom, &mut check, &start, aim, iterations) {
+        Some(one) if one.volume > found.volume => {
+            *solver = check;
+            Ok(one)
+        }
+        _ => Ok(found),
     }
 }
