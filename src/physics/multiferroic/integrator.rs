@@ -441,6 +441,7 @@ impl Motor {
                 // kept (zeroing it would lose its coasting distance `omega I / c` each time).
                 run.limited = true;
                 run.settled = false;
+                run.onion_escaped = true;
                 run.dt = dt_try;
             }
             None if forced => {

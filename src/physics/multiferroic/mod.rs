@@ -70,6 +70,9 @@ mod resolved_tests;
 mod rhs;
 mod ringing;
 pub mod schedule;
+mod slow_onion;
+#[cfg(test)]
+mod slow_onion_tests;
 mod spin;
 #[cfg(test)]
 mod spin_tests;

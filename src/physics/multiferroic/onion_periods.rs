@@ -150,21 +150,7 @@ impl Motor {
                 return false;
             }
         }
-        // The onion block of the Jacobian at a minimum of curvature k: trace -g a (k + t),
-        // determinant g^2 (1 + a^2) k t; the slower of its decay rates.
-        let (g, a, t) = (
-            self.llg_rate,
-            self.params.gilbert_damping,
-            self.tilt_stiffness,
-        );
-        let half_trace = 0.5 * g * a * (curvature + t);
-        let det = g * g * (1.0 + a * a) * curvature * t;
-        let disc = half_trace * half_trace - det;
-        let slowest = if disc > 0.0 {
-            det / (half_trace + disc.sqrt())
-        } else {
-            half_trace
-        };
+        let slowest = self.slowest_onion_decay(curvature);
         let memory = 1.0 + 1.0 / (slowest * s.step_period);
         self.torque_bound() / curvature * memory <= 0.01 * self.params.tolerance
     }

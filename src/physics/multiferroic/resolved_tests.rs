@@ -16,7 +16,13 @@ const PRECESSING: &str = "load_torque=-2.671e-7 ring_outer_diameter=2.661e-6 \
 
 /// Classical RK4 of the motor's ODE (its right-hand side alone, at `per_ns` equal substeps per
 /// nanosecond of each segment of constant drive) from `state` to `t_end`.
-fn rk4(m: &Motor, state: &MotorState, inputs: &MotorInputs, t_end: f64, per_ns: f64) -> Vector {
+pub(super) fn rk4(
+    m: &Motor,
+    state: &MotorState,
+    inputs: &MotorInputs,
+    t_end: f64,
+    per_ns: f64,
+) -> Vector {
     let mut y = [
         state.rotor_angle,
         state.rotor_speed,

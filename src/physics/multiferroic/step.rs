@@ -9,6 +9,8 @@ pub(super) struct StepRun {
     pub(super) y: Vector,
     pub(super) t: f64,
     pub(super) t_end: f64,
+    /// The step's start (s).
+    pub(super) start: f64,
     /// Attempted substeps (accepted and rejected), settles and turn jumps.
     pub(super) attempts: u32,
     /// Budget spent beyond `attempts`: a Gilbert substep costs [`GILBERT_SUBSTEP_WEIGHT`].
@@ -54,6 +56,9 @@ pub(super) struct StepRun {
     pub(super) average_check_at: u32,
     /// The attempt from which the orbit-averaged ringing is tried next.
     pub(super) orbit_check_at: u32,
+    /// The Gilbert onion left its bounds at the smallest substep allowed: the next pass drops
+    /// its ringing however slowly it decays ([`Motor::follows_branch`]).
+    pub(super) onion_escaped: bool,
     /// The stepping schedule switching inside this step, if any.
     pub(super) schedule: Option<super::SteppingSchedule>,
 }
@@ -69,6 +74,7 @@ impl StepRun {
             ],
             t: state.time,
             t_end: state.time + h,
+            start: state.time,
             attempts: 0,
             extra_cost: 0,
             limited: false,
@@ -94,6 +100,7 @@ impl StepRun {
             rim_barrier: (f64::NAN, Rims::NONE),
             average_check_at: 0,
             orbit_check_at: 0,
+            onion_escaped: false,
             schedule: None,
         }
     }
@@ -288,7 +295,9 @@ impl Motor {
     /// `gilbert_damping` 1e-4 the rotor then missed its step); the rotor answers the ringing's
     /// alternating torque by at most `A tau_o / (tau_rotor sqrt(1 + (omega_p tau_o)^2))` to first
     /// order, far less than the step it would lose. The step stays flagged. (Only for an onion
-    /// that relaxes at all within a tenth of the rotor's time, as in [`Self::relaxed_onion`].)
+    /// that relaxes at all within a tenth of the rotor's time, as in [`Self::relaxed_onion`], and
+    /// that heads for its minimum within the step, [`Self::heads_for_minimum`], unless it left
+    /// its bounds.)
     fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
@@ -299,7 +308,10 @@ impl Motor {
         // ringing now instead, as once forced, and flag the step.
         let spent = run.attempts.saturating_add(run.extra_cost);
         let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
-        let dropped = (run.limited || broke) && self.onion_relaxes_fast();
+        let dropped = (run.limited || broke)
+            && self.onion_relaxes_fast()
+            && (run.onion_escaped || self.heads_for_minimum(&run.y, d, run.t_end - run.start));
+        run.onion_escaped = false;
         run.limited |= dropped;
         if !dropped {
             // The check settles the onion (a march as in a quasi-static substep): it counts as
