@@ -50,19 +50,22 @@ impl Motor {
         relaxed: bool,
         offset: f64,
     ) -> bool {
+        let index = s.step_index(run.t);
         if !relaxed {
-            if let Some(Some(since)) = run.relaxed_switch.as_mut().map(|r| r.since.as_mut()) {
-                since.push([run.y[2], run.y[3]]);
-            }
             if let Some(r) = run.relaxed_switch.as_mut() {
-                if r.since.as_ref().is_some_and(|v| v.len() > KEPT_SWITCHES) {
-                    r.since = None;
+                // Kept only while every switch since the relaxed one is, in order.
+                let next = r.since.as_ref().map_or(0.0, |v| v.len() as f64) + 1.0;
+                match r.since.as_mut() {
+                    Some(v) if index == r.index + next && v.len() < KEPT_SWITCHES => {
+                        v.push([run.y[2], run.y[3]]);
+                    }
+                    _ => r.since = None,
                 }
             }
             return false;
         }
         let here = RelaxedSwitch {
-            index: s.step_index(run.t),
+            index,
             offset,
             onion: run.y[2],
             since: Some(Vec::new()),
@@ -70,7 +73,6 @@ impl Motor {
         let Some(last) = run.relaxed_switch.replace(here) else {
             return false;
         };
-        let index = s.step_index(run.t);
         let cycle = index - last.index;
         let periods_left = s.step_index(run.t_end) - index;
         if !(cycle >= 1.0 && periods_left >= 1.0) {
