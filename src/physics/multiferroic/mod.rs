@@ -51,6 +51,9 @@ pub mod model_exchange;
 #[cfg(test)]
 mod model_exchange_tests;
 pub mod onion;
+mod onion_cycles;
+#[cfg(test)]
+mod onion_cycles_tests;
 mod onion_periods;
 #[cfg(test)]
 mod onion_periods_tests;

@@ -93,6 +93,9 @@ impl Motor {
                 return true;
             }
             run.onion_period_mismatch = mismatch;
+            if self.skip_onion_cycles(run, s, inputs, relaxed, relative[0]) {
+                return true;
+            }
         }
         run.onion_period_end = Some(relative);
         false
@@ -109,6 +112,18 @@ impl Motor {
         turn: f64,
     ) -> bool {
         let t = (s.step_index(run.t_end) * s.step_period).min(run.t_end);
+        self.advance_onion_periods_to(run, inputs, t, periods * turn)
+    }
+
+    /// A skip of repeated periods to the switch at `t`, turning the onion by `turn` in all;
+    /// `false` (nothing changed) if the rotor would leave its bounds.
+    pub(super) fn advance_onion_periods_to(
+        &self,
+        run: &mut StepRun,
+        inputs: &MotorInputs,
+        t: f64,
+        turn: f64,
+    ) -> bool {
         let mut y = run.y;
         if inputs.rotor_locked {
             y[1] = 0.0;
@@ -118,7 +133,7 @@ impl Motor {
             y[0] += y[1] * coast + load * torque_angle;
             y[1] = y[1] * (1.0 - self.drag * torque_speed) + load * torque_speed;
         }
-        y[2] += periods * turn;
+        y[2] += turn;
         if !(self.rotor_sane(&y) && Self::onion_sane(&y)) {
             return false;
         }
@@ -129,6 +144,7 @@ impl Motor {
         run.period_mismatch = f64::INFINITY;
         run.onion_period_end = None;
         run.onion_period_mismatch = f64::INFINITY;
+        run.relaxed_switch = None;
         run.angles = None;
         run.settled = false;
         run.attempts = run.attempts.saturating_add(1);

@@ -40,6 +40,8 @@ pub(super) struct StepRun {
     pub(super) onion_period_end: Option<[f64; 4]>,
     pub(super) onion_period_mismatch: f64,
     pub(super) onion_decoupled: Option<bool>,
+    /// The last switch at which the Gilbert onion had relaxed (see [`Motor::skip_onion_cycles`]).
+    pub(super) relaxed_switch: Option<super::onion_cycles::RelaxedSwitch>,
     /// The eq. 3.3-3.4 angles' sines and cosines at the last evaluated state, the starting point
     /// of the next evaluation's (see [`angles`](super::angles)).
     pub(super) angles: Option<Angles>,
@@ -94,6 +96,7 @@ impl StepRun {
             onion_period_end: None,
             onion_period_mismatch: f64::INFINITY,
             onion_decoupled: None,
+            relaxed_switch: None,
             angles: None,
             settled: false,
             following: f64::NAN,
@@ -156,7 +159,10 @@ impl Motor {
     /// periods that let the rotor settle and faster ones where it turns continuously on a
     /// periodic orbit. Where the strain holds the onion at an end of its axis and the rotor is
     /// locked or drifts (the ring cannot move it over the rest of the step), the rest of the
-    /// step's periods are taken at once too ([`Self::skip_strain_held_periods`]), and so are a
+    /// step's periods are taken at once too ([`Self::skip_strain_held_periods`]), as are whole
+    /// cycles of periods between two switches at which a Gilbert onion that the ring barely
+    /// moves had relaxed with the same offset from the strain ([`Self::skip_onion_cycles`]), and
+    /// so are a
     /// spinning rotor's while the onion's cycle turned with the strain is known
     /// ([`Self::advance_spinning`]). Hence what "accurate" means for a long step: the state at its end, and at
     /// every switch inside it, is the resolved trajectory's within the tolerance; the transients
