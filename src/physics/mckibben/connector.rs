@@ -9,7 +9,7 @@ use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 impl McKibben {
     /// The muscle lengths the connector solve searches: the muscle's range, inset by 1e-9 of
     /// it where a bladder makes its ends singular.
-    fn connector_edges(&self) -> (f64, f64) {
+    pub(super) fn connector_edges(&self) -> (f64, f64) {
         match &self.bladder {
             Some(_) => {
                 let (a, b) = (self.min_length(), self.max_length());
@@ -122,6 +122,22 @@ impl McKibben {
         c: f64,
         branch: &BranchEnd,
     ) -> Result<Core, String> {
+        let solved = self.solve_connector(pressure, reported, history, c, branch);
+        #[cfg(test)]
+        if let Ok(core) = &solved {
+            sampled::record(reported, core.out.actual_length, core.out.force, c);
+        }
+        solved
+    }
+
+    fn solve_connector(
+        &self,
+        pressure: f64,
+        reported: f64,
+        history: &HysteresisState,
+        c: f64,
+        branch: &BranchEnd,
+    ) -> Result<Core, String> {
         let (lo_edge, hi_edge) = self.connector_edges();
         let eval = |l: f64| -> Result<(f64, Core), String> {
             let core = self.at_actual_length(pressure, l, history)?;
@@ -162,6 +178,16 @@ impl McKibben {
             Bracket::None => (on_shortest_branch()?, true),
             found => (found, false),
         };
+        // A solution satisfies the relation to LIMIT_MARGIN of the muscle's length range (the
+        // rounding noise of a nearly stress-free wall's force, 1e-8 to 1e-4 of the range, which
+        // the solve's first guess may have landed across), beyond the rounding of the sum
+        // `L + c F`. Checked on the residual itself: a jump of the force, or a wall too steep
+        // for any float of `L` to meet it, leaves no solution there.
+        let noise = LIMIT_MARGIN * (hi_edge - lo_edge);
+        let on_relation = |h: f64, core: &Core| {
+            let sum = reported.abs() + core.out.actual_length.abs() + (c * core.out.force).abs();
+            h.abs() <= noise + 4.0 * f64::EPSILON * sum
+        };
         // h rises with L (slope 1 + c dF/dL > 0 on the stable branch). Converged when the length
         // moves by less than rounding; F then changes by K times that. A sign change that the
         // slope cannot explain within 1e-9 of the range is a jump of the force, which the
@@ -190,28 +216,87 @@ impl McKibben {
             let core = root
                 .payload
                 .ok_or_else(|| "connector solve did not run".to_string())?;
-            // A root, or a gap within LIMIT_MARGIN of the range: the rounding noise of a nearly
-            // stress-free wall's force (1e-8 to 1e-4 of the range), which the solve's first
-            // guess may have landed across. The finder may also narrow onto a jump whose ends'
-            // slopes are noise: its residual tells.
-            let noise = LIMIT_MARGIN * (hi_edge - lo_edge);
-            let (h, slope) = (
+            let (x, h) = (
+                core.out.actual_length,
                 root.x + c * core.out.force - reported,
-                1.0 + c * core.newton_slope,
             );
-            if h.abs() <= noise || (slope > 0.0 && (h / slope).abs() <= noise) {
+            if on_relation(h, &core) {
                 return Ok(core);
+            }
+            // The finder also stops where its Newton step is below rounding far from the root
+            // (a slope that misjudges the steep wall next to the muscle's singular ends): the
+            // rest of the bracket is bisected on the residual alone.
+            if !root.jump && x > lo && x < hi {
+                let (a, b) = if h < 0.0 { (x, hi) } else { (lo, x) };
+                if let Some(core) = self.steep_root(a, b, c, reported, &eval, &on_relation)? {
+                    return Ok(core);
+                }
             }
             if shortest {
                 return Err(format!(
                     "{}; the muscle's force jumps across it at muscle length {} m",
                     unreachable(),
-                    root.x
+                    x
                 ));
             }
             // Past a jump the branch from the shortest length may still reach it.
             (bracket, shortest) = (on_shortest_branch()?, true);
         }
+    }
+
+    /// The root of the connector residual `h` in `(a, b)`, where `h(a) < 0 < h(b)`, by bisection
+    /// on `h` alone: the first length on a rising stretch (`1 + c dF/dL > 0`, a stable
+    /// equilibrium of muscle and connector) that satisfies the relation (`on_relation`), else, at
+    /// adjacent floats of the muscle's length, the wall's own step across the root (the slopes
+    /// there explain the residual's step, to the factor 4 of the finder's jump test): the muscle
+    /// is steeper than the floats of `L` resolve (next to its singular ends, `dF/dL` up to
+    /// 1e15 N/m and more: 0.01 N between adjacent floats), and the state at the float nearer
+    /// the root carries the relation's force `(reported - L) / c`, which lies between the
+    /// muscle's forces at the two floats. `None` at a jump of the force (no solution there).
+    fn steep_root(
+        &self,
+        a: f64,
+        b: f64,
+        c: f64,
+        reported: f64,
+        eval: &impl Fn(f64) -> Result<(f64, Core), String>,
+        on_relation: &impl Fn(f64, &Core) -> bool,
+    ) -> Result<Option<Core>, String> {
+        let (mut a, mut b) = (a, b);
+        let (mut at_a, mut at_b) = (None, None);
+        // Capped as the branch's end is: halvings down to adjacent floats, subnormals included.
+        for _ in 0..1100 {
+            let mid = 0.5 * (a + b);
+            if !(mid > a && mid < b) {
+                break;
+            }
+            let (h, core) = eval(mid)?;
+            if on_relation(h, &core) && 1.0 + c * core.newton_slope > 0.0 {
+                return Ok(Some(core));
+            }
+            if h < 0.0 {
+                (a, at_a) = (mid, Some((h, core)));
+            } else {
+                (b, at_b) = (mid, Some((h, core)));
+            }
+        }
+        let (h_a, core_a) = match at_a {
+            Some(at) => at,
+            None => eval(a)?,
+        };
+        let (h_b, core_b) = match at_b {
+            Some(at) => at,
+            None => eval(b)?,
+        };
+        // Across adjacent floats the residual rises (bisection keeps `h(a) < 0 < h(b)`); a step
+        // that the steeper end's slope does not explain is a jump of the force.
+        let steeper = f64::max(c * core_a.newton_slope, c * core_b.newton_slope) + 1.0;
+        if !(h_a < 0.0 && h_b > 0.0 && h_b - h_a <= 4.0 * steeper * (b - a)) {
+            return Ok(None);
+        }
+        let mut core = if -h_a <= h_b { core_a } else { core_b };
+        core.out.force = (reported - core.out.actual_length) / c;
+        Ok(Some(core))
     }
 
     /// Brackets the root of the connector residual `h` from `x0` (where `h = h0 != 0`) by
@@ -262,6 +347,10 @@ enum Bracket {
     /// No sign change inside the muscle's lengths.
     None,
 }
+
+#[cfg(test)]
+#[path = "connector_sampled.rs"]
+pub(super) mod sampled;
 
 #[cfg(test)]
 mod tests {
