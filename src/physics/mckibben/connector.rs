@@ -90,10 +90,18 @@ impl McKibben {
             return Some(at_edge);
         }
         let tolerance = 1e-9 * (hi_edge - lo_edge);
+        // Resolved in the reported length too: next to the muscle's singular ends the wall
+        // rises through all of its reported lengths (1e10 m and more) within 1e-9 of the range,
+        // so the end is narrowed until its slope moves the reported length by less than
+        // LIMIT_MARGIN of the range across what is left.
+        let resolved = |end: &(f64, Core), width: f64| {
+            width <= tolerance
+                && (1.0 + c * end.1.newton_slope) * width <= LIMIT_MARGIN * (hi_edge - lo_edge)
+        };
         let mut past = hi_edge;
         for _ in 0..1100 {
             let mid = 0.5 * (end.0 + past);
-            if past - end.0 <= tolerance || mid <= end.0 || mid >= past {
+            if resolved(&end, past - end.0) || mid <= end.0 || mid >= past {
                 break;
             }
             match on_branch(mid, &end) {
@@ -204,8 +212,16 @@ impl McKibben {
                 Bracket::Between(lo, hi) => (lo, hi),
                 Bracket::None => return Err(unreachable()),
             };
+            // The narrowest sign change the finder has seen, where the bisection below starts.
+            let seen = std::cell::Cell::new((lo, hi));
             let root = newton_bisection(lo, hi, 0.5 * (lo + hi), true, options, |x| {
                 let (value, core) = eval(x)?;
+                let (a, b) = seen.get();
+                if value < 0.0 && x > a {
+                    seen.set((x, b));
+                } else if value > 0.0 && x < b {
+                    seen.set((a, x));
+                }
                 let slope = 1.0 + c * core.newton_slope;
                 Ok::<_, String>(Some(Sample {
                     value,
@@ -216,19 +232,18 @@ impl McKibben {
             let core = root
                 .payload
                 .ok_or_else(|| "connector solve did not run".to_string())?;
-            let (x, h) = (
-                core.out.actual_length,
-                root.x + c * core.out.force - reported,
-            );
+            let h = root.x + c * core.out.force - reported;
             if on_relation(h, &core) {
                 return Ok(core);
             }
             // The finder also stops where its Newton step is below rounding far from the root
-            // (a slope that misjudges the steep wall next to the muscle's singular ends): the
-            // rest of the bracket is bisected on the residual alone.
-            if !root.jump && x > lo && x < hi {
-                let (a, b) = if h < 0.0 { (x, hi) } else { (lo, x) };
-                if let Some(core) = self.steep_root(a, b, c, reported, &eval, &on_relation)? {
+            // (a slope that misjudges the steep wall next to the muscle's singular ends): what
+            // is left of its bracket is bisected on the residual alone.
+            if !root.jump {
+                let (a, b) = seen.get();
+                if let Some(core) =
+                    self.steep_root(a, b, c, reported, options.jump_width, &eval, &on_relation)?
+                {
                     return Ok(core);
                 }
             }
@@ -236,7 +251,7 @@ impl McKibben {
                 return Err(format!(
                     "{}; the muscle's force jumps across it at muscle length {} m",
                     unreachable(),
-                    x
+                    core.out.actual_length
                 ));
             }
             // Past a jump the branch from the shortest length may still reach it.
@@ -259,16 +274,29 @@ impl McKibben {
         b: f64,
         c: f64,
         reported: f64,
+        jump_width: f64,
         eval: &impl Fn(f64) -> Result<(f64, Core), String>,
         on_relation: &impl Fn(f64, &Core) -> bool,
     ) -> Result<Option<Core>, String> {
         let (mut a, mut b) = (a, b);
-        let (mut at_a, mut at_b) = (None, None);
+        let (mut at_a, mut at_b): (Option<(f64, Core)>, Option<(f64, Core)>) = (None, None);
+        // Across the bracket the residual rises (bisection keeps `h(a) < 0 < h(b)`); a step
+        // that the steeper end's slope does not explain is a jump of the force, told once the
+        // bracket is narrower than `jump_width` (as the finder tells it).
+        let explained = |(h_a, at_a): &(f64, Core), (h_b, at_b): &(f64, Core), width: f64| {
+            let steeper = f64::max(c * at_a.newton_slope, c * at_b.newton_slope) + 1.0;
+            h_b - h_a <= 4.0 * steeper * width
+        };
         // Capped as the branch's end is: halvings down to adjacent floats, subnormals included.
         for _ in 0..1100 {
             let mid = 0.5 * (a + b);
             if !(mid > a && mid < b) {
                 break;
+            }
+            if let (Some(lo), Some(hi), true) = (&at_a, &at_b, b - a <= jump_width) {
+                if !explained(lo, hi, b - a) {
+                    return Ok(None);
+                }
             }
             let (h, core) = eval(mid)?;
             if on_relation(h, &core) && 1.0 + c * core.newton_slope > 0.0 {
@@ -288,10 +316,7 @@ impl McKibben {
             Some(at) => at,
             None => eval(b)?,
         };
-        // Across adjacent floats the residual rises (bisection keeps `h(a) < 0 < h(b)`); a step
-        // that the steeper end's slope does not explain is a jump of the force.
-        let steeper = f64::max(c * core_a.newton_slope, c * core_b.newton_slope) + 1.0;
-        if !(h_a < 0.0 && h_b > 0.0 && h_b - h_a <= 4.0 * steeper * (b - a)) {
+        if !(h_a < 0.0 && h_b > 0.0 && explained(&(h_a, core_a), &(h_b, core_b), b - a)) {
             return Ok(None);
         }
         let mut core = if -h_a <= h_b { core_a } else { core_b };

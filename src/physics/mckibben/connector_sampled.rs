@@ -194,7 +194,8 @@ fn residuals_over_tolerance(m: &McKibben) -> Vec<f64> {
 /// of the muscle's length range (where the finder's Newton step alone decided, lengths off it
 /// by up to 332 m were accepted, 30 draws off by more than 1e-3 m); the solve at the input
 /// ends in a solution or an error with its reason, never an inconsistent pair; and no draw
-/// takes more than 40,000 wall evaluations.
+/// takes more than 3,000 wall evaluations (16,428 where the rising branch from the shortest
+/// length ended 1e-9 of the range short of its steep wall).
 #[test]
 fn every_accepted_connector_solution_is_on_the_relation() {
     let kernels = crate::physics::bladder::kernel_count;
@@ -237,7 +238,7 @@ fn every_accepted_connector_solution_is_on_the_relation() {
         solutions > 200 && refused > 0,
         "{solutions} solutions, {refused} refused"
     );
-    assert!(most <= 40_000, "{most} wall evaluations");
+    assert!(most <= 3_000, "{most} wall evaluations");
 }
 
 /// Draw 282: Table 2.1's muscle A, 45 layers as written, `mooney_c2` 3.5e-4 Pa under a 4.1 kPa
