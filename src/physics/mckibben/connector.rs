@@ -232,7 +232,7 @@ impl McKibben {
             let core = root
                 .payload
                 .ok_or_else(|| "connector solve did not run".to_string())?;
-            let h = root.x + c * core.out.force - reported;
+            let h = core.out.actual_length + c * core.out.force - reported;
             if on_relation(h, &core) {
                 return Ok(core);
             }
@@ -242,7 +242,7 @@ impl McKibben {
             if !root.jump {
                 let (a, b) = seen.get();
                 if let Some(core) =
-                    self.steep_root(a, b, c, reported, options.jump_width, &eval, &on_relation)?
+                    self.steep_root((a, b), c, reported, options.jump_width, &eval, &on_relation)?
                 {
                     return Ok(core);
                 }
@@ -270,8 +270,7 @@ impl McKibben {
     /// muscle's forces at the two floats. `None` at a jump of the force (no solution there).
     fn steep_root(
         &self,
-        a: f64,
-        b: f64,
+        (a, b): (f64, f64),
         c: f64,
         reported: f64,
         jump_width: f64,
@@ -279,7 +278,7 @@ impl McKibben {
         on_relation: &impl Fn(f64, &Core) -> bool,
     ) -> Result<Option<Core>, String> {
         let (mut a, mut b) = (a, b);
-        let (mut at_a, mut at_b): (Option<(f64, Core)>, Option<(f64, Core)>) = (None, None);
+        let (mut at_a, mut at_b) = (None::<(f64, Core)>, None::<(f64, Core)>);
         // Across the bracket the residual rises (bisection keeps `h(a) < 0 < h(b)`); a step
         // that the steeper end's slope does not explain is a jump of the force, told once the
         // bracket is narrower than `jump_width` (as the finder tells it).
