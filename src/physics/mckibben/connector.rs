@@ -109,6 +109,19 @@ impl McKibben {
                 None => past = mid,
             }
         }
+        // At adjacent floats, a wall that tops out between them (its slope steps from rising
+        // to falling) reaches the length past it: the connector solve meets the reported
+        // lengths in between with the relation's force ([`Self::steep_root`]'s test, the step
+        // explained by the steeper end's slope).
+        if past == end.0.next_up() && past < hi_edge {
+            if let Ok(top) = self.at_actual_length(pressure, past, history) {
+                let step = reported(&(past, top)) - reported(&end);
+                let steeper = 1.0 + c * f64::max(end.1.newton_slope, top.newton_slope);
+                if step > 0.0 && step <= 4.0 * steeper * (past - end.0) {
+                    return Some((past, top));
+                }
+            }
+        }
         Some(end)
     }
 
