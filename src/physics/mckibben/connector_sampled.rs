@@ -260,3 +260,40 @@ fn a_root_steeper_than_the_floats_carries_the_relation_force() {
     );
     assert!((o.force - 0.0578).abs() < 1e-3, "{}", o.force);
 }
+
+/// Draw 108: Table 2.1's muscle A, 3 layers as written, `mooney_c2` 7.1e-3 Pa under a 17 kPa
+/// vacuum with friction, 3.44 m reported through a connector of 0.37 N/m. The connector
+/// reaches no further than the top of the steep wall at the muscle's shortest length (0.64 m
+/// reported; the muscle pushes towards its longest length): the input has no solution. The
+/// refusing policy refuses it with its reason; the evaluating policy names it and evaluates a
+/// reported length that has one, whose outputs satisfy the relation there (the finder's Newton
+/// step accepted a length 57 m off it, and the strands were stretched to the breaking length
+/// from there: 468.7 N).
+#[test]
+fn an_input_past_the_reach_is_refused_or_evaluated_where_it_has_a_solution() {
+    let d = draws(1, 300)[108];
+    let m = d.muscle();
+    let (p, r, history) = (d.pressure, d.length, &d.history);
+    let why = m.evaluate(p, r, history).unwrap_err();
+    assert!(
+        why.contains("cannot be reached through the connector"),
+        "{why}"
+    );
+    let refused = m.refused_past_breaking(p, r, history).unwrap();
+    assert!(refused.point.is_none() && !refused.reason.is_empty());
+    let (out, clamp) = m.evaluate_with_strands(p, r, strand_stiffness(&m), history);
+    let (out, clamp) = (out.unwrap(), clamp.unwrap());
+    assert!(
+        clamp.reason.contains("cannot be reached"),
+        "{}",
+        clamp.reason
+    );
+    let (at_p, at_l) = clamp.point.unwrap();
+    assert_eq!(at_p, p);
+    let h = out.actual_length + out.force / d.stiffness - at_l;
+    assert!(
+        h.abs() <= LIMIT_MARGIN * (m.max_length() - m.min_length()),
+        "{h} m"
+    );
+    assert!(out.force.abs() < 1.0, "{}", out.force);
+}
