@@ -109,17 +109,29 @@ impl McKibben {
                 None => past = mid,
             }
         }
-        // At adjacent floats, a wall that tops out between them (its slope steps from rising
-        // to falling) reaches the length past it: the connector solve meets the reported
-        // lengths in between with the relation's force ([`Self::steep_root`]'s test, the step
-        // explained by the steeper end's slope).
-        if past == end.0.next_up() && past < hi_edge {
-            if let Ok(top) = self.at_actual_length(pressure, past, history) {
-                let step = reported(&(past, top)) - reported(&end);
-                let steeper = 1.0 + c * f64::max(end.1.newton_slope, top.newton_slope);
-                if step > 0.0 && step <= 4.0 * steeper * (past - end.0) {
-                    return Some((past, top));
+        // At adjacent floats (only a steep wall narrows the end that far) the wall's force
+        // scatters by rounding over a few floats: the branch goes on over the next few where
+        // it rises again, and a wall that tops out between two of them (its slope steps from
+        // rising to falling) reaches the length past the top, where the connector solve meets
+        // the reported lengths in between with the relation's force ([`Self::steep_root`]'s
+        // test, the step explained by the steeper end's slope).
+        if past == end.0.next_up() {
+            let mut x = past;
+            for _ in 0..8 {
+                if x >= hi_edge {
+                    break;
                 }
+                let Ok(at) = self.at_actual_length(pressure, x, history) else {
+                    break;
+                };
+                let step = reported(&(x, at)) - reported(&end);
+                let steeper = 1.0 + c * f64::max(end.1.newton_slope, at.newton_slope);
+                if 1.0 + c * at.newton_slope > 0.0 && step >= 0.0 {
+                    end = (x, at);
+                } else if step > 0.0 && step <= 4.0 * steeper * (x - end.0) {
+                    return Some((x, at));
+                }
+                x = x.next_up();
             }
         }
         Some(end)
