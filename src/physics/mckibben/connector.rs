@@ -60,8 +60,11 @@ impl McKibben {
     /// force jumps (a vacuum the free bladder can no longer hold), or at the longest length the
     /// connector solve searches. Found in `L` by bisection to 1e-9 of the muscle's length range
     /// (about 30 muscle evaluations, where bisecting the reported length took a whole connector
-    /// solve per step): the end returned always rises, so the connector solve and the strands'
-    /// transition agree on it exactly; short of a fold it moves the reach by second order, short
+    /// solve per step), and on a steep wall until the reported length is resolved too (down to
+    /// adjacent floats, where a wall topping out between two of them ends the branch past its
+    /// top, which the connector solve meets with the relation's force): the end returned rises
+    /// or tops out such a wall, so the connector solve and the strands' transition agree on it
+    /// exactly; short of a fold it moves the reach by second order, short
     /// of a jump by `1 + c dF/dL` times at most 1e-9 of the range. `None` where the reported
     /// length does not rise at `from`.
     fn branch_end(
@@ -146,7 +149,8 @@ impl McKibben {
     /// the force instead of a root (the reported length falls in the jump's gap); where that
     /// branch does not reach it either, the length is out of reach. What it returns solves the
     /// relation, to [`LIMIT_MARGIN`] of the muscle's length range at worst (a wall's rounding
-    /// noise).
+    /// noise), tested on the residual itself; where the wall is steeper than the floats of `L`
+    /// resolve, with the relation's force ([`Self::steep_root`]).
     pub(super) fn through_connector(
         &self,
         pressure: f64,
