@@ -409,7 +409,7 @@ impl McKibben {
 
     /// The muscle itself at its own length `l`.
     #[inline]
-    fn at_actual_length(
+    pub(super) fn at_actual_length(
         &self,
         pressure: f64,
         l: f64,

@@ -9,7 +9,7 @@ use crate::physics::numerics::root::{newton_bisection, RootOptions, Sample};
 impl McKibben {
     /// The muscle lengths the connector solve searches: the muscle's range, inset by 1e-9 of
     /// it where a bladder makes its ends singular.
-    fn connector_edges(&self) -> (f64, f64) {
+    pub(super) fn connector_edges(&self) -> (f64, f64) {
         match &self.bladder {
             Some(_) => {
                 let (a, b) = (self.min_length(), self.max_length());
@@ -60,8 +60,11 @@ impl McKibben {
     /// force jumps (a vacuum the free bladder can no longer hold), or at the longest length the
     /// connector solve searches. Found in `L` by bisection to 1e-9 of the muscle's length range
     /// (about 30 muscle evaluations, where bisecting the reported length took a whole connector
-    /// solve per step): the end returned always rises, so the connector solve and the strands'
-    /// transition agree on it exactly; short of a fold it moves the reach by second order, short
+    /// solve per step), and on a steep wall until the reported length is resolved too (down to
+    /// adjacent floats, where a wall topping out between two of them ends the branch past its
+    /// top, which the connector solve meets with the relation's force): the end returned rises
+    /// or tops out such a wall, so the connector solve and the strands' transition agree on it
+    /// exactly; short of a fold it moves the reach by second order, short
     /// of a jump by `1 + c dF/dL` times at most 1e-9 of the range. `None` where the reported
     /// length does not rise at `from`.
     fn branch_end(
@@ -90,15 +93,48 @@ impl McKibben {
             return Some(at_edge);
         }
         let tolerance = 1e-9 * (hi_edge - lo_edge);
+        // Resolved in the reported length too: next to the muscle's singular ends the wall
+        // rises through all of its reported lengths (1e10 m and more) within 1e-9 of the range,
+        // so the end is narrowed until its slope moves the reported length by less than
+        // LIMIT_MARGIN of the range across what is left.
+        let resolved = |end: &(f64, Core), width: f64| {
+            width <= tolerance
+                && (1.0 + c * end.1.newton_slope) * width <= LIMIT_MARGIN * (hi_edge - lo_edge)
+        };
         let mut past = hi_edge;
         for _ in 0..1100 {
             let mid = 0.5 * (end.0 + past);
-            if past - end.0 <= tolerance || mid <= end.0 || mid >= past {
+            if resolved(&end, past - end.0) || mid <= end.0 || mid >= past {
                 break;
             }
             match on_branch(mid, &end) {
                 Some(at) => end = at,
                 None => past = mid,
+            }
+        }
+        // At adjacent floats (only a steep wall narrows the end that far) the wall's force
+        // scatters by rounding over a few floats: the branch goes on over the next few where
+        // it rises again, and a wall that tops out between two of them (its slope steps from
+        // rising to falling) reaches the length past the top, where the connector solve meets
+        // the reported lengths in between with the relation's force ([`Self::steep_root`]'s
+        // test, the step explained by the steeper end's slope).
+        if past == end.0.next_up() {
+            let mut x = past;
+            for _ in 0..8 {
+                if x >= hi_edge {
+                    break;
+                }
+                let Ok(at) = self.at_actual_length(pressure, x, history) else {
+                    break;
+                };
+                let step = reported(&(x, at)) - reported(&end);
+                let steeper = 1.0 + c * f64::max(end.1.newton_slope, at.newton_slope);
+                if 1.0 + c * at.newton_slope > 0.0 && step >= 0.0 {
+                    end = (x, at);
+                } else if step > 0.0 && step <= 4.0 * steeper * (x - end.0) {
+                    return Some((x, at));
+                }
+                x = x.next_up();
             }
         }
         Some(end)
@@ -113,8 +149,25 @@ impl McKibben {
     /// the force instead of a root (the reported length falls in the jump's gap); where that
     /// branch does not reach it either, the length is out of reach. What it returns solves the
     /// relation, to [`LIMIT_MARGIN`] of the muscle's length range at worst (a wall's rounding
-    /// noise).
+    /// noise), tested on the residual itself; where the wall is steeper than the floats of `L`
+    /// resolve, with the relation's force ([`Self::steep_root`]).
     pub(super) fn through_connector(
+        &self,
+        pressure: f64,
+        reported: f64,
+        history: &HysteresisState,
+        c: f64,
+        branch: &BranchEnd,
+    ) -> Result<Core, String> {
+        let solved = self.solve_connector(pressure, reported, history, c, branch);
+        #[cfg(test)]
+        if let Ok(core) = &solved {
+            sampled::record(reported, core.out.actual_length, core.out.force, c);
+        }
+        solved
+    }
+
+    fn solve_connector(
         &self,
         pressure: f64,
         reported: f64,
@@ -162,6 +215,16 @@ impl McKibben {
             Bracket::None => (on_shortest_branch()?, true),
             found => (found, false),
         };
+        // A solution satisfies the relation to LIMIT_MARGIN of the muscle's length range (the
+        // rounding noise of a nearly stress-free wall's force, 1e-8 to 1e-4 of the range, which
+        // the solve's first guess may have landed across), beyond the rounding of the sum
+        // `L + c F`. Checked on the residual itself: a jump of the force, or a wall too steep
+        // for any float of `L` to meet it, leaves no solution there.
+        let noise = LIMIT_MARGIN * (hi_edge - lo_edge);
+        let on_relation = |h: f64, core: &Core| {
+            let sum = reported.abs() + core.out.actual_length.abs() + (c * core.out.force).abs();
+            h.abs() <= noise + 4.0 * f64::EPSILON * sum
+        };
         // h rises with L (slope 1 + c dF/dL > 0 on the stable branch). Converged when the length
         // moves by less than rounding; F then changes by K times that. A sign change that the
         // slope cannot explain within 1e-9 of the range is a jump of the force, which the
@@ -178,8 +241,16 @@ impl McKibben {
                 Bracket::Between(lo, hi) => (lo, hi),
                 Bracket::None => return Err(unreachable()),
             };
+            // The narrowest sign change the finder has seen, where the bisection below starts.
+            let seen = std::cell::Cell::new((lo, hi));
             let root = newton_bisection(lo, hi, 0.5 * (lo + hi), true, options, |x| {
                 let (value, core) = eval(x)?;
+                let (a, b) = seen.get();
+                if value < 0.0 && x > a {
+                    seen.set((x, b));
+                } else if value > 0.0 && x < b {
+                    seen.set((a, x));
+                }
                 let slope = 1.0 + c * core.newton_slope;
                 Ok::<_, String>(Some(Sample {
                     value,
@@ -190,28 +261,95 @@ impl McKibben {
             let core = root
                 .payload
                 .ok_or_else(|| "connector solve did not run".to_string())?;
-            // A root, or a gap within LIMIT_MARGIN of the range: the rounding noise of a nearly
-            // stress-free wall's force (1e-8 to 1e-4 of the range), which the solve's first
-            // guess may have landed across. The finder may also narrow onto a jump whose ends'
-            // slopes are noise: its residual tells.
-            let noise = LIMIT_MARGIN * (hi_edge - lo_edge);
-            let (h, slope) = (
-                root.x + c * core.out.force - reported,
-                1.0 + c * core.newton_slope,
-            );
-            if h.abs() <= noise || (slope > 0.0 && (h / slope).abs() <= noise) {
+            let h = core.out.actual_length + c * core.out.force - reported;
+            if on_relation(h, &core) {
                 return Ok(core);
+            }
+            // The finder also stops where its Newton step is below rounding far from the root
+            // (a slope that misjudges the steep wall next to the muscle's singular ends): what
+            // is left of its bracket is bisected on the residual alone.
+            if !root.jump {
+                let (a, b) = seen.get();
+                if let Some(core) =
+                    self.steep_root((a, b), c, reported, options.jump_width, &eval, &on_relation)?
+                {
+                    return Ok(core);
+                }
             }
             if shortest {
                 return Err(format!(
                     "{}; the muscle's force jumps across it at muscle length {} m",
                     unreachable(),
-                    root.x
+                    core.out.actual_length
                 ));
             }
             // Past a jump the branch from the shortest length may still reach it.
             (bracket, shortest) = (on_shortest_branch()?, true);
         }
+    }
+
+    /// The root of the connector residual `h` in `(a, b)`, where `h(a) < 0 < h(b)`, by bisection
+    /// on `h` alone: the first length on a rising stretch (`1 + c dF/dL > 0`, a stable
+    /// equilibrium of muscle and connector) that satisfies the relation (`on_relation`), else, at
+    /// adjacent floats of the muscle's length, the wall's own step across the root (the slopes
+    /// there explain the residual's step, to the factor 4 of the finder's jump test): the muscle
+    /// is steeper than the floats of `L` resolve (next to its singular ends, `dF/dL` up to
+    /// 1e15 N/m and more: 0.01 N between adjacent floats), and the state at the float nearer
+    /// the root carries the relation's force `(reported - L) / c`, which lies between the
+    /// muscle's forces at the two floats. `None` at a jump of the force (no solution there).
+    fn steep_root(
+        &self,
+        (a, b): (f64, f64),
+        c: f64,
+        reported: f64,
+        jump_width: f64,
+        eval: &impl Fn(f64) -> Result<(f64, Core), String>,
+        on_relation: &impl Fn(f64, &Core) -> bool,
+    ) -> Result<Option<Core>, String> {
+        let (mut a, mut b) = (a, b);
+        let (mut at_a, mut at_b) = (None::<(f64, Core)>, None::<(f64, Core)>);
+        // Across the bracket the residual rises (bisection keeps `h(a) < 0 < h(b)`); a step
+        // that the steeper end's slope does not explain is a jump of the force, told once the
+        // bracket is narrower than `jump_width` (as the finder tells it).
+        let explained = |(h_a, at_a): &(f64, Core), (h_b, at_b): &(f64, Core), width: f64| {
+            let steeper = f64::max(c * at_a.newton_slope, c * at_b.newton_slope) + 1.0;
+            h_b - h_a <= 4.0 * steeper * width
+        };
+        // Capped as the branch's end is: halvings down to adjacent floats, subnormals included.
+        for _ in 0..1100 {
+            let mid = 0.5 * (a + b);
+            if !(mid > a && mid < b) {
+                break;
+            }
+            if let (Some(lo), Some(hi), true) = (&at_a, &at_b, b - a <= jump_width) {
+                if !explained(lo, hi, b - a) {
+                    return Ok(None);
+                }
+            }
+            let (h, core) = eval(mid)?;
+            if on_relation(h, &core) && 1.0 + c * core.newton_slope > 0.0 {
+                return Ok(Some(core));
+            }
+            if h < 0.0 {
+                (a, at_a) = (mid, Some((h, core)));
+            } else {
+                (b, at_b) = (mid, Some((h, core)));
+            }
+        }
+        let (h_a, core_a) = match at_a {
+            Some(at) => at,
+            None => eval(a)?,
+        };
+        let (h_b, core_b) = match at_b {
+            Some(at) => at,
+            None => eval(b)?,
+        };
+        if !(h_a < 0.0 && h_b > 0.0 && explained(&(h_a, core_a), &(h_b, core_b), b - a)) {
+            return Ok(None);
+        }
+        let mut core = if -h_a <= h_b { core_a } else { core_b };
+        core.out.force = (reported - core.out.actual_length) / c;
+        Ok(Some(core))
     }
 
     /// Brackets the root of the connector residual `h` from `x0` (where `h = h0 != 0`) by
@@ -262,6 +400,10 @@ enum Bracket {
     /// No sign change inside the muscle's lengths.
     None,
 }
+
+#[cfg(test)]
+#[path = "connector_sampled.rs"]
+pub(super) mod sampled;
 
 #[cfg(test)]
 mod tests {
