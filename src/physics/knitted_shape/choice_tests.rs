@@ -133,9 +133,9 @@ fn paired_nucleation_sleeves_build_in_bounded_work() {
     // 3-11 a node.
     for c in PAIRED_NUCLEATION {
         let (g, end) = sleeve(c);
-        super::newton::ITERATIONS.with(|n| n.set(0));
+        super::solver::ITERATIONS.with(|n| n.set(0));
         let t = ShapeTable::build(g, end, DEFAULT_TABLE_NODES).unwrap();
-        let work = super::newton::ITERATIONS.with(|n| n.get());
+        let work = super::solver::ITERATIONS.with(|n| n.get());
         assert!(t.volume.len() > 120, "m {}: {} nodes", c.0, t.volume.len());
         assert!(work <= 2000, "m {}: {work} iterations", c.0);
     }

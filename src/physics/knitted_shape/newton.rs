@@ -17,12 +17,6 @@
 use super::geometry::ShapeGeometry;
 use super::solver::{PathPoint, Solver};
 
-#[cfg(test)]
-thread_local! {
-    /// Iterations of both solves on this thread: the tests bound a table's work with it.
-    pub(super) static ITERATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
-}
-
 /// Newton iterations on the path before giving up to the robust solve; a warm start needs 2-5.
 pub(super) const MAX_PATH_ITERATIONS: usize = 40;
 /// Releases of one ring from the floor within a solve before it stays there.
@@ -70,7 +64,7 @@ impl Solver {
         let mut saddle_run = 0;
         for iteration in 0..max_iterations + MAX_BACKTRACKS {
             #[cfg(test)]
-            ITERATIONS.with(|c| c.set(c.get() + 1));
+            super::solver::ITERATIONS.with(|c| c.set(c.get() + 1));
             let Some((length, volume)) = self.assemble(geom) else {
                 let (alpha, lambda0, dlambda) = step?;
                 backtracks += 1;

@@ -4,6 +4,12 @@
 #![allow(clippy::neg_cmp_op_on_partial_ord, clippy::needless_range_loop)]
 use super::geometry::{Segment, ShapeGeometry};
 
+#[cfg(test)]
+thread_local! {
+    /// Iterations of both solves on this thread: the tests bound a table's work with it.
+    pub(super) static ITERATIONS: std::cell::Cell<usize> = const { std::cell::Cell::new(0) };
+}
+
 /// Newton iterations per solve; the warm start usually converges in 3-5.
 pub(super) const MAX_NEWTON: usize = 60;
 /// Active-set passes per solve (rings released from the minimum radius).
@@ -338,7 +344,7 @@ impl Solver {
         let mut last_mu = 0.0;
         for _it in 0..max_iterations {
             #[cfg(test)]
-            super::newton::ITERATIONS.with(|c| c.set(c.get() + 1));
+            ITERATIONS.with(|c| c.set(c.get() + 1));
             self.assemble(geom).ok_or("assemble")?;
             let lambda = self.multiplier().ok_or("multiplier")?;
             self.lambda = lambda;
