@@ -38,6 +38,8 @@
 pub mod angles;
 pub mod branch;
 mod cycle;
+#[cfg(test)]
+mod decoupled_tests;
 mod drift;
 pub mod drive;
 mod gilbert;
