@@ -38,6 +38,7 @@
 pub mod angles;
 pub mod branch;
 mod cycle;
+mod decoupled;
 #[cfg(test)]
 mod decoupled_tests;
 mod drift;
