@@ -37,7 +37,8 @@ impl Motor {
         }
         let impulse = 2.0 * torque_bound(&self.ring_bar) * remaining;
         // (A NaN fails.)
-        if !(impulse <= 0.01 * self.params.tolerance * self.drag) {
+        let negligible = impulse <= 0.01 * self.params.tolerance * self.drag;
+        if !negligible {
             return false;
         }
         // Any decay rate finds the rims: the impulse bound holds whatever the ringing does.
@@ -61,7 +62,8 @@ impl Motor {
                 left = left.min(reach * (-rate * remaining).exp());
             }
         }
-        if !(left <= self.params.tolerance + self.relaxed_slack()) {
+        let decays = left <= self.params.tolerance + self.relaxed_slack();
+        if !decays {
             return false;
         }
         let k_bar = self.ring_bar.stiffness(settled - y[0]);
