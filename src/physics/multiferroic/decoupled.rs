@@ -2,7 +2,7 @@
 //! segment: the Gilbert onion's trapped ringing is then dropped at once (see
 //! [`Motor::decoupled_ringing`]).
 
-use super::ringing::{sublevel_gradient_bound, Rims, MAX_FOLLOWED_LAG};
+use super::ringing::{sublevel_gradient_bound, Rims, MAX_FOLLOWED_LAG, RIM_SLOWDOWN};
 use super::{Drive, Motor, Vector};
 
 impl Motor {
@@ -41,8 +41,26 @@ impl Motor {
         if !negligible {
             return false;
         }
-        // Any decay rate finds the rims: the impulse bound holds whatever the ringing does.
-        let Some(trap) = self.trapped_ringing(y, d, settled, Some((rims, 0.0))) else {
+        // The rims are looked for (a march over the well) only where ringing out to them, half
+        // a turn wide at most, could decay to the slack within the segment at the faster of the
+        // rates it is held to there (the sublevel bound's `kappa` is at most the curvature at
+        // the minimum); near the minimum no search is needed.
+        let slack = self.params.tolerance + self.relaxed_slack();
+        let needed = (std::f64::consts::PI / slack).ln().max(0.0) / remaining;
+        let k = self
+            .landscape(y[0], d.direction, d.stress)
+            .curvature(settled);
+        let (g, alpha, t) = (
+            self.llg_rate,
+            self.params.gilbert_damping,
+            self.tilt_stiffness,
+        );
+        let linear = self
+            .onion_decay_rate(0.5 * k)
+            .max(self.onion_decay_rate(1.5 * k));
+        let reachable = (linear / RIM_SLOWDOWN).max(g * alpha * k.min(t)) >= needed;
+        let least_rate = if reachable { 0.0 } else { f64::INFINITY };
+        let Some(trap) = self.trapped_ringing(y, d, settled, Some((rims, least_rate))) else {
             return false;
         };
         // The onion must meet the segment's end (a switch, or the step's end where the inputs
@@ -56,13 +74,12 @@ impl Motor {
             let floor = super::orbit::point(&land, settled).0;
             let kappa = sublevel_gradient_bound(&land, settled, floor, level, rims);
             if kappa > 0.0 {
-                let rate =
-                    self.llg_rate * self.params.gilbert_damping * kappa.min(self.tilt_stiffness);
+                let rate = g * alpha * kappa.min(t);
                 let reach = trap.amplitude.min((2.0 * level / kappa).sqrt());
                 left = left.min(reach * (-rate * remaining).exp());
             }
         }
-        let decays = left <= self.params.tolerance + self.relaxed_slack();
+        let decays = left <= slack;
         if !decays {
             return false;
         }

@@ -410,7 +410,7 @@ pub(super) struct Trap {
 /// How much slower than its linearization's at the minimum ringing that reaches out to the rims of
 /// its well may decay (see [`Motor::averaged_ringing`]): the curvature falls to zero on the way
 /// and the orbit lingers near the rims.
-const RIM_SLOWDOWN: f64 = 100.0;
+pub(super) const RIM_SLOWDOWN: f64 = 100.0;
 
 /// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
 /// drop (see [`Motor::relaxed_onion`]).
