@@ -38,6 +38,9 @@
 pub mod angles;
 pub mod branch;
 mod cycle;
+mod decoupled;
+#[cfg(test)]
+mod decoupled_tests;
 mod drift;
 pub mod drive;
 mod gilbert;

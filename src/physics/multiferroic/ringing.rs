@@ -100,6 +100,9 @@ impl Motor {
     /// once it is trapped, at the cost of the onion's outputs: it is reported at the centre of its
     /// ringing, the minimum, not at the ringing's phase.
     ///
+    /// Where the ring's whole torque over the rest of the segment cannot move a free rotor, the
+    /// trapped ringing is dropped at once ([`Self::decoupled_ringing`]).
+    ///
     /// A locked rotor takes no impulse, so those bounds decide nothing for it: trapped ringing is
     /// dropped there only when it decays to within the tolerance of the minimum in the `remaining`
     /// time of its segment (s), at its bound on the decay rate, so that the onion meets the
@@ -112,6 +115,9 @@ impl Motor {
         rim_barrier: &mut Rims,
         remaining: f64,
     ) -> Option<f64> {
+        if self.decoupled_ringing(y, d, settled, rim_barrier, remaining) {
+            return Some(0.0);
+        }
         let limit = 0.1 * self.params.tolerance * self.drag;
         let k_bar = self.ring_bar.stiffness(settled - y[0]);
         // The rims are looked for only where ringing anywhere in the turn, and the rotor's turn
@@ -416,11 +422,11 @@ pub(super) struct Trap {
 /// How much slower than its linearization's at the minimum ringing that reaches out to the rims of
 /// its well may decay (see [`Motor::averaged_ringing`]): the curvature falls to zero on the way
 /// and the orbit lingers near the rims.
-const RIM_SLOWDOWN: f64 = 100.0;
+pub(super) const RIM_SLOWDOWN: f64 = 100.0;
 
 /// The largest lag of the Gilbert onion behind its branch (rad) that following the branch may
 /// drop (see [`Motor::relaxed_onion`]).
-const MAX_FOLLOWED_LAG: f64 = 1e-3;
+pub(super) const MAX_FOLLOWED_LAG: f64 = 1e-3;
 
 #[cfg(test)]
 mod tests {
