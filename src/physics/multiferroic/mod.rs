@@ -75,6 +75,8 @@ pub mod phi;
 mod resolved_tests;
 mod rhs;
 mod ringing;
+#[cfg(test)]
+mod ringing_drop_tests;
 pub mod schedule;
 mod slow_onion;
 #[cfg(test)]

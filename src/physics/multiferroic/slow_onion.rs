@@ -25,10 +25,11 @@ impl Motor {
     }
 
     /// Whether the Gilbert onion at `y` heads for the minimum of eq. 3.4 it sits in for the drive
-    /// `d` within `horizon` seconds (the communication step): its ringing decays by a factor `e`
-    /// at least over that time (`lambda horizon >= 1`, `lambda` [`Self::slowest_onion_decay`] at
-    /// the minimum's curvature `k`), or ends within the tolerance of the minimum (its distance in
-    /// the energy's norm, `sqrt(dpsi^2 + t theta^2 / k)`, times `exp(-lambda horizon)`).
+    /// `d` within `horizon` seconds (the step, or what is left of it): its ringing decays by a
+    /// factor `e` at least over that time (`lambda horizon >= 1`, `lambda`
+    /// [`Self::slowest_onion_decay`] at the minimum's curvature `k`), or ends within the
+    /// tolerance of the minimum (its distance in the energy's norm, `sqrt(dpsi^2 + t theta^2 / k)`,
+    /// times `exp(-lambda horizon)`).
     ///
     /// An onion that does not cannot follow the strain within the step at all; putting it on the
     /// quasi-static branch turned it with the strain at every switch where the resolved onion

@@ -305,7 +305,9 @@ impl Motor {
     /// under a free rotor, that heads for its minimum within the step,
     /// [`Self::heads_for_minimum`], unless it left its bounds. A locked rotor's onion is dropped
     /// regardless: kept, its forced substeps ended a 1 us step on a 22 ns schedule 0.66 rad off
-    /// an RK4, against 8.5e-3 rad dropped.)
+    /// an RK4, against 8.5e-3 rad dropped.) Otherwise it follows once relaxed
+    /// ([`Self::relaxed_onion`]) and, under a free rotor, heads for its minimum within the rest
+    /// of the step: ringing that barely moves the rotor still places the onion.
     fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
@@ -337,10 +339,13 @@ impl Motor {
                 run.average_check_at = run.attempts + 1 + run.attempts / 8;
             }
             let rims = average.then_some(&mut run.rim_barrier.1);
+            // Ringing that neither decays within the step nor ends within the tolerance is
+            // kept, whatever its effect on a free rotor: the onion itself would be off by it.
+            let decays = |y: &Vector| d.locked || self.heads_for_minimum(y, d, run.t_end - run.t);
             match self.relaxed_onion(&run.y, d, rims, segment_end - run.t) {
                 // The averaged ringing's impulse on the rotor.
-                Some(kick) => run.y[1] += kick,
-                None => return false,
+                Some(kick) if decays(&run.y) => run.y[1] += kick,
+                _ => return false,
             }
         }
         run.following = segment_end;
