@@ -10,40 +10,21 @@ use super::*;
 /// `0.02 / r` with `r` the fastest rate of the equations' Jacobian at the start (halving them
 /// moves the onion by a thousandth of the tolerance at most in the cases below).
 fn rk4(m: &Motor, state: &MotorState, inputs: &MotorInputs, t_end: f64) -> MotorState {
-    let s = inputs.schedule.get().unwrap();
-    let mut y = [
+    let y = [
         state.rotor_angle,
         state.rotor_speed,
         state.onion_angle,
         state.onion_tilt,
     ];
-    let mut t = state.time;
-    let d0 = m.drive_at(inputs, t);
-    let j = m.rhs_jacobian(&y, &d0, 0.0).1;
+    let j = m.rhs_jacobian(&y, &m.drive_at(inputs, state.time), 0.0).1;
     let fastest = j
         .iter()
         .map(|row| row.iter().map(|x| x.abs()).sum::<f64>())
         .fold(0.0, f64::max);
-    let dt_max = 0.02 / fastest;
-    while t < t_end {
-        let next = s.next_switch_after(t).min(t_end);
-        let d = m.drive_at(inputs, t);
-        let n = ((next - t) / dt_max).ceil().max(1.0);
-        let h = (next - t) / n;
-        let f = |z: &Vector| m.rhs_jacobian(z, &d, h).0;
-        for _ in 0..n as usize {
-            let k1 = f(&y);
-            let k2 = f(&std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
-            let k3 = f(&std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
-            let k4 = f(&std::array::from_fn(|i| y[i] + h * k3[i]));
-            y = std::array::from_fn(|i| {
-                y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            });
-        }
-        t = next;
-    }
+    // Steps of 0.02 over the fastest rate: `per_ns` steps in each nanosecond.
+    let y = super::resolved_tests::rk4(m, state, inputs, t_end, fastest * 1e-9 / 0.02);
     MotorState {
-        time: t,
+        time: t_end,
         rotor_angle: y[0],
         rotor_speed: y[1],
         onion_angle: y[2],
