@@ -47,9 +47,8 @@ impl Motor {
         // the minimum); near the minimum no search is needed.
         let slack = self.params.tolerance + self.relaxed_slack();
         let needed = (std::f64::consts::PI / slack).ln().max(0.0) / remaining;
-        let k = self
-            .landscape(y[0], d.direction, d.stress)
-            .curvature(settled);
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let k = land.curvature(settled);
         let (g, alpha, t) = (
             self.llg_rate,
             self.params.gilbert_damping,
@@ -70,7 +69,6 @@ impl Motor {
         let mut left = trap.amplitude * (-trap.rate * remaining).exp();
         if let Some((level, rims)) = trap.sublevel {
             // Out to the rims, also at the decay its energy's sublevel gradient bound guarantees.
-            let land = self.landscape(y[0], d.direction, d.stress);
             let floor = super::orbit::point(&land, settled).0;
             let kappa = sublevel_gradient_bound(&land, settled, floor, level, rims);
             if kappa > 0.0 {

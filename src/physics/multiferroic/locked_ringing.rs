@@ -65,15 +65,14 @@ impl Motor {
         // The linearization at the minimum first (no rims): its averaged energy decay rate
         // `g alpha (k + T)` bounds the decay time from below, its loss per orbit
         // `2 pi alpha (k + T) / sqrt(k T)` must be small.
-        let minimum = settled;
-        let k = land.curvature(minimum);
+        let k = land.curvature(settled);
         let m = land.third_derivative_bound();
         if !(k > 0.0 && k.is_finite() && m > 0.0 && m.is_finite()) {
             return false;
         }
         let linear_rate = g * alpha * (k + t);
         let linear_loss = 2.0 * std::f64::consts::PI * alpha * (k + t) / (k * t).sqrt();
-        let floor = point(&land, minimum).0;
+        let floor = point(&land, settled).0;
         let e0 = point(&land, y[2]).0 - floor + 0.5 * t * y[3] * y[3];
         let e1 = tol * tol * (5.0 * k / 12.0).min(0.5 * t);
         let window = 0.5 * k / m;
@@ -99,7 +98,7 @@ impl Motor {
         };
         if !(well.below < y[2]
             && y[2] < well.above
-            && (well.minimum - minimum).abs() <= 1e-9 * (1.0 + minimum.abs())
+            && (well.minimum - settled).abs() <= 1e-9 * (1.0 + settled.abs())
             && e0 <= RIM_MARGIN * well.barrier)
         {
             return false;

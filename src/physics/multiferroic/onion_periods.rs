@@ -166,7 +166,7 @@ impl Motor {
                 return false;
             }
         }
-        let slowest = self.slowest_onion_decay(curvature);
+        let slowest = self.onion_decay_rate(curvature);
         let memory = 1.0 + 1.0 / (slowest * s.step_period);
         self.torque_bound() / curvature * memory <= 0.01 * self.params.tolerance
     }

@@ -42,7 +42,7 @@ fn slowest_decay_is_the_onion_blocks_slower_eigenvalue() {
         } else {
             -half_trace
         };
-        let rate = m.slowest_onion_decay(k);
+        let rate = m.onion_decay_rate(k);
         println!("stress {stress}: curvature {k:e}, rate {rate:e} against {slower:e}");
         assert!(k > 0.0);
         assert!(
