@@ -413,7 +413,7 @@ impl McKibben {
         c: f64,
         eval: &impl Fn(f64) -> Result<(f64, Core), String>,
     ) -> Result<Bracket, String> {
-        if !(rise0 > 1.0) {
+        if rise0.is_nan() || rise0 <= 1.0 {
             return Ok(Bracket::None);
         }
         let (lo_edge, hi_edge) = self.connector_edges();
@@ -424,7 +424,7 @@ impl McKibben {
         let (mut inner, mut h_inner) = (x0, h0);
         // Doublings from a float's spacing span the range in about 60 steps.
         for _ in 0..128 {
-            if !(d < reach) {
+            if d.is_nan() || d >= reach {
                 break;
             }
             let cand = if upward { x0 + d } else { x0 - d };

@@ -311,7 +311,6 @@ fn an_input_past_the_reach_is_refused_or_evaluated_where_it_has_a_solution() {
     assert!(out.force.abs() < 1.0, "{}", out.force);
 }
 
-
 /// Seed 2's draw 180: Table 2.1's muscle B, 60 layers as written, `mooney_c2` 3.5e-4 Pa under a
 /// 541 Pa vacuum with friction, 0.242 m reported through a connector of 3.2 N/m, past the
 /// breaking length (0.113 m). The reported length `L + F/k` rises from about `L + 1.5e-5` m on
@@ -332,14 +331,22 @@ fn a_length_on_the_steep_wall_is_solved_in_bounded_work() {
     let (d, m) = steep_wall_draw();
     let kernels = crate::physics::bladder::kernel_count;
     let before = kernels();
-    let (out, clamp) = m.evaluate_with_strands(d.pressure, d.length, strand_stiffness(&m), &d.history);
+    let (out, clamp) =
+        m.evaluate_with_strands(d.pressure, d.length, strand_stiffness(&m), &d.history);
     let cost = kernels() - before;
     assert!(cost <= 200, "{cost} wall evaluations");
     let out = out.unwrap();
     assert!(clamp.is_none(), "{clamp:?}");
     let h = out.actual_length + out.force / d.stiffness - d.length;
-    assert!(h.abs() <= LIMIT_MARGIN * (m.max_length() - m.min_length()), "{h} m");
-    assert!(out.stiffness > 0.0 && out.stiffness < d.stiffness, "{}", out.stiffness);
+    assert!(
+        h.abs() <= LIMIT_MARGIN * (m.max_length() - m.min_length()),
+        "{h} m"
+    );
+    assert!(
+        out.stiffness > 0.0 && out.stiffness < d.stiffness,
+        "{}",
+        out.stiffness
+    );
 }
 
 /// The same draw against a scan of the muscle's own length, in steps that halve towards the
@@ -365,7 +372,11 @@ fn the_solution_on_the_steep_wall_is_the_scanned_crossing() {
     for &l in &scan[1..] {
         let core = at(l);
         let reported = l + c * core.out.force;
-        assert!(reported >= previous.1, "falls at {l}: {reported} < {}", previous.1);
+        assert!(
+            reported >= previous.1,
+            "falls at {l}: {reported} < {}",
+            previous.1
+        );
         let series = core.out.stiffness / (1.0 + c * core.out.stiffness);
         assert!(series < k_s, "{l}: {series}");
         if crossing.is_none() && reported >= d.length {
@@ -381,5 +392,7 @@ fn the_solution_on_the_steep_wall_is_the_scanned_crossing() {
         "{} not in [{below}, {above}]",
         out.actual_length
     );
-    assert!(m.strand_point(d.pressure, d.length, k_s, &d.history).is_none());
+    assert!(m
+        .strand_point(d.pressure, d.length, k_s, &d.history)
+        .is_none());
 }
