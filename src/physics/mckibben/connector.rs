@@ -141,8 +141,10 @@ impl McKibben {
     }
 
     /// Solves `reported = L + c F(L)` for the muscle length `L` (c = 1/k): bracket by doubling
-    /// steps inside the muscle's length range, then safeguarded Newton-bisection. Hand-written,
-    /// capped loops for robustness on the per-step path. Where that finds no bracket from a first
+    /// steps inside the muscle's length range (from a first guess on a steep rising wall, by
+    /// steps that double from a fraction of Newton's, [`Self::bracket_on_wall`]), then
+    /// safeguarded Newton-bisection. Hand-written, capped loops for robustness on the per-step
+    /// path. Where that finds no bracket from a first
     /// guess past a fold or a jump of the force (the reported length falls with `L` there), it
     /// brackets on the branch rising from the muscle's shortest length (up to its end,
     /// [`Self::branch_end`], kept in `branch`), and so it does where the bracket holds a jump of
@@ -211,7 +213,12 @@ impl McKibben {
             Ok(Bracket::Between(lo_edge, end))
         };
         let (mut bracket, mut shortest) = match self.bracket(x0, h0, &eval)? {
-            Bracket::None if 1.0 + c * core0.newton_slope > 0.0 => return Err(unreachable()),
+            Bracket::None if 1.0 + c * core0.newton_slope > 0.0 => {
+                match self.bracket_on_wall((x0, h0, 1.0 + c * core0.newton_slope), c, &eval)? {
+                    Bracket::None => return Err(unreachable()),
+                    found => (found, false),
+                }
+            }
             Bracket::None => (on_shortest_branch()?, true),
             found => (found, false),
         };
@@ -386,6 +393,65 @@ impl McKibben {
             }
             inner = cand;
             step *= 2.0;
+        }
+        Ok(Bracket::None)
+    }
+}
+
+impl McKibben {
+    /// Brackets the root of the connector residual `h` on the rising stretch through `x0`
+    /// (`h = h0 != 0`, slope `rise0 = 1 + c dF/dL` there) where [`Self::bracket`] found no
+    /// sign change: its first step, `|h0|`, is `rise0` times Newton's, and on a steep wall next
+    /// to a singular end (`rise0` 1e17 and more) it crosses the whole range to the far end's
+    /// wall, of the same sign, past a root 1e-9 of the range away. Only there (`rise0 > 1`):
+    /// from a sixteenth of Newton's step the distance doubles while `|h|` falls towards the
+    /// root, up to `|h0|`; off the wall (`1 + c dF/dL <= 1`) [`Self::bracket`] goes on from
+    /// there, and a rise of `|h|` (past a fold or a jump of the force) ends the stretch.
+    fn bracket_on_wall(
+        &self,
+        (x0, h0, rise0): (f64, f64, f64),
+        c: f64,
+        eval: &impl Fn(f64) -> Result<(f64, Core), String>,
+    ) -> Result<Bracket, String> {
+        if rise0.is_nan() || rise0 <= 1.0 {
+            return Ok(Bracket::None);
+        }
+        let (lo_edge, hi_edge) = self.connector_edges();
+        let upward = h0 < 0.0;
+        let span = if upward { hi_edge - x0 } else { x0 - lo_edge };
+        let reach = span.min(h0.abs());
+        let mut d = (h0.abs() / rise0 / 16.0).max(f64::EPSILON * x0.abs());
+        let (mut inner, mut h_inner) = (x0, h0);
+        // Doublings from a float's spacing span the range in about 60 steps.
+        for _ in 0..128 {
+            if d.is_nan() || d >= reach {
+                break;
+            }
+            let cand = if upward { x0 + d } else { x0 - d };
+            d *= 2.0;
+            if cand == inner {
+                continue;
+            }
+            let Ok((h, core)) = eval(cand) else {
+                break;
+            };
+            if h == 0.0 {
+                return Ok(Bracket::Root(core));
+            }
+            if (h > 0.0) == upward {
+                return Ok(if upward {
+                    Bracket::Between(inner, cand)
+                } else {
+                    Bracket::Between(cand, inner)
+                });
+            }
+            if h.abs() > h_inner.abs() {
+                break;
+            }
+            if 1.0 + c * core.newton_slope <= 1.0 {
+                return self.bracket(cand, h, eval);
+            }
+            (inner, h_inner) = (cand, h);
         }
         Ok(Bracket::None)
     }

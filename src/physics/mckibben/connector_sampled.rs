@@ -310,3 +310,89 @@ fn an_input_past_the_reach_is_refused_or_evaluated_where_it_has_a_solution() {
     );
     assert!(out.force.abs() < 1.0, "{}", out.force);
 }
+
+/// Seed 2's draw 180: Table 2.1's muscle B, 60 layers as written, `mooney_c2` 3.5e-4 Pa under a
+/// 541 Pa vacuum with friction, 0.242 m reported through a connector of 3.2 N/m, past the
+/// breaking length (0.113 m). The reported length `L + F/k` rises from about `L + 1.5e-5` m on
+/// the stretch below the steep wall at `max_length` through all reported lengths up to 2.9e7 m
+/// within 2.5e-9 m of it, where the input is solved.
+fn steep_wall_draw() -> (Draw, McKibben) {
+    let d = draws(2, 181)[180];
+    (d, d.muscle())
+}
+
+/// That draw evaluated with Table 2.1's strands: the rigid muscle, softer than its strands,
+/// in a bounded number of wall evaluations (the bracket's first step of `|h|`, 2.9e7 m, crossed
+/// the range to the shortest length's wall and the input was taken out of reach; the strands'
+/// transition was then searched through 55 connector solves, 3,513 wall evaluations, and the
+/// strands were stretched to the breaking length: 470 N).
+#[test]
+fn a_length_on_the_steep_wall_is_solved_in_bounded_work() {
+    let (d, m) = steep_wall_draw();
+    let kernels = crate::physics::bladder::kernel_count;
+    let before = kernels();
+    let (out, clamp) =
+        m.evaluate_with_strands(d.pressure, d.length, strand_stiffness(&m), &d.history);
+    let cost = kernels() - before;
+    assert!(cost <= 200, "{cost} wall evaluations");
+    let out = out.unwrap();
+    assert!(clamp.is_none(), "{clamp:?}");
+    let h = out.actual_length + out.force / d.stiffness - d.length;
+    assert!(
+        h.abs() <= LIMIT_MARGIN * (m.max_length() - m.min_length()),
+        "{h} m"
+    );
+    assert!(
+        out.stiffness > 0.0 && out.stiffness < d.stiffness,
+        "{}",
+        out.stiffness
+    );
+}
+
+/// The same draw against a scan of the muscle's own length, in steps that halve towards the
+/// top of the connector's lengths: the reported length rises through the input between two
+/// neighbouring scanned lengths, on a stretch rising from the plateau below the wall, and the
+/// solution lies between them; nowhere on the way is the muscle stiffer than its strands in
+/// series with the connector, so the strands do not take over (the transition was found at
+/// 0.1069 m, where the bracket's first guess reached the wall).
+#[test]
+fn the_solution_on_the_steep_wall_is_the_scanned_crossing() {
+    let (d, m) = steep_wall_draw();
+    let (c, k_s) = (1.0 / d.stiffness, strand_stiffness(&m));
+    let (_, hi) = m.connector_edges();
+    let at = |l: f64| m.at_actual_length(d.pressure, l, &d.history).unwrap();
+    // From 0.01 m below the top, the distance halving down to a float's spacing, each halving
+    // in 8 steps.
+    let mut scan: Vec<f64> = (0..=8 * 40)
+        .map(|j| hi - 0.01 * 0.5f64.powf(f64::from(j) / 8.0))
+        .collect();
+    scan.dedup();
+    let mut previous = (scan[0], scan[0] + c * at(scan[0]).out.force);
+    let mut crossing = None;
+    for &l in &scan[1..] {
+        let core = at(l);
+        let reported = l + c * core.out.force;
+        assert!(
+            reported >= previous.1,
+            "falls at {l}: {reported} < {}",
+            previous.1
+        );
+        let series = core.out.stiffness / (1.0 + c * core.out.stiffness);
+        assert!(series < k_s, "{l}: {series}");
+        if crossing.is_none() && reported >= d.length {
+            crossing = Some((previous.0, l));
+        }
+        previous = (l, reported);
+    }
+    let (below, above) = crossing.unwrap();
+    assert!(above - below < 3e-9, "{below} {above}");
+    let out = m.evaluate(d.pressure, d.length, &d.history).unwrap();
+    assert!(
+        below <= out.actual_length && out.actual_length <= above,
+        "{} not in [{below}, {above}]",
+        out.actual_length
+    );
+    assert!(m
+        .strand_point(d.pressure, d.length, k_s, &d.history)
+        .is_none());
+}
