@@ -54,11 +54,23 @@ fn slowest_decay_is_the_onion_blocks_slower_eigenvalue() {
 
 /// A 1 us step of [`SLOW_ONION`] against an RK4 of the motor's equations (0.5 ps and 0.25 ps
 /// steps, agreeing within a thousandth of the tolerance): the rotor and the onion within the
-/// tolerance. Putting the onion on its quasi-static branch once the budget ran out turned it
-/// with the strain at each of the last ~200 switches: 38.5 rad off, 1.5e11 tolerances.
+/// tolerance, in at most one substep a switch (2,785 when only the explicit pair was tried
+/// within its reach, whose rejections each switch's tilt transient drew), and, with a budget
+/// too small for that (3,000: 600 Gilbert substeps), once the budget runs out. Putting the
+/// onion on its quasi-static branch then turned it with the strain at each of the last ~200
+/// switches: 38.5 rad off, 1.5e11 tolerances.
 #[test]
 fn a_slow_onion_keeps_its_place_when_the_budget_runs_out() {
-    let (m, start, inputs) = case(&values(SLOW_ONION)).unwrap();
+    keeps_its_place(None);
+    keeps_its_place(Some(3e3));
+}
+
+fn keeps_its_place(budget: Option<f64>) {
+    let mut kv = values(SLOW_ONION);
+    if let Some(b) = budget {
+        kv.insert("max_substeps".into(), b);
+    }
+    let (m, start, inputs) = case(&kv).unwrap();
     let tol = m.params.tolerance;
     // The first period resolved alone (the step under test then spans whole periods only).
     let s = *inputs.schedule.get().unwrap();
@@ -81,6 +93,8 @@ fn a_slow_onion_keeps_its_place_when_the_budget_runs_out() {
         "{st:?} against {reference:?}"
     );
     assert!((st.onion_tilt - reference[3]).abs() <= tol);
+    // The step's 794 switches.
+    assert!(report.substeps <= 800, "{} substeps", report.substeps);
 }
 
 /// A benchmark case: a free rotor on a 1.03 ns schedule at damping 1.2e-4 whose onion decays by
