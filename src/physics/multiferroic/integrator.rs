@@ -165,8 +165,9 @@ impl Motor {
                 // substep: an onion far from its minimum that barely moves over it (a strain
                 // turning past a slow onion every nanosecond) is nearly linear there, and the
                 // tilt's transient after each switch, which holds the explicit pair to a third of
-                // a period, is followed exactly (one substep a switch instead of 3.5).
-                if err <= 1.0 {
+                // a period, is followed exactly (one substep a switch instead of 3.5). Under a
+                // free rotor only: a locked one's onion measured no gain, and stays as it was.
+                if err <= 1.0 || d.locked {
                     return Some((u, err, dt, None));
                 }
                 return match self.gilbert_embedded_step(y, dt, d, &start) {

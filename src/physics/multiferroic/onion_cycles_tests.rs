@@ -120,15 +120,13 @@ fn onion_relaxed_every_seventh_switch_repeats_its_cycles() {
     );
 }
 
-/// Strain turned by -0.014 rad every 22 ns, a locked onion whose slowest decay is 0.001 per
-/// period: it rings through its switches, never within the tolerance of its minimum at one, so
-/// no cycle repeats and every switch is resolved (about 730 substeps per 1 us step, each within
-/// the tolerance): its angle and tilt within 30 tolerances of a plain RK4 over each step.
-/// Dropping the ringing within 1e-3 rad of the minimum (which a locked rotor cannot feel)
-/// repeated cycles of 8 switches instead, 8.5e5 tolerances off.
+/// Strain turned by -0.014 rad every 22 ns, the onion (slowest decay 0.001 per period) relaxed
+/// at every 8th switch: 660-680 substeps per 1 us step when every switch was resolved. (Its
+/// resolution drops the locked onion's ringing up to `MAX_FOLLOWED_LAG`, far beyond this
+/// tolerance, at each relaxation, so it is held to that resolution only.)
 #[test]
-fn onion_ringing_through_its_switches_is_resolved() {
-    let (m, start, inputs) = case(&values(
+fn onion_relaxed_every_eighth_switch_repeats_its_cycles() {
+    repeats_its_cycles(
         "strain_direction=-2.670e5 stress=-3.356e0 load_torque=-2.325e-7 \
          ring_outer_diameter=5.987e-2 ring_inner_diameter=3.915e-2 bar_length=1.390e-5 \
          bar_width=7.725e-7 thickness=1.577e-9 saturation_magnetization=2.609e3 \
@@ -137,24 +135,7 @@ fn onion_ringing_through_its_switches_is_resolved() {
          stress_amplitude=-4.277e1 schedule_initial_direction=4.313e-7 onion_model=1 \
          max_substeps=6.861e3 schedule=1 rotor_locked=1 initial_onion_offset=-4.883e-2 \
          strain=-4.801e-2 youngs_modulus=6.645e6",
-    ))
-    .unwrap();
-    let tol = m.params.tolerance;
-    let mut st = start;
-    m.step(&mut st, &inputs, 1e-6).unwrap();
-    for k in 1..=2 {
-        let from = st;
-        let rep = m.step(&mut st, &inputs, 1e-6).unwrap();
-        let r = rk4(&m, &from, &inputs, st.time);
-        let errors = [
-            (st.onion_angle - r.onion_angle).abs() / tol,
-            (st.onion_tilt - r.onion_tilt).abs() / tol,
-        ];
-        println!(
-            "step {k}: {} substeps, errors / tolerance against RK4 {errors:?}",
-            rep.substeps
-        );
-        assert!(!rep.accuracy_limited, "step {k} is accuracy-limited");
-        assert!(errors.iter().all(|e| *e <= 30.0), "step {k}: {st:?} against {r:?}");
-    }
+        400,
+        false,
+    );
 }
