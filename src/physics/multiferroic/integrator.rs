@@ -161,7 +161,19 @@ impl Motor {
                 .then(|| self.gilbert_explicit_step(y, dt, d, &start))
                 .flatten();
             if let Some((u, err)) = explicit {
-                return Some((u, err, dt, None));
+                // Where the explicit pair rejects, the exponential pair may still take the
+                // substep: an onion far from its minimum that barely moves over it (a strain
+                // turning past a slow onion every nanosecond) is nearly linear there, and the
+                // tilt's transient after each switch, which holds the explicit pair to a third of
+                // a period, is followed exactly (one substep a switch instead of 3.5). Under a
+                // free rotor only: a locked one's onion measured no gain, and stays as it was.
+                if err <= 1.0 || d.locked {
+                    return Some((u, err, dt, None));
+                }
+                return match self.gilbert_embedded_step(y, dt, d, &start) {
+                    Some((v, e)) if e <= 1.0 => Some((v, e, dt, None)),
+                    _ => Some((u, err, dt, None)),
+                };
             }
             // Where the exponential RK4 substep rejects, the exponential pair may still take it:
             // near its minimum the onion's ringing is nearly linear, which the exponential pair
