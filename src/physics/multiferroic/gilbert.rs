@@ -187,11 +187,12 @@ impl Motor {
     ///
     /// With the rotor locked `L` is the onion's own block `g [[-alpha U'', -T], [U'', -alpha T]]`
     /// (eq. 3.4's landscape frozen) and the rest, the change of the landscape's curvature along
-    /// the substep, is explicit: it is tried where the explicit pair is out of reach, an onion
-    /// whose tilt relaxes far faster than it turns (`alpha^2 T > 4 U''`, real eigenvalues), which
-    /// creeps downhill over its wells' rims after a release far from its minimum and left the
-    /// second-order pair to take about a thousand substeps a microsecond at tolerances near
-    /// 2e-10 rad. Its error estimate is held to [`LOCKED_ETD_ERROR_SCALE`] times less.
+    /// the substep, is explicit: it is tried where the explicit pair is out of reach and the
+    /// onion's tilt relaxes faster than it turns (`alpha^2 T > 4 |U''|`, real eigenvalues): an
+    /// onion that creeps downhill over its wells' rims after a release far from its minimum,
+    /// which left the second-order pair to take about a thousand substeps a microsecond at
+    /// tolerances near 2e-10 rad. Its error estimate is held to [`LOCKED_ETD_ERROR_SCALE`] times
+    /// less.
     pub(super) fn gilbert_exponential_rk4_step(
         &self,
         y: &Vector,
@@ -205,6 +206,15 @@ impl Motor {
         // (False for a NaN rate too.)
         let within_reach = d.locked || dt * self.onion_rate_bound(j) <= ETD_REACH;
         if !within_reach {
+            return None;
+        }
+        // A locked onion's block is taken only where its tilt relaxes faster than the onion
+        // turns, `alpha^2 T > 4 |U''|` (the block's eigenvalues real whatever the curvature's
+        // sign; `U''` is its (3, 2) entry over `g`): where it rings, the exponential RK4 took
+        // no fewer substeps than the exponential pair, each costing more.
+        let (alpha, t) = (self.params.gilbert_damping, self.tilt_stiffness);
+        let curvature = j[3][2] / self.llg_rate;
+        if d.locked && !(alpha * alpha * t > 4.0 * curvature.abs()) {
             return None;
         }
         let b = if d.locked { 2 } else { 0 };
