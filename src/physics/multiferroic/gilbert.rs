@@ -1,5 +1,6 @@
 //! The Gilbert onion's error-controlled substeps: the exponential pair, the explicit
-//! Dormand-Prince pair while the onion rings, and an exponential RK4 on a stiff rotor.
+//! Dormand-Prince pair while the onion rings, and an exponential RK4 on a stiff rotor or a locked
+//! rotor's overdamped onion.
 
 use super::phi::Phi2x2;
 use super::{Angles, Drive, Motor, Vector};
@@ -181,9 +182,17 @@ impl Motor {
     /// doubling's (one full step against two halves, which share the start's stage), taken
     /// whole rather than divided by `2^4 - 1`, so that an order lost to stiffness cannot hide;
     /// the two halves are the result. Returned as `err^(5/8)`, as the explicit pair's (about the
-    /// fourth order's `err^(-1/5)` step rule). `None` for a locked rotor (the explicit pair
-    /// reaches it), out of reach, for an underdamped rotor block (complex eigenvalues) or when
-    /// the step fails.
+    /// fourth order's `err^(-1/5)` step rule). `None` out of reach, for an underdamped block
+    /// (complex eigenvalues) or when the step fails.
+    ///
+    /// With the rotor locked `L` is the onion's own block `g [[-alpha U'', -T], [U'', -alpha T]]`
+    /// (eq. 3.4's landscape frozen) and the rest, the change of the landscape's curvature along
+    /// the substep, is explicit: it is tried where the explicit pair is out of reach and the
+    /// onion's tilt relaxes faster than it turns (`alpha^2 T > 4 |U''|`, real eigenvalues): an
+    /// onion that creeps downhill over its wells' rims after a release far from its minimum,
+    /// which left the second-order pair to take about a thousand substeps a microsecond at
+    /// tolerances near 2e-10 rad. Its error estimate is held to [`LOCKED_ETD_ERROR_SCALE`] times
+    /// less.
     pub(super) fn gilbert_exponential_rk4_step(
         &self,
         y: &Vector,
@@ -192,61 +201,84 @@ impl Motor {
         start: &Linearized,
     ) -> Option<(Vector, f64)> {
         let j = &start.j;
+        // With the rotor locked the onion's own block is the linear part (its rates then all
+        // in it); otherwise the rotor's, the onion's rates within the explicit reach.
         // (False for a NaN rate too.)
-        let within_reach = dt * self.onion_rate_bound(j) <= ETD_REACH;
-        if d.locked || !within_reach {
+        let within_reach = d.locked || dt * self.onion_rate_bound(j) <= ETD_REACH;
+        if !within_reach {
             return None;
         }
-        let block = |h: f64| [[h * j[0][0], h * j[0][1]], [h * j[1][0], h * j[1][1]]];
+        if d.locked {
+            // A locked onion's block is taken only where its tilt relaxes faster than the onion
+            // turns, `alpha^2 T > 4 |U''|` (the block's eigenvalues real whatever the
+            // curvature's sign; `U''` is its (3, 2) entry over `g`): where it rings, the
+            // exponential RK4 took no fewer substeps than the exponential pair, each costing
+            // more.
+            let (alpha, t) = (self.params.gilbert_damping, self.tilt_stiffness);
+            let curvature = j[3][2] / self.llg_rate;
+            if curvature.is_nan() || alpha * alpha * t <= 4.0 * curvature.abs() {
+                return None;
+            }
+        }
+        let b = if d.locked { 2 } else { 0 };
+        let block = |h: f64| {
+            [
+                [h * j[b][b], h * j[b][b + 1]],
+                [h * j[b + 1][b], h * j[b + 1][b + 1]],
+            ]
+        };
         let (full, half, quarter) = (block(dt), block(0.5 * dt), block(0.25 * dt));
         let phi_full = Phi2x2::new(&full)?;
         let phi_half = Phi2x2::new(&half)?;
         let phi_quarter = Phi2x2::new(&quarter)?;
         let rate =
             |z: &Vector| self.gilbert_rate(z, d, &start.angles.moved(z[2], z[0], d.direction));
-        let whole = self.etd_rk4(
-            y,
-            start.f,
-            dt,
-            j,
-            (&phi_half, &half),
-            (&phi_full, &full),
-            rate,
-        );
-        let first = self.etd_rk4(
+        // The block's index is a constant of each instance (the free rotor's substeps are the
+        // hot path of viscous motors).
+        let etd = |y0: &Vector, f0: Vector, h: f64, half, full| {
+            if d.locked {
+                self.etd_rk4::<2>(y0, f0, h, j, half, full, rate)
+            } else {
+                self.etd_rk4::<0>(y0, f0, h, j, half, full, rate)
+            }
+        };
+        let whole = etd(y, start.f, dt, (&phi_half, &half), (&phi_full, &full));
+        let first = etd(
             y,
             start.f,
             0.5 * dt,
-            j,
             (&phi_quarter, &quarter),
             (&phi_half, &half),
-            rate,
         );
-        let two = self.etd_rk4(
+        let two = etd(
             &first,
             rate(&first),
             0.5 * dt,
-            j,
             (&phi_quarter, &quarter),
             (&phi_half, &half),
-            rate,
         );
-        let u = self.checked_end(two, y, false)?;
-        let err = self.error_norm(|i| two[i] - whole[i], y, &u);
+        let u = self.checked_end(two, y, d.locked)?;
+        let scale = if d.locked {
+            LOCKED_ETD_ERROR_SCALE
+        } else {
+            1.0
+        };
+        let err = scale * self.error_norm(|i| two[i] - whole[i], y, &u);
         err.is_finite().then(|| (u, fifth_order_error(err)))
     }
 
-    /// One ETDRK4 step of `h` from `y0` (where the rate is `f0`) with the rotor block of `j` as
-    /// the linear part; `half` and `full` are its `phi` functions at `h L / 2` and `h L` with
-    /// those matrices. With `u` the deviation from `y0` and `N(u) = F(y0 + u) - L u`:
+    /// One ETDRK4 step of `h` from `y0` (where the rate is `f0`) with the 2x2 block of `j` at
+    /// `(B, B)` as the linear part `L` (the rotor's at 0, the onion's at 2); `half` and `full`
+    /// are its `phi` functions at `h L / 2` and `h L` with those matrices. With `u` the
+    /// deviation from `y0` and `N(u) = F(y0 + u) - L u`:
     /// `a = h/2 phi_1(z/2) N(0)`, `b = h/2 phi_1(z/2) N(a)`,
     /// `c = e^(z/2) a + h/2 phi_1(z/2) (2 N(b) - N(0))` and the end
     /// `h [phi_1 N(0) + phi_2 (2 N(a) + 2 N(b) - N(c) - 3 N(0)) + 4 phi_3 D]` with
-    /// `D = N(0) - N(a) - N(b) + N(c)` (`phi_k` at `z = h L`; at `L = 0`, on the onion, this is
-    /// classical RK4).
+    /// `D = N(0) - N(a) - N(b) + N(c)` (`phi_k` at `z = h L`; at `L = 0`, on the other block,
+    /// this is classical RK4).
     #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    fn etd_rk4(
+    fn etd_rk4<const B: usize>(
         &self,
         y0: &Vector,
         f0: Vector,
@@ -256,30 +288,34 @@ impl Motor {
         full: (&Phi2x2, &[[f64; 2]; 2]),
         rate: impl Fn(&Vector) -> Vector,
     ) -> Vector {
-        // phi_k of the linear part (the rotor block; zero on the onion) applied to v.
+        // phi_k of the linear part (the block at B; zero on the other) applied to v.
         let apply = |(p, a): (&Phi2x2, &[[f64; 2]; 2]), k: u32, v: &Vector| -> Vector {
-            let [r0, r1] = p.apply(k, a, [v[0], v[1]]);
-            let onion = [1.0, 0.5, 1.0 / 6.0][k as usize - 1];
-            [r0, r1, onion * v[2], onion * v[3]]
+            let [r0, r1] = p.apply(k, a, [v[B], v[B + 1]]);
+            let other = [1.0, 0.5, 1.0 / 6.0][k as usize - 1];
+            if B == 0 {
+                [r0, r1, other * v[2], other * v[3]]
+            } else {
+                [other * v[0], other * v[1], r0, r1]
+            }
         };
         let n = |u: &Vector| -> Vector {
             let mut f = rate(&std::array::from_fn(|i| y0[i] + u[i]));
-            f[0] -= j[0][0] * u[0] + j[0][1] * u[1];
-            f[1] -= j[1][0] * u[0] + j[1][1] * u[1];
+            f[B] -= j[B][B] * u[B] + j[B][B + 1] * u[B + 1];
+            f[B + 1] -= j[B + 1][B] * u[B] + j[B + 1][B + 1] * u[B + 1];
             f
         };
         let scaled = |c: f64, v: Vector| -> Vector { v.map(|x| c * x) };
         let n0 = f0;
         let a = scaled(0.5 * h, apply(half, 1, &n0));
         let na = n(&a);
-        let b = scaled(0.5 * h, apply(half, 1, &na));
-        let nb = n(&b);
-        // e^(z/2) a = a + (z/2) phi_1(z/2) a, with z/2 the half matrix on the rotor.
+        let b_stage = scaled(0.5 * h, apply(half, 1, &na));
+        let nb = n(&b_stage);
+        // e^(z/2) a = a + (z/2) phi_1(z/2) a, with z/2 the half matrix on the block.
         let pa = apply(half, 1, &a);
         let ha = half.1;
         let mut ea = a;
-        ea[0] += ha[0][0] * pa[0] + ha[0][1] * pa[1];
-        ea[1] += ha[1][0] * pa[0] + ha[1][1] * pa[1];
+        ea[B] += ha[0][0] * pa[B] + ha[0][1] * pa[B + 1];
+        ea[B + 1] += ha[1][0] * pa[B] + ha[1][1] * pa[B + 1];
         let forcing: Vector = std::array::from_fn(|i| 2.0 * nb[i] - n0[i]);
         let c_half = scaled(0.5 * h, apply(half, 1, &forcing));
         let c: Vector = std::array::from_fn(|i| ea[i] + c_half[i]);
@@ -327,6 +363,12 @@ const SPEED_ROUNDING: f64 = 64.0 * f64::EPSILON;
 /// [`Motor::gilbert_exponential_rk4_step`]): classical RK4's stability region reaches about 2.8
 /// along the negative real axis and the imaginary one.
 const ETD_REACH: f64 = 2.5;
+
+/// A locked rotor's exponential RK4 substep holds its error estimate to 1/this of the
+/// tolerance: along an overdamped onion's creep over the rims of its wells the substeps' errors
+/// add up (at the tolerance itself a 1 us step ended 2.6 tolerances off a fine RK4; the
+/// second-order pair, at many more substeps, 1.3; at a sixteenth 0.45).
+const LOCKED_ETD_ERROR_SCALE: f64 = 16.0;
 
 /// The longest explicit substep relative to the fastest rate (see
 /// [`Motor::gilbert_explicit_step`]): Dormand-Prince 5(4)'s stability region reaches about 3.3
