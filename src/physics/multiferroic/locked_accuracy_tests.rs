@@ -82,7 +82,10 @@ fn step_against_rk4(text: &str, warm: usize, per_ns: f64, bound: f64) -> [f64; 2
     );
     assert!(!report.accuracy_limited, "{report:?}");
     assert_eq!(st.rotor_angle, start.rotor_angle);
-    assert!(errors.iter().all(|e| *e <= bound), "{st:?} against {truth:?}");
+    assert!(
+        errors.iter().all(|e| *e <= bound),
+        "{st:?} against {truth:?}"
+    );
     errors
 }
 
