@@ -223,9 +223,9 @@ impl Motor {
         (amplitude * stiffness <= limit * rate).then_some(0.0)
     }
 
-    /// The Gilbert onion's ringing about `settled` when it is trapped in that minimum's well and,
-    /// under a free rotor, relaxes within a tenth of the rotor's relaxation time (see
-    /// [`Self::averaged_ringing`]).
+    /// The Gilbert onion's ringing about `settled` when it is trapped in that minimum's well and
+    /// relaxes within a tenth of the rotor's relaxation time (see [`Self::averaged_ringing`]);
+    /// under a locked rotor also slower, within the window about the minimum.
     ///
     /// Out of the window about the minimum, the rims are looked for when `rims` is given, none
     /// were found yet in this segment (the search, a march over the well both ways, records
@@ -252,8 +252,10 @@ impl Motor {
         let rate = self
             .onion_decay_rate(0.5 * k)
             .min(self.onion_decay_rate(1.5 * k));
-        // (A locked rotor does not answer the ringing: no separation of time scales is needed.)
-        if !(rate > 0.0 && (d.locked || rate * self.rotor_relaxation_time() >= 10.0)) {
+        // A locked rotor does not answer the ringing: no separation of time scales is needed
+        // about the minimum, but its rims are looked for only with one, as for a free rotor.
+        let separated = rate * self.rotor_relaxation_time() >= 10.0;
+        if !(rate > 0.0 && (separated || d.locked)) {
             return None;
         }
         let window = 0.5 * k / m;
@@ -273,7 +275,7 @@ impl Motor {
             return Some(trap(near, rate, true));
         }
         let found = match rims {
-            Some((found, least_rate)) if rate >= least_rate * RIM_SLOWDOWN => found,
+            Some((found, least_rate)) if separated && rate >= least_rate * RIM_SLOWDOWN => found,
             _ => return None,
         };
         // A locked rotor's landscape is frozen: the well found in this segment stays the same
