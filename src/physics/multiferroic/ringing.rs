@@ -86,6 +86,17 @@ impl Motor {
     /// 1 us at tolerance 1e-8.)
     fn locked_ringing_ends(&self, y: &Vector, d: &Drive, settled: f64, remaining: f64) -> bool {
         let tol = self.params.tolerance;
+        // The reach is at least the onion's distance from the minimum, decaying at the same
+        // rate: most passes of a ringing onion fail on it, before the rest of the trap is built.
+        let k = self
+            .landscape(y[0], d.direction, d.stress)
+            .curvature(settled);
+        let rate = self
+            .onion_decay_rate(0.5 * k)
+            .min(self.onion_decay_rate(1.5 * k));
+        if (settled - y[2]).abs() * (-rate * remaining).exp() > tol {
+            return false;
+        }
         self.trapped_ringing(y, d, settled, None)
             .is_some_and(|trap| trap.amplitude * (-trap.rate * remaining).exp() <= tol)
     }
