@@ -45,7 +45,7 @@ impl Motor {
         // a turn wide at most, could decay to the slack within the segment at the faster of the
         // rates it is held to there (the sublevel bound's `kappa` is at most the curvature at
         // the minimum); near the minimum no search is needed.
-        let slack = self.params.tolerance + self.relaxed_slack();
+        let slack = self.params.tolerance + self.relaxed_slack(false);
         let needed = (std::f64::consts::PI / slack).ln().max(0.0) / remaining;
         let land = self.landscape(y[0], d.direction, d.stress);
         let k = land.curvature(settled);

@@ -45,6 +45,8 @@ mod drift;
 pub mod drive;
 mod gilbert;
 mod integrator;
+#[cfg(test)]
+mod locked_accuracy_tests;
 mod locked_ringing;
 #[cfg(test)]
 mod locked_ringing_tests;

@@ -190,7 +190,7 @@ impl Motor {
         let mut k1 = avg.rate(&s)?;
         let tol = self.params.tolerance;
         let speed_scale = tol * self.speed_scale;
-        let slack = self.relaxed_slack();
+        let slack = self.relaxed_slack(d.locked);
         // Ringing that the branch drops once it is within the slack (see [`Self::averageable`]):
         // its phase only places the advance's end on a turning point, and its width only
         // matters against the slack.
@@ -305,8 +305,12 @@ impl Motor {
 
     /// Ringing narrower than this (rad) is within the relaxed onion's slack (see
     /// [`Self::relaxed_onion`]): the averaged advance stops there and the branch takes over.
-    pub(super) fn relaxed_slack(&self) -> f64 {
+    /// Half the tolerance under a `locked` rotor, whose onion's angle the ringing moves.
+    pub(super) fn relaxed_slack(&self, locked: bool) -> f64 {
         let tol = self.params.tolerance;
+        if locked {
+            return 0.5 * tol;
+        }
         0.5 * (0.1 * tol * self.rotor_relaxation_time() / self.onion_relaxation_time()).min(1e-3)
     }
 
@@ -369,7 +373,7 @@ impl Motor {
         let shift = alpha * alpha * (t - k) * (t - k) / (8.0 * k * t);
         let width = o.half_width();
         let mut orbits = remaining / o.period;
-        let slack = self.relaxed_slack();
+        let slack = self.relaxed_slack(d.locked);
         if self.onion_relaxes_fast() && slack < width {
             orbits = orbits.min(2.0 * (width / slack).ln() / loss);
         }

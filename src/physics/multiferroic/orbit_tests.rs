@@ -111,7 +111,7 @@ fn orbit_averaged_ringing_matches_a_fine_rk4_of_the_full_system() {
             // Ended where the ringing is within the slack, which the branch then drops at
             // whatever phase it has: the resolved onion is within the slack of its minimum and
             // the averaged one on the same orbit, to the tolerance.
-            let slack = m.relaxed_slack();
+            let slack = m.relaxed_slack(locked);
             let minimum = m
                 .landscape(truth[0], d.direction, d.stress)
                 .settle(truth[2]);

@@ -10,7 +10,8 @@ impl Motor {
     /// the minimum of eq. 3.4 it would settle into are within `tolerance` plus the larger of its
     /// lag behind a turning rotor and the ringing that no longer matters, and below
     /// [`MAX_FOLLOWED_LAG`] (no kick), or its ringing is trapped about that minimum and averages
-    /// out ([`Self::averaged_ringing`]).
+    /// out ([`Self::averaged_ringing`]). A locked rotor's onion is held to the tolerance alone
+    /// ([`Self::locked_ringing_ends`]): its angle is the output that the ringing moves.
     ///
     /// Ringing of amplitude `A` left undecayed turns the rotor by at most `A tau_o / tau_rotor`
     /// (its torque acts over about `tau_o`, the rotor answers over `tau_rotor`; the precession's
@@ -41,15 +42,23 @@ impl Motor {
         to_switch: f64,
     ) -> Option<f64> {
         // Without the averaged ringing only the first test can pass, and its slack is at most
-        // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle.
+        // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle (a
+        // locked onion's, which may still decay within its segment, waits for the averaged
+        // ringing's check).
         let small_tilt = y[3].abs() <= self.params.tolerance + MAX_FOLLOWED_LAG;
         if rim_barrier.is_none() && !small_tilt {
             return None;
         }
         let settled = self.settle(y, d);
-        if self.onion_relaxes_fast() {
+        if d.locked {
+            // The onion's angle is the output and nothing else is moved by its ringing: it is
+            // dropped only where it ends the segment within the tolerance of the minimum.
+            if self.locked_ringing_ends(y, d, settled, remaining) {
+                return Some(0.0);
+            }
+        } else if self.onion_relaxes_fast() {
             let lag_time = self.onion_relaxation_time();
-            let rate = if d.locked { 0.0 } else { y[1].abs() };
+            let rate = y[1].abs();
             // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
             let ringing = 0.1 * self.params.tolerance * self.rotor_relaxation_time() / lag_time;
             let tol = self.params.tolerance;
@@ -58,8 +67,7 @@ impl Motor {
             let (tilt, offset) = (y[3].abs(), (settled - y[2]).abs());
             if tilt <= slack
                 && offset <= slack
-                && (d.locked
-                    || tilt.max(offset) <= tol + lag
+                && (tilt.max(offset) <= tol + lag
                     || self.ringing_ends_in(y, d, settled, to_switch, tol + lag))
             {
                 return Some(0.0);
@@ -81,9 +89,9 @@ impl Motor {
     /// energy's norm, `sqrt(dpsi^2 + t theta^2 / k)`, times `exp(-lambda remaining)`.
     ///
     /// Ringing that the rotor cannot feel is dropped only so: the onion's own angle carries it
-    /// over the switch, where the minimum moves away. On a 1 ns schedule at `lambda T = 0.04` (the onion remembers 25
-    /// switches) an onion snapped 1e-3 rad onto a minimum that the next switch moves away ended
-    /// its 1 us step 1.5e-3 rad off a plain RK4 (5e4 tolerances).
+    /// over the switch, where the minimum moves away. On a 1 ns schedule at `lambda T = 0.04`
+    /// (the onion remembers 25 switches) an onion snapped 1e-3 rad onto a minimum that the next
+    /// switch moves away would end its 1 us step 1.5e-3 rad off a plain RK4 (5e4 tolerances).
     fn ringing_ends_in(
         &self,
         y: &Vector,
@@ -101,6 +109,34 @@ impl Motor {
         let t = self.tilt_stiffness;
         let gap = ((settled - y[2]).powi(2) + t * y[3] * y[3] / k).sqrt();
         gap * (-self.onion_decay_rate(k) * remaining).exp() <= slack
+    }
+
+    /// Whether a locked rotor's Gilbert onion at `y` ends the `remaining` time of its segment (s)
+    /// within the tolerance of the minimum `settled` it rings about, so that putting it there
+    /// now moves the onion's angle at the segment's end (the step's end or the next switch) by
+    /// the tolerance at most: its ringing lies in the window about the minimum where the
+    /// curvature of eq. 3.4 stays within half of its value `k` ([`Self::trapped_ringing`]), its
+    /// reach there `sqrt(12 E / (5 k))` (`E` its energy above the minimum, tilt included), and
+    /// that reach times `exp(-lambda remaining)`, `lambda` the slowest decay rate of the onion's
+    /// linearization anywhere in the window, is at most the tolerance. (The free rotor's
+    /// allowance, ringing that moves the rotor by a tenth of the tolerance, up to
+    /// [`MAX_FOLLOWED_LAG`], would leave a 22 ns schedule's locked onion 8.5e-3 rad off an RK4
+    /// after 1 us at tolerance 1e-8.)
+    fn locked_ringing_ends(&self, y: &Vector, d: &Drive, settled: f64, remaining: f64) -> bool {
+        let tol = self.params.tolerance;
+        // The reach is at least the onion's distance from the minimum, decaying at the same
+        // rate: most passes of a ringing onion fail on it, before the rest of the trap is built.
+        let k = self
+            .landscape(y[0], d.direction, d.stress)
+            .curvature(settled);
+        let rate = self
+            .onion_decay_rate(0.5 * k)
+            .min(self.onion_decay_rate(1.5 * k));
+        if (settled - y[2]).abs() * (-rate * remaining).exp() > tol {
+            return false;
+        }
+        self.trapped_ringing(y, d, settled, None)
+            .is_some_and(|trap| trap.amplitude * (-trap.rate * remaining).exp() <= tol)
     }
 
     /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
@@ -237,7 +273,8 @@ impl Motor {
     }
 
     /// The Gilbert onion's ringing about `settled` when it is trapped in that minimum's well and
-    /// relaxes within a tenth of the rotor's relaxation time (see [`Self::averaged_ringing`]).
+    /// relaxes within a tenth of the rotor's relaxation time (see [`Self::averaged_ringing`]);
+    /// under a locked rotor also slower, within the window about the minimum.
     ///
     /// Out of the window about the minimum, the rims are looked for when `rims` is given, none
     /// were found yet in this segment (the search, a march over the well both ways, records
@@ -264,7 +301,10 @@ impl Motor {
         let rate = self
             .onion_decay_rate(0.5 * k)
             .min(self.onion_decay_rate(1.5 * k));
-        if !(rate > 0.0 && rate * self.rotor_relaxation_time() >= 10.0) {
+        // A locked rotor does not answer the ringing: no separation of time scales is needed
+        // about the minimum, but its rims are looked for only with one, as for a free rotor.
+        let separated = rate * self.rotor_relaxation_time() >= 10.0;
+        if !(rate > 0.0 && (separated || d.locked)) {
             return None;
         }
         let window = 0.5 * k / m;
@@ -284,7 +324,7 @@ impl Motor {
             return Some(trap(near, rate, true));
         }
         let found = match rims {
-            Some((found, least_rate)) if rate >= least_rate * RIM_SLOWDOWN => found,
+            Some((found, least_rate)) if separated && rate >= least_rate * RIM_SLOWDOWN => found,
             _ => return None,
         };
         // A locked rotor's landscape is frozen: the well found in this segment stays the same

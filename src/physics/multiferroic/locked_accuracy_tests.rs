@@ -1,0 +1,151 @@
+//! A locked rotor's Gilbert onion over whole 1 us steps against a plain RK4 of the macrospin:
+//! its angle is the output, so its ringing is dropped only within the tolerance on that angle
+//! ([`Motor::relaxed_onion`]).
+
+use super::onion_periods_tests::{case, values};
+use super::*;
+
+/// The classical RK4 of the motor's equations from `start` to `t_end` at `per_ns` substeps per
+/// nanosecond and at twice that, written here (the schedule's drive held over each period):
+/// the finer result, once the two agree within a hundredth of the tolerance in the onion's angle
+/// and tilt.
+fn converged_rk4(
+    m: &Motor,
+    start: &MotorState,
+    inputs: &MotorInputs,
+    t_end: f64,
+    per_ns: f64,
+) -> Vector {
+    let s = inputs.schedule.get().unwrap();
+    let run = |per_ns: f64| {
+        let mut y = [
+            start.rotor_angle,
+            start.rotor_speed,
+            start.onion_angle,
+            start.onion_tilt,
+        ];
+        let mut t = start.time;
+        while t < t_end {
+            let next = s.next_switch_after(t).min(t_end);
+            let d = m.drive_at(inputs, t);
+            let n = ((next - t) * 1e9 * per_ns).ceil().max(1.0) as usize;
+            let h = (next - t) / n as f64;
+            let f = |z: &Vector| {
+                let mut rate = m.rhs_jacobian(z, &d, h).0;
+                // The locked rotor holds.
+                rate[0] = 0.0;
+                rate[1] = 0.0;
+                rate
+            };
+            for _ in 0..n {
+                let k1 = f(&y);
+                let k2 = f(&std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
+                let k3 = f(&std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
+                let k4 = f(&std::array::from_fn(|i| y[i] + h * k3[i]));
+                for i in 0..4 {
+                    y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+                }
+            }
+            t = next;
+        }
+        y
+    };
+    let (coarse, fine) = (run(per_ns), run(2.0 * per_ns));
+    let tol = m.params.tolerance;
+    assert!(
+        (coarse[2] - fine[2]).abs() <= 0.01 * tol && (coarse[3] - fine[3]).abs() <= 0.01 * tol,
+        "RK4 not converged: {coarse:?} {fine:?}"
+    );
+    fine
+}
+
+/// A benchmark case's 1 us step after `warm` others (which bring the onion onto its cycle of
+/// switches) against [`converged_rk4`] from the same start: not accuracy-limited, the onion's
+/// angle and tilt within `bound` tolerances of it. Returns the errors in tolerances.
+fn step_against_rk4(text: &str, warm: usize, per_ns: f64, bound: f64) -> [f64; 2] {
+    let (m, mut st, inputs) = case(&values(text)).unwrap();
+    assert!(inputs.rotor_locked);
+    for _ in 0..warm {
+        m.step(&mut st, &inputs, 1e-6).unwrap();
+    }
+    let start = st;
+    let report = m.step(&mut st, &inputs, 1e-6).unwrap();
+    let truth = converged_rk4(&m, &start, &inputs, st.time, per_ns);
+    let tol = m.params.tolerance;
+    let errors = [
+        (st.onion_angle - truth[2]).abs() / tol,
+        (st.onion_tilt - truth[3]).abs() / tol,
+    ];
+    println!(
+        "{} substeps, errors / tolerance against RK4 {errors:?}",
+        report.substeps
+    );
+    assert!(!report.accuracy_limited, "{report:?}");
+    assert_eq!(st.rotor_angle, start.rotor_angle);
+    assert!(
+        errors.iter().all(|e| *e <= bound),
+        "{st:?} against {truth:?}"
+    );
+    errors
+}
+
+/// Strain turned by -0.014 rad every 22 ns, gilbert_damping 1.4e-4, tolerance 1e-8: the onion
+/// rings through every switch. Within a tolerance per switch of the step (45) of the RK4; the
+/// free rotor's allowance for ringing (up to 1e-3 rad) ended it 8.5e5 tolerances off.
+#[test]
+fn locked_onion_on_a_22_ns_schedule_against_rk4() {
+    step_against_rk4(
+        "strain_direction=-2.670e5 stress=-3.356e0 load_torque=-2.325e-7 \
+         ring_outer_diameter=5.987e-2 ring_inner_diameter=3.915e-2 bar_length=1.390e-5 \
+         bar_width=7.725e-7 thickness=1.577e-9 saturation_magnetization=2.609e3 \
+         magnetostriction=6.341e-3 wall_volume=1.532e-12 density=5.774e3 fluid_viscosity=4.801e-2 \
+         gilbert_damping=1.448e-4 tolerance=1.012e-8 step_angle=-1.358e-2 step_period=2.224e-8 \
+         stress_amplitude=-4.277e1 schedule_initial_direction=4.313e-7 onion_model=1 \
+         max_substeps=6.861e3 schedule=1 rotor_locked=1 initial_onion_offset=-4.883e-2 \
+         strain=-4.801e-2 youngs_modulus=6.645e6",
+        1,
+        100.0,
+        45.0,
+    );
+}
+
+/// Strain turned by 0.083 rad every 1.1 ns, gilbert_damping 4.9e-4, tolerance 1.6e-2: each
+/// switch kicks the onion again, its ringing (tilt 5e-3 rad, several tolerances in angle) never
+/// decays within the tolerance. Within the tolerance of the RK4; dropped where it came within
+/// the free rotor's allowance, it ended 4 tolerances off.
+#[test]
+fn locked_onion_on_a_1_ns_schedule_against_rk4() {
+    step_against_rk4(
+        "strain_direction=1.339e8 stress=-1.679e6 load_torque=4.062e-7 \
+         ring_outer_diameter=6.792e-1 ring_inner_diameter=3.939e-1 bar_length=9.345e-7 \
+         bar_width=8.587e-7 thickness=6.104e-9 saturation_magnetization=6.218e4 \
+         magnetostriction=9.855e-3 wall_volume=7.798e-11 density=1.016e4 fluid_viscosity=1.506e8 \
+         gilbert_damping=4.936e-4 tolerance=1.576e-2 step_angle=3.225e0 step_period=1.124e-9 \
+         stress_amplitude=2.000e2 schedule_initial_direction=-2.932e-4 onion_model=1 \
+         max_substeps=1.223e4 schedule=1 rotor_locked=1 initial_onion_offset=-7.576e-11 \
+         strain=5.453e-3 youngs_modulus=4.263e6 strain_drive=1",
+        1,
+        100.0,
+        1.0,
+    );
+}
+
+/// Gilbert damping 0.78, tolerance 5.8e-10, a 15.6 us period: the onion creeps towards its
+/// minimum through the third 1 us step. Within the tolerance of the RK4; put on its branch
+/// where it came within the free rotor's allowance, it ended 1.7e-4 rad (3e5 tolerances) off.
+#[test]
+fn locked_onion_creeping_to_its_minimum_against_rk4() {
+    step_against_rk4(
+        "strain_direction=5.519e3 stress=-1.144e6 load_torque=-5.975e-7 \
+         ring_outer_diameter=2.221e-1 ring_inner_diameter=5.259e-3 bar_length=5.108e-4 \
+         bar_width=9.605e-7 thickness=1.137e-8 saturation_magnetization=1.503e5 \
+         magnetostriction=-8.649e-3 wall_volume=7.000e-11 density=2.131e4 fluid_viscosity=1.527e8 \
+         gilbert_damping=7.778e-1 tolerance=5.791e-10 step_angle=-5.341e-1 step_period=1.558e-5 \
+         stress_amplitude=9.325e1 schedule_initial_direction=-3.007e-6 onion_model=1 \
+         max_substeps=1.111e4 schedule=1 rotor_locked=1 initial_onion_offset=1.035e-1 \
+         strain=4.858e-2 youngs_modulus=7.320e6",
+        2,
+        1000.0,
+        1.0,
+    );
+}
