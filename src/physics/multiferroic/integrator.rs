@@ -166,7 +166,7 @@ impl Motor {
                 // turning past a slow onion every nanosecond) is nearly linear there, and the
                 // tilt's transient after each switch, which holds the explicit pair to a third of
                 // a period, is followed exactly (one substep a switch instead of 3.5). Under a
-                // free rotor only: a locked one's onion measured no gain, and stays as it was.
+                // free rotor only: it gains nothing for a locked rotor's onion.
                 if err <= 1.0 || d.locked {
                     return Some((u, err, dt, None));
                 }
