@@ -190,8 +190,8 @@ impl Motor {
     /// the substep, is explicit: it is tried where the explicit pair is out of reach and the
     /// onion's tilt relaxes faster than it turns (`alpha^2 T > 4 |U''|`, real eigenvalues): an
     /// onion that creeps downhill over its wells' rims after a release far from its minimum,
-    /// which left the second-order pair to take about a thousand substeps a microsecond at
-    /// tolerances near 2e-10 rad. Its error estimate is held to [`LOCKED_ETD_ERROR_SCALE`] times
+    /// where the second-order pair takes about a thousand substeps a microsecond at tolerances
+    /// near 2e-10 rad. Its error estimate is held to [`LOCKED_ETD_ERROR_SCALE`] times
     /// less.
     pub(super) fn gilbert_exponential_rk4_step(
         &self,
@@ -212,7 +212,7 @@ impl Motor {
             // A locked onion's block is taken only where its tilt relaxes faster than the onion
             // turns, `alpha^2 T > 4 |U''|` (the block's eigenvalues real whatever the
             // curvature's sign; `U''` is its (3, 2) entry over `g`): where it rings, the
-            // exponential RK4 took no fewer substeps than the exponential pair, each costing
+            // exponential RK4 takes no fewer substeps than the exponential pair, each costing
             // more.
             let (alpha, t) = (self.params.gilbert_damping, self.tilt_stiffness);
             let curvature = j[3][2] / self.llg_rate;
