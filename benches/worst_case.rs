@@ -19,7 +19,9 @@
 //! after the re-timing every case one of whose steps takes longer than `s` seconds, with each
 //! step's cost and the variables set away from their start values. `WORST_CASE_CASES=i,j` runs
 //! only the random draws `random i`, `random j` (the same draws as a full run), each five times,
-//! printing every value at full precision and each run's step costs.
+//! printing every value at full precision and each run's step costs. `WORST_CASE_BY=a,b` groups
+//! each FMU's random points by the values of variables `a` and `b` together (an option's value,
+//! a Real's decade) and prints the step median, p99 and maximum of each group.
 
 #[path = "../tests/common/mod.rs"]
 mod common;
@@ -330,6 +332,59 @@ fn ratio(max: f64, median: f64) -> String {
     }
 }
 
+/// The random points' step costs grouped by the values of `split` (knobs with their indices):
+/// an option's value, a Real's decade (its sign apart where its range crosses 0).
+fn print_split(split: &[(Knob, usize)], cases: &[Case]) {
+    let key_of = |knob: &Knob, x: f64| match knob.kind {
+        VarType::Real if x == 0.0 => (0, i64::MIN),
+        VarType::Real => (x.signum() as i64, x.abs().log10().floor() as i64),
+        _ => (x as i64, 0),
+    };
+    let label_of = |knob: &Knob, (sign, decade): (i64, i64)| match knob.kind {
+        VarType::Real if decade == i64::MIN => "0".to_string(),
+        VarType::Real => {
+            let minus = if sign < 0 { "-" } else { "" };
+            format!("{minus}[1e{decade}, 1e{})", decade + 1)
+        }
+        _ => sign.to_string(),
+    };
+    let mut groups: std::collections::BTreeMap<Vec<(i64, i64)>, Vec<f64>> = Default::default();
+    for c in cases
+        .iter()
+        .filter(|c| c.label.starts_with("random") && !c.refused)
+    {
+        let key = split
+            .iter()
+            .map(|(k, at)| key_of(k, c.values[*at]))
+            .collect();
+        let ran = c.steps.len() - usize::from(c.step_refused);
+        groups.entry(key).or_default().extend(&c.steps[..ran]);
+    }
+    let names: Vec<&str> = split.iter().map(|(k, _)| k.name).collect();
+    println!(
+        "\n| {} | steps | step median | step p99 | step max |",
+        names.join(" | ")
+    );
+    println!("|{}---|---|---|---|", "---|".repeat(names.len()));
+    for (key, mut steps) in groups {
+        steps.sort_by(f64::total_cmp);
+        let labels: Vec<String> = split
+            .iter()
+            .zip(key)
+            .map(|((k, _), x)| label_of(k, x))
+            .collect();
+        let us = |q: f64| format!("{:.1} us", quantile(&steps, q) * 1e6);
+        println!(
+            "| {} | {} | {} | {} | {} |",
+            labels.join(" | "),
+            steps.len(),
+            us(0.5),
+            us(0.99),
+            us(1.0)
+        );
+    }
+}
+
 fn quantile(sorted: &[f64], q: f64) -> f64 {
     if sorted.is_empty() {
         return f64::NAN;
@@ -354,6 +409,9 @@ fn main() {
         .ok()
         .and_then(|s| s.parse().ok())
         .unwrap_or(f64::INFINITY);
+    let by: Option<Vec<String>> = std::env::var("WORST_CASE_BY")
+        .ok()
+        .map(|s| s.split(',').map(|n| n.trim().to_string()).collect());
     let overhead = clock_cost();
     println!(
         "(thread CPU time; the clock's own {:.0} ns subtracted)\n",
@@ -529,6 +587,16 @@ fn main() {
             us(quantile(&inits, 0.99)),
             us(quantile(&inits, 1.0)),
         );
+        if let Some(by) = &by {
+            let split: Vec<(Knob, usize)> = by
+                .iter()
+                .filter_map(|name| knobs.iter().position(|k| k.name == name))
+                .map(|at| (knobs[at], at))
+                .collect();
+            if !split.is_empty() {
+                print_split(&split, &cases);
+            }
+        }
         cases.sort_by(|a, b| {
             let worst = |c: &Case| c.steps.iter().copied().fold(c.init, f64::max);
             worst(b).total_cmp(&worst(a))
