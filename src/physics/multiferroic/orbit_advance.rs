@@ -405,7 +405,7 @@ impl Motor {
     /// plus eq. 3.4's `2 |E|`) Sturm's comparison with `x'' = -g^2 T K x` puts the orbit's
     /// passes through the minimum at least `pi / (g sqrt(K T))` apart: its period is at least
     /// `2 pi / (g sqrt(K T))`.
-    fn period_floor(&self, land: &Landscape) -> f64 {
+    pub(super) fn period_floor(&self, land: &Landscape) -> f64 {
         let bound = land.ring_bar.stiffness_bound() + 2.0 * land.magnetoelastic.abs();
         2.0 * PI / (self.llg_rate * (bound * self.tilt_stiffness).sqrt())
     }
