@@ -188,6 +188,16 @@ impl RingBar {
                 + 3.0 * ar * s * s * (1.0 / (b2 * b2 * b) - 1.0 / (a2 * a2 * a)))
     }
 
+    /// An upper bound of `|`[`Self::stiffness`]`|` at every offset (N m / rad): both distances
+    /// are at least `r - a`, so `K a r (2 / (r - a)^3 + 3 a r / (r - a)^5)` (eq. 3.3).
+    pub fn stiffness_bound(&self) -> f64 {
+        let (a, r) = (self.bar_charge_radius, self.wall_radius);
+        let ar = a * r;
+        let d = r - a;
+        let d3 = d * d * d;
+        (self.coupling * ar).abs() * (2.0 / d3 + 3.0 * ar / (d3 * d * d))
+    }
+
     /// `d^3 U_m / d beta^3` (N m / rad^2): the slope of [`Self::stiffness`], for the quasi-static
     /// onion's fold (where its minimum vanishes, the inflection's motion depends on it).
     pub fn stiffness_slope(&self, offset: f64) -> f64 {

@@ -27,6 +27,9 @@ const AVERAGED_STEP_WEIGHT: u32 = 6 * ORBIT_EVALUATION_WEIGHT;
 /// A free rotor whose speed relaxes within this fraction of an orbit (`I / c`) is taken as
 /// overdamped over the averaged advance: it turns at `(<tau> + load) / c`.
 const OVERDAMPED: f64 = 0.01;
+/// The relative error allowed to an orbit's quadrature against [`Motor::period_floor`] (the
+/// midpoint rule converges spectrally, within 1e-10 up to 0.99 of the rim; see `orbit.rs`).
+const PERIOD_FLOOR_MARGIN: f64 = 1e-3;
 /// The most RK4 steps of the march to the first turning point (two orbits), one unit each.
 const MARCH_STEPS: u32 = 256;
 
@@ -319,6 +322,11 @@ impl Motor {
     fn averageable(&self, y: &Vector, d: &Drive, remaining: f64) -> Option<(Well, Orbit, bool)> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;
+        // Fewer than `MIN_ORBITS` of the shortest period any orbit can have: refused below
+        // without a search or a quadrature.
+        if remaining < MIN_ORBITS * (1.0 - PERIOD_FLOOR_MARGIN) * self.period_floor(&land) {
+            return None;
+        }
         // First from the linearization at the minimum (no search for the rims): its period
         // `2 pi / (g sqrt(k T))` and energy loss per orbit `g alpha (k + T) P` (the orbit's are
         // within a factor of two of them in the wells met), against the checks below.
@@ -393,6 +401,17 @@ impl Motor {
         }
         let drift = 2.0 * PI * shift * orbits * end_width * (k / t).sqrt();
         (drift <= tol).then_some((well, o, false))
+    }
+
+    /// A lower bound of every orbit's period in the landscape `land` (s): the frozen orbit obeys
+    /// `x'' = -g^2 T q x` about the minimum (`x = psi - psi*`, `q = U'(psi) / x` the mean of `U''`
+    /// over `[psi*, psi]`), and with `U'' <= K` everywhere (`K` the ring-bar stiffness's bound
+    /// plus eq. 3.4's `2 |E|`) Sturm's comparison with `x'' = -g^2 T K x` puts the orbit's
+    /// passes through the minimum at least `pi / (g sqrt(K T))` apart: its period is at least
+    /// `2 pi / (g sqrt(K T))`.
+    pub(super) fn period_floor(&self, land: &Landscape) -> f64 {
+        let bound = land.ring_bar.stiffness_bound() + 2.0 * land.magnetoelastic.abs();
+        2.0 * PI / (self.llg_rate * (bound * self.tilt_stiffness).sqrt())
     }
 
     /// The full macrospin and rotor from `y` to the onion's next lower turning point (its tilt

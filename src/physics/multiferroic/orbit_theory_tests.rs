@@ -19,7 +19,7 @@
 
 use super::orbit_tests::resolved;
 use super::tests::{motor_with, rk4_step, schedule};
-use super::{Drive, Motor, OnionModel, Vector};
+use super::{Drive, Motor, MotorInputs, OnionModel, Vector};
 
 /// An orbit of the frozen, undamped macrospin in a well.
 struct Orbit {
@@ -240,4 +240,47 @@ fn orbit_averaged_ringing_keeps_the_rotor_of_a_full_integration() {
             assert!(without > 10.0 * error, "{alpha} {entry}: {without:e}");
         }
     }
+}
+
+/// The averaged advance's refusal before any quadrature rests on two bounds: the ring-bar
+/// stiffness never exceeds [`super::magnetics::RingBar::stiffness_bound`] (against the stiffness
+/// at 0.01 degree steps), and no orbit is shorter than [`Motor::period_floor`] (against the
+/// test-side quadrature above, 256 nodes and bisected turning points, and `orbit.rs`'s) at
+/// energies up to 0.95 of the lowest rim, in wells from ring-dominated to strain-dominated, with
+/// the bar short and long against the ring.
+#[test]
+fn no_orbit_is_shorter_than_the_period_floor() {
+    let mut checked = 0;
+    for bar_length in [350e-9, 150e-9, 450e-9] {
+        let m = motor_with(|p| {
+            p.onion_model = OnionModel::Gilbert;
+            p.bar_length = bar_length;
+        });
+        let bound = m.ring_bar.stiffness_bound();
+        for i in 0..36_000 {
+            let k = m.ring_bar.stiffness(i as f64 * std::f64::consts::TAU / 36_000.0);
+            assert!(k.abs() <= bound, "stiffness {k} above its bound {bound}");
+        }
+        for stress in [0.0, 1e5, 1e7, 2e8, 1e9] {
+            let d = m.drive_at(&MotorInputs::fixed(0.5, stress), 0.0);
+            let land = m.landscape(0.3, d.direction, d.stress);
+            let floor = m.period_floor(&land);
+            for near in [0.0, 1.0, 2.0, 3.0, 4.0, 5.0] {
+                let Some(well) = m.onion_well(&land, near) else {
+                    continue;
+                };
+                let rims = (well.below, well.above);
+                for share in [1e-6, 0.01, 0.1, 0.3, 0.6, 0.9, 0.95] {
+                    let e = share * well.barrier;
+                    let test_side = orbit(&m, &d, 0.3, (well.minimum, rims), e, 256).period;
+                    assert!(test_side >= floor, "{test_side} below the floor {floor}");
+                    let guess = (well.minimum - 1e-3, well.minimum + 1e-3);
+                    let o = m.orbit(&land, &well, e, guess).unwrap();
+                    assert!(o.period >= floor, "{} below the floor {floor}", o.period);
+                    checked += 1;
+                }
+            }
+        }
+    }
+    assert!(checked >= 100, "only {checked} orbits checked");
 }
