@@ -142,11 +142,13 @@ impl Motor {
     /// onion is first resolved to that point (classical RK4 at 1/128 of a period); the averaged
     /// equations are integrated by Dormand-Prince 5(4), each step's error within a tenth of the
     /// tolerance on the rotor and on the onion's place (through the energy and the phase, at
-    /// the orbit's width); the advance ends at the last whole orbit before `segment_end`, or
-    /// earlier once the ringing is within the relaxed onion's slack (the branch then takes over,
-    /// see [`Self::relaxed_onion`]). The onion is put back at its turning point, and the rest of
-    /// the segment (less than an orbit) is left to the resolved substeps. `None` (and `run`
-    /// untouched) where it does not apply.
+    /// the orbit's width, under a locked rotor at the width it keeps until `segment_end`, see
+    /// [`Self::locked_fade`]); the advance ends at the last whole orbit before `segment_end`, or
+    /// earlier once the ringing is within the relaxed onion's slack, or under a locked rotor
+    /// where [`Self::locked_handover`] finds it ends the segment within the tolerance (the
+    /// branch then takes over, see [`Self::relaxed_onion`]). The onion is put back at its
+    /// turning point, and the rest of the segment (less than an orbit) is left to the resolved
+    /// substeps. `None` (and `run` untouched) where it does not apply.
     pub(super) fn advance_orbits(
         &self,
         run: &mut StepRun,
@@ -327,7 +329,12 @@ impl Motor {
         }
         // The same energy, all in the tilt, at the minimum: the check sees only the energy.
         let minimum = avg.well.minimum;
-        let y = [s[0], 0.0, minimum, (2.0 * energy / self.tilt_stiffness).sqrt()];
+        let y = [
+            s[0],
+            0.0,
+            minimum,
+            (2.0 * energy / self.tilt_stiffness).sqrt(),
+        ];
         self.locked_ringing_ends(&y, d, minimum, remaining)
     }
 
@@ -370,7 +377,8 @@ impl Motor {
 
     /// Ringing narrower than this (rad) is within the relaxed onion's slack (see
     /// [`Self::relaxed_onion`]): the averaged advance stops there and the branch takes over.
-    /// Half the tolerance under a `locked` rotor, whose onion's angle the ringing moves.
+    /// Half the tolerance under a `locked` rotor, whose onion's angle the ringing moves (there
+    /// it only bounds where the advance ends, [`Self::locked_handover`] ends it).
     pub(super) fn relaxed_slack(&self, locked: bool) -> f64 {
         let tol = self.params.tolerance;
         if locked {

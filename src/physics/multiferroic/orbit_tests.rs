@@ -37,9 +37,9 @@ fn gilbert(alpha: f64) -> Motor {
 /// overdamped). The averaged path is taken (its steps counted, at most 162, against the ~1e5
 /// substeps of the resolved ringing) and ends at the last lower turning point (or where the
 /// ringing is within the relaxed onion's slack, or, locked, where it ends the segment within the
-/// tolerance of its minimum, as the resolved onion then does); the rotor ends within a tenth of the tolerance
-/// (2.1e-8 rad at most, where the ringing moves it by 5.5e-4 rad at damping 1e-4) and its speed
-/// within the tolerance on its scale; the onion's angle within 4.1e-8 rad and its tilt within
+/// tolerance of its minimum, as the resolved onion then does); the rotor ends within a tenth of the
+/// tolerance (2.1e-8 rad at most, where the ringing moves it by 5.5e-4 rad at damping 1e-4) and its
+/// speed within the tolerance on its scale; the onion's angle within 4.1e-8 rad and its tilt within
 /// 3.4e-7 rad. At damping 1e-2 the energy drops by a third per orbit: the averaged path is not
 /// taken.
 #[test]
