@@ -145,11 +145,13 @@ impl Motor {
     /// onion is first resolved to that point (classical RK4 at 1/128 of a period); the averaged
     /// equations are integrated by Dormand-Prince 5(4), each step's error within a tenth of the
     /// tolerance on the rotor and on the onion's place (through the energy and the phase, at
-    /// the orbit's width); the advance ends at the last whole orbit before `segment_end`, or
-    /// earlier once the ringing is within the relaxed onion's slack (the branch then takes over,
-    /// see [`Self::relaxed_onion`]). The onion is put back at its turning point, and the rest of
-    /// the segment (less than an orbit) is left to the resolved substeps. `None` (and `run`
-    /// untouched) where it does not apply.
+    /// the orbit's width, under a locked rotor at the width it keeps until `segment_end`, see
+    /// [`Self::locked_fade`]); the advance ends at the last whole orbit before `segment_end`, or
+    /// earlier once the ringing is within the relaxed onion's slack, or under a locked rotor
+    /// where [`Self::locked_handover`] finds it ends the segment within the tolerance (the
+    /// branch then takes over, see [`Self::relaxed_onion`]). The onion is put back at its
+    /// turning point, and the rest of the segment (less than an orbit) is left to the resolved
+    /// substeps. `None` (and `run` untouched) where it does not apply.
     pub(super) fn advance_orbits(
         &self,
         run: &mut StepRun,
@@ -206,12 +208,23 @@ impl Motor {
         let mut h = (0.1 * s[2] / k1[2].abs()).min(segment_end - start);
         let mut time = start;
         let mut steps = 0u32;
+        // A locked onion's averaged steps are held below half the last one whose stages left the
+        // well (an explicit step of the energy's exponential decay overshoots it past the
+        // minimum): the landscape is frozen, so the decay's rate, and with it that size, change
+        // little along the advance.
+        let mut ceiling = f64::INFINITY;
         // The accepted steps' starts: the last whole orbit is found from one of them.
         let mut history: Vec<(f64, Slow, Slow)> = Vec::new();
         while time < segment_end && steps < max_steps {
             let h_try = h.min(segment_end - time);
             steps += 1;
+            let fade = if d.locked {
+                self.locked_fade(&avg, &s, &k1, segment_end - time - h_try)
+            } else {
+                1.0
+            };
             let Some((next, k7, err)) = dormand_prince(&mut avg, &s, &k1, h_try, |next, width| {
+                let width = width * fade;
                 [
                     0.1 * tol,
                     0.1 * speed_scale,
@@ -224,6 +237,9 @@ impl Motor {
                 ]
             }) else {
                 h = 0.25 * h_try;
+                if d.locked {
+                    ceiling = 0.5 * h_try;
+                }
                 if h < 4.0 * o.period {
                     break;
                 }
@@ -238,11 +254,16 @@ impl Motor {
                 };
                 s = next;
                 k1 = k7;
-                if self.onion_relaxes_fast() && avg.orbit.half_width() <= slack {
+                let handover = if d.locked {
+                    self.locked_handover(&avg, &s, &k1, d, segment_end - time)
+                } else {
+                    self.onion_relaxes_fast() && avg.orbit.half_width() <= slack
+                };
+                if handover {
                     break;
                 }
             }
-            h = h_try * (0.9 * err.powf(-0.2)).clamp(0.2, 5.0);
+            h = (h_try * (0.9 * err.powf(-0.2)).clamp(0.2, 5.0)).min(ceiling);
             // Where the first steps cannot reach beyond a few orbits the averaging gains nothing
             // over resolving them.
             if steps < 8 && h < 2.0 * avg.orbit.period && time < segment_end {
@@ -288,6 +309,57 @@ impl Motor {
         })
     }
 
+    /// Whether a locked rotor's onion on the averaged orbit `s` (rates `rate` there), with
+    /// `remaining` time (s) left in its segment, is handed over to the branch: whether
+    /// [`Self::locked_ringing_ends`], the check that [`Self::relaxed_onion`] makes on it next,
+    /// accepts an onion of the energy it has at the lower turning point where the advance ends.
+    /// That point lies up to an orbit back (`1 / phase'`), where the energy is bounded by the
+    /// present one raised by twice the present loss over an orbit, and has more time left to
+    /// decay: the ringing dropped there ends the segment within the tolerance of the minimum.
+    fn locked_handover(
+        &self,
+        avg: &Averager,
+        s: &Slow,
+        rate: &Slow,
+        d: &Drive,
+        remaining: f64,
+    ) -> bool {
+        let orbit = 1.0 / rate[3];
+        let loss = (-rate[2] / s[2]).max(0.0) * orbit;
+        let energy = s[2] * (2.0 * loss).exp();
+        if !(energy.is_finite() && energy >= 0.0) {
+            return false;
+        }
+        // The same energy, all in the tilt, at the minimum: the check sees only the energy.
+        let minimum = avg.well.minimum;
+        let y = [
+            s[0],
+            0.0,
+            minimum,
+            (2.0 * energy / self.tilt_stiffness).sqrt(),
+        ];
+        self.locked_ringing_ends(&y, d, minimum, remaining)
+    }
+
+    /// The fraction of its present width (at least) that a locked rotor's ringing on the
+    /// averaged orbit `s` (rates `rate` there) keeps over the `left` time (s) to its segment's
+    /// end. Its energy and phase only place the onion at that end (the landscape is frozen, the
+    /// rotor takes no impulse), to within the width there times the relative error of the
+    /// energy over two and the phase's error in radians, both carried along unchanged by the
+    /// decay: each step's error is held to a tenth of the tolerance at that width, not at the
+    /// present one. The width decays at half the energy's rate or faster (a softening well's
+    /// width grows faster than `sqrt(E)`), and that rate tends to the linearization's
+    /// ([`Self::onion_decay_rate`]) as the ringing decays: half the slower of the two is taken.
+    fn locked_fade(&self, avg: &Averager, s: &Slow, rate: &Slow, left: f64) -> f64 {
+        let own = 0.5 * (-rate[2] / s[2]);
+        let linear = self.onion_decay_rate(avg.well.curvature);
+        let r = 0.5 * own.min(linear);
+        if r.is_nan() || r <= 0.0 || left <= 0.0 {
+            return 1.0;
+        }
+        (-r * left).exp()
+    }
+
     /// Whether a free rotor is taken as overdamped over orbits of `period` (see [`OVERDAMPED`]).
     fn overdamped(&self, period: f64) -> bool {
         self.inertia <= OVERDAMPED * self.drag * period
@@ -308,7 +380,8 @@ impl Motor {
 
     /// Ringing narrower than this (rad) is within the relaxed onion's slack (see
     /// [`Self::relaxed_onion`]): the averaged advance stops there and the branch takes over.
-    /// Half the tolerance under a `locked` rotor, whose onion's angle the ringing moves.
+    /// Half the tolerance under a `locked` rotor, whose onion's angle the ringing moves (there
+    /// it only bounds where the advance ends, [`Self::locked_handover`] ends it).
     pub(super) fn relaxed_slack(&self, locked: bool) -> f64 {
         let tol = self.params.tolerance;
         if locked {

@@ -122,7 +122,13 @@ impl Motor {
     /// allowance, ringing that moves the rotor by a tenth of the tolerance, up to
     /// [`MAX_FOLLOWED_LAG`], would leave a 22 ns schedule's locked onion 8.5e-3 rad off an RK4
     /// after 1 us at tolerance 1e-8.)
-    fn locked_ringing_ends(&self, y: &Vector, d: &Drive, settled: f64, remaining: f64) -> bool {
+    pub(super) fn locked_ringing_ends(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        settled: f64,
+        remaining: f64,
+    ) -> bool {
         let tol = self.params.tolerance;
         // The reach is at least the onion's distance from the minimum, decaying at the same
         // rate: most passes of a ringing onion fail on it, before the rest of the trap is built.
