@@ -258,7 +258,9 @@ fn no_orbit_is_shorter_than_the_period_floor() {
         });
         let bound = m.ring_bar.stiffness_bound();
         for i in 0..36_000 {
-            let k = m.ring_bar.stiffness(i as f64 * std::f64::consts::TAU / 36_000.0);
+            let k = m
+                .ring_bar
+                .stiffness(i as f64 * std::f64::consts::TAU / 36_000.0);
             assert!(k.abs() <= bound, "stiffness {k} above its bound {bound}");
         }
         for stress in [0.0, 1e5, 1e7, 2e8, 1e9] {
