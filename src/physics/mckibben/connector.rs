@@ -381,11 +381,7 @@ impl McKibben {
                 return Ok(Bracket::Root(core));
             }
             if (h > 0.0) == upward {
-                return Ok(if upward {
-                    Bracket::Between(inner, cand)
-                } else {
-                    Bracket::Between(cand, inner)
-                });
+                return Ok(Bracket::crossed(upward, inner, cand));
             }
             let at_edge = cand == if upward { hi_edge } else { lo_edge };
             if at_edge {
@@ -439,11 +435,7 @@ impl McKibben {
                 return Ok(Bracket::Root(core));
             }
             if (h > 0.0) == upward {
-                return Ok(if upward {
-                    Bracket::Between(inner, cand)
-                } else {
-                    Bracket::Between(cand, inner)
-                });
+                return Ok(Bracket::crossed(upward, inner, cand));
             }
             if h.abs() > h_inner.abs() {
                 break;
@@ -465,6 +457,18 @@ enum Bracket {
     Between(f64, f64),
     /// No sign change inside the muscle's lengths.
     None,
+}
+
+impl Bracket {
+    /// The bracket between the last length `inner` without a sign change and `cand`, the first
+    /// with one, searching up (`upward`) or down.
+    fn crossed(upward: bool, inner: f64, cand: f64) -> Self {
+        if upward {
+            Bracket::Between(inner, cand)
+        } else {
+            Bracket::Between(cand, inner)
+        }
+    }
 }
 
 #[cfg(test)]
