@@ -12,7 +12,7 @@ impl Motor {
     /// times `exp(-lambda horizon)`).
     ///
     /// An onion that does not cannot follow the strain within the step at all; putting it on the
-    /// quasi-static branch turned it with the strain at every switch where the resolved onion
+    /// quasi-static branch would turn it with the strain at every switch where the resolved onion
     /// barely moves: 38.5 rad off after a 1 us step on a 1.26 ns schedule (`lambda T` 4e-6).
     pub(super) fn heads_for_minimum(&self, y: &Vector, d: &Drive, horizon: f64) -> bool {
         let land = self.landscape(y[0], d.direction, d.stress);
