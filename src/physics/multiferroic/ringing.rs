@@ -84,9 +84,8 @@ impl Motor {
     }
 
     /// Whether the Gilbert onion's ringing at `y` about the minimum `settled` of eq. 3.4 decays to
-    /// within `slack` of it in the `remaining` time before the drive switches (s), at the slowest
-    /// decay rate of its linearization there ([`Self::onion_decay_rate`]): its distance in the
-    /// energy's norm, `sqrt(dpsi^2 + t theta^2 / k)`, times `exp(-lambda remaining)`.
+    /// within `slack` of it in the `remaining` time before the drive switches (s)
+    /// ([`Self::decayed_gap`]).
     ///
     /// Ringing that the rotor cannot feel is dropped only so: the onion's own angle carries it
     /// over the switch, where the minimum moves away. On a 1 ns schedule at `lambda T = 0.04`
@@ -103,12 +102,7 @@ impl Motor {
         let k = self
             .landscape(y[0], d.direction, d.stress)
             .curvature(settled);
-        if k.is_nan() || k <= 0.0 {
-            return false;
-        }
-        let t = self.tilt_stiffness;
-        let gap = ((settled - y[2]).powi(2) + t * y[3] * y[3] / k).sqrt();
-        gap * (-self.onion_decay_rate(k) * remaining).exp() <= slack
+        k > 0.0 && self.decayed_gap(y, settled, k, remaining) <= slack
     }
 
     /// Whether a locked rotor's Gilbert onion at `y` ends the `remaining` time of its segment (s)

@@ -22,11 +22,15 @@ impl Motor {
             return false;
         }
         let decay = self.onion_decay_rate(k) * horizon;
-        if decay >= 1.0 {
-            return true;
-        }
+        decay >= 1.0 || self.decayed_gap(y, minimum, k, horizon) <= self.params.tolerance
+    }
+
+    /// The Gilbert onion's distance at `y` from the `minimum` of eq. 3.4 (curvature `k > 0`) in
+    /// the energy's norm, `sqrt(dpsi^2 + t theta^2 / k)`, after `horizon` seconds of decay at
+    /// the slowest rate of its linearization there ([`Self::onion_decay_rate`]).
+    pub(super) fn decayed_gap(&self, y: &Vector, minimum: f64, k: f64, horizon: f64) -> f64 {
         let t = self.tilt_stiffness;
         let gap = ((minimum - y[2]).powi(2) + t * y[3] * y[3] / k).sqrt();
-        gap * (-decay).exp() <= self.params.tolerance
+        gap * (-self.onion_decay_rate(k) * horizon).exp()
     }
 }
