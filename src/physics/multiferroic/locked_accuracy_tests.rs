@@ -3,12 +3,12 @@
 //! ([`Motor::relaxed_onion`]).
 
 use super::onion_periods_tests::{case, values};
+use super::resolved_tests::rk4;
 use super::*;
 
-/// The classical RK4 of the motor's equations from `start` to `t_end` at `per_ns` substeps per
-/// nanosecond and at twice that, written here (the schedule's drive held over each period):
-/// the finer result, once the two agree within a hundredth of the tolerance in the onion's angle
-/// and tilt.
+/// The classical RK4 of the motor's equations ([`rk4`], the locked rotor's rows zero) from
+/// `start` to `t_end` at `per_ns` substeps per nanosecond and at twice that: the finer result,
+/// once the two agree within a hundredth of the tolerance in the onion's angle and tilt.
 fn converged_rk4(
     m: &Motor,
     start: &MotorState,
@@ -16,40 +16,7 @@ fn converged_rk4(
     t_end: f64,
     per_ns: f64,
 ) -> Vector {
-    let s = inputs.schedule.get().unwrap();
-    let run = |per_ns: f64| {
-        let mut y = [
-            start.rotor_angle,
-            start.rotor_speed,
-            start.onion_angle,
-            start.onion_tilt,
-        ];
-        let mut t = start.time;
-        while t < t_end {
-            let next = s.next_switch_after(t).min(t_end);
-            let d = m.drive_at(inputs, t);
-            let n = ((next - t) * 1e9 * per_ns).ceil().max(1.0) as usize;
-            let h = (next - t) / n as f64;
-            let f = |z: &Vector| {
-                let mut rate = m.rhs_jacobian(z, &d, h).0;
-                // The locked rotor holds.
-                rate[0] = 0.0;
-                rate[1] = 0.0;
-                rate
-            };
-            for _ in 0..n {
-                let k1 = f(&y);
-                let k2 = f(&std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
-                let k3 = f(&std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
-                let k4 = f(&std::array::from_fn(|i| y[i] + h * k3[i]));
-                for i in 0..4 {
-                    y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-                }
-            }
-            t = next;
-        }
-        y
-    };
+    let run = |per_ns: f64| rk4(m, start, inputs, t_end, per_ns);
     let (coarse, fine) = (run(per_ns), run(2.0 * per_ns));
     let tol = m.params.tolerance;
     assert!(
