@@ -105,9 +105,16 @@ impl RingBar {
     /// Distances `A` (opposite charges, bar + to wall -) and `B` (like charges) at offset beta.
     #[inline]
     fn distances(&self, offset: f64) -> (f64, f64, f64) {
+        self.distances_of_cos(turned_back(offset).cos())
+    }
+
+    /// [`Self::distances`] from the offset's cosine, for the callers that take its sine too:
+    /// one `sin_cos` instead of a `cos` and a `sin_cos` of the same angle.
+    #[inline]
+    fn distances_of_cos(&self, cos_offset: f64) -> (f64, f64, f64) {
         let (a, r) = (self.bar_charge_radius, self.wall_radius);
         let sum = a * a + r * r;
-        let cross = 2.0 * a * r * turned_back(offset).cos();
+        let cross = 2.0 * a * r * cos_offset;
         // a < r (checked), so both are positive.
         ((sum - cross).sqrt(), (sum + cross).sqrt(), a * r)
     }
@@ -129,8 +136,9 @@ impl RingBar {
     /// Section 3.2.2: torque on the bar (N m), `tau_bar = dU_m/d beta = K a r sin(beta)(1/A^3 + 1/B^3)`.
     /// Positive when the onion state leads the bar: it pulls the bar forward.
     pub fn torque(&self, offset: f64) -> f64 {
-        let (a, b, ar) = self.distances(offset);
-        self.coupling * ar * turned_back(offset).sin() * (1.0 / (a * a * a) + 1.0 / (b * b * b))
+        let (s, c) = turned_back(offset).sin_cos();
+        let (a, b, ar) = self.distances_of_cos(c);
+        self.coupling * ar * s * (1.0 / (a * a * a) + 1.0 / (b * b * b))
     }
 
     /// [`Self::torque`] and [`Self::stiffness`] together from one `sin_cos` of the offset and one
@@ -179,8 +187,8 @@ impl RingBar {
 
     /// `d^2 U_m / d beta^2` (N m / rad): the ring-bar spring stiffness.
     pub fn stiffness(&self, offset: f64) -> f64 {
-        let (a, b, ar) = self.distances(offset);
         let (s, c) = turned_back(offset).sin_cos();
+        let (a, b, ar) = self.distances_of_cos(c);
         let (a2, b2) = (a * a, b * b);
         self.coupling
             * ar
@@ -201,8 +209,8 @@ impl RingBar {
     /// `d^3 U_m / d beta^3` (N m / rad^2): the slope of [`Self::stiffness`], for the quasi-static
     /// onion's fold (where its minimum vanishes, the inflection's motion depends on it).
     pub fn stiffness_slope(&self, offset: f64) -> f64 {
-        let (a, b, ar) = self.distances(offset);
         let (s, c) = turned_back(offset).sin_cos();
+        let (a, b, ar) = self.distances_of_cos(c);
         let (ia, ib) = (1.0 / a, 1.0 / b);
         let (ia3, ib3) = (ia * ia * ia, ib * ib * ib);
         let (ia5, ib5) = (ia3 * ia * ia, ib3 * ib * ib);

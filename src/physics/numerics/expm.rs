@@ -80,15 +80,9 @@ fn scaled_to_a_quarter<const N: usize>(m: &Mat<N>) -> Option<(Mat<N>, u32, f64)>
     if !norm.is_finite() {
         return None;
     }
-    let mut squarings = 0u32;
-    let mut scale = 1.0;
-    while norm * scale > 0.25 {
-        scale *= 0.5;
-        squarings += 1;
-        if squarings > 200 {
-            return None;
-        }
-    }
+    let squarings = quarter_squarings(norm)?;
+    // Exact: 2^-squarings is a normal number (squarings <= 200).
+    let scale = 0.5f64.powi(squarings as i32);
     let mut a = *m;
     for row in a.iter_mut() {
         for x in row.iter_mut() {
@@ -96,6 +90,22 @@ fn scaled_to_a_quarter<const N: usize>(m: &Mat<N>) -> Option<(Mat<N>, u32, f64)>
         }
     }
     Some((a, squarings, scale))
+}
+
+/// The fewest halvings `s` that bring the finite `norm >= 0` to at most 1/4, or `None` above
+/// 200. With `norm = (1 + f) 2^e`, `norm 2^-s <= 2^-2` holds from `s = e + 2` when `f = 0` and
+/// from `e + 3` otherwise: read off the bits instead of halving until it holds (a multiplication
+/// and a dependent comparison per squaring, on every substep's exponential).
+fn quarter_squarings(norm: f64) -> Option<u32> {
+    if norm <= 0.25 {
+        return Some(0);
+    }
+    // Above 1/4 the number is normal: its biased exponent is e + 1023.
+    let bits = norm.to_bits();
+    let exponent = (bits >> 52) as i64 - 1023;
+    let fraction = bits & ((1 << 52) - 1);
+    let s = exponent + 2 + i64::from(fraction != 0);
+    (s <= 200).then_some(s as u32)
 }
 
 /// `a v`.
@@ -178,6 +188,29 @@ mod tests {
         assert!(expm_affine(&block, &[1.0; 4]).is_none());
         m[3][3] = f64::NAN;
         assert!(expm(&m).is_none());
+    }
+
+    /// The squarings read off the bits are those of halving until the norm is at most 1/4.
+    #[test]
+    fn squarings_are_the_halvings_to_a_quarter() {
+        let halvings = |norm: f64| {
+            let (mut s, mut scaled) = (0u32, norm);
+            while scaled > 0.25 {
+                scaled *= 0.5;
+                s += 1;
+            }
+            (s <= 200).then_some(s)
+        };
+        let mut norms = vec![0.0, 1e-300, 0.1, 0.25, 2.5e-1 + 1e-17, 0.3, 0.5, 1.0, 3.0, 1e11];
+        for e in -3..=205 {
+            let p = 2f64.powi(e);
+            norms.extend([p, p * (1.0 + f64::EPSILON), p * (1.0 - f64::EPSILON / 2.0), 1.7 * p]);
+        }
+        for norm in norms {
+            assert_eq!(quarter_squarings(norm), halvings(norm), "{norm:e}");
+        }
+        assert_eq!(quarter_squarings(2f64.powi(198)), Some(200));
+        assert_eq!(quarter_squarings(1.5 * 2f64.powi(198)), None);
     }
 
     /// The affine exponential's blocks match the closed form from a small forcing to one that
