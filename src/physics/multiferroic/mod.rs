@@ -66,6 +66,7 @@ mod onion_periods_tests;
 mod onion_tests;
 mod orbit;
 mod orbit_advance;
+mod orbit_finish;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]

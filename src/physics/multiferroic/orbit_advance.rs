@@ -4,6 +4,7 @@
 
 use super::onion::Landscape;
 use super::orbit::{point, Orbit, Well};
+use super::orbit_finish::MAX_FINISH_STEPS;
 use super::step::StepRun;
 use super::{Drive, Motor, Vector};
 use crate::physics::numerics::dormand_prince;
@@ -32,6 +33,9 @@ const OVERDAMPED: f64 = 0.01;
 const PERIOD_FLOOR_MARGIN: f64 = 1e-3;
 /// The most RK4 steps of the march to the first turning point (two orbits), one unit each.
 const MARCH_STEPS: u32 = 256;
+/// Under a locked rotor the rest of the segment after the advance, up to this many orbits, is
+/// resolved at once ([`Motor::finish_locked_orbits`]).
+const FINISH_ORBITS: f64 = 1.5;
 
 /// The averaged ringing's state: rotor angle and speed (rad, rad/s), the orbit's energy above
 /// the minimum (J) and its phase (cycles).
@@ -151,7 +155,8 @@ impl Motor {
     /// where [`Self::locked_handover`] finds it ends the segment within the tolerance (the
     /// branch then takes over, see [`Self::relaxed_onion`]). The onion is put back at its
     /// turning point, and the rest of the segment (less than an orbit) is left to the resolved
-    /// substeps. `None` (and `run` untouched) where it does not apply.
+    /// substeps, or under a locked rotor resolved at once within the tolerance
+    /// ([`Self::finish_locked_orbits`]). `None` (and `run` untouched) where it does not apply.
     pub(super) fn advance_orbits(
         &self,
         run: &mut StepRun,
@@ -302,6 +307,18 @@ impl Motor {
         run.t = time;
         run.angles = None;
         run.settled = false;
+        // A locked rotor's last orbit to the segment's end, resolved within the tolerance.
+        let mut resolved = resolved;
+        if d.locked && segment_end - time <= FINISH_ORBITS * o.period {
+            let cap = allowance.min(MAX_FINISH_STEPS);
+            let (y, steps) =
+                self.finish_locked_orbits(&run.y, d, segment_end - time, o.period, cap);
+            resolved = resolved.saturating_add(steps);
+            if let Some(y) = y {
+                run.y = y;
+                run.t = segment_end;
+            }
+        }
         Some(OrbitAdvance {
             steps,
             evaluations: avg.evaluations,
