@@ -170,10 +170,10 @@ impl Motor {
             return None;
         }
         let max_steps = (allowance - MARCH_STEPS - 4) / AVERAGED_STEP_WEIGHT;
-        let (well, o, _) = self.averageable(&run.y, d, segment_end - run.t)?;
+        let (well, o, _, _) = self.averageable(&run.y, d, segment_end - run.t)?;
         let (y, marched, resolved) = self.march_to_turning_point(&run.y, d, &well, o.period)?;
         let start = run.t + marched;
-        let (well, o, dropped) = self.averageable(&y, d, segment_end - start)?;
+        let (well, o, dropped, placed) = self.averageable(&y, d, segment_end - start)?;
         let land = self.landscape(y[0], d.direction, d.stress);
         let overdamped = !d.locked && self.overdamped(o.period);
         let omega = self.rotor_speed(&y, d, overdamped);
@@ -307,9 +307,10 @@ impl Motor {
         run.t = time;
         run.angles = None;
         run.settled = false;
-        // A locked rotor's last orbit to the segment's end, resolved within the tolerance.
+        // A locked rotor's last orbit to the segment's end, resolved within the tolerance where
+        // the advance placed the onion within it.
         let mut resolved = resolved;
-        if d.locked && segment_end - time <= FINISH_ORBITS * o.period {
+        if d.locked && placed && segment_end - time <= FINISH_ORBITS * o.period {
             let cap = allowance.min(MAX_FINISH_STEPS);
             let (y, steps) =
                 self.finish_locked_orbits(&run.y, d, segment_end - time, o.period, cap);
@@ -408,8 +409,16 @@ impl Motor {
     }
 
     /// The well and orbit of the onion at `y` when the averaged advance applies to it with
-    /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]).
-    fn averageable(&self, y: &Vector, d: &Drive, remaining: f64) -> Option<(Well, Orbit, bool)> {
+    /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]), whether its
+    /// ringing is dropped at the advance's end, and whether the advance places the onion within
+    /// the tolerance in angle as well as tilt (then a locked rotor's last orbit is resolved at
+    /// once, [`Self::finish_locked_orbits`]).
+    fn averageable(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        remaining: f64,
+    ) -> Option<(Well, Orbit, bool, bool)> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;
         // Fewer than `MIN_ORBITS` of the shortest period any orbit can have: refused below
@@ -487,10 +496,14 @@ impl Motor {
             && (d.locked || !self.overdamped(o.period))
             && 4.0 * (width / slack).max(1.0).ln() / least_loss <= remaining / o.period;
         if dropped {
-            return Some((well, o, true));
+            return Some((well, o, true, false));
         }
         let drift = 2.0 * PI * shift * orbits * end_width * (k / t).sqrt();
-        (drift <= tol).then_some((well, o, false))
+        // The same misplacement along the orbit reaches the angle's amplitude `A` a quarter
+        // orbit on: the onion is placed within the tolerance in both where
+        // `drift max(1, sqrt(T / k))` is.
+        let placed = drift * (t / k).sqrt().max(1.0) <= tol;
+        (drift <= tol).then_some((well, o, false, placed))
     }
 
     /// A lower bound of every orbit's period in the landscape `land` (s): the frozen orbit obeys
