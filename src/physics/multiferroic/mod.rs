@@ -23,7 +23,8 @@
 //! pair (exprb32) estimates the local error. The Gilbert onion's ringing takes an explicit
 //! Dormand-Prince 5(4) pair within its stability reach, an exponential RK4 where only the rotor's
 //! drag keeps that pair out of reach, else an exponential Rosenbrock pair (`gilbert.rs`); weakly
-//! damped ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`).
+//! damped ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`;
+//! a locked rotor's last orbit is resolved at once, `orbit_finish.rs`).
 //! The estimate sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see [`MotorParams::max_substeps`]).
 //!
@@ -66,6 +67,7 @@ mod onion_periods_tests;
 mod onion_tests;
 mod orbit;
 mod orbit_advance;
+mod orbit_finish;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]

@@ -4,6 +4,7 @@
 
 use super::onion::Landscape;
 use super::orbit::{point, Orbit, Well};
+use super::orbit_finish::MAX_FINISH_STEPS;
 use super::step::StepRun;
 use super::{Drive, Motor, Vector};
 use crate::physics::numerics::dormand_prince;
@@ -32,6 +33,9 @@ const OVERDAMPED: f64 = 0.01;
 const PERIOD_FLOOR_MARGIN: f64 = 1e-3;
 /// The most RK4 steps of the march to the first turning point (two orbits), one unit each.
 const MARCH_STEPS: u32 = 256;
+/// Under a locked rotor the rest of the segment after the advance, up to this many orbits, is
+/// resolved at once ([`Motor::finish_locked_orbits`]).
+const FINISH_ORBITS: f64 = 1.5;
 
 /// The averaged ringing's state: rotor angle and speed (rad, rad/s), the orbit's energy above
 /// the minimum (J) and its phase (cycles).
@@ -151,7 +155,8 @@ impl Motor {
     /// where [`Self::locked_handover`] finds it ends the segment within the tolerance (the
     /// branch then takes over, see [`Self::relaxed_onion`]). The onion is put back at its
     /// turning point, and the rest of the segment (less than an orbit) is left to the resolved
-    /// substeps. `None` (and `run` untouched) where it does not apply.
+    /// substeps, or under a locked rotor resolved at once within the tolerance
+    /// ([`Self::finish_locked_orbits`]). `None` (and `run` untouched) where it does not apply.
     pub(super) fn advance_orbits(
         &self,
         run: &mut StepRun,
@@ -165,10 +170,10 @@ impl Motor {
             return None;
         }
         let max_steps = (allowance - MARCH_STEPS - 4) / AVERAGED_STEP_WEIGHT;
-        let (well, o, _) = self.averageable(&run.y, d, segment_end - run.t)?;
+        let (well, o, _, _) = self.averageable(&run.y, d, segment_end - run.t)?;
         let (y, marched, resolved) = self.march_to_turning_point(&run.y, d, &well, o.period)?;
         let start = run.t + marched;
-        let (well, o, dropped) = self.averageable(&y, d, segment_end - start)?;
+        let (well, o, dropped, placed) = self.averageable(&y, d, segment_end - start)?;
         let land = self.landscape(y[0], d.direction, d.stress);
         let overdamped = !d.locked && self.overdamped(o.period);
         let omega = self.rotor_speed(&y, d, overdamped);
@@ -302,6 +307,19 @@ impl Motor {
         run.t = time;
         run.angles = None;
         run.settled = false;
+        // A locked rotor's last orbit to the segment's end, resolved within the tolerance where
+        // the advance placed the onion within it.
+        let mut resolved = resolved;
+        if d.locked && placed && segment_end - time <= FINISH_ORBITS * o.period {
+            let cap = allowance.min(MAX_FINISH_STEPS);
+            let (y, steps) =
+                self.finish_locked_orbits(&run.y, d, segment_end - time, o.period, cap);
+            resolved = resolved.saturating_add(steps);
+            if let Some(y) = y {
+                run.y = y;
+                run.t = segment_end;
+            }
+        }
         Some(OrbitAdvance {
             steps,
             evaluations: avg.evaluations,
@@ -391,8 +409,16 @@ impl Motor {
     }
 
     /// The well and orbit of the onion at `y` when the averaged advance applies to it with
-    /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]).
-    fn averageable(&self, y: &Vector, d: &Drive, remaining: f64) -> Option<(Well, Orbit, bool)> {
+    /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]), whether its
+    /// ringing is dropped at the advance's end, and whether the advance places the onion within
+    /// the tolerance in angle as well as tilt (then a locked rotor's last orbit is resolved at
+    /// once, [`Self::finish_locked_orbits`]).
+    fn averageable(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        remaining: f64,
+    ) -> Option<(Well, Orbit, bool, bool)> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;
         // Fewer than `MIN_ORBITS` of the shortest period any orbit can have: refused below
@@ -470,10 +496,14 @@ impl Motor {
             && (d.locked || !self.overdamped(o.period))
             && 4.0 * (width / slack).max(1.0).ln() / least_loss <= remaining / o.period;
         if dropped {
-            return Some((well, o, true));
+            return Some((well, o, true, false));
         }
         let drift = 2.0 * PI * shift * orbits * end_width * (k / t).sqrt();
-        (drift <= tol).then_some((well, o, false))
+        // The same misplacement along the orbit reaches the angle's amplitude `A` a quarter
+        // orbit on: the onion is placed within the tolerance in both where
+        // `drift max(1, sqrt(T / k))` is.
+        let placed = drift * (t / k).sqrt().max(1.0) <= tol;
+        (drift <= tol).then_some((well, o, false, placed))
     }
 
     /// A lower bound of every orbit's period in the landscape `land` (s): the frozen orbit obeys

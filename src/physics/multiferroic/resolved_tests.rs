@@ -30,9 +30,11 @@ pub(super) fn rk4(
         state.onion_tilt,
     ];
     let mut t = state.time;
-    let s = inputs.schedule.get().unwrap();
     while t < t_end {
-        let next = s.next_switch_after(t).min(t_end);
+        let next = inputs
+            .schedule
+            .get()
+            .map_or(t_end, |s| s.next_switch_after(t).min(t_end));
         let d = m.drive_at(inputs, t);
         let n = ((next - t) * 1e9 * per_ns).ceil().max(1.0) as usize;
         let h = (next - t) / n as f64;

@@ -111,11 +111,11 @@ impl Motor {
     /// the tolerance at most: its ringing lies in the window about the minimum where the
     /// curvature of eq. 3.4 stays within half of its value `k` ([`Self::trapped_ringing`]), its
     /// reach there `sqrt(12 E / (5 k))` (`E` its energy above the minimum, tilt included), and
-    /// that reach times `exp(-lambda remaining)`, `lambda` the slowest decay rate of the onion's
-    /// linearization anywhere in the window, is at most the tolerance. (The free rotor's
-    /// allowance, ringing that moves the rotor by a tenth of the tolerance, up to
-    /// [`MAX_FOLLOWED_LAG`], would leave a 22 ns schedule's locked onion 8.5e-3 rad off an RK4
-    /// after 1 us at tolerance 1e-8.)
+    /// that reach and the tilt's `sqrt(2 E / T)` times `exp(-lambda remaining)`, `lambda` the
+    /// slowest decay rate of the onion's linearization anywhere in the window, are at most the
+    /// tolerance. (The free rotor's allowance, ringing that moves the rotor by a tenth of the
+    /// tolerance, up to [`MAX_FOLLOWED_LAG`], would leave a 22 ns schedule's locked onion
+    /// 8.5e-3 rad off an RK4 after 1 us at tolerance 1e-8.)
     pub(super) fn locked_ringing_ends(
         &self,
         y: &Vector,
@@ -126,17 +126,23 @@ impl Motor {
         let tol = self.params.tolerance;
         // The reach is at least the onion's distance from the minimum, decaying at the same
         // rate: most passes of a ringing onion fail on it, before the rest of the trap is built.
-        let k = self
-            .landscape(y[0], d.direction, d.stress)
-            .curvature(settled);
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let k = land.curvature(settled);
         let rate = self
             .onion_decay_rate(0.5 * k)
             .min(self.onion_decay_rate(1.5 * k));
         if (settled - y[2]).abs() * (-rate * remaining).exp() > tol {
             return false;
         }
+        // The tilt, put to zero with the ringing, is an output as well: its reach
+        // `sqrt(2 E / T)` decays with the energy as the angle's does.
+        let excess =
+            land.energy(y[2]) - land.energy(settled) + 0.5 * self.tilt_stiffness * y[3] * y[3];
+        let tilt_reach = (2.0 * excess.max(0.0) / self.tilt_stiffness).sqrt();
         self.trapped_ringing(y, d, settled, None)
-            .is_some_and(|trap| trap.amplitude * (-trap.rate * remaining).exp() <= tol)
+            .is_some_and(|trap| {
+                trap.amplitude.max(tilt_reach) * (-trap.rate * remaining).exp() <= tol
+            })
     }
 
     /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
