@@ -51,6 +51,9 @@ mod locked_accuracy_tests;
 mod locked_ringing;
 #[cfg(test)]
 mod locked_ringing_tests;
+mod locked_switches;
+#[cfg(test)]
+mod locked_switches_tests;
 mod long_steps;
 pub mod magnetics;
 pub mod model_exchange;

@@ -63,6 +63,9 @@ pub(super) struct StepRun {
     pub(super) onion_escaped: bool,
     /// The stepping schedule switching inside this step, if any.
     pub(super) schedule: Option<super::SteppingSchedule>,
+    /// A locked rotor's ringing onion outlasts what the budget left can resolve (see
+    /// [`Motor::locked_budget_drop`]): the step is refused.
+    pub(super) unresolvable: bool,
 }
 
 impl StepRun {
@@ -105,6 +108,7 @@ impl StepRun {
             orbit_check_at: 0,
             onion_escaped: false,
             schedule: None,
+            unresolvable: false,
         }
     }
 
@@ -219,6 +223,9 @@ impl Motor {
             } else {
                 self
             };
+            if run.unresolvable {
+                return Err(self.unresolvable_message(state.time, h));
+            }
             if !run.is_settled(&d) {
                 run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
                 run.settled = model.quasi_static();
@@ -303,9 +310,9 @@ impl Motor {
     /// order, far less than the step it would lose. The step stays flagged. (Only for an onion
     /// that relaxes at all within a tenth of the rotor's time, as in [`Self::relaxed_onion`], and,
     /// under a free rotor, that heads for its minimum within the step,
-    /// [`Self::heads_for_minimum`], unless it left its bounds. A locked rotor's onion is dropped
-    /// regardless: kept, its forced substeps ended a 1 us step on a 22 ns schedule 0.66 rad off
-    /// an RK4, against 8.5e-3 rad dropped.) Otherwise it follows once relaxed
+    /// [`Self::heads_for_minimum`], unless it left its bounds; a locked rotor's as
+    /// [`Self::locked_budget_drop`] says, which refuses the step where neither dropping nor
+    /// forced substeps can follow the onion through the schedule's switches.) Otherwise it follows once relaxed
     /// ([`Self::relaxed_onion`]) and, under a free rotor, heads for its minimum within the rest
     /// of the step: ringing that barely moves the rotor still places the onion.
     fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
@@ -318,11 +325,16 @@ impl Motor {
         // ringing now instead, as once forced, and flag the step.
         let spent = run.attempts.saturating_add(run.extra_cost);
         let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
-        let dropped = (run.limited || broke)
-            && self.onion_relaxes_fast()
-            && (d.locked
-                || run.onion_escaped
-                || self.heads_for_minimum(&run.y, d, run.t_end - run.start));
+        let out_of_budget = (run.limited || broke) && self.onion_relaxes_fast();
+        let dropped = out_of_budget
+            && if d.locked {
+                run.onion_escaped || self.locked_budget_drop(run, d, segment_end)
+            } else {
+                run.onion_escaped || self.heads_for_minimum(&run.y, d, run.t_end - run.start)
+            };
+        if run.unresolvable {
+            return false;
+        }
         run.onion_escaped = false;
         run.limited |= dropped;
         if !dropped {
