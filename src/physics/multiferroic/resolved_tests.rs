@@ -15,7 +15,7 @@ const PRECESSING: &str = "load_torque=-2.671e-7 ring_outer_diameter=2.661e-6 \
     initial_onion_offset=-5.832e-5";
 
 /// Classical RK4 of the motor's ODE (its right-hand side alone, at `per_ns` equal substeps per
-/// nanosecond of each segment of constant drive) from `state` to `t_end`.
+/// nanosecond of each segment of constant drive, the step one segment without a schedule) from `state` to `t_end`.
 pub(super) fn rk4(
     m: &Motor,
     state: &MotorState,
@@ -30,9 +30,11 @@ pub(super) fn rk4(
         state.onion_tilt,
     ];
     let mut t = state.time;
-    let s = inputs.schedule.get().unwrap();
     while t < t_end {
-        let next = s.next_switch_after(t).min(t_end);
+        let next = inputs
+            .schedule
+            .get()
+            .map_or(t_end, |s| s.next_switch_after(t).min(t_end));
         let d = m.drive_at(inputs, t);
         let n = ((next - t) * 1e9 * per_ns).ceil().max(1.0) as usize;
         let h = (next - t) / n as f64;
