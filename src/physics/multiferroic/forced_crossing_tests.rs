@@ -3,7 +3,6 @@
 
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4;
-use super::*;
 
 /// A benchmark case: a free rotor that the load turns and the ring barely moves, no schedule, its Gilbert onion (damping
 /// 1.3e-3) released 0.64 rad from its minimum rings 0.6 rad wide through a 1 us step, far longer
