@@ -420,7 +420,7 @@ impl Motor {
         run.extra_cost = run.extra_cost.saturating_add(bisections);
         match result {
             Some((y_new, err, _, _))
-                if forced && err > 1.0 && self.forced_out_of_well(&run.y, &y_new, d) =>
+                if forced && err > 1.0 && self.forced_out_of_well(&run.y, &y_new, err, d) =>
             {
                 // Not taken: the next pass drops the ringing from here, as for an onion that left
                 // its bounds.
