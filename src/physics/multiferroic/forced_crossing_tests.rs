@@ -56,3 +56,40 @@ fn budget_bound_onion_stays_in_its_well() {
     // The ring barely moves the rotor: it stays within the tolerance.
     assert!((st.rotor_angle - reference[0]).abs() <= tol);
 }
+
+/// A benchmark case: a free rotor that the ring barely moves, no schedule, its Gilbert onion
+/// (damping 3e-3) ringing through a 1 us step that its budget of 503 substeps cannot resolve at
+/// a tolerance of 1.5e-8 rad.
+const PUMPED_RINGING: &str = "strain_direction=2.7978746258783985e1 \
+    stress=4.775887545759327e0 load_torque=-5.182915971377839e-7 \
+    ring_outer_diameter=7.961406580798013e-1 ring_inner_diameter=4.359324131190089e-2 \
+    bar_length=4.071635230948753e-3 bar_width=2.9935271310954098e-5 \
+    thickness=2.487593208662239e-7 saturation_magnetization=8.296337566605736e1 \
+    magnetostriction=-7.7240132015470205e-3 wall_volume=5.090184028298043e-11 \
+    density=4.482227132894987e3 fluid_viscosity=1.5130221499148394e1 \
+    gilbert_damping=2.9636758559733723e-3 tolerance=1.499773439829388e-8 \
+    onion_model=1 max_substeps=503 schedule=0 rotor_locked=0 \
+    initial_onion_offset=7.874487900664065e-11";
+
+/// Forced substeps must not pump energy into the onion: the damped macrospin's energy rises
+/// only by the work of the rotor's turn. Taken, they left the flagged step's onion 2.75 rad off
+/// an RK4 of the macrospin; refused (the ringing dropped where the first one would raise the
+/// onion's energy), it ends 0.39 rad off.
+#[test]
+fn forced_substeps_do_not_pump_the_onion() {
+    let (m, start, inputs) = case(&values(PUMPED_RINGING)).unwrap();
+    let t_end = 1e-6;
+    let reference = rk4(&m, &start, &inputs, t_end, 1000.0);
+    let coarse = rk4(&m, &start, &inputs, t_end, 500.0);
+    let tol = m.params.tolerance;
+    assert!(
+        (reference[2] - coarse[2]).abs() <= 0.01 * tol,
+        "{reference:?} {coarse:?}"
+    );
+    let mut st = start;
+    let report = m.step(&mut st, &inputs, t_end).unwrap();
+    println!("{st:?} against {reference:?}");
+    assert!(report.accuracy_limited);
+    assert!((st.onion_angle - reference[2]).abs() <= 0.5);
+    assert!((st.rotor_angle - reference[0]).abs() <= tol);
+}
