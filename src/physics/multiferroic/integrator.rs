@@ -419,6 +419,16 @@ impl Motor {
         let result = self.controlled_step(&run.y, dt_try, d, &angles, forced, &mut bisections);
         run.extra_cost = run.extra_cost.saturating_add(bisections);
         match result {
+            Some((y_new, err, _, _))
+                if forced && err > 1.0 && self.forced_out_of_well(&run.y, &y_new, err, d) =>
+            {
+                // Not taken: the next pass drops the ringing from here, as for an onion that left
+                // its bounds.
+                run.limited = true;
+                run.settled = false;
+                run.onion_escaped = true;
+                run.dt = dt_try;
+            }
             Some((y_new, err, taken, new_angles)) if err <= 1.0 || forced => {
                 if err > 1.0 {
                     run.limited = true;

@@ -44,6 +44,9 @@ mod decoupled;
 mod decoupled_tests;
 mod drift;
 pub mod drive;
+mod forced_crossing;
+#[cfg(test)]
+mod forced_crossing_tests;
 mod gilbert;
 mod integrator;
 #[cfg(test)]

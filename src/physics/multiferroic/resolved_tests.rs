@@ -15,7 +15,8 @@ const PRECESSING: &str = "load_torque=-2.671e-7 ring_outer_diameter=2.661e-6 \
     initial_onion_offset=-5.832e-5";
 
 /// Classical RK4 of the motor's ODE (its right-hand side alone, at `per_ns` equal substeps per
-/// nanosecond of each segment of constant drive) from `state` to `t_end`.
+/// nanosecond of each segment of constant drive; without a schedule the step is one segment)
+/// from `state` to `t_end`.
 pub(super) fn rk4(
     m: &Motor,
     state: &MotorState,
