@@ -43,6 +43,7 @@ mod decoupled;
 mod decoupled_tests;
 mod drift;
 pub mod drive;
+mod etd_blocks;
 mod gilbert;
 mod integrator;
 #[cfg(test)]
@@ -87,6 +88,8 @@ mod spin;
 #[cfg(test)]
 mod spin_tests;
 mod step;
+#[cfg(test)]
+mod stiff_rotor_tests;
 #[cfg(test)]
 mod tests;
 
