@@ -117,7 +117,7 @@ impl Motor {
 
     /// A substep's end `u` with a locked rotor put back where it was (`y`'s angle, at rest);
     /// `None` if the rotor or the onion is not sane there.
-    fn checked_end(&self, mut u: Vector, y: &Vector, locked: bool) -> Option<Vector> {
+    pub(super) fn checked_end(&self, mut u: Vector, y: &Vector, locked: bool) -> Option<Vector> {
         if locked {
             u[0] = y[0];
             u[1] = 0.0;
@@ -131,7 +131,7 @@ impl Motor {
     /// undamped frequency, the speed's scale, of 1e-4 rad/s and less: at a load's 500 rad/s its
     /// speed's tolerance fell below the speed's own rounding, and the error estimates, then
     /// rounding noise, held the substeps to picoseconds.)
-    fn error_norm(&self, e: impl Fn(usize) -> f64, y: &Vector, u: &Vector) -> f64 {
+    pub(super) fn error_norm(&self, e: impl Fn(usize) -> f64, y: &Vector, u: &Vector) -> f64 {
         let tol = self.params.tolerance;
         let speed = (tol * self.speed_scale).max(SPEED_ROUNDING * y[1].abs().max(u[1].abs()));
         let scales = [tol, speed, tol, tol];
@@ -141,7 +141,7 @@ impl Motor {
     /// The right-hand side of [`Self::rhs_jacobian`] alone, for the Gilbert onion, from the
     /// angles at `y`.
     #[inline]
-    fn gilbert_rate(&self, y: &Vector, d: &Drive, a: &Angles) -> Vector {
+    pub(super) fn gilbert_rate(&self, y: &Vector, d: &Drive, a: &Angles) -> Vector {
         let (tau, _) = self
             .ring_bar
             .torque_stiffness_of(a.sin_offset, a.cos_offset);
@@ -170,8 +170,11 @@ impl Motor {
 
 impl Motor {
     /// A substep by the exponential Runge-Kutta method of Cox and Matthews (ETDRK4, J. Comput.
-    /// Phys. 176, 2002) with the rotor's linearization at the start, `L = [[0, 1], [-k/I, -c/I]]`,
-    /// taken exactly and everything else (the onion, the torque's change along the substep) as
+    /// Phys. 176, 2002). A free rotor takes both diagonal blocks of the Jacobian as its linear
+    /// part ([`Self::gilbert_block_etd_step`]) wherever their `phi` functions are available;
+    /// elsewhere (an onion block with nearly repeated eigenvalues) it takes the rotor's
+    /// linearization at the start, `L = [[0, 1], [-k/I, -c/I]]`,
+    /// exactly and everything else (the onion, the torque's change along the substep) as
     /// its nonlinear part, for the Gilbert onion's ringing on a stiff rotor: a viscous fluid puts
     /// the rotor's drag rate `c/I` far above the onion's precession, which keeps the explicit pair
     /// ([`Self::gilbert_explicit_step`]) out of reach and left the second-order exponential pair
@@ -201,6 +204,11 @@ impl Motor {
         start: &Linearized,
     ) -> Option<(Vector, f64)> {
         let j = &start.j;
+        // A free rotor's onion block is part of the linear part wherever its `phi` functions
+        // are available.
+        if let Some(result) = self.gilbert_block_etd_step(y, dt, d, start) {
+            return result;
+        }
         // With the rotor locked the onion's own block is the linear part (its rates then all
         // in it); otherwise the rotor's, the onion's rates within the explicit reach.
         // (False for a NaN rate too.)
@@ -350,7 +358,7 @@ impl Motor {
 /// `err^(5/8)` by three square roots (libm's `pow` was 5% of a Gilbert step): the error of a
 /// fifth- or fourth-order substep in the second-order step-size rule's terms (see
 /// [`Motor::gilbert_explicit_step`]); 1 at 1, increasing, so acceptance (`<= 1`) is unchanged.
-fn fifth_order_error(err: f64) -> f64 {
+pub(super) fn fifth_order_error(err: f64) -> f64 {
     let root = err.sqrt();
     root * root.sqrt().sqrt()
 }

@@ -44,6 +44,7 @@ mod decoupled;
 mod decoupled_tests;
 mod drift;
 pub mod drive;
+mod etd_blocks;
 mod forced_crossing;
 #[cfg(test)]
 mod forced_crossing_tests;
@@ -95,6 +96,8 @@ mod spin;
 #[cfg(test)]
 mod spin_tests;
 mod step;
+#[cfg(test)]
+mod stiff_rotor_tests;
 #[cfg(test)]
 mod tests;
 

@@ -1,0 +1,345 @@
+//! The exponential RK4 substep of a free rotor with both 2x2 diagonal blocks of the Jacobian as
+//! its linear part, the rotor's `[[0, 1], [-k/I, -c/I]]` and the onion's
+//! `g [[-alpha U'', -T], [U'', -alpha T]]` (eq. 3.4's landscape at the substep's start), for a
+//! ringing onion on a stiff rotor; and the `phi` functions of a real 2x2 block with real or
+//! complex eigenvalues (a precessing onion), which [`super::phi::Phi2x2`] leaves out.
+
+use super::gilbert::{fifth_order_error, Linearized};
+use super::phi::phis;
+use super::{Drive, Motor, Vector};
+
+/// `phi_1..3(A)` of a real 2x2 matrix `A`, as matrices (`phi_k(A) = c_0 I + c_1 A` by
+/// Cayley-Hamilton, see [`super::phi`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct BlockPhi {
+    p: [[[f64; 2]; 2]; 3],
+}
+
+impl BlockPhi {
+    /// `None` for a block whose eigenvalues are nearly repeated (relative gap below 1e-6) and
+    /// whose norm is above 1/4, or that is not finite.
+    #[inline(always)]
+    pub(super) fn new(a: &[[f64; 2]; 2]) -> Option<Self> {
+        let norm = (a[0][0].abs() + a[0][1].abs()).max(a[1][0].abs() + a[1][1].abs());
+        if !norm.is_finite() {
+            return None;
+        }
+        if norm <= 0.25 {
+            return Some(Self::series(a));
+        }
+        let m = 0.5 * (a[0][0] + a[1][1]);
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        let disc = m * m - det;
+        let gap = disc.abs().sqrt();
+        if gap.is_nan() || gap <= 1e-6 * (m.abs() + gap) {
+            return None;
+        }
+        let coefficients: [(f64, f64); 3] = if disc > 0.0 {
+            // Real eigenvalues: the larger without cancellation, the smaller from the
+            // determinant (Sylvester's formula, as [`super::phi::Phi2x2`]).
+            let mu1 = if m <= 0.0 { m - gap } else { m + gap };
+            let mu2 = det / mu1;
+            let inv = 1.0 / (mu1 - mu2);
+            let (f1, f2) = (phis(mu1), phis(mu2));
+            std::array::from_fn(|k| {
+                let c1 = (f1[k] - f2[k]) * inv;
+                (f2[k] - mu2 * c1, c1)
+            })
+        } else {
+            // Eigenvalues m +- i b: c_1 = Im f(m + i b) / b, c_0 = Re f(m + i b) - m c_1.
+            let f = complex_phis(m, gap);
+            std::array::from_fn(|k| {
+                let c1 = f[k].1 / gap;
+                (f[k].0 - m * c1, c1)
+            })
+        };
+        let p = coefficients.map(|(c0, c1)| {
+            [
+                [c0 + c1 * a[0][0], c1 * a[0][1]],
+                [c1 * a[1][0], c0 + c1 * a[1][1]],
+            ]
+        });
+        p.iter()
+            .flatten()
+            .flatten()
+            .all(|x| x.is_finite())
+            .then_some(Self { p })
+    }
+
+    /// `phi_k(A) = sum_n A^n / (n + k)!` by Horner's rule for `||A|| <= 1/4`: 14 terms leave
+    /// less than `0.25^14 / 14!` ~ 1e-19.
+    fn series(a: &[[f64; 2]; 2]) -> Self {
+        let mul = |x: &[[f64; 2]; 2]| -> [[f64; 2]; 2] {
+            std::array::from_fn(|i| std::array::from_fn(|k| a[i][0] * x[0][k] + a[i][1] * x[1][k]))
+        };
+        let plus_identity =
+            |x: [[f64; 2]; 2], c: f64| [[x[0][0] + c, x[0][1]], [x[1][0], x[1][1] + c]];
+        let mut inv_factorial = [1.0f64; 18];
+        for n in 1..18 {
+            inv_factorial[n] = inv_factorial[n - 1] / n as f64;
+        }
+        let mut p3 = [[inv_factorial[16], 0.0], [0.0, inv_factorial[16]]];
+        for n in (0..13).rev() {
+            p3 = plus_identity(mul(&p3), inv_factorial[n + 3]);
+        }
+        let p2 = plus_identity(mul(&p3), 0.5);
+        let p1 = plus_identity(mul(&p2), 1.0);
+        Self { p: [p1, p2, p3] }
+    }
+
+    /// `phi_k(2A)` from `phi_k(A)` (`a` is `A`): `phi_k(2A) = 2^-k (e^A phi_k(A) + sum_{j=1}^k
+    /// phi_j(A) / (k - j)!)` with `e^A = I + A phi_1(A)` (all of them functions of `A`, so
+    /// they commute).
+    #[inline(always)]
+    pub(super) fn doubled(&self, a: &[[f64; 2]; 2]) -> Self {
+        let mul = |x: &[[f64; 2]; 2], y: &[[f64; 2]; 2]| -> [[f64; 2]; 2] {
+            std::array::from_fn(|i| std::array::from_fn(|k| x[i][0] * y[0][k] + x[i][1] * y[1][k]))
+        };
+        let [p1, p2, p3] = self.p;
+        let mut e = mul(a, &p1);
+        e[0][0] += 1.0;
+        e[1][1] += 1.0;
+        let (e1, e2, e3) = (mul(&e, &p1), mul(&e, &p2), mul(&e, &p3));
+        let p = [
+            std::array::from_fn(|i| std::array::from_fn(|k| 0.5 * (e1[i][k] + p1[i][k]))),
+            std::array::from_fn(|i| {
+                std::array::from_fn(|k| 0.25 * (e2[i][k] + p1[i][k] + p2[i][k]))
+            }),
+            std::array::from_fn(|i| {
+                std::array::from_fn(|k| 0.125 * (e3[i][k] + 0.5 * p1[i][k] + p2[i][k] + p3[i][k]))
+            }),
+        ];
+        Self { p }
+    }
+
+    /// `phi_k(A) v` for `k` in 1..=3.
+    #[inline(always)]
+    pub(super) fn apply(&self, k: usize, v: [f64; 2]) -> [f64; 2] {
+        let p = &self.p[k - 1];
+        [
+            p[0][0] * v[0] + p[0][1] * v[1],
+            p[1][0] * v[0] + p[1][1] * v[1],
+        ]
+    }
+}
+
+/// `[phi_1, phi_2, phi_3]` at `x + i y` as `(re, im)`: the series of `phi_3` near 0 and the
+/// downward recurrence `phi_{k+1} = (phi_k - 1/k!) / z` from `e^z - 1` elsewhere (as
+/// [`phis`]).
+fn complex_phis(x: f64, y: f64) -> [(f64, f64); 3] {
+    let mul = |p: (f64, f64), q: (f64, f64)| (p.0 * q.0 - p.1 * q.1, p.0 * q.1 + p.1 * q.0);
+    let z = (x, y);
+    if x.hypot(y) < 0.5 {
+        let mut sum = (0.0, 0.0);
+        let mut inv_factorial = [1.0f64; 19];
+        for n in 1..19 {
+            inv_factorial[n] = inv_factorial[n - 1] / n as f64;
+        }
+        for n in (0..16).rev() {
+            let s = mul(sum, z);
+            sum = (s.0 + inv_factorial[n + 3], s.1);
+        }
+        let p2 = mul(z, sum);
+        let phi2 = (0.5 + p2.0, p2.1);
+        let p1 = mul(z, phi2);
+        return [(1.0 + p1.0, p1.1), phi2, sum];
+    }
+    let inv_z = {
+        let r = 1.0 / (x * x + y * y);
+        (x * r, -y * r)
+    };
+    // e^z - 1 = expm1(x) cos y - 2 sin^2(y/2) + i e^x sin y.
+    let em1 = if x < -40.0 {
+        (-1.0, 0.0)
+    } else {
+        let (s, c) = y.sin_cos();
+        let half = (0.5 * y).sin();
+        (x.exp_m1() * c - 2.0 * half * half, x.exp() * s)
+    };
+    let phi1 = mul(em1, inv_z);
+    let phi2 = mul((phi1.0 - 1.0, phi1.1), inv_z);
+    let phi3 = mul((phi2.0 - 0.5, phi2.1), inv_z);
+    [phi1, phi2, phi3]
+}
+
+/// A block-diagonal linear part's `phi` functions and matrices at one substep length: the rotor's
+/// block (states 0, 1) and the onion's (states 2, 3), each times that length.
+struct Blocks {
+    phi: [BlockPhi; 2],
+    z: [[[f64; 2]; 2]; 2],
+}
+
+impl Blocks {
+    /// `None` where a block's `phi` functions are not available ([`BlockPhi::new`]).
+    #[inline(always)]
+    fn new(j: &[[f64; 4]; 4], h: f64) -> Option<Self> {
+        let block = |b: usize| {
+            [
+                [h * j[b][b], h * j[b][b + 1]],
+                [h * j[b + 1][b], h * j[b + 1][b + 1]],
+            ]
+        };
+        let z = [block(0), block(2)];
+        Some(Self {
+            phi: [BlockPhi::new(&z[0])?, BlockPhi::new(&z[1])?],
+            z,
+        })
+    }
+
+    /// The blocks at twice the length.
+    #[inline(always)]
+    fn doubled(&self) -> Self {
+        let z = self.z.map(|b| b.map(|r| r.map(|x| 2.0 * x)));
+        Self {
+            phi: [
+                self.phi[0].doubled(&self.z[0]),
+                self.phi[1].doubled(&self.z[1]),
+            ],
+            z,
+        }
+    }
+
+    /// `phi_k(Z) v` on both blocks.
+    #[inline(always)]
+    fn apply(&self, k: usize, v: &Vector) -> Vector {
+        let [r0, r1] = self.phi[0].apply(k, [v[0], v[1]]);
+        let [o0, o1] = self.phi[1].apply(k, [v[2], v[3]]);
+        [r0, r1, o0, o1]
+    }
+
+    /// `e^Z v = v + Z phi_1(Z) v`.
+    #[inline(always)]
+    fn exp_apply(&self, v: &Vector) -> Vector {
+        let p = self.apply(1, v);
+        let mut out = *v;
+        for (b, z) in self.z.iter().enumerate() {
+            let (i, k) = (2 * b, 2 * b + 1);
+            out[i] += z[0][0] * p[i] + z[0][1] * p[k];
+            out[k] += z[1][0] * p[i] + z[1][1] * p[k];
+        }
+        out
+    }
+}
+
+/// One ETDRK4 step of `h` from `y0` (rate `f0`) with the block-diagonal part of `j` as `L`
+/// (the formulas of the one-block [`Motor::etd_rk4`]); `half` and `full` are its blocks at
+/// `h/2` and `h`.
+#[inline(always)]
+fn etd_rk4_blocks(
+    y0: &Vector,
+    f0: Vector,
+    h: f64,
+    j: &[[f64; 4]; 4],
+    half: &Blocks,
+    full: &Blocks,
+    rate: impl Fn(&Vector) -> Vector,
+) -> Vector {
+    let n = |u: &Vector| -> Vector {
+        let mut f = rate(&std::array::from_fn(|i| y0[i] + u[i]));
+        for b in [0, 2] {
+            f[b] -= j[b][b] * u[b] + j[b][b + 1] * u[b + 1];
+            f[b + 1] -= j[b + 1][b] * u[b] + j[b + 1][b + 1] * u[b + 1];
+        }
+        f
+    };
+    let scaled = |c: f64, v: Vector| -> Vector { v.map(|x| c * x) };
+    let n0 = f0;
+    let a = scaled(0.5 * h, half.apply(1, &n0));
+    let na = n(&a);
+    let b_stage = scaled(0.5 * h, half.apply(1, &na));
+    let nb = n(&b_stage);
+    let ea = half.exp_apply(&a);
+    let forcing: Vector = std::array::from_fn(|i| 2.0 * nb[i] - n0[i]);
+    let c_half = scaled(0.5 * h, half.apply(1, &forcing));
+    let c: Vector = std::array::from_fn(|i| ea[i] + c_half[i]);
+    let nc = n(&c);
+    let second: Vector = std::array::from_fn(|i| 2.0 * na[i] + 2.0 * nb[i] - nc[i] - 3.0 * n0[i]);
+    let third: Vector = std::array::from_fn(|i| 4.0 * (n0[i] - na[i] - nb[i] + nc[i]));
+    let (p1, p2, p3) = (
+        full.apply(1, &n0),
+        full.apply(2, &second),
+        full.apply(3, &third),
+    );
+    std::array::from_fn(|i| y0[i] + h * (p1[i] + p2[i] + p3[i]))
+}
+
+impl Motor {
+    /// A substep by the exponential Runge-Kutta method of Cox and Matthews (ETDRK4, J. Comput.
+    /// Phys. 176, 2002) with the block-diagonal part of the Jacobian at the start as its linear
+    /// part `L`: the rotor's block and the onion's, each taken exactly, and the rest (their
+    /// coupling through the offset `psi - phi`, the change of the landscape's curvature along the
+    /// substep) as its nonlinear part, for a free rotor. The onion's ringing, linear in its
+    /// block, is then followed over many substeps with an error set by the ringing's departure
+    /// from it alone; with the onion explicit ([`Motor::gilbert_exponential_rk4_step`] on the
+    /// rotor's block) classical RK4's error on the ringing's phase added up to 40 tolerances a
+    /// 1 us step. Tried where `dt` times the coupling's rates ([`Self::coupling_rate_bound`]) is
+    /// within [`ETD_REACH`] and those rates are at most [`WEAK_COUPLING`] of the onion block's
+    /// own. The error is step doubling's taken whole, as the one-block
+    /// method's, and returned as `err^(5/8)`.
+    ///
+    /// `None` where it does not apply (out of reach, or a block's `phi` functions not available:
+    /// [`BlockPhi::new`]); `Some(None)` when the substep fails.
+    pub(super) fn gilbert_block_etd_step(
+        &self,
+        y: &Vector,
+        dt: f64,
+        d: &Drive,
+        start: &Linearized,
+    ) -> Option<Option<(Vector, f64)>> {
+        let j = &start.j;
+        let coupling = self.coupling_rate_bound(j);
+        let reach = dt * coupling / ETD_REACH;
+        let onion =
+            (j[2][2] + j[3][3]).abs() + (j[2][2] * j[3][3] - j[2][3] * j[3][2]).abs().sqrt();
+        // (False for a NaN rate too.)
+        let applies = reach <= 1.0 && coupling <= WEAK_COUPLING * onion;
+        if d.locked || !applies {
+            return None;
+        }
+        let quarter = Blocks::new(j, 0.25 * dt)?;
+        let half = quarter.doubled();
+        let full = half.doubled();
+        let rate =
+            |z: &Vector| self.gilbert_rate(z, d, &start.angles.moved(z[2], z[0], d.direction));
+        let whole = etd_rk4_blocks(y, start.f, dt, j, &half, &full, rate);
+        let first = etd_rk4_blocks(y, start.f, 0.5 * dt, j, &quarter, &half, rate);
+        let two = etd_rk4_blocks(&first, rate(&first), 0.5 * dt, j, &quarter, &half, rate);
+        let Some(u) = self.checked_end(two, y, d.locked) else {
+            return Some(None);
+        };
+        let err = self.error_norm(|i| two[i] - whole[i], y, &u);
+        // Raised to at least `(0.9 reach)^3` (at most 0.73 within reach, so acceptance is
+        // unchanged), at which the step-size rule ([`super::integrator::step_factor`]) proposes no
+        // substep beyond the reach: an onion that its block follows closely would otherwise
+        // propose substeps out of reach, which the other pairs then reject.
+        let floor = (0.9 * reach).powi(3);
+        Some(
+            err.is_finite()
+                .then(|| (u, fifth_order_error(err).max(floor))),
+        )
+    }
+
+    /// A bound on the moduli of the rates that [`Self::gilbert_block_etd_step`] treats
+    /// explicitly (1/s): the onion's rates per rotor turn and the loop through the rotor, which
+    /// answers the onion's torque over its drag, the rotor's relaxation rate `k/c` and
+    /// `sqrt(|d psi'/d phi| (k/I) / (c/I))` (the one-block method's bound without the onion
+    /// block's own rates). Infinite for a rotor without drag.
+    fn coupling_rate_bound(&self, j: &[[f64; 4]; 4]) -> f64 {
+        let coupling = j[2][0].abs() + j[3][0].abs();
+        let drag_rate = j[1][1].abs();
+        let relaxation = j[1][0].abs() / drag_rate;
+        let through_rotor = (coupling * j[1][2].abs() / drag_rate).sqrt();
+        coupling + relaxation + through_rotor
+    }
+}
+
+/// The block-diagonal part is taken only where the coupling's rates are at most this fraction of
+/// the onion block's own (`|trace| + sqrt(|det|)`): where the rotor's turn moves the onion faster
+/// than its own precession (a large ring holding a light onion) the coupling is the dynamics, and
+/// with it explicit a 1 us step ended hundreds of tolerances off a plain RK4 where the one-block
+/// method stays within a few.
+const WEAK_COUPLING: f64 = 1.0 / 16.0;
+
+/// The longest substep relative to the explicit rates: classical RK4's stability region reaches
+/// about 2.8 along the negative real axis and the imaginary one (as the one-block method's).
+const ETD_REACH: f64 = 2.5;
