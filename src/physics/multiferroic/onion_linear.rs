@@ -25,6 +25,9 @@ thread_local! {
     pub(super) static SPANS: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
     /// Turns [`Motor::advance_onion_linear`] off on this thread (for tests: the other paths).
     pub(super) static OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Each span taken on this thread (for tests): the state and time at its start, its end,
+    /// the onion and tilt there and their bound.
+    pub(super) static SPAN_LOG: std::cell::RefCell<Vec<(super::Vector, f64, f64, [f64; 2], f64)>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// The step's macro-span state: switches to try next (0 before the first), or disabled.
@@ -123,6 +126,9 @@ fn flow(a: &M2, h: f64) -> Option<Flow> {
     };
     let k = (top * h).exp() * (1.0 + reach * norm(&n));
     let size = norm(a);
+    if !(size.is_finite() && h.is_finite()) {
+        return None;
+    }
     let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
     let j = if size * h >= 1.0 && det.abs() >= 1e-2 * size * size {
         let d = [[e[0][0] - 1.0, e[0][1]], [e[1][0], e[1][1] - 1.0]];
@@ -183,9 +189,10 @@ impl Motor {
     /// `K_k (|w_k| + h_k |b|)`) widened by the forward bound of the error so far
     /// (`eps_k+1 = ||exp(A h_k)|| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound
     /// at the span's end is `sum_k ||P_k|| c_k`, `P_k` the exact product of the later intervals'
-    /// maps. (The widening takes `c_k` from the reach before it is widened by itself: the bound is
-    /// exact to first order in `c_k / r_k`, which the acceptance keeps below a hundredth of
-    /// the tolerance over `r_k`.) A span is taken only where that bound is within a hundredth of
+    /// maps. This is a bound on the true onion's distance from the chained maps' (through eq.
+    /// 3.4's trigonometric terms and eq. 3.3's torque alike) but for one step: `c_k` is evaluated
+    /// on the reach widened by itself once, not by its fixed point, which differs at second order
+    /// in `c_k / r_k` (the spans taken keep `c_k` far below `r_k`). A span is taken only where that bound is within a hundredth of
     /// the tolerance; otherwise a shorter one is tried, and where a single interval fails the
     /// rest of the step is left to the other paths (an onion swinging through eq. 3.4's
     /// nonlinear range, where the linearization fails at once).
@@ -217,9 +224,13 @@ impl Motor {
             if let Some((t, y, bound)) = tried.result {
                 if bound <= target {
                     let y_new = [run.y[0], run.y[1], y[0], y[1]];
+                    #[cfg(test)]
+                    let start = (run.y, run.t);
                     if self.commit_linear_span(run, inputs, t, y_new) {
                         let units = u32::try_from(chained / SWITCHES_PER_UNIT).unwrap_or(u32::MAX);
                         run.extra_cost = run.extra_cost.saturating_add(units);
+                        #[cfg(test)]
+                        SPAN_LOG.with(|l| l.borrow_mut().push((start.0, start.1, t, y, bound)));
                         // Next span sized from this bound (it grows about as the span's cube).
                         let grow = (target / bound.max(1e-300)).cbrt().clamp(0.5, 2.0);
                         run.onion_linear.next =
