@@ -12,6 +12,10 @@ type M2 = [[f64; 2]; 2];
 const BOUND_SHARE: f64 = 0.01;
 /// Switches of the first macro span tried in a step; later spans follow the last bound.
 const FIRST_SPAN: usize = 4;
+/// Switches at which the repeated periods' skips ([`Motor::skip_onion_periods`]) must have
+/// declined in a step before a span is tried: an onion that settles within a few periods
+/// repeats them at no cost at all, which a span would end (it restarts their comparison).
+const WAIT_SWITCHES: u32 = 8;
 /// Largest growth of the onion block's exponential over a switch (`e^50`): beyond it the
 /// linearization is far out of its reach anyway and the bound would overflow.
 const MAX_GROWTH_EXPONENT: f64 = 50.0;
@@ -27,14 +31,21 @@ thread_local! {
     pub(super) static OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Each span taken on this thread (for tests): the state and time at its start, its end,
     /// the onion and tilt there and their bound.
-    pub(super) static SPAN_LOG: std::cell::RefCell<Vec<(super::Vector, f64, f64, [f64; 2], f64)>> = const { std::cell::RefCell::new(Vec::new()) };
+    pub(super) static SPAN_LOG: std::cell::RefCell<Vec<SpanRecord>> = const { std::cell::RefCell::new(Vec::new()) };
 }
 
-/// The step's macro-span state: switches to try next (0 before the first), or disabled.
+/// A span taken (for tests): the state and time at its start, its end, the onion and tilt
+/// there and their bound.
+#[cfg(test)]
+pub(super) type SpanRecord = (super::Vector, f64, f64, [f64; 2], f64);
+
+/// The step's macro-span state: switches to try next (0 before the first), or disabled, and
+/// the switches passed before the first.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct LinearSpan {
     next: usize,
     disabled: bool,
+    waited: u32,
 }
 
 /// One switch's exact affine map of the linearized onion and its flow's bound.
@@ -111,7 +122,8 @@ fn flow(a: &M2, h: f64) -> Option<Flow> {
     } else {
         (m + w).max(0.0)
     };
-    if !(top * h <= MAX_GROWTH_EXPONENT) {
+    // (A NaN declines too.)
+    if top * h > MAX_GROWTH_EXPONENT || top.is_nan() || h.is_nan() {
         return None;
     }
     let em = (m * h).exp();
@@ -157,7 +169,7 @@ fn flow(a: &M2, h: f64) -> Option<Flow> {
         }
         let mut j = [[j[0][0] * hs, j[0][1] * hs], [j[1][0] * hs, j[1][1] * hs]];
         for _ in 0..halvings {
-            let ej = mul(&a, &j);
+            let ej = mul(a, &j);
             // I + exp(A hs) = 2 I + A J(hs).
             let p = [[2.0 + ej[0][0], ej[0][1]], [ej[1][0], 2.0 + ej[1][1]]];
             j = mul(&p, &j);
@@ -209,6 +221,10 @@ impl Motor {
         if self.quasi_static() || run.onion_linear.disabled || run.onion_decoupled != Some(true) {
             return false;
         }
+        if run.onion_linear.next == 0 && run.onion_linear.waited < WAIT_SWITCHES {
+            run.onion_linear.waited += 1;
+            return false;
+        }
         let mut span = if run.onion_linear.next == 0 {
             FIRST_SPAN
         } else {
@@ -234,7 +250,7 @@ impl Motor {
                         // Next span sized from this bound (it grows about as the span's cube).
                         let grow = (target / bound.max(1e-300)).cbrt().clamp(0.5, 2.0);
                         run.onion_linear.next =
-                            ((tried.switches as f64 * 0.9 * grow) as usize).max(1);
+                            ((tried.switches as f64 * 0.9 * grow).ceil() as usize).max(1);
                         return true;
                     }
                     break;
