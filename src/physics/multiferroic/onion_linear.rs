@@ -180,8 +180,8 @@ fn flow(a: &M2, h: f64) -> Option<Flow> {
 }
 
 impl Motor {
-    /// Advances the rest of the step's switches, or some of them, at once where eq. 3.3's
-    /// ring-bar torque is negligible ([`Self::ring_decoupled`], as for
+    /// Advances the rest of the step's switches, or some of them, at once where a free rotor's
+    /// eq. 3.3 ring-bar torque is negligible ([`Self::ring_decoupled`], as for
     /// [`Self::skip_onion_periods`]) and the Gilbert onion stays close enough to where a macro
     /// span of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
     ///
@@ -218,7 +218,13 @@ impl Motor {
         if OFF.with(|c| c.get()) {
             return false;
         }
-        if self.quasi_static() || run.onion_linear.disabled || run.onion_decoupled != Some(true) {
+        // Free rotors only: a locked rotor's onion is left to the skips of repeated periods and
+        // cycles (`onion_cycles.rs`), which compare against the switches resolved one by one.
+        if self.quasi_static()
+            || inputs.rotor_locked
+            || run.onion_linear.disabled
+            || run.onion_decoupled != Some(true)
+        {
             return false;
         }
         if run.onion_linear.next == 0 && run.onion_linear.waited < WAIT_SWITCHES {

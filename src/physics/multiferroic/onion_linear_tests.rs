@@ -23,7 +23,7 @@ fn spans() -> u32 {
 }
 
 /// The onion and tilt at `t_end` from `state`: RK4 on the full rates (eq. 3.3's ring torque
-/// included) with the rotor on its exact drift under the load, `n` substeps per switch interval.
+/// included) with the rotor on its exact drift under the load ([`drifted`]), `n` substeps per switch interval.
 fn onion_rk4(
     m: &Motor,
     state: &MotorState,
@@ -33,11 +33,9 @@ fn onion_rk4(
 ) -> [f64; 2] {
     let s = inputs.schedule.get().unwrap();
     let rate = |z: [f64; 2], d: &Drive, t: f64| -> [f64; 2] {
-        let (coast, torque_speed, torque_angle) = m.drift_response(t - state.time);
-        let load = inputs.load_torque;
-        let phi = state.rotor_angle + state.rotor_speed * coast + load * torque_angle;
-        let omega = state.rotor_speed * (1.0 - m.drag * torque_speed) + load * torque_speed;
-        let f = m.rhs_jacobian(&[phi, omega, z[0], z[1]], d, 1e-300).0;
+        let rotor = drifted(m, state, inputs, t, z);
+        let y = [rotor.rotor_angle, rotor.rotor_speed, z[0], z[1]];
+        let f = m.rhs_jacobian(&y, d, 1e-300).0;
         [f[2], f[3]]
     };
     let mut z = [state.onion_angle, state.onion_tilt];
@@ -83,8 +81,18 @@ fn converged(m: &Motor, state: &MotorState, inputs: &MotorInputs, t_end: f64) ->
     }
 }
 
-/// The rotor on its exact drift under the load from `state` to `t`, with the onion `z`.
+/// The rotor on its exact drift under the load from `state` to `t` (held if locked), with the
+/// onion `z`.
 fn drifted(m: &Motor, state: &MotorState, inputs: &MotorInputs, t: f64, z: [f64; 2]) -> MotorState {
+    if inputs.rotor_locked {
+        return MotorState {
+            time: t,
+            rotor_speed: 0.0,
+            onion_angle: z[0],
+            onion_tilt: z[1],
+            ..*state
+        };
+    }
     let (coast, torque_speed, torque_angle) = m.drift_response(t - state.time);
     let load = inputs.load_torque;
     MotorState {
