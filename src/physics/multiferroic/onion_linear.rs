@@ -31,7 +31,8 @@ thread_local! {
     pub(super) static OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Each span taken on this thread (for tests): the state and time at its start, its end,
     /// the onion and tilt there and their bound.
-    pub(super) static SPAN_LOG: std::cell::RefCell<Vec<SpanRecord>> = const { std::cell::RefCell::new(Vec::new()) };
+    pub(super) static SPAN_LOG: std::cell::RefCell<Vec<SpanRecord>> =
+        const { std::cell::RefCell::new(Vec::new()) };
 }
 
 /// A span taken (for tests): the state and time at its start, its end, the onion and tilt
@@ -180,34 +181,35 @@ fn flow(a: &M2, h: f64) -> Option<Flow> {
 }
 
 impl Motor {
-    /// Advances the rest of the step's switches, or some of them, at once where a free rotor's
-    /// eq. 3.3 ring-bar torque is negligible ([`Self::ring_decoupled`], as for
-    /// [`Self::skip_onion_periods`]) and the Gilbert onion stays close enough to where a macro
-    /// span of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
+    /// Advances the rest of the step's switches, or some of them, at once where a free rotor's eq.
+    /// 3.3 ring-bar torque is negligible ([`Self::ring_decoupled`], as for
+    /// [`Self::skip_onion_periods`]) and the Gilbert onion stays close enough to where a macro span
+    /// of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
     ///
     /// The rotor then follows load and drag alone, exactly ([`Self::drift_response`]). The onion
-    /// obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient
-    /// `E sin 2(psi - gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq.
-    /// 3.4) plus the ring's torque (eq. 3.3). About the span's start `psi0`, with
-    /// `delta = psi - psi0`, the gradient is `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k)`,
-    /// `d_k = 2 E cos 2(psi0 - gamma_k)`: each interval is an exact affine map of
-    /// `(delta, theta)` (see [`flow`]), chained over the span. The dropped term is bounded by
-    /// `|R| <= 2 |E| delta^2 + tau_max` (Taylor's remainder: `|d^2/dx^2 sin 2x| <= 4`; `tau_max`
-    /// the ring torque's bound, [`torque_bound`]), and enters the rates as `g (-a R, R)`, of max
-    /// norm `g max(1, a) |R|`. Over interval `k` of length `h_k` its effect at the interval's end is
-    /// at most `c_k = h_k K_k g max(1, a) (2 |E| r_k^2 + tau_max)` (variation of constants; `K_k`
-    /// bounds the interval's propagator), with `r_k` a bound on `|delta|` there: the linear path's
-    /// reach (`max(|delta_k|, |delta_k+1|) + h_k K_k |A w_k + b| / 2`, or
-    /// `K_k (|w_k| + h_k |b|)`) widened by the forward bound of the error so far
+    /// obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin 2(psi -
+    /// gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq. 3.4) plus the ring's
+    /// torque (eq. 3.3). About the span's start `psi0`, with `delta = psi - psi0`, the gradient is
+    /// `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k)`, `d_k = 2 E cos 2(psi0 - gamma_k)`:
+    /// each interval is an exact affine map of `(delta, theta)` (see [`flow`]), chained over the
+    /// span. The dropped term is bounded by `|R| <= 2 |E| delta^2 + tau_max` (Taylor's remainder:
+    /// `|d^2/dx^2 sin 2x| <= 4`; `tau_max` the ring torque's bound, [`torque_bound`]), and enters
+    /// the rates as `g (-a R, R)`, of max norm `g max(1, a) |R|`. Over interval `k` of length `h_k`
+    /// its effect at the interval's end is at most `c_k = h_k K_k g max(1, a) (2 |E| r_k^2 +
+    /// tau_max)` (variation of constants; `K_k` bounds the interval's propagator), with `r_k` a
+    /// bound on `|delta|` there: the linear path's reach (`max(|delta_k|, |delta_k+1|) + h_k K_k |A
+    /// w_k + b| / 2`, or `K_k (|w_k| + h_k |b|)`) widened by the forward bound of the error so far
     /// (`eps_k+1 = ||exp(A h_k)|| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound
     /// at the span's end is `sum_k ||P_k|| c_k`, `P_k` the exact product of the later intervals'
-    /// maps. This is a bound on the true onion's distance from the chained maps' (through eq.
-    /// 3.4's trigonometric terms and eq. 3.3's torque alike) but for one step: `c_k` is evaluated
-    /// on the reach widened by itself once, not by its fixed point, which differs at second order
-    /// in `c_k / r_k` (the spans taken keep `c_k` far below `r_k`). A span is taken only where that bound is within a hundredth of
-    /// the tolerance; otherwise a shorter one is tried, and where a single interval fails the
-    /// rest of the step is left to the other paths (an onion swinging through eq. 3.4's
-    /// nonlinear range, where the linearization fails at once).
+    /// maps. `c_k` is taken where it bounds the remainder on the reach it widens itself (`c_k >=
+    /// c(r + c_k)`, `r` the reach widened by `eps_k` alone; tried at 1.25 times `c(r + c(r))`), so
+    /// that the true onion cannot first leave that reach: the bound is a real bound on the true
+    /// onion's distance from the chained maps' (through eq. 3.4's trigonometric terms and eq. 3.3's
+    /// torque alike), but for rounding. A span is taken only where that bound is within a hundredth
+    /// of the tolerance; otherwise a shorter one is tried, and where a single interval fails the
+    /// rest of the step is left to the other paths (an onion swinging through eq. 3.4's nonlinear
+    /// range, where the linearization fails at once). Tried once the skips of repeated periods have
+    /// declined at [`WAIT_SWITCHES`] switches.
     pub(super) fn advance_onion_linear(
         &self,
         run: &mut StepRun,
@@ -320,9 +322,13 @@ impl Motor {
             let reach =
                 (w[0].abs().max(w_next[0].abs()) + 0.5 * h * f.k * slope).min(f.k * (wn + h * bn));
             let remainder = |r: f64| h * f.k * to_rate * (2.0 * e.abs() * r * r + tau);
-            let c = remainder(reach + f.k * eps + remainder(reach + f.k * eps));
+            // A bound `c` that holds given itself (`remainder(reach + K eps + c) < c`) holds: the
+            // true path cannot first leave the reach it implies.
+            let near = reach + f.k * eps;
+            let c = 1.25 * remainder(near + remainder(near));
+            let holds = remainder(near + c) < c || c == 0.0;
             eps = norm(&f.e) * eps + c;
-            if !(c.is_finite() && eps.is_finite()) {
+            if !(holds && c.is_finite() && eps.is_finite()) {
                 return Tried {
                     switches,
                     result: None,

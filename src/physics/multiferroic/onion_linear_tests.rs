@@ -23,7 +23,8 @@ fn spans() -> u32 {
 }
 
 /// The onion and tilt at `t_end` from `state`: RK4 on the full rates (eq. 3.3's ring torque
-/// included) with the rotor on its exact drift under the load ([`drifted`]), `n` substeps per switch interval.
+/// included) with the rotor on its exact drift under the load ([`drifted`]), `n` substeps per
+/// switch interval.
 fn onion_rk4(
     m: &Motor,
     state: &MotorState,
