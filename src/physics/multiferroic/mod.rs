@@ -67,6 +67,9 @@ pub mod onion;
 mod onion_cycles;
 #[cfg(test)]
 mod onion_cycles_tests;
+mod onion_linear;
+#[cfg(test)]
+mod onion_linear_tests;
 mod onion_periods;
 #[cfg(test)]
 mod onion_periods_tests;

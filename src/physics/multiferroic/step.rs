@@ -40,6 +40,8 @@ pub(super) struct StepRun {
     pub(super) onion_period_end: Option<[f64; 4]>,
     pub(super) onion_period_mismatch: f64,
     pub(super) onion_decoupled: Option<bool>,
+    /// The Gilbert onion's linear macro spans in this step (see [`Motor::advance_onion_linear`]).
+    pub(super) onion_linear: super::onion_linear::LinearSpan,
     /// The last switch at which the Gilbert onion had relaxed (see [`Motor::skip_onion_cycles`]).
     pub(super) relaxed_switch: Option<super::onion_cycles::RelaxedSwitch>,
     /// The eq. 3.3-3.4 angles' sines and cosines at the last evaluated state, the starting point
@@ -99,6 +101,7 @@ impl StepRun {
             onion_period_end: None,
             onion_period_mismatch: f64::INFINITY,
             onion_decoupled: None,
+            onion_linear: Default::default(),
             relaxed_switch: None,
             angles: None,
             settled: false,
@@ -209,6 +212,7 @@ impl Motor {
             if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
                 if self.skip_repeated_periods(&mut run, s)
                     || self.skip_onion_periods(&mut run, s, inputs)
+                    || self.advance_onion_linear(&mut run, s, inputs)
                 {
                     continue;
                 }

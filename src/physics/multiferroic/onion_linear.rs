@@ -1,0 +1,400 @@
+//! A Gilbert onion on a fast schedule that the ring barely couples to the rotor and that stays
+//! in its linear regime, advanced over many switches at once by exact affine maps (see
+//! [`Motor::advance_onion_linear`]).
+
+use super::angles::turned_back;
+use super::decoupled::torque_bound;
+use super::{Motor, MotorInputs, StepRun, SteppingSchedule};
+
+type M2 = [[f64; 2]; 2];
+
+/// Part of the tolerance the bound of the dropped nonlinear term may take over one macro span.
+const BOUND_SHARE: f64 = 0.01;
+/// Switches of the first macro span tried in a step; later spans follow the last bound.
+const FIRST_SPAN: usize = 4;
+/// Switches at which the repeated periods' skips ([`Motor::skip_onion_periods`]) must have
+/// declined in a step before a span is tried: an onion that settles within a few periods
+/// repeats them at no cost at all, which a span would end (it restarts their comparison).
+const WAIT_SWITCHES: u32 = 8;
+/// Largest growth of the onion block's exponential over a switch (`e^50`): beyond it the
+/// linearization is far out of its reach anyway and the bound would overflow.
+const MAX_GROWTH_EXPONENT: f64 = 50.0;
+/// Switches charged as one unit of the step's budget (about 0.1 us each against 0.32 us a
+/// substep of the quasi-static onion).
+const SWITCHES_PER_UNIT: usize = 3;
+
+#[cfg(test)]
+thread_local! {
+    /// Macro spans taken by [`Motor::advance_onion_linear`] on this thread (for tests).
+    pub(super) static SPANS: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+    /// Turns [`Motor::advance_onion_linear`] off on this thread (for tests: the other paths).
+    pub(super) static OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    /// Each span taken on this thread (for tests): the state and time at its start, its end,
+    /// the onion and tilt there and their bound.
+    pub(super) static SPAN_LOG: std::cell::RefCell<Vec<SpanRecord>> =
+        const { std::cell::RefCell::new(Vec::new()) };
+}
+
+/// A span taken (for tests): the state and time at its start, its end, the onion and tilt
+/// there and their bound.
+#[cfg(test)]
+pub(super) type SpanRecord = (super::Vector, f64, f64, [f64; 2], f64);
+
+/// The step's macro-span state: switches to try next (0 before the first), or disabled, and
+/// the switches passed before the first.
+#[derive(Clone, Copy, Debug, Default)]
+pub(super) struct LinearSpan {
+    next: usize,
+    disabled: bool,
+    waited: u32,
+}
+
+/// One switch's exact affine map of the linearized onion and its flow's bound.
+struct Flow {
+    /// `exp(A h)`.
+    e: M2,
+    /// `int_0^h exp(A s) ds`.
+    j: M2,
+    /// A bound on `||exp(A s)||` (max norm) for `0 <= s <= h`.
+    k: f64,
+}
+
+fn norm(a: &M2) -> f64 {
+    (a[0][0].abs() + a[0][1].abs()).max(a[1][0].abs() + a[1][1].abs())
+}
+
+fn mul(a: &M2, b: &M2) -> M2 {
+    [
+        [
+            a[0][0] * b[0][0] + a[0][1] * b[1][0],
+            a[0][0] * b[0][1] + a[0][1] * b[1][1],
+        ],
+        [
+            a[1][0] * b[0][0] + a[1][1] * b[1][0],
+            a[1][0] * b[0][1] + a[1][1] * b[1][1],
+        ],
+    ]
+}
+
+fn apply(a: &M2, x: [f64; 2]) -> [f64; 2] {
+    [
+        a[0][0] * x[0] + a[0][1] * x[1],
+        a[1][0] * x[0] + a[1][1] * x[1],
+    ]
+}
+
+/// `sin(x) / x` (`oscillating`) or `sinh(x) / x`, exact to rounding at small `x`.
+fn sinc(x: f64, oscillating: bool) -> f64 {
+    let x2 = if oscillating { -x * x } else { x * x };
+    if x.abs() < 1e-3 {
+        1.0 + x2 / 6.0 * (1.0 + x2 / 20.0)
+    } else if oscillating {
+        x.sin() / x
+    } else {
+        x.sinh() / x
+    }
+}
+
+/// The exact flow of `w' = A w + b` over `h` for a 2x2 `A`, in closed form.
+///
+/// Hand-written rather than a general exponential: it runs once a switch, hundreds of times a
+/// step, where a scaled-and-squared 3x3 exponential cost about as much as the substeps it
+/// replaces. With `A = m I + N`, `N^2 = q I` (trace-free), `exp(A s) = e^{m s} (C I + S N)`,
+/// `C, S = cos(w s), sin(w s) / w` for `q = -w^2 < 0` and `cosh, sinh / w` for `q = w^2`;
+/// hence `||exp(A s)|| <= max(1, e^{m h}) (1 + min(h, 1/w) ||N||)` in the first case and
+/// `e^{max(m + w, 0) h} (1 + min(h, 1/(2w)) ||N||)` in the second (`|sin(w s)/w| <= min(s, 1/w)`,
+/// `sinh(w s)/w <= e^{w s} min(s, 1/(2w))`). The integral is `A^{-1} (exp(A h) - I)` where `A`
+/// is well conditioned and `h` long; else its Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`)
+/// doubled `n` times (`J(2h) = (I + exp(A h)) J(h)`), which holds through a singular `A`.
+/// `None` if the flow could grow beyond `e^50`.
+fn flow(a: &M2, h: f64) -> Option<Flow> {
+    let m = 0.5 * (a[0][0] + a[1][1]);
+    let n: M2 = [[a[0][0] - m, a[0][1]], [a[1][0], a[1][1] - m]];
+    let q = n[0][0] * n[0][0] + n[0][1] * n[1][0];
+    let oscillating = q < 0.0;
+    let w = q.abs().sqrt();
+    let (c, s) = if oscillating {
+        ((w * h).cos(), h * sinc(w * h, true))
+    } else {
+        ((w * h).cosh(), h * sinc(w * h, false))
+    };
+    let top = if oscillating {
+        m.max(0.0)
+    } else {
+        (m + w).max(0.0)
+    };
+    // (A NaN declines too.)
+    if top * h > MAX_GROWTH_EXPONENT || top.is_nan() || h.is_nan() {
+        return None;
+    }
+    let em = (m * h).exp();
+    let e = [
+        [em * (c + s * n[0][0]), em * s * n[0][1]],
+        [em * s * n[1][0], em * (c + s * n[1][1])],
+    ];
+    let reach = if oscillating {
+        h.min(1.0 / w)
+    } else {
+        h.min(0.5 / w)
+    };
+    let k = (top * h).exp() * (1.0 + reach * norm(&n));
+    let size = norm(a);
+    if !(size.is_finite() && h.is_finite()) {
+        return None;
+    }
+    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    let j = if size * h >= 1.0 && det.abs() >= 1e-2 * size * size {
+        let d = [[e[0][0] - 1.0, e[0][1]], [e[1][0], e[1][1] - 1.0]];
+        let inv = [
+            [a[1][1] / det, -a[0][1] / det],
+            [-a[1][0] / det, a[0][0] / det],
+        ];
+        mul(&inv, &d)
+    } else {
+        let mut halvings = 0;
+        let mut hs = h;
+        while size * hs > 0.5 {
+            hs *= 0.5;
+            halvings += 1;
+        }
+        // J = hs sum_n (A hs)^n / (n + 1)!, by Horner; 12 terms leave 0.5^13 / 14! ~ 1e-15.
+        let x = [[a[0][0] * hs, a[0][1] * hs], [a[1][0] * hs, a[1][1] * hs]];
+        let mut j: M2 = [[1.0, 0.0], [0.0, 1.0]];
+        for i in (1..=12).rev() {
+            let f = 1.0 / f64::from(i + 1);
+            let xj = mul(&x, &j);
+            j = [
+                [1.0 + f * xj[0][0], f * xj[0][1]],
+                [f * xj[1][0], 1.0 + f * xj[1][1]],
+            ];
+        }
+        let mut j = [[j[0][0] * hs, j[0][1] * hs], [j[1][0] * hs, j[1][1] * hs]];
+        for _ in 0..halvings {
+            let ej = mul(a, &j);
+            // I + exp(A hs) = 2 I + A J(hs).
+            let p = [[2.0 + ej[0][0], ej[0][1]], [ej[1][0], 2.0 + ej[1][1]]];
+            j = mul(&p, &j);
+        }
+        j
+    };
+    Some(Flow { e, j, k })
+}
+
+impl Motor {
+    /// Advances the rest of the step's switches, or some of them, at once where a free rotor's eq.
+    /// 3.3 ring-bar torque is negligible ([`Self::ring_decoupled`], as for
+    /// [`Self::skip_onion_periods`]) and the Gilbert onion stays close enough to where a macro span
+    /// of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
+    ///
+    /// The rotor then follows load and drag alone, exactly ([`Self::drift_response`]). The onion
+    /// obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin 2(psi -
+    /// gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq. 3.4) plus the ring's
+    /// torque (eq. 3.3). About the span's start `psi0`, with `delta = psi - psi0`, the gradient is
+    /// `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k)`, `d_k = 2 E cos 2(psi0 - gamma_k)`:
+    /// each interval is an exact affine map of `(delta, theta)` (see [`flow`]), chained over the
+    /// span. The dropped term is bounded by `|R| <= 2 |E| delta^2 + tau_max` (Taylor's remainder:
+    /// `|d^2/dx^2 sin 2x| <= 4`; `tau_max` the ring torque's bound, [`torque_bound`]), and enters
+    /// the rates as `g (-a R, R)`, of max norm `g max(1, a) |R|`. Over interval `k` of length `h_k`
+    /// its effect at the interval's end is at most `c_k = h_k K_k g max(1, a) (2 |E| r_k^2 +
+    /// tau_max)` (variation of constants; `K_k` bounds the interval's propagator), with `r_k` a
+    /// bound on `|delta|` there: the linear path's reach (`max(|delta_k|, |delta_k+1|) + h_k K_k |A
+    /// w_k + b| / 2`, or `K_k (|w_k| + h_k |b|)`) widened by the forward bound of the error so far
+    /// (`eps_k+1 = ||exp(A h_k)|| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound
+    /// at the span's end is `sum_k ||P_k|| c_k`, `P_k` the exact product of the later intervals'
+    /// maps. `c_k` is taken where it bounds the remainder on the reach it widens itself (`c_k >=
+    /// c(r + c_k)`, `r` the reach widened by `eps_k` alone; tried at 1.25 times `c(r + c(r))`), so
+    /// that the true onion cannot first leave that reach: the bound is a real bound on the true
+    /// onion's distance from the chained maps' (through eq. 3.4's trigonometric terms and eq. 3.3's
+    /// torque alike), but for rounding. A span is taken only where that bound is within a hundredth
+    /// of the tolerance; otherwise a shorter one is tried, and where a single interval fails the
+    /// rest of the step is left to the other paths (an onion swinging through eq. 3.4's nonlinear
+    /// range, where the linearization fails at once). Tried once the skips of repeated periods have
+    /// declined at [`WAIT_SWITCHES`] switches.
+    pub(super) fn advance_onion_linear(
+        &self,
+        run: &mut StepRun,
+        s: &SteppingSchedule,
+        inputs: &MotorInputs,
+    ) -> bool {
+        #[cfg(test)]
+        if OFF.with(|c| c.get()) {
+            return false;
+        }
+        // Free rotors only: a locked rotor's onion is left to the skips of repeated periods and
+        // cycles (`onion_cycles.rs`), which compare against the switches resolved one by one.
+        if self.quasi_static()
+            || inputs.rotor_locked
+            || run.onion_linear.disabled
+            || run.onion_decoupled != Some(true)
+        {
+            return false;
+        }
+        if run.onion_linear.next == 0 && run.onion_linear.waited < WAIT_SWITCHES {
+            run.onion_linear.waited += 1;
+            return false;
+        }
+        let mut span = if run.onion_linear.next == 0 {
+            FIRST_SPAN
+        } else {
+            run.onion_linear.next
+        };
+        let target = BOUND_SHARE * self.params.tolerance;
+        // Switch intervals chained, charged to the budget once a span is taken (a declined
+        // span charges nothing: the other paths then run exactly as without this one).
+        let mut chained = 0;
+        loop {
+            let tried = self.onion_linear_span(run, s, inputs, span);
+            chained += tried.switches;
+            if let Some((t, y, bound)) = tried.result {
+                if bound <= target {
+                    let y_new = [run.y[0], run.y[1], y[0], y[1]];
+                    #[cfg(test)]
+                    let start = (run.y, run.t);
+                    if self.commit_linear_span(run, inputs, t, y_new) {
+                        let units = u32::try_from(chained / SWITCHES_PER_UNIT).unwrap_or(u32::MAX);
+                        run.extra_cost = run.extra_cost.saturating_add(units);
+                        #[cfg(test)]
+                        SPAN_LOG.with(|l| l.borrow_mut().push((start.0, start.1, t, y, bound)));
+                        // Next span sized from this bound (it grows about as the span's cube).
+                        let grow = (target / bound.max(1e-300)).cbrt().clamp(0.5, 2.0);
+                        run.onion_linear.next =
+                            ((tried.switches as f64 * 0.9 * grow).ceil() as usize).max(1);
+                        return true;
+                    }
+                    break;
+                }
+            }
+            if span <= 1 || tried.switches <= 1 {
+                break;
+            }
+            span = (tried.switches / 2).max(1);
+        }
+        run.onion_linear.disabled = true;
+        false
+    }
+
+    /// The chained maps over at most `span` switch intervals from `run.t` (to the step's end at
+    /// most): the span's end, the onion and tilt there and the bound of
+    /// [`Self::advance_onion_linear`].
+    fn onion_linear_span(
+        &self,
+        run: &StepRun,
+        s: &SteppingSchedule,
+        inputs: &MotorInputs,
+        span: usize,
+    ) -> Tried {
+        let (g, a, t) = (
+            self.llg_rate,
+            self.params.gilbert_damping,
+            self.tilt_stiffness,
+        );
+        let e = self.magnetoelastic_per_stress * s.stress_amplitude;
+        let to_rate = g * a.max(1.0);
+        let tau = torque_bound(&self.ring_bar);
+        let psi0 = run.y[2];
+        let mut w = [0.0, run.y[3]];
+        let mut time = run.t;
+        let mut eps: f64 = 0.0;
+        let mut maps: Vec<(M2, f64)> = Vec::with_capacity(span.min(4096));
+        let mut switches = 0;
+        while switches < span && time < run.t_end {
+            let next = s.next_switch_after(time).min(run.t_end);
+            let h = next - time;
+            let gamma = self.drive_at(inputs, time).direction;
+            let (s2, c2) = turned_back(2.0 * (psi0 - gamma)).sin_cos();
+            let (grad, d) = (e * s2, 2.0 * e * c2);
+            let am: M2 = [[-g * a * d, -g * t], [g * d, -g * a * t]];
+            let b = [-g * a * grad, g * grad];
+            switches += 1;
+            let Some(f) = flow(&am, h) else {
+                return Tried {
+                    switches,
+                    result: None,
+                };
+            };
+            let jb = apply(&f.j, b);
+            let ew = apply(&f.e, w);
+            let w_next = [ew[0] + jb[0], ew[1] + jb[1]];
+            let aw = apply(&am, w);
+            let slope = (aw[0] + b[0]).abs().max((aw[1] + b[1]).abs());
+            let wn = w[0].abs().max(w[1].abs());
+            let bn = b[0].abs().max(b[1].abs());
+            let reach =
+                (w[0].abs().max(w_next[0].abs()) + 0.5 * h * f.k * slope).min(f.k * (wn + h * bn));
+            let remainder = |r: f64| h * f.k * to_rate * (2.0 * e.abs() * r * r + tau);
+            // A bound `c` that holds given itself (`remainder(reach + K eps + c) < c`) holds: the
+            // true path cannot first leave the reach it implies.
+            let near = reach + f.k * eps;
+            let c = 1.25 * remainder(near + remainder(near));
+            let holds = remainder(near + c) < c || c == 0.0;
+            eps = norm(&f.e) * eps + c;
+            if !(holds && c.is_finite() && eps.is_finite()) {
+                return Tried {
+                    switches,
+                    result: None,
+                };
+            }
+            maps.push((f.e, c));
+            w = w_next;
+            time = next;
+        }
+        // Carried to the end by the exact products of the later maps.
+        let mut later: M2 = [[1.0, 0.0], [0.0, 1.0]];
+        let mut bound = 0.0;
+        for (e_k, c_k) in maps.iter().rev() {
+            bound += norm(&later) * c_k;
+            later = mul(&later, e_k);
+        }
+        let y = [psi0 + w[0], w[1]];
+        Tried {
+            switches,
+            result: (bound.is_finite() && y[0].is_finite() && y[1].is_finite())
+                .then_some((time, y, bound)),
+        }
+    }
+
+    /// Moves the run to `t` with the onion and tilt of `y` and the rotor on its drift; `false`
+    /// (nothing changed) if the state would leave its bounds.
+    fn commit_linear_span(
+        &self,
+        run: &mut StepRun,
+        inputs: &MotorInputs,
+        t: f64,
+        mut y: super::Vector,
+    ) -> bool {
+        if inputs.rotor_locked {
+            y[1] = 0.0;
+        } else {
+            let (coast, torque_speed, torque_angle) = self.drift_response(t - run.t);
+            let load = inputs.load_torque;
+            y[0] += y[1] * coast + load * torque_angle;
+            y[1] = y[1] * (1.0 - self.drag * torque_speed) + load * torque_speed;
+        }
+        if !(self.rotor_sane(&y) && Self::onion_sane(&y)) {
+            return false;
+        }
+        run.y = y;
+        run.t = t;
+        // At a switch: the next pass tries the next span before resolving anything.
+        run.segment_end = t;
+        run.period_end = None;
+        run.period_mismatch = f64::INFINITY;
+        run.onion_period_end = None;
+        run.onion_period_mismatch = f64::INFINITY;
+        run.relaxed_switch = None;
+        run.angles = None;
+        run.settled = false;
+        run.following = f64::NAN;
+        run.attempts = run.attempts.saturating_add(1);
+        #[cfg(test)]
+        SPANS.with(|c| c.set(c.get() + 1));
+        true
+    }
+}
+
+/// A tried macro span: the switch intervals chained, and the span's end, onion angle and tilt
+/// and bound where they are finite.
+struct Tried {
+    switches: usize,
+    result: Option<(f64, [f64; 2], f64)>,
+}
