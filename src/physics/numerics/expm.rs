@@ -201,10 +201,26 @@ mod tests {
             }
             (s <= 200).then_some(s)
         };
-        let mut norms = vec![0.0, 1e-300, 0.1, 0.25, 2.5e-1 + 1e-17, 0.3, 0.5, 1.0, 3.0, 1e11];
+        let mut norms = vec![
+            0.0,
+            1e-300,
+            0.1,
+            0.25,
+            2.5e-1 + 1e-17,
+            0.3,
+            0.5,
+            1.0,
+            3.0,
+            1e11,
+        ];
         for e in -3..=205 {
             let p = 2f64.powi(e);
-            norms.extend([p, p * (1.0 + f64::EPSILON), p * (1.0 - f64::EPSILON / 2.0), 1.7 * p]);
+            norms.extend([
+                p,
+                p * (1.0 + f64::EPSILON),
+                p * (1.0 - f64::EPSILON / 2.0),
+                1.7 * p,
+            ]);
         }
         for norm in norms {
             assert_eq!(quarter_squarings(norm), halvings(norm), "{norm:e}");
