@@ -275,7 +275,8 @@ impl Motor {
     /// 1 us step. Tried where `dt` times the coupling's rates ([`Self::coupling_rate_bound`]) is
     /// within [`ETD_REACH`] and those rates are at most [`WEAK_COUPLING`] of the onion block's
     /// own. The error is step doubling's taken whole, as the one-block
-    /// method's, and returned as `err^(5/8)`.
+    /// method's, and returned as `err^(5/8)`, with whether the exponential pair is worth a retry
+    /// where this rejects: not where it rejects by less than [`RETRY_ABOVE`].
     ///
     /// `None` where it does not apply (out of reach, or a block's `phi` functions not available:
     /// [`BlockPhi::new`]); `Some(None)` when the substep fails.
@@ -285,7 +286,7 @@ impl Motor {
         dt: f64,
         d: &Drive,
         start: &Linearized,
-    ) -> Option<Option<(Vector, f64)>> {
+    ) -> Option<Option<(Vector, f64, bool)>> {
         let j = &start.j;
         let coupling = self.coupling_rate_bound(j);
         let reach = dt * coupling / ETD_REACH;
@@ -313,10 +314,10 @@ impl Motor {
         // substep beyond the reach: an onion that its block follows closely would otherwise
         // propose substeps out of reach, which the other pairs then reject.
         let floor = (0.9 * reach).powi(3);
-        Some(
-            err.is_finite()
-                .then(|| (u, fifth_order_error(err).max(floor))),
-        )
+        Some(err.is_finite().then(|| {
+            let err = fifth_order_error(err).max(floor);
+            (u, err, err > RETRY_ABOVE)
+        }))
     }
 
     /// A bound on the moduli of the rates that [`Self::gilbert_block_etd_step`] treats
@@ -332,6 +333,13 @@ impl Motor {
         coupling + relaxation + through_rotor
     }
 }
+
+/// A rejection by [`Motor::gilbert_block_etd_step`] within this factor of the tolerance is not
+/// retried by the exponential pair: there the onion's error changes along its orbit by about
+/// that much between substeps of the same length (the step-size rule's proposal overshoots it),
+/// and the pair, of second order, took none of about 1,000 such retries on the benchmark's
+/// slowest free rotors, where it does take larger rejections on a nearly linear onion.
+pub(super) const RETRY_ABOVE: f64 = std::f64::consts::SQRT_2;
 
 /// The block-diagonal part is taken only where the coupling's rates are at most this fraction of
 /// the onion block's own (`|trace| + sqrt(|det|)`): where the rotor's turn moves the onion faster

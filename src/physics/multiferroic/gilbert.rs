@@ -185,8 +185,9 @@ impl Motor {
     /// doubling's (one full step against two halves, which share the start's stage), taken
     /// whole rather than divided by `2^4 - 1`, so that an order lost to stiffness cannot hide;
     /// the two halves are the result. Returned as `err^(5/8)`, as the explicit pair's (about the
-    /// fourth order's `err^(-1/5)` step rule). `None` out of reach, for an underdamped block
-    /// (complex eigenvalues) or when the step fails.
+    /// fourth order's `err^(-1/5)` step rule), with whether the exponential pair is worth a retry
+    /// where it rejects ([`Self::gilbert_block_etd_step`] says for itself). `None` out of reach,
+    /// for an underdamped block (complex eigenvalues) or when the step fails.
     ///
     /// With the rotor locked `L` is the onion's own block `g [[-alpha U'', -T], [U'', -alpha T]]`
     /// (eq. 3.4's landscape frozen) and the rest, the change of the landscape's curvature along
@@ -202,7 +203,7 @@ impl Motor {
         dt: f64,
         d: &Drive,
         start: &Linearized,
-    ) -> Option<(Vector, f64)> {
+    ) -> Option<(Vector, f64, bool)> {
         let j = &start.j;
         // A free rotor's onion block is part of the linear part wherever its `phi` functions
         // are available.
@@ -272,7 +273,7 @@ impl Motor {
             1.0
         };
         let err = scale * self.error_norm(|i| two[i] - whole[i], y, &u);
-        err.is_finite().then(|| (u, fifth_order_error(err)))
+        err.is_finite().then(|| (u, fifth_order_error(err), true))
     }
 
     /// One ETDRK4 step of `h` from `y0` (where the rate is `f0`) with the 2x2 block of `j` at
@@ -957,7 +958,7 @@ mod tests {
                     let start = m.linearized(&y, &d, dt, &Angles::exact(y[2], y[0], d.direction));
                     assert!(m.gilbert_explicit_step(&y, dt, &d, &start).is_none());
                     let (u, estimate) = match m.gilbert_exponential_rk4_step(&y, dt, &d, &start) {
-                        Some((u, estimate)) if estimate <= 1.0 => (u, estimate),
+                        Some((u, estimate, _)) if estimate <= 1.0 => (u, estimate),
                         _ => {
                             declined += 1;
                             continue;

@@ -181,14 +181,21 @@ impl Motor {
             let rk4 = (!forced)
                 .then(|| self.gilbert_exponential_rk4_step(y, dt, d, &start))
                 .flatten();
-            if let Some((u, err)) = rk4.filter(|(_, err)| *err <= 1.0) {
+            if let Some((u, err, _)) = rk4.filter(|(_, err, _)| *err <= 1.0) {
                 return Some((u, err, dt, None));
             }
+            // A rejection by little is the step-size rule's overshoot, which the exponential pair
+            // does not take either ([`super::etd_blocks::RETRY_ABOVE`]).
+            if let Some((u, err, false)) = rk4 {
+                return Some((u, err, dt, None));
+            }
+            #[cfg(test)]
+            PAIR_AFTER_RK4.with(|c| c.set(c.get() + 1));
             match self.gilbert_embedded_step(y, dt, d, &start) {
                 Some((u, err)) if err <= 1.0 || rk4.is_none() => return Some((u, err, dt, None)),
                 _ => {}
             }
-            if let Some((u, err)) = rk4 {
+            if let Some((u, err, _)) = rk4 {
                 return Some((u, err, dt, None));
             }
         }
@@ -482,6 +489,12 @@ impl Motor {
             None => run.dt = (0.2 * dt_try).max(dt_min),
         }
     }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// The exponential pair's substeps after the exponential RK4's (tests count them).
+    pub(super) static PAIR_AFTER_RK4: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
 }
 
 /// The onion's predicted turn along its branch is used as the settle's start only when it stays
