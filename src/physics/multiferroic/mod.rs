@@ -22,11 +22,18 @@
 //! functions come in closed form and the third-order member of an embedded exponential Rosenbrock
 //! pair (exprb32) estimates the local error. The Gilbert onion's ringing takes an explicit
 //! Dormand-Prince 5(4) pair within its stability reach, an exponential RK4 where only the rotor's
-//! drag keeps that pair out of reach, else an exponential Rosenbrock pair (`gilbert.rs`); weakly
-//! damped ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`;
-//! a locked rotor's last orbit is resolved at once, `orbit_finish.rs`).
-//! The estimate sizes the next substep.
-//! A budget of attempted substeps per call bounds the cost of a long step (see [`MotorParams::max_substeps`]).
+//! drag keeps that pair out of reach (with the onion's block exact too where the two barely
+//! couple, `etd_blocks.rs`), else an exponential Rosenbrock pair (`gilbert.rs`); weakly damped
+//! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`; a locked
+//! rotor's last orbit is resolved at once, `orbit_finish.rs`). On fast schedules whose ring barely
+//! couples the onion to the rotor, repeated periods and cycles are taken at once
+//! (`onion_periods.rs`, `onion_cycles.rs`) and an onion near its path advances by exact affine
+//! maps per switch (`onion_linear.rs`). The estimate sizes the next substep.
+//! A budget of attempted substeps per call bounds the cost of a long step (see
+//! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
+//! not follow are not taken (`forced_crossing.rs`), and a locked rotor's ringing onion that
+//! neither a drop nor forced substeps can follow through the schedule's switches refuses the step
+//! (`locked_switches.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
