@@ -1,8 +1,14 @@
 //! A locked rotor's Gilbert onion on a schedule faster than its ringing, once the step's budget
 //! is spent (see [`Motor::locked_budget_drop`]).
 
-use super::{reduced_direction, Drive, Motor, StepRun};
+use super::{reduced_direction, Drive, Motor, MotorInputs, StepRun};
 use std::f64::consts::PI;
+
+#[cfg(test)]
+thread_local! {
+    /// Passes of [`Motor::step`]'s loop on this thread (tests count them).
+    pub(super) static PASSES: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
 
 impl Motor {
     /// Whether a locked rotor's Gilbert onion is put into the minimum of eq. 3.4 it rings about
@@ -96,6 +102,47 @@ impl Motor {
             spread < k && distance * (-rate * time).exp() <= tol
         };
         decays(kick.max(folded), s.step_period) && decays(gap, run.t_end - run.t)
+    }
+
+    /// Whether a locked rotor's Gilbert step on a schedule is sure to be refused for its
+    /// switches outnumbering the step's `passes` (the loop of [`Self::step`]), decided before
+    /// any substep. Every pass then ends within its segment of constant drive, since none of
+    /// the skips over whole periods can apply: those of repeated periods compare the rotor's
+    /// offset from the strain, which turns by the step angle folded into the half turn of eq. 3.4
+    /// (here beyond their threshold of `tolerance / 1000`) from period to period while the rotor
+    /// stays; those of the onion's periods and its linear range need a ring decoupled from the
+    /// onion ([`Self::ring_decoupled`]); the unstrained advance needs no strain, and the
+    /// strain-held one a quasi-static onion. So a step whose switches outnumber its passes would
+    /// end its passes short of the step's end, having spent the budget on them.
+    pub(super) fn switches_outnumber_passes(
+        &self,
+        run: &StepRun,
+        inputs: &MotorInputs,
+        passes: u64,
+    ) -> bool {
+        let Some(s) = inputs.schedule.get() else {
+            return false;
+        };
+        if self.quasi_static()
+            || !inputs.rotor_locked
+            || self.magnetoelastic_per_stress * s.stress_amplitude == 0.0
+        {
+            return false;
+        }
+        // Each pass ends by the next switch, so after `n` passes the schedule's index is at
+        // most `n` past the start's; one more is allowed for rounding (the index is never NaN).
+        let switches = s.step_index(run.t_end) - s.step_index(run.start);
+        if switches <= passes as f64 + 1.0 {
+            return false;
+        }
+        let folded = (s.step_angle - PI * (s.step_angle / PI).round()).abs();
+        let largest = s
+            .direction(run.start)
+            .abs()
+            .max(s.direction(run.t_end).abs());
+        let rounding = 16.0 * f64::EPSILON * (largest + run.y[0].abs() + PI);
+        folded > 1e-3 * self.params.tolerance + rounding
+            && !self.ring_decoupled(s, true, run.t_end - run.start)
     }
 
     /// Why a locked rotor's step was refused by [`Self::locked_budget_drop`].

@@ -101,3 +101,65 @@ fn ringing_onion_the_budget_cannot_resolve_is_refused() {
         (Ok(_), errors) => assert!(errors.unwrap().iter().all(|e| *e <= 1.0), "{errors:?}"),
     }
 }
+
+/// Strain turned by -1.23 rad every 1.26 ns, gilbert_damping 0.12, tolerance 1.1e-2, on a weak
+/// landscape: the onion creeps (its curvature's `4 |U''|` is 1/160 of `alpha^2 T`) and its
+/// budget of 803 pays for about one forced substep per switch. Those follow it within 1e-4
+/// tolerances of the RK4 over three steps; dropped into its minimum at every switch it turned
+/// with the strain, 786 rad (7e4 tolerances) a step.
+#[test]
+fn creeping_onion_with_a_substep_per_switch_stays_within_the_tolerance() {
+    let text =
+        "ring_outer_diameter=2.3732846645843895e-3 ring_inner_diameter=2.235360017070524e-3 \
+         bar_length=2.5242264618915877e-5 bar_width=1.3645023005758869e-5 \
+         thickness=5.547779367029385e-8 saturation_magnetization=4.272071942222984e5 \
+         magnetostriction=4.698776092010361e-3 wall_volume=8.569481140353211e-11 \
+         density=1.9368520390350972e4 fluid_viscosity=9.001813455484988e3 \
+         gilbert_damping=1.2032259494896219e-1 tolerance=1.0854033961432157e-2 \
+         step_angle=-1.2317253989238903e0 step_period=1.2569923667204684e-9 \
+         stress_amplitude=-3.6475081819685323e2 schedule_initial_direction=7.520818991331611e-8 \
+         onion_model=1 max_substeps=803 schedule=1 rotor_locked=1 \
+         initial_onion_offset=6.040605507789597e-3 load_torque=8.906150444115635e-7";
+    let (m, mut st, inputs) = case(&values(text)).unwrap();
+    let tol = m.params.tolerance;
+    for _ in 0..3 {
+        let start = st;
+        let report = m.step(&mut st, &inputs, 1e-6).unwrap();
+        let truth = converged_rk4(&m, &start, &inputs, st.time, 100.0);
+        let errors = [
+            (st.onion_angle - truth[2]).abs() / tol,
+            (st.onion_tilt - truth[3]).abs() / tol,
+        ];
+        assert!(!report.accuracy_limited, "{report:?}");
+        assert!(errors.iter().all(|e| *e <= 1.0), "{errors:?}");
+    }
+}
+
+/// Strain turned by -3.80 rad every 1.06 ns, max_substeps 244: the step's 945 switches
+/// outnumber the 504 passes of the step's loop, each of which ends by the next switch (the ring
+/// is coupled to the onion, the step angle is 0.66 rad from a half turn). The step is refused
+/// before any pass; the loop ran its 504 passes to refuse it.
+#[test]
+fn switches_outnumbering_the_passes_are_refused_before_any_pass() {
+    let text =
+        "ring_outer_diameter=4.302247854625061e-1 ring_inner_diameter=1.5054081044621184e-1 \
+         bar_length=9.274267935169457e-3 bar_width=2.5693537220634243e-5 \
+         thickness=9.440400270168416e-6 saturation_magnetization=1.188406483468047e5 \
+         magnetostriction=9.233616109814114e-3 wall_volume=4.9630438246177514e-11 \
+         density=5.624347808445323e3 fluid_viscosity=2.4343251316995634e1 \
+         gilbert_damping=6.531395533724416e-2 tolerance=6.915035545887459e-8 \
+         step_angle=-3.7968861455216523e0 step_period=1.0583607727844343e-9 \
+         stress_amplitude=-2.173350085795131e-3 schedule_initial_direction=4.001602968982926e5 \
+         onion_model=1 max_substeps=244 schedule=1 rotor_locked=1 \
+         initial_onion_offset=2.637016264541723e-12 load_torque=-7.405277369757061e-7";
+    let (m, mut st, inputs) = case(&values(text)).unwrap();
+    let start = st;
+    super::locked_switches::PASSES.with(|c| c.set(0));
+    let e = m.step(&mut st, &inputs, 1e-6).unwrap_err();
+    assert!(
+        e.contains("spans more schedule switches than max_substeps = 244"),
+        "{e}"
+    );
+    assert_eq!(super::locked_switches::PASSES.with(|c| c.get()), 0);
+    assert_eq!(st, start);
+}

@@ -202,13 +202,27 @@ impl Motor {
         // relaxes does not clone the motor.
         let twin = std::cell::OnceCell::new();
         let long_segment = 10.0 * self.rotor_relaxation_time();
+        let passes = 2 * u64::from(budget) + 16;
+        let too_many_switches = || {
+            format!(
+                "the step from t = {} s by {h} s spans more schedule switches than \
+                 max_substeps = {budget} allows to resolve (the rotor cannot settle within a \
+                 period of the schedule); shorten the step or raise max_substeps",
+                state.time
+            )
+        };
+        if self.switches_outnumber_passes(&run, inputs, passes) {
+            return Err(too_many_switches());
+        }
         // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
         // repeated periods; the minimum substep reaches the segment's end once the budget is
         // spent, so the cap ends the loop early only when the switches outnumber the budget.
-        for _ in 0..(2 * budget as u64 + 16) {
+        for _ in 0..passes {
             if run.t >= run.t_end {
                 break;
             }
+            #[cfg(test)]
+            super::locked_switches::PASSES.with(|c| c.set(c.get() + 1));
             if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
                 if self.skip_repeated_periods(&mut run, s)
                     || self.skip_onion_periods(&mut run, s, inputs)
@@ -263,12 +277,7 @@ impl Motor {
             model.substep(&mut run, &d, segment_end, budget);
         }
         if run.t < run.t_end {
-            return Err(format!(
-                "the step from t = {} s by {h} s spans more schedule switches than \
-                 max_substeps = {budget} allows to resolve (the rotor cannot settle within a \
-                 period of the schedule); shorten the step or raise max_substeps",
-                state.time
-            ));
+            return Err(too_many_switches());
         }
         let d = self.drive_at(inputs, run.t_end);
         if !run.is_settled(&d) {
