@@ -75,7 +75,7 @@ impl Motor {
         };
         let cycle = index - last.index;
         let periods_left = s.step_index(run.t_end) - index;
-        if !(cycle >= 1.0 && periods_left >= 1.0) {
+        if !(cycle >= 1.0 && periods_left >= 1.0 && self.snaps_forgotten(s, cycle)) {
             return false;
         }
         let shift = offset - last.offset;
