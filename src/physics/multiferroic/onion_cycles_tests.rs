@@ -65,10 +65,10 @@ fn not_repeated(text: &str, warm: usize, steps: usize, bound: f64) -> usize {
     answered
 }
 
-/// A locked rotor, the strain turned by 1.99 rad every 1.67 ns: the onion (slowest decay 0.03 per
-/// period) stays put while the strain turns about it, within the tolerance (4.3e-2) of a minimum
-/// of eq. 3.4 at every 30th switch. Repeating the cycles between those placements drifted it by
-/// 0.68 rad, 16 tolerances, a step; the linear spans follow it ([`Motor::advance_onion_linear`]).
+/// A locked rotor, the strain turned by 1.99 rad every 1.67 ns: the onion (damping 3.3e-2) stays
+/// put while the strain turns about it, within the tolerance (4.3e-2) of a minimum of eq. 3.4 at
+/// every 30th switch. Repeating the cycles between those placements would drift it by 0.68 rad,
+/// 16 tolerances, a step; the linear spans follow it ([`Motor::advance_onion_linear`]).
 #[test]
 fn a_locked_onion_the_strain_turns_about_is_not_repeated() {
     let answered = not_repeated(LOCKED_TURNED_ABOUT, 0, 3, 0.01);
@@ -76,8 +76,8 @@ fn a_locked_onion_the_strain_turns_about_is_not_repeated() {
 }
 
 /// A free rotor, the strain turned by -7.98 rad every 1.48 ns: the onion (damping 1.7e-4) within
-/// the tolerance (0.31) of a minimum at every other switch. Repeating those cycles drifted it by
-/// 83 rad, 267 tolerances, a step; the step is now refused for its budget (5) instead.
+/// the tolerance (0.31) of a minimum at every other switch. Repeating those cycles would drift it
+/// by 83 rad, 267 tolerances, a step; the step is refused for its budget (5) instead.
 #[test]
 fn a_free_rotor_onion_the_strain_turns_about_is_not_repeated() {
     not_repeated(FREE_TURNED_ABOUT, 0, 1, 1.0);

@@ -30,7 +30,8 @@ impl Motor {
     /// the same tilt (within `tolerance / 100`, then `tolerance / 1000`), every later period
     /// repeats the last one turned by `step_angle`; two, within `tolerance / 1000`, where the
     /// onion ended both on its quasi-static branch (relaxed: the period that follows depends
-    /// on that offset alone). This is where a schedule turns the strain
+    /// on that offset alone) and had forgotten the first placement ([`Self::snaps_forgotten`]).
+    /// This is where a schedule turns the strain
     /// faster than the rotor can follow (by angles that never repeat, so the rotor never
     /// comes back to the same place relative to the strain, as
     /// [`Self::skip_repeated_periods`] needs) while the onion settles or rings down within a
