@@ -26,7 +26,8 @@ pub(super) struct RelaxedSwitch {
 impl Motor {
     /// Takes whole cycles of `L` periods of the schedule at once when the Gilbert onion has
     /// relaxed onto its quasi-static branch at two switches `L` periods apart with the same
-    /// offset from the strain (within `tolerance / 1000`, modulo the half turn of eq. 3.4), in
+    /// offset from the strain (within `tolerance / 1000`, modulo the half turn of eq. 3.4), the
+    /// first placement forgotten within the cycle ([`Self::snaps_forgotten`]), in
     /// the regime where eq. 3.3's ring-bar torque is negligible
     /// ([`Self::ring_decoupled`]); `relaxed` says whether it has at this switch, `offset` is its
     /// offset there. The step's last switch inside a cycle is reached too, the onion's angle and
@@ -75,7 +76,7 @@ impl Motor {
         };
         let cycle = index - last.index;
         let periods_left = s.step_index(run.t_end) - index;
-        if !(cycle >= 1.0 && periods_left >= 1.0) {
+        if !(cycle >= 1.0 && periods_left >= 1.0 && self.snaps_forgotten(s, cycle)) {
             return false;
         }
         let shift = offset - last.offset;

@@ -181,12 +181,15 @@ fn flow(a: &M2, h: f64) -> Option<Flow> {
 }
 
 impl Motor {
-    /// Advances the rest of the step's switches, or some of them, at once where a free rotor's eq.
-    /// 3.3 ring-bar torque is negligible ([`Self::ring_decoupled`], as for
+    /// Advances the rest of the step's switches, or some of them, at once where eq. 3.3's
+    /// ring-bar torque is negligible ([`Self::ring_decoupled`], as for
     /// [`Self::skip_onion_periods`]) and the Gilbert onion stays close enough to where a macro span
     /// of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
     ///
-    /// The rotor then follows load and drag alone, exactly ([`Self::drift_response`]). The onion
+    /// A locked rotor stays; a free one follows load and drag alone, exactly
+    /// ([`Self::drift_response`]). The bound below holds for the onion whatever its placements on
+    /// its quasi-static branch would have been, which the skips of repeated periods rest on
+    /// ([`Self::snaps_forgotten`]): an onion the strain turns fast about is advanced here. The onion
     /// obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin 2(psi -
     /// gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq. 3.4) plus the ring's
     /// torque (eq. 3.3). About the span's start `psi0`, with `delta = psi - psi0`, the gradient is
@@ -220,13 +223,7 @@ impl Motor {
         if OFF.with(|c| c.get()) {
             return false;
         }
-        // Free rotors only: a locked rotor's onion is left to the skips of repeated periods and
-        // cycles (`onion_cycles.rs`), which compare against the switches resolved one by one.
-        if self.quasi_static()
-            || inputs.rotor_locked
-            || run.onion_linear.disabled
-            || run.onion_decoupled != Some(true)
-        {
+        if self.quasi_static() || run.onion_linear.disabled || run.onion_decoupled != Some(true) {
             return false;
         }
         if run.onion_linear.next == 0 && run.onion_linear.waited < WAIT_SWITCHES {

@@ -9,6 +9,10 @@ use std::f64::consts::PI;
 /// compared: an unwrapped angle of many turns carries that much rounding from every substep.
 const ROUNDING_ULPS: f64 = 64.0;
 
+/// The decay, `e^{-lambda t}`, an onion placed on its quasi-static branch must have undergone
+/// before it is compared at another such placement (see [`Motor::snaps_forgotten`]).
+const SNAP_DECAY: f64 = 1e-2;
+
 #[cfg(test)]
 thread_local! {
     /// Periods skipped by [`Motor::skip_onion_periods`] on this thread (for tests).
@@ -26,7 +30,8 @@ impl Motor {
     /// the same tilt (within `tolerance / 100`, then `tolerance / 1000`), every later period
     /// repeats the last one turned by `step_angle`; two, within `tolerance / 1000`, where the
     /// onion ended both on its quasi-static branch (relaxed: the period that follows depends
-    /// on that offset alone). This is where a schedule turns the strain
+    /// on that offset alone) and had forgotten the first placement ([`Self::snaps_forgotten`]).
+    /// This is where a schedule turns the strain
     /// faster than the rotor can follow (by angles that never repeat, so the rotor never
     /// comes back to the same place relative to the strain, as
     /// [`Self::skip_repeated_periods`] needs) while the onion settles or rings down within a
@@ -85,7 +90,8 @@ impl Motor {
             // Two periods from the branch with the same offset repeat for good; otherwise the
             // one before must have converged too.
             let from_branch = relaxed && run.onion_period_end.is_some_and(|p| p[3] == 1.0);
-            if mismatch <= 1e-3 * tol + rounding
+            if (!from_branch || self.snaps_forgotten(s, 1.0))
+                && mismatch <= 1e-3 * tol + rounding
                 && (from_branch || run.onion_period_mismatch <= 1e-2 * tol + rounding)
                 && periods >= 1.0
                 && self.advance_onion_periods(run, s, inputs, periods, turn)
@@ -151,6 +157,26 @@ impl Motor {
         #[cfg(test)]
         SKIPS.with(|c| c.set(c.get() + 1));
         true
+    }
+
+    /// Whether an onion placed on its quasi-static branch at a switch has forgotten that placement
+    /// `periods` periods of the schedule `s` later: its slowest decay at eq. 3.4's curvature at a
+    /// minimum, `2 |E|` ([`Self::onion_decay_rate`]), shrinks a perturbation to [`SNAP_DECAY`]
+    /// of itself over that time.
+    ///
+    /// An onion is placed on its branch where it is within the tolerance of it
+    /// ([`Self::relaxed_onion`]), its ringing dropped. Two such placements compare alike by
+    /// construction (the offset at the branch's minimum), whether the onion relaxed there or
+    /// the strain merely swung past it: an onion that barely moves while the strain turns fast
+    /// about it sits within the tolerance of some minimum every few switches, and each placement
+    /// then moves it by up to the tolerance, the same way each time. Repeating such periods
+    /// turns that shift into a drift of the tolerance per cycle (hundreds of tolerances a step),
+    /// where the true onion stays put. Once the onion's own decay has forgotten a placement
+    /// within the cycle, the repeated state is the onion's, not the placement's.
+    pub(super) fn snaps_forgotten(&self, s: &SteppingSchedule, periods: f64) -> bool {
+        let curvature = 2.0 * (self.magnetoelastic_per_stress * s.stress_amplitude).abs();
+        let decay = self.onion_decay_rate(curvature) * periods * s.step_period;
+        decay >= -SNAP_DECAY.ln()
     }
 
     /// Whether the ring-bar torque is negligible over `h` seconds of the schedule `s`, for the
