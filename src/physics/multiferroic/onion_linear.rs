@@ -370,19 +370,9 @@ impl Motor {
         if !(self.rotor_sane(&y) && Self::onion_sane(&y)) {
             return false;
         }
-        run.y = y;
-        run.t = t;
         // At a switch: the next pass tries the next span before resolving anything.
-        run.segment_end = t;
-        run.period_end = None;
-        run.period_mismatch = f64::INFINITY;
-        run.onion_period_end = None;
-        run.onion_period_mismatch = f64::INFINITY;
-        run.relaxed_switch = None;
-        run.angles = None;
-        run.settled = false;
+        run.jump_onion_to(y, t, t);
         run.following = f64::NAN;
-        run.attempts = run.attempts.saturating_add(1);
         #[cfg(test)]
         SPANS.with(|c| c.set(c.get() + 1));
         true

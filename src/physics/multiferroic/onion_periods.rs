@@ -143,17 +143,7 @@ impl Motor {
         if !(self.rotor_sane(&y) && Self::onion_sane(&y)) {
             return false;
         }
-        run.y = y;
-        run.t = t;
-        run.segment_end = f64::NAN;
-        run.period_end = None;
-        run.period_mismatch = f64::INFINITY;
-        run.onion_period_end = None;
-        run.onion_period_mismatch = f64::INFINITY;
-        run.relaxed_switch = None;
-        run.angles = None;
-        run.settled = false;
-        run.attempts = run.attempts.saturating_add(1);
+        run.jump_onion_to(y, t, f64::NAN);
         #[cfg(test)]
         SKIPS.with(|c| c.set(c.get() + 1));
         true

@@ -38,21 +38,28 @@ pub(super) fn rk4(
             .map_or(t_end, |s| s.next_switch_after(t).min(t_end));
         let d = m.drive_at(inputs, t);
         let n = ((next - t) * 1e9 * per_ns).ceil().max(1.0) as usize;
-        let h = (next - t) / n as f64;
-        let f = |y: &Vector| m.rhs_jacobian(y, &d, 1e-300).0;
-        for _ in 0..n {
-            let k1 = f(&y);
-            let y2: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]);
-            let k2 = f(&y2);
-            let y3: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]);
-            let k3 = f(&y3);
-            let y4: Vector = std::array::from_fn(|i| y[i] + h * k3[i]);
-            let k4 = f(&y4);
-            for i in 0..4 {
-                y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-            }
-        }
+        y = rk4_span(m, &d, y, next - t, n);
         t = next;
+    }
+    y
+}
+
+/// Classical RK4 of the motor's ODE (its right-hand side alone) from `y` over `span` in `n`
+/// equal steps under the constant drive `d`.
+pub(super) fn rk4_span(m: &Motor, d: &Drive, mut y: Vector, span: f64, n: usize) -> Vector {
+    let h = span / n as f64;
+    let f = |y: &Vector| m.rhs_jacobian(y, d, 1e-300).0;
+    for _ in 0..n {
+        let k1 = f(&y);
+        let y2: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]);
+        let k2 = f(&y2);
+        let y3: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]);
+        let k3 = f(&y3);
+        let y4: Vector = std::array::from_fn(|i| y[i] + h * k3[i]);
+        let k4 = f(&y4);
+        for i in 0..4 {
+            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
+        }
     }
     y
 }

@@ -133,6 +133,23 @@ impl StepRun {
             self.segment_direction = direction;
         }
     }
+
+    /// Moves the run to the Gilbert onion's state `y` at `t`, reached by a shortcut over whole
+    /// switches (one attempt): the periods compared so far and the onion's last relaxed switch
+    /// no longer precede it, and its angles are evaluated afresh.
+    pub(super) fn jump_onion_to(&mut self, y: Vector, t: f64, segment_end: f64) {
+        self.y = y;
+        self.t = t;
+        self.segment_end = segment_end;
+        self.period_end = None;
+        self.period_mismatch = f64::INFINITY;
+        self.onion_period_end = None;
+        self.onion_period_mismatch = f64::INFINITY;
+        self.relaxed_switch = None;
+        self.angles = None;
+        self.settled = false;
+        self.attempts = self.attempts.saturating_add(1);
+    }
 }
 
 impl Motor {

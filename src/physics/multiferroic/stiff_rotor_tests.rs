@@ -3,7 +3,7 @@
 
 use super::etd_blocks::BlockPhi;
 use super::onion_periods_tests::{case, values};
-use super::*;
+use super::resolved_tests::rk4_span;
 
 /// A benchmark case: a Gilbert onion (damping 7.6e-3) ringing through whole microseconds, about
 /// a radian off its minimum, on a rotor in a fluid 1.7e5 times as viscous as water (drag rate
@@ -22,27 +22,6 @@ const RINGING_ON_A_STIFF_ROTOR: &str = "strain_direction=2.760727418263646e10 \
     stress_amplitude=-6.133278697980404e0 schedule_initial_direction=1.1478010554570153e-6 \
     onion_model=1 max_substeps=12161 schedule=1 initial_onion_offset=9.810646276129092e-7";
 
-/// Classical RK4 of the motor's ODE (its right-hand side alone) from `y` over `span` in `n`
-/// equal steps under the drive `d`.
-fn plain_rk4(m: &Motor, d: &Drive, y: Vector, span: f64, n: usize) -> Vector {
-    let h = span / n as f64;
-    let f = |y: &Vector| m.rhs_jacobian(y, d, 1e-300).0;
-    let mut y = y;
-    for _ in 0..n {
-        let k1 = f(&y);
-        let y2: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]);
-        let k2 = f(&y2);
-        let y3: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]);
-        let k3 = f(&y3);
-        let y4: Vector = std::array::from_fn(|i| y[i] + h * k3[i]);
-        let k4 = f(&y4);
-        for i in 0..4 {
-            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
-    }
-    y
-}
-
 /// The second and third 1 us steps of [`RINGING_ON_A_STIFF_ROTOR`] (no switch inside them)
 /// against a plain RK4 of the full system from each step's start at steps of the rotor's
 /// inertial time `I/c` and of half of it, which agree within a hundredth of the tolerance: the
@@ -52,7 +31,7 @@ fn plain_rk4(m: &Motor, d: &Drive, y: Vector, span: f64, n: usize) -> Vector {
 /// 1e-6 rad from a maximum of its landscape, and a start moved by the tolerance ends 2e6
 /// tolerances away.
 #[test]
-fn ringing_onion_on_a_stiff_rotor_keeps_to_a_plain_rk4() {
+fn ringing_onion_on_a_stiff_rotor_keeps_to_a_rk4_span() {
     let (m, start, inputs) = case(&values(RINGING_ON_A_STIFF_ROTOR)).unwrap();
     let tol = m.params.tolerance;
     let mut s = start;
@@ -62,8 +41,8 @@ fn ringing_onion_on_a_stiff_rotor_keeps_to_a_plain_rk4() {
         let d = m.drive_at(&inputs, s.time);
         let y = [s.rotor_angle, s.rotor_speed, s.onion_angle, s.onion_tilt];
         let report = m.step(&mut s, &inputs, 1e-6).unwrap();
-        let coarse = plain_rk4(&m, &d, y, 1e-6, n);
-        let truth = plain_rk4(&m, &d, y, 1e-6, 2 * n);
+        let coarse = rk4_span(&m, &d, y, 1e-6, n);
+        let truth = rk4_span(&m, &d, y, 1e-6, 2 * n);
         let got = [s.rotor_angle, s.rotor_speed, s.onion_angle, s.onion_tilt];
         println!(
             "{} substeps: {got:?} against {truth:?} (off {:e}, {:e}, {:e} tolerances)",
