@@ -359,14 +359,7 @@ impl Motor {
         t: f64,
         mut y: super::Vector,
     ) -> bool {
-        if inputs.rotor_locked {
-            y[1] = 0.0;
-        } else {
-            let (coast, torque_speed, torque_angle) = self.drift_response(t - run.t);
-            let load = inputs.load_torque;
-            y[0] += y[1] * coast + load * torque_angle;
-            y[1] = y[1] * (1.0 - self.drag * torque_speed) + load * torque_speed;
-        }
+        self.drift_rotor(&mut y, inputs, t - run.t);
         if !(self.rotor_sane(&y) && Self::onion_sane(&y)) {
             return false;
         }

@@ -121,6 +121,19 @@ impl Motor {
         self.advance_onion_periods_to(run, inputs, t, periods * turn)
     }
 
+    /// The rotor of `y` over `dt` where the ring's torque is negligible: a locked one stays, at
+    /// rest; a free one follows load and drag alone, exactly ([`Self::drift_response`]).
+    pub(super) fn drift_rotor(&self, y: &mut super::Vector, inputs: &MotorInputs, dt: f64) {
+        if inputs.rotor_locked {
+            y[1] = 0.0;
+        } else {
+            let (coast, torque_speed, torque_angle) = self.drift_response(dt);
+            let load = inputs.load_torque;
+            y[0] += y[1] * coast + load * torque_angle;
+            y[1] = y[1] * (1.0 - self.drag * torque_speed) + load * torque_speed;
+        }
+    }
+
     /// A skip of repeated periods to the switch at `t`, turning the onion by `turn` in all;
     /// `false` (nothing changed) if the rotor would leave its bounds.
     pub(super) fn advance_onion_periods_to(
@@ -131,14 +144,7 @@ impl Motor {
         turn: f64,
     ) -> bool {
         let mut y = run.y;
-        if inputs.rotor_locked {
-            y[1] = 0.0;
-        } else {
-            let (coast, torque_speed, torque_angle) = self.drift_response(t - run.t);
-            let load = inputs.load_torque;
-            y[0] += y[1] * coast + load * torque_angle;
-            y[1] = y[1] * (1.0 - self.drag * torque_speed) + load * torque_speed;
-        }
+        self.drift_rotor(&mut y, inputs, t - run.t);
         y[2] += turn;
         if !(self.rotor_sane(&y) && Self::onion_sane(&y)) {
             return false;
