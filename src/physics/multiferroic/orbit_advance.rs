@@ -8,6 +8,7 @@ use super::orbit_finish::MAX_FINISH_STEPS;
 use super::step::StepRun;
 use super::{Drive, Motor, Vector};
 use crate::physics::numerics::dormand_prince;
+use crate::physics::numerics::rk4::rk4_step;
 use std::f64::consts::PI;
 
 /// The orbit's energy at most this fraction of the lowest rim's height above the minimum: the
@@ -542,16 +543,7 @@ impl Motor {
             }
             f
         };
-        let step = |z: &Vector, h: f64| {
-            let k1 = rate(z);
-            let k2 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k1[i]));
-            let k3 = rate(&std::array::from_fn(|i| z[i] + 0.5 * h * k2[i]));
-            let k4 = rate(&std::array::from_fn(|i| z[i] + h * k3[i]));
-            let out: Vector = std::array::from_fn(|i| {
-                z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-            });
-            out
-        };
+        let step = |z: &Vector, h: f64| rk4_step(&rate, z, h);
         let below = |z: &Vector| z[2] < well.minimum;
         let (mut z, mut time) = (*y, 0.0);
         for n in 0..MARCH_STEPS {

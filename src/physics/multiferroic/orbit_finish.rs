@@ -4,6 +4,7 @@
 
 use super::orbit::point;
 use super::{Drive, Motor, Vector};
+use crate::physics::numerics::rk4::rk4_step;
 
 /// The most RK4 steps the finish takes, over all its tries (one budget unit each).
 pub(super) const MAX_FINISH_STEPS: u32 = 1536;
@@ -16,8 +17,9 @@ impl Motor {
     /// on `2 n` equal steps, `n` doubled until the two agree within 0.15 of the tolerance in the
     /// onion's angle and tilt (RK4's error falls 16-fold as its steps halve: the finer result
     /// is then within about a hundredth of the tolerance), at most `cap` steps in all. The
-    /// finer result, if found, and the RK4 steps taken either way. (The resolved substeps that end the segment otherwise are
-    /// each held to the tolerance on their own, and several of them add up beyond it.)
+    /// finer result, if found, and the RK4 steps taken either way. (The resolved substeps that end
+    /// the segment otherwise are each held to the tolerance on their own, and several of them add
+    /// up beyond it.)
     pub(super) fn finish_locked_orbits(
         &self,
         y: &Vector,
@@ -32,18 +34,12 @@ impl Motor {
         let tol = self.params.tolerance;
         // The rotor is locked: the onion's angle and tilt alone, in the frozen landscape.
         let land = self.landscape(y[0], d.direction, d.stress);
-        let rate = |z: [f64; 2]| self.onion_rate(point(&land, z[0]).1, z[1]);
+        let rate = |z: &[f64; 2]| self.onion_rate(point(&land, z[0]).1, z[1]);
         let run = |n: u32| {
             let h = left / f64::from(n);
             let mut z = [y[2], y[3]];
             for _ in 0..n {
-                let k1 = rate(z);
-                let k2 = rate(std::array::from_fn(|i| z[i] + 0.5 * h * k1[i]));
-                let k3 = rate(std::array::from_fn(|i| z[i] + 0.5 * h * k2[i]));
-                let k4 = rate(std::array::from_fn(|i| z[i] + h * k3[i]));
-                z = std::array::from_fn(|i| {
-                    z[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i])
-                });
+                z = rk4_step(&rate, &z, h);
             }
             [y[0], 0.0, z[0], z[1]]
         };

@@ -2,6 +2,7 @@
 //! of the macrospin, a free rotor under load and drag against its exact solution.
 
 use super::onion_periods_tests::{case, values};
+use super::tests::rk4_step;
 use super::*;
 
 /// A benchmark case: a weakly damped Gilbert onion (damping 1.26e-2) on a 12 ns schedule, the
@@ -50,16 +51,7 @@ pub(super) fn rk4_span(m: &Motor, d: &Drive, mut y: Vector, span: f64, n: usize)
     let h = span / n as f64;
     let f = |y: &Vector| m.rhs_jacobian(y, d, 1e-300).0;
     for _ in 0..n {
-        let k1 = f(&y);
-        let y2: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]);
-        let k2 = f(&y2);
-        let y3: Vector = std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]);
-        let k3 = f(&y3);
-        let y4: Vector = std::array::from_fn(|i| y[i] + h * k3[i]);
-        let k4 = f(&y4);
-        for i in 0..4 {
-            y[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
-        }
+        y = rk4_step(&f, &y, h);
     }
     y
 }

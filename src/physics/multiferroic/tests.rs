@@ -1204,12 +1204,5 @@ fn gilbert_onion_at_millisecond_steps_agrees_with_microsecond_steps_and_a_fine_i
     );
 }
 
-/// One classical RK4 step of `y' = rate(y)` from `y` over `h`: the fine reference the tests
-/// integrate against.
-pub(super) fn rk4_step(rate: &impl Fn(&Vector) -> Vector, y: &Vector, h: f64) -> Vector {
-    let k1 = rate(y);
-    let k2 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k1[i]));
-    let k3 = rate(&std::array::from_fn(|i| y[i] + 0.5 * h * k2[i]));
-    let k4 = rate(&std::array::from_fn(|i| y[i] + h * k3[i]));
-    std::array::from_fn(|i| y[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]))
-}
+/// One classical RK4 step: the fine reference the tests integrate against.
+pub(super) use crate::physics::numerics::rk4::rk4_step;
