@@ -342,9 +342,10 @@ impl Motor {
     /// under a free rotor, that heads for its minimum within the step,
     /// [`Self::heads_for_minimum`], unless it left its bounds; a locked rotor's as
     /// [`Self::locked_budget_drop`] says, which refuses the step where neither dropping nor
-    /// forced substeps can follow the onion through the schedule's switches.) Otherwise it follows once relaxed
-    /// ([`Self::relaxed_onion`]) and, under a free rotor, heads for its minimum within the rest
-    /// of the step: ringing that barely moves the rotor still places the onion.
+    /// forced substeps can follow the onion through the schedule's switches.) Otherwise it
+    /// follows once relaxed ([`Self::relaxed_onion`]) and, under a free rotor, heads for its
+    /// minimum within the rest of the step: ringing that barely moves the rotor still places the
+    /// onion.
     fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
@@ -357,11 +358,12 @@ impl Motor {
         let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
         let out_of_budget = (run.limited || broke) && self.onion_relaxes_fast();
         let dropped = out_of_budget
-            && if d.locked {
-                run.onion_escaped || self.locked_budget_drop(run, d, segment_end)
-            } else {
-                run.onion_escaped || self.heads_for_minimum(&run.y, d, run.t_end - run.start)
-            };
+            && (run.onion_escaped
+                || if d.locked {
+                    self.locked_budget_drop(run, d, segment_end)
+                } else {
+                    self.heads_for_minimum(&run.y, d, run.t_end - run.start)
+                });
         if run.unresolvable {
             return false;
         }
