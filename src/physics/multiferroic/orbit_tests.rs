@@ -324,7 +324,10 @@ fn turning_points_of_small_orbits_stop_where_the_bracket_does() {
                 }
             }
             let reach = (x - well.minimum).abs();
-            assert!((x - inside).abs() <= 1e-4 * reach, "{e:e}: {x} against {inside}");
+            assert!(
+                (x - inside).abs() <= 1e-4 * reach,
+                "{e:e}: {x} against {inside}"
+            );
             capped += usize::from(n > 64);
         }
     }
