@@ -24,11 +24,11 @@
 //! Dormand-Prince 5(4) pair within its stability reach, an exponential RK4 where only the rotor's
 //! drag keeps that pair out of reach (with the onion's block exact too where the two barely
 //! couple, `etd_blocks.rs`), else an exponential Rosenbrock pair (`gilbert.rs`); weakly damped
-//! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`; a locked
-//! rotor's last orbit is resolved at once, `orbit_finish.rs`). On fast schedules whose ring barely
-//! couples the onion to the rotor, repeated periods and cycles are taken at once
-//! (`onion_periods.rs`, `onion_cycles.rs`) and an onion near its path advances by exact affine
-//! maps per switch (`onion_linear.rs`). The estimate sizes the next substep.
+//! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`,
+//! `orbit_averager.rs`; a locked rotor's last orbit is resolved at once, `orbit_finish.rs`). On
+//! fast schedules whose ring barely couples the onion to the rotor, repeated periods and cycles
+//! are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an onion near its path advances
+//! by exact affine maps per switch (`onion_linear.rs`). The estimate sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), and a locked rotor's ringing onion that
@@ -84,6 +84,7 @@ mod onion_periods_tests;
 mod onion_tests;
 mod orbit;
 mod orbit_advance;
+mod orbit_averager;
 mod orbit_finish;
 #[cfg(test)]
 mod orbit_tests;

@@ -167,15 +167,19 @@ fn gauss_nodes() -> &'static [(f64, f64); GAUSS] {
 
 /// The point between `inside` (below the level) and `outside` (above it) where the landscape
 /// stands `e` above `floor`: Newton's method kept inside the bracket (bisection when it would
-/// leave it), from `guess` when it lies inside. `None` if `outside` is not above the level.
-fn turning_point(
+/// leave it), from `guess` when it lies inside, and the landscape's evaluations it took. `None`
+/// if `outside` is not above the level. Near the minimum of a small orbit the energy's rounding
+/// (its terms are far larger than their difference) over the small gradient there can move
+/// Newton's step beyond its stopping size at every point: the bracket then shrinks to two
+/// neighbouring floats, and the point where it can shrink no more is the root.
+pub(super) fn turning_point(
     land: &Landscape,
     floor: f64,
     e: f64,
     mut inside: f64,
     mut outside: f64,
     guess: f64,
-) -> Option<f64> {
+) -> Option<(f64, u32)> {
     if point(land, outside).0 - floor - e <= 0.0 {
         return None;
     }
@@ -185,26 +189,31 @@ fn turning_point(
     } else {
         0.5 * (inside + outside)
     };
-    for _ in 0..100 {
+    for n in 1..=100 {
         let (u, grad, _) = point(land, x);
         let f = u - floor - e;
         let newton = x - f / grad;
-        // (The energy's rounding moves the root by about 1e-15 rad.)
+        // (The energy's rounding moves the root by about 1e-15 rad, more where `grad` is small.)
         if (newton - x).abs() <= 1e-13 * (1.0 + x.abs()) || f == 0.0 {
-            return Some(newton);
+            return Some((newton, n));
         }
         if f < 0.0 {
             inside = x;
         } else {
             outside = x;
         }
-        x = if between(newton, inside, outside) {
+        let next = if between(newton, inside, outside) {
             newton
         } else {
             0.5 * (inside + outside)
         };
+        // The bracket cannot shrink further: every later pass repeats this one.
+        if next == x {
+            return Some((x, n));
+        }
+        x = next;
     }
-    Some(x)
+    Some((x, 100))
 }
 
 /// Partial integrals along the half orbit rising from the turning point below (see
@@ -245,8 +254,8 @@ impl Motor {
         if !(e > 0.0 && e < well.barrier) {
             return None;
         }
-        let a = turning_point(land, well.floor, e, well.minimum, well.below, guess.0)?;
-        let b = turning_point(land, well.floor, e, well.minimum, well.above, guess.1)?;
+        let a = turning_point(land, well.floor, e, well.minimum, well.below, guess.0)?.0;
+        let b = turning_point(land, well.floor, e, well.minimum, well.above, guess.1)?.0;
         let (c, h) = (0.5 * (a + b), 0.5 * (b - a));
         let (g, t) = (self.llg_rate, self.tilt_stiffness);
         let du = PI / NODES as f64;

@@ -4,6 +4,7 @@
 
 use super::onion::Landscape;
 use super::orbit::{point, Orbit, Well};
+use super::orbit_averager::{Averager, Slow};
 use super::orbit_finish::MAX_FINISH_STEPS;
 use super::step::StepRun;
 use super::{Drive, Motor, Vector};
@@ -37,76 +38,6 @@ const MARCH_STEPS: u32 = 256;
 /// Under a locked rotor the rest of the segment after the advance, up to this many orbits, is
 /// resolved at once ([`Motor::finish_locked_orbits`]).
 const FINISH_ORBITS: f64 = 1.5;
-
-/// The averaged ringing's state: rotor angle and speed (rad, rad/s), the orbit's energy above
-/// the minimum (J) and its phase (cycles).
-type Slow = [f64; 4];
-
-/// The averaged equations' right-hand side at one rotor angle after another, each well and orbit
-/// found from the last (the landscape moves little between calls).
-struct Averager<'a> {
-    m: &'a Motor,
-    d: &'a Drive,
-    well: Well,
-    orbit: Orbit,
-    /// Evaluations of the right-hand side.
-    evaluations: u32,
-    /// The rotor is overdamped (see [`OVERDAMPED`]).
-    overdamped: bool,
-}
-
-impl Averager<'_> {
-    /// The well at rotor angle `phi`: the last one's rims moved with its minimum (they bracket
-    /// the turning points; [`turning_point`] checks that they still do).
-    fn well_at(&self, land: &Landscape) -> Option<Well> {
-        let minimum = land.settle(self.well.minimum);
-        let shift = minimum - self.well.minimum;
-        let k = land.curvature(minimum);
-        let rims = (self.well.below + shift, self.well.above + shift);
-        Some(Well::between(land, minimum, rims, k)).filter(|w| k > 0.0 && w.barrier > 0.0)
-    }
-
-    /// The well and orbit at the slow state `s`, the turning points' iterations started from the
-    /// last orbit's moved with its minimum.
-    fn orbit_at(&self, s: &Slow) -> Option<(Well, Orbit)> {
-        let land = self.m.landscape(s[0], self.d.direction, self.d.stress);
-        let well = self.well_at(&land)?;
-        let shift = well.minimum - self.well.minimum;
-        let guess = (self.orbit.below + shift, self.orbit.above + shift);
-        let o = self.m.orbit(&land, &well, s[2], guess)?;
-        Some((well, o))
-    }
-
-    /// The averaged equations: the rotor driven by the orbit's mean torque, the energy lowered by
-    /// the damping and by the landscape turning under the orbit (the orbit's mean of
-    /// `dU/dphi omega` less the minimum's), the phase at the damped orbit's frequency.
-    fn rate(&mut self, s: &Slow) -> Option<Slow> {
-        self.evaluations += 1;
-        let m = self.m;
-        let (well, o) = self.orbit_at(s)?;
-        let (alpha, t) = (m.params.gilbert_damping, m.tilt_stiffness);
-        let k = well.curvature;
-        let shift = 1.0 - alpha * alpha * (t - k) * (t - k) / (4.0 * k * t);
-        if shift.is_nan() || shift <= 0.0 {
-            return None;
-        }
-        self.well = well;
-        self.orbit = o;
-        let rotor = if self.d.locked {
-            [0.0, 0.0]
-        } else if self.overdamped {
-            [(o.torque + self.d.load) / m.drag, 0.0]
-        } else {
-            [s[1], (o.torque + self.d.load - m.drag * s[1]) / m.inertia]
-        };
-        Some([
-            rotor[0],
-            rotor[1],
-            o.damping_rate(alpha) - rotor[0] * (o.torque - o.torque_at_minimum),
-            shift.sqrt() / o.period,
-        ])
-    }
-}
 
 /// What [`Motor::advance_orbits`] did.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -189,7 +120,10 @@ impl Motor {
         } else {
             omega - impulse / self.inertia
         };
-        let mut s: Slow = [y[0], speed, o.energy - damped, phase];
+        let energy = o.energy - damped;
+        let log_energy = d.locked;
+        let energy = if log_energy { energy.ln() } else { energy };
+        let mut s: Slow = [y[0], speed, energy, phase];
         let mut avg = Averager {
             m: self,
             d,
@@ -197,6 +131,7 @@ impl Motor {
             orbit: o,
             evaluations: 0,
             overdamped,
+            log_energy,
         };
         let mut k1 = avg.rate(&s)?;
         let tol = self.params.tolerance;
@@ -211,13 +146,16 @@ impl Motor {
             (0.1 * tol, 0.1 * tol)
         };
         // A first step of a tenth of the energy's decay time.
-        let mut h = (0.1 * s[2] / k1[2].abs()).min(segment_end - start);
+        let first = if log_energy {
+            0.1 / k1[2].abs()
+        } else {
+            0.1 * s[2] / k1[2].abs()
+        };
+        let mut h = first.min(segment_end - start);
         let mut time = start;
         let mut steps = 0u32;
         // A locked onion's averaged steps are held below half the last one whose stages left the
-        // well (an explicit step of the energy's exponential decay overshoots it past the
-        // minimum): the landscape is frozen, so the decay's rate, and with it that size, change
-        // little along the advance.
+        // well: the landscape is frozen, so that size changes little along the advance.
         let mut ceiling = f64::INFINITY;
         // The accepted steps' starts: the last whole orbit is found from one of them.
         let mut history: Vec<(f64, Slow, Slow)> = Vec::new();
@@ -231,10 +169,12 @@ impl Motor {
             };
             let Some((next, k7, err)) = dormand_prince(&mut avg, &s, &k1, h_try, |next, width| {
                 let width = width * fade;
+                // (The energy's relative error moves the onion by half that times the width.)
+                let energy = if log_energy { 1.0 } else { next[2].abs() };
                 [
                     0.1 * tol,
                     0.1 * speed_scale,
-                    width_error * 2.0 * next[2].abs() / width,
+                    width_error * 2.0 * energy / width,
                     if dropped {
                         phase_error
                     } else {
@@ -344,8 +284,8 @@ impl Motor {
         remaining: f64,
     ) -> bool {
         let orbit = 1.0 / rate[3];
-        let loss = (-rate[2] / s[2]).max(0.0) * orbit;
-        let energy = s[2] * (2.0 * loss).exp();
+        let loss = (-avg.relative_rate(s, rate)).max(0.0) * orbit;
+        let energy = avg.energy(s) * (2.0 * loss).exp();
         if !(energy.is_finite() && energy >= 0.0) {
             return false;
         }
@@ -370,7 +310,7 @@ impl Motor {
     /// width grows faster than `sqrt(E)`), and that rate tends to the linearization's
     /// ([`Self::onion_decay_rate`]) as the ringing decays: half the slower of the two is taken.
     fn locked_fade(&self, avg: &Averager, s: &Slow, rate: &Slow, left: f64) -> f64 {
-        let own = 0.5 * (-rate[2] / s[2]);
+        let own = 0.5 * (-avg.relative_rate(s, rate));
         let linear = self.onion_decay_rate(avg.well.curvature);
         let r = 0.5 * own.min(linear);
         if r.is_nan() || r <= 0.0 || left <= 0.0 {
