@@ -1,12 +1,47 @@
-//! A free rotor that the ring's torque cannot move, whose Gilbert onion the budget can no longer
-//! resolve: its ringing is dropped into the minimum of the well it is trapped in (see
-//! [`Motor::decoupled_budget_drop`]).
+//! A free rotor that the ring's torque cannot move: the Gilbert onion's ringing is dropped where
+//! its orbit-averaged decay ends it within the segment ([`Motor::decoupled_ringing_decays`]), or
+//! where the budget can no longer resolve it, into the minimum of the well it is trapped in
+//! ([`Motor::decoupled_budget_drop`]).
 
 use super::decoupled::torque_bound;
 use super::orbit::point;
+use super::ringing::{Rims, MAX_FOLLOWED_LAG};
 use super::{Drive, Motor, Vector};
 
 impl Motor {
+    /// Whether the Gilbert onion at `y`, under a free rotor that the ring's torque cannot move
+    /// (the first condition of [`Self::decoupled_ringing`], checked there), ends the `remaining`
+    /// time of its segment (s) within the tolerance of the minimum `settled` it rings about, at its
+    /// orbit-averaged energy loss in the landscape frozen at the rotor's present angle
+    /// ([`Self::locked_ringing_decays`]: from at most 0.999 of its well's lowest rim, losing at
+    /// most a tenth of its energy per orbit, within 3/4 of the time left). The ring-bar term
+    /// moves the well with the rotor, its minimum at `omega k_bar / k`: held within
+    /// [`MAX_FOLLOWED_LAG`] over the segment, as the decoupled ringing's lag (the well moves
+    /// adiabatically, as [`Self::trapped_ringing`] takes it). The instantaneous bounds of
+    /// [`Self::decoupled_ringing`] see ringing near the rims decay 100 times slower than its
+    /// linearization at the minimum, or at the sublevel bound's rate, which vanishes at a rim: an
+    /// onion released at 0.99 of its rim was resolved until the budget ran out.
+    /// `rims.decay_retry_level` spaces the retries as for a locked rotor.
+    pub(super) fn decoupled_ringing_decays(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        settled: f64,
+        rims: &mut Rims,
+        remaining: f64,
+    ) -> bool {
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let drift =
+            (self.ring_bar.stiffness(settled - y[0]) / land.curvature(settled) * y[1]).abs();
+        // (A NaN fails.)
+        let follows = drift * remaining <= MAX_FOLLOWED_LAG;
+        if !follows {
+            return false;
+        }
+        let frozen = Drive { locked: true, ..*d };
+        self.locked_ringing_decays(y, &frozen, settled, remaining, &mut rims.decay_retry_level)
+    }
+
     /// Whether the Gilbert onion at `y`, which the budget can no longer resolve (a forced substep
     /// went beyond the tolerance), may be dropped into the minimum of its well for the `remaining` time of
     /// the step (s) under a free rotor, though it does not head for that minimum within the step
@@ -45,7 +80,8 @@ impl Motor {
         }
         let tau_max = torque_bound(&self.ring_bar);
         // (A NaN fails.)
-        if !(2.0 * tau_max * remaining <= 0.01 * self.params.tolerance * self.drag) {
+        let negligible = 2.0 * tau_max * remaining <= 0.01 * self.params.tolerance * self.drag;
+        if !negligible {
             return false;
         }
         let land = self.landscape(y[0], d.direction, d.stress);

@@ -108,3 +108,59 @@ fn decoupled_drop_needs_a_constant_drive_a_weak_ring_and_a_trapped_onion() {
     let tilt = (2.0 * well.barrier / m.tilt_stiffness).sqrt() * 1.01;
     assert!(!m.decoupled_budget_drop(&[y[0], y[1], y[2], tilt], &d, h, f64::INFINITY));
 }
+
+/// A benchmark case: a load-driven rotor (inertial time 3e-13 s) at 1.2e7 rad/s whose ring's
+/// torque (below 3e-23 N m) cannot move it, no schedule, its onion (damping 2.4e-3, relaxation
+/// 10 ns) released at 0.99 of its well's lowest rim.
+const NEAR_RIM: &str = "strain_direction=4.9573496376592675e3 stress=-2.9063956307800426e10 \
+    load_torque=1.3911610755181714e-8 ring_outer_diameter=4.9724188941146524e-1 \
+    ring_inner_diameter=1.1278201485996085e-2 bar_length=3.021870150038794e-6 \
+    bar_width=2.9384524405437306e-7 thickness=5.952528605027693e-9 \
+    saturation_magnetization=3.625129236553573e5 magnetostriction=7.92609670438753e-3 \
+    wall_volume=1.8111051577475945e-12 density=8.860038477290867e4 \
+    fluid_viscosity=1.4281887716978093e2 gilbert_damping=2.412727593685618e-3 \
+    tolerance=2.1841371437116797e-7 step_angle=4.719108860732808e0 \
+    step_period=2.3134189274696487e-2 stress_amplitude=-1.213480749478304e4 \
+    schedule_initial_direction=-6.654105375290676e2 onion_model=1 max_substeps=6242 \
+    schedule=0 rotor_locked=0 initial_onion_offset=1.247482838385613e-2 \
+    strain=-9.477238940835138e-2 youngs_modulus=5.526073415009557e6 strain_drive=1";
+
+/// [`NEAR_RIM`]'s first step against the exact load-and-drag rotor and a converged RK4 of the
+/// macrospin driven by it ([`driven_rk4`]): the ringing's orbit-averaged decay ends it within the
+/// step, so it is dropped at once, the step not flagged, within the tolerance of the reference
+/// (the rotor within a hundredth of it). Resolved until its budget ran out (the instantaneous
+/// decay bounds fail near the rim), it took 626 substeps and was flagged.
+#[test]
+fn decoupled_ringing_near_its_rim_is_dropped_at_its_averaged_decay() {
+    let (m, start, inputs) = case(&values(NEAR_RIM)).unwrap();
+    let h = 1e-6;
+    let d = m.drive_at(&inputs, 0.0);
+    let y0 = [start.rotor_angle, 0.0, start.onion_angle, start.onion_tilt];
+    let (coarse, truth) = (driven_rk4(&m, &d, y0, h, 1), driven_rk4(&m, &d, y0, h, 2));
+    let tol = m.params.tolerance;
+    assert!(
+        (coarse[2] - truth[2]).abs() <= 0.01 * tol && (coarse[3] - truth[3]).abs() <= 0.01 * tol,
+        "{coarse:?} {truth:?}"
+    );
+    let land = m.landscape(y0[0], d.direction, d.stress);
+    let well = m.onion_well(&land, y0[2]).unwrap();
+    let excess = point(&land, y0[2]).0 - well.floor;
+    assert!(excess > 0.98 * well.barrier, "{}", excess / well.barrier);
+    let mut st = start;
+    let report = m.step(&mut st, &inputs, h).unwrap();
+    let errors = [
+        (st.rotor_angle - truth[0]).abs() / tol,
+        (st.onion_angle - truth[2]).abs() / tol,
+        (st.onion_tilt - truth[3]).abs() / tol,
+    ];
+    println!(
+        "{} substeps, flagged {}; errors / tolerance {errors:?}",
+        report.substeps, report.accuracy_limited
+    );
+    assert!(!report.accuracy_limited);
+    assert!(report.substeps <= 60, "{}", report.substeps);
+    assert!(
+        errors[0] <= 0.01 && errors[1] <= 1.0 && errors[2] <= 1.0,
+        "{errors:?}"
+    );
+}
