@@ -22,7 +22,9 @@ impl Motor {
     /// to the relaxed onion's slack ([`Self::relaxed_slack`] plus the tolerance), so that the onion
     /// ends the segment where the resolved one does; and its lag behind the minimum, which moves at
     /// `omega k_bar / k` with the rotor, within [`MAX_FOLLOWED_LAG`] over the ringing's decay time,
-    /// as for the relaxed onion ([`Self::relaxed_onion`]). A locked rotor is not served here: its
+    /// as for the relaxed onion ([`Self::relaxed_onion`]). Where those instantaneous decay bounds
+    /// fail (ringing near its rims), it may decay within the segment by its orbit-averaged loss
+    /// instead ([`Self::decoupled_ringing_decays`]). A locked rotor is not served here: its
     /// onion's ringing is dropped only once it has decayed.
     pub(super) fn decoupled_ringing(
         &self,
@@ -59,8 +61,8 @@ impl Motor {
             .max(self.onion_decay_rate(1.5 * k));
         let reachable = (linear / RIM_SLOWDOWN).max(g * alpha * k.min(t)) >= needed;
         let least_rate = if reachable { 0.0 } else { f64::INFINITY };
-        let Some(trap) = self.trapped_ringing(y, d, settled, Some((rims, least_rate))) else {
-            return false;
+        let Some(trap) = self.trapped_ringing(y, d, settled, Some((&mut *rims, least_rate))) else {
+            return self.decoupled_ringing_decays(y, d, settled, rims, remaining);
         };
         // The onion must meet the segment's end (a switch, or the step's end where the inputs
         // may change) where the resolved one does: its phase there decides which well it rings
@@ -79,7 +81,7 @@ impl Motor {
         }
         let decays = left <= slack;
         if !decays {
-            return false;
+            return self.decoupled_ringing_decays(y, d, settled, rims, remaining);
         }
         let k_bar = self.ring_bar.stiffness(settled - y[0]);
         let drift = (k_bar / trap.curvature * y[1]).abs();

@@ -203,7 +203,7 @@ fn decoupled_ringing_is_dropped_once_trapped() {
 /// macrospin driven by it, from `y0` over `span` in steps `refine` times finer than a
 /// fiftieth of the onion's fastest rate (the rotor's own time `I / c`, down to 0.3 ps here,
 /// is left to the exact solution).
-fn driven_rk4(m: &Motor, d: &Drive, y0: Vector, span: f64, refine: usize) -> Vector {
+pub(super) fn driven_rk4(m: &Motor, d: &Drive, y0: Vector, span: f64, refine: usize) -> Vector {
     let (c, tau) = (m.drag, m.inertia / m.drag);
     let rotor = |t: f64| {
         let decay = (-t / tau).exp_m1();

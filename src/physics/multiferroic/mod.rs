@@ -31,9 +31,10 @@
 //! by exact affine maps per switch (`onion_linear.rs`). The estimate sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
-//! not follow are not taken (`forced_crossing.rs`), and a locked rotor's ringing onion that
-//! neither a drop nor forced substeps can follow through the schedule's switches refuses the step
-//! (`locked_switches.rs`).
+//! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
+//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
+//! rotor's ringing onion that neither a drop nor forced substeps can follow through the
+//! schedule's switches refuses the step (`locked_switches.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
@@ -47,6 +48,9 @@ pub mod angles;
 pub mod branch;
 mod cycle;
 mod decoupled;
+mod decoupled_drop;
+#[cfg(test)]
+mod decoupled_drop_tests;
 #[cfg(test)]
 mod decoupled_tests;
 mod drift;

@@ -340,7 +340,9 @@ impl Motor {
     /// order, far less than the step it would lose. The step stays flagged. (Only for an onion
     /// that relaxes at all within a tenth of the rotor's time, as in [`Self::relaxed_onion`], and,
     /// under a free rotor, that heads for its minimum within the step,
-    /// [`Self::heads_for_minimum`], unless it left its bounds; a locked rotor's as
+    /// [`Self::heads_for_minimum`], or, once forced beyond the tolerance, is trapped in its well
+    /// with the ring unable to move the rotor and no switch left in the step,
+    /// [`Self::decoupled_budget_drop`], unless it left its bounds; a locked rotor's as
     /// [`Self::locked_budget_drop`] says, which refuses the step where neither dropping nor
     /// forced substeps can follow the onion through the schedule's switches.) Otherwise it
     /// follows once relaxed ([`Self::relaxed_onion`]) and, under a free rotor, heads for its
@@ -362,7 +364,12 @@ impl Motor {
                 || if d.locked {
                     self.locked_budget_drop(run, d, segment_end)
                 } else {
+                    let to_switch = run
+                        .schedule
+                        .map_or(f64::INFINITY, |s| s.next_switch_after(run.t) - run.t);
                     self.heads_for_minimum(&run.y, d, run.t_end - run.start)
+                        || run.limited
+                            && self.decoupled_budget_drop(&run.y, d, run.t_end - run.t, to_switch)
                 });
         if run.unresolvable {
             return false;
