@@ -423,7 +423,13 @@ impl Motor {
         run.angles = Some(angles);
         // A substep across a snap of the onion is charged its bisection's substeps too.
         let mut bisections = 0;
-        let result = self.controlled_step(&run.y, dt_try, d, &angles, forced, &mut bisections);
+        let result = self
+            .controlled_step(&run.y, dt_try, d, &angles, forced, &mut bisections)
+            .map(|(u, err, taken, a)| {
+                let ledger = &mut run.rim_ledger;
+                let err = self.energy_checked_error(ledger, (&run.y, &u), taken, d, err);
+                (u, err, taken, a)
+            });
         run.extra_cost = run.extra_cost.saturating_add(bisections);
         match result {
             Some((y_new, err, _, _))

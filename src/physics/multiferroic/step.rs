@@ -68,6 +68,8 @@ pub(super) struct StepRun {
     /// A locked rotor's ringing onion outlasts what the budget left can resolve (see
     /// [`Motor::locked_budget_drop`]): the step is refused.
     pub(super) unresolvable: bool,
+    /// The energy bound of a locked rotor's Gilbert onion (see [`Motor::energy_checked_error`]).
+    pub(super) rim_ledger: super::rim_energy::RimLedger,
 }
 
 impl StepRun {
@@ -112,6 +114,7 @@ impl StepRun {
             onion_escaped: false,
             schedule: None,
             unresolvable: false,
+            rim_ledger: super::rim_energy::RimLedger::NONE,
         }
     }
 
