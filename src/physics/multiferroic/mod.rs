@@ -100,6 +100,8 @@ mod params;
 mod periods;
 pub mod phi;
 #[cfg(test)]
+mod placement_tests;
+#[cfg(test)]
 mod resolved_tests;
 mod rhs;
 mod rim_energy;

@@ -160,15 +160,12 @@ impl Motor {
     /// minimum, `2 |E|` ([`Self::onion_decay_rate`]), shrinks a perturbation to [`SNAP_DECAY`]
     /// of itself over that time.
     ///
-    /// An onion is placed on its branch where it is within the tolerance of it
-    /// ([`Self::relaxed_onion`]), its ringing dropped. Two such placements compare alike by
-    /// construction (the offset at the branch's minimum), whether the onion relaxed there or
-    /// the strain merely swung past it: an onion that barely moves while the strain turns fast
-    /// about it sits within the tolerance of some minimum every few switches, and each placement
-    /// then moves it by up to the tolerance, the same way each time. Repeating such periods
-    /// turns that shift into a drift of the tolerance per cycle (hundreds of tolerances a step),
-    /// where the true onion stays put. Once the onion's own decay has forgotten a placement
-    /// within the cycle, the repeated state is the onion's, not the placement's.
+    /// A placement on the branch drops what is left of the onion's ringing
+    /// ([`Self::relaxed_onion`]), and two placements compare alike by construction (the offset at
+    /// the branch's minimum). Repeating the periods between them turns whatever shift a
+    /// placement leaves into a drift every cycle, where the true onion keeps forgetting it. Once
+    /// the onion's own decay has forgotten a placement within the cycle, the repeated state is
+    /// the onion's, not the placement's.
     pub(super) fn snaps_forgotten(&self, s: &SteppingSchedule, periods: f64) -> bool {
         let curvature = 2.0 * (self.magnetoelastic_per_stress * s.stress_amplitude).abs();
         let decay = self.onion_decay_rate(curvature) * periods * s.step_period;

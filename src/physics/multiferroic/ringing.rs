@@ -29,17 +29,22 @@ impl Motor {
     /// onion that relaxes slower than a tenth of the rotor, is integrated in full. A fold met on
     /// the branch is taken by the quasi-static memory rule (downhill to the nearest minimum).
     /// The averaged ringing is tried when `rim_barrier` is given, the lowest rim found in this
-    /// segment (see [`Self::trapped_ringing`]); `remaining` is the time left in the segment (s),
-    /// `to_switch` the time to the schedule's next switch (s; infinite without one): under a free
-    /// rotor, ringing beyond the tolerance and the lag is dropped only where it dies out before
-    /// that switch ([`Self::ringing_ends_in`]).
+    /// segment (see [`Self::trapped_ringing`]); `remaining` is the time left in the segment (s).
+    ///
+    /// Under a free rotor the onion must also have relaxed in fact, whichever way it is placed:
+    /// `switches` holds the time to the schedule's next switch and its period (s; both infinite
+    /// without one), and the gap that placing the onion drops, decayed to that switch and summed
+    /// over the switches the onion remembers, must be within a tenth of the tolerance beyond the
+    /// lag ([`Self::ringing_ends_in`]). Being near a minimum is not enough: an onion that relaxes
+    /// slowly against the switches passes within the tolerance of some minimum every few of
+    /// them, and each placement would move it there, the same way each time.
     pub(super) fn relaxed_onion(
         &self,
         y: &Vector,
         d: &Drive,
         rim_barrier: Option<&mut Rims>,
         remaining: f64,
-        to_switch: f64,
+        switches: (f64, f64),
     ) -> Option<f64> {
         // Without the averaged ringing only the first test can pass, and its slack is at most
         // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle (a
@@ -56,21 +61,21 @@ impl Motor {
             if self.locked_ringing_ends(y, d, settled, remaining) {
                 return Some(0.0);
             }
-        } else if self.onion_relaxes_fast() {
-            let lag_time = self.onion_relaxation_time();
-            let rate = y[1].abs();
-            // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
-            let ringing = 0.1 * self.params.tolerance * self.rotor_relaxation_time() / lag_time;
+        } else {
             let tol = self.params.tolerance;
-            let lag = (4.0 * lag_time * rate).min(MAX_FOLLOWED_LAG);
-            let slack = tol + lag.max(ringing).min(MAX_FOLLOWED_LAG);
-            let (tilt, offset) = (y[3].abs(), (settled - y[2]).abs());
-            if tilt <= slack
-                && offset <= slack
-                && (tilt.max(offset) <= tol + lag
-                    || self.ringing_ends_in(y, d, settled, to_switch, tol + lag))
-            {
-                return Some(0.0);
+            let lag_time = self.onion_relaxation_time();
+            let lag = (4.0 * lag_time * y[1].abs()).min(MAX_FOLLOWED_LAG);
+            // Whatever is dropped here, the onion carries over the next switch.
+            if !self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag) {
+                return None;
+            }
+            if self.onion_relaxes_fast() {
+                // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
+                let ringing = 0.1 * tol * self.rotor_relaxation_time() / lag_time;
+                let slack = tol + lag.max(ringing).min(MAX_FOLLOWED_LAG);
+                if y[3].abs() <= slack && (settled - y[2]).abs() <= slack {
+                    return Some(0.0);
+                }
             }
         }
         let rims = rim_barrier?;
@@ -83,26 +88,33 @@ impl Motor {
             .then_some(0.0)
     }
 
-    /// Whether the Gilbert onion's ringing at `y` about the minimum `settled` of eq. 3.4 decays to
-    /// within `slack` of it in the `remaining` time before the drive switches (s)
-    /// ([`Self::decayed_gap`]).
+    /// Whether the gap between the Gilbert onion at `y` and the minimum `settled` of eq. 3.4, which
+    /// placing it there drops, stays within `slack` over the schedule's switches: decayed over
+    /// the time to the next switch ([`Self::decayed_gap`], at the slowest rate `lambda` of the
+    /// onion's linearization there), times the switches the onion remembers, `1 + 1 / (lambda T)`
+    /// (`T` the period; `(to_switch, period)` both infinite without a schedule, nothing carried).
     ///
-    /// Ringing that the rotor cannot feel is dropped only so: the onion's own angle carries it
-    /// over the switch, where the minimum moves away. On a 1 ns schedule at `lambda T = 0.04`
-    /// (the onion remembers 25 switches) an onion snapped 1e-3 rad onto a minimum that the next
-    /// switch moves away would end its 1 us step 1.5e-3 rad off a plain RK4 (5e4 tolerances).
+    /// What is left of the gap at a switch, the onion carries into the next period, where the
+    /// minimum moves away and the resolved onion would not have dropped it. Placements at later
+    /// switches shift the onion the same way, while each shift decays by `exp(-lambda T)` a
+    /// period: their sum is at most the shift times the memory. On a 1 ns schedule at
+    /// `lambda T = 0.04` (the onion remembers 25 switches) an onion snapped 1e-3 rad onto a
+    /// minimum that the next switch moves away would end its 1 us step 1.5e-3 rad off a plain
+    /// RK4 (5e4 tolerances); one within the tolerance (0.56 rad) of a minimum every few switches
+    /// of a 2.2 ns schedule at `lambda T = 0.26`, 93 tolerances.
     fn ringing_ends_in(
         &self,
         y: &Vector,
         d: &Drive,
         settled: f64,
-        remaining: f64,
+        (to_switch, period): (f64, f64),
         slack: f64,
     ) -> bool {
         let k = self
             .landscape(y[0], d.direction, d.stress)
             .curvature(settled);
-        k > 0.0 && self.decayed_gap(y, settled, k, remaining) <= slack
+        let memory = 1.0 + 1.0 / (self.onion_decay_rate(k) * period);
+        k > 0.0 && self.decayed_gap(y, settled, k, to_switch) * memory <= slack
     }
 
     /// Whether a locked rotor's Gilbert onion at `y` ends the `remaining` time of its segment (s)

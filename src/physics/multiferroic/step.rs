@@ -398,10 +398,10 @@ impl Motor {
             let decays = |y: &Vector| d.locked || self.heads_for_minimum(y, d, run.t_end - run.t);
             // Dropped ringing carries over a switch; before it, it only shifts the reported
             // onion from the centre of its ringing, which it decays to.
-            let to_switch = run
-                .schedule
-                .map_or(f64::INFINITY, |s| s.next_switch_after(run.t) - run.t);
-            match self.relaxed_onion(&run.y, d, rims, segment_end - run.t, to_switch) {
+            let switches = run.schedule.map_or((f64::INFINITY, f64::INFINITY), |s| {
+                (s.next_switch_after(run.t) - run.t, s.step_period)
+            });
+            match self.relaxed_onion(&run.y, d, rims, segment_end - run.t, switches) {
                 // The averaged ringing's impulse on the rotor.
                 Some(kick) if decays(&run.y) => run.y[1] += kick,
                 _ => return false,
