@@ -10,7 +10,7 @@ impl Motor {
     /// the minimum of eq. 3.4 it would settle into are within `tolerance` plus the larger of its
     /// lag behind a turning rotor and the ringing that no longer matters, and below
     /// [`MAX_FOLLOWED_LAG`] (no kick), or its ringing is trapped about that minimum and averages
-    /// out ([`Self::averaged_ringing`]). A locked rotor's onion is held to the tolerance alone
+    /// out ([`Self::averaged_ringing`]). A locked rotor's onion is held to the tolerance instead
     /// ([`Self::locked_ringing_ends`]): its angle is the output that the ringing moves.
     ///
     /// Ringing of amplitude `A` left undecayed turns the rotor by at most `A tau_o / tau_rotor`
@@ -31,13 +31,15 @@ impl Motor {
     /// The averaged ringing is tried when `rim_barrier` is given, the lowest rim found in this
     /// segment (see [`Self::trapped_ringing`]); `remaining` is the time left in the segment (s).
     ///
-    /// Under a free rotor the onion must also have relaxed in fact, whichever way it is placed:
-    /// `switches` holds the time to the schedule's next switch and its period (s; both infinite
-    /// without one), and the gap that placing the onion drops, decayed to that switch and summed
-    /// over the switches the onion remembers, must be within a tenth of the tolerance beyond the
-    /// lag ([`Self::ringing_ends_in`]). Being near a minimum is not enough: an onion that relaxes
-    /// slowly against the switches passes within the tolerance of some minimum every few of
-    /// them, and each placement would move it there, the same way each time.
+    /// The onion must also have relaxed in fact, whichever way it is placed and whether the rotor
+    /// is free or locked: `switches` holds the time to the schedule's next switch and its period
+    /// (s; both infinite without one), and the gap that placing the onion drops, decayed to that
+    /// switch and summed over the switches the onion remembers, must be within a tenth of the
+    /// tolerance beyond the lag ([`Self::ringing_ends_in`]; a locked rotor has none). Being near
+    /// a minimum is not enough, nor is ending the segment within the tolerance of it: an onion
+    /// that relaxes slowly against the switches passes within the tolerance of some minimum
+    /// every few of them, and each placement would move it there, the same way each time (and
+    /// repeated periods or cycles repeat that shift).
     pub(super) fn relaxed_onion(
         &self,
         y: &Vector,
@@ -55,6 +57,14 @@ impl Motor {
             return None;
         }
         let settled = self.settle(y, d);
+        let tol = self.params.tolerance;
+        let lag_time = self.onion_relaxation_time();
+        let lag = (4.0 * lag_time * y[1].abs()).min(MAX_FOLLOWED_LAG);
+        // Whatever is dropped here, the onion carries over the next switch (a locked rotor's
+        // speed, and so its lag, is 0).
+        if !self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag) {
+            return None;
+        }
         if d.locked {
             // The onion's angle is the output and nothing else is moved by its ringing: it is
             // dropped only where it ends the segment within the tolerance of the minimum.
@@ -62,13 +72,6 @@ impl Motor {
                 return Some(0.0);
             }
         } else {
-            let tol = self.params.tolerance;
-            let lag_time = self.onion_relaxation_time();
-            let lag = (4.0 * lag_time * y[1].abs()).min(MAX_FOLLOWED_LAG);
-            // Whatever is dropped here, the onion carries over the next switch.
-            if !self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag) {
-                return None;
-            }
             if self.onion_relaxes_fast() {
                 // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
                 let ringing = 0.1 * tol * self.rotor_relaxation_time() / lag_time;
