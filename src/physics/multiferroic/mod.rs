@@ -85,6 +85,9 @@ mod onion_tests;
 mod orbit;
 mod orbit_advance;
 mod orbit_finish;
+mod orbit_phase;
+#[cfg(test)]
+mod orbit_phase_tests;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]
