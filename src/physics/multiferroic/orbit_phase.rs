@@ -25,7 +25,8 @@
 //! orbits gain at most `2 alpha^2 sum_j c_j mu0^j (1 - e^(-j N l)) / (1 - e^(-j l))` cycles.
 //! The periods themselves, integrals of `1 / sqrt(E - U + U(psi*))`, err by the energy's rounding
 //! at the landscape's scale over `E` (added, `N` times): ringing whose energy is within a
-//! few thousand roundoffs of that scale (the quadrature swamped by the rounding) is refused.
+//! few thousand roundoffs of that scale (the quadrature swamped by the rounding) gains nothing.
+//! The advance takes the smaller of this bound and the linearization's shift's.
 
 use super::onion::Landscape;
 use super::orbit::{Orbit, Well};
@@ -37,11 +38,6 @@ const PENDULUM: f64 = 1e-4;
 /// The averaged phase's error is bounded in the pendulum well up to this fraction of the rim
 /// (the envelope's reach; beyond it the error grows faster than `mu^3`).
 const PENDULUM_REACH: f64 = 0.7;
-/// The averaged advance is refused below this fraction of the rim: the orbit's rates, from
-/// energy differences rounded at the landscape's scale, carry noise beyond 1e-7 there, and the
-/// averaged steps' error control, fed by it, shrinks them to a few orbits each (a 1 us step of
-/// 490 orbits took 5 ms, against 0.3 ms resolved).
-const RESOLVED_FLOOR: f64 = 1e-8;
 /// Twice the measured envelope.
 const SAFETY: f64 = 2.0;
 /// The relative error of an orbit's period from its energy `E` rounded at the landscape's
@@ -73,9 +69,8 @@ impl Motor {
     /// A bound on the phase error (cycles) that the averaged advance gains over `orbits` orbits
     /// from the orbit `o` of `well` in the landscape `land`, its energy falling by at least
     /// `least_loss` of itself per orbit (see the module documentation). `None` where the well
-    /// is not eq. 3.4's pendulum (the linearization's shift bounds the frequency's error there,
-    /// see [`Self::advance_orbits`]); infinite beyond [`PENDULUM_REACH`] of the rim and below
-    /// [`RESOLVED_FLOOR`] of it.
+    /// is not eq. 3.4's pendulum or lies beyond [`PENDULUM_REACH`] of its rim (the
+    /// linearization's shift alone is taken there, see [`Self::advance_orbits`]).
     pub(super) fn averaged_phase_error(
         &self,
         land: &Landscape,
@@ -89,8 +84,8 @@ impl Motor {
             return None;
         }
         let frac = o.energy / well.barrier;
-        if !((RESOLVED_FLOOR..=PENDULUM_REACH).contains(&frac) && orbits >= 0.0) {
-            return Some(f64::INFINITY);
+        if !((0.0..=PENDULUM_REACH).contains(&frac) && orbits >= 0.0) {
+            return None;
         }
         let mu = pendulum_anharmonicity(frac);
         let alpha = self.params.gilbert_damping;
@@ -112,6 +107,6 @@ impl Motor {
         // The period's quadrature, from energies rounded at the landscape's scale.
         let rounding = orbits * ROUNDING * (well.floor.abs() + well.barrier) / o.energy;
         let cycles = SAFETY * alpha * alpha * cycles + rounding;
-        Some(if cycles.is_nan() { f64::INFINITY } else { cycles })
+        Some(if cycles.is_finite() { cycles } else { f64::INFINITY })
     }
 }

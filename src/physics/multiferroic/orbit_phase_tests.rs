@@ -85,8 +85,9 @@ fn pendulum_orbit_error(r: f64, frac: f64, a: f64) -> (f64, f64, f64) {
 /// and up to 0.7 of the rim, at the damping that loses 5% of the energy per orbit (the most the
 /// advance takes): its part even in the damping within the envelope, all of it within twice the
 /// envelope, the bound [`Motor::averaged_phase_error`] takes. The linearization's shift
-/// `alpha^2 (T - k)^2 / (8 k T)`, the bound before, is exceeded: 9 times at `k / T` = 0.5 and 0.3
-/// of the rim, and wherever the ringing is nonlinear at `k = T`, where the shift vanishes.
+/// `alpha^2 (T - k)^2 / (8 k T)`, which the advance also takes where it is the smaller, is
+/// exceeded: 9 times at `k / T` = 0.5 and 0.3 of the rim, and wherever the ringing is nonlinear
+/// at `k = T`, where the shift vanishes.
 #[test]
 fn pendulum_phase_error_within_its_envelope() {
     let mut worst: f64 = 0.0;
