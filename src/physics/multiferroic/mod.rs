@@ -92,6 +92,9 @@ mod orbit;
 mod orbit_advance;
 mod orbit_averager;
 mod orbit_finish;
+mod orbit_phase;
+#[cfg(test)]
+mod orbit_phase_tests;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]
