@@ -63,6 +63,9 @@ mod forced_crossing;
 mod forced_crossing_tests;
 mod gilbert;
 mod integrator;
+mod linear_ringing;
+#[cfg(test)]
+mod linear_ringing_tests;
 #[cfg(test)]
 mod locked_accuracy_tests;
 mod locked_ringing;
