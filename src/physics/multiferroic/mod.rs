@@ -63,6 +63,9 @@ mod forced_crossing;
 mod forced_crossing_tests;
 mod gilbert;
 mod integrator;
+mod linear_ringing;
+#[cfg(test)]
+mod linear_ringing_tests;
 #[cfg(test)]
 mod locked_accuracy_tests;
 mod locked_ringing;
@@ -92,6 +95,9 @@ mod orbit;
 mod orbit_advance;
 mod orbit_averager;
 mod orbit_finish;
+mod orbit_phase;
+#[cfg(test)]
+mod orbit_phase_tests;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]

@@ -6,7 +6,7 @@ use super::angles::turned_back;
 use super::decoupled::torque_bound;
 use super::{Motor, MotorInputs, StepRun, SteppingSchedule};
 
-type M2 = [[f64; 2]; 2];
+pub(super) type M2 = [[f64; 2]; 2];
 
 /// Part of the tolerance the bound of the dropped nonlinear term may take over one macro span.
 const BOUND_SHARE: f64 = 0.01;
@@ -50,11 +50,11 @@ pub(super) struct LinearSpan {
 }
 
 /// One switch's exact affine map of the linearized onion and its flow's bound.
-struct Flow {
+pub(super) struct Flow {
     /// `exp(A h)`.
-    e: M2,
+    pub(super) e: M2,
     /// `int_0^h exp(A s) ds`.
-    j: M2,
+    pub(super) j: M2,
     /// A bound on `||exp(A s)||` (max norm) for `0 <= s <= h`.
     k: f64,
 }
@@ -76,7 +76,7 @@ fn mul(a: &M2, b: &M2) -> M2 {
     ]
 }
 
-fn apply(a: &M2, x: [f64; 2]) -> [f64; 2] {
+pub(super) fn apply(a: &M2, x: [f64; 2]) -> [f64; 2] {
     [
         a[0][0] * x[0] + a[0][1] * x[1],
         a[1][0] * x[0] + a[1][1] * x[1],
@@ -107,7 +107,7 @@ fn sinc(x: f64, oscillating: bool) -> f64 {
 /// is well conditioned and `h` long; else its Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`)
 /// doubled `n` times (`J(2h) = (I + exp(A h)) J(h)`), which holds through a singular `A`.
 /// `None` if the flow could grow beyond `e^50`.
-fn flow(a: &M2, h: f64) -> Option<Flow> {
+pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     let m = 0.5 * (a[0][0] + a[1][1]);
     let n: M2 = [[a[0][0] - m, a[0][1]], [a[1][0], a[1][1] - m]];
     let q = n[0][0] * n[0][0] + n[0][1] * n[1][0];

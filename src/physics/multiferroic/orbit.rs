@@ -14,8 +14,9 @@
 //! gains what the onion loses). The rotor feels the orbit's mean ring torque `<tau>`, and the
 //! phase advances at `1/P` cycles per second less the damped precession's frequency shift (for
 //! the linearization `sqrt(1 - alpha^2 (T - k)^2 / (4 k T))`, `k = U''(psi*)`, exact once the
-//! ringing is small). While the rotor turns, the minimum moves at `m' = omega k_bar / k` and the
-//! onion rings about the tilt `-m' / (g T)`.
+//! ringing is small; its error along a nonlinear orbit is bounded in `orbit_phase.rs`). While
+//! the rotor turns, the minimum moves at `m' = omega k_bar / k` and the onion rings about the
+//! tilt `-m' / (g T)`.
 //!
 //! The phase is counted from the turning point below the minimum. The time-reversal symmetry of
 //! the undamped orbit about its turning points makes the oscillating parts of the rotor's

@@ -60,6 +60,9 @@ pub(super) struct StepRun {
     pub(super) average_check_at: u32,
     /// The attempt from which the orbit-averaged ringing is tried next.
     pub(super) orbit_check_at: u32,
+    /// The segment (its end) and the time before which the linear ringing's bound cannot hold
+    /// (see [`Motor::advance_linear_ringing`]).
+    pub(super) linear_wait: (f64, f64),
     /// The Gilbert onion left its bounds at the smallest substep allowed: the next pass drops
     /// its ringing however slowly it decays ([`Motor::follows_branch`]).
     pub(super) onion_escaped: bool,
@@ -111,6 +114,7 @@ impl StepRun {
             rim_barrier: (f64::NAN, Rims::NONE),
             average_check_at: 0,
             orbit_check_at: 0,
+            linear_wait: (f64::NAN, f64::NAN),
             onion_escaped: false,
             schedule: None,
             unresolvable: false,
@@ -285,6 +289,9 @@ impl Motor {
                 }
             }
             if !model.quasi_static() && run.attempts >= run.orbit_check_at {
+                if self.advance_linear_ringing(&mut run, &d, segment_end) {
+                    continue;
+                }
                 // Tried at attempts spaced by an eighth of those made, as the averaged ringing.
                 let advance = self.advance_orbits(&mut run, &d, segment_end);
                 run.orbit_check_at = run.attempts + 1 + run.attempts / 8;
