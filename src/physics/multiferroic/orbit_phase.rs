@@ -107,6 +107,10 @@ impl Motor {
         // The period's quadrature, from energies rounded at the landscape's scale.
         let rounding = orbits * ROUNDING * (well.floor.abs() + well.barrier) / o.energy;
         let cycles = SAFETY * alpha * alpha * cycles + rounding;
-        Some(if cycles.is_finite() { cycles } else { f64::INFINITY })
+        Some(if cycles.is_finite() {
+            cycles
+        } else {
+            f64::INFINITY
+        })
     }
 }

@@ -92,12 +92,17 @@ fn pendulum_orbit_error(r: f64, frac: f64, a: f64) -> (f64, f64, f64) {
 fn pendulum_phase_error_within_its_envelope() {
     let mut worst: f64 = 0.0;
     let mut beyond_shift = 0;
-    for r in [1e-3_f64, 1e-2, 0.1, 0.5, 1.0, 2.0, 3.4, 10.0, 65.0, 338.0, 3000.0, 1e4] {
+    for r in [
+        1e-3_f64, 1e-2, 0.1, 0.5, 1.0, 2.0, 3.4, 10.0, 65.0, 338.0, 3000.0, 1e4,
+    ] {
         let a = 0.05 / (2.0 * PI * (r.sqrt() + 1.0 / r.sqrt()));
         let shift = a * a * (1.0 - r) * (1.0 - r) / (8.0 * r);
         for frac in [1e-3, 1e-2, 0.05, 0.1, 0.2, 0.3, 0.5, 0.7] {
             let (total, even, mu) = pendulum_orbit_error(r, frac, a);
-            assert!((mu - pendulum_anharmonicity(frac)).abs() <= 1e-9, "{r} {frac} {mu}");
+            assert!(
+                (mu - pendulum_anharmonicity(frac)).abs() <= 1e-9,
+                "{r} {frac} {mu}"
+            );
             let [c1, c2, c3] = envelope(r);
             let bound = a * a * (c1 * mu + c2 * mu * mu + c3 * mu * mu * mu);
             println!(
