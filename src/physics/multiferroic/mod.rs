@@ -25,12 +25,14 @@
 //! drag keeps that pair out of reach (with the onion's block exact too where the two barely
 //! couple, `etd_blocks.rs`), else an exponential Rosenbrock pair (`gilbert.rs`); weakly damped
 //! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`,
-//! `orbit_averager.rs`; a locked rotor's last orbit is resolved at once, `orbit_finish.rs`); a
-//! locked rotor's onion near or above its wells' rims is held to what its energy, which only
-//! falls, can reach (`rim_energy.rs`). On fast schedules whose ring barely couples the onion to
-//! the rotor, repeated periods and cycles are taken at once (`onion_periods.rs`,
-//! `onion_cycles.rs`) and an onion near its path advances by exact affine maps per switch
-//! (`onion_linear.rs`). The estimate sizes the next substep.
+//! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`; a locked rotor's last
+//! orbit is resolved at once, `orbit_finish.rs`, and its ringing small enough to be linear
+//! advances by its exact linear flow, `linear_ringing.rs`); a locked rotor's onion near or
+//! above its wells' rims is held to what its energy, which only falls, can reach
+//! (`rim_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
+//! repeated periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an
+//! onion near its path advances by exact affine maps per switch (`onion_linear.rs`). The
+//! estimate sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
