@@ -81,6 +81,9 @@ mod onion_cycles;
 #[cfg(test)]
 mod onion_cycles_tests;
 mod onion_linear;
+mod onion_linear_locked;
+#[cfg(test)]
+mod onion_linear_locked_tests;
 #[cfg(test)]
 mod onion_linear_tests;
 mod onion_periods;
