@@ -13,7 +13,9 @@ const BOUND_SHARE: f64 = 0.01;
 const FIRST_SPAN: usize = 4;
 /// Switches at which the repeated periods' skips ([`Motor::skip_onion_periods`]) must have
 /// declined in a step before a span is tried: an onion that settles within a few periods
-/// repeats them at no cost at all, which a span would end (it restarts their comparison).
+/// repeats them at no cost at all, which a span would end (it restarts their comparison). Where
+/// the ring couples to the onion (a locked rotor's, [`Motor::linear_ring_term`]) there are no
+/// skips to wait for, and spans are tried from the first switch.
 const WAIT_SWITCHES: u32 = 8;
 /// Largest growth of the onion block's exponential over a switch (`e^50`): beyond it the
 /// linearization is far out of its reach anyway and the bound would overflow.
@@ -231,7 +233,10 @@ impl Motor {
         {
             return false;
         }
-        if run.onion_linear.next == 0 && run.onion_linear.waited < WAIT_SWITCHES {
+        if run.onion_linear.next == 0
+            && run.onion_linear.waited < WAIT_SWITCHES
+            && run.onion_decoupled == Some(true)
+        {
             run.onion_linear.waited += 1;
             return false;
         }

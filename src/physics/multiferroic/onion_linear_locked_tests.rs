@@ -14,6 +14,12 @@ use super::*;
 /// torque on it is not negligible over that memory ([`Motor::ring_decoupled`] fails).
 const CREEPING: &str = "strain_direction=5.135114264928168e5 stress=2.2820645588306966e5 load_torque=-9.915438607453414e-7 ring_outer_diameter=2.8469494225458643e-2 ring_inner_diameter=6.604890130437266e-3 bar_length=1.0779507175724333e-6 bar_width=4.503890913627021e-8 thickness=2.18195679941534e-8 saturation_magnetization=5.126149671924257e4 magnetostriction=-7.836896931303874e-3 wall_volume=9.347236765285793e-12 density=2.4551449322208205e3 fluid_viscosity=7.559771757926201e4 gilbert_damping=2.21062817452914e-1 tolerance=1.4276541243319657e-6 step_angle=-2.8076869365881514e0 step_period=1.474231744190367e-9 stress_amplitude=-4.209278983086497e-1 schedule_initial_direction=-2.0404417070533065e0 onion_model=1e0 max_substeps=2.488e3 schedule=1e0 rotor_locked=1e0 initial_onion_offset=1.3736214822621958e-11 strain=-6.679330975597986e-2 youngs_modulus=3.0745565676329876e6 strain_drive=1e0";
 
+/// A benchmark draw (full precision): the rotor locked, a 1.32 ns schedule turning the strain
+/// by -1.67 rad a switch, damping 0.022 and a loose tolerance, 0.55 rad. The onion stays within
+/// 2e-4 rad of where it starts; resolved switch by switch within that tolerance it drifted by
+/// about 0.1 rad a switch, 75 rad a step.
+const LOOSE: &str = "strain_direction=-1.0535612392453895e0 stress=-3.961210400445306e5 load_torque=-7.814790441179216e-7 ring_outer_diameter=7.398422859608355e-1 ring_inner_diameter=8.91044441285702e-3 bar_length=4.639656708876403e-4 bar_width=2.4444698418419133e-6 thickness=1.968226364393448e-6 saturation_magnetization=1.74910007621288e5 magnetostriction=-6.940916553667385e-3 wall_volume=6.373614827219518e-11 density=1.7715962462335365e3 fluid_viscosity=9.758242284399974e4 gilbert_damping=2.216716264841276e-2 tolerance=5.452540087689379e-1 step_angle=-1.6715220744944652e0 step_period=1.3246326092283046e-9 stress_amplitude=-1.4907986882368496e0 schedule_initial_direction=-1.4029170443384658e0 onion_model=1e0 max_substeps=6.44e2 schedule=1e0 rotor_locked=1e0 initial_onion_offset=-3.1926781009303563e-7 strain=2.8362029390469612e-2 youngs_modulus=2.7522548582146226e12 strain_drive=1e0";
+
 /// The onion and tilt from a span's start `y` at `t` to `t_end`: RK4 over each switch
 /// interval at `n` substeps.
 fn span_rk4(
@@ -33,19 +39,19 @@ fn span_rk4(
     y
 }
 
-/// Three 1 us steps (as the benchmark takes them), each against a converged RK4 from its start
-/// within the tolerance in at most 200 substeps each (84 to 91; without the ring folded into the
-/// spans the onion's creep is resolved substep by substep through every switch, 679 to 685); and
-/// every span's end within its bound of an RK4 from the span's start (at most 1.2% of it).
-#[test]
-fn locked_creeping_onion_spans_against_rk4() {
-    let (m, mut st, inputs) = case(&values(CREEPING)).unwrap();
+/// Three 1 us steps of a draw (as the benchmark takes them), each against a converged RK4 from
+/// its start within the tolerance (onion angle and tilt) and in at most `max_substeps`; every
+/// span's end within its bound (at most a hundredth of the tolerance) of an RK4 from the span's
+/// start. Returns the largest error in tolerances and the largest span error over its bound.
+fn three_steps(text: &str, max_substeps: u32) -> (f64, f64) {
+    let (m, mut st, inputs) = case(&values(text)).unwrap();
     assert!(inputs.rotor_locked);
     let s = inputs.schedule.get().unwrap();
     assert!(!m.ring_decoupled(s, true, 1e-6));
     let tol = m.params.tolerance;
     SPAN_LOG.with(|l| l.borrow_mut().clear());
     let spans_before = SPANS.with(|c| c.get());
+    let mut worst_step: f64 = 0.0;
     for _ in 0..3 {
         let start = st;
         let report = m.step(&mut st, &inputs, 1e-6).unwrap();
@@ -60,11 +66,12 @@ fn locked_creeping_onion_spans_against_rk4() {
         );
         assert_eq!(st.rotor_angle, start.rotor_angle);
         assert!(errors.iter().all(|e| *e <= 1.0), "{st:?} against {truth:?}");
-        assert!(report.substeps <= 200, "{report:?}");
+        assert!(report.substeps <= max_substeps, "{report:?}");
+        worst_step = worst_step.max(errors[0]).max(errors[1]);
     }
     assert!(SPANS.with(|c| c.get()) > spans_before);
     let log = SPAN_LOG.with(|l| l.borrow().clone());
-    let mut worst: f64 = 0.0;
+    let mut worst_span: f64 = 0.0;
     for (y, t, t_end, end, bound) in log {
         let (coarse, fine) = (
             span_rk4(&m, &inputs, y, t, t_end, 32),
@@ -81,9 +88,26 @@ fn locked_creeping_onion_spans_against_rk4() {
             "span from {t:e} to {t_end:e}: {error:e} beyond {bound:e}"
         );
         assert!(bound <= 0.01 * tol);
-        worst = worst.max(error / bound);
+        worst_span = worst_span.max(error / bound);
     }
-    println!("worst span error / bound {worst:.3}");
+    println!("worst step error / tolerance {worst_step:e}, span error / bound {worst_span:.3}");
+    (worst_step, worst_span)
+}
+
+/// [`CREEPING`] in at most 200 substeps a step (77 to 80; without the ring folded into the spans
+/// the onion's creep is resolved substep by substep through every switch, 679 to 685), within
+/// 2e-4 tolerances of the RK4, its spans within 2% of their bounds.
+#[test]
+fn locked_creeping_onion_spans_against_rk4() {
+    three_steps(CREEPING, 200);
+}
+
+/// [`LOOSE`] within the tolerance of the RK4 (2e-11 tolerances) in at most 300 substeps a step
+/// (190; resolved switch by switch the onion ended 139 tolerances off in 757, the step flagged
+/// as limited by its budget of 644).
+#[test]
+fn locked_onion_at_a_loose_tolerance_against_rk4() {
+    three_steps(LOOSE, 300);
 }
 
 /// [`stiffness_slope_bound`] bounds eq. 3.3's third derivative ([`RingBar::stiffness_slope`])
