@@ -30,7 +30,8 @@
 //! falls, can reach (`rim_energy.rs`). On fast schedules whose ring barely couples the onion to
 //! the rotor, repeated periods and cycles are taken at once (`onion_periods.rs`,
 //! `onion_cycles.rs`) and an onion near its path advances by exact affine maps per switch
-//! (`onion_linear.rs`). The estimate sizes the next substep.
+//! (`onion_linear.rs`; a locked rotor's, the ring's torque folded into them, by
+//! `onion_linear_locked.rs`). The estimate sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot

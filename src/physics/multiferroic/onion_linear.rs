@@ -215,8 +215,8 @@ impl Motor {
     /// torque alike), but for rounding. A span is taken only where that bound is within a hundredth
     /// of the tolerance; otherwise a shorter one is tried, and where a single interval fails the
     /// rest of the step is left to the other paths (an onion swinging through eq. 3.4's nonlinear
-    /// range, where the linearization fails at once). Tried once the skips of repeated periods have
-    /// declined at [`WAIT_SWITCHES`] switches.
+    /// range, where the linearization fails at once). Tried, with a decoupled ring, once the skips
+    /// of repeated periods have declined at [`WAIT_SWITCHES`] switches.
     pub(super) fn advance_onion_linear(
         &self,
         run: &mut StepRun,
