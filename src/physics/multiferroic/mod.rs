@@ -31,8 +31,9 @@
 //! above its wells' rims is held to what its energy, which only falls, can reach
 //! (`rim_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
 //! repeated periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an
-//! onion near its path advances by exact affine maps per switch (`onion_linear.rs`). The
-//! estimate sizes the next substep.
+//! onion near its path advances by exact affine maps per switch (`onion_linear.rs`; a locked
+//! rotor's, the ring's torque folded into them, by `onion_linear_locked.rs`). The estimate
+//! sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
@@ -86,6 +87,9 @@ mod onion_cycles;
 #[cfg(test)]
 mod onion_cycles_tests;
 mod onion_linear;
+mod onion_linear_locked;
+#[cfg(test)]
+mod onion_linear_locked_tests;
 #[cfg(test)]
 mod onion_linear_tests;
 mod onion_periods;

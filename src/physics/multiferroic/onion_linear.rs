@@ -1,9 +1,8 @@
-//! A Gilbert onion on a fast schedule that the ring barely couples to the rotor and that stays
-//! in its linear regime, advanced over many switches at once by exact affine maps (see
-//! [`Motor::advance_onion_linear`]).
+//! A Gilbert onion on a fast schedule that the ring barely couples to the rotor, or whose rotor
+//! is locked, and that stays in its linear regime, advanced over many switches at once by exact
+//! affine maps (see [`Motor::advance_onion_linear`]).
 
 use super::angles::turned_back;
-use super::decoupled::torque_bound;
 use super::{Motor, MotorInputs, StepRun, SteppingSchedule};
 
 pub(super) type M2 = [[f64; 2]; 2];
@@ -14,7 +13,9 @@ const BOUND_SHARE: f64 = 0.01;
 const FIRST_SPAN: usize = 4;
 /// Switches at which the repeated periods' skips ([`Motor::skip_onion_periods`]) must have
 /// declined in a step before a span is tried: an onion that settles within a few periods
-/// repeats them at no cost at all, which a span would end (it restarts their comparison).
+/// repeats them at no cost at all, which a span would end (it restarts their comparison). Where
+/// the ring couples to the onion (a locked rotor's, [`Motor::linear_ring_term`]) there are no
+/// skips to wait for, and spans are tried from the first switch.
 const WAIT_SWITCHES: u32 = 8;
 /// Largest growth of the onion block's exponential over a switch (`e^50`): beyond it the
 /// linearization is far out of its reach anyway and the bound would overflow.
@@ -183,7 +184,8 @@ pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
 impl Motor {
     /// Advances the rest of the step's switches, or some of them, at once where eq. 3.3's
     /// ring-bar torque is negligible ([`Self::ring_decoupled`], as for
-    /// [`Self::skip_onion_periods`]) and the Gilbert onion stays close enough to where a macro span
+    /// [`Self::skip_onion_periods`]) or the rotor is locked ([`Self::linear_ring_term`]) and the
+    /// Gilbert onion stays close enough to where a macro span
     /// of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
     ///
     /// A locked rotor stays; a free one follows load and drag alone, exactly
@@ -193,13 +195,15 @@ impl Motor {
     /// obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin 2(psi -
     /// gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq. 3.4) plus the ring's
     /// torque (eq. 3.3). About the span's start `psi0`, with `delta = psi - psi0`, the gradient is
-    /// `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k)`, `d_k = 2 E cos 2(psi0 - gamma_k)`:
-    /// each interval is an exact affine map of `(delta, theta)` (see [`flow`]), chained over the
-    /// span. The dropped term is bounded by `|R| <= 2 |E| delta^2 + tau_max` (Taylor's remainder:
-    /// `|d^2/dx^2 sin 2x| <= 4`; `tau_max` the ring torque's bound, [`torque_bound`]), and enters
+    /// `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k) + tau_0`, `d_k = 2 E cos 2(psi0 -
+    /// gamma_k) + k_0` (`tau_0, k_0` the ring's linear term, zero where it is dropped,
+    /// [`Self::linear_ring_term`]): each interval is an exact affine map of `(delta, theta)` (see
+    /// [`flow`]), chained over the span. The dropped term is bounded by `|R| <= (2 |E| + rho)
+    /// delta^2 + tau_r` (Taylor's remainder: `|d^2/dx^2 sin 2x| <= 4`; `rho delta^2 + tau_r` the
+    /// ring term's remainder), and enters
     /// the rates as `g (-a R, R)`, of max norm `g max(1, a) |R|`. Over interval `k` of length `h_k`
-    /// its effect at the interval's end is at most `c_k = h_k K_k g max(1, a) (2 |E| r_k^2 +
-    /// tau_max)` (variation of constants; `K_k` bounds the interval's propagator), with `r_k` a
+    /// its effect at the interval's end is at most `c_k = h_k K_k g max(1, a) ((2 |E| + rho)
+    /// r_k^2 + tau_r)` (variation of constants; `K_k` bounds the interval's propagator), with `r_k` a
     /// bound on `|delta|` there: the linear path's reach (`max(|delta_k|, |delta_k+1|) + h_k K_k |A
     /// w_k + b| / 2`, or `K_k (|w_k| + h_k |b|)`) widened by the forward bound of the error so far
     /// (`eps_k+1 = ||exp(A h_k)|| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound
@@ -211,8 +215,8 @@ impl Motor {
     /// torque alike), but for rounding. A span is taken only where that bound is within a hundredth
     /// of the tolerance; otherwise a shorter one is tried, and where a single interval fails the
     /// rest of the step is left to the other paths (an onion swinging through eq. 3.4's nonlinear
-    /// range, where the linearization fails at once). Tried once the skips of repeated periods have
-    /// declined at [`WAIT_SWITCHES`] switches.
+    /// range, where the linearization fails at once). Tried, with a decoupled ring, once the skips
+    /// of repeated periods have declined at [`WAIT_SWITCHES`] switches.
     pub(super) fn advance_onion_linear(
         &self,
         run: &mut StepRun,
@@ -223,10 +227,16 @@ impl Motor {
         if OFF.with(|c| c.get()) {
             return false;
         }
-        if self.quasi_static() || run.onion_linear.disabled || run.onion_decoupled != Some(true) {
+        if self.quasi_static()
+            || run.onion_linear.disabled
+            || self.linear_ring_term(run, inputs).is_none()
+        {
             return false;
         }
-        if run.onion_linear.next == 0 && run.onion_linear.waited < WAIT_SWITCHES {
+        if run.onion_linear.next == 0
+            && run.onion_linear.waited < WAIT_SWITCHES
+            && run.onion_decoupled == Some(true)
+        {
             run.onion_linear.waited += 1;
             return false;
         }
@@ -287,7 +297,13 @@ impl Motor {
         );
         let e = self.magnetoelastic_per_stress * s.stress_amplitude;
         let to_rate = g * a.max(1.0);
-        let tau = torque_bound(&self.ring_bar);
+        let Some(ring) = self.linear_ring_term(run, inputs) else {
+            return Tried {
+                switches: 0,
+                result: None,
+            };
+        };
+        let quadratic = 2.0 * e.abs() + ring.curvature;
         let psi0 = run.y[2];
         let mut w = [0.0, run.y[3]];
         let mut time = run.t;
@@ -299,7 +315,7 @@ impl Motor {
             let h = next - time;
             let gamma = self.drive_at(inputs, time).direction;
             let (s2, c2) = turned_back(2.0 * (psi0 - gamma)).sin_cos();
-            let (grad, d) = (e * s2, 2.0 * e * c2);
+            let (grad, d) = (e * s2 + ring.value, 2.0 * e * c2 + ring.stiffness);
             let am: M2 = [[-g * a * d, -g * t], [g * d, -g * a * t]];
             let b = [-g * a * grad, g * grad];
             switches += 1;
@@ -318,7 +334,7 @@ impl Motor {
             let bn = b[0].abs().max(b[1].abs());
             let reach =
                 (w[0].abs().max(w_next[0].abs()) + 0.5 * h * f.k * slope).min(f.k * (wn + h * bn));
-            let remainder = |r: f64| h * f.k * to_rate * (2.0 * e.abs() * r * r + tau);
+            let remainder = |r: f64| h * f.k * to_rate * (quadratic * r * r + ring.constant);
             // A bound `c` that holds given itself (`remainder(reach + K eps + c) < c`) holds: the
             // true path cannot first leave the reach it implies.
             let near = reach + f.k * eps;
