@@ -61,11 +61,12 @@ impl Motor {
         let lag_time = self.onion_relaxation_time();
         let lag = (4.0 * lag_time * y[1].abs()).min(MAX_FOLLOWED_LAG);
         // Whatever is dropped here, the onion carries over the next switch (a locked rotor's
-        // speed, and so its lag, is 0).
-        if !self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag) {
-            return None;
-        }
+        // speed, and so its lag, is 0). A free rotor's onion takes the cheap slack test first.
+        let relaxed_in_fact = || self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag);
         if d.locked {
+            if !relaxed_in_fact() {
+                return None;
+            }
             // The onion's angle is the output and nothing else is moved by its ringing: it is
             // dropped only where it ends the segment within the tolerance of the minimum.
             if self.locked_ringing_ends(y, d, settled, remaining) {
@@ -77,8 +78,11 @@ impl Motor {
                 let ringing = 0.1 * tol * self.rotor_relaxation_time() / lag_time;
                 let slack = tol + lag.max(ringing).min(MAX_FOLLOWED_LAG);
                 if y[3].abs() <= slack && (settled - y[2]).abs() <= slack {
-                    return Some(0.0);
+                    return relaxed_in_fact().then_some(0.0);
                 }
+            }
+            if rim_barrier.is_none() || !relaxed_in_fact() {
+                return None;
             }
         }
         let rims = rim_barrier?;
