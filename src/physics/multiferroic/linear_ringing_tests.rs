@@ -4,6 +4,7 @@
 use super::linear_ringing::{OFF, TAKEN};
 use super::locked_accuracy_tests::converged_rk4;
 use super::onion_periods_tests::{case, values};
+use super::orbit_phase_tests::DRAW_471993;
 
 /// Steps 1 to 3 (1 us each) of a locked-rotor bench draw with and without the propagator: per
 /// step the substeps reported, whether the propagator ended the step, and the onion's angle and
@@ -39,18 +40,7 @@ fn three_steps(text: &str, off: bool) -> Vec<(u32, bool, [f64; 2])> {
 /// the ringing then within the relaxed onion's slack, is one substep either way.
 #[test]
 fn draw_471993_small_ringing_propagated_against_rk4() {
-    let text = "strain_direction=-3.582043116176418e2 stress=-2.3742058803290483e7 \
-         load_torque=-9.289288534026785e-7 ring_outer_diameter=6.115698173376787e-2 \
-         ring_inner_diameter=4.0092551029250476e-4 bar_length=2.460706112286761e-4 \
-         bar_width=1.2661084717608525e-5 thickness=5.435338189656536e-9 \
-         saturation_magnetization=8.957842349045626e3 magnetostriction=2.163398117708994e-3 \
-         wall_volume=2.7575693767556043e-11 density=1.5464631574472187e4 \
-         fluid_viscosity=1.4923355543508592e2 gilbert_damping=2.506347617196131e-3 \
-         tolerance=2.1883930430180764e-9 step_angle=7.138442047152314e0 \
-         step_period=4.662720296671801e-4 stress_amplitude=-1.937942147494172e-2 \
-         schedule_initial_direction=9.557759192980527e1 onion_model=1 max_substeps=5.714e3 \
-         schedule=0e0 rotor_locked=1e0 initial_onion_offset=-2.2106260614260723e-10 \
-         strain=5.3382549327004175e-3 youngs_modulus=7.0448472765716165e6 strain_drive=1";
+    let text = DRAW_471993;
     let before = three_steps(text, true);
     let after = three_steps(text, false);
     println!("without: {before:?}\nwith: {after:?}");

@@ -30,7 +30,12 @@ pub(super) fn converged_rk4(
 /// switches) against [`converged_rk4`] from the same start: not accuracy-limited, the onion's
 /// angle and tilt within `bound` tolerances of it. Returns the errors in tolerances and the
 /// step's substeps.
-fn step_against_rk4(text: &str, warm: usize, per_ns: f64, bound: f64) -> ([f64; 2], u32) {
+pub(super) fn step_against_rk4(
+    text: &str,
+    warm: usize,
+    per_ns: f64,
+    bound: f64,
+) -> ([f64; 2], u32) {
     let (m, mut st, inputs) = case(&values(text)).unwrap();
     assert!(inputs.rotor_locked);
     for _ in 0..warm {
