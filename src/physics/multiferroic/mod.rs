@@ -104,6 +104,9 @@ mod orbit_finish;
 mod orbit_phase;
 #[cfg(test)]
 mod orbit_phase_tests;
+mod orbit_rim_refusal;
+#[cfg(test)]
+mod orbit_rim_refusal_tests;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]
