@@ -26,7 +26,8 @@
 //! couple, `etd_blocks.rs`), else an exponential Rosenbrock pair (`gilbert.rs`); weakly damped
 //! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`,
 //! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`; a locked rotor's last
-//! orbit is resolved at once, `orbit_finish.rs`, and its ringing small enough to be linear
+//! orbit is resolved at once, `orbit_finish.rs`, its onion refused near the rim is refused
+//! again from the well kept, `orbit_rim_refusal.rs`, and its ringing small enough to be linear
 //! advances by its exact linear flow, `linear_ringing.rs`); a locked rotor's onion near or
 //! above its wells' rims is held to what its energy, which only falls, can reach
 //! (`rim_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
@@ -104,6 +105,9 @@ mod orbit_finish;
 mod orbit_phase;
 #[cfg(test)]
 mod orbit_phase_tests;
+mod orbit_rim_refusal;
+#[cfg(test)]
+mod orbit_rim_refusal_tests;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]

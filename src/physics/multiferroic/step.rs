@@ -63,6 +63,9 @@ pub(super) struct StepRun {
     /// The segment (its end) and the time before which the linear ringing's bound cannot hold
     /// (see [`Motor::advance_linear_ringing`]).
     pub(super) linear_wait: (f64, f64),
+    /// The well in which the orbit-averaged advance last refused a locked rotor's onion too near
+    /// its rim (see [`Motor::rim_refusal_holds`]).
+    pub(super) rim_refusal: super::orbit_rim_refusal::RimRefusal,
     /// The Gilbert onion left its bounds at the smallest substep allowed: the next pass drops
     /// its ringing however slowly it decays ([`Motor::follows_branch`]).
     pub(super) onion_escaped: bool,
@@ -115,6 +118,7 @@ impl StepRun {
             average_check_at: 0,
             orbit_check_at: 0,
             linear_wait: (f64::NAN, f64::NAN),
+            rim_refusal: super::orbit_rim_refusal::RimRefusal::NONE,
             onion_escaped: false,
             schedule: None,
             unresolvable: false,
@@ -293,7 +297,12 @@ impl Motor {
                     continue;
                 }
                 // Tried at attempts spaced by an eighth of those made, as the averaged ringing.
-                let advance = self.advance_orbits(&mut run, &d, segment_end);
+                // (Not repeated in full while a locked rotor's onion stays too near its rim.)
+                let advance = if self.rim_refusal_holds(&run.rim_refusal, &run.y, &d, segment_end) {
+                    None
+                } else {
+                    self.advance_orbits(&mut run, &d, segment_end)
+                };
                 run.orbit_check_at = run.attempts + 1 + run.attempts / 8;
                 if let Some(a) = advance {
                     run.attempts = run.attempts.saturating_add(a.steps);
