@@ -40,7 +40,8 @@
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
 //! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
 //! rotor's ringing onion that neither a drop nor forced substeps can follow through the
-//! schedule's switches refuses the step (`locked_switches.rs`).
+//! schedule's switches refuses the step (`locked_switches.rs`), as does a locked step whose
+//! switches outnumber its loop's passes once the linear spans fail (`switch_count.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
@@ -136,6 +137,9 @@ mod spin_tests;
 mod step;
 #[cfg(test)]
 mod stiff_rotor_tests;
+mod switch_count;
+#[cfg(test)]
+mod switch_count_tests;
 #[cfg(test)]
 mod tests;
 mod validation;

@@ -239,15 +239,16 @@ impl Motor {
                 state.time
             )
         };
-        if self.switches_outnumber_passes(&run, inputs, passes) {
-            return Err(too_many_switches());
-        }
+        let outnumbered = self.switches_outnumber_passes(&run, inputs, passes);
         // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
         // repeated periods; the minimum substep reaches the segment's end once the budget is
         // spent, so the cap ends the loop early only when the switches outnumber the budget.
-        for _ in 0..passes {
+        for pass in 0..passes {
             if run.t >= run.t_end {
                 break;
+            }
+            if outnumbered && self.passes_run_out(&run, inputs, passes - pass) {
+                return Err(too_many_switches());
             }
             #[cfg(test)]
             super::locked_switches::PASSES.with(|c| c.set(c.get() + 1));
@@ -270,7 +271,13 @@ impl Motor {
                 self
             };
             if run.unresolvable {
-                return Err(self.unresolvable_message(state.time, h));
+                // A step whose switches outnumber its passes is refused for them, whichever
+                // refusal comes first.
+                return Err(if outnumbered {
+                    too_many_switches()
+                } else {
+                    self.unresolvable_message(state.time, h)
+                });
             }
             if !run.is_settled(&d) {
                 run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
