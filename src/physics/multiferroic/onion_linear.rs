@@ -17,6 +17,10 @@ const FIRST_SPAN: usize = 4;
 /// 2.4e-3 so ends its fifth 1 us step 1.8 tolerances off the RK4) and save little over resolving
 /// those switches.
 pub(super) const MIN_SPAN: usize = 4;
+/// Declined spans in a row after which none is tried again in the step (an onion swinging
+/// through eq. 3.4's nonlinear range declines at once); before, spans are retried after 1, 2,
+/// 4, ... switches resolved by the other paths.
+const MAX_DECLINES: u32 = 6;
 /// Switches at which the repeated periods' skips ([`Motor::skip_onion_periods`]) must have
 /// declined in a step before a span is tried: an onion that settles within a few periods
 /// repeats them at no cost at all, which a span would end (it restarts their comparison). Where
@@ -47,13 +51,16 @@ thread_local! {
 #[cfg(test)]
 pub(super) type SpanRecord = (super::Vector, f64, f64, [f64; 2], f64);
 
-/// The step's macro-span state: switches to try next (0 before the first), or disabled, and
-/// the switches passed before the first.
+/// The step's macro-span state: switches to try next (0 before the first), or disabled, the
+/// switches passed before the first, the spans declined in a row and the switches to pass
+/// before the next try.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct LinearSpan {
     next: usize,
     disabled: bool,
     waited: u32,
+    declined: u32,
+    retry_in: u32,
 }
 
 /// One switch's exact affine map of the linearized onion and its flow's bound.
@@ -243,9 +250,9 @@ impl Motor {
     /// onion's distance from the chained maps' (through eq. 3.4's trigonometric terms and eq. 3.3's
     /// torque alike), but for rounding. A span is taken only where that bound is within a hundredth
     /// of the tolerance and covers at least [`MIN_SPAN`] switches (or ends the step); otherwise
-    /// a shorter one is tried, and where the shortest fails the rest of the step is left to the
-    /// other paths (an onion swinging through eq. 3.4's nonlinear range, where the linearization
-    /// fails at once). Tried, with a decoupled ring, once the skips
+    /// a shorter one is tried, and where the shortest fails the next switches are left to the
+    /// other paths, for good after [`MAX_DECLINES`] in a row (an onion swinging through eq.
+    /// 3.4's nonlinear range, where the linearization fails at once). Tried, with a decoupled ring, once the skips
     /// of repeated periods have declined at [`WAIT_SWITCHES`] switches.
     pub(super) fn advance_onion_linear(
         &self,
@@ -268,6 +275,10 @@ impl Motor {
             && run.onion_decoupled == Some(true)
         {
             run.onion_linear.waited += 1;
+            return false;
+        }
+        if run.onion_linear.retry_in > 0 {
+            run.onion_linear.retry_in -= 1;
             return false;
         }
         let mut span = if run.onion_linear.next == 0 {
@@ -296,6 +307,7 @@ impl Motor {
                         let grow = (target / bound.max(1e-300)).cbrt().clamp(0.5, 2.0);
                         run.onion_linear.next =
                             ((tried.switches as f64 * 0.9 * grow).ceil() as usize).max(1);
+                        run.onion_linear.declined = 0;
                         return true;
                     }
                     break;
@@ -306,7 +318,13 @@ impl Motor {
             }
             span = (tried.switches / 2).max(1);
         }
-        run.onion_linear.disabled = true;
+        // Declined: retried after 1, 2, 4, ... switches, and not again in the step after
+        // [`MAX_DECLINES`] in a row.
+        let spans = &mut run.onion_linear;
+        spans.declined += 1;
+        spans.disabled = spans.declined > MAX_DECLINES;
+        spans.retry_in = 1 << (spans.declined - 1).min(16);
+        spans.next = MIN_SPAN;
         false
     }
 
