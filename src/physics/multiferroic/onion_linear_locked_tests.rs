@@ -2,7 +2,7 @@
 //! linear macro spans ([`Motor::linear_ring_term`]), against RK4s of the macrospin.
 
 use super::locked_accuracy_tests::converged_rk4;
-use super::onion_linear::{MIN_SPAN, SPANS, SPAN_LOG};
+use super::onion_linear::{SPANS, SPAN_LOG};
 use super::onion_linear_locked::stiffness_slope_bound;
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
@@ -143,10 +143,11 @@ fn locked_onion_at_a_loose_tolerance_against_rk4() {
     assert!(longest >= 200.0, "{longest} switches");
 }
 
-/// [`SHORT_SPANS`] over five 1 us steps, each step's end within the tolerance of [`converged_rk4`]
-/// from the start (2.7e-5 tolerances at the fifth): spans shorter than [`MIN_SPAN`] switches are
-/// not taken. Taken, about 300 spans a step of two or three switches each, each within its
-/// bound, drifted the onion 0.36 tolerances off by the third step and 1.8 by the fifth.
+/// [`SHORT_SPANS`] over five 1 us steps, each step's end within a hundredth of the tolerance of
+/// [`converged_rk4`] from the start (2.7e-5 tolerances at the fifth): spans shorter than four
+/// switches are not taken. Taken, about 300 spans a step of two or three switches each, each
+/// within its bound, drifted the onion 0.36 tolerances off by the third step and 1.8 by the
+/// fifth.
 #[test]
 fn short_locked_spans_are_not_taken() {
     let (m, mut st, inputs) = case(&values(SHORT_SPANS)).unwrap();
