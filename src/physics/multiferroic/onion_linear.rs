@@ -11,6 +11,16 @@ pub(super) type M2 = [[f64; 2]; 2];
 const BOUND_SHARE: f64 = 0.01;
 /// Switches of the first macro span tried in a step; later spans follow the last bound.
 const FIRST_SPAN: usize = 4;
+/// Fewest switches a macro span takes (but for the step's last): each span may leave up to
+/// [`BOUND_SHARE`] of the tolerance, all the same way where the onion keeps its offset, so spans
+/// of one to three switches add that up hundreds of times a step (a locked onion at damping
+/// 2.4e-3 so ends its fifth 1 us step 1.8 tolerances off the RK4) and save little over resolving
+/// those switches.
+pub(super) const MIN_SPAN: usize = 4;
+/// Declined spans in a row after which none is tried again in the step (an onion swinging
+/// through eq. 3.4's nonlinear range declines at once); before, spans are retried after 1, 2,
+/// 4, ... switches resolved by the other paths.
+const MAX_DECLINES: u32 = 6;
 /// Switches at which the repeated periods' skips ([`Motor::skip_onion_periods`]) must have
 /// declined in a step before a span is tried: an onion that settles within a few periods
 /// repeats them at no cost at all, which a span would end (it restarts their comparison). Where
@@ -41,13 +51,16 @@ thread_local! {
 #[cfg(test)]
 pub(super) type SpanRecord = (super::Vector, f64, f64, [f64; 2], f64);
 
-/// The step's macro-span state: switches to try next (0 before the first), or disabled, and
-/// the switches passed before the first.
+/// The step's macro-span state: switches to try next (0 before the first), or disabled, the
+/// switches passed before the first, the spans declined in a row and the switches to pass
+/// before the next try.
 #[derive(Clone, Copy, Debug, Default)]
 pub(super) struct LinearSpan {
     next: usize,
     disabled: bool,
     waited: u32,
+    declined: u32,
+    retry_in: u32,
 }
 
 impl LinearSpan {
@@ -63,12 +76,19 @@ pub(super) struct Flow {
     pub(super) e: M2,
     /// `int_0^h exp(A s) ds`.
     pub(super) j: M2,
-    /// A bound on `||exp(A s)||` (max norm) for `0 <= s <= h`.
-    k: f64,
+    /// An entrywise bound on `|exp(A s)|` for `0 <= s <= h`.
+    k: M2,
 }
 
 fn norm(a: &M2) -> f64 {
     (a[0][0].abs() + a[0][1].abs()).max(a[1][0].abs() + a[1][1].abs())
+}
+
+fn abs(a: &M2) -> M2 {
+    [
+        [a[0][0].abs(), a[0][1].abs()],
+        [a[1][0].abs(), a[1][1].abs()],
+    ]
 }
 
 fn mul(a: &M2, b: &M2) -> M2 {
@@ -109,11 +129,12 @@ fn sinc(x: f64, oscillating: bool) -> f64 {
 /// step, where a scaled-and-squared 3x3 exponential cost about as much as the substeps it
 /// replaces. With `A = m I + N`, `N^2 = q I` (trace-free), `exp(A s) = e^{m s} (C I + S N)`,
 /// `C, S = cos(w s), sin(w s) / w` for `q = -w^2 < 0` and `cosh, sinh / w` for `q = w^2`;
-/// hence `||exp(A s)|| <= max(1, e^{m h}) (1 + min(h, 1/w) ||N||)` in the first case and
-/// `e^{max(m + w, 0) h} (1 + min(h, 1/(2w)) ||N||)` in the second (`|sin(w s)/w| <= min(s, 1/w)`,
-/// `sinh(w s)/w <= e^{w s} min(s, 1/(2w))`). The integral is `A^{-1} (exp(A h) - I)` where `A`
-/// is well conditioned and `h` long; else its Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`)
-/// doubled `n` times (`J(2h) = (I + exp(A h)) J(h)`), which holds through a singular `A`.
+/// hence, entry by entry, `|exp(A s)| <= max(1, e^{m h}) (I + min(h, 1/w) |N|)` in the first
+/// case and `e^{max(m + w, 0) h} (I + min(h, 1/(2w)) |N|)` in the second (`|sin(w s)/w| <=
+/// min(s, 1/w)`, `cosh(w s) <= e^{w s}`, `sinh(w s)/w <= e^{w s} min(s, 1/(2w))`). The
+/// integral is `A^{-1} (exp(A h) - I)` where `A` is well conditioned and `h` long; else its
+/// Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`) doubled `n` times (`J(2h) = (I +
+/// exp(A h)) J(h)`), which holds through a singular `A`.
 /// `None` if the flow could grow beyond `e^50`.
 pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     let m = 0.5 * (a[0][0] + a[1][1]);
@@ -145,7 +166,17 @@ pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     } else {
         h.min(0.5 / w)
     };
-    let k = (top * h).exp() * (1.0 + reach * norm(&n));
+    let grow = (top * h).exp();
+    let k = [
+        [
+            grow * (1.0 + reach * n[0][0].abs()),
+            grow * reach * n[0][1].abs(),
+        ],
+        [
+            grow * reach * n[1][0].abs(),
+            grow * (1.0 + reach * n[1][1].abs()),
+        ],
+    ];
     let size = norm(a);
     if !(size.is_finite() && h.is_finite()) {
         return None;
@@ -207,22 +238,28 @@ impl Motor {
     /// [`Self::linear_ring_term`]): each interval is an exact affine map of `(delta, theta)` (see
     /// [`flow`]), chained over the span. The dropped term is bounded by `|R| <= (2 |E| + rho)
     /// delta^2 + tau_r` (Taylor's remainder: `|d^2/dx^2 sin 2x| <= 4`; `rho delta^2 + tau_r` the
-    /// ring term's remainder), and enters
-    /// the rates as `g (-a R, R)`, of max norm `g max(1, a) |R|`. Over interval `k` of length `h_k`
-    /// its effect at the interval's end is at most `c_k = h_k K_k g max(1, a) ((2 |E| + rho)
-    /// r_k^2 + tau_r)` (variation of constants; `K_k` bounds the interval's propagator), with `r_k` a
-    /// bound on `|delta|` there: the linear path's reach (`max(|delta_k|, |delta_k+1|) + h_k K_k |A
-    /// w_k + b| / 2`, or `K_k (|w_k| + h_k |b|)`) widened by the forward bound of the error so far
-    /// (`eps_k+1 = ||exp(A h_k)|| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound
-    /// at the span's end is `sum_k ||P_k|| c_k`, `P_k` the exact product of the later intervals'
-    /// maps. `c_k` is taken where it bounds the remainder on the reach it widens itself (`c_k >=
-    /// c(r + c_k)`, `r` the reach widened by `eps_k` alone; tried at 1.25 times `c(r + c(r))`), so
+    /// ring term's remainder), and enters the rates as `g (-a R, R)`. All bounds on vectors are
+    /// entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the entrywise
+    /// bound on the interval's propagator `|exp(A s)|` ([`flow`]). Over interval `k` of length
+    /// `h_k` the remainder's effect is at most `c_k = K_k (h_k g a, h_k g) R_k` (variation of
+    /// constants), `R_k` a bound on `|R|` there from `r_k`, a bound on `|delta|`: the linear
+    /// path's reach (`max(|delta_k|, |delta_k+1|) + h_k (K_k |A w_k + b|)_0 / 2`, or
+    /// `(K_k (|w_k| + h_k |b|))_0`) widened by the forward bound of the error so far (`eps_k+1 =
+    /// |exp(A h_k)| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound at the
+    /// span's end is the larger entry of `sum_k |P_k| c_k`, `P_k` the exact product of the later
+    /// intervals' maps. Entry by entry, not in a norm: the tilt's stiffness `T` far exceeds the
+    /// angle's `|d_k|`, so a switch's map carries the tilt into the angle many times over (a max
+    /// norm of 5 to 32 on fast schedules) where its products over many switches stay near 1,
+    /// and a norm's bound grows geometrically with the span. `R_k` is taken where it bounds the
+    /// remainder on the reach it widens itself (`R_k >= R(r + (c_k)_0)`, `r` the reach widened by
+    /// `eps_k` alone; tried at 1.25 times `R(r + (c(R(r)))_0)`), so
     /// that the true onion cannot first leave that reach: the bound is a real bound on the true
     /// onion's distance from the chained maps' (through eq. 3.4's trigonometric terms and eq. 3.3's
     /// torque alike), but for rounding. A span is taken only where that bound is within a hundredth
-    /// of the tolerance; otherwise a shorter one is tried, and where a single interval fails the
-    /// rest of the step is left to the other paths (an onion swinging through eq. 3.4's nonlinear
-    /// range, where the linearization fails at once). Tried, with a decoupled ring, once the skips
+    /// of the tolerance and covers at least [`MIN_SPAN`] switches (or ends the step); otherwise
+    /// a shorter one is tried, and where the shortest fails the next switches are left to the
+    /// other paths, for good after [`MAX_DECLINES`] in a row (an onion swinging through eq.
+    /// 3.4's nonlinear range, where the linearization fails at once). Tried, with a decoupled ring, once the skips
     /// of repeated periods have declined at [`WAIT_SWITCHES`] switches.
     pub(super) fn advance_onion_linear(
         &self,
@@ -247,6 +284,10 @@ impl Motor {
             run.onion_linear.waited += 1;
             return false;
         }
+        if run.onion_linear.retry_in > 0 {
+            run.onion_linear.retry_in -= 1;
+            return false;
+        }
         let mut span = if run.onion_linear.next == 0 {
             FIRST_SPAN
         } else {
@@ -260,7 +301,7 @@ impl Motor {
             let tried = self.onion_linear_span(run, s, inputs, span);
             chained += tried.switches;
             if let Some((t, y, bound)) = tried.result {
-                if bound <= target {
+                if bound <= target && (tried.switches >= MIN_SPAN || t >= run.t_end) {
                     let y_new = [run.y[0], run.y[1], y[0], y[1]];
                     #[cfg(test)]
                     let start = (run.y, run.t);
@@ -273,17 +314,24 @@ impl Motor {
                         let grow = (target / bound.max(1e-300)).cbrt().clamp(0.5, 2.0);
                         run.onion_linear.next =
                             ((tried.switches as f64 * 0.9 * grow).ceil() as usize).max(1);
+                        run.onion_linear.declined = 0;
                         return true;
                     }
                     break;
                 }
             }
-            if span <= 1 || tried.switches <= 1 {
+            if tried.switches < 2 * MIN_SPAN {
                 break;
             }
             span = (tried.switches / 2).max(1);
         }
-        run.onion_linear.disabled = true;
+        // Declined: retried after 1, 2, 4, ... switches, and not again in the step after
+        // [`MAX_DECLINES`] in a row.
+        let spans = &mut run.onion_linear;
+        spans.declined += 1;
+        spans.disabled = spans.declined > MAX_DECLINES;
+        spans.retry_in = 1 << (spans.declined - 1).min(16);
+        spans.next = MIN_SPAN;
         false
     }
 
@@ -303,7 +351,6 @@ impl Motor {
             self.tilt_stiffness,
         );
         let e = self.magnetoelastic_per_stress * s.stress_amplitude;
-        let to_rate = g * a.max(1.0);
         let Some(ring) = self.linear_ring_term(run, inputs) else {
             return Tried {
                 switches: 0,
@@ -314,8 +361,8 @@ impl Motor {
         let psi0 = run.y[2];
         let mut w = [0.0, run.y[3]];
         let mut time = run.t;
-        let mut eps: f64 = 0.0;
-        let mut maps: Vec<(M2, f64)> = Vec::with_capacity(span.min(4096));
+        let mut eps = [0.0, 0.0];
+        let mut maps: Vec<(M2, [f64; 2])> = Vec::with_capacity(span.min(4096));
         let mut switches = 0;
         while switches < span && time < run.t_end {
             let next = s.next_switch_after(time).min(run.t_end);
@@ -336,19 +383,30 @@ impl Motor {
             let ew = apply(&f.e, w);
             let w_next = [ew[0] + jb[0], ew[1] + jb[1]];
             let aw = apply(&am, w);
-            let slope = (aw[0] + b[0]).abs().max((aw[1] + b[1]).abs());
-            let wn = w[0].abs().max(w[1].abs());
-            let bn = b[0].abs().max(b[1].abs());
-            let reach =
-                (w[0].abs().max(w_next[0].abs()) + 0.5 * h * f.k * slope).min(f.k * (wn + h * bn));
-            let remainder = |r: f64| h * f.k * to_rate * (quadratic * r * r + ring.constant);
-            // A bound `c` that holds given itself (`remainder(reach + K eps + c) < c`) holds: the
-            // true path cannot first leave the reach it implies.
-            let near = reach + f.k * eps;
-            let c = 1.25 * remainder(near + remainder(near));
-            let holds = remainder(near + c) < c || c == 0.0;
-            eps = norm(&f.e) * eps + c;
-            if !(holds && c.is_finite() && eps.is_finite()) {
+            let slope = apply(&f.k, [(aw[0] + b[0]).abs(), (aw[1] + b[1]).abs()])[0];
+            let spread = apply(
+                &f.k,
+                [w[0].abs() + h * b[0].abs(), w[1].abs() + h * b[1].abs()],
+            )[0];
+            let reach = (w[0].abs().max(w_next[0].abs()) + 0.5 * h * slope).min(spread);
+            // The dropped term's effect over the interval per unit of `|R|`: the rates
+            // `g (-a R, R)` through `|exp(A s)|`.
+            let unit = apply(&f.k, [h * g * a, h * g]);
+            let remainder = |r: f64| quadratic * r * r + ring.constant;
+            // A bound `rb` on `|R|` that holds given itself (`remainder(reach + (K eps)_0 +
+            // unit_0 rb) < rb`) holds: the true path cannot first leave the reach it implies.
+            let near = reach + apply(&f.k, eps)[0];
+            let rb = 1.25 * remainder(near + unit[0] * remainder(near));
+            let holds = remainder(near + unit[0] * rb) < rb || rb == 0.0;
+            let c = [unit[0] * rb, unit[1] * rb];
+            let carried = apply(&abs(&f.e), eps);
+            eps = [carried[0] + c[0], carried[1] + c[1]];
+            if !(holds
+                && c[0].is_finite()
+                && c[1].is_finite()
+                && eps[0].is_finite()
+                && eps[1].is_finite())
+            {
                 return Tried {
                     switches,
                     result: None,
@@ -360,11 +418,13 @@ impl Motor {
         }
         // Carried to the end by the exact products of the later maps.
         let mut later: M2 = [[1.0, 0.0], [0.0, 1.0]];
-        let mut bound = 0.0;
+        let mut ends = [0.0, 0.0];
         for (e_k, c_k) in maps.iter().rev() {
-            bound += norm(&later) * c_k;
+            let carried = apply(&abs(&later), *c_k);
+            ends = [ends[0] + carried[0], ends[1] + carried[1]];
             later = mul(&later, e_k);
         }
+        let bound = ends[0].max(ends[1]);
         let y = [psi0 + w[0], w[1]];
         Tried {
             switches,
