@@ -134,6 +134,9 @@ mod step;
 mod stiff_rotor_tests;
 #[cfg(test)]
 mod tests;
+mod tilt_exit;
+#[cfg(test)]
+mod tilt_exit_tests;
 mod validation;
 
 use angles::Angles;

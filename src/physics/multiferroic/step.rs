@@ -63,9 +63,13 @@ pub(super) struct StepRun {
     /// The segment (its end) and the time before which the linear ringing's bound cannot hold
     /// (see [`Motor::advance_linear_ringing`]).
     pub(super) linear_wait: (f64, f64),
-    /// The Gilbert onion left its bounds at the smallest substep allowed: the next pass drops
-    /// its ringing however slowly it decays ([`Motor::follows_branch`]).
+    /// The Gilbert onion left its bounds at the smallest substep allowed, or within a substep
+    /// ([`Motor::leave_bounds`]): the next pass drops its ringing however slowly it decays
+    /// ([`Motor::follows_branch`]).
     pub(super) onion_escaped: bool,
+    /// The time at which the Gilbert onion was last found to leave its bounds within a
+    /// refused substep (see [`Motor::leave_bounds`]).
+    pub(super) bounds_exit_at: f64,
     /// The stepping schedule switching inside this step, if any.
     pub(super) schedule: Option<super::SteppingSchedule>,
     /// A locked rotor's ringing onion outlasts what the budget left can resolve (see
@@ -116,6 +120,7 @@ impl StepRun {
             orbit_check_at: 0,
             linear_wait: (f64::NAN, f64::NAN),
             onion_escaped: false,
+            bounds_exit_at: f64::NAN,
             schedule: None,
             unresolvable: false,
             rim_ledger: super::rim_energy::RimLedger::NONE,
