@@ -37,7 +37,9 @@
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
-//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
+//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), a free
+//! rotor's onion whose tilt leaves its bounds escapes at the substep that carries it out
+//! (`tilt_exit.rs`), and a locked
 //! rotor's ringing onion that neither a drop nor forced substeps can follow through the
 //! schedule's switches refuses the step (`locked_switches.rs`).
 //!
