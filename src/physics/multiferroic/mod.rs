@@ -37,11 +37,11 @@
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
-//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), a free
-//! rotor's onion whose tilt leaves its bounds escapes at the substep that carries it out
-//! (`tilt_exit.rs`), and a locked
+//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
 //! rotor's ringing onion that neither a drop nor forced substeps can follow through the
-//! schedule's switches refuses the step (`locked_switches.rs`).
+//! schedule's switches refuses the step (`locked_switches.rs`). A free rotor's onion whose tilt
+//! leaves its bounds escapes at the substep that carries it out, not at the budget's smallest
+//! (`tilt_exit.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
