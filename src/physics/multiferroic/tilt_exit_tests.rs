@@ -25,7 +25,7 @@ const SOFT_TILT: &str = "strain_direction=-6.483190734194401e10 stress=9.1488855
 /// carries its tilt past 10 rad within the step), the step is flagged, and the onion is dropped
 /// into the minimum of the well in which the RK4's onion crosses the bound, the rotor where the
 /// RK4 puts it. Found at the substep that carries the onion out, the step takes 10 substeps;
-/// substeps shrinking towards the bound until the budget's smallest was forced took 77.
+/// shrinking the substeps towards the bound until the budget's smallest is forced takes 77.
 #[test]
 fn onion_leaving_its_bounds_is_dropped_at_the_substep_that_carries_it_out() {
     let (m, start, inputs) = case(&values(SOFT_TILT)).unwrap();
