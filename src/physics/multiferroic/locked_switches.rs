@@ -104,16 +104,15 @@ impl Motor {
         decays(kick.max(folded), s.step_period) && decays(gap, run.t_end - run.t)
     }
 
-    /// Whether a locked rotor's Gilbert step on a schedule is sure to be refused for its
-    /// switches outnumbering the step's `passes` (the loop of [`Self::step`]), decided before
-    /// any substep. Every pass then ends within its segment of constant drive, since none of
-    /// the skips over whole periods can apply: those of repeated periods compare the rotor's
-    /// offset from the strain, which turns by the step angle folded into the half turn of eq. 3.4
-    /// (here beyond their threshold of `tolerance / 1000`) from period to period while the rotor
-    /// stays; those of the onion's periods and its linear range need a ring decoupled from the
-    /// onion ([`Self::ring_decoupled`]); the unstrained advance needs no strain, and the
-    /// strain-held one a quasi-static onion. So a step whose switches outnumber its passes would
-    /// end its passes short of the step's end, having spent the budget on them.
+    /// Whether a locked rotor's Gilbert step on a schedule has more switches than the step's
+    /// `passes` (the loop of [`Self::step`]) where no skip over whole periods but the onion's
+    /// linear spans can apply: those of repeated periods compare the rotor's offset from the
+    /// strain, which turns by the step angle folded into the half turn of eq. 3.4 (here beyond
+    /// their threshold of `tolerance / 1000`) from period to period while the rotor stays; those
+    /// of the onion's periods and cycles need a ring decoupled from the onion
+    /// ([`Self::ring_decoupled`]); the unstrained advance needs no strain, and the strain-held
+    /// one a quasi-static onion. Such a step is refused once its linear spans are over
+    /// ([`Self::passes_run_out`]): every pass then ends within its segment of constant drive.
     pub(super) fn switches_outnumber_passes(
         &self,
         run: &StepRun,

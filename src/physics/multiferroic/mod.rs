@@ -26,7 +26,8 @@
 //! couple, `etd_blocks.rs`), else an exponential Rosenbrock pair (`gilbert.rs`); weakly damped
 //! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`,
 //! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`; a locked rotor's last
-//! orbit is resolved at once, `orbit_finish.rs`, and its ringing small enough to be linear
+//! orbit is resolved at once, `orbit_finish.rs`, its onion refused near the rim is refused
+//! again from the well kept, `orbit_rim_refusal.rs`, and its ringing small enough to be linear
 //! advances by its exact linear flow, `linear_ringing.rs`); a locked rotor's onion near or
 //! above its wells' rims is held to what its energy, which only falls, can reach
 //! (`rim_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
@@ -39,9 +40,10 @@
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
 //! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
 //! rotor's ringing onion that neither a drop nor forced substeps can follow through the
-//! schedule's switches refuses the step (`locked_switches.rs`). A free rotor's onion whose tilt
-//! leaves its bounds escapes at the substep that carries it out, not at the budget's smallest
-//! (`tilt_exit.rs`).
+//! schedule's switches refuses the step (`locked_switches.rs`), as does a locked step whose
+//! switches outnumber its loop's passes once the linear spans fail (`switch_count.rs`). A free
+//! rotor's onion whose tilt leaves its bounds escapes at the substep that carries it out, not at
+//! the budget's smallest (`tilt_exit.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
@@ -106,6 +108,9 @@ mod orbit_finish;
 mod orbit_phase;
 #[cfg(test)]
 mod orbit_phase_tests;
+mod orbit_rim_refusal;
+#[cfg(test)]
+mod orbit_rim_refusal_tests;
 #[cfg(test)]
 mod orbit_tests;
 #[cfg(test)]
@@ -134,6 +139,9 @@ mod spin_tests;
 mod step;
 #[cfg(test)]
 mod stiff_rotor_tests;
+mod switch_count;
+#[cfg(test)]
+mod switch_count_tests;
 #[cfg(test)]
 mod tests;
 mod tilt_exit;

@@ -50,6 +50,13 @@ pub(super) struct LinearSpan {
     waited: u32,
 }
 
+impl LinearSpan {
+    /// Whether a span failed in this step: none is tried again before its end.
+    pub(super) fn disabled(&self) -> bool {
+        self.disabled
+    }
+}
+
 /// One switch's exact affine map of the linearized onion and its flow's bound.
 pub(super) struct Flow {
     /// `exp(A h)`.

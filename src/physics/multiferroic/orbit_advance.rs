@@ -6,6 +6,7 @@ use super::onion::Landscape;
 use super::orbit::{point, Orbit, Well};
 use super::orbit_averager::{Averager, Slow};
 use super::orbit_finish::MAX_FINISH_STEPS;
+use super::orbit_rim_refusal::RimRefusal;
 use super::step::StepRun;
 use super::{Drive, Motor, Vector};
 use crate::physics::numerics::dormand_prince;
@@ -15,7 +16,7 @@ use std::f64::consts::PI;
 /// The orbit's energy at most this fraction of the lowest rim's height above the minimum: the
 /// quadrature stays converged and the averaged orbit's energy off by its oscillating part
 /// cannot leave the well.
-const RIM_MARGIN: f64 = 0.9;
+pub(super) const RIM_MARGIN: f64 = 0.9;
 /// At most this fraction of the energy lost per orbit (the averaging's small parameter).
 const MAX_LOSS_PER_ORBIT: f64 = 0.05;
 /// The averaged advance is tried when the segment has at least this many orbits left (fewer
@@ -102,10 +103,15 @@ impl Motor {
             return None;
         }
         let max_steps = (allowance - MARCH_STEPS - 4) / AVERAGED_STEP_WEIGHT;
-        let (well, o, _, _) = self.averageable(&run.y, d, segment_end - run.t)?;
+        let mut near_rim = None;
+        let first = self.averageable(&run.y, d, segment_end - run.t, &mut near_rim);
+        if let Some(well) = near_rim {
+            run.rim_refusal = RimRefusal::new(segment_end, run.y[0], &well, RIM_MARGIN);
+        }
+        let (well, o, _, _) = first?;
         let (y, marched, resolved) = self.march_to_turning_point(&run.y, d, &well, o.period)?;
         let start = run.t + marched;
-        let (well, o, dropped, placed) = self.averageable(&y, d, segment_end - start)?;
+        let (well, o, dropped, placed) = self.averageable(&y, d, segment_end - start, &mut None)?;
         let land = self.landscape(y[0], d.direction, d.stress);
         let overdamped = !d.locked && self.overdamped(o.period);
         let omega = self.rotor_speed(&y, d, overdamped);
@@ -353,12 +359,15 @@ impl Motor {
     /// `remaining` time (s) left in its segment (see [`Self::advance_orbits`]), whether its
     /// ringing is dropped at the advance's end, and whether the advance places the onion within
     /// the tolerance in angle as well as tilt (then a locked rotor's last orbit is resolved at
-    /// once, [`Self::finish_locked_orbits`]).
+    /// once, [`Self::finish_locked_orbits`]). Refused for a locked rotor's onion within its
+    /// well's rims above [`RIM_MARGIN`] of its barrier, `near_rim` is that well (see
+    /// [`Self::rim_refusal_holds`]).
     fn averageable(
         &self,
         y: &Vector,
         d: &Drive,
         remaining: f64,
+        near_rim: &mut Option<Well>,
     ) -> Option<(Well, Orbit, bool, bool)> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;
@@ -384,7 +393,11 @@ impl Motor {
         // The tilt about the orbit's centre.
         let tilt = y[3] - self.tilt_centre(&land, &well, omega);
         let e = point(&land, y[2]).0 - well.floor + 0.5 * t * tilt * tilt;
-        if !(well.below < y[2] && y[2] < well.above && e <= RIM_MARGIN * well.barrier) {
+        let inside = well.below < y[2] && y[2] < well.above;
+        if !(inside && e <= RIM_MARGIN * well.barrier) {
+            if d.locked && inside {
+                *near_rim = Some(well);
+            }
             return None;
         }
         let guess = (well.minimum - 1e-3, well.minimum + 1e-3);

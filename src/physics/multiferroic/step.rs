@@ -63,6 +63,9 @@ pub(super) struct StepRun {
     /// The segment (its end) and the time before which the linear ringing's bound cannot hold
     /// (see [`Motor::advance_linear_ringing`]).
     pub(super) linear_wait: (f64, f64),
+    /// The well in which the orbit-averaged advance last refused a locked rotor's onion too near
+    /// its rim (see [`Motor::rim_refusal_holds`]).
+    pub(super) rim_refusal: super::orbit_rim_refusal::RimRefusal,
     /// The Gilbert onion left its bounds at the smallest substep allowed, or within a substep
     /// ([`Motor::leave_bounds`]): the next pass drops its ringing however slowly it decays
     /// ([`Motor::follows_branch`]).
@@ -119,6 +122,7 @@ impl StepRun {
             average_check_at: 0,
             orbit_check_at: 0,
             linear_wait: (f64::NAN, f64::NAN),
+            rim_refusal: super::orbit_rim_refusal::RimRefusal::NONE,
             onion_escaped: false,
             bounds_exit_at: f64::NAN,
             schedule: None,
@@ -240,15 +244,16 @@ impl Motor {
                 state.time
             )
         };
-        if self.switches_outnumber_passes(&run, inputs, passes) {
-            return Err(too_many_switches());
-        }
+        let outnumbered = self.switches_outnumber_passes(&run, inputs, passes);
         // Each pass accepts a substep, counts a rejected attempt, settles a segment or jumps over
         // repeated periods; the minimum substep reaches the segment's end once the budget is
         // spent, so the cap ends the loop early only when the switches outnumber the budget.
-        for _ in 0..passes {
+        for pass in 0..passes {
             if run.t >= run.t_end {
                 break;
+            }
+            if outnumbered && self.passes_run_out(&run, inputs, passes - pass) {
+                return Err(too_many_switches());
             }
             #[cfg(test)]
             super::locked_switches::PASSES.with(|c| c.set(c.get() + 1));
@@ -271,7 +276,13 @@ impl Motor {
                 self
             };
             if run.unresolvable {
-                return Err(self.unresolvable_message(state.time, h));
+                // A step whose switches outnumber its passes is refused for them, whichever
+                // refusal comes first.
+                return Err(if outnumbered {
+                    too_many_switches()
+                } else {
+                    self.unresolvable_message(state.time, h)
+                });
             }
             if !run.is_settled(&d) {
                 run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
@@ -298,7 +309,12 @@ impl Motor {
                     continue;
                 }
                 // Tried at attempts spaced by an eighth of those made, as the averaged ringing.
-                let advance = self.advance_orbits(&mut run, &d, segment_end);
+                // (Not repeated in full while a locked rotor's onion stays too near its rim.)
+                let advance = if self.rim_refusal_holds(&run.rim_refusal, &run.y, &d, segment_end) {
+                    None
+                } else {
+                    self.advance_orbits(&mut run, &d, segment_end)
+                };
                 run.orbit_check_at = run.attempts + 1 + run.attempts / 8;
                 if let Some(a) = advance {
                     run.attempts = run.attempts.saturating_add(a.steps);
