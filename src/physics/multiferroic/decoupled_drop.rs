@@ -21,7 +21,10 @@ impl Motor {
     /// [`Self::decoupled_ringing`] see ringing near the rims decay 100 times slower than its
     /// linearization at the minimum, or at the sublevel bound's rate, which vanishes at a rim: an
     /// onion released at 0.99 of its rim was resolved until the budget ran out.
-    /// `rims.decay_retry_level` spaces the retries as for a locked rotor.
+    /// `rims.decay_retry_level` spaces the retries as for a locked rotor. Tried only in the
+    /// step's last segment (`rims.ends_step`, no switch before the step's end): a switch rings
+    /// the onion again, so a drop before one saves at most the rest of its segment, while a fast
+    /// schedule would try it in every segment. Declining leaves the ringing resolved.
     pub(super) fn decoupled_ringing_decays(
         &self,
         y: &Vector,
@@ -30,6 +33,9 @@ impl Motor {
         rims: &mut Rims,
         remaining: f64,
     ) -> bool {
+        if !rims.ends_step {
+            return false;
+        }
         let land = self.landscape(y[0], d.direction, d.stress);
         let drift =
             (self.ring_bar.stiffness(settled - y[0]) / land.curvature(settled) * y[1]).abs();

@@ -30,7 +30,7 @@
 //! again from the well kept, `orbit_rim_refusal.rs`, and its ringing small enough to be linear
 //! advances by its exact linear flow, `linear_ringing.rs`); a locked rotor's onion near or
 //! above its wells' rims is held to what its energy, which only falls, can reach
-//! (`rim_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
+//! (`rim_energy.rs`), a free rotor's to what the rotor's turn can feed it (`free_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
 //! repeated periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an
 //! onion near its path advances by exact affine maps per switch (`onion_linear.rs`; a locked
 //! rotor's, the ring's torque folded into them, by `onion_linear_locked.rs`). The estimate
@@ -68,6 +68,9 @@ mod etd_blocks;
 mod forced_crossing;
 #[cfg(test)]
 mod forced_crossing_tests;
+mod free_energy;
+#[cfg(test)]
+mod free_energy_tests;
 mod gilbert;
 mod integrator;
 mod linear_ringing;

@@ -43,18 +43,18 @@ use super::{Drive, Motor, Vector};
 
 /// The error given to a substep that breaks the energy bound: the step-size rule then shortens
 /// it to about 0.45 of its size.
-const BEYOND_RIM: f64 = 8.0;
+pub(super) const BEYOND_RIM: f64 = 8.0;
 /// The most wells walked over a turn of the landscape to find its rims.
 const MAX_WELLS: usize = 8;
 /// Energies within this fraction of the landscape's span over a turn are equal to rounding.
-const ROUNDING: f64 = 1e-9;
+pub(super) const ROUNDING: f64 = 1e-9;
 /// The rims are looked for from this many substeps in one landscape on (see
 /// [`Motor::energy_checked_error`]).
 const LEVELS_AFTER: u32 = 2;
 
 /// The rims and the lowest minimum of a landscape over a turn.
 #[derive(Clone, Copy, Debug)]
-struct Levels {
+pub(super) struct Levels {
     /// The rims' heights (J), the first `count` of them.
     rims: [f64; MAX_WELLS + 1],
     count: usize,
@@ -72,7 +72,7 @@ impl Levels {
     }
 
     /// Whether a rim's height lies in `(low, high]`.
-    fn between(&self, low: f64, high: f64) -> bool {
+    pub(super) fn between(&self, low: f64, high: f64) -> bool {
         self.rims().iter().any(|&h| low < h && h <= high)
     }
 }
@@ -93,6 +93,8 @@ pub(super) struct RimLedger {
     walked: bool,
     /// The last substep's start and end with their energies (J).
     last: [(Vector, f64); 2],
+    /// A free rotor's ([`Motor::free_energy_checked_error`]).
+    pub(super) free: super::free_energy::FreeLedger,
 }
 
 impl RimLedger {
@@ -104,6 +106,7 @@ impl RimLedger {
         substeps: 0,
         walked: false,
         last: [([f64::NAN; 4], 0.0); 2],
+        free: super::free_energy::FreeLedger::NONE,
     };
 }
 
@@ -120,8 +123,11 @@ impl Motor {
         err: f64,
     ) -> f64 {
         // A substep rejected already needs nothing more; one forced beyond it is flagged.
-        if !d.locked || self.quasi_static() || err > 1.0 || err.is_nan() {
+        if self.quasi_static() || err > 1.0 || err.is_nan() {
             return err;
+        }
+        if !d.locked {
+            return self.free_energy_checked_error(&mut ledger.free, (y, y_new), dt, d, err);
         }
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;
@@ -212,7 +218,7 @@ impl Motor {
 
     /// The rims and lowest minimum of the landscape `land` over a turn, from the wells met
     /// walking up from the one about `near`; `None` where a well is not found.
-    fn levels(&self, land: &Landscape, near: f64) -> Option<Levels> {
+    pub(super) fn levels(&self, land: &Landscape, near: f64) -> Option<Levels> {
         let first = self.onion_well(land, near)?;
         let end = first.below + 2.0 * std::f64::consts::PI;
         let mut levels = Levels {

@@ -382,6 +382,7 @@ impl Motor {
                 above,
                 sampled_level: f64::INFINITY,
                 decay_retry_level: f64::INFINITY,
+                ..*found
             };
         }
         let Rims {
@@ -493,6 +494,9 @@ pub(super) struct Rims {
     /// The energy above the minimum (J) below which [`Motor::locked_ringing_decays`] is tried
     /// again in this segment; infinite before.
     pub(super) decay_retry_level: f64,
+    /// Whether the segment ends at the step's end, no switch before it (see
+    /// [`Motor::decoupled_ringing`]).
+    pub(super) ends_step: bool,
 }
 
 impl Rims {
@@ -503,6 +507,7 @@ impl Rims {
         above: f64::NAN,
         sampled_level: f64::INFINITY,
         decay_retry_level: f64::INFINITY,
+        ends_step: true,
     };
 }
 

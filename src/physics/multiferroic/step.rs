@@ -412,7 +412,14 @@ impl Motor {
             // one substep in the budget.
             run.extra_cost = run.extra_cost.saturating_add(1);
             if run.rim_barrier.0 != segment_end {
-                run.rim_barrier = (segment_end, Rims::NONE);
+                let ends_step = segment_end >= run.t_end;
+                run.rim_barrier = (
+                    segment_end,
+                    Rims {
+                        ends_step,
+                        ..Rims::NONE
+                    },
+                );
             }
             // The averaging's check costs about half a Gilbert substep: it is tried at attempts
             // spaced by an eighth of those made (the ringing decays geometrically in time).
