@@ -164,7 +164,7 @@ fn complex_phis(x: f64, y: f64) -> [(f64, f64); 3] {
 
 /// A block-diagonal linear part's `phi` functions and matrices at one substep length: the rotor's
 /// block (states 0, 1) and the onion's (states 2, 3), each times that length.
-struct Blocks {
+pub(super) struct Blocks {
     phi: [BlockPhi; 2],
     z: [[[f64; 2]; 2]; 2],
 }
@@ -172,7 +172,7 @@ struct Blocks {
 impl Blocks {
     /// `None` where a block's `phi` functions are not available ([`BlockPhi::new`]).
     #[inline(always)]
-    fn new(j: &[[f64; 4]; 4], h: f64) -> Option<Self> {
+    pub(super) fn new(j: &[[f64; 4]; 4], h: f64) -> Option<Self> {
         let block = |b: usize| {
             [
                 [h * j[b][b], h * j[b][b + 1]],
@@ -188,7 +188,7 @@ impl Blocks {
 
     /// The blocks at twice the length.
     #[inline(always)]
-    fn doubled(&self) -> Self {
+    pub(super) fn doubled(&self) -> Self {
         let z = self.z.map(|b| b.map(|r| r.map(|x| 2.0 * x)));
         Self {
             phi: [
@@ -225,7 +225,7 @@ impl Blocks {
 /// (the formulas of the one-block [`Motor::etd_rk4`]); `half` and `full` are its blocks at
 /// `h/2` and `h`.
 #[inline(always)]
-fn etd_rk4_blocks(
+pub(super) fn etd_rk4_blocks(
     y0: &Vector,
     f0: Vector,
     h: f64,
@@ -325,7 +325,7 @@ impl Motor {
     /// answers the onion's torque over its drag, the rotor's relaxation rate `k/c` and
     /// `sqrt(|d psi'/d phi| (k/I) / (c/I))` (the one-block method's bound without the onion
     /// block's own rates). Infinite for a rotor without drag.
-    fn coupling_rate_bound(&self, j: &[[f64; 4]; 4]) -> f64 {
+    pub(super) fn coupling_rate_bound(&self, j: &[[f64; 4]; 4]) -> f64 {
         let coupling = j[2][0].abs() + j[3][0].abs();
         let drag_rate = j[1][1].abs();
         let relaxation = j[1][0].abs() / drag_rate;
@@ -346,8 +346,8 @@ pub(super) const RETRY_ABOVE: f64 = std::f64::consts::SQRT_2;
 /// than its own precession (a large ring holding a light onion) the coupling is the dynamics, and
 /// with it explicit a 1 us step ended hundreds of tolerances off a plain RK4 where the one-block
 /// method stays within a few.
-const WEAK_COUPLING: f64 = 1.0 / 16.0;
+pub(super) const WEAK_COUPLING: f64 = 1.0 / 16.0;
 
 /// The longest substep relative to the explicit rates: classical RK4's stability region reaches
 /// about 2.8 along the negative real axis and the imaginary one (as the one-block method's).
-const ETD_REACH: f64 = 2.5;
+pub(super) const ETD_REACH: f64 = 2.5;

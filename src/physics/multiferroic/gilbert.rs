@@ -159,7 +159,7 @@ impl Motor {
     /// `|trace| + sqrt(|det|)` (its eigenvalues' sum and product), the rotor's drag rate and
     /// undamped frequency, and the onion's rates per rotor turn. The explicit pair's stability needs `dt` times it
     /// within [`EXPLICIT_REACH`].
-    fn fastest_rate(&self, j: &[[f64; 4]; 4]) -> f64 {
+    pub(super) fn fastest_rate(&self, j: &[[f64; 4]; 4]) -> f64 {
         let onion_trace = (j[2][2] + j[3][3]).abs();
         let onion_det = (j[2][2] * j[3][3] - j[2][3] * j[3][2]).abs();
         let rotor = j[1][1].abs() + j[1][0].abs().sqrt() + j[1][2].abs().sqrt();
@@ -382,7 +382,7 @@ const LOCKED_ETD_ERROR_SCALE: f64 = 16.0;
 /// The longest explicit substep relative to the fastest rate (see
 /// [`Motor::gilbert_explicit_step`]): Dormand-Prince 5(4)'s stability region reaches about 3.3
 /// along the negative real axis and 3.4 along the imaginary one.
-const EXPLICIT_REACH: f64 = 3.0;
+pub(super) const EXPLICIT_REACH: f64 = 3.0;
 
 /// `(6 I - 1.5 dt J)^-1 v`, the (0,1) Padé approximant of `phi_3(dt J)` applied to `v`, solved
 /// with the speed in units of `unit` (as the exponential is balanced, see

@@ -492,6 +492,9 @@ impl Motor {
                 run.t = if from_rest { segment_end } else { t + dt_try }.min(run.t_end);
                 run.dt = dt_try;
             }
+            None if self.onion_leaves_bounds(&run.y, dt_try, d, &angles) => {
+                Self::leave_bounds(run, dt_try);
+            }
             None => run.dt = (0.2 * dt_try).max(dt_min),
         }
     }

@@ -41,7 +41,9 @@
 //! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
 //! rotor's ringing onion that neither a drop nor forced substeps can follow through the
 //! schedule's switches refuses the step (`locked_switches.rs`), as does a locked step whose
-//! switches outnumber its loop's passes once the linear spans fail (`switch_count.rs`).
+//! switches outnumber its loop's passes once the linear spans fail (`switch_count.rs`). A free
+//! rotor's onion whose tilt leaves its bounds escapes at the substep that carries it out, not at
+//! the budget's smallest (`tilt_exit.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
@@ -145,6 +147,9 @@ mod switch_count;
 mod switch_count_tests;
 #[cfg(test)]
 mod tests;
+mod tilt_exit;
+#[cfg(test)]
+mod tilt_exit_tests;
 mod validation;
 
 use angles::Angles;

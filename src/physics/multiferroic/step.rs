@@ -66,9 +66,13 @@ pub(super) struct StepRun {
     /// The well in which the orbit-averaged advance last refused a locked rotor's onion too near
     /// its rim (see [`Motor::rim_refusal_holds`]).
     pub(super) rim_refusal: super::orbit_rim_refusal::RimRefusal,
-    /// The Gilbert onion left its bounds at the smallest substep allowed: the next pass drops
-    /// its ringing however slowly it decays ([`Motor::follows_branch`]).
+    /// The Gilbert onion left its bounds at the smallest substep allowed, or within a substep
+    /// ([`Motor::leave_bounds`]): the next pass drops its ringing however slowly it decays
+    /// ([`Motor::follows_branch`]).
     pub(super) onion_escaped: bool,
+    /// The time at which the Gilbert onion was last found to leave its bounds within a
+    /// refused substep (see [`Motor::leave_bounds`]).
+    pub(super) bounds_exit_at: f64,
     /// The stepping schedule switching inside this step, if any.
     pub(super) schedule: Option<super::SteppingSchedule>,
     /// A locked rotor's ringing onion outlasts what the budget left can resolve (see
@@ -120,6 +124,7 @@ impl StepRun {
             linear_wait: (f64::NAN, f64::NAN),
             rim_refusal: super::orbit_rim_refusal::RimRefusal::NONE,
             onion_escaped: false,
+            bounds_exit_at: f64::NAN,
             schedule: None,
             unresolvable: false,
             rim_ledger: super::rim_energy::RimLedger::NONE,
