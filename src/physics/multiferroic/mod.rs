@@ -102,6 +102,9 @@ mod orbit;
 mod orbit_advance;
 mod orbit_averager;
 mod orbit_finish;
+mod orbit_kept_well;
+#[cfg(test)]
+mod orbit_kept_well_tests;
 mod orbit_phase;
 #[cfg(test)]
 mod orbit_phase_tests;
