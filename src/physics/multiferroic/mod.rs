@@ -25,9 +25,10 @@
 //! drag keeps that pair out of reach (with the onion's block exact too where the two barely
 //! couple, `etd_blocks.rs`), else an exponential Rosenbrock pair (`gilbert.rs`); weakly damped
 //! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`,
-//! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`; a locked rotor's last
-//! orbit is resolved at once, `orbit_finish.rs`, its onion refused near the rim is refused
-//! again from the well kept, `orbit_rim_refusal.rs`, and its ringing small enough to be linear
+//! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`, the wells its checks find
+//! kept per landscape, `orbit_kept_well.rs`; a locked rotor's last orbit is resolved at once,
+//! `orbit_finish.rs`, its onion refused near the rim is refused again from the well kept,
+//! `orbit_rim_refusal.rs`, and its ringing small enough to be linear
 //! advances by its exact linear flow, `linear_ringing.rs`); a locked rotor's onion near or
 //! above its wells' rims is held to what its energy, which only falls, can reach
 //! (`rim_energy.rs`), a free rotor's to what the rotor's turn can feed it (`free_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
@@ -108,6 +109,9 @@ mod orbit;
 mod orbit_advance;
 mod orbit_averager;
 mod orbit_finish;
+mod orbit_kept_well;
+#[cfg(test)]
+mod orbit_kept_well_tests;
 mod orbit_phase;
 #[cfg(test)]
 mod orbit_phase_tests;

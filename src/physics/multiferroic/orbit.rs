@@ -232,7 +232,11 @@ impl Motor {
     /// The well of eq. 3.4 at rotor angle `phi` whose minimum the onion at `near` settles into,
     /// with its rims; `None` where it has none (a flat or degenerate landscape).
     pub(super) fn onion_well(&self, land: &Landscape, near: f64) -> Option<Well> {
-        let minimum = land.settle(near);
+        self.well_of_minimum(land, land.settle(near))
+    }
+
+    /// [`Self::onion_well`] of the minimum `minimum` (`land.settle` of the onion).
+    pub(super) fn well_of_minimum(&self, land: &Landscape, minimum: f64) -> Option<Well> {
         let k = land.curvature(minimum);
         let m = land.third_derivative_bound();
         if !(k > 0.0 && k.is_finite() && m > 0.0 && m.is_finite()) {

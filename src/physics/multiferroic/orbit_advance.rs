@@ -6,6 +6,7 @@ use super::onion::Landscape;
 use super::orbit::{point, Orbit, Well};
 use super::orbit_averager::{Averager, Slow};
 use super::orbit_finish::MAX_FINISH_STEPS;
+use super::orbit_kept_well::KeptWell;
 use super::orbit_rim_refusal::RimRefusal;
 use super::step::StepRun;
 use super::{Drive, Motor, Vector};
@@ -104,14 +105,16 @@ impl Motor {
         }
         let max_steps = (allowance - MARCH_STEPS - 4) / AVERAGED_STEP_WEIGHT;
         let mut near_rim = None;
-        let first = self.averageable(&run.y, d, segment_end - run.t, &mut near_rim);
+        let kept = &mut run.kept_well;
+        let first = self.averageable(&run.y, d, segment_end - run.t, &mut near_rim, kept);
         if let Some(well) = near_rim {
             run.rim_refusal = RimRefusal::new(segment_end, run.y[0], &well, RIM_MARGIN);
         }
         let (well, o, _, _) = first?;
         let (y, marched, resolved) = self.march_to_turning_point(&run.y, d, &well, o.period)?;
         let start = run.t + marched;
-        let (well, o, dropped, placed) = self.averageable(&y, d, segment_end - start, &mut None)?;
+        let (well, o, dropped, placed) =
+            self.averageable(&y, d, segment_end - start, &mut None, &mut run.kept_well)?;
         let land = self.landscape(y[0], d.direction, d.stress);
         let overdamped = !d.locked && self.overdamped(o.period);
         let omega = self.rotor_speed(&y, d, overdamped);
@@ -368,6 +371,7 @@ impl Motor {
         d: &Drive,
         remaining: f64,
         near_rim: &mut Option<Well>,
+        kept: &mut KeptWell,
     ) -> Option<(Well, Orbit, bool, bool)> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;
@@ -379,7 +383,8 @@ impl Motor {
         // First from the linearization at the minimum (no search for the rims): its period
         // `2 pi / (g sqrt(k T))` and energy loss per orbit `g alpha (k + T) P` (the orbit's are
         // within a factor of two of them in the wells met), against the checks below.
-        let k = land.curvature(land.settle(y[2]));
+        let minimum = land.settle(y[2]);
+        let k = land.curvature(minimum);
         let period = 2.0 * PI / (self.llg_rate * (k * t).sqrt());
         let loss = self.llg_rate * self.params.gilbert_damping * (k + t) * period;
         let stiff = !d.locked
@@ -388,7 +393,7 @@ impl Motor {
         if !(loss <= 2.0 * MAX_LOSS_PER_ORBIT && remaining >= 0.5 * MIN_ORBITS * period) || stiff {
             return None;
         }
-        let well = self.onion_well(&land, y[2])?;
+        let well = self.kept_onion_well(kept, &land, minimum)?;
         let omega = self.rotor_speed(y, d, self.overdamped(period));
         // The tilt about the orbit's centre.
         let tilt = y[3] - self.tilt_centre(&land, &well, omega);

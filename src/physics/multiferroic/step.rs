@@ -66,6 +66,9 @@ pub(super) struct StepRun {
     /// The well in which the orbit-averaged advance last refused a locked rotor's onion too near
     /// its rim (see [`Motor::rim_refusal_holds`]).
     pub(super) rim_refusal: super::orbit_rim_refusal::RimRefusal,
+    /// The wells that the orbit-averaged advance's checks found in the last landscape they
+    /// searched (see [`Motor::kept_onion_well`]).
+    pub(super) kept_well: super::orbit_kept_well::KeptWell,
     /// The Gilbert onion left its bounds at the smallest substep allowed, or within a substep
     /// ([`Motor::leave_bounds`]): the next pass drops its ringing however slowly it decays
     /// ([`Motor::follows_branch`]).
@@ -123,6 +126,7 @@ impl StepRun {
             orbit_check_at: 0,
             linear_wait: (f64::NAN, f64::NAN),
             rim_refusal: super::orbit_rim_refusal::RimRefusal::NONE,
+            kept_well: super::orbit_kept_well::KeptWell::NONE,
             onion_escaped: false,
             bounds_exit_at: f64::NAN,
             schedule: None,
