@@ -51,6 +51,7 @@
 
 pub mod angles;
 pub mod branch;
+mod branch_settle;
 mod cycle;
 mod decoupled;
 mod decoupled_drop;
