@@ -8,9 +8,10 @@ use super::angles::Angles;
 use super::{Drive, Motor, Vector};
 
 impl Motor {
-    /// Whether the minimum of eq. 3.4 that the onion at `y` settles into for the drive `d`
-    /// ([`Self::settle`]) lies provably more than `gap` (rad) from it, from the gradient `U'` and
-    /// curvature `U''` at the onion alone (one evaluation where the settle marches and refines).
+    /// The angles at the onion at `y` for the drive `d`, where the settle starts
+    /// ([`Self::settle`]), or `None` where the minimum it settles into lies provably more than
+    /// `gap` (rad) from it, from the gradient `U'` and curvature `U''` at the onion alone (one
+    /// evaluation where the settle marches and refines).
     ///
     /// Along `s` rad from the onion, `|U''| <= |U''(psi)| + M s` with `M` the landscape's
     /// third-derivative bound, so `|U'|` stays above `|U'(psi)| - |U''(psi)| s - M s^2 / 2`: no
@@ -19,16 +20,18 @@ impl Motor {
     /// tolerance; `r` is taken as four times `gap` plus four root tolerances, so the first
     /// stride, each Newton step that converges and each bracket the refinement returns from all
     /// lie beyond `gap`. Where the settle would stay at the start (a gradient within its
-    /// rounding, or no finite third-derivative bound) this returns `false`. `false` for NaN.
-    pub(super) fn settles_farther_than(&self, y: &Vector, d: &Drive, gap: f64) -> bool {
+    /// rounding, or no finite third-derivative bound) the angles are returned, as for NaN.
+    pub(super) fn settle_start_within(&self, y: &Vector, d: &Drive, gap: f64) -> Option<Angles> {
         let land = self.landscape(y[0], d.direction, d.stress);
-        let (g, c) = land.gradient_curvature_of(&land.angles(y[2]));
+        let start = land.angles(y[2]);
+        let (g, c) = land.gradient_curvature_of(&start);
         let m = land.third_derivative_bound();
         if !(g.abs() > land.gradient_tolerance() && m.is_finite() && m > 0.0) {
-            return false;
+            return Some(start);
         }
         let r = 4.0 * (gap + land.root_tolerance(y[2]));
-        g.abs() > c.abs() * r + 0.5 * m * r * r
+        let beyond = g.abs() > c.abs() * r + 0.5 * m * r * r;
+        (!beyond).then_some(start)
     }
 
     /// [`Self::heads_for_minimum`] with the angles at the minimum it settles into, `None` where

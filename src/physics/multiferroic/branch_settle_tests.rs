@@ -83,7 +83,7 @@ fn following_onion_settles_twice_a_switch() {
     assert!(settles <= 2 * switches as u64 + 100, "{settles} settles, {switches} switches");
 }
 
-/// [`Motor::settles_farther_than`] against the settle itself, over both cases' landscapes, every
+/// [`Motor::settle_start_within`] against the settle itself, over both cases' landscapes, every
 /// rotor angle, strain direction and onion angle on a grid and gaps from 1e-12 to 1 rad: where
 /// it says the minimum is beyond the gap, the settle lands beyond it. It must also say so
 /// often, or the check would be empty.
@@ -113,7 +113,7 @@ fn settle_bound_never_misses_a_minimum_within_the_gap() {
                     for e in 0..13 {
                         let gap = 10f64.powi(-e);
                         checked += 1;
-                        if m.settles_farther_than(&y, &d, gap) {
+                        if m.settle_start_within(&y, &d, gap).is_none() {
                             farther += 1;
                             assert!(
                                 (settled - onion).abs() > gap,

@@ -65,15 +65,18 @@ impl Motor {
             let ringing = 0.1 * tol * self.rotor_relaxation_time() / lag_time;
             tol + lag.max(ringing).min(MAX_FOLLOWED_LAG)
         };
-        if !d.locked
-            && rim_barrier.is_none()
-            && (!self.onion_relaxes_fast()
-                || y[3].abs() > slack()
-                || self.settles_farther_than(y, d, slack()))
-        {
-            return None;
-        }
-        let settled = self.settle(y, d);
+        let settled = if !d.locked && rim_barrier.is_none() {
+            if !self.onion_relaxes_fast() || y[3].abs() > slack() {
+                return None;
+            }
+            // The same march as `self.settle`, from the angles the bound evaluated.
+            let start = self.settle_start_within(y, d, slack())?;
+            self.landscape(y[0], d.direction, d.stress)
+                .settle_from(start)
+                .onion
+        } else {
+            self.settle(y, d)
+        };
         // Whatever is dropped here, the onion carries over the next switch (a locked rotor's
         // speed, and so its lag, is 0). A free rotor's onion takes the cheap slack test first.
         let relaxed_in_fact = || self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag);
