@@ -4,7 +4,7 @@
 
 use super::onion::SETTLES;
 use super::onion_periods_tests::{case, values};
-use super::{Drive, Motor, MotorState, MotorInputs};
+use super::{Drive, Motor, MotorInputs, MotorState};
 
 /// A benchmark case: a free rotor on a 1.26 ns schedule turning the strain 0.2 rad (mod pi) a
 /// switch, its onion (damping 0.32, relaxation 0.85 ns) taking one Gilbert substep a switch
@@ -68,7 +68,10 @@ fn branch_check_skips_the_settle_far_from_the_minimum() {
     let (substeps, switches, settles) = settles_in_a_step(ONE_SUBSTEP_A_SWITCH, 1);
     println!("{substeps} substeps, {switches} switches, {settles} settles");
     assert!(switches > 700, "{switches}");
-    assert!(10 * settles <= switches as u64, "{settles} settles, {switches} switches");
+    assert!(
+        10 * settles <= switches as u64,
+        "{settles} settles, {switches} switches"
+    );
 }
 
 /// The onion following its branch after the budget is spent is settled once at each switch by
@@ -80,7 +83,10 @@ fn following_onion_settles_twice_a_switch() {
     let (substeps, switches, settles) = settles_in_a_step(FOLLOWING_A_FAST_SCHEDULE, 1);
     println!("{substeps} substeps, {switches} switches, {settles} settles");
     assert!(switches > 700, "{switches}");
-    assert!(settles <= 2 * switches as u64 + 100, "{settles} settles, {switches} switches");
+    assert!(
+        settles <= 2 * switches as u64 + 100,
+        "{settles} settles, {switches} switches"
+    );
 }
 
 /// [`Motor::settle_start_within`] against the settle itself, over both cases' landscapes, every

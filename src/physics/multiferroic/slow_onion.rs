@@ -22,7 +22,13 @@ impl Motor {
 
     /// [`Self::heads_for_minimum`] for the onion at `y` and the `minimum` of `land` it settles
     /// into.
-    pub(super) fn heads_for(&self, y: &Vector, minimum: f64, land: &Landscape, horizon: f64) -> bool {
+    pub(super) fn heads_for(
+        &self,
+        y: &Vector,
+        minimum: f64,
+        land: &Landscape,
+        horizon: f64,
+    ) -> bool {
         let k = land.curvature(minimum);
         if k.is_nan() || k <= 0.0 {
             return false;
