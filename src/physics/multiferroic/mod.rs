@@ -56,6 +56,9 @@
 
 pub mod angles;
 pub mod branch;
+mod branch_settle;
+#[cfg(test)]
+mod branch_settle_tests;
 mod cycle;
 mod decoupled;
 mod decoupled_drop;

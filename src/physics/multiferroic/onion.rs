@@ -45,6 +45,12 @@ pub fn curvature_slope_bound(ring_bar: &RingBar) -> f64 {
     1.25 * max
 }
 
+#[cfg(test)]
+thread_local! {
+    /// Calls of [`Landscape::settle_from`] (tests count them).
+    pub(super) static SETTLES: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
 /// Energy landscape of eq. 3.4 in the onion angle, for a fixed bar angle and strain.
 #[derive(Clone, Copy, Debug)]
 pub struct Landscape<'a> {
@@ -143,6 +149,8 @@ impl Landscape<'_> {
     /// returning the angles at the minimum: each evaluation turns the last one's angles (see
     /// [`Angles::moved`]) instead of calling libm.
     pub fn settle_from(&self, start: Angles) -> Angles {
+        #[cfg(test)]
+        SETTLES.with(|c| c.set(c.get() + 1));
         let (g0, c0) = self.gradient_curvature_of(&start);
         let tiny = self.gradient_tolerance();
         if g0.abs() <= tiny && c0 > 0.0 {

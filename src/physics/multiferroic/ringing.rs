@@ -56,10 +56,27 @@ impl Motor {
         if rim_barrier.is_none() && !small_tilt {
             return None;
         }
-        let settled = self.settle(y, d);
         let tol = self.params.tolerance;
         let lag_time = self.onion_relaxation_time();
         let lag = (4.0 * lag_time * y[1].abs()).min(MAX_FOLLOWED_LAG);
+        // A free rotor's onion without the averaged ringing passes only the slack test below,
+        // which a minimum provably beyond the slack fails without the settle's march.
+        let slack = || {
+            let ringing = 0.1 * tol * self.rotor_relaxation_time() / lag_time;
+            tol + lag.max(ringing).min(MAX_FOLLOWED_LAG)
+        };
+        let settled = if !d.locked && rim_barrier.is_none() {
+            if !self.onion_relaxes_fast() || y[3].abs() > slack() {
+                return None;
+            }
+            // The same march as `self.settle`, from the angles the bound evaluated.
+            let start = self.settle_start_within(y, d, slack())?;
+            self.landscape(y[0], d.direction, d.stress)
+                .settle_from(start)
+                .onion
+        } else {
+            self.settle(y, d)
+        };
         // Whatever is dropped here, the onion carries over the next switch (a locked rotor's
         // speed, and so its lag, is 0). A free rotor's onion takes the cheap slack test first.
         let relaxed_in_fact = || self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag);
@@ -75,8 +92,7 @@ impl Motor {
         } else {
             if self.onion_relaxes_fast() {
                 // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
-                let ringing = 0.1 * tol * self.rotor_relaxation_time() / lag_time;
-                let slack = tol + lag.max(ringing).min(MAX_FOLLOWED_LAG);
+                let slack = slack();
                 if y[3].abs() <= slack && (settled - y[2]).abs() <= slack {
                     return relaxed_in_fact().then_some(0.0);
                 }

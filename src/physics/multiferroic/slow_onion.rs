@@ -1,6 +1,7 @@
 //! Whether a Gilbert onion that a step cannot afford to resolve may be put on its quasi-static
 //! branch: only if it heads for the branch's minimum within the step anyway.
 
+use super::onion::Landscape;
 use super::{Drive, Motor, Vector};
 
 impl Motor {
@@ -16,7 +17,18 @@ impl Motor {
     /// barely moves: 38.5 rad off after a 1 us step on a 1.26 ns schedule (`lambda T` 4e-6).
     pub(super) fn heads_for_minimum(&self, y: &Vector, d: &Drive, horizon: f64) -> bool {
         let land = self.landscape(y[0], d.direction, d.stress);
-        let minimum = land.settle(y[2]);
+        self.heads_for(y, land.settle(y[2]), &land, horizon)
+    }
+
+    /// [`Self::heads_for_minimum`] for the onion at `y` and the `minimum` of `land` it settles
+    /// into.
+    pub(super) fn heads_for(
+        &self,
+        y: &Vector,
+        minimum: f64,
+        land: &Landscape,
+        horizon: f64,
+    ) -> bool {
         let k = land.curvature(minimum);
         if k.is_nan() || k <= 0.0 {
             return false;

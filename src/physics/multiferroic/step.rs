@@ -394,6 +394,8 @@ impl Motor {
         let spent = run.attempts.saturating_add(run.extra_cost);
         let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
         let out_of_budget = (run.limited || broke) && self.onion_relaxes_fast();
+        // The minimum an onion heading for it settles into, where the branch then starts.
+        let mut minimum = None;
         let dropped = out_of_budget
             && (run.onion_escaped
                 || if d.locked {
@@ -402,7 +404,8 @@ impl Motor {
                     let to_switch = run
                         .schedule
                         .map_or(f64::INFINITY, |s| s.next_switch_after(run.t) - run.t);
-                    self.heads_for_minimum(&run.y, d, run.t_end - run.start)
+                    minimum = self.heads_for_settled(&run.y, d, run.t_end - run.start);
+                    minimum.is_some()
                         || run.limited
                             && self.decoupled_budget_drop(&run.y, d, run.t_end - run.t, to_switch)
                 });
@@ -451,6 +454,13 @@ impl Motor {
         run.angles = None;
         run.settled = false;
         run.settle_tried_for = f64::NAN;
+        if let Some(a) = minimum {
+            // What the next constrain would settle the onion into (the same march from the
+            // same angles).
+            run.y[2] = a.onion;
+            run.angles = Some(a);
+            run.settled = true;
+        }
         true
     }
 

@@ -1,0 +1,47 @@
+//! The quasi-static settle behind the Gilbert onion's checks for its branch
+//! ([`Motor::relaxed_onion`], [`Motor::heads_for_minimum`]): skipped where a bound on eq. 3.4's
+//! landscape shows that the minimum lies beyond the checks' slack (the onion right after a
+//! switch of a fast schedule, once a switch), and handed on where the onion joins its branch so
+//! that the next constrain does not march to the same minimum again.
+
+use super::angles::Angles;
+use super::{Drive, Motor, Vector};
+
+impl Motor {
+    /// The angles at the onion at `y` for the drive `d`, where the settle starts
+    /// ([`Self::settle`]), or `None` where the minimum it settles into lies provably more than
+    /// `gap` (rad) from it, from the gradient `U'` and curvature `U''` at the onion alone (one
+    /// evaluation where the settle marches and refines).
+    ///
+    /// Along `s` rad from the onion, `|U''| <= |U''(psi)| + M s` with `M` the landscape's
+    /// third-derivative bound, so `|U'|` stays above `|U'(psi)| - |U''(psi)| s - M s^2 / 2`: no
+    /// root of the gradient lies within `r` where that is positive at `s = r`. The settle's
+    /// downhill march never steps over a root (see [`super::onion`]) and ends on one, to its root
+    /// tolerance; `r` is taken as four times `gap` plus four root tolerances, so the first
+    /// stride, each Newton step that converges and each bracket the refinement returns from all
+    /// lie beyond `gap`. Where the settle would stay at the start (a gradient within its
+    /// rounding, or no finite third-derivative bound) the angles are returned, as for NaN.
+    pub(super) fn settle_start_within(&self, y: &Vector, d: &Drive, gap: f64) -> Option<Angles> {
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let start = land.angles(y[2]);
+        let (g, c) = land.gradient_curvature_of(&start);
+        let m = land.third_derivative_bound();
+        if !(g.abs() > land.gradient_tolerance() && m.is_finite() && m > 0.0) {
+            return Some(start);
+        }
+        let r = 4.0 * (gap + land.root_tolerance(y[2]));
+        let beyond = g.abs() > c.abs() * r + 0.5 * m * r * r;
+        (!beyond).then_some(start)
+    }
+
+    /// [`Self::heads_for_minimum`] with the angles at the minimum it settles into, `None` where
+    /// the onion does not head for it: the minimum is [`Self::constrain`]'s for a quasi-static
+    /// onion at `y` (the same march from the same angles), so the branch that the onion joins
+    /// starts there without a second march.
+    pub(super) fn heads_for_settled(&self, y: &Vector, d: &Drive, horizon: f64) -> Option<Angles> {
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let minimum = land.settle_from(land.angles(y[2]));
+        self.heads_for(y, minimum.onion, &land, horizon)
+            .then_some(minimum)
+    }
+}
