@@ -31,7 +31,9 @@
 //! `orbit_rim_refusal.rs`, and its ringing small enough to be linear
 //! advances by its exact linear flow, `linear_ringing.rs`); a locked rotor's onion near or
 //! above its wells' rims is held to what its energy, which only falls, can reach
-//! (`rim_energy.rs`), a free rotor's to what the rotor's turn can feed it (`free_energy.rs`). On fast schedules whose ring barely couples the onion to the rotor,
+//! (`rim_energy.rs`), a free rotor's to what the rotor's turn can feed it (`free_energy.rs`).
+//! A free rotor's onion is settled on its branch only where a minimum can lie within the check's
+//! slack (`branch_settle.rs`). On fast schedules whose ring barely couples the onion to the rotor,
 //! repeated periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an
 //! onion near its path advances by exact affine maps per switch (`onion_linear.rs`; a locked
 //! rotor's, the ring's torque folded into them, by `onion_linear_locked.rs`). The estimate
