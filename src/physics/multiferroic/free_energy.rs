@@ -73,6 +73,10 @@ impl Motor {
         d: &Drive,
         err: f64,
     ) -> f64 {
+        // A substep rejected already needs nothing more; one forced beyond it is flagged.
+        if self.quasi_static() || err > 1.0 || err.is_nan() {
+            return err;
+        }
         let key = [d.direction, d.stress];
         if ledger.key != key {
             *ledger = FreeLedger {

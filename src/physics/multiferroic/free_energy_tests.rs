@@ -1,10 +1,10 @@
 //! A free rotor's Gilbert onion held to what its energy can do ([`Motor::free_energy_checked_error`])
 //! on a benchmark draw, against a plain RK4 of the motor's equations.
 
+use super::free_energy::FreeLedger;
 use super::locked_accuracy_tests::converged_rk4;
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
-use super::rim_energy::RimLedger;
 use super::*;
 
 /// A benchmark draw: a load-driven rotor (3,006 rad/s) whose ring's torque (below 6e-20 N m)
@@ -55,12 +55,12 @@ fn a_substep_that_raises_the_energy_beyond_the_tolerance_is_rejected() {
     let off = [(u[2] - truth[2]).abs() / tol, (u[3] - truth[3]).abs() / tol];
     println!("estimate {err}, off by {off:?} tolerances");
     assert!(err <= 1.0 && off[0] > 4.0 && off[1] > 4.0, "{err} {off:?}");
-    let mut ledger = RimLedger::NONE;
-    let checked = m.energy_checked_error(&mut ledger, (&y0, &u), dt, &d, err);
+    let mut ledger = FreeLedger::NONE;
+    let checked = m.free_energy_checked_error(&mut ledger, (&y0, &u), dt, &d, err);
     assert!(checked > 1.0, "{checked}");
     // The RK4's own end passes.
-    let mut ledger = RimLedger::NONE;
-    let exact = m.energy_checked_error(&mut ledger, (&y0, &truth), dt, &d, 0.5);
+    let mut ledger = FreeLedger::NONE;
+    let exact = m.free_energy_checked_error(&mut ledger, (&y0, &truth), dt, &d, 0.5);
     assert_eq!(exact, 0.5);
 }
 

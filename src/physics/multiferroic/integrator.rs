@@ -426,8 +426,17 @@ impl Motor {
         let result = self
             .controlled_step(&run.y, dt_try, d, &angles, forced, &mut bisections)
             .map(|(u, err, taken, a)| {
-                let ledger = &mut run.rim_ledger;
-                let err = self.energy_checked_error(ledger, (&run.y, &u), taken, d, err);
+                let err = if d.locked {
+                    self.energy_checked_error(&mut run.rim_ledger, (&run.y, &u), taken, d, err)
+                } else {
+                    self.free_energy_checked_error(
+                        &mut run.free_ledger,
+                        (&run.y, &u),
+                        taken,
+                        d,
+                        err,
+                    )
+                };
                 (u, err, taken, a)
             });
         run.extra_cost = run.extra_cost.saturating_add(bisections);

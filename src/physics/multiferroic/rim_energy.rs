@@ -93,8 +93,6 @@ pub(super) struct RimLedger {
     walked: bool,
     /// The last substep's start and end with their energies (J).
     last: [(Vector, f64); 2],
-    /// A free rotor's ([`Motor::free_energy_checked_error`]).
-    pub(super) free: super::free_energy::FreeLedger,
 }
 
 impl RimLedger {
@@ -106,7 +104,6 @@ impl RimLedger {
         substeps: 0,
         walked: false,
         last: [([f64::NAN; 4], 0.0); 2],
-        free: super::free_energy::FreeLedger::NONE,
     };
 }
 
@@ -123,11 +120,8 @@ impl Motor {
         err: f64,
     ) -> f64 {
         // A substep rejected already needs nothing more; one forced beyond it is flagged.
-        if self.quasi_static() || err > 1.0 || err.is_nan() {
+        if !d.locked || self.quasi_static() || err > 1.0 || err.is_nan() {
             return err;
-        }
-        if !d.locked {
-            return self.free_energy_checked_error(&mut ledger.free, (y, y_new), dt, d, err);
         }
         let land = self.landscape(y[0], d.direction, d.stress);
         let t = self.tilt_stiffness;

@@ -83,6 +83,9 @@ pub(super) struct StepRun {
     pub(super) unresolvable: bool,
     /// The energy bound of a locked rotor's Gilbert onion (see [`Motor::energy_checked_error`]).
     pub(super) rim_ledger: super::rim_energy::RimLedger,
+    /// The energy bound of a free rotor's Gilbert onion (see
+    /// [`Motor::free_energy_checked_error`]).
+    pub(super) free_ledger: super::free_energy::FreeLedger,
 }
 
 impl StepRun {
@@ -132,6 +135,7 @@ impl StepRun {
             schedule: None,
             unresolvable: false,
             rim_ledger: super::rim_energy::RimLedger::NONE,
+            free_ledger: super::free_energy::FreeLedger::NONE,
         }
     }
 
