@@ -90,20 +90,8 @@ fn linear_spans_carry_steps_whose_switches_outnumber_a_small_budget() {
 /// saying so, within a few passes of its start rather than after all 216, its state untouched.
 #[test]
 fn switches_outnumbering_the_passes_are_refused_once_the_spans_fail() {
-    let (report, passes, _) = first_step(
-        "ring_outer_diameter=6.689773374482153e-1 ring_inner_diameter=5.229719702063255e-4 \
-         bar_length=4.2246868198660125e-6 bar_width=4.0243948089677603e-7 \
-         thickness=1.4288504805448858e-7 saturation_magnetization=3.665867080948071e5 \
-         magnetostriction=9.351657340221425e-3 wall_volume=5.519678402375946e-11 \
-         density=6.12984964452289e4 fluid_viscosity=1.4404841299204888e-2 \
-         gilbert_damping=9.397088279062384e-4 tolerance=4.2497998935769707e-10 \
-         step_angle=1.731028576858023e0 step_period=1.2947742291561714e-9 \
-         stress_amplitude=2.239088779306622e2 schedule_initial_direction=8.628510614585825e5 \
-         onion_model=1 schedule=1 rotor_locked=1 \
-         initial_onion_offset=1.9820298572340874e-9 load_torque=-2.480124847198726e-7",
-        100.0,
-        200.0,
-    );
+    let (report, passes, _) =
+        first_step(super::locked_switches_tests::SWINGING_ONION, 100.0, 200.0);
     let e = report.unwrap_err();
     assert!(
         e.contains("spans more schedule switches than max_substeps = 100"),
