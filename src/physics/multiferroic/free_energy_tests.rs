@@ -5,23 +5,13 @@ use super::free_energy::FreeLedger;
 use super::locked_accuracy_tests::converged_rk4;
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
+use super::ringing_drop_tests::C655285;
 use super::*;
 
-/// A benchmark draw: a load-driven rotor (3,006 rad/s) whose ring's torque (below 6e-20 N m)
-/// cannot move it, its onion (damping 6.1e-4, tolerance 0.36 rad) ringing at half to 0.99 of its
+/// [`C655285`]: a load-driven rotor (3,006 rad/s) whose ring's torque (below 6e-20 N m) cannot
+/// move it, its onion (damping 6.1e-4, tolerance 0.36 rad) ringing at half to 0.99 of its
 /// well's rims after each switch of a 148 ns schedule.
-const KNIFE_EDGE: &str = "strain_direction=1.9087674027677695e-1 stress=1.1350007912624836e-2 \
-     load_torque=2.590576462439583e-7 ring_outer_diameter=2.648514502119364e-3 \
-     ring_inner_diameter=4.1335535873901675e-4 bar_length=4.532641425623112e-5 \
-     bar_width=1.0639732046329858e-5 thickness=1.6058389738259973e-7 \
-     saturation_magnetization=2.38431494744953e3 magnetostriction=-3.4212792500328115e-3 \
-     wall_volume=5.9868584587886245e-12 density=1.697099807139386e4 \
-     fluid_viscosity=2.468116466070059e3 gilbert_damping=6.053927675786335e-4 \
-     tolerance=3.560022380381095e-1 step_angle=9.198994615173781e-1 \
-     step_period=1.4776389860623927e-7 stress_amplitude=-1.879794226775489e3 \
-     schedule_initial_direction=-1.0773113871354449e-3 onion_model=1e0 max_substeps=1.8944e4 \
-     schedule=1e0 rotor_locked=0e0 initial_onion_offset=-8.072311717358694e-3 \
-     strain=4.353636316653803e-2 youngs_modulus=1.2960551957357111e10 strain_drive=0e0";
+const KNIFE_EDGE: &str = C655285;
 
 /// After its fourth orbit-averaged advance the onion of [`KNIFE_EDGE`] rings at half its rim's
 /// height. The exponential pair's substep of 4.2 ns from there estimates its error at 0.66

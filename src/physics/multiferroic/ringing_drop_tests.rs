@@ -21,7 +21,8 @@ const C370371: &str = "strain_direction=4.496967955863598e3 stress=1.80767719094
     strain=-6.663143066831397e-2 youngs_modulus=6.129546203860929e10 strain_drive=1e0";
 /// A benchmark case (full precision): a free rotor turning at 3000 rad/s under its load on a
 /// 148 ns schedule, a Gilbert onion damped at 6e-4.
-const C655285: &str = "strain_direction=1.9087674027677695e-1 stress=1.1350007912624836e-2 \
+pub(super) const C655285: &str =
+    "strain_direction=1.9087674027677695e-1 stress=1.1350007912624836e-2 \
     load_torque=2.590576462439583e-7 ring_outer_diameter=2.648514502119364e-3 \
     ring_inner_diameter=4.1335535873901675e-4 bar_length=4.532641425623112e-5 \
     bar_width=1.0639732046329858e-5 thickness=1.6058389738259973e-7 \
