@@ -7,10 +7,31 @@
 use super::angles::Angles;
 use super::{Drive, Motor, Vector};
 
+/// Where a settle starts: the angles at the onion and the gradient and curvature of eq. 3.4
+/// there, which the settle's first iteration uses ([`super::onion::Landscape::settle_from_slope`]).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SettleStart {
+    pub(super) angles: Angles,
+    pub(super) gradient: f64,
+    pub(super) curvature: f64,
+}
+
+/// A Gilbert onion relaxed onto its quasi-static branch ([`Motor::relaxed_onion`]): the rotor's
+/// speed kick (rad/s), the angles at the minimum it settles into (where the branch starts, the
+/// same march from the same angles as the next constrain's) and the curvature of eq. 3.4 there
+/// (which the check evaluated).
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Relaxed {
+    pub(super) kick: f64,
+    pub(super) settled: Angles,
+    pub(super) curvature: f64,
+}
+
 impl Motor {
     /// The angles at the onion at `y` for the drive `d`, where the settle starts
-    /// ([`Self::settle`]), or `None` where the minimum it settles into lies provably more than
-    /// `gap` (rad) from it, from the gradient `U'` and curvature `U''` at the onion alone (one
+    /// ([`Self::settle`]), with the gradient and curvature there (the settle's first iteration
+    /// uses them), or `None` where the minimum it settles into lies provably more than `gap`
+    /// (rad) from it, from the gradient `U'` and curvature `U''` at the onion alone (one
     /// evaluation where the settle marches and refines).
     ///
     /// Along `s` rad from the onion, `|U''| <= |U''(psi)| + M s` with `M` the landscape's
@@ -21,10 +42,20 @@ impl Motor {
     /// stride, each Newton step that converges and each bracket the refinement returns from all
     /// lie beyond `gap`. Where the settle would stay at the start (a gradient within its
     /// rounding, or no finite third-derivative bound) the angles are returned, as for NaN.
-    pub(super) fn settle_start_within(&self, y: &Vector, d: &Drive, gap: f64) -> Option<Angles> {
+    pub(super) fn settle_start_within(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        gap: f64,
+    ) -> Option<SettleStart> {
         let land = self.landscape(y[0], d.direction, d.stress);
-        let start = land.angles(y[2]);
-        let (g, c) = land.gradient_curvature_of(&start);
+        let angles = land.angles(y[2]);
+        let (g, c) = land.gradient_curvature_of(&angles);
+        let start = SettleStart {
+            angles,
+            gradient: g,
+            curvature: c,
+        };
         let m = land.third_derivative_bound();
         if !(g.abs() > land.gradient_tolerance() && m.is_finite() && m > 0.0) {
             return Some(start);
@@ -34,14 +65,14 @@ impl Motor {
         (!beyond).then_some(start)
     }
 
-    /// [`Self::heads_for_minimum`] with the angles at the minimum it settles into, `None` where
-    /// the onion does not head for it: the minimum is [`Self::constrain`]'s for a quasi-static
-    /// onion at `y` (the same march from the same angles), so the branch that the onion joins
-    /// starts there without a second march.
+    /// The angles at the minimum of eq. 3.4 that the onion at `y` settles into for the drive
+    /// `d`, `None` where it does not head for it within `horizon` ([`Self::heads_for_minimum`]):
+    /// the minimum is [`Self::constrain`]'s for a quasi-static onion at `y` (the same march from
+    /// the same angles), so the branch that the onion joins starts there without a second march.
     pub(super) fn heads_for_settled(&self, y: &Vector, d: &Drive, horizon: f64) -> Option<Angles> {
         let land = self.landscape(y[0], d.direction, d.stress);
         let minimum = land.settle_from(land.angles(y[2]));
-        self.heads_for(y, minimum.onion, &land, horizon)
+        self.heads_for_minimum(y, minimum.onion, land.curvature(minimum.onion), horizon)
             .then_some(minimum)
     }
 }

@@ -2,8 +2,9 @@
 //! the minimum lies provably beyond the checks' slack, never where it does not, and made once
 //! where the onion joins its branch.
 
-use super::onion::SETTLES;
+use super::onion::{EVALUATIONS, SETTLES};
 use super::onion_periods_tests::{case, values};
+use super::step::StepRun;
 use super::{Drive, Motor, MotorInputs, MotorState};
 
 /// A benchmark case: a free rotor on a 1.26 ns schedule turning the strain 0.2 rad (mod pi) a
@@ -134,4 +135,52 @@ fn settle_bound_never_misses_a_minimum_within_the_gap() {
     }
     println!("{farther} of {checked} beyond the gap");
     assert!(2 * farther >= checked, "{farther} of {checked}");
+}
+
+/// The settles and landscape evaluations (gradient or curvature of eq. 3.4) that `f` makes.
+fn counted<T>(f: impl FnOnce() -> T) -> (T, u64, u64) {
+    SETTLES.with(|c| c.set(0));
+    EVALUATIONS.with(|c| c.set(0));
+    let out = f();
+    (
+        out,
+        SETTLES.with(|c| c.get()),
+        EVALUATIONS.with(|c| c.get()),
+    )
+}
+
+/// A free rotor's relaxed onion (a thousandth of the tolerance off its minimum, untilted) joins
+/// its branch after one settle: the relaxed check's, whose slope at the start is the bound's,
+/// whose minimum the check that the onion heads for it reuses with its curvature, and which
+/// the branch starts from (the constrain has nothing left to do). The landscape is evaluated
+/// exactly as often as by that settle alone plus the curvature at its minimum, with or without
+/// the averaged ringing's check; the onion lands on that settle's minimum, bit for bit.
+#[test]
+fn relaxed_onion_joins_its_branch_after_one_settle() {
+    let (m, s, inputs) = case(&values(ONE_SUBSTEP_A_SWITCH)).unwrap();
+    let d = m.drive_at(&inputs, 0.0);
+    let land = m.landscape(s.rotor_angle, d.direction, d.stress);
+    let onion = land.settle(s.onion_angle) + 1e-3 * m.params.tolerance;
+    let state = MotorState {
+        onion_angle: onion,
+        onion_tilt: 0.0,
+        ..s
+    };
+    let (minimum, _, alone) = counted(|| {
+        let a = land.settle_from(land.angles(onion));
+        land.curvature(a.onion);
+        a
+    });
+    for average_check_at in [0, u32::MAX] {
+        let mut run = StepRun::new(&state, 1e-6);
+        run.average_check_at = average_check_at;
+        let segment_end = run.t_end;
+        let (follows, settles, evaluations) =
+            counted(|| m.follows_branch(&mut run, &d, segment_end));
+        assert!(follows, "averaged check at {average_check_at}");
+        assert_eq!(settles, 1, "averaged check at {average_check_at}");
+        assert_eq!(evaluations, alone, "averaged check at {average_check_at}");
+        assert!(run.is_settled(&d));
+        assert_eq!(run.y[2].to_bits(), minimum.onion.to_bits());
+    }
 }

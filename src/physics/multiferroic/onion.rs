@@ -47,8 +47,17 @@ pub fn curvature_slope_bound(ring_bar: &RingBar) -> f64 {
 
 #[cfg(test)]
 thread_local! {
-    /// Calls of [`Landscape::settle_from`] (tests count them).
+    /// Settles ([`Landscape::settle_from`], [`Landscape::settle_from_slope`]; tests count them).
     pub(super) static SETTLES: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    /// Evaluations of the landscape's gradient or curvature (tests count them).
+    pub(super) static EVALUATIONS: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+}
+
+/// Counts one evaluation of the landscape in tests.
+#[inline]
+fn count_evaluation() {
+    #[cfg(test)]
+    EVALUATIONS.with(|c| c.set(c.get() + 1));
 }
 
 /// Energy landscape of eq. 3.4 in the onion angle, for a fixed bar angle and strain.
@@ -69,6 +78,7 @@ impl Landscape<'_> {
     /// `dU/dpsi` (J/rad).
     #[inline]
     pub fn gradient(&self, onion: f64) -> f64 {
+        count_evaluation();
         self.ring_bar.torque(onion - self.bar_angle)
             + self.magnetoelastic * turned_back(2.0 * (onion - self.strain_direction)).sin()
     }
@@ -76,6 +86,7 @@ impl Landscape<'_> {
     /// `d^2U/dpsi^2` (J/rad^2).
     #[inline]
     pub fn curvature(&self, onion: f64) -> f64 {
+        count_evaluation();
         self.ring_bar.stiffness(onion - self.bar_angle)
             + 2.0 * self.magnetoelastic * turned_back(2.0 * (onion - self.strain_direction)).cos()
     }
@@ -89,6 +100,7 @@ impl Landscape<'_> {
     /// [`Self::gradient_curvature`] from the angles' sines and cosines (no trigonometry).
     #[inline]
     pub fn gradient_curvature_of(&self, a: &Angles) -> (f64, f64) {
+        count_evaluation();
         let (tau, k) = self
             .ring_bar
             .torque_stiffness_of(a.sin_offset, a.cos_offset);
@@ -149,9 +161,22 @@ impl Landscape<'_> {
     /// returning the angles at the minimum: each evaluation turns the last one's angles (see
     /// [`Angles::moved`]) instead of calling libm.
     pub fn settle_from(&self, start: Angles) -> Angles {
+        let (g0, c0) = self.gradient_curvature_of(&start);
+        self.march_from(start, g0, c0)
+    }
+
+    /// [`Self::settle_from`] where the gradient `g0` and curvature `c0` at `start` are known
+    /// ([`Self::gradient_curvature_of`] of it): the same march, without evaluating them again.
+    pub(super) fn settle_from_slope(&self, start: Angles, g0: f64, c0: f64) -> Angles {
+        self.march_from(start, g0, c0)
+    }
+
+    /// The settle's march and refinement from `start`, where the gradient is `g0` and the
+    /// curvature `c0` (inlined into both entries, so the common one keeps its code).
+    #[inline(always)]
+    fn march_from(&self, start: Angles, g0: f64, c0: f64) -> Angles {
         #[cfg(test)]
         SETTLES.with(|c| c.set(c.get() + 1));
-        let (g0, c0) = self.gradient_curvature_of(&start);
         let tiny = self.gradient_tolerance();
         if g0.abs() <= tiny && c0 > 0.0 {
             return start;

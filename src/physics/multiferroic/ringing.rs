@@ -2,16 +2,18 @@
 //! quasi-static branch, when it is trapped in its well and can be averaged out, and how fast it
 //! decays (see [`Motor::relaxed_onion`], [`Motor::averaged_ringing`]).
 
+use super::branch_settle::Relaxed;
 use super::{Drive, Motor, Vector};
 
 impl Motor {
     /// Whether the Gilbert onion at `y` has relaxed onto its quasi-static branch, with the speed
-    /// kick (rad/s) that its averaged ringing gives the rotor: either its tilt and its distance to
-    /// the minimum of eq. 3.4 it would settle into are within `tolerance` plus the larger of its
-    /// lag behind a turning rotor and the ringing that no longer matters, and below
-    /// [`MAX_FOLLOWED_LAG`] (no kick), or its ringing is trapped about that minimum and averages
-    /// out ([`Self::averaged_ringing`]). A locked rotor's onion is held to the tolerance instead
-    /// ([`Self::locked_ringing_ends`]): its angle is the output that the ringing moves.
+    /// kick (rad/s) that its averaged ringing gives the rotor and the minimum it settles into
+    /// ([`Relaxed`]): either its tilt and its distance to the minimum of eq. 3.4 it would settle
+    /// into are within `tolerance` plus the larger of its lag behind a turning rotor and the
+    /// ringing that no longer matters, and below [`MAX_FOLLOWED_LAG`] (no kick), or its ringing is
+    /// trapped about that minimum and averages out ([`Self::averaged_ringing`]). A locked rotor's
+    /// onion is held to the tolerance instead ([`Self::locked_ringing_ends`]): its angle is the
+    /// output that the ringing moves.
     ///
     /// Ringing of amplitude `A` left undecayed turns the rotor by at most `A tau_o / tau_rotor`
     /// (its torque acts over about `tau_o`, the rotor answers over `tau_rotor`; the precession's
@@ -47,7 +49,7 @@ impl Motor {
         rim_barrier: Option<&mut Rims>,
         remaining: f64,
         switches: (f64, f64),
-    ) -> Option<f64> {
+    ) -> Option<Relaxed> {
         // Without the averaged ringing only the first test can pass, and its slack is at most
         // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle (a
         // locked onion's, which may still decay within its segment, waits for the averaged
@@ -65,57 +67,66 @@ impl Motor {
             let ringing = 0.1 * tol * self.rotor_relaxation_time() / lag_time;
             tol + lag.max(ringing).min(MAX_FOLLOWED_LAG)
         };
-        let settled = if !d.locked && rim_barrier.is_none() {
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let minimum = if !d.locked && rim_barrier.is_none() {
             if !self.onion_relaxes_fast() || y[3].abs() > slack() {
                 return None;
             }
-            // The same march as `self.settle`, from the angles the bound evaluated.
+            // The same march as `self.settle`, from the angles and slope the bound evaluated.
             let start = self.settle_start_within(y, d, slack())?;
-            self.landscape(y[0], d.direction, d.stress)
-                .settle_from(start)
-                .onion
+            land.settle_from_slope(start.angles, start.gradient, start.curvature)
         } else {
-            self.settle(y, d)
+            land.settle_from(land.angles(y[2]))
+        };
+        let settled = minimum.onion;
+        let relaxed = |kick: f64, curvature: f64| Relaxed {
+            kick,
+            settled: minimum,
+            curvature,
         };
         // Whatever is dropped here, the onion carries over the next switch (a locked rotor's
         // speed, and so its lag, is 0). A free rotor's onion takes the cheap slack test first.
-        let relaxed_in_fact = || self.ringing_ends_in(y, d, settled, switches, 0.1 * tol + lag);
-        if d.locked {
-            if !relaxed_in_fact() {
-                return None;
-            }
+        // Made once at most, it gives the curvature at the minimum where it passes.
+        let relaxed_in_fact = || {
+            let k = land.curvature(settled);
+            self.ringing_ends_in(y, settled, k, switches, 0.1 * tol + lag)
+                .then_some(k)
+        };
+        let k = if d.locked {
+            let k = relaxed_in_fact()?;
             // The onion's angle is the output and nothing else is moved by its ringing: it is
             // dropped only where it ends the segment within the tolerance of the minimum.
             if self.locked_ringing_ends(y, d, settled, remaining) {
-                return Some(0.0);
+                return Some(relaxed(0.0, k));
             }
+            k
         } else {
             if self.onion_relaxes_fast() {
                 // Ringing of amplitude A left behind moves the rotor by at most A tau_o / tau_rotor.
                 let slack = slack();
                 if y[3].abs() <= slack && (settled - y[2]).abs() <= slack {
-                    return relaxed_in_fact().then_some(0.0);
+                    return relaxed_in_fact().map(|k| relaxed(0.0, k));
                 }
             }
-            if rim_barrier.is_none() || !relaxed_in_fact() {
-                return None;
-            }
-        }
+            rim_barrier.as_ref()?;
+            relaxed_in_fact()?
+        };
         let rims = rim_barrier?;
         if let Some(kick) = self.averaged_ringing(y, d, settled, rims, remaining) {
-            return Some(kick);
+            return Some(relaxed(kick, k));
         }
         // A locked rotor's ringing that its orbit-averaged loss ends within the segment.
         let retry = &mut rims.decay_retry_level;
         self.locked_ringing_decays(y, d, settled, remaining, retry)
-            .then_some(0.0)
+            .then(|| relaxed(0.0, k))
     }
 
-    /// Whether the gap between the Gilbert onion at `y` and the minimum `settled` of eq. 3.4, which
-    /// placing it there drops, stays within `slack` over the schedule's switches: decayed over
-    /// the time to the next switch ([`Self::decayed_gap`], at the slowest rate `lambda` of the
-    /// onion's linearization there), times the switches the onion remembers, `1 + 1 / (lambda T)`
-    /// (`T` the period; `(to_switch, period)` both infinite without a schedule, nothing carried).
+    /// Whether the gap between the Gilbert onion at `y` and the minimum `settled` of eq. 3.4
+    /// (curvature `k` there), which placing it there drops, stays within `slack` over the
+    /// schedule's switches: decayed over the time to the next switch ([`Self::decayed_gap`], at the
+    /// slowest rate `lambda` of the onion's linearization there), times the switches the onion
+    /// remembers, `1 + 1 / (lambda T)` (`T` the period; `(to_switch, period)` both infinite without
+    /// a schedule, nothing carried).
     ///
     /// What is left of the gap at a switch, the onion carries into the next period, where the
     /// minimum moves away and the resolved onion would not have dropped it. Placements at later
@@ -128,14 +139,11 @@ impl Motor {
     fn ringing_ends_in(
         &self,
         y: &Vector,
-        d: &Drive,
         settled: f64,
+        k: f64,
         (to_switch, period): (f64, f64),
         slack: f64,
     ) -> bool {
-        let k = self
-            .landscape(y[0], d.direction, d.stress)
-            .curvature(settled);
         let memory = 1.0 + 1.0 / (self.onion_decay_rate(k) * period);
         k > 0.0 && self.decayed_gap(y, settled, k, to_switch) * memory <= slack
     }

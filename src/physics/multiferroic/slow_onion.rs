@@ -1,35 +1,20 @@
 //! Whether a Gilbert onion that a step cannot afford to resolve may be put on its quasi-static
 //! branch: only if it heads for the branch's minimum within the step anyway.
 
-use super::onion::Landscape;
-use super::{Drive, Motor, Vector};
+use super::{Motor, Vector};
 
 impl Motor {
-    /// Whether the Gilbert onion at `y` heads for the minimum of eq. 3.4 it sits in for the drive
-    /// `d` within `horizon` seconds (the step, or what is left of it): its ringing decays by a
-    /// factor `e` at least over that time (`lambda horizon >= 1`, `lambda`
-    /// [`Self::onion_decay_rate`] at the minimum's curvature `k`), or ends within the
+    /// Whether the Gilbert onion at `y` heads for the `minimum` of eq. 3.4 it sits in (the one
+    /// it settles into, curvature `k` there) within `horizon` seconds (the step, or what is
+    /// left of it): its ringing decays by a factor `e` at least over that time
+    /// (`lambda horizon >= 1`, `lambda` [`Self::onion_decay_rate`] at `k`), or ends within the
     /// tolerance of the minimum (its distance in the energy's norm, `sqrt(dpsi^2 + t theta^2 / k)`,
     /// times `exp(-lambda horizon)`).
     ///
     /// An onion that does not cannot follow the strain within the step at all; putting it on the
     /// quasi-static branch would turn it with the strain at every switch where the resolved onion
     /// barely moves: 38.5 rad off after a 1 us step on a 1.26 ns schedule (`lambda T` 4e-6).
-    pub(super) fn heads_for_minimum(&self, y: &Vector, d: &Drive, horizon: f64) -> bool {
-        let land = self.landscape(y[0], d.direction, d.stress);
-        self.heads_for(y, land.settle(y[2]), &land, horizon)
-    }
-
-    /// [`Self::heads_for_minimum`] for the onion at `y` and the `minimum` of `land` it settles
-    /// into.
-    pub(super) fn heads_for(
-        &self,
-        y: &Vector,
-        minimum: f64,
-        land: &Landscape,
-        horizon: f64,
-    ) -> bool {
-        let k = land.curvature(minimum);
+    pub(super) fn heads_for_minimum(&self, y: &Vector, minimum: f64, k: f64, horizon: f64) -> bool {
         if k.is_nan() || k <= 0.0 {
             return false;
         }

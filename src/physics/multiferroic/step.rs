@@ -1,6 +1,7 @@
 //! One communication step of the motor: the loop that cuts it at the schedule's switches and
 //! advances each piece of constant drive (see [`Motor::step`]).
 
+use super::branch_settle::Relaxed;
 use super::ringing::Rims;
 use super::{Angles, Drive, Motor, MotorInputs, MotorState, StepReport, Vector, MAX_STEP};
 
@@ -387,7 +388,7 @@ impl Motor {
     /// follows once relaxed ([`Self::relaxed_onion`]) and, under a free rotor, heads for its
     /// minimum within the rest of the step: ringing that barely moves the rotor still places the
     /// onion.
-    fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
+    pub(super) fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
         }
@@ -441,15 +442,22 @@ impl Motor {
             let rims = average.then_some(&mut run.rim_barrier.1);
             // Ringing that neither decays within the step nor ends within the tolerance is
             // kept, whatever its effect on a free rotor: the onion itself would be off by it.
-            let decays = |y: &Vector| d.locked || self.heads_for_minimum(y, d, run.t_end - run.t);
+            let horizon = run.t_end - run.t;
+            let decays = |r: &Relaxed| {
+                d.locked || self.heads_for_minimum(&run.y, r.settled.onion, r.curvature, horizon)
+            };
             // Dropped ringing carries over a switch; before it, it only shifts the reported
             // onion from the centre of its ringing, which it decays to.
             let switches = run.schedule.map_or((f64::INFINITY, f64::INFINITY), |s| {
                 (s.next_switch_after(run.t) - run.t, s.step_period)
             });
             match self.relaxed_onion(&run.y, d, rims, segment_end - run.t, switches) {
-                // The averaged ringing's impulse on the rotor.
-                Some(kick) if decays(&run.y) => run.y[1] += kick,
+                // The averaged ringing's impulse on the rotor (the constrain settles a free
+                // rotor's onion from the same angles, so the branch starts at that minimum).
+                Some(r) if decays(&r) => {
+                    run.y[1] += r.kick;
+                    minimum = (!d.locked).then_some(r.settled);
+                }
                 _ => return false,
             }
         }
