@@ -145,14 +145,15 @@ pub(super) fn block_phi1(a: &[[f64; 2]; 2]) -> Option<[[f64; 2]; 2]> {
         let mu1 = if m <= 0.0 { m - gap } else { m + gap };
         let mu2 = det / mu1;
         let (f1, f2) = (phis(mu1)[0], phis(mu2)[0]);
-        if !((f1 - f2).abs() >= PHI1_SEPARATED * (f1.abs() + f2.abs())) {
+        // (Values that are not finite fail the final check.)
+        if (f1 - f2).abs() < PHI1_SEPARATED * (f1.abs() + f2.abs()) {
             return None;
         }
         let c1 = (f1 - f2) / (mu1 - mu2);
         (f2 - mu2 * c1, c1)
     } else {
         let (re, im) = complex_phis(m, gap)[0];
-        if !(im.abs() >= PHI1_SEPARATED * re.hypot(im)) {
+        if im.abs() < PHI1_SEPARATED * re.hypot(im) {
             return None;
         }
         let c1 = im / gap;
