@@ -128,20 +128,41 @@ impl BlockPhi {
 /// but about two of its digits.
 const PHI1_SEPARATED: f64 = 1e-2;
 
-/// `phi_1(A) = sum_n A^n / (n + 1)!` of a real 2x2 matrix `A` as `c_0 I + c_1 A`, with `c_0, c_1`
-/// from `phi_1` at the eigenvalues as in [`BlockPhi::new`]. `None` where `c_1`'s divided
-/// difference would cancel (nearly repeated eigenvalues, or a zero of `Im phi_1` on a complex
-/// pair) or the matrix is not finite: the caller then takes a series.
+/// Terms of [`block_phi1`]'s series within the unit disc: the `n`-th is at most `n / (n + 1)!`
+/// (`|h_m| <= m + 1`), below 1e-18 from the 20th.
+const PHI1_SERIES_TERMS: usize = 20;
+
+/// `phi_1(A) = sum_n A^n / (n + 1)!` of a real 2x2 matrix `A` as `c_0 I + c_1 A`. With both
+/// eigenvalues within the unit disc (however large `A` itself, as a stiff tilt over a soft angle
+/// makes it), by the series of `A^n = -det h_{n-2} I + h_{n-1} A` (Cayley-Hamilton; `h_n` the
+/// complete symmetric polynomials of the eigenvalues, `h_n = tr h_{n-1} - det h_{n-2}`), which
+/// holds through repeated eigenvalues; else from `phi_1` at the eigenvalues as in
+/// [`BlockPhi::new`]. `None` where that divided difference would cancel (nearly repeated
+/// eigenvalues, or a zero of `Im phi_1` on a complex pair) or the matrix is not finite: the
+/// caller then takes a series of its own.
 #[inline]
 pub(super) fn block_phi1(a: &[[f64; 2]; 2]) -> Option<[[f64; 2]; 2]> {
     let m = 0.5 * (a[0][0] + a[1][1]);
     let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
     let disc = m * m - det;
     let gap = disc.abs().sqrt();
-    if !(gap.is_finite() && gap > 0.0) {
+    if !gap.is_finite() {
         return None;
     }
-    let (c0, c1) = if disc > 0.0 {
+    let (c0, c1) = if m.abs() + gap <= 1.0 {
+        let (mut c0, mut c1) = (1.0, 0.0);
+        let (mut before, mut h) = (0.0, 1.0);
+        let mut inv_factorial = 1.0;
+        for n in 1..=PHI1_SERIES_TERMS {
+            inv_factorial /= (n + 1) as f64;
+            c0 -= det * before * inv_factorial;
+            c1 += h * inv_factorial;
+            (before, h) = (h, 2.0 * m * h - det * before);
+        }
+        (c0, c1)
+    } else if gap == 0.0 {
+        return None;
+    } else if disc > 0.0 {
         let mu1 = if m <= 0.0 { m - gap } else { m + gap };
         let mu2 = det / mu1;
         let (f1, f2) = (phis(mu1)[0], phis(mu2)[0]);

@@ -36,7 +36,7 @@ fn onion_block(alpha: f64, d: f64, t: f64) -> M2 {
 #[test]
 fn flow_matches_the_augmented_exponential() {
     let mut blocks: Vec<(M2, f64)> = Vec::new();
-    for &alpha in &[2e-3, 0.03, 0.3, 1.5] {
+    for &alpha in &[1e-4, 2e-3, 0.03, 0.3, 1.5] {
         for &d in &[-3.0, -0.2, -1e-3, 0.0, 1e-6, 1e-3, 0.05, 0.5, 2.0, 30.0, 200.0] {
             for &h in &[1e-3, 0.02, 0.4, 1.0] {
                 blocks.push((onion_block(alpha, d, 40.0), h));
@@ -56,6 +56,8 @@ fn flow_matches_the_augmented_exponential() {
         ([[-1e-3, 5.0], [-1e-12, -1e-3]], 2.0),
         ([[0.3, 40.0], [-1e-7, 0.3]], 1.0),
         ([[-0.5, 40.0], [1e-5, -0.5]], 1.0),
+        ([[-0.2, 40.0], [0.0, -0.2]], 1.0),
+        ([[0.6, -0.3], [0.3, 0.0]], 1.0),
     ] {
         blocks.push((a, h));
     }
