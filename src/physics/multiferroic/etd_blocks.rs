@@ -132,6 +132,17 @@ const PHI1_SEPARATED: f64 = 1e-2;
 /// (`|h_m| <= m + 1`), below 1e-18 from the 20th.
 const PHI1_SERIES_TERMS: usize = 20;
 
+/// `1 / n!` for the terms of [`block_phi1`]'s series.
+const INV_FACTORIAL: [f64; PHI1_SERIES_TERMS + 2] = {
+    let mut t = [1.0; PHI1_SERIES_TERMS + 2];
+    let mut n = 1;
+    while n < t.len() {
+        t[n] = t[n - 1] / n as f64;
+        n += 1;
+    }
+    t
+};
+
 /// `phi_1(A) = sum_n A^n / (n + 1)!` of a real 2x2 matrix `A` as `c_0 I + c_1 A`. With both
 /// eigenvalues within the unit disc (however large `A` itself, as a stiff tilt over a soft angle
 /// makes it), by the series of `A^n = -det h_{n-2} I + h_{n-1} A` (Cayley-Hamilton; `h_n` the
@@ -152,9 +163,7 @@ pub(super) fn block_phi1(a: &[[f64; 2]; 2]) -> Option<[[f64; 2]; 2]> {
     let (c0, c1) = if m.abs() + gap <= 1.0 {
         let (mut c0, mut c1) = (1.0, 0.0);
         let (mut before, mut h) = (0.0, 1.0);
-        let mut inv_factorial = 1.0;
-        for n in 1..=PHI1_SERIES_TERMS {
-            inv_factorial /= (n + 1) as f64;
+        for inv_factorial in &INV_FACTORIAL[2..PHI1_SERIES_TERMS + 2] {
             c0 -= det * before * inv_factorial;
             c1 += h * inv_factorial;
             (before, h) = (h, 2.0 * m * h - det * before);
