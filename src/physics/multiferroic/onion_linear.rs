@@ -136,8 +136,8 @@ fn sinc(x: f64, oscillating: bool) -> f64 {
 /// integral is `A^{-1} (exp(A h) - I)` where `A` is well conditioned and `h` long; else, beyond
 /// `||A|| h = 1/2`, `h phi_1(A h)` from the eigenvalues ([`block_phi1`]: a nearly singular `A`,
 /// as a stiff tilt makes it, has one eigenvalue near 0 and the other far off, or both near 0);
-/// else its Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`) doubled `n` times (`J(2h) = (I
-/// + exp(A h)) J(h)`), which holds through a singular `A`.
+/// else its Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`) doubled `n` times
+/// (`J(2h) = (I + exp(A h)) J(h)`), which holds through a singular `A`.
 /// `None` if the flow could grow beyond `e^50`.
 pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     let m = 0.5 * (a[0][0] + a[1][1]);
