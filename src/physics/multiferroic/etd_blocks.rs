@@ -123,6 +123,79 @@ impl BlockPhi {
     }
 }
 
+/// Least `|f(mu_1) - f(mu_2)|` (real eigenvalues) or `|Im f(m + i b)|` (a complex pair)
+/// relative to the values of `f = phi_1` that [`block_phi1`] takes: its `c_1` then keeps all
+/// but about two of its digits.
+const PHI1_SEPARATED: f64 = 1e-2;
+
+/// Terms of [`block_phi1`]'s series within the unit disc: the `n`-th is at most `n / (n + 1)!`
+/// (`|h_m| <= m + 1`), below 1e-18 from the 20th.
+const PHI1_SERIES_TERMS: usize = 20;
+
+/// `1 / n!` for the terms of [`block_phi1`]'s series.
+const INV_FACTORIAL: [f64; PHI1_SERIES_TERMS + 2] = {
+    let mut t = [1.0; PHI1_SERIES_TERMS + 2];
+    let mut n = 1;
+    while n < t.len() {
+        t[n] = t[n - 1] / n as f64;
+        n += 1;
+    }
+    t
+};
+
+/// `phi_1(A) = sum_n A^n / (n + 1)!` of a real 2x2 matrix `A` as `c_0 I + c_1 A`. With both
+/// eigenvalues within the unit disc (however large `A` itself, as a stiff tilt over a soft angle
+/// makes it), by the series of `A^n = -det h_{n-2} I + h_{n-1} A` (Cayley-Hamilton; `h_n` the
+/// complete symmetric polynomials of the eigenvalues, `h_n = tr h_{n-1} - det h_{n-2}`), which
+/// holds through repeated eigenvalues; else from `phi_1` at the eigenvalues as in
+/// [`BlockPhi::new`]. `None` where that divided difference would cancel (nearly repeated
+/// eigenvalues, or a zero of `Im phi_1` on a complex pair) or the matrix is not finite: the
+/// caller then takes a series of its own.
+#[inline]
+pub(super) fn block_phi1(a: &[[f64; 2]; 2]) -> Option<[[f64; 2]; 2]> {
+    let m = 0.5 * (a[0][0] + a[1][1]);
+    let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+    let disc = m * m - det;
+    let gap = disc.abs().sqrt();
+    if !gap.is_finite() {
+        return None;
+    }
+    let (c0, c1) = if m.abs() + gap <= 1.0 {
+        let (mut c0, mut c1) = (1.0, 0.0);
+        let (mut before, mut h) = (0.0, 1.0);
+        for inv_factorial in &INV_FACTORIAL[2..PHI1_SERIES_TERMS + 2] {
+            c0 -= det * before * inv_factorial;
+            c1 += h * inv_factorial;
+            (before, h) = (h, 2.0 * m * h - det * before);
+        }
+        (c0, c1)
+    } else if gap == 0.0 {
+        return None;
+    } else if disc > 0.0 {
+        let mu1 = if m <= 0.0 { m - gap } else { m + gap };
+        let mu2 = det / mu1;
+        let (f1, f2) = (phis(mu1)[0], phis(mu2)[0]);
+        // (Values that are not finite fail the final check.)
+        if (f1 - f2).abs() < PHI1_SEPARATED * (f1.abs() + f2.abs()) {
+            return None;
+        }
+        let c1 = (f1 - f2) / (mu1 - mu2);
+        (f2 - mu2 * c1, c1)
+    } else {
+        let (re, im) = complex_phis(m, gap)[0];
+        if im.abs() < PHI1_SEPARATED * re.hypot(im) {
+            return None;
+        }
+        let c1 = im / gap;
+        (re - m * c1, c1)
+    };
+    let p = [
+        [c0 + c1 * a[0][0], c1 * a[0][1]],
+        [c1 * a[1][0], c0 + c1 * a[1][1]],
+    ];
+    p.iter().flatten().all(|x| x.is_finite()).then_some(p)
+}
+
 /// `[phi_1, phi_2, phi_3]` at `x + i y` as `(re, im)`: the series of `phi_3` near 0 and the
 /// downward recurrence `phi_{k+1} = (phi_k - 1/k!) / z` from `e^z - 1` elsewhere (as
 /// [`phis`]).

@@ -99,6 +99,8 @@ pub mod onion;
 mod onion_cycles;
 #[cfg(test)]
 mod onion_cycles_tests;
+#[cfg(test)]
+mod onion_flow_tests;
 mod onion_linear;
 mod onion_linear_locked;
 #[cfg(test)]

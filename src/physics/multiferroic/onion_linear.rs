@@ -3,6 +3,7 @@
 //! affine maps (see [`Motor::advance_onion_linear`]).
 
 use super::angles::turned_back;
+use super::etd_blocks::block_phi1;
 use super::{Motor, MotorInputs, StepRun, SteppingSchedule};
 
 pub(super) type M2 = [[f64; 2]; 2];
@@ -132,9 +133,11 @@ fn sinc(x: f64, oscillating: bool) -> f64 {
 /// hence, entry by entry, `|exp(A s)| <= max(1, e^{m h}) (I + min(h, 1/w) |N|)` in the first
 /// case and `e^{max(m + w, 0) h} (I + min(h, 1/(2w)) |N|)` in the second (`|sin(w s)/w| <=
 /// min(s, 1/w)`, `cosh(w s) <= e^{w s}`, `sinh(w s)/w <= e^{w s} min(s, 1/(2w))`). The
-/// integral is `A^{-1} (exp(A h) - I)` where `A` is well conditioned and `h` long; else its
-/// Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`) doubled `n` times (`J(2h) = (I +
-/// exp(A h)) J(h)`), which holds through a singular `A`.
+/// integral is `A^{-1} (exp(A h) - I)` where `A` is well conditioned and `h` long; else, beyond
+/// `||A|| h = 1/2`, `h phi_1(A h)` from the eigenvalues ([`block_phi1`]: a nearly singular `A`,
+/// as a stiff tilt makes it, has one eigenvalue near 0 and the other far off, or both near 0);
+/// else its Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`) doubled `n` times
+/// (`J(2h) = (I + exp(A h)) J(h)`), which holds through a singular `A`.
 /// `None` if the flow could grow beyond `e^50`.
 pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     let m = 0.5 * (a[0][0] + a[1][1]);
@@ -189,6 +192,11 @@ pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
             [-a[1][0] / det, a[0][0] / det],
         ];
         mul(&inv, &d)
+    } else if let Some(p) = (size * h > 0.5)
+        .then(|| block_phi1(&[[a[0][0] * h, a[0][1] * h], [a[1][0] * h, a[1][1] * h]]))
+        .flatten()
+    {
+        [[p[0][0] * h, p[0][1] * h], [p[1][0] * h, p[1][1] * h]]
     } else {
         let mut halvings = 0;
         let mut hs = h;
