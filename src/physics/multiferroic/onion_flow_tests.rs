@@ -37,7 +37,9 @@ fn onion_block(alpha: f64, d: f64, t: f64) -> M2 {
 fn flow_matches_the_augmented_exponential() {
     let mut blocks: Vec<(M2, f64)> = Vec::new();
     for &alpha in &[1e-4, 2e-3, 0.03, 0.3, 1.5] {
-        for &d in &[-3.0, -0.2, -1e-3, 0.0, 1e-6, 1e-3, 0.05, 0.5, 2.0, 30.0, 200.0] {
+        for &d in &[
+            -3.0, -0.2, -1e-3, 0.0, 1e-6, 1e-3, 0.05, 0.5, 2.0, 30.0, 200.0,
+        ] {
             for &h in &[1e-3, 0.02, 0.4, 1.0] {
                 blocks.push((onion_block(alpha, d, 40.0), h));
                 blocks.push((onion_block(alpha, d, 1.0), h));
