@@ -4,26 +4,15 @@
 
 use super::onion::{EVALUATIONS, SETTLES};
 use super::onion_periods_tests::{case, values};
+use super::ringing_drop_tests::C370371;
 use super::step::StepRun;
 use super::{Drive, Motor, MotorInputs, MotorState};
 
-/// A benchmark case: a free rotor on a 1.26 ns schedule turning the strain 0.2 rad (mod pi) a
+/// [`C370371`]: a free rotor on a 1.26 ns schedule turning the strain 0.2 rad (mod pi) a
 /// switch, its onion (damping 0.32, relaxation 0.85 ns) taking one Gilbert substep a switch
 /// and checked for its branch at each, right after the switch, about 0.1 rad from the new
 /// minimum (tolerance 2.6e-10 rad).
-const ONE_SUBSTEP_A_SWITCH: &str = "\
-    strain_direction=4.496967955863598e3 stress=1.8076771909404648e4 \
-    load_torque=-4.5073129082524036e-7 ring_outer_diameter=9.276586521395332e-1 \
-    ring_inner_diameter=8.43369288914428e-1 bar_length=2.8433506450522517e-1 \
-    bar_width=8.968135402974918e-8 thickness=4.304155241729274e-8 \
-    saturation_magnetization=3.7057741425325214e4 magnetostriction=1.7311948228292805e-3 \
-    wall_volume=9.03389210748996e-12 density=8.7551023639625e4 \
-    fluid_viscosity=4.943465256551358e-3 gilbert_damping=3.1558718993994206e-1 \
-    tolerance=2.6242492377974097e-10 step_angle=6.481863160009269e0 \
-    step_period=1.2585376881230376e-9 stress_amplitude=4.043248236617939e-2 \
-    schedule_initial_direction=-1.9944516708302974e1 onion_model=1e0 max_substeps=1.2917e4 \
-    schedule=1e0 initial_onion_offset=-2.0457051067970277e-8 strain=-6.663143066831397e-2 \
-    youngs_modulus=6.129546203860929e10 strain_drive=1e0";
+const ONE_SUBSTEP_A_SWITCH: &str = C370371;
 
 /// A benchmark case: a free rotor on a 1.26 ns schedule that the ring cannot move, its onion
 /// (damping 1e-4) beyond what the budget of 688 resolves: after its first forced substep the

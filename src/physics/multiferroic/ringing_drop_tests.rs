@@ -7,7 +7,8 @@ use super::*;
 
 /// A benchmark case (full precision): a free rotor in a 0.93 m ring on a 1.26 ns schedule
 /// under 0.04 Pa, a Gilbert onion damped at 0.32.
-const C370371: &str = "strain_direction=4.496967955863598e3 stress=1.8076771909404648e4 \
+pub(super) const C370371: &str =
+    "strain_direction=4.496967955863598e3 stress=1.8076771909404648e4 \
     load_torque=-4.5073129082524036e-7 ring_outer_diameter=9.276586521395332e-1 \
     ring_inner_diameter=8.43369288914428e-1 bar_length=2.8433506450522517e-1 \
     bar_width=8.968135402974918e-8 thickness=4.304155241729274e-8 \
