@@ -2,7 +2,7 @@
 //! against a converged RK4 of the motor, written independently in `locked_accuracy_tests.rs`.
 
 use super::linear_ringing::{OFF, TAKEN};
-use super::locked_accuracy_tests::converged_rk4;
+use super::locked_accuracy_tests::onion_errors;
 use super::onion_periods_tests::{case, values};
 use super::orbit_phase_tests::DRAW_471993;
 
@@ -12,7 +12,6 @@ use super::orbit_phase_tests::DRAW_471993;
 fn three_steps(text: &str, off: bool) -> Vec<(u32, bool, [f64; 2])> {
     let (m, mut st, inputs) = case(&values(text)).unwrap();
     assert!(inputs.rotor_locked);
-    let tol = m.params.tolerance;
     OFF.with(|c| c.set(off));
     let rows = (0..3)
         .map(|_| {
@@ -20,11 +19,7 @@ fn three_steps(text: &str, off: bool) -> Vec<(u32, bool, [f64; 2])> {
             let taken = TAKEN.with(|c| c.get());
             let report = m.step(&mut st, &inputs, 1e-6).unwrap();
             assert!(!report.accuracy_limited, "{report:?}");
-            let truth = converged_rk4(&m, &start, &inputs, st.time, 2000.0);
-            let errors = [
-                (st.onion_angle - truth[2]).abs() / tol,
-                (st.onion_tilt - truth[3]).abs() / tol,
-            ];
+            let errors = onion_errors(&m, &start, &st, &inputs, 2000.0);
             (report.substeps, TAKEN.with(|c| c.get()) > taken, errors)
         })
         .collect();

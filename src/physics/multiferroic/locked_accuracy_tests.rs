@@ -26,6 +26,23 @@ pub(super) fn converged_rk4(
     fine
 }
 
+/// The onion's angle and tilt at `end` against [`converged_rk4`] from `start` to `end.time` at
+/// `per_ns`, in tolerances.
+pub(super) fn onion_errors(
+    m: &Motor,
+    start: &MotorState,
+    end: &MotorState,
+    inputs: &MotorInputs,
+    per_ns: f64,
+) -> [f64; 2] {
+    let truth = converged_rk4(m, start, inputs, end.time, per_ns);
+    let tol = m.params.tolerance;
+    [
+        (end.onion_angle - truth[2]).abs() / tol,
+        (end.onion_tilt - truth[3]).abs() / tol,
+    ]
+}
+
 /// A benchmark case's 1 us step after `warm` others (which bring the onion onto its cycle of
 /// switches) against [`converged_rk4`] from the same start: not accuracy-limited, the onion's
 /// angle and tilt within `bound` tolerances of it. Returns the errors in tolerances and the

@@ -2,7 +2,7 @@
 //! out, against a plain RK4 of the macrospin over the whole 1 us step
 //! ([`Motor::locked_budget_drop`]).
 
-use super::locked_accuracy_tests::converged_rk4;
+use super::locked_accuracy_tests::onion_errors;
 use super::onion_periods_tests::{case, values};
 use super::*;
 
@@ -30,12 +30,7 @@ fn first_step(text: &str, per_ns: f64) -> (Result<StepReport, String>, Option<[f
     if report.is_err() {
         return (report, None);
     }
-    let truth = converged_rk4(&m, &start, &inputs, st.time, per_ns);
-    let tol = m.params.tolerance;
-    let errors = [
-        (st.onion_angle - truth[2]).abs() / tol,
-        (st.onion_tilt - truth[3]).abs() / tol,
-    ];
+    let errors = onion_errors(&m, &start, &st, &inputs, per_ns);
     println!("{report:?}: errors / tolerance against RK4 {errors:?}");
     assert_eq!(st.rotor_angle, start.rotor_angle);
     (report, Some(errors))
@@ -123,15 +118,10 @@ fn creeping_onion_with_a_substep_per_switch_stays_within_the_tolerance() {
          onion_model=1 max_substeps=803 schedule=1 rotor_locked=1 \
          initial_onion_offset=6.040605507789597e-3 load_torque=8.906150444115635e-7";
     let (m, mut st, inputs) = case(&values(text)).unwrap();
-    let tol = m.params.tolerance;
     for _ in 0..3 {
         let start = st;
         let report = m.step(&mut st, &inputs, 1e-6).unwrap();
-        let truth = converged_rk4(&m, &start, &inputs, st.time, 100.0);
-        let errors = [
-            (st.onion_angle - truth[2]).abs() / tol,
-            (st.onion_tilt - truth[3]).abs() / tol,
-        ];
+        let errors = onion_errors(&m, &start, &st, &inputs, 100.0);
         assert!(!report.accuracy_limited, "{report:?}");
         assert!(errors.iter().all(|e| *e <= 1.0), "{errors:?}");
     }

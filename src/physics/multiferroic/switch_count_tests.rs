@@ -2,7 +2,7 @@
 //! ([`Motor::passes_run_out`]): carried by the onion's linear spans, against a plain RK4, or
 //! refused once the spans are over.
 
-use super::locked_accuracy_tests::converged_rk4;
+use super::locked_accuracy_tests::onion_errors;
 use super::onion_periods_tests::{case, values};
 use super::*;
 
@@ -27,12 +27,7 @@ fn first_step(
         return (report, passes, None);
     };
     println!("{r:?} in {passes} passes");
-    let truth = converged_rk4(&m, &start, &inputs, st.time, per_ns);
-    let tol = m.params.tolerance;
-    let errors = [
-        (st.onion_angle - truth[2]).abs() / tol,
-        (st.onion_tilt - truth[3]).abs() / tol,
-    ];
+    let errors = onion_errors(&m, &start, &st, &inputs, per_ns);
     println!("errors / tolerance against RK4 {errors:?}");
     (report, passes, Some(errors))
 }
