@@ -44,7 +44,8 @@
 //! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
 //! rotor's ringing onion that neither a drop nor forced substeps can follow through the
 //! schedule's switches refuses the step (`locked_switches.rs`), as does a locked step whose
-//! switches outnumber its loop's passes once the linear spans fail (`switch_count.rs`). A free
+//! switches outnumber its loop's passes once the linear spans fail or the budget cannot pay for
+//! them (`switch_count.rs`; the spans count one unit per two switches they chain). A free
 //! rotor's onion whose tilt leaves its bounds escapes at the substep that carries it out, not at
 //! the budget's smallest (`tilt_exit.rs`).
 //!
@@ -147,6 +148,8 @@ pub mod schedule;
 mod slow_onion;
 #[cfg(test)]
 mod slow_onion_tests;
+#[cfg(test)]
+mod span_charge_tests;
 mod spin;
 #[cfg(test)]
 mod spin_tests;

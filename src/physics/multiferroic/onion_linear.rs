@@ -31,14 +31,21 @@ const WAIT_SWITCHES: u32 = 8;
 /// Largest growth of the onion block's exponential over a switch (`e^50`): beyond it the
 /// linearization is far out of its reach anyway and the bound would overflow.
 const MAX_GROWTH_EXPONENT: f64 = 50.0;
-/// Switches charged as one unit of the step's budget (about 0.1 us each against 0.32 us a
-/// substep of the quasi-static onion).
-const SWITCHES_PER_UNIT: usize = 3;
+/// Switches of a macro span charged as one unit of the step's budget, tried or taken: a
+/// switch's closed-form flow ([`flow`]), its entrywise bound and its share of the backward
+/// products cost 0.12-0.15 us (thread CPU, release, x86-64), a budget unit up to 0.4 us (a
+/// quasi-static substep, a quarter of a Gilbert one, [`super::GILBERT_SUBSTEP_WEIGHT`]), so
+/// that the spans' work per unit stays below the substeps'.
+pub(super) const SWITCHES_PER_UNIT: usize = 2;
 
 #[cfg(test)]
 thread_local! {
     /// Macro spans taken by [`Motor::advance_onion_linear`] on this thread (for tests).
     pub(super) static SPANS: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+    /// Switch intervals chained by the macro spans on this thread, taken or declined, and the
+    /// budget units charged for them (for tests).
+    pub(super) static CHAINED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
+    pub(super) static CHARGED: std::cell::Cell<u64> = const { std::cell::Cell::new(0) };
     /// Turns [`Motor::advance_onion_linear`] off on this thread (for tests: the other paths).
     pub(super) static OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Each span taken on this thread (for tests): the state and time at its start, its end,
@@ -268,7 +275,11 @@ impl Motor {
     /// a shorter one is tried, and where the shortest fails the next switches are left to the
     /// other paths, for good after [`MAX_DECLINES`] in a row (an onion swinging through eq.
     /// 3.4's nonlinear range, where the linearization fails at once). Tried, with a decoupled ring, once the skips
-    /// of repeated periods have declined at [`WAIT_SWITCHES`] switches.
+    /// of repeated periods have declined at [`WAIT_SWITCHES`] switches. Every switch chained,
+    /// in a span taken or declined, is charged to the step's budget ([`SWITCHES_PER_UNIT`]), and
+    /// the spans chain no more switches than the budget left pays for: they are over for the
+    /// step once it cannot pay for [`MIN_SPAN`], so that `max_substeps` bounds their cost as it
+    /// bounds the substeps'.
     pub(super) fn advance_onion_linear(
         &self,
         run: &mut StepRun,
@@ -283,6 +294,15 @@ impl Motor {
             || run.onion_linear.disabled
             || self.linear_ring_term(run, inputs).is_none()
         {
+            return false;
+        }
+        // The switches the budget left pays for, over all the tries below: the spans are
+        // over for the step where it cannot pay for the shortest (whether or not one is due).
+        let spent = run.attempts.saturating_add(run.extra_cost);
+        let affordable = (self.params.max_substeps.saturating_sub(spent) as usize)
+            .saturating_mul(SWITCHES_PER_UNIT);
+        if affordable < MIN_SPAN {
+            run.onion_linear.disabled = true;
             return false;
         }
         if run.onion_linear.next == 0
@@ -302,11 +322,16 @@ impl Motor {
             run.onion_linear.next
         };
         let target = BOUND_SHARE * self.params.tolerance;
-        // Switch intervals chained, charged to the budget once a span is taken (a declined
-        // span charges nothing: the other paths then run exactly as without this one).
+        // Switch intervals chained, taken or declined, charged to the budget.
         let mut chained = 0;
+        let charge = |run: &mut StepRun, chained: usize| {
+            let units = u32::try_from(chained.div_ceil(SWITCHES_PER_UNIT)).unwrap_or(u32::MAX);
+            run.extra_cost = run.extra_cost.saturating_add(units);
+            #[cfg(test)]
+            CHARGED.with(|c| c.set(c.get() + u64::from(units)));
+        };
         loop {
-            let tried = self.onion_linear_span(run, s, inputs, span);
+            let tried = self.onion_linear_span(run, s, inputs, span.min(affordable - chained));
             chained += tried.switches;
             if let Some((t, y, bound)) = tried.result {
                 if bound <= target && (tried.switches >= MIN_SPAN || t >= run.t_end) {
@@ -314,8 +339,7 @@ impl Motor {
                     #[cfg(test)]
                     let start = (run.y, run.t);
                     if self.commit_linear_span(run, inputs, t, y_new) {
-                        let units = u32::try_from(chained / SWITCHES_PER_UNIT).unwrap_or(u32::MAX);
-                        run.extra_cost = run.extra_cost.saturating_add(units);
+                        charge(run, chained);
                         #[cfg(test)]
                         SPAN_LOG.with(|l| l.borrow_mut().push((start.0, start.1, t, y, bound)));
                         // Next span sized from this bound (it grows about as the span's cube).
@@ -328,11 +352,12 @@ impl Motor {
                     break;
                 }
             }
-            if tried.switches < 2 * MIN_SPAN {
+            if tried.switches < 2 * MIN_SPAN || affordable - chained < MIN_SPAN {
                 break;
             }
             span = (tried.switches / 2).max(1);
         }
+        charge(run, chained);
         // Declined: retried after 1, 2, 4, ... switches, and not again in the step after
         // [`MAX_DECLINES`] in a row.
         let spans = &mut run.onion_linear;
@@ -381,6 +406,8 @@ impl Motor {
             let am: M2 = [[-g * a * d, -g * t], [g * d, -g * a * t]];
             let b = [-g * a * grad, g * grad];
             switches += 1;
+            #[cfg(test)]
+            CHAINED.with(|c| c.set(c.get() + 1));
             let Some(f) = flow(&am, h) else {
                 return Tried {
                     switches,

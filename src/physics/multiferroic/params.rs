@@ -69,8 +69,9 @@ pub struct MotorParams {
     /// stability do not. Substeps never span a schedule switch, so a step whose switches
     /// outnumber the budget and cannot be settled is refused. A substep of the Gilbert onion
     /// counts as [`GILBERT_SUBSTEP_WEIGHT`](super::GILBERT_SUBSTEP_WEIGHT) (its cost); the
-    /// quasi-static onion's marches count one per four settles, and a substep cut at an onion
-    /// snap counts its bisection's substeps too.
+    /// quasi-static onion's marches count one per four settles, a substep cut at an onion
+    /// snap counts its bisection's substeps too, and the Gilbert onion's linear spans count one
+    /// per two switches they chain (`onion_linear.rs`).
     pub max_substeps: u32,
 }
 

@@ -12,11 +12,12 @@ impl Motor {
     /// outnumber the passes left (one more allowed for rounding), and the onion's linear spans
     /// ([`Self::advance_onion_linear`]) are over for the step. Those spans, the locked rotor's
     /// ring torque folded into their affine maps, cross many switches in one pass; they are
-    /// tried at every switch until one fails and then no more in the step (or never, where the
-    /// ring's stiffness slope has no finite bound). From then on every pass ends by the next
-    /// switch. So the step is refused once its spans are over, not before its first pass: where
-    /// the spans carry the onion, the step ends (945 switches of a 1.06 ns schedule in 120
-    /// passes of 504).
+    /// tried at every switch until they fail or the budget cannot pay for them and then no more
+    /// in the step (or never, where the ring's stiffness slope has no finite bound). From then
+    /// on every pass ends by the next switch. So the step is refused once its spans are over,
+    /// not before its first pass: where the spans carry the onion as far as the budget pays,
+    /// the step ends (945 switches of a 1.06 ns schedule with `max_substeps` 600, in a few
+    /// dozen passes of 1216).
     pub(super) fn passes_run_out(
         &self,
         run: &StepRun,
