@@ -85,6 +85,9 @@ mod linear_ringing_tests;
 #[cfg(test)]
 mod locked_accuracy_tests;
 mod locked_ringing;
+mod locked_stiff;
+#[cfg(test)]
+mod locked_stiff_tests;
 #[cfg(test)]
 mod locked_ringing_tests;
 mod locked_switches;
