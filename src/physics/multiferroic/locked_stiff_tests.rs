@@ -37,7 +37,10 @@ fn creep(dt: f64, steps: usize) -> Vec<(u32, [f64; 2])> {
                 (st.onion_angle - truth[2]).abs() / tol,
                 (st.onion_tilt - truth[3]).abs() / tol,
             ];
-            println!("{} substeps, errors / tolerance {errors:?}", report.substeps);
+            println!(
+                "{} substeps, errors / tolerance {errors:?}",
+                report.substeps
+            );
             (report.substeps, errors)
         })
         .collect()
