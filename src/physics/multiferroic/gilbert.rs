@@ -191,10 +191,11 @@ impl Motor {
     ///
     /// With the rotor locked `L` is the onion's own block `g [[-alpha U'', -T], [U'', -alpha T]]`
     /// (eq. 3.4's landscape frozen) and the rest, the change of the landscape's curvature along
-    /// the substep, is explicit: it is tried where the explicit pair is out of reach and the
-    /// onion's tilt relaxes faster than it turns (`alpha^2 T > 4 |U''|`, real eigenvalues): an
-    /// onion that creeps downhill over its wells' rims after a release far from its minimum,
-    /// where the second-order pair takes about a thousand substeps a microsecond at tolerances
+    /// the substep, is explicit: it is tried where the explicit pair is out of reach or near its
+    /// stability limit ([`Self::locked_stiff_step`]) and the onion's tilt relaxes faster than it
+    /// turns (`alpha^2 T > 4 |U''|`, real eigenvalues): an onion that creeps downhill over its
+    /// wells' rims after a release far from its minimum, where the second-order pair takes about
+    /// a thousand substeps a microsecond at tolerances
     /// near 2e-10 rad. Its error estimate is held to [`LOCKED_ETD_ERROR_SCALE`] times
     /// less.
     pub(super) fn gilbert_exponential_rk4_step(

@@ -128,7 +128,8 @@ impl Motor {
     /// time it advances (`dt`, or less when the quasi-static onion snaps inside it, see
     /// [`Self::step_to_onion_snap`]). The quasi-static rotor uses the embedded pair
     /// ([`Self::embedded_step`]), the Gilbert onion its own ([`Self::gilbert_embedded_step`];
-    /// unless `forced`, first the explicit [`Self::gilbert_explicit_step`] within its reach, else
+    /// unless `forced`, first a locked rotor's creeping onion's exponential RK4 near the explicit
+    /// pair's stability limit ([`Self::locked_stiff_step`]), then the explicit [`Self::gilbert_explicit_step`] within its reach, else
     /// the exponential RK4 [`Self::gilbert_exponential_rk4_step`] within its own, where the
     /// exponential pair takes over what it rejects); step doubling remains where none applies.
     /// `angles` are those at `y`; the result carries those at the new state when known.
@@ -157,6 +158,13 @@ impl Motor {
             // A forced substep takes the exponential pair, which cannot amplify. All three start
             // from the same right-hand side and Jacobian.
             let start = self.linearized(y, d, dt, angles);
+            // A locked rotor's creeping onion near the explicit pair's stability limit.
+            if let Some((u, err)) = (!forced)
+                .then(|| self.locked_stiff_step(y, dt, d, &start))
+                .flatten()
+            {
+                return Some((u, err, dt, None));
+            }
             let explicit = (!forced)
                 .then(|| self.gilbert_explicit_step(y, dt, d, &start))
                 .flatten();

@@ -23,9 +23,11 @@
 //! pair (exprb32) estimates the local error. The Gilbert onion's ringing takes an explicit
 //! Dormand-Prince 5(4) pair within its stability reach, an exponential RK4 where only the rotor's
 //! drag keeps that pair out of reach (with the onion's block exact too where the two barely
-//! couple, `etd_blocks.rs`), else an exponential Rosenbrock pair (`gilbert.rs`); weakly damped
-//! ringing trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`,
-//! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`, the wells its checks find
+//! couple, `etd_blocks.rs`; a locked rotor's creeping onion's block exact, and tried first near
+//! that pair's stability limit, `locked_stiff.rs`), else an exponential Rosenbrock pair
+//! (`gilbert.rs`); weakly damped ringing trapped in its well advances orbit-averaged (`orbit.rs`,
+//! `orbit_advance.rs`, `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`, the
+//! wells its checks find
 //! kept per landscape, `orbit_kept_well.rs`; a locked rotor's last orbit is resolved at once,
 //! `orbit_finish.rs`, its onion refused near the rim is refused again from the well kept,
 //! `orbit_rim_refusal.rs`, and its ringing small enough to be linear
@@ -88,6 +90,9 @@ mod locked_accuracy_tests;
 mod locked_ringing;
 #[cfg(test)]
 mod locked_ringing_tests;
+mod locked_stiff;
+#[cfg(test)]
+mod locked_stiff_tests;
 mod locked_switches;
 #[cfg(test)]
 mod locked_switches_tests;
