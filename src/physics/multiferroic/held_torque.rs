@@ -1,6 +1,6 @@
 //! A segment of constant drive over which the ring's torque on the bar barely changes: the rotor
 //! advances exactly under the torque held at the segment's start, at the cost of one onion
-//! settle (see [`Motor::advance_held_torque`]).
+//! settle a segment (see [`Motor::advance_held_torque`]).
 
 use super::{phi, Drive, Motor, StepRun};
 
@@ -11,8 +11,9 @@ impl Motor {
     /// exactly with `tau` held at its start value `tau_0` (eq. 3.3's torque at the settled onion),
     /// and the onion is settled on its branch of eq. 3.4 at the new rotor angle. This is the
     /// rotor of a nanosecond schedule whose inertial time `I/c` and relaxation time `c/k` are far
-    /// longer than a period: one exponential substep and three settles per switch became one
-    /// closed-form advance and two settles.
+    /// longer than a period: a switch costs one closed-form advance and one settle, where an
+    /// exponential substep took three (the old landscape's settle at the switch is left out where
+    /// the new landscape is convex about the onion, see below).
     ///
     /// The bound. Over the segment of length `h` the rotor leaves its start by at most
     /// `D = |omega_0| I/c (1 - e^(-h c/I)) + (|load| + tau_max) g(h)`, with `g(h)` the angle a
@@ -92,16 +93,57 @@ impl Motor {
         if !(rotor.is_finite() && rotor.abs() <= super::MAX_ANGLE && speed.is_finite()) {
             return false;
         }
-        let start = a.moved(a.onion + k / curvature * turn, rotor, d.direction);
-        let settled = self
-            .landscape(rotor, d.direction, d.stress)
-            .settle_from(start);
+        let predicted = a.onion + k / curvature * turn;
+        // The onion's branch bends by at most `|psi''| <= 4 M (1 + r) (2 C + |k|) / C^2` (its
+        // slope `k / (k + k_me)` differentiated, with the bounds above), so the prediction is off
+        // the minimum at the new rotor angle by at most `|psi''| turn^2 / 2`, plus the settles'
+        // own tolerances.
+        let bend = 4.0 * m * (1.0 + ratio) * (2.0 * curvature + k.abs()) / (curvature * curvature);
+        let slack = 4.0
+            * (landscape.root_tolerance(a.onion)
+                + landscape.gradient_tolerance() / (0.5 * curvature));
+        let miss = 0.5 * bend * turn * turn + slack;
+        let next = (segment_end < run.t_end)
+            .then(|| self.switched(run, d, segment_end))
+            .flatten();
+        let settled = match next {
+            Some(new) => {
+                // At a switch, the onion goes downhill in the new landscape from the old one's
+                // minimum. Where the new landscape is convex within `miss` of the prediction,
+                // which holds that minimum, the march from the prediction ends in the same
+                // minimum: the old landscape's settle is left out.
+                let landscape = self.landscape(rotor, new.direction, new.stress);
+                let start = a.moved(predicted, rotor, new.direction);
+                let (g, c) = landscape.gradient_curvature_of(&start);
+                if c > 2.0 * landscape.third_derivative_bound() * miss {
+                    Some(landscape.settle_from_slope(start, g, c))
+                } else {
+                    None
+                }
+            }
+            None => None,
+        };
+        let settled = settled.unwrap_or_else(|| {
+            self.landscape(rotor, d.direction, d.stress)
+                .settle_from(a.moved(predicted, rotor, d.direction))
+        });
         run.y = [rotor, speed, settled.onion, 0.0];
         run.angles = Some(settled);
         run.settled = true;
         run.t = segment_end;
         run.attempts = run.attempts.saturating_add(1);
         true
+    }
+
+    /// The drive of the segment after the switch at `switch` ([`Motor::drive_at`] there, the
+    /// load and stress as in `d`).
+    fn switched(&self, run: &StepRun, d: &Drive, switch: f64) -> Option<Drive> {
+        let applied = run.schedule.as_ref()?.direction(switch);
+        Some(Drive {
+            direction: super::reduced_direction(applied),
+            applied_direction: applied,
+            ..*d
+        })
     }
 }
 

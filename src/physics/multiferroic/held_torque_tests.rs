@@ -44,6 +44,7 @@ const C834513: &str = "\
 /// Classical RK4 of `I phi'' = tau + load - c phi'` (section 3.2.2) with the quasi-static onion
 /// settled at every stage from the onion at the last step's end (the memory rule), `n` equal
 /// steps per segment of constant drive, from `start` to `t_end`: rotor angle, speed and onion.
+/// A locked rotor stays where it starts, its onion settled at every switch.
 fn quasi_static_rk4(
     m: &Motor,
     start: &MotorState,
@@ -62,9 +63,12 @@ fn quasi_static_rk4(
             .get()
             .map_or(t_end, |s| s.next_switch_after(t).min(t_end));
         let d = m.drive_at(inputs, t);
+        if d.locked {
+            y[1] = 0.0;
+        }
         psi = settle(&d, y[0], psi);
         let h = (next - t) / n as f64;
-        for _ in 0..n {
+        for _ in 0..if d.locked { 0 } else { n } {
             let rate = |z: &[f64; 2]| {
                 let onion = settle(&d, z[0], psi);
                 let torque = m.ring_bar.torque(onion - z[0]);
@@ -128,7 +132,7 @@ fn counted<T>(f: impl FnOnce() -> T) -> (T, u64, u64) {
 }
 
 /// [`C650914`]'s three 1 us steps, each against the converged RK4 from its start: rotor angle,
-/// speed and onion within the tolerance, at two settles a switch (an exponential substep took
+/// speed and onion within the tolerance, at one settle a switch (an exponential substep took
 /// three, 2,440 a step, and 4,500-4,630 evaluations).
 #[test]
 fn draw_650914_switches_under_the_held_torque_against_rk4() {
@@ -145,10 +149,10 @@ fn draw_650914_switches_under_the_held_torque_against_rk4() {
         assert!(!report.accuracy_limited);
         assert!(e.iter().all(|x| *x <= 1.0), "step {k}: {e:?}");
         assert!(
-            settles <= 2 * u64::from(report.substeps) + 2,
+            settles <= u64::from(report.substeps) + 2,
             "step {k}: {settles} settles"
         );
-        assert!(evaluations <= 4000, "step {k}: {evaluations} evaluations");
+        assert!(evaluations <= 3200, "step {k}: {evaluations} evaluations");
     }
 }
 
