@@ -55,7 +55,9 @@ impl Motor {
             return false;
         };
         let h = segment_end - run.t;
-        if !(h > 0.0) {
+        // Comparisons false for NaN, so that a NaN anywhere declines the advance.
+        let positive = h > 0.0;
+        if !positive {
             return false;
         }
         let landscape = self.landscape(run.y[0], d.direction, d.stress);
@@ -63,7 +65,8 @@ impl Motor {
             .ring_bar
             .torque_stiffness_of(a.sin_offset, a.cos_offset);
         let curvature = k + 2.0 * landscape.magnetoelastic * a.cos_double;
-        if !(curvature > 0.0) {
+        let convex = curvature > 0.0;
+        if !convex {
             return false;
         }
         let (i, c) = (self.inertia, self.drag);
@@ -75,7 +78,8 @@ impl Motor {
         let reach = omega.abs() * coast + (d.load.abs() + self.torque_bound()) * torque_angle;
         let ratio = 1.0 + 2.0 * k.abs() / curvature;
         let m = landscape.third_derivative_bound();
-        if !(m * reach * (1.0 + ratio) <= 0.5 * curvature) {
+        let no_fold = m * reach * (1.0 + ratio) <= 0.5 * curvature;
+        if !no_fold {
             return false;
         }
         let torque_change = (k.abs() + 0.5 * curvature) * (1.0 + ratio) * reach;
