@@ -149,6 +149,8 @@ mod ringing;
 #[cfg(test)]
 mod ringing_drop_tests;
 pub mod schedule;
+#[cfg(test)]
+mod slip_layer_tests;
 mod slow_onion;
 #[cfg(test)]
 mod slow_onion_tests;
