@@ -235,7 +235,8 @@ impl Motor {
     /// turn repeats it (onion back to the same place modulo 2 pi within `tolerance / 1000`), as
     /// many more such turns as fit while leaving at least one turn of the interval to the error-
     /// controlled integrator. Returns the time advanced and the state; `None` if the rotor does
-    /// not slip or too little time is left.
+    /// not slip, too little time is left, or its speed's initial layer (`20 I/c`) does not fit in
+    /// the interval.
     pub(super) fn slip_turns(
         &self,
         y: &Vector,
@@ -244,7 +245,10 @@ impl Motor {
         settles: &Cell<u32>,
     ) -> Option<(f64, Vector)> {
         let (i, c) = (self.inertia, self.drag);
-        if d.locked || !self.quasi_static() || c <= 0.0 {
+        // The overdamped limit holds after the speed's initial layer (20 I/c, as in
+        // `settle_rotor`): a rotor whose inertial time is not far below the interval speeds up
+        // along `I phi'' = F - c phi'`, not at once to `F / c`.
+        if d.locked || !self.quasi_static() || c <= 0.0 || 20.0 * i / c >= available {
             return None;
         }
         let coast = y[1] * i / c;

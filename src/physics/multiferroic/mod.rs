@@ -35,7 +35,9 @@
 //! above its wells' rims is held to what its energy, which only falls, can reach
 //! (`rim_energy.rs`), a free rotor's to what the rotor's turn can feed it (`free_energy.rs`).
 //! A free rotor's onion is settled on its branch only where a minimum can lie within the check's
-//! slack (`branch_settle.rs`). On fast schedules whose ring barely couples the onion to the rotor,
+//! slack (`branch_settle.rs`). A free rotor that turns too little between a schedule's switches
+//! for the ring's torque to change beyond the tolerance advances under that torque held, in
+//! closed form, with the quasi-static onion settled once per segment (`held_torque.rs`). On fast schedules whose ring barely couples the onion to the rotor,
 //! repeated periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an
 //! onion near its path advances by exact affine maps per switch (`onion_linear.rs`; a locked
 //! rotor's, the ring's torque folded into them, by `onion_linear_locked.rs`). The estimate
@@ -81,6 +83,9 @@ mod free_energy;
 #[cfg(test)]
 mod free_energy_tests;
 mod gilbert;
+mod held_torque;
+#[cfg(test)]
+mod held_torque_tests;
 mod integrator;
 mod linear_ringing;
 #[cfg(test)]
@@ -150,6 +155,8 @@ mod ringing;
 #[cfg(test)]
 mod ringing_drop_tests;
 pub mod schedule;
+#[cfg(test)]
+mod slip_layer_tests;
 mod slow_onion;
 #[cfg(test)]
 mod slow_onion_tests;

@@ -331,6 +331,9 @@ impl Motor {
                     continue;
                 }
             }
+            if model.advance_held_torque(&mut run, &d, segment_end) {
+                continue;
+            }
             model.substep(&mut run, &d, segment_end, budget);
         }
         if run.t < run.t_end {
