@@ -127,6 +127,8 @@ mod orbit;
 mod orbit_advance;
 mod orbit_averager;
 mod orbit_finish;
+#[cfg(test)]
+mod orbit_free_tests;
 mod orbit_kept_well;
 #[cfg(test)]
 mod orbit_kept_well_tests;

@@ -8,7 +8,7 @@ use super::orbit::{Orbit, Well};
 use super::{Drive, Motor};
 
 /// The averaged ringing's state: rotor angle and speed (rad, rad/s), the orbit's energy above
-/// the minimum (J; under a locked rotor its logarithm, see [`Averager::log_energy`]) and its
+/// the minimum (J; or its logarithm, see [`Averager::log_energy`]) and its
 /// phase (cycles).
 pub(super) type Slow = [f64; 4];
 
@@ -23,11 +23,11 @@ pub(super) struct Averager<'a> {
     pub(super) evaluations: u32,
     /// The rotor is overdamped (see `orbit_advance.rs`).
     pub(super) overdamped: bool,
-    /// The slow state carries the energy's logarithm (a locked rotor): the energy then decays
-    /// at a rate `<E'> / E` that changes only with the orbit's shape, which the explicit steps
-    /// follow at any length, where an explicit step of the energy itself overshoots past the
-    /// minimum once it spans about a decay time. The error held on it is the energy's relative
-    /// one, as on the energy.
+    /// The slow state carries the energy's logarithm (a locked rotor, or ringing dropped at the
+    /// advance's end): the energy then decays at a rate `<E'> / E` that changes only with the
+    /// orbit's shape, which the explicit steps follow at any length, where an explicit step of
+    /// the energy itself overshoots past the minimum once it spans about a decay time. The error
+    /// held on it is the energy's relative one, as on the energy.
     pub(super) log_energy: bool,
 }
 

@@ -222,7 +222,7 @@ fn weakly_damped_gilbert_onion_averages_its_ringing_at_one_microsecond() {
 /// what is left of its ringing (which the branch drops, reporting its centre). The substeps
 /// are counted (the averaged advance's steps and the relaxed onion's settles included): at
 /// damping 1e-3 the free onion's ringing that decays within the step is averaged without its
-/// phase (88 substeps, where resolving it took 616), and the locked onion's is dropped at once
+/// phase (58 substeps, where resolving it took 616), and the locked onion's is dropped at once
 /// (1 substep), as from 0.03 up, since its energy's guaranteed decay ends it within the step; at
 /// 1e-2 that happens once the ringing has decayed far enough (318, against 575). The free
 /// onion's ringing is resolved by the explicit pair until the relaxed onion takes over: 703,
@@ -272,7 +272,7 @@ fn ringing_after_a_release_keeps_to_a_fine_rk4_over_a_step() {
             );
             assert!(!report.accuracy_limited, "{alpha} {locked}");
             let most = match (alpha, locked) {
-                (1e-3, false) => 150,
+                (1e-3, false) => 70,
                 (1e-2, true) => 400,
                 (1e-2, false) => 800,
                 (0.03, false) => 280,
