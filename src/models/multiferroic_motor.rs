@@ -402,9 +402,10 @@ impl Model for MultiferroicMotor {
                     report.warn(format!(
                         "the step from t = {time} s by {step} s was completed beyond tolerance \
                          = {} rad (its substep budget max_substeps = {} ran out, a Gilbert \
-                         onion substep counting as {GILBERT_SUBSTEP_WEIGHT}, or a slipping rotor \
-                         was advanced by whole turns); shorten the step or raise max_substeps \
-                         where this matters",
+                         onion substep counting as {GILBERT_SUBSTEP_WEIGHT}, a slipping rotor \
+                         was advanced by whole turns, or the Gilbert onion's dynamics amplify \
+                         its substeps' errors far beyond the tolerance); shorten the step or \
+                         raise max_substeps where this matters",
                         self.motor.params.tolerance, self.motor.params.max_substeps
                     ));
                 }

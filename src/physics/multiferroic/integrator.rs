@@ -462,6 +462,15 @@ impl Motor {
             Some((y_new, err, taken, new_angles)) if err <= 1.0 || forced => {
                 if err > 1.0 {
                     run.limited = true;
+                } else if !self.quasi_static() {
+                    self.record_amplification(
+                        &mut run.amplification,
+                        (&run.y, &y_new),
+                        (t, taken),
+                        d,
+                        &angles,
+                        err,
+                    );
                 }
                 run.y = y_new;
                 // The embedded pair's state is settled, with its angles; the others are not.

@@ -51,7 +51,9 @@
 //! switches outnumber its loop's passes once the linear spans fail or the budget cannot pay for
 //! them (`switch_count.rs`; the spans count one unit per two switches they chain). A free
 //! rotor's onion whose tilt leaves its bounds escapes at the substep that carries it out, not at
-//! the budget's smallest (`tilt_exit.rs`).
+//! the budget's smallest (`tilt_exit.rs`). A Gilbert step whose onion's dynamics carry its
+//! resolved substeps' local errors far beyond the tolerance by its end is flagged
+//! (`amplification.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
 //! through a negative (past-the-peak) stiffness, which would amplify by `exp(h |k| / c)`. Instead
@@ -61,6 +63,7 @@
 //! turns; what is left is integrated, and a forced substep drops the negative stiffness so it
 //! cannot amplify. See [`Motor::step`].
 
+mod amplification;
 pub mod angles;
 pub mod branch;
 mod branch_settle;
@@ -167,6 +170,8 @@ mod span_charge_tests;
 mod spin;
 #[cfg(test)]
 mod spin_tests;
+#[cfg(test)]
+mod spinning_onion_tests;
 mod step;
 #[cfg(test)]
 mod stiff_rotor_tests;
@@ -308,8 +313,10 @@ pub struct StepReport {
     pub outputs: MotorOutputs,
     /// Attempted substeps (accepted and rejected).
     pub substeps: u32,
-    /// True when the substep budget or a failed substep forced steps beyond the tolerance, or a
-    /// slipping rotor was advanced by whole turns (their phase is not held to the tolerance).
+    /// True when the substep budget or a failed substep forced steps beyond the tolerance, a
+    /// slipping rotor was advanced by whole turns (their phase is not held to the tolerance), or
+    /// the Gilbert onion's dynamics carry the substeps' errors far beyond the tolerance
+    /// (`amplification.rs`).
     pub accuracy_limited: bool,
 }
 

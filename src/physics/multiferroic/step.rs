@@ -87,6 +87,8 @@ pub(super) struct StepRun {
     /// The energy bound of a free rotor's Gilbert onion (see
     /// [`Motor::free_energy_checked_error`]).
     pub(super) free_ledger: super::free_energy::FreeLedger,
+    /// The resolved Gilbert substeps' propagators (see [`Motor::flag_amplified_errors`]).
+    pub(super) amplification: super::amplification::Amplification,
 }
 
 impl StepRun {
@@ -137,6 +139,7 @@ impl StepRun {
             unresolvable: false,
             rim_ledger: super::rim_energy::RimLedger::NONE,
             free_ledger: super::free_energy::FreeLedger::NONE,
+            amplification: Default::default(),
         }
     }
 
@@ -339,6 +342,7 @@ impl Motor {
         if run.t < run.t_end {
             return Err(too_many_switches());
         }
+        self.flag_amplified_errors(&mut run);
         let d = self.drive_at(inputs, run.t_end);
         if !run.is_settled(&d) {
             self.constrain(&mut run.y, &d, run.angles.as_ref());

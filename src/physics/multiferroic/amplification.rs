@@ -1,0 +1,163 @@
+//! A step whose Gilbert onion carries its substeps' local errors far beyond the tolerance by the
+//! step's end is flagged ([`Motor::flag_amplified_errors`]).
+//!
+//! The error control holds each resolved substep's local error to the tolerance. An error `e_i`
+//! made over substep `i` reaches the step's end as `G_i e_i` to first order, `G_i` the propagator
+//! of the linearized flow over the later substeps: the product of their `exp(J_o dt)`, `J_o` the
+//! onion's block of the Jacobian of the macrospin's equations (eq. 3.4 plus the tilt's shape
+//! anisotropy, [`Motor::onion_relaxation_time`]) at each substep's start. The step's end is then
+//! off by at most `sum_i e_i |G_i|` tolerances to first order ([`Amplification::bound`], `|G|`
+//! the largest row sum).
+//!
+//! Where the onion passes close above a rim of its well (a saddle of the macrospin's energy),
+//! the time it takes to pass, and so its angle and tilt after it, depend on its energy there
+//! like the logarithm of the energy's margin over the rim: a weakly damped onion spinning just
+//! above its rims while the schedule turns the landscape under it passes many rims, and each
+//! passage multiplies the errors. `|G|` then grows by many orders of magnitude within a step
+//! (an RK4 of the motor's equations started 1e-11 rad away ends 3.4e-3 rad away after 1 us),
+//! and the step's end is off by far more than its substeps' errors: resolving it would take a
+//! tolerance that many times finer, which the budget cannot pay for. Such a step is flagged as
+//! one the budget could not resolve.
+//!
+//! The bound takes every local error at the tolerance its estimate reports and in the direction
+//! the flow amplifies most; ringing onions whose tilt is far stiffer than their well (`|G|` up
+//! to `sqrt(T / k)` along the ellipse of their precession) stay within the tolerance at bounds
+//! up to about 1e6. Only a bound beyond [`AMPLIFIED_BEYOND`] flags the step. The onion's own
+//! block is taken alone: the rotor's coupling to it and the paths that do not resolve the
+//! onion's substeps (averaged, settled, linear spans) carry the errors unchanged in the bound.
+
+use super::step::StepRun;
+use super::{Angles, Drive, Motor, Vector};
+
+type Mat2 = [[f64; 2]; 2];
+
+/// A step whose [`Amplification::bound`] exceeds this many tolerances is flagged.
+const AMPLIFIED_BEYOND: f64 = 1e6;
+
+/// The resolved Gilbert substeps of one step: each one's propagator of the onion's angle and
+/// tilt and its error estimate in tolerances.
+#[derive(Clone, Debug, Default)]
+pub(super) struct Amplification {
+    substeps: Vec<(Mat2, f64)>,
+    /// The state and time at the last recorded substep's end.
+    end: Option<(Vector, f64)>,
+    /// The bound carried from chains of substeps that another path interrupted.
+    carried: f64,
+}
+
+impl Amplification {
+    /// `sum_i e_i |G_i|` (tolerances) over the substeps recorded, `|G_i|` the largest row sum of
+    /// the propagator from the end of substep `i` to the last recorded one's end; a path other
+    /// than the resolved substeps between two of them is taken to carry the errors unchanged.
+    pub(super) fn bound(&mut self) -> f64 {
+        self.fold();
+        self.carried
+    }
+
+    /// Folds the chain recorded so far into `carried`.
+    fn fold(&mut self) {
+        let mut p: Mat2 = [[1.0, 0.0], [0.0, 1.0]];
+        let mut total = 0.0;
+        for (phi, err) in self.substeps.iter().rev() {
+            let gain = (p[0][0].abs() + p[0][1].abs()).max(p[1][0].abs() + p[1][1].abs());
+            // (A NaN flags the step too.)
+            if gain.is_nan() || gain > 1e100 {
+                total = f64::INFINITY;
+                break;
+            }
+            total += err * gain;
+            p = [
+                [
+                    p[0][0] * phi[0][0] + p[0][1] * phi[1][0],
+                    p[0][0] * phi[0][1] + p[0][1] * phi[1][1],
+                ],
+                [
+                    p[1][0] * phi[0][0] + p[1][1] * phi[1][0],
+                    p[1][0] * phi[0][1] + p[1][1] * phi[1][1],
+                ],
+            ];
+        }
+        self.carried += total;
+        self.substeps.clear();
+    }
+}
+
+/// `exp(a)` of a 2x2 matrix: `e^s (C I + S (a - s I))`, `s` half the trace,
+/// `q = ((a00 - a11) / 2)^2 + a01 a10`, `C = cosh sqrt(q)`, `S = sinh sqrt(q) / sqrt(q)` (their
+/// circular forms for `q < 0`, the series near 0).
+pub(super) fn exp2(a: &Mat2) -> Mat2 {
+    let s = 0.5 * (a[0][0] + a[1][1]);
+    let h = 0.5 * (a[0][0] - a[1][1]);
+    let q = h * h + a[0][1] * a[1][0];
+    // `e^s C` and `e^s S`; for `q > 0` from `e^(s -+ sqrt(q))`, which do not overflow where the
+    // flow decays (an overdamped onion over a long substep).
+    let (c, sh) = if q.abs() < 1e-6 {
+        let e = s.exp();
+        (
+            e * (1.0 + 0.5 * q + q * q / 24.0),
+            e * (1.0 + q / 6.0 + q * q / 120.0),
+        )
+    } else if q > 0.0 {
+        let r = q.sqrt();
+        let (up, down) = ((s + r).exp(), (s - r).exp());
+        (0.5 * (up + down), 0.5 * (up - down) / r)
+    } else {
+        let r = (-q).sqrt();
+        let e = s.exp();
+        (e * r.cos(), e * r.sin() / r)
+    };
+    [[c + sh * h, sh * a[0][1]], [sh * a[1][0], c - sh * h]]
+}
+
+impl Motor {
+    /// Records a resolved Gilbert substep from `y` at `t` (angles `angles`) to `u` over `dt` (s)
+    /// under `d`, its error estimate `err` in tolerances (see [`Amplification`]).
+    pub(super) fn record_amplification(
+        &self,
+        amp: &mut Amplification,
+        (y, u): (&Vector, &Vector),
+        (t, dt): (f64, f64),
+        d: &Drive,
+        angles: &Angles,
+        err: f64,
+    ) {
+        if amp.end != Some((*y, t)) {
+            amp.fold();
+        }
+        amp.end = Some((*u, t + dt));
+        // The onion's block of the Jacobian ([`Self::rhs_jacobian`]).
+        let (_, k_bar) = self
+            .ring_bar
+            .torque_stiffness_of(angles.sin_offset, angles.cos_offset);
+        let curvature =
+            k_bar + 2.0 * self.magnetoelastic_per_stress * d.stress * angles.cos_double;
+        let (g, alpha, tilt) = (
+            self.llg_rate * dt,
+            self.params.gilbert_damping,
+            self.tilt_stiffness,
+        );
+        let a = [
+            [-g * alpha * curvature, -g * tilt],
+            [g * curvature, -g * alpha * tilt],
+        ];
+        amp.substeps.push((exp2(&a), err));
+    }
+
+    /// Flags the step of `run` whose resolved Gilbert substeps' errors its onion's dynamics carry
+    /// beyond [`AMPLIFIED_BEYOND`] tolerances by its end (see the module documentation).
+    pub(super) fn flag_amplified_errors(&self, run: &mut StepRun) {
+        if self.quasi_static() || run.limited {
+            return;
+        }
+        let bound = run.amplification.bound();
+        #[cfg(test)]
+        AMPLIFICATION.with(|c| c.set(bound));
+        run.limited = bound > AMPLIFIED_BEYOND;
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// The last unflagged step's [`Amplification::bound`] (tests read it).
+    pub(super) static AMPLIFICATION: std::cell::Cell<f64> = const { std::cell::Cell::new(0.0) };
+}
