@@ -1,5 +1,5 @@
 //! A step whose Gilbert onion carries its substeps' local errors far beyond the tolerance by the
-//! step's end is flagged ([`Motor::flag_amplified_errors`]).
+//! step's end is flagged ([`Motor::errors_amplified`]).
 //!
 //! The error control holds each resolved substep's local error to the tolerance. An error `e_i`
 //! made over substep `i` reaches the step's end as `G_i e_i` to first order, `G_i` the propagator
@@ -26,7 +26,6 @@
 //! block is taken alone: the rotor's coupling to it and the paths that do not resolve the
 //! onion's substeps (averaged, settled, linear spans) carry the errors unchanged in the bound.
 
-use super::step::StepRun;
 use super::{Angles, Drive, Motor, Vector};
 
 type Mat2 = [[f64; 2]; 2];
@@ -129,8 +128,7 @@ impl Motor {
         let (_, k_bar) = self
             .ring_bar
             .torque_stiffness_of(angles.sin_offset, angles.cos_offset);
-        let curvature =
-            k_bar + 2.0 * self.magnetoelastic_per_stress * d.stress * angles.cos_double;
+        let curvature = k_bar + 2.0 * self.magnetoelastic_per_stress * d.stress * angles.cos_double;
         let (g, alpha, tilt) = (
             self.llg_rate * dt,
             self.params.gilbert_damping,
@@ -143,16 +141,17 @@ impl Motor {
         amp.substeps.push((exp2(&a), err));
     }
 
-    /// Flags the step of `run` whose resolved Gilbert substeps' errors its onion's dynamics carry
-    /// beyond [`AMPLIFIED_BEYOND`] tolerances by its end (see the module documentation).
-    pub(super) fn flag_amplified_errors(&self, run: &mut StepRun) {
-        if self.quasi_static() || run.limited {
-            return;
+    /// Whether the resolved Gilbert substeps' errors recorded in `amp` are carried beyond
+    /// [`AMPLIFIED_BEYOND`] tolerances by the step's end (see the module documentation): such a
+    /// step is flagged.
+    pub(super) fn errors_amplified(&self, amp: &mut Amplification) -> bool {
+        if self.quasi_static() {
+            return false;
         }
-        let bound = run.amplification.bound();
+        let bound = amp.bound();
         #[cfg(test)]
         AMPLIFICATION.with(|c| c.set(bound));
-        run.limited = bound > AMPLIFIED_BEYOND;
+        bound > AMPLIFIED_BEYOND
     }
 }
 

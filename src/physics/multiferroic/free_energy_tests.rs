@@ -59,7 +59,7 @@ fn a_substep_that_raises_the_energy_beyond_the_tolerance_is_rejected() {
 /// and it spun 920 rad away (2,580 tolerances) in 419 substeps. Ringing at 0.99 of its rims, the
 /// onion decides between wells on energy differences that a loose tolerance does not resolve:
 /// its dynamics carry the substeps' errors far beyond the tolerance
-/// ([`Motor::flag_amplified_errors`]), it ends 7 tolerances off in angle, and the step is
+/// ([`Motor::errors_amplified`]), it ends 7 tolerances off in angle, and the step is
 /// flagged.
 #[test]
 fn draw_ringing_near_its_rims_stays_in_its_well_against_rk4() {

@@ -1,6 +1,6 @@
 //! A free rotor's Gilbert onion spinning just above its wells' rims: its dynamics carry the
 //! substeps' local errors far beyond the tolerance, and the step is flagged
-//! ([`Motor::flag_amplified_errors`]).
+//! ([`Motor::errors_amplified`]).
 
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4;
@@ -49,7 +49,10 @@ fn onion_spinning_above_its_rims_is_flagged() {
     };
     let apart = rk4(&m, &nudged, &inputs, t_end, 100.0);
     assert!(
-        (apart[2] - coarse[2]).abs().max((apart[3] - coarse[3]).abs()) > 1e-4,
+        (apart[2] - coarse[2])
+            .abs()
+            .max((apart[3] - coarse[3]).abs())
+            > 1e-4,
         "{apart:?} {coarse:?}"
     );
     let mut st = start;
@@ -82,7 +85,11 @@ fn onion_block_exponential_matches_the_series() {
         let reference = expm(&a).unwrap();
         for (row, expected) in e.iter().zip(&reference) {
             for (x, r) in row.iter().zip(expected) {
-                let scale = reference.iter().flatten().map(|v| v.abs()).fold(0.0, f64::max);
+                let scale = reference
+                    .iter()
+                    .flatten()
+                    .map(|v| v.abs())
+                    .fold(0.0, f64::max);
                 assert!((x - r).abs() <= 1e-12 * scale, "{a:?}: {e:?} {reference:?}");
             }
         }

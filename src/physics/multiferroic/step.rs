@@ -87,7 +87,7 @@ pub(super) struct StepRun {
     /// The energy bound of a free rotor's Gilbert onion (see
     /// [`Motor::free_energy_checked_error`]).
     pub(super) free_ledger: super::free_energy::FreeLedger,
-    /// The resolved Gilbert substeps' propagators (see [`Motor::flag_amplified_errors`]).
+    /// The resolved Gilbert substeps' propagators (see [`Motor::errors_amplified`]).
     pub(super) amplification: super::amplification::Amplification,
 }
 
@@ -342,7 +342,7 @@ impl Motor {
         if run.t < run.t_end {
             return Err(too_many_switches());
         }
-        self.flag_amplified_errors(&mut run);
+        run.limited = run.limited || self.errors_amplified(&mut run.amplification);
         let d = self.drive_at(inputs, run.t_end);
         if !run.is_settled(&d) {
             self.constrain(&mut run.y, &d, run.angles.as_ref());
