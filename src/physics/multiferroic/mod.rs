@@ -166,6 +166,8 @@ mod slow_onion;
 #[cfg(test)]
 mod slow_onion_tests;
 #[cfg(test)]
+mod slow_decay_tests;
+#[cfg(test)]
 mod span_charge_tests;
 mod spin;
 #[cfg(test)]

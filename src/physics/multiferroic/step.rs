@@ -392,9 +392,9 @@ impl Motor {
     /// [`Self::decoupled_budget_drop`], unless it left its bounds; a locked rotor's as
     /// [`Self::locked_budget_drop`] says, which refuses the step where neither dropping nor
     /// forced substeps can follow the onion through the schedule's switches.) Otherwise it
-    /// follows once relaxed ([`Self::relaxed_onion`]) and, under a free rotor, heads for its
-    /// minimum within the rest of the step: ringing that barely moves the rotor still places the
-    /// onion.
+    /// follows once relaxed ([`Self::relaxed_onion`]) and, under a free rotor, ends the rest of
+    /// the step within the tolerance of its minimum ([`Self::ends_at_minimum`]): ringing that
+    /// barely moves the rotor still places the onion.
     pub(super) fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
@@ -447,11 +447,11 @@ impl Motor {
                 run.average_check_at = run.attempts + 1 + run.attempts / 8;
             }
             let rims = average.then_some(&mut run.rim_barrier.1);
-            // Ringing that neither decays within the step nor ends within the tolerance is
-            // kept, whatever its effect on a free rotor: the onion itself would be off by it.
+            // Ringing that does not end the step within the tolerance of the minimum is kept,
+            // whatever its effect on a free rotor: the onion itself would be off by it.
             let horizon = run.t_end - run.t;
             let decays = |r: &Relaxed| {
-                d.locked || self.heads_for_minimum(&run.y, r.settled.onion, r.curvature, horizon)
+                d.locked || self.ends_at_minimum(&run.y, r.settled.onion, r.curvature, horizon)
             };
             // Dropped ringing carries over a switch; before it, it only shifts the reported
             // onion from the centre of its ringing, which it decays to.
