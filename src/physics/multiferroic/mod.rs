@@ -145,6 +145,9 @@ mod orbit_rim_refusal_tests;
 mod orbit_tests;
 #[cfg(test)]
 mod orbit_theory_tests;
+mod pair_midpoint;
+#[cfg(test)]
+mod pair_midpoint_tests;
 mod params;
 mod periods;
 pub mod phi;
