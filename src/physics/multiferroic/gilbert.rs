@@ -54,7 +54,7 @@ impl Motor {
     ) -> Option<(Vector, f64)> {
         let (f0, j) = (start.f, start.j);
         let unit = self.speed_unit();
-        let (_, increments) = self.increments_of::<4>(&f0, &j, dt, false, unit)?;
+        let (half, increments) = self.increments_of::<4>(&f0, &j, dt, true, unit)?;
         let u1 = self.finish_exponential_step(y, &increments, d)?;
         let f1 = self.gilbert_rate(&u1, d, &start.angles.moved(u1[2], u1[0], d.direction));
         let step: Vector = std::array::from_fn(|i| u1[i] - y[i]);
@@ -68,7 +68,9 @@ impl Motor {
             *x += c;
         }
         let u3 = self.checked_end(u3, y, d.locked)?;
-        let err = self.error_norm(|i| correction[i], y, &u3);
+        let err = self
+            .error_norm(|i| correction[i], y, &u3)
+            .max(self.pair_midpoint_error(y, dt, d, start, &half?)?);
         // Beyond the tolerance the correction is no longer small and the substep, if taken at
         // all (forced at the budget's minimum size), is the exponential Euler step, which is
         // exact for the linear part and cannot amplify (see [`Self::rhs_jacobian`]).
@@ -390,7 +392,7 @@ pub(super) const EXPLICIT_REACH: f64 = 3.0;
 /// [`Motor::exponential_increments`]) by Gaussian elimination with partial pivoting; `None` if
 /// the matrix is singular or the result not finite. Hand-written: one fixed 4x4 solve per
 /// Gilbert substep, on the hot path, where the library has no linear-algebra dependency.
-fn pade_phi3_apply(j: &[[f64; 4]; 4], dt: f64, v: &Vector, unit: f64) -> Option<Vector> {
+pub(super) fn pade_phi3_apply(j: &[[f64; 4]; 4], dt: f64, v: &Vector, unit: f64) -> Option<Vector> {
     let scale = |i: usize| if i == 1 { unit } else { 1.0 };
     let mut m = [[0.0; 5]; 4];
     for (i, row) in m.iter_mut().enumerate() {

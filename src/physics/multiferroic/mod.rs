@@ -25,7 +25,7 @@
 //! drag keeps that pair out of reach (with the onion's block exact too where the two barely
 //! couple, `etd_blocks.rs`; a locked rotor's creeping onion's block exact, and tried first near
 //! that pair's stability limit, `locked_stiff.rs`), else an exponential Rosenbrock pair
-//! (`gilbert.rs`); weakly damped ringing trapped in its well advances orbit-averaged (`orbit.rs`,
+//! (`gilbert.rs`, its defect also sampled at the substep's midpoint, `pair_midpoint.rs`); weakly damped ringing trapped in its well advances orbit-averaged (`orbit.rs`,
 //! `orbit_advance.rs`, `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`, the
 //! wells its checks find
 //! kept per landscape, `orbit_kept_well.rs`; a locked rotor's last orbit is resolved at once,
@@ -145,6 +145,9 @@ mod orbit_rim_refusal_tests;
 mod orbit_tests;
 #[cfg(test)]
 mod orbit_theory_tests;
+mod pair_midpoint;
+#[cfg(test)]
+mod pair_midpoint_tests;
 mod params;
 mod periods;
 pub mod phi;
