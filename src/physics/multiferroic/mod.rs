@@ -165,11 +165,11 @@ mod ringing_drop_tests;
 pub mod schedule;
 #[cfg(test)]
 mod slip_layer_tests;
+#[cfg(test)]
+mod slow_decay_tests;
 mod slow_onion;
 #[cfg(test)]
 mod slow_onion_tests;
-#[cfg(test)]
-mod slow_decay_tests;
 #[cfg(test)]
 mod span_charge_tests;
 mod spin;
