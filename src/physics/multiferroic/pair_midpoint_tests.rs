@@ -40,6 +40,21 @@ fn estimate_and_error(m: &Motor, d: &Drive, y: &Vector, dt: f64) -> (f64, f64) {
     (estimate, error)
 }
 
+/// The pair's substep from `y` over `dt` is off by more than the tolerance, and its estimate says
+/// at least half of that.
+fn assert_estimate_sees_the_error(m: &Motor, d: &Drive, y: &Vector, dt: f64) {
+    let (estimate, error) = estimate_and_error(m, d, y, dt);
+    println!("estimate {estimate}, true error {error} tolerances");
+    assert!(
+        error > 1.0,
+        "the substep's result is within the tolerance: {error}"
+    );
+    assert!(
+        estimate >= 0.5 * error,
+        "estimate {estimate}, true error {error}"
+    );
+}
+
 /// A free rotor at 4.5e5 rad/s under a lightly damped Gilbert onion (damping 3.6e-4) whose
 /// substep of 0.21 us turns its onion by 5.6 rad, about a precession period, back near its
 /// start, where the defect at the end is small. The pair's estimate was 0.30 for a true error
@@ -66,16 +81,7 @@ fn pair_estimate_sees_an_onion_precessing_about_a_period() {
         -5.059926003919625e-5,
         -7.332586240895857e-5,
     ];
-    let (estimate, error) = estimate_and_error(&m, &d, &y, 2.0686140866954464e-7);
-    println!("estimate {estimate}, true error {error} tolerances");
-    assert!(
-        error > 1.0,
-        "the substep's result is within the tolerance: {error}"
-    );
-    assert!(
-        estimate >= 0.5 * error,
-        "estimate {estimate}, true error {error}"
-    );
+    assert_estimate_sees_the_error(&m, &d, &y, 2.0686140866954464e-7);
 }
 
 /// A rotor held at its drag speed (3.2e6 rad/s, `c/I` 7e16 1/s) under an onion whose angle's
@@ -106,14 +112,5 @@ fn pair_estimate_sees_an_onion_angle_that_swings_out_and_back() {
         -3.12791620149206,
         -6.121052072423149e-2,
     ];
-    let (estimate, error) = estimate_and_error(&m, &d, &y, 7.895657523891764e-9);
-    println!("estimate {estimate}, true error {error} tolerances");
-    assert!(
-        error > 1.0,
-        "the substep's result is within the tolerance: {error}"
-    );
-    assert!(
-        estimate >= 0.5 * error,
-        "estimate {estimate}, true error {error}"
-    );
+    assert_estimate_sees_the_error(&m, &d, &y, 7.895657523891764e-9);
 }
