@@ -12,6 +12,8 @@
 //! So the section's torque matches the stress reading; its "200 micro-strain" would give a quarter
 //! of it (a third) unless the domain walls are larger than the calibration makes them.
 
+use std::f64::consts::PI;
+
 /// Young's modulus of polycrystalline nickel, 200 GPa (CRC Handbook of Chemistry and Physics,
 /// "Elastic constants of polycrystalline metals"; Cullity and Graham list the same).
 pub const NICKEL_YOUNGS_MODULUS: f64 = 200e9;
@@ -34,6 +36,36 @@ pub fn uniaxial_stress(strain: f64, youngs_modulus: f64) -> Result<f64, String> 
             super::MAX_STRESS
         ))
     }
+}
+
+/// Eq. 3.4 depends on the strain direction only modulo pi (through `2 (psi - gamma)`). A direction
+/// of many turns is reduced modulo pi above this size: the onion's angle, which follows the rotor,
+/// then meets a direction of its own size, so `psi - gamma` keeps the onion's precision instead of
+/// the direction's (beside 1e12 rad it is 1e-4 rad), and the long-step paths, which turn the
+/// rotor back near zero, hand libm small arguments ([`super::angles::turned_back`] guards the
+/// rest). The rounding of pi times the turns stays below the direction's own spacing.
+pub(super) const REDUCED_DIRECTION_ABOVE: f64 = 1e3;
+
+/// The strain direction the physics uses for an applied one (see [`REDUCED_DIRECTION_ABOVE`]).
+pub(super) fn reduced_direction(applied: f64) -> f64 {
+    if applied.abs() > REDUCED_DIRECTION_ABOVE {
+        applied.rem_euclid(PI)
+    } else {
+        applied
+    }
+}
+
+/// Strain, stress and load held over one substep.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Drive {
+    /// The strain direction the physics uses: the applied one, brought into `[0, pi)` when far
+    /// beyond a few turns (see [`REDUCED_DIRECTION_ABOVE`]).
+    pub(super) direction: f64,
+    /// The strain direction as applied, for the `applied_strain_direction` output.
+    pub(super) applied_direction: f64,
+    pub(super) stress: f64,
+    pub(super) load: f64,
+    pub(super) locked: bool,
 }
 
 #[cfg(test)]

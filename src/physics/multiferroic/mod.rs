@@ -191,6 +191,7 @@ mod tilt_exit_tests;
 mod validation;
 
 use angles::Angles;
+use drive::{reduced_direction, Drive};
 use magnetics::{RingBar, GYROMAGNETIC_RATIO, MU0};
 use onion::Landscape;
 pub use params::*;
@@ -323,36 +324,6 @@ pub struct StepReport {
     /// the Gilbert onion's dynamics carry the substeps' errors far beyond the tolerance
     /// (`amplification.rs`).
     pub accuracy_limited: bool,
-}
-
-/// Eq. 3.4 depends on the strain direction only modulo pi (through `2 (psi - gamma)`). A direction
-/// of many turns is reduced modulo pi above this size: the onion's angle, which follows the rotor,
-/// then meets a direction of its own size, so `psi - gamma` keeps the onion's precision instead of
-/// the direction's (beside 1e12 rad it is 1e-4 rad), and the long-step paths, which turn the
-/// rotor back near zero, hand libm small arguments ([`angles::turned_back`] guards the rest). The
-/// rounding of pi times the turns stays below the direction's own spacing.
-const REDUCED_DIRECTION_ABOVE: f64 = 1e3;
-
-/// The strain direction the physics uses for an applied one (see [`REDUCED_DIRECTION_ABOVE`]).
-fn reduced_direction(applied: f64) -> f64 {
-    if applied.abs() > REDUCED_DIRECTION_ABOVE {
-        applied.rem_euclid(PI)
-    } else {
-        applied
-    }
-}
-
-/// Strain, stress and load held over one substep.
-#[derive(Clone, Copy, Debug)]
-struct Drive {
-    /// The strain direction the physics uses: the applied one, brought into `[0, pi)` when far
-    /// beyond a few turns (see [`REDUCED_DIRECTION_ABOVE`]).
-    direction: f64,
-    /// The strain direction as applied, for the `applied_strain_direction` output.
-    applied_direction: f64,
-    stress: f64,
-    load: f64,
-    locked: bool,
 }
 
 /// State vector of the integrator: rotor angle, rotor speed, onion angle, onion tilt.
