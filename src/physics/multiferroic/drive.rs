@@ -1,6 +1,6 @@
-//! Strain as the motor's drive. Eq. 3.1 is written in stress, `sigma11 - sigma22`;
-//! a piezoelectric substrate imposes strain. For uniaxial stress in the ring's plane
-//! (`sigma22 = 0`) Hooke's law gives `sigma11 - sigma22 = E epsilon`.
+//! The motor's drive: strain, and what a substep holds ([`Drive`]). Eq. 3.1 is written in
+//! stress, `sigma11 - sigma22`; a piezoelectric substrate imposes strain. For uniaxial stress in
+//! the ring's plane (`sigma22 = 0`) Hooke's law gives `sigma11 - sigma22 = E epsilon`.
 //!
 //! Two readings of section 3.3: its LLG simulation applies "a tensile strain of 200 micro-strain",
 //! which in nickel is `200e-6 * 200 GPa = 40 MPa`, while Fig. 3.3b's 23 degree offset (to which
