@@ -1,7 +1,7 @@
 //! A locked rotor's creeping onion with the exponential RK4 tried first near the explicit
 //! pair's stability limit ([`Motor::locked_stiff_step`]), against a plain RK4.
 
-use super::locked_accuracy_tests::{converged_rk4, step_against_rk4};
+use super::locked_accuracy_tests::{onion_errors, step_against_rk4};
 use super::onion_periods_tests::{case, values};
 
 /// Gilbert damping 0.16, tolerance 1.3e-10, the rotor locked and no switch within the step: the
@@ -21,22 +21,17 @@ const CREEPER: &str = "strain_direction=4.767180892121511e11 stress=9.2704701288
     strain=-5.5748546746975804e-2 youngs_modulus=9.398411927250062e11 strain_drive=0";
 
 /// Steps of `dt` from the creeper's start: each step's substeps and its onion angle's and tilt's
-/// errors in tolerances against [`converged_rk4`] from that step's start.
+/// errors in tolerances against the converged RK4 ([`onion_errors`]) from that step's start.
 fn creep(dt: f64, steps: usize) -> Vec<(u32, [f64; 2])> {
     let (m, mut st, inputs) = case(&values(CREEPER)).unwrap();
     assert!(inputs.rotor_locked);
-    let tol = m.params.tolerance;
     (0..steps)
         .map(|_| {
             let start = st;
             let report = m.step(&mut st, &inputs, dt).unwrap();
             assert!(!report.accuracy_limited, "{report:?}");
             assert_eq!(st.rotor_angle, start.rotor_angle);
-            let truth = converged_rk4(&m, &start, &inputs, st.time, 1000.0);
-            let errors = [
-                (st.onion_angle - truth[2]).abs() / tol,
-                (st.onion_tilt - truth[3]).abs() / tol,
-            ];
+            let errors = onion_errors(&m, &start, &st, &inputs, 1000.0);
             println!(
                 "{} substeps, errors / tolerance {errors:?}",
                 report.substeps
