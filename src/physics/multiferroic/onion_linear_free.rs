@@ -22,7 +22,7 @@ impl Motor {
     /// (|load| + tau_max) / c)`, which bounds `|p|` over the span (the bound's
     /// [`RingTerm::drift_speed`]). An undamped rotor (`c = 0`) is left to the other paths.
     pub(super) fn free_ring_term(&self, run: &StepRun, inputs: &MotorInputs) -> Option<RingTerm> {
-        if inputs.rotor_locked || !(self.drag > 0.0) {
+        if inputs.rotor_locked || self.drag <= 0.0 {
             return None;
         }
         let (_, torque_speed, torque_angle) = self.drift_response(run.t_end - run.t);

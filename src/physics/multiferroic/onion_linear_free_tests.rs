@@ -6,7 +6,6 @@ use super::locked_accuracy_tests::converged_rk4;
 use super::onion_linear::SPANS;
 use super::onion_periods_tests::{case, values};
 use super::ringing_drop_tests::C370371;
-use super::*;
 
 /// A benchmark case (full precision): a free rotor spinning at 3,540 rad/s under its load on a
 /// 1.03 ns schedule, a Gilbert onion damped at 1.2e-4 that the ring's torque offsets by 1.7e-4
