@@ -23,6 +23,21 @@ const C993794: &str = "strain_direction=-3.7235154732822815e10 stress=-2.6344017
     schedule=1e0 rotor_locked=0e0 initial_onion_offset=2.5361047823027893e-5 \
     strain=4.9709541722195216e-2 youngs_modulus=1.244836482447901e10 strain_drive=1e0";
 
+/// A benchmark case (full precision): a free rotor in a 0.70 m ring on a 1.12 ns schedule, a
+/// Gilbert onion damped at 0.037 at a tolerance of 0.17 rad and a budget of 1,972 substeps.
+const C943623: &str = "strain_direction=9.293128595768033e6 stress=1.3358571039689146e4 \
+    load_torque=-3.619377309010687e-8 ring_outer_diameter=6.994020640659625e-1 \
+    ring_inner_diameter=4.289385074105419e-2 bar_length=1.4485937814359398e-3 \
+    bar_width=4.3511616612279064e-4 thickness=5.275909592993535e-5 \
+    saturation_magnetization=1.7975444909092315e4 magnetostriction=8.549807029133888e-3 \
+    wall_volume=7.680704808540798e-11 density=1.2856617152333592e3 \
+    fluid_viscosity=1.997890428144144e-5 gilbert_damping=3.7320167074652175e-2 \
+    tolerance=1.7462770666924735e-1 step_angle=-3.0600772731864385e0 \
+    step_period=1.1231512719289451e-9 stress_amplitude=1.0839590285512827e-2 \
+    schedule_initial_direction=8.382962296192973e3 onion_model=1e0 max_substeps=1.972e3 \
+    schedule=1e0 rotor_locked=0e0 initial_onion_offset=5.2027271397217515e-11 \
+    strain=-4.5106828132214984e-2 youngs_modulus=1.4669750900788707e8 strain_drive=0e0";
+
 /// A case's first 1 us step with its tolerance scaled by `scale` against [`converged_rk4`] at
 /// `per_ns`: the errors of the rotor's and the onion's angles and the onion's tilt in
 /// tolerances, the step's substeps and the spans taken.
@@ -72,4 +87,17 @@ fn a_spinning_free_rotor_turns_the_ring_torque_within_the_bound() {
     let (errors, _, spans) = first_step(C993794, 1e3, 2e3);
     assert!(errors.iter().all(|&e| e <= 1.0), "{errors:?}");
     assert!(spans >= 1, "{spans} spans");
+}
+
+/// One substep a switch spent this draw's budget within the step (893 substeps, the step
+/// flagged, 4.2e-3 tolerances off the RK4); the spans chain its 889 switches in about 50
+/// substeps, unflagged.
+#[test]
+fn a_free_rotor_whose_switches_outran_its_budget_chains_them() {
+    let (errors, substeps, spans) = first_step(C943623, 1.0, 20.0);
+    assert!(errors.iter().all(|&e| e <= 1.0), "{errors:?}");
+    assert!(
+        spans >= 1 && substeps <= 200,
+        "{substeps} substeps, {spans} spans"
+    );
 }
