@@ -41,7 +41,8 @@
 //! schedules whose ring barely couples the onion to the rotor, repeated periods and cycles are
 //! taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an onion near its path advances by
 //! exact affine maps per switch (`onion_linear.rs`; a locked rotor's, the ring's torque folded
-//! into them, by `onion_linear_locked.rs`). The estimate sizes the next substep.
+//! into them, by `onion_linear_locked.rs`; a free rotor's that the ring turns the onion of but
+//! barely turns itself, by `onion_linear_free.rs`). The estimate sizes the next substep.
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
@@ -116,6 +117,9 @@ mod onion_cycles_tests;
 #[cfg(test)]
 mod onion_flow_tests;
 mod onion_linear;
+mod onion_linear_free;
+#[cfg(test)]
+mod onion_linear_free_tests;
 mod onion_linear_locked;
 #[cfg(test)]
 mod onion_linear_locked_tests;

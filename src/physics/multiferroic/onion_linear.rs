@@ -237,12 +237,14 @@ pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
 impl Motor {
     /// Advances the rest of the step's switches, or some of them, at once where eq. 3.3's
     /// ring-bar torque is negligible ([`Self::ring_decoupled`], as for
-    /// [`Self::skip_onion_periods`]) or the rotor is locked ([`Self::linear_ring_term`]) and the
+    /// [`Self::skip_onion_periods`]), the rotor is locked ([`Self::linear_ring_term`]) or the
+    /// ring barely turns the free rotor ([`Self::free_ring_term`]), and the
     /// Gilbert onion stays close enough to where a macro span
     /// of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
     ///
-    /// A locked rotor stays; a free one follows load and drag alone, exactly
-    /// ([`Self::drift_response`]). The bound below holds for the onion whatever its placements on
+    /// A locked rotor stays; a free one follows load and drag alone ([`Self::drift_response`]),
+    /// exactly where the ring is dropped, within [`Self::free_ring_term`]'s bound where the
+    /// onion keeps it. The bound below holds for the onion whatever its placements on
     /// its quasi-static branch would have been, which the skips of repeated periods rest on
     /// ([`Self::snaps_forgotten`]): an onion the strain turns fast about is advanced here. The onion
     /// obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin 2(psi -
@@ -253,7 +255,8 @@ impl Motor {
     /// [`Self::linear_ring_term`]): each interval is an exact affine map of `(delta, theta)` (see
     /// [`flow`]), chained over the span. The dropped term is bounded by `|R| <= (2 |E| + rho)
     /// delta^2 + tau_r` (Taylor's remainder: `|d^2/dx^2 sin 2x| <= 4`; `rho delta^2 + tau_r` the
-    /// ring term's remainder), and enters the rates as `g (-a R, R)`. All bounds on vectors are
+    /// ring term's remainder; under a free rotor the bar's turn `p` makes it `rho (|delta| +
+    /// |p|)^2 + |k_0| |p|`, [`Self::free_ring_term`]), and enters the rates as `g (-a R, R)`. All bounds on vectors are
     /// entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the entrywise
     /// bound on the interval's propagator `|exp(A s)|` ([`flow`]). Over interval `k` of length
     /// `h_k` the remainder's effect is at most `c_k = K_k (h_k g a, h_k g) R_k` (variation of
@@ -427,7 +430,20 @@ impl Motor {
             // The dropped term's effect over the interval per unit of `|R|`: the rates
             // `g (-a R, R)` through `|exp(A s)|`.
             let unit = apply(&f.k, [h * g * a, h * g]);
-            let remainder = |r: f64| quadratic * r * r + ring.constant;
+            // The bar's turn since the span's start, at most, on a free rotor
+            // ([`Motor::free_ring_term`]).
+            let p = ring.drift_speed * (next - run.t);
+            let remainder = |r: f64| {
+                if p == 0.0 {
+                    quadratic * r * r + ring.constant
+                } else {
+                    let q = r + p;
+                    2.0 * e.abs() * r * r
+                        + ring.curvature * q * q
+                        + ring.stiffness.abs() * p
+                        + ring.constant
+                }
+            };
             // A bound `rb` on `|R|` that holds given itself (`remainder(reach + (K eps)_0 +
             // unit_0 rb) < rb`) holds: the true path cannot first leave the reach it implies.
             let near = reach + apply(&f.k, eps)[0];

@@ -19,6 +19,11 @@ pub(super) struct RingTerm {
     pub curvature: f64,
     /// The remainder's constant part.
     pub constant: f64,
+    /// A bound on the rotor's speed over the span where the rotor turns under the ring (rad/s):
+    /// the bar's turn `p` since the span's start moves the offset, adding `|stiffness| |p|` to
+    /// the remainder and `|p|` to its `delta` (zero where the rotor stays or the ring is dropped
+    /// whole).
+    pub drift_speed: f64,
 }
 
 impl Motor {
@@ -31,7 +36,8 @@ impl Motor {
     /// function of the onion angle alone, `tau(psi - phi)` (eq. 3.3): its value and slope (the
     /// ring-bar stiffness) at the span's start join the affine maps, and Taylor's remainder,
     /// `|tau''| / 2 delta^2`, joins the bound with `|tau''|` at most
-    /// [`stiffness_slope_bound`]. A free rotor the ring couples to is left to the other paths.
+    /// [`stiffness_slope_bound`]. A free rotor the ring couples to the onion but not to the
+    /// rotor itself, see [`Self::free_ring_term`].
     pub(super) fn linear_ring_term(&self, run: &StepRun, inputs: &MotorInputs) -> Option<RingTerm> {
         match run.onion_decoupled {
             Some(true) => Some(RingTerm {
@@ -39,6 +45,7 @@ impl Motor {
                 stiffness: 0.0,
                 curvature: 0.0,
                 constant: torque_bound(&self.ring_bar),
+                drift_speed: 0.0,
             }),
             Some(false) if inputs.rotor_locked => {
                 let (value, stiffness) = self.ring_bar.torque_stiffness(run.y[2] - run.y[0]);
@@ -47,10 +54,12 @@ impl Motor {
                     stiffness,
                     curvature: 0.5 * stiffness_slope_bound(&self.ring_bar),
                     constant: 0.0,
+                    drift_speed: 0.0,
                 };
                 (value.is_finite() && stiffness.is_finite() && term.curvature.is_finite())
                     .then_some(term)
             }
+            Some(false) => self.free_ring_term(run, inputs),
             _ => None,
         }
     }
