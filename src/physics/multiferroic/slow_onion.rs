@@ -24,13 +24,59 @@ impl Motor {
 
     /// Whether the Gilbert onion at `y` ends `horizon` seconds (what is left of the step) within
     /// the tolerance of the `minimum` of eq. 3.4 it settles into (curvature `k` there): its
-    /// decayed distance ([`Self::decayed_gap`]). A step that drops the onion's ringing unflagged
-    /// reports the minimum at its end, so the ringing must have decayed to the tolerance by
-    /// then, not merely by a factor `e` ([`Self::heads_for_minimum`], which serves the flagged
-    /// budget drop): an onion started 0.039 rad from a minimum that it approaches at
+    /// decayed distance ([`Self::decayed_gap`]), and its angle and tilt carried to the step's end
+    /// by the linearization there ([`Self::propagated_gap`]). A step that drops the onion's
+    /// ringing unflagged reports the minimum at its end, so the ringing must have decayed to the
+    /// tolerance by then, not merely by a factor `e` ([`Self::heads_for_minimum`], which serves
+    /// the flagged budget drop): an onion started 0.039 rad from a minimum that it approaches at
     /// `lambda = 1e6 /s` ended a 1 us step 0.014 rad (4,300 tolerances) off a plain RK4.
+    ///
+    /// The tolerance bounds the angle and the tilt alike, while the energy's norm weighs the tilt
+    /// by `sqrt(t / k)`: an onion settled in angle, its tilt 3.35 rad in a well `2.7e9` times
+    /// stiffer than the tilt, decays at `lambda = 2.9e6 /s` to 0.18 rad by the end of a 1 us
+    /// step, which its norm's distance put within the tolerance.
     pub(super) fn ends_at_minimum(&self, y: &Vector, minimum: f64, k: f64, horizon: f64) -> bool {
-        k > 0.0 && self.decayed_gap(y, minimum, k, horizon) <= self.params.tolerance
+        let tol = self.params.tolerance;
+        k > 0.0
+            && self.decayed_gap(y, minimum, k, horizon) <= tol
+            && self.propagated_gap(y, minimum, k, horizon) <= tol
+    }
+
+    /// The larger of the Gilbert onion's angle from the `minimum` (curvature `k > 0`) and its
+    /// tilt after `horizon` seconds of the macrospin's equations linearized there (eq. 3.4's
+    /// torque `k (psi - minimum)`; the rates are linear in the tilt), exactly:
+    /// `exp(A horizon) (psi - minimum, theta)` with `A = g [[-alpha k, -t], [k, -alpha t]]`
+    /// (the rows of [`Self::rhs_jacobian`]), by its eigenvalues `m +- w`.
+    pub(super) fn propagated_gap(&self, y: &Vector, minimum: f64, k: f64, horizon: f64) -> f64 {
+        let (g, alpha, t) = (
+            self.llg_rate,
+            self.params.gilbert_damping,
+            self.tilt_stiffness,
+        );
+        let a = [[-g * alpha * k, -g * t], [g * k, -g * alpha * t]];
+        let x = [y[2] - minimum, y[3]];
+        let m = 0.5 * (a[0][0] + a[1][1]);
+        // (A - m) x, and the discriminant m^2 - det(A) = ((a00 - a11) / 2)^2 + a01 a10.
+        let ax = [0, 1].map(|i| a[i][0] * x[0] + a[i][1] * x[1] - m * x[i]);
+        let half = 0.5 * (a[0][0] - a[1][1]);
+        let disc = half * half + a[0][1] * a[1][0];
+        let h = horizon;
+        let w = disc.abs().sqrt();
+        let end = if disc < 0.0 {
+            let (s, c) = (w * h).sin_cos();
+            let e = (m * h).exp();
+            [0, 1].map(|i| e * (c * x[i] + s / w * ax[i]))
+        } else if w * h < 1.0 {
+            // cosh and sinh bounded: no 0 x inf where `m h` is large.
+            let e = (m * h).exp();
+            let sinhc = if w > 0.0 { (w * h).sinh() / w } else { h };
+            [0, 1].map(|i| e * ((w * h).cosh() * x[i] + sinhc * ax[i]))
+        } else {
+            // Real eigenvalues m -+ w, each mode decaying (or growing) on its own.
+            let (slow, fast) = (((m + w) * h).exp(), ((m - w) * h).exp());
+            [0, 1].map(|i| 0.5 * ((slow + fast) * x[i] + (slow - fast) / w * ax[i]))
+        };
+        end[0].abs().max(end[1].abs())
     }
 
     /// The Gilbert onion's distance at `y` from the `minimum` of eq. 3.4 (curvature `k > 0`) in
