@@ -45,7 +45,8 @@ impl Motor {
             return false;
         }
         let frozen = Drive { locked: true, ..*d };
-        self.locked_ringing_decays(y, &frozen, settled, remaining, &mut rims.decay_retry_level)
+        let (retry, orbits) = (&mut rims.decay_retry_level, &mut rims.decay_orbits);
+        self.locked_ringing_decays(y, &frozen, settled, remaining, retry, orbits)
     }
 
     /// Whether the Gilbert onion at `y`, which the budget can no longer resolve (a forced substep

@@ -26,6 +26,18 @@ const MAX_LOSS_PER_ORBIT: f64 = 0.1;
 /// actual energy, staircase-like over each orbit, lags the averaged one by at most an orbit's
 /// loss, and the averaging errs by the loss per orbit to second order.
 const TIME_MARGIN: f64 = 0.75;
+/// An orbit's quadrature in [`Motor::locked_ringing_decays`] (about 1.4 us) in the budget's
+/// units, substeps of the quasi-static onion (0.32 us, see [`super::GILBERT_SUBSTEP_WEIGHT`]),
+/// so that the budget bounds the check's cost as it bounds the substeps'.
+pub(super) const ORBIT_WEIGHT: u32 = 4;
+#[cfg(test)]
+thread_local! {
+    /// The orbits' quadratures of [`Motor::locked_ringing_decays`] and the units charged for
+    /// them on this thread (tests count them).
+    pub(super) static DECAY_CHARGE: std::cell::Cell<(u64, u64)> =
+        const { std::cell::Cell::new((0, 0)) };
+}
+
 /// The energy's ratio between the nodes of the decay time's quadrature.
 const BIN: f64 = 2.0;
 /// Below this fraction of the window `k / (2 M)` in amplitude the orbit is linear: the curvature
@@ -44,6 +56,8 @@ impl Motor {
     /// onion settles into; `retry` the energy above it (J) below which the check is tried again in
     /// this segment, set on each failure: half the energy where the decay time was too long (it
     /// only shrinks as the energy falls), just below it where the onion was too close to a rim.
+    /// `orbits` counts the orbits' quadratures it evaluates (up to 14 a check, about 1.4 us
+    /// each), for which the step pays [`ORBIT_WEIGHT`] units of its budget each.
     pub(super) fn locked_ringing_decays(
         &self,
         y: &Vector,
@@ -51,6 +65,7 @@ impl Motor {
         settled: f64,
         remaining: f64,
         retry: &mut f64,
+        orbits: &mut u32,
     ) -> bool {
         if !d.locked || remaining.is_nan() || remaining <= 0.0 {
             return false;
@@ -108,6 +123,7 @@ impl Motor {
         // not found or loses too much per orbit.
         let mut guess = (well.minimum - 1e-3, well.minimum + 1e-3);
         let mut ratio = |e: f64| -> Option<f64> {
+            *orbits = orbits.saturating_add(1);
             let o = self.orbit(&land, &well, e, guess)?;
             guess = (o.below, o.above);
             let loss = -o.damping_rate(alpha) * o.period / e;

@@ -90,7 +90,7 @@ fn locked_decay_time_is_not_shorter_than_the_resolved_one() {
         let decays = |remaining: f64| {
             let mut retry = f64::INFINITY;
             let settled = m.landscape(0.0, d.direction, d.stress).settle(y[2]);
-            m.locked_ringing_decays(&y, &d, settled, remaining, &mut retry)
+            m.locked_ringing_decays(&y, &d, settled, remaining, &mut retry, &mut 0)
         };
         // Released at or beyond 0.999 of the rim: refused whatever the time left.
         let land = m.landscape(0.0, d.direction, d.stress);

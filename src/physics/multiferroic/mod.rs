@@ -71,6 +71,8 @@ mod branch_settle;
 #[cfg(test)]
 mod branch_settle_tests;
 mod cycle;
+#[cfg(test)]
+mod decay_charge_tests;
 mod decoupled;
 mod decoupled_drop;
 #[cfg(test)]

@@ -116,8 +116,8 @@ impl Motor {
             return Some(relaxed(kick, k));
         }
         // A locked rotor's ringing that its orbit-averaged loss ends within the segment.
-        let retry = &mut rims.decay_retry_level;
-        self.locked_ringing_decays(y, d, settled, remaining, retry)
+        let (retry, orbits) = (&mut rims.decay_retry_level, &mut rims.decay_orbits);
+        self.locked_ringing_decays(y, d, settled, remaining, retry, orbits)
             .then(|| relaxed(0.0, k))
     }
 
@@ -521,6 +521,9 @@ pub(super) struct Rims {
     /// Whether the segment ends at the step's end, no switch before it (see
     /// [`Motor::decoupled_ringing`]).
     pub(super) ends_step: bool,
+    /// The orbits' quadratures [`Motor::locked_ringing_decays`] evaluated in this segment (the
+    /// step charges them to its budget).
+    pub(super) decay_orbits: u32,
 }
 
 impl Rims {
@@ -532,6 +535,7 @@ impl Rims {
         sampled_level: f64::INFINITY,
         decay_retry_level: f64::INFINITY,
         ends_step: true,
+        decay_orbits: 0,
     };
 }
 

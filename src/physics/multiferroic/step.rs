@@ -2,6 +2,7 @@
 //! advances each piece of constant drive (see [`Motor::step`]).
 
 use super::branch_settle::Relaxed;
+use super::locked_ringing::ORBIT_WEIGHT;
 use super::ringing::Rims;
 use super::{Angles, Drive, Motor, MotorInputs, MotorState, StepReport, Vector, MAX_STEP};
 
@@ -446,6 +447,7 @@ impl Motor {
             if average {
                 run.average_check_at = run.attempts + 1 + run.attempts / 8;
             }
+            let orbits_before = run.rim_barrier.1.decay_orbits;
             let rims = average.then_some(&mut run.rim_barrier.1);
             // Ringing that does not end the step within the tolerance of the minimum is kept,
             // whatever its effect on a free rotor: the onion itself would be off by it.
@@ -458,7 +460,17 @@ impl Motor {
             let switches = run.schedule.map_or((f64::INFINITY, f64::INFINITY), |s| {
                 (s.next_switch_after(run.t) - run.t, s.step_period)
             });
-            match self.relaxed_onion(&run.y, d, rims, segment_end - run.t, switches) {
+            let relaxed = self.relaxed_onion(&run.y, d, rims, segment_end - run.t, switches);
+            // The decay check's orbits are charged on top of the check's own unit.
+            let orbits = run.rim_barrier.1.decay_orbits.saturating_sub(orbits_before);
+            let units = orbits.saturating_mul(ORBIT_WEIGHT);
+            run.extra_cost = run.extra_cost.saturating_add(units);
+            #[cfg(test)]
+            super::locked_ringing::DECAY_CHARGE.with(|c| {
+                let (o, u) = c.get();
+                c.set((o + u64::from(orbits), u + u64::from(units)));
+            });
+            match relaxed {
                 // The averaged ringing's impulse on the rotor (the constrain settles a free
                 // rotor's onion from the same angles, so the branch starts at that minimum).
                 Some(r) if decays(&r) => {
