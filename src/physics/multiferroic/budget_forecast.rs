@@ -96,8 +96,7 @@ impl Motor {
             return false;
         }
         let (last_t, last_spent) = std::mem::replace(&mut s.last, (run.t, spent));
-        // The fine floor holds while `2 left > budget + 1`.
-        // (From this spending on, `2 left > budget + 1` fails.)
+        // The fine floor holds while `2 left > budget + 1`: until this spending.
         let fine_end = budget.saturating_sub(1).div_ceil(2);
         if spent >= fine_end {
             return false;
