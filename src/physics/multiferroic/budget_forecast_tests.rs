@@ -7,22 +7,13 @@ use super::*;
 
 /// The case: the load drives the rotor at `tau / c` (1.4e6 rad/s) through a ring whose torque
 /// cannot move it; a switch every 78.5 ns turns a weak strain by 1.4 rad, and the onion then
-/// rings near its rims, its tilt above 2 rad, decaying by `e` in about 0.3 us. The exponential
+/// rings near its rims, its tilt above 2 rad (its linearization at the minimum decays by `e` in
+/// about 0.2 us). The exponential
 /// RK4 resolves it at about 56 ps a substep: 18,000 substeps a 1 us step against a budget of
 /// 3,282 Gilbert substeps. Classical RK4s at 4,000, 8,000 and 16,000 substeps a nanosecond end
 /// the first step with the onion 1,475, 361 and 769 rad from its start: its path over a step is
 /// not resolvable at any affordable cost, and the step is flagged.
-const OUTLASTING: &str = "strain_direction=-1.554122678401819e2 stress=-3.479031041687615e9 \
-    load_torque=3.022337314507582e-7 ring_outer_diameter=5.9280961443378716e-5 \
-    ring_inner_diameter=3.8194746212636794e-5 bar_length=1.983684983299965e-5 \
-    bar_width=1.0339555921940574e-5 thickness=1.8907428537130158e-9 \
-    saturation_magnetization=1.3725082270133316e4 magnetostriction=6.175377615668639e-3 \
-    wall_volume=8.990225427710952e-11 density=5.6033971852967725e3 \
-    fluid_viscosity=1.0923420605366032e2 gilbert_damping=5.586777528696512e-4 \
-    tolerance=3.074548873010051e-5 step_angle=1.401337090158865e0 \
-    step_period=7.854046876472495e-8 stress_amplitude=-6.51759975053556e4 \
-    schedule_initial_direction=7.320039591034606e3 onion_model=1e0 max_substeps=1.3127e4 \
-    schedule=1e0 rotor_locked=0e0 initial_onion_offset=-7.309428939339728e-12";
+const OUTLASTING: &str = super::stiff_rotor_tests::BUDGET_BOUND_FREE_ROTOR;
 
 /// Three 1 us steps with the forecast on or off: each step's report and end state.
 fn three_steps(forecast: bool) -> Vec<(StepReport, MotorState)> {
