@@ -8,11 +8,11 @@ use super::*;
 /// The case: the load drives the rotor at `tau / c` (1.4e6 rad/s) through a ring whose torque
 /// cannot move it; a switch every 78.5 ns turns a weak strain by 1.4 rad, and the onion then
 /// rings near its rims, its tilt above 2 rad (its linearization at the minimum decays by `e` in
-/// about 0.2 us). The exponential
-/// RK4 resolves it at about 56 ps a substep: 18,000 substeps a 1 us step against a budget of
-/// 3,282 Gilbert substeps. Classical RK4s at 4,000, 8,000 and 16,000 substeps a nanosecond end
-/// the first step with the onion 1,475, 361 and 769 rad from its start: its path over a step is
-/// not resolvable at any affordable cost, and the step is flagged.
+/// about 0.2 us). The exponential RK4 resolves it at about 56 ps a substep: 18,000 substeps a
+/// 1 us step against a budget of 3,282 Gilbert substeps. Classical RK4s at 4,000, 8,000 and
+/// 16,000 substeps a nanosecond end the first step with the onion 1,475, 361 and 769 rad from
+/// its start: its path over a step is not resolvable at any affordable cost, and the step is
+/// flagged.
 const OUTLASTING: &str = super::stiff_rotor_tests::BUDGET_BOUND_FREE_ROTOR;
 
 /// Three 1 us steps with the forecast on or off: each step's report and end state.
