@@ -46,7 +46,9 @@
 //! A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
-//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`), and a locked
+//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`; at once where its
+//! persisting ringing is forecast to spend the budget's fine half within its segment,
+//! `budget_forecast.rs`), and a locked
 //! rotor's ringing onion that neither a drop nor forced substeps can follow through the
 //! schedule's switches refuses the step (`locked_switches.rs`), as does a locked step whose
 //! switches outnumber its loop's passes once the linear spans fail or the budget cannot pay for
@@ -70,6 +72,9 @@ pub mod branch;
 mod branch_settle;
 #[cfg(test)]
 mod branch_settle_tests;
+mod budget_forecast;
+#[cfg(test)]
+mod budget_forecast_tests;
 mod cycle;
 #[cfg(test)]
 mod decay_charge_tests;

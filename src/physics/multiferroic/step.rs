@@ -90,6 +90,8 @@ pub(super) struct StepRun {
     pub(super) free_ledger: super::free_energy::FreeLedger,
     /// The resolved Gilbert substeps' propagators (see [`Motor::errors_amplified`]).
     pub(super) amplification: super::amplification::Amplification,
+    /// The present segment's spending (see [`Motor::budget_forecast_drops`]).
+    pub(super) segment_spending: super::budget_forecast::SegmentSpending,
 }
 
 impl StepRun {
@@ -141,6 +143,7 @@ impl StepRun {
             rim_ledger: super::rim_energy::RimLedger::NONE,
             free_ledger: super::free_energy::FreeLedger::NONE,
             amplification: Default::default(),
+            segment_spending: super::budget_forecast::SegmentSpending::NONE,
         }
     }
 
@@ -380,7 +383,8 @@ impl Motor {
     ///
     /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance
     /// at the budget's minimum size), or is about to be (the budget left cannot pay for another
-    /// Gilbert substep): the ringing that the budget cannot resolve is dropped, the
+    /// Gilbert substep, or a free rotor's persisting ringing is forecast to spend the budget's
+    /// fine half within the segment, [`Self::budget_forecast_drops`]): the ringing that the budget cannot resolve is dropped, the
     /// onion settled into the minimum it rings about. Forced exponential substeps spanning several
     /// precession periods could otherwise carry a weakly damped onion into the wrong minimum (at
     /// `gilbert_damping` 1e-4 the rotor then missed its step); the rotor answers the ringing's
@@ -406,7 +410,9 @@ impl Motor {
         // ringing now instead, as once forced, and flag the step.
         let spent = run.attempts.saturating_add(run.extra_cost);
         let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
-        let out_of_budget = (run.limited || broke) && self.onion_relaxes_fast();
+        let out_of_budget =
+            (run.limited || broke || self.budget_forecast_drops(run, d, segment_end))
+                && self.onion_relaxes_fast();
         // The minimum an onion heading for it settles into, where the branch then starts.
         let mut minimum = None;
         let dropped = out_of_budget

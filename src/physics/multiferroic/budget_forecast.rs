@@ -1,0 +1,130 @@
+//! A free rotor's ringing Gilbert onion whose resolution is forecast to spend the budget's fine
+//! half within its segment: dropped at once, into the minimum that the budget's drop would reach
+//! later in the same segment ([`Motor::budget_forecast_drops`]).
+
+use super::step::StepRun;
+use super::{Drive, Motor};
+
+/// The spending of one segment, from its first pass: its start (s) and the budget spent then,
+/// the time and budget spent at the last forecast tried, and the budget spent at which it is
+/// tried next.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct SegmentSpending {
+    segment_end: f64,
+    start: f64,
+    spent: u32,
+    last: (f64, u32),
+    next_check: u32,
+}
+
+impl SegmentSpending {
+    pub(super) const NONE: Self = Self {
+        segment_end: f64::NAN,
+        start: f64::NAN,
+        spent: 0,
+        last: (f64::NAN, 0),
+        next_check: 0,
+    };
+}
+
+/// The forecast holds only where the segment's spending so far, kept up, reaches the budget's
+/// fine half within `1 / FORECAST_MARGIN` of the segment's time left: the rate may fall by a third
+/// over that time (the ringing decaying, its substeps growing) and the half is still reached.
+const FORECAST_MARGIN: f64 = 1.5;
+
+/// The forecast is first tried once the segment has spent this fraction of the budget, and then
+/// at spending spaced by an eighth of the segment's.
+const FIRST_FORECAST_SHARE: u32 = 64;
+
+/// The least budget a segment has spent before its rate forecasts anything: 64 Gilbert substeps.
+const MIN_OBSERVED: u32 = 64 * super::GILBERT_SUBSTEP_WEIGHT;
+
+impl Motor {
+    /// Whether the Gilbert onion of a free rotor at the run's state, which the budget's drop
+    /// ([`Motor::follows_branch`]) would put on its branch once the budget's fine half is spent
+    /// (its resolved substeps then forced at the even spread of the rest, beyond the
+    /// tolerance), may be dropped now, in the segment ending at `segment_end`. The step is then
+    /// flagged, as it would be.
+    ///
+    /// - **Forecast**: at the lesser of the segment's spending rate (budget per second) and its
+    ///   rate since the last try, the budget's fine half ([`super::integrator`]'s floor while
+    ///   more than half is left) is spent within `1 / FORECAST_MARGIN` of the segment's time
+    ///   left, and the ringing persists: every mode of the onion's linearization at its minimum
+    ///   decays by at most a factor `e` over that time. This is a forecast, not a bound: ringing
+    ///   whose substeps grow much within the segment could still end it resolved.
+    /// - **The same minimum**: the ring cannot move the rotor and the ringing is trapped in its
+    ///   well for the rest of the segment ([`Motor::decoupled_budget_drop`] over that time, with
+    ///   no switch in it): whenever the budget's drop comes within the segment, the onion lies in
+    ///   the same well, marches downhill to the same minimum (that of the rotor's angle then,
+    ///   which the branch follows from an earlier drop), and the rotor's path differs by at most
+    ///   a hundredth of the tolerance.
+    ///
+    /// The caller then drops as the budget's drop does (where the onion heads for its minimum
+    /// within the step, [`Motor::heads_for_settled`]).
+    pub(super) fn budget_forecast_drops(
+        &self,
+        run: &mut StepRun,
+        d: &Drive,
+        segment_end: f64,
+    ) -> bool {
+        if d.locked || self.quasi_static() {
+            return false;
+        }
+        #[cfg(test)]
+        if FORECAST_OFF.with(|c| c.get()) {
+            return false;
+        }
+        let budget = self.params.max_substeps;
+        let spent = run.attempts.saturating_add(run.extra_cost);
+        let s = &mut run.segment_spending;
+        if s.segment_end != segment_end {
+            *s = SegmentSpending {
+                segment_end,
+                start: run.t,
+                spent,
+                last: (run.t, spent),
+                next_check: spent.saturating_add(budget / FIRST_FORECAST_SHARE),
+            };
+            return false;
+        }
+        if spent < s.next_check {
+            return false;
+        }
+        let used = spent - s.spent;
+        s.next_check = spent.saturating_add(1 + used / 8);
+        if used < MIN_OBSERVED {
+            return false;
+        }
+        let (last_t, last_spent) = std::mem::replace(&mut s.last, (run.t, spent));
+        // The fine floor holds while `2 left > budget + 1`: until this spending.
+        let fine_end = budget.saturating_sub(1).div_ceil(2);
+        if spent >= fine_end {
+            return false;
+        }
+        let left = segment_end - run.t;
+        // The lesser of the segment's rate and the rate since the last forecast: ringing that
+        // decays spends less as it goes.
+        let rate = (f64::from(used) / (run.t - s.start))
+            .min(f64::from(spent - last_spent) / (run.t - last_t));
+        // (False for a NaN.)
+        let forecast = FORECAST_MARGIN * f64::from(fine_end - spent) / rate <= left;
+        if !forecast {
+            return false;
+        }
+        // Every mode of the onion's linearization at its minimum decays by at most a factor `e`
+        // over the time left (their rates sum to the trace `g alpha (k + T)`, eq. 3.4 with the
+        // LLG damping): the ringing, and the rate at which its substeps spend, persist.
+        let land = self.landscape(run.y[0], d.direction, d.stress);
+        let k = land.curvature(land.settle(run.y[2]));
+        let trace = self.llg_rate * self.params.gilbert_damping * (k + self.tilt_stiffness);
+        // (False for a NaN.)
+        let persists = trace * left <= 1.0;
+        persists && self.decoupled_budget_drop(&run.y, d, left, left)
+    }
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Turns the forecast off (tests compare it with the budget's drop it anticipates).
+    pub(super) static FORECAST_OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+}
