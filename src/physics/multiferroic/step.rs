@@ -384,8 +384,8 @@ impl Motor {
     /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance
     /// at the budget's minimum size), or is about to be (the budget left cannot pay for another
     /// Gilbert substep, or a free rotor's persisting ringing is forecast to spend the budget's
-    /// fine half within the segment, [`Self::budget_forecast_drops`]): the ringing that the budget cannot resolve is dropped, the
-    /// onion settled into the minimum it rings about. Forced exponential substeps spanning several
+    /// fine half within the segment, [`Self::budget_forecast_drops`]): the ringing that the
+    /// budget cannot resolve is dropped, the onion settled into the minimum it rings about. Forced exponential substeps spanning several
     /// precession periods could otherwise carry a weakly damped onion into the wrong minimum (at
     /// `gilbert_damping` 1e-4 the rotor then missed its step); the rotor answers the ringing's
     /// alternating torque by at most `A tau_o / (tau_rotor sqrt(1 + (omega_p tau_o)^2))` to first
