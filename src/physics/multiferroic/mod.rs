@@ -156,6 +156,8 @@ mod orbit_rim_refusal_tests;
 mod orbit_tests;
 #[cfg(test)]
 mod orbit_theory_tests;
+#[cfg(test)]
+mod orbit_turning_tests;
 mod pair_midpoint;
 #[cfg(test)]
 mod pair_midpoint_tests;

@@ -232,7 +232,10 @@ impl Motor {
             }
         }
         // Back to the last lower turning point: the step from the last accepted start before it
-        // that ends there, by the secant method on its length.
+        // that ends there, by the secant method on its length; under a locked rotor only until
+        // the phase misses it by less than the averaged steps' own errors allow
+        // ([`turning_slack`]): each iteration is a step of the averaged equations (six orbit
+        // quadratures), and the quadratures leave the phase's last digits noisy.
         let whole = s[3].floor();
         let (t0, s0, k0) = *history.iter().rev().find(|(_, z, _)| z[3] <= whole)?;
         let mut length = (whole - s0[3]) / k0[3];
@@ -240,10 +243,15 @@ impl Motor {
             let (z, _, _) = dormand_prince(&mut avg, &s0, &k0, length, |_, _| [1.0; 4])?;
             let miss = whole - z[3];
             s = z;
+            #[cfg(test)]
+            RETURN_STEPS.with(|c| c.set(c.get() + 1));
             if miss.abs() <= 1e-12 {
                 break;
             }
             length += miss / k0[3];
+            if d.locked && miss.abs() <= turning_slack(&avg, dropped, phase_error) {
+                break;
+            }
         }
         let time = t0 + length;
         if !(time > run.t && time <= segment_end) {
@@ -534,6 +542,27 @@ impl Motor {
         }
         None
     }
+}
+
+/// The phase's miss (cycles) within which the averaged advance's end is taken as its lower
+/// turning point: the onion put there is then misplaced along its orbit by at most a tenth of
+/// what each averaged step may err by (`phase_error` cycles where the ringing is dropped, else a
+/// displacement of `phase_error` rad at the orbit's reach, the larger of its half width and its
+/// largest tilt `sqrt(2 E / T)`).
+fn turning_slack(avg: &Averager, dropped: bool, phase_error: f64) -> f64 {
+    if dropped {
+        return 0.1 * phase_error;
+    }
+    let o = &avg.orbit;
+    let tilt = (2.0 * o.energy / avg.m.tilt_stiffness).sqrt();
+    0.1 * phase_error / (2.0 * PI * o.half_width().max(tilt))
+}
+
+#[cfg(test)]
+thread_local! {
+    /// Steps of the averaged equations taken back to the advance's last turning point on this
+    /// thread (for tests).
+    pub(super) static RETURN_STEPS: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
 }
 
 /// One Dormand-Prince 5(4) step of the averaged equations from `s` (rates `k1` there) over `h`:
