@@ -14,7 +14,12 @@
 //! `m - w` is the one of larger magnitude (`det / (m - w)`, no cancellation: a stiff mode beside
 //! a slow one), as [`crate::physics::multiferroic::phi::Phi2x2`] does.
 //!
-//! Cost: one `exp` and one `expm1` (real eigenvalues) or one `exp` and one `sin_cos` (complex).
+//! Cost: one `exp` near repeated eigenvalues (`|q| <= 1e-2`, series of `C` and `S`), else one
+//! `exp` and one `exp` or `expm1` (real eigenvalues) or one `exp` and one `sin_cos` (complex).
+
+/// `|q|` (the squared half gap of the eigenvalues) below which `C` and `S` are summed as series:
+/// one `exp` instead of two transcendental calls where a substep resolves the ringing.
+const SERIES_BELOW: f64 = 1e-2;
 
 /// A real 2x2 matrix, rows first.
 pub type M2 = [[f64; 2]; 2];
@@ -25,12 +30,21 @@ pub type M2 = [[f64; 2]; 2];
 /// eigenvalue's real part beyond about 709, or entries beyond about 1e154, whose square
 /// overflows); otherwise every entry is finite (an entry below the smallest normal underflows
 /// towards 0, as its true value).
-#[inline]
+#[inline(always)]
 pub fn expm2(z: &M2) -> Option<M2> {
     let m = 0.5 * (z[0][0] + z[1][1]);
     let n0 = 0.5 * (z[0][0] - z[1][1]);
     let q = n0 * n0 + z[0][1] * z[1][0];
-    let (c, s) = if q > 0.0 {
+    let (c, s) = if q.abs() <= SERIES_BELOW {
+        // `C = sum q^k / (2k)!`, `S = sum q^k / (2k + 1)!` to `q^5`: the remainders are below
+        // `q^6 / 12!` ~ 2e-21 relative.
+        let em = m.exp();
+        let c = 1.0
+            + q / 2.0 * (1.0 + q / 12.0 * (1.0 + q / 30.0 * (1.0 + q / 56.0 * (1.0 + q / 90.0))));
+        let s = 1.0
+            + q / 6.0 * (1.0 + q / 20.0 * (1.0 + q / 42.0 * (1.0 + q / 72.0 * (1.0 + q / 110.0))));
+        (em * c, em * s)
+    } else if q > 0.0 {
         let w = q.sqrt();
         // The larger eigenvalue, from the determinant where `m + w` would cancel.
         let det = z[0][0] * z[1][1] - z[0][1] * z[1][0];
@@ -40,8 +54,12 @@ pub fn expm2(z: &M2) -> Option<M2> {
             det / (m - w)
         };
         let up = hi.exp();
-        // e^{-2w} - 1, in [-1, 0].
-        let gap = (-2.0 * w).exp_m1();
+        // e^{-2w} - 1, in [-1, 0]: from `expm1` where it would cancel (`exp` costs less).
+        let gap = if w < 0.35 {
+            (-2.0 * w).exp_m1()
+        } else {
+            (-2.0 * w).exp() - 1.0
+        };
         (up * (1.0 + 0.5 * gap), up * (-gap / (2.0 * w)))
     } else if q < 0.0 {
         let w = (-q).sqrt();
@@ -49,8 +67,8 @@ pub fn expm2(z: &M2) -> Option<M2> {
         let (sin, cos) = w.sin_cos();
         (em * cos, em * (sin / w))
     } else {
-        let em = m.exp();
-        (em, em)
+        // (A NaN `q`: refused below.)
+        (f64::NAN, f64::NAN)
     };
     let e = [[c + s * n0, s * z[0][1]], [s * z[1][0], c - s * n0]];
     e.iter().flatten().all(|x| x.is_finite()).then_some(e)
