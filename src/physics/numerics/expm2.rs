@@ -149,7 +149,11 @@ mod tests {
             }
         }
         // Around critical damping: `q = n^2 - b c` crossing 0 by a few ulps and by more.
-        for eps in [-1e-6, -1e-12, -1e-15, 0.0, 1e-15, 1e-12, 1e-6] {
+        // (`q = -9 eps`: both sides of the series' reach, 1e-2, and of `w = 0.35`.)
+        for eps in [
+            -0.0137, -0.0135, -2e-3, -1e-3, -1e-6, -1e-12, -1e-15, 0.0, 1e-15, 1e-12, 1e-6, 1e-3,
+            2e-3,
+        ] {
             for m in [-50.0, -1.0, 0.0, 2.0] {
                 out.push([[m + 3.0, 9.0 * (1.0 + eps)], [-1.0, m - 3.0]]);
             }
