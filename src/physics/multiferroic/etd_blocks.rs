@@ -7,7 +7,6 @@
 use super::gilbert::{fifth_order_error, Linearized};
 use super::phi::phis;
 use super::{Drive, Motor, Vector};
-use crate::physics::numerics::expm2::expm2;
 
 /// `phi_1..3(A)` of a real 2x2 matrix `A`, as matrices (`phi_k(A) = c_0 I + c_1 A` by
 /// Cayley-Hamilton, see [`super::phi`]).
@@ -88,12 +87,19 @@ impl BlockPhi {
         Self { p: [p1, p2, p3] }
     }
 
-    /// `phi_k(2A)` from `phi_k(A)` and `e = e^A` ([`expm2`]): `phi_k(2A) = 2^-k (e^A phi_k(A) +
-    /// sum_{j=1}^k phi_j(A) / (k - j)!)` (all of them functions of `A`, so they commute).
+    /// `phi_k(2A)` from `phi_k(A)` (`a` is `A`): `phi_k(2A) = 2^-k (e^A phi_k(A) + sum_{j=1}^k
+    /// phi_j(A) / (k - j)!)` with `e^A = I + A phi_1(A)` (all of them functions of `A`, so
+    /// they commute).
     #[inline(always)]
-    pub(super) fn doubled(&self, e: &[[f64; 2]; 2]) -> Self {
+    pub(super) fn doubled(&self, a: &[[f64; 2]; 2]) -> Self {
+        let mul = |x: &[[f64; 2]; 2], y: &[[f64; 2]; 2]| -> [[f64; 2]; 2] {
+            std::array::from_fn(|i| std::array::from_fn(|k| x[i][0] * y[0][k] + x[i][1] * y[1][k]))
+        };
         let [p1, p2, p3] = self.p;
-        let (e1, e2, e3) = (mul2(e, &p1), mul2(e, &p2), mul2(e, &p3));
+        let mut e = mul(a, &p1);
+        e[0][0] += 1.0;
+        e[1][1] += 1.0;
+        let (e1, e2, e3) = (mul(&e, &p1), mul(&e, &p2), mul(&e, &p3));
         let p = [
             std::array::from_fn(|i| std::array::from_fn(|k| 0.5 * (e1[i][k] + p1[i][k]))),
             std::array::from_fn(|i| {
@@ -229,22 +235,15 @@ fn complex_phis(x: f64, y: f64) -> [(f64, f64); 3] {
     [phi1, phi2, phi3]
 }
 
-/// `x y` of 2x2 matrices.
-#[inline(always)]
-fn mul2(x: &[[f64; 2]; 2], y: &[[f64; 2]; 2]) -> [[f64; 2]; 2] {
-    std::array::from_fn(|i| std::array::from_fn(|k| x[i][0] * y[0][k] + x[i][1] * y[1][k]))
-}
-
-/// A block-diagonal linear part's `phi` functions and exponentials ([`expm2`]) at one substep
-/// length: the rotor's block (states 0, 1) and the onion's (states 2, 3), each times that length.
+/// A block-diagonal linear part's `phi` functions and matrices at one substep length: the rotor's
+/// block (states 0, 1) and the onion's (states 2, 3), each times that length.
 pub(super) struct Blocks {
     phi: [BlockPhi; 2],
-    e: [[[f64; 2]; 2]; 2],
+    z: [[[f64; 2]; 2]; 2],
 }
 
 impl Blocks {
-    /// `None` where a block's `phi` functions are not available ([`BlockPhi::new`]) or its
-    /// exponential is beyond the range.
+    /// `None` where a block's `phi` functions are not available ([`BlockPhi::new`]).
     #[inline(always)]
     pub(super) fn new(j: &[[f64; 4]; 4], h: f64) -> Option<Self> {
         let block = |b: usize| {
@@ -256,19 +255,20 @@ impl Blocks {
         let z = [block(0), block(2)];
         Some(Self {
             phi: [BlockPhi::new(&z[0])?, BlockPhi::new(&z[1])?],
-            e: [expm2(&z[0])?, expm2(&z[1])?],
+            z,
         })
     }
 
-    /// The blocks at twice the length (`e^{2Z} = (e^Z)^2`).
+    /// The blocks at twice the length.
     #[inline(always)]
     pub(super) fn doubled(&self) -> Self {
+        let z = self.z.map(|b| b.map(|r| r.map(|x| 2.0 * x)));
         Self {
             phi: [
-                self.phi[0].doubled(&self.e[0]),
-                self.phi[1].doubled(&self.e[1]),
+                self.phi[0].doubled(&self.z[0]),
+                self.phi[1].doubled(&self.z[1]),
             ],
-            e: self.e.map(|e| mul2(&e, &e)),
+            z,
         }
     }
 
@@ -280,16 +280,17 @@ impl Blocks {
         [r0, r1, o0, o1]
     }
 
-    /// `e^Z v` on both blocks.
+    /// `e^Z v = v + Z phi_1(Z) v`.
     #[inline(always)]
     fn exp_apply(&self, v: &Vector) -> Vector {
-        let [r, o] = &self.e;
-        [
-            r[0][0] * v[0] + r[0][1] * v[1],
-            r[1][0] * v[0] + r[1][1] * v[1],
-            o[0][0] * v[2] + o[0][1] * v[3],
-            o[1][0] * v[2] + o[1][1] * v[3],
-        ]
+        let p = self.apply(1, v);
+        let mut out = *v;
+        for (b, z) in self.z.iter().enumerate() {
+            let (i, k) = (2 * b, 2 * b + 1);
+            out[i] += z[0][0] * p[i] + z[0][1] * p[k];
+            out[k] += z[1][0] * p[i] + z[1][1] * p[k];
+        }
+        out
     }
 }
 
