@@ -27,6 +27,7 @@
 //! onion's substeps (averaged, settled, linear spans) carry the errors unchanged in the bound.
 
 use super::{Angles, Drive, Motor, Vector};
+use crate::physics::numerics::expm2::expm2;
 
 type Mat2 = [[f64; 2]; 2];
 
@@ -81,33 +82,6 @@ impl Amplification {
     }
 }
 
-/// `exp(a)` of a 2x2 matrix: `e^s (C I + S (a - s I))`, `s` half the trace,
-/// `q = ((a00 - a11) / 2)^2 + a01 a10`, `C = cosh sqrt(q)`, `S = sinh sqrt(q) / sqrt(q)` (their
-/// circular forms for `q < 0`, the series near 0).
-pub(super) fn exp2(a: &Mat2) -> Mat2 {
-    let s = 0.5 * (a[0][0] + a[1][1]);
-    let h = 0.5 * (a[0][0] - a[1][1]);
-    let q = h * h + a[0][1] * a[1][0];
-    // `e^s C` and `e^s S`; for `q > 0` from `e^(s -+ sqrt(q))`, which do not overflow where the
-    // flow decays (an overdamped onion over a long substep).
-    let (c, sh) = if q.abs() < 1e-6 {
-        let e = s.exp();
-        (
-            e * (1.0 + 0.5 * q + q * q / 24.0),
-            e * (1.0 + q / 6.0 + q * q / 120.0),
-        )
-    } else if q > 0.0 {
-        let r = q.sqrt();
-        let (up, down) = ((s + r).exp(), (s - r).exp());
-        (0.5 * (up + down), 0.5 * (up - down) / r)
-    } else {
-        let r = (-q).sqrt();
-        let e = s.exp();
-        (e * r.cos(), e * r.sin() / r)
-    };
-    [[c + sh * h, sh * a[0][1]], [sh * a[1][0], c - sh * h]]
-}
-
 impl Motor {
     /// Records a resolved Gilbert substep from `y` at `t` (angles `angles`) to `u` over `dt` (s)
     /// under `d`, its error estimate `err` in tolerances (see [`Amplification`]).
@@ -138,7 +112,10 @@ impl Motor {
             [-g * alpha * curvature, -g * tilt],
             [g * curvature, -g * alpha * tilt],
         ];
-        amp.substeps.push((exp2(&a), err));
+        // An exponential beyond the range ([`expm2`]) carries any earlier error beyond
+        // [`AMPLIFIED_BEYOND`].
+        let propagator = expm2(&a).unwrap_or([[f64::MAX, 0.0], [0.0, f64::MAX]]);
+        amp.substeps.push((propagator, err));
     }
 
     /// Whether the resolved Gilbert substeps' errors recorded in `amp` are carried beyond

@@ -97,3 +97,56 @@ fn flow_matches_the_augmented_exponential() {
     let a = onion_block(0.03, 1e-2, 44.0);
     assert!(block_phi1(&a).is_some());
 }
+
+/// A strongly overdamped switch interval, `m h = -1000` and `w h` about 999 (eigenvalues about
+/// -1 and -1999 per interval; `e^{m h} cosh(w h)` formed apart is `0 x inf`): the flow is taken
+/// and is the eigen-decomposition's, `sum_i f(mu_i) P_i`, `P_1 = (A - mu_2 I) / (mu_1 - mu_2)`,
+/// with `f = e^{mu h}` and `(e^{mu h} - 1) / mu`, for a symmetric block and eq. 3.4's onion
+/// block under heavy damping.
+#[test]
+fn a_long_overdamped_interval_is_taken() {
+    let alpha = 3.0;
+    let (d, t) = (1e-3, 40.0);
+    let onion = onion_block(alpha, d, t);
+    let h_onion = 1000.0 / (0.5 * alpha * (d + t));
+    for (a, h) in [
+        ([[-1000.0, 999.0], [999.0, -1000.0]], 1.0),
+        (onion, h_onion),
+    ] {
+        let m = 0.5 * (a[0][0] + a[1][1]);
+        let det = a[0][0] * a[1][1] - a[0][1] * a[1][0];
+        let fast = m - (m * m - det).sqrt();
+        let slow = det / fast;
+        assert!((m * h + 1000.0).abs() < 1e-9 && slow * h > -1.5 && fast * h < -1998.0);
+        let projector = |mu: f64, other: f64| -> M2 {
+            let r = 1.0 / (mu - other);
+            [
+                [(a[0][0] - other) * r, a[0][1] * r],
+                [a[1][0] * r, (a[1][1] - other) * r],
+            ]
+        };
+        let (p_slow, p_fast) = (projector(slow, fast), projector(fast, slow));
+        let combine = |fs: f64, ff: f64| -> M2 {
+            std::array::from_fn(|i| std::array::from_fn(|k| fs * p_slow[i][k] + ff * p_fast[i][k]))
+        };
+        let e = combine((slow * h).exp(), (fast * h).exp());
+        let j = combine((slow * h).exp_m1() / slow, (fast * h).exp_m1() / fast);
+        let f = flow(&a, h).unwrap_or_else(|| panic!("{a:?} {h}: declined"));
+        let scale_e = e.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
+        let scale_j = j.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
+        for i in 0..2 {
+            for k in 0..2 {
+                assert!(
+                    (f.e[i][k] - e[i][k]).abs() <= 1e-12 * scale_e,
+                    "{a:?} {h}: exp {:?} vs {e:?}",
+                    f.e
+                );
+                assert!(
+                    (f.j[i][k] - j[i][k]).abs() <= 1e-12 * scale_j,
+                    "{a:?} {h}: J {:?} vs {j:?}",
+                    f.j
+                );
+            }
+        }
+    }
+}

@@ -5,6 +5,7 @@
 use super::angles::turned_back;
 use super::etd_blocks::block_phi1;
 use super::{Motor, MotorInputs, StepRun, SteppingSchedule};
+use crate::physics::numerics::expm2::expm2;
 
 pub(super) type M2 = [[f64; 2]; 2];
 
@@ -119,26 +120,15 @@ pub(super) fn apply(a: &M2, x: [f64; 2]) -> [f64; 2] {
     ]
 }
 
-/// `sin(x) / x` (`oscillating`) or `sinh(x) / x`, exact to rounding at small `x`.
-fn sinc(x: f64, oscillating: bool) -> f64 {
-    let x2 = if oscillating { -x * x } else { x * x };
-    if x.abs() < 1e-3 {
-        1.0 + x2 / 6.0 * (1.0 + x2 / 20.0)
-    } else if oscillating {
-        x.sin() / x
-    } else {
-        x.sinh() / x
-    }
-}
-
 /// The exact flow of `w' = A w + b` over `h` for a 2x2 `A`, in closed form.
 ///
 /// Hand-written rather than a general exponential: it runs once a switch, hundreds of times a
 /// step, where a scaled-and-squared 3x3 exponential cost about as much as the substeps it
-/// replaces. With `A = m I + N`, `N^2 = q I` (trace-free), `exp(A s) = e^{m s} (C I + S N)`,
-/// `C, S = cos(w s), sin(w s) / w` for `q = -w^2 < 0` and `cosh, sinh / w` for `q = w^2`;
-/// hence, entry by entry, `|exp(A s)| <= max(1, e^{m h}) (I + min(h, 1/w) |N|)` in the first
-/// case and `e^{max(m + w, 0) h} (I + min(h, 1/(2w)) |N|)` in the second (`|sin(w s)/w| <=
+/// replaces. `exp(A h)` is the closed form of [`expm2`], finite over the whole range (a long
+/// overdamped interval among it). With `A = m I + N`, `N^2 = q I` (trace-free), `exp(A s) =
+/// e^{m s} (C I + S N)`, `C, S = cos(w s), sin(w s) / w` for `q = -w^2 < 0` and `cosh, sinh /
+/// w` for `q = w^2`; hence, entry by entry, `|exp(A s)| <= max(1, e^{m h}) (I + min(h, 1/w)
+/// |N|)` in the first case and `e^{max(m + w, 0) h} (I + min(h, 1/(2w)) |N|)` in the second (`|sin(w s)/w| <=
 /// min(s, 1/w)`, `cosh(w s) <= e^{w s}`, `sinh(w s)/w <= e^{w s} min(s, 1/(2w))`). The
 /// integral is `A^{-1} (exp(A h) - I)` where `A` is well conditioned and `h` long; else, beyond
 /// `||A|| h = 1/2`, `h phi_1(A h)` from the eigenvalues ([`block_phi1`]: a nearly singular `A`,
@@ -152,11 +142,6 @@ pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     let q = n[0][0] * n[0][0] + n[0][1] * n[1][0];
     let oscillating = q < 0.0;
     let w = q.abs().sqrt();
-    let (c, s) = if oscillating {
-        ((w * h).cos(), h * sinc(w * h, true))
-    } else {
-        ((w * h).cosh(), h * sinc(w * h, false))
-    };
     let top = if oscillating {
         m.max(0.0)
     } else {
@@ -166,11 +151,8 @@ pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     if top * h > MAX_GROWTH_EXPONENT || top.is_nan() || h.is_nan() {
         return None;
     }
-    let em = (m * h).exp();
-    let e = [
-        [em * (c + s * n[0][0]), em * s * n[0][1]],
-        [em * s * n[1][0], em * (c + s * n[1][1])],
-    ];
+    let ah = [[a[0][0] * h, a[0][1] * h], [a[1][0] * h, a[1][1] * h]];
+    let e = expm2(&ah)?;
     let reach = if oscillating {
         h.min(1.0 / w)
     } else {
@@ -199,10 +181,7 @@ pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
             [-a[1][0] / det, a[0][0] / det],
         ];
         mul(&inv, &d)
-    } else if let Some(p) = (size * h > 0.5)
-        .then(|| block_phi1(&[[a[0][0] * h, a[0][1] * h], [a[1][0] * h, a[1][1] * h]]))
-        .flatten()
-    {
+    } else if let Some(p) = (size * h > 0.5).then(|| block_phi1(&ah)).flatten() {
         [[p[0][0] * h, p[0][1] * h], [p[1][0] * h, p[1][1] * h]]
     } else {
         let mut halvings = 0;

@@ -81,7 +81,7 @@ fn onion_block_exponential_matches_the_series() {
         [[-0.02, -25.0], [0.01, -0.03]],
     ];
     for a in blocks {
-        let e = super::amplification::exp2(&a);
+        let e = crate::physics::numerics::expm2::expm2(&a).unwrap();
         let reference = expm(&a).unwrap();
         for (row, expected) in e.iter().zip(&reference) {
             for (x, r) in row.iter().zip(expected) {
