@@ -2,6 +2,7 @@
 //! branch: only if it heads for the branch's minimum within the step anyway.
 
 use super::{Motor, Vector};
+use crate::physics::numerics::expm2::expm2;
 
 impl Motor {
     /// Whether the Gilbert onion at `y` heads for the `minimum` of eq. 3.4 it sits in (the one
@@ -46,37 +47,29 @@ impl Motor {
     /// tilt after `horizon` seconds of the macrospin's equations linearized there (eq. 3.4's
     /// torque `k (psi - minimum)`; the rates are linear in the tilt), exactly:
     /// `exp(A horizon) (psi - minimum, theta)` with `A = g [[-alpha k, -t], [k, -alpha t]]`
-    /// (the rows of [`Self::rhs_jacobian`]), by its eigenvalues `m +- w`.
+    /// (the rows of [`Self::rhs_jacobian`]); infinite where that exponential is out of range.
     pub(super) fn propagated_gap(&self, y: &Vector, minimum: f64, k: f64, horizon: f64) -> f64 {
         let (g, alpha, t) = (
             self.llg_rate,
             self.params.gilbert_damping,
             self.tilt_stiffness,
         );
-        let a = [[-g * alpha * k, -g * t], [g * k, -g * alpha * t]];
-        let x = [y[2] - minimum, y[3]];
-        let m = 0.5 * (a[0][0] + a[1][1]);
-        // (A - m) x, and the discriminant m^2 - det(A) = ((a00 - a11) / 2)^2 + a01 a10.
-        let ax = [0, 1].map(|i| a[i][0] * x[0] + a[i][1] * x[1] - m * x[i]);
-        let half = 0.5 * (a[0][0] - a[1][1]);
-        let disc = half * half + a[0][1] * a[1][0];
         let h = horizon;
-        let w = disc.abs().sqrt();
-        let end = if disc < 0.0 {
-            let (s, c) = (w * h).sin_cos();
-            let e = (m * h).exp();
-            [0, 1].map(|i| e * (c * x[i] + s / w * ax[i]))
-        } else if w * h < 1.0 {
-            // cosh and sinh bounded: no 0 x inf where `m h` is large.
-            let e = (m * h).exp();
-            let sinhc = if w > 0.0 { (w * h).sinh() / w } else { h };
-            [0, 1].map(|i| e * ((w * h).cosh() * x[i] + sinhc * ax[i]))
-        } else {
-            // Real eigenvalues m -+ w, each mode decaying (or growing) on its own.
-            let (slow, fast) = (((m + w) * h).exp(), ((m - w) * h).exp());
-            [0, 1].map(|i| 0.5 * ((slow + fast) * x[i] + (slow - fast) / w * ax[i]))
+        let ah = [
+            [-g * alpha * k * h, -g * t * h],
+            [g * k * h, -g * alpha * t * h],
+        ];
+        let Some(e) = expm2(&ah) else {
+            return f64::INFINITY;
         };
-        end[0].abs().max(end[1].abs())
+        let x = [y[2] - minimum, y[3]];
+        let end = e.map(|row| row[0] * x[0] + row[1] * x[1]);
+        let gap = end[0].abs().max(end[1].abs());
+        if gap.is_nan() {
+            f64::INFINITY
+        } else {
+            gap
+        }
     }
 
     /// The Gilbert onion's distance at `y` from the `minimum` of eq. 3.4 (curvature `k > 0`) in
