@@ -17,45 +17,43 @@
 //! linearizes the rotor (and in the Gilbert option the onion) about its start and advances that
 //! linear system exactly with a matrix exponential, so the 2 ns inertial mode and the GHz onion
 //! precession never limit the substep (no stiffness instability; the overdamped first-order limit
-//! comes out by itself), while the quasi-static onion is re-solved at the end of every substep.
-//! The method is second order. With the quasi-static onion the rotor block is 2x2, its `phi`
-//! functions come in closed form and the third-order member of an embedded exponential Rosenbrock
-//! pair (exprb32) estimates the local error. The Gilbert onion's ringing takes an explicit
+//! comes out by itself), while the quasi-static onion is re-solved at the end of every substep. The
+//! method is second order. With the quasi-static onion the rotor block is 2x2, its `phi` functions
+//! come in closed form and the third-order member of an embedded exponential Rosenbrock pair
+//! (exprb32) estimates the local error. The Gilbert onion's ringing takes an explicit
 //! Dormand-Prince 5(4) pair within its stability reach, an exponential RK4 where only the rotor's
-//! drag keeps that pair out of reach (with the onion's block exact too where the two barely
-//! couple, `etd_blocks.rs`; a locked rotor's creeping onion's block exact, and tried first near
-//! that pair's stability limit, `locked_stiff.rs`), else an exponential Rosenbrock pair
-//! (`gilbert.rs`, its defect also sampled at the substep's midpoint, `pair_midpoint.rs`); weakly damped ringing trapped in its well advances orbit-averaged (`orbit.rs`,
-//! `orbit_advance.rs`, `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`, the
-//! wells its checks find
-//! kept per landscape, `orbit_kept_well.rs`; a locked rotor's last orbit is resolved at once,
+//! drag keeps that pair out of reach (with the onion's block exact too where the two barely couple,
+//! `etd_blocks.rs`; a locked rotor's creeping onion's block exact, and tried first near that pair's
+//! stability limit, `locked_stiff.rs`), else an exponential Rosenbrock pair (`gilbert.rs`, its
+//! defect also sampled at the substep's midpoint, `pair_midpoint.rs`); weakly damped ringing
+//! trapped in its well advances orbit-averaged (`orbit.rs`, `orbit_advance.rs`,
+//! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`, the wells its checks find kept
+//! per landscape, `orbit_kept_well.rs`; a locked rotor's last orbit is resolved at once,
 //! `orbit_finish.rs`, its onion refused near the rim is refused again from the well kept,
-//! `orbit_rim_refusal.rs`, and its ringing small enough to be linear
-//! advances by its exact linear flow, `linear_ringing.rs`); a locked rotor's onion near or
-//! above its wells' rims is held to what its energy, which only falls, can reach
-//! (`rim_energy.rs`), a free rotor's to what the rotor's turn can feed it (`free_energy.rs`).
-//! A free rotor's onion is settled on its branch only where a minimum can lie within the check's
-//! slack (`branch_settle.rs`). A free rotor that turns too little between a schedule's switches
-//! for the ring's torque to change beyond the tolerance advances under that torque held, in
-//! closed form, with the quasi-static onion settled once per segment (`held_torque.rs`). On fast
-//! schedules whose ring barely couples the onion to the rotor, repeated periods and cycles are
-//! taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an onion near its path advances by
-//! exact affine maps per switch (`onion_linear.rs`; a locked rotor's, the ring's torque folded
-//! into them, by `onion_linear_locked.rs`; a free rotor's that the ring turns the onion of but
-//! barely turns itself, by `onion_linear_free.rs`). The estimate sizes the next substep.
-//! A budget of attempted substeps per call bounds the cost of a long step (see
-//! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
-//! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
+//! `orbit_rim_refusal.rs`, and its ringing small enough to be linear advances by its exact linear
+//! flow, `linear_ringing.rs`); a locked rotor's onion near or above its wells' rims is held to what
+//! its energy, which only falls, can reach (`rim_energy.rs`), a free rotor's to what the rotor's
+//! turn can feed it (`free_energy.rs`). A free rotor's onion is settled on its branch only where a
+//! minimum can lie within the check's slack (`branch_settle.rs`). A free rotor that turns too
+//! little between a schedule's switches for the ring's torque to change beyond the tolerance
+//! advances under that torque held, in closed form, with the quasi-static onion settled once per
+//! segment (`held_torque.rs`). On fast schedules whose ring barely couples the onion to the rotor,
+//! repeated periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an
+//! onion near its path advances by exact affine maps per switch (`onion_linear.rs`; a locked
+//! rotor's, the ring's torque folded into them, by `onion_linear_locked.rs`; a free rotor's that
+//! the ring turns the onion of but barely turns itself, by `onion_linear_free.rs`). The estimate
+//! sizes the next substep. A budget of attempted substeps per call bounds the cost of a long step
+//! (see [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion
+//! could not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
 //! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`; at once where its
 //! persisting ringing is forecast to spend the budget's fine half within its segment,
-//! `budget_forecast.rs`), and a locked
-//! rotor's ringing onion that neither a drop nor forced substeps can follow through the
-//! schedule's switches refuses the step (`locked_switches.rs`), as does a locked step whose
-//! switches outnumber its loop's passes once the linear spans fail or the budget cannot pay for
-//! them (`switch_count.rs`; the spans count one unit per two switches they chain). A free
-//! rotor's onion whose tilt leaves its bounds escapes at the substep that carries it out, not at
-//! the budget's smallest (`tilt_exit.rs`). A Gilbert step whose onion's dynamics carry its
-//! resolved substeps' local errors far beyond the tolerance by its end is flagged
+//! `budget_forecast.rs`), and a locked rotor's ringing onion that neither a drop nor forced
+//! substeps can follow through the schedule's switches refuses the step (`locked_switches.rs`), as
+//! does a locked step whose switches outnumber its loop's passes once the linear spans fail or the
+//! budget cannot pay for them (`switch_count.rs`; the spans count one unit per two switches they
+//! chain). A free rotor's onion whose tilt leaves its bounds escapes at the substep that carries it
+//! out, not at the budget's smallest (`tilt_exit.rs`). A Gilbert step whose onion's dynamics carry
+//! its resolved substeps' local errors far beyond the tolerance by its end is flagged
 //! (`amplification.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated

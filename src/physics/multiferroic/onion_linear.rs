@@ -122,20 +122,19 @@ pub(super) fn apply(a: &M2, x: [f64; 2]) -> [f64; 2] {
 
 /// The exact flow of `w' = A w + b` over `h` for a 2x2 `A`, in closed form.
 ///
-/// Hand-written rather than a general exponential: it runs once a switch, hundreds of times a
-/// step, where a scaled-and-squared 3x3 exponential cost about as much as the substeps it
-/// replaces. `exp(A h)` is the closed form of [`expm2`], finite over the whole range (a long
-/// overdamped interval among it). With `A = m I + N`, `N^2 = q I` (trace-free), `exp(A s) =
-/// e^{m s} (C I + S N)`, `C, S = cos(w s), sin(w s) / w` for `q = -w^2 < 0` and `cosh, sinh /
-/// w` for `q = w^2`; hence, entry by entry, `|exp(A s)| <= max(1, e^{m h}) (I + min(h, 1/w)
-/// |N|)` in the first case and `e^{max(m + w, 0) h} (I + min(h, 1/(2w)) |N|)` in the second (`|sin(w s)/w| <=
-/// min(s, 1/w)`, `cosh(w s) <= e^{w s}`, `sinh(w s)/w <= e^{w s} min(s, 1/(2w))`). The
-/// integral is `A^{-1} (exp(A h) - I)` where `A` is well conditioned and `h` long; else, beyond
-/// `||A|| h = 1/2`, `h phi_1(A h)` from the eigenvalues ([`block_phi1`]: a nearly singular `A`,
-/// as a stiff tilt makes it, has one eigenvalue near 0 and the other far off, or both near 0);
-/// else its Taylor series over `h / 2^n` (`||A|| h / 2^n <= 1/2`) doubled `n` times
-/// (`J(2h) = (I + exp(A h)) J(h)`), which holds through a singular `A`.
-/// `None` if the flow could grow beyond `e^50`.
+/// Hand-written rather than a general exponential: it runs once a switch, hundreds of times a step,
+/// where a scaled-and-squared 3x3 exponential cost about as much as the substeps it replaces.
+/// `exp(A h)` is the closed form of [`expm2`], finite over the whole range (a long overdamped
+/// interval among it). With `A = m I + N`, `N^2 = q I` (trace-free), `exp(A s) = e^{m s} (C I + S
+/// N)`, `C, S = cos(w s), sin(w s) / w` for `q = -w^2 < 0` and `cosh, sinh / w` for `q = w^2`;
+/// hence, entry by entry, `|exp(A s)| <= max(1, e^{m h}) (I + min(h, 1/w) |N|)` in the first case
+/// and `e^{max(m + w, 0) h} (I + min(h, 1/(2w)) |N|)` in the second (`|sin(w s)/w| <= min(s, 1/w)`,
+/// `cosh(w s) <= e^{w s}`, `sinh(w s)/w <= e^{w s} min(s, 1/(2w))`). The integral is `A^{-1} (exp(A
+/// h) - I)` where `A` is well conditioned and `h` long; else, beyond `||A|| h = 1/2`, `h phi_1(A
+/// h)` from the eigenvalues ([`block_phi1`]: a nearly singular `A`, as a stiff tilt makes it, has
+/// one eigenvalue near 0 and the other far off, or both near 0); else its Taylor series over `h /
+/// 2^n` (`||A|| h / 2^n <= 1/2`) doubled `n` times (`J(2h) = (I + exp(A h)) J(h)`), which holds
+/// through a singular `A`. `None` if the flow could grow beyond `e^50`.
 pub(super) fn flow(a: &M2, h: f64) -> Option<Flow> {
     let m = 0.5 * (a[0][0] + a[1][1]);
     let n: M2 = [[a[0][0] - m, a[0][1]], [a[1][0], a[1][1] - m]];
@@ -222,46 +221,45 @@ impl Motor {
     /// of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
     ///
     /// A locked rotor stays; a free one follows load and drag alone ([`Self::drift_response`]),
-    /// exactly where the ring is dropped, within [`Self::free_ring_term`]'s bound where the
-    /// onion keeps it. The bound below holds for the onion whatever its placements on
-    /// its quasi-static branch would have been, which the skips of repeated periods rest on
-    /// ([`Self::snaps_forgotten`]): an onion the strain turns fast about is advanced here. The onion
-    /// obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin 2(psi -
-    /// gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq. 3.4) plus the ring's
-    /// torque (eq. 3.3). About the span's start `psi0`, with `delta = psi - psi0`, the gradient is
-    /// `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k) + tau_0`, `d_k = 2 E cos 2(psi0 -
-    /// gamma_k) + k_0` (`tau_0, k_0` the ring's linear term, zero where it is dropped,
+    /// exactly where the ring is dropped, within [`Self::free_ring_term`]'s bound where the onion
+    /// keeps it. The bound below holds for the onion whatever its placements on its quasi-static
+    /// branch would have been, which the skips of repeated periods rest on
+    /// ([`Self::snaps_forgotten`]): an onion the strain turns fast about is advanced here. The
+    /// onion obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin
+    /// 2(psi - gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq. 3.4) plus
+    /// the ring's torque (eq. 3.3). About the span's start `psi0`, with `delta = psi - psi0`, the
+    /// gradient is `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k) + tau_0`, `d_k = 2 E cos
+    /// 2(psi0 - gamma_k) + k_0` (`tau_0, k_0` the ring's linear term, zero where it is dropped,
     /// [`Self::linear_ring_term`]): each interval is an exact affine map of `(delta, theta)` (see
     /// [`flow`]), chained over the span. The dropped term is bounded by `|R| <= (2 |E| + rho)
     /// delta^2 + tau_r` (Taylor's remainder: `|d^2/dx^2 sin 2x| <= 4`; `rho delta^2 + tau_r` the
-    /// ring term's remainder; under a free rotor the bar's turn `p` makes it `rho (|delta| +
-    /// |p|)^2 + |k_0| |p|`, [`Self::free_ring_term`]), and enters the rates as `g (-a R, R)`. All bounds on vectors are
-    /// entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the entrywise
-    /// bound on the interval's propagator `|exp(A s)|` ([`flow`]). Over interval `k` of length
-    /// `h_k` the remainder's effect is at most `c_k = K_k (h_k g a, h_k g) R_k` (variation of
-    /// constants), `R_k` a bound on `|R|` there from `r_k`, a bound on `|delta|`: the linear
-    /// path's reach (`max(|delta_k|, |delta_k+1|) + h_k (K_k |A w_k + b|)_0 / 2`, or
-    /// `(K_k (|w_k| + h_k |b|))_0`) widened by the forward bound of the error so far (`eps_k+1 =
-    /// |exp(A h_k)| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound at the
-    /// span's end is the larger entry of `sum_k |P_k| c_k`, `P_k` the exact product of the later
-    /// intervals' maps. Entry by entry, not in a norm: the tilt's stiffness `T` far exceeds the
-    /// angle's `|d_k|`, so a switch's map carries the tilt into the angle many times over (a max
-    /// norm of 5 to 32 on fast schedules) where its products over many switches stay near 1,
-    /// and a norm's bound grows geometrically with the span. `R_k` is taken where it bounds the
-    /// remainder on the reach it widens itself (`R_k >= R(r + (c_k)_0)`, `r` the reach widened by
-    /// `eps_k` alone; tried at 1.25 times `R(r + (c(R(r)))_0)`), so
-    /// that the true onion cannot first leave that reach: the bound is a real bound on the true
-    /// onion's distance from the chained maps' (through eq. 3.4's trigonometric terms and eq. 3.3's
-    /// torque alike), but for rounding. A span is taken only where that bound is within a hundredth
-    /// of the tolerance and covers at least [`MIN_SPAN`] switches (or ends the step); otherwise
-    /// a shorter one is tried, and where the shortest fails the next switches are left to the
-    /// other paths, for good after [`MAX_DECLINES`] in a row (an onion swinging through eq.
-    /// 3.4's nonlinear range, where the linearization fails at once). Tried, with a decoupled ring, once the skips
-    /// of repeated periods have declined at [`WAIT_SWITCHES`] switches. Every switch chained,
-    /// in a span taken or declined, is charged to the step's budget ([`SWITCHES_PER_UNIT`]), and
-    /// the spans chain no more switches than the budget left pays for: they are over for the
-    /// step once it cannot pay for [`MIN_SPAN`], so that `max_substeps` bounds their cost as it
-    /// bounds the substeps'.
+    /// ring term's remainder; under a free rotor the bar's turn `p` makes it `rho (|delta| + |p|)^2
+    /// + |k_0| |p|`, [`Self::free_ring_term`]), and enters the rates as `g (-a R, R)`. All bounds
+    /// on vectors are entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the
+    /// entrywise bound on the interval's propagator `|exp(A s)|` ([`flow`]). Over interval `k` of
+    /// length `h_k` the remainder's effect is at most `c_k = K_k (h_k g a, h_k g) R_k` (variation
+    /// of constants), `R_k` a bound on `|R|` there from `r_k`, a bound on `|delta|`: the linear
+    /// path's reach (`max(|delta_k|, |delta_k+1|) + h_k (K_k |A w_k + b|)_0 / 2`, or `(K_k (|w_k| +
+    /// h_k |b|))_0`) widened by the forward bound of the error so far (`eps_k+1 = |exp(A h_k)|
+    /// eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound at the span's end is the
+    /// larger entry of `sum_k |P_k| c_k`, `P_k` the exact product of the later intervals' maps.
+    /// Entry by entry, not in a norm: the tilt's stiffness `T` far exceeds the angle's `|d_k|`, so
+    /// a switch's map carries the tilt into the angle many times over (a max norm of 5 to 32 on
+    /// fast schedules) where its products over many switches stay near 1, and a norm's bound grows
+    /// geometrically with the span. `R_k` is taken where it bounds the remainder on the reach it
+    /// widens itself (`R_k >= R(r + (c_k)_0)`, `r` the reach widened by `eps_k` alone; tried at
+    /// 1.25 times `R(r + (c(R(r)))_0)`), so that the true onion cannot first leave that reach: the
+    /// bound is a real bound on the true onion's distance from the chained maps' (through eq. 3.4's
+    /// trigonometric terms and eq. 3.3's torque alike), but for rounding. A span is taken only
+    /// where that bound is within a hundredth of the tolerance and covers at least [`MIN_SPAN`]
+    /// switches (or ends the step); otherwise a shorter one is tried, and where the shortest fails
+    /// the next switches are left to the other paths, for good after [`MAX_DECLINES`] in a row (an
+    /// onion swinging through eq. 3.4's nonlinear range, where the linearization fails at once).
+    /// Tried, with a decoupled ring, once the skips of repeated periods have declined at
+    /// [`WAIT_SWITCHES`] switches. Every switch chained, in a span taken or declined, is charged to
+    /// the step's budget ([`SWITCHES_PER_UNIT`]), and the spans chain no more switches than the
+    /// budget left pays for: they are over for the step once it cannot pay for [`MIN_SPAN`], so
+    /// that `max_substeps` bounds their cost as it bounds the substeps'.
     pub(super) fn advance_onion_linear(
         &self,
         run: &mut StepRun,

@@ -381,25 +381,25 @@ impl Motor {
     /// ending at `segment_end`: it does from the first pass at which it is relaxed, and then
     /// starts on the branch (no tilt, the onion settled).
     ///
-    /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance
-    /// at the budget's minimum size), or is about to be (the budget left cannot pay for another
-    /// Gilbert substep, or a free rotor's persisting ringing is forecast to spend the budget's
-    /// fine half within the segment, [`Self::budget_forecast_drops`]): the ringing that the
-    /// budget cannot resolve is dropped, the onion settled into the minimum it rings about. Forced exponential substeps spanning several
-    /// precession periods could otherwise carry a weakly damped onion into the wrong minimum (at
-    /// `gilbert_damping` 1e-4 the rotor then missed its step); the rotor answers the ringing's
-    /// alternating torque by at most `A tau_o / (tau_rotor sqrt(1 + (omega_p tau_o)^2))` to first
-    /// order, far less than the step it would lose. The step stays flagged. (Only for an onion
-    /// that relaxes at all within a tenth of the rotor's time, as in [`Self::relaxed_onion`], and,
-    /// under a free rotor, that heads for its minimum within the step,
-    /// [`Self::heads_for_minimum`], or, once forced beyond the tolerance, is trapped in its well
-    /// with the ring unable to move the rotor and no switch left in the step,
+    /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance at
+    /// the budget's minimum size), or is about to be (the budget left cannot pay for another
+    /// Gilbert substep, or a free rotor's persisting ringing is forecast to spend the budget's fine
+    /// half within the segment, [`Self::budget_forecast_drops`]): the ringing that the budget
+    /// cannot resolve is dropped, the onion settled into the minimum it rings about. Forced
+    /// exponential substeps spanning several precession periods could otherwise carry a weakly
+    /// damped onion into the wrong minimum (at `gilbert_damping` 1e-4 the rotor then missed its
+    /// step); the rotor answers the ringing's alternating torque by at most `A tau_o / (tau_rotor
+    /// sqrt(1 + (omega_p tau_o)^2))` to first order, far less than the step it would lose. The step
+    /// stays flagged. (Only for an onion that relaxes at all within a tenth of the rotor's time, as
+    /// in [`Self::relaxed_onion`], and, under a free rotor, that heads for its minimum within the
+    /// step, [`Self::heads_for_minimum`], or, once forced beyond the tolerance, is trapped in its
+    /// well with the ring unable to move the rotor and no switch left in the step,
     /// [`Self::decoupled_budget_drop`], unless it left its bounds; a locked rotor's as
-    /// [`Self::locked_budget_drop`] says, which refuses the step where neither dropping nor
-    /// forced substeps can follow the onion through the schedule's switches.) Otherwise it
-    /// follows once relaxed ([`Self::relaxed_onion`]) and, under a free rotor, ends the rest of
-    /// the step within the tolerance of its minimum ([`Self::ends_at_minimum`]): ringing that
-    /// barely moves the rotor still places the onion.
+    /// [`Self::locked_budget_drop`] says, which refuses the step where neither dropping nor forced
+    /// substeps can follow the onion through the schedule's switches.) Otherwise it follows once
+    /// relaxed ([`Self::relaxed_onion`]) and, under a free rotor, ends the rest of the step within
+    /// the tolerance of its minimum ([`Self::ends_at_minimum`]): ringing that barely moves the
+    /// rotor still places the onion.
     pub(super) fn follows_branch(&self, run: &mut StepRun, d: &Drive, segment_end: f64) -> bool {
         if run.following == segment_end {
             return true;
