@@ -35,7 +35,8 @@
 //! above its wells' rims is held to what its energy, which only falls, can reach
 //! (`rim_energy.rs`), a free rotor's to what the rotor's turn can feed it (`free_energy.rs`).
 //! A free rotor's onion is settled on its branch only where a minimum can lie within the check's
-//! slack (`branch_settle.rs`). A free rotor that turns too little between a schedule's switches
+//! slack (`branch_settle.rs`), and the checks of its branch in one pass share one settle of
+//! its state (`settle_memo.rs`). A free rotor that turns too little between a schedule's switches
 //! for the ring's torque to change beyond the tolerance advances under that torque held, in
 //! closed form, with the quasi-static onion settled once per segment (`held_torque.rs`). On fast
 //! schedules whose ring barely couples the onion to the rotor, repeated periods and cycles are
@@ -176,6 +177,9 @@ mod ringing;
 #[cfg(test)]
 mod ringing_drop_tests;
 pub mod schedule;
+mod settle_memo;
+#[cfg(test)]
+mod settle_memo_tests;
 #[cfg(test)]
 mod slip_layer_tests;
 #[cfg(test)]
