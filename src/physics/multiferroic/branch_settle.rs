@@ -5,6 +5,7 @@
 //! that the next constrain does not march to the same minimum again.
 
 use super::angles::Angles;
+use super::settle_memo::SettleMemo;
 use super::{Drive, Motor, Vector};
 
 /// Where a settle starts: the angles at the onion and the gradient and curvature of eq. 3.4
@@ -69,10 +70,17 @@ impl Motor {
     /// `d`, `None` where it does not head for it within `horizon` ([`Self::heads_for_minimum`]):
     /// the minimum is [`Self::constrain`]'s for a quasi-static onion at `y` (the same march from
     /// the same angles), so the branch that the onion joins starts there without a second march.
-    pub(super) fn heads_for_settled(&self, y: &Vector, d: &Drive, horizon: f64) -> Option<Angles> {
-        let land = self.landscape(y[0], d.direction, d.stress);
-        let minimum = land.settle_from(land.angles(y[2]));
-        self.heads_for_minimum(y, minimum.onion, land.curvature(minimum.onion), horizon)
+    ///
+    /// The minimum and its curvature are kept in `memo` for the other checks of the pass.
+    pub(super) fn heads_for_settled(
+        &self,
+        y: &Vector,
+        d: &Drive,
+        horizon: f64,
+        memo: &SettleMemo,
+    ) -> Option<Angles> {
+        let (minimum, k) = self.settled_curvature(memo, y, d);
+        self.heads_for_minimum(y, minimum.onion, k, horizon)
             .then_some(minimum)
     }
 }

@@ -114,12 +114,11 @@ impl Motor {
         // Every mode of the onion's linearization at its minimum decays by at most a factor `e`
         // over the time left (their rates sum to the trace `g alpha (k + T)`, eq. 3.4 with the
         // LLG damping): the ringing, and the rate at which its substeps spend, persist.
-        let land = self.landscape(run.y[0], d.direction, d.stress);
-        let k = land.curvature(land.settle(run.y[2]));
+        let (_, k) = self.settled_curvature(&run.settle_memo, &run.y, d);
         let trace = self.llg_rate * self.params.gilbert_damping * (k + self.tilt_stiffness);
         // (False for a NaN.)
         let persists = trace * left <= 1.0;
-        persists && self.decoupled_budget_drop(&run.y, d, left, left)
+        persists && self.decoupled_budget_drop(&run.y, d, (left, left), &run.settle_memo)
     }
 }
 

@@ -6,6 +6,7 @@
 use super::decoupled::torque_bound;
 use super::orbit::point;
 use super::ringing::{Rims, MAX_FOLLOWED_LAG};
+use super::settle_memo::SettleMemo;
 use super::{Drive, Motor, Vector};
 
 impl Motor {
@@ -75,12 +76,14 @@ impl Motor {
     /// one rings. Forced substeps instead, each beyond the tolerance and spanning a good part of
     /// a precession period, can carry ringing near the rims over one into the next well, and
     /// they spend the rest of the budget.
+    ///
+    /// The minimum that the onion settles into is `memo`'s ([`Self::settled_minimum`]).
     pub(super) fn decoupled_budget_drop(
         &self,
         y: &Vector,
         d: &Drive,
-        remaining: f64,
-        to_switch: f64,
+        (remaining, to_switch): (f64, f64),
+        memo: &SettleMemo,
     ) -> bool {
         if d.locked || to_switch < remaining {
             return false;
@@ -92,7 +95,8 @@ impl Motor {
             return false;
         }
         let land = self.landscape(y[0], d.direction, d.stress);
-        let Some(well) = self.onion_well(&land, y[2]) else {
+        let minimum = self.settled_minimum(memo, y, d).onion;
+        let Some(well) = self.well_of_minimum(&land, minimum) else {
             return false;
         };
         let excess = point(&land, y[2]).0 - well.floor + 0.5 * self.tilt_stiffness * y[3] * y[3];

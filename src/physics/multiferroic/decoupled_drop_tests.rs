@@ -93,21 +93,26 @@ fn decoupled_drop_needs_a_constant_drive_a_weak_ring_and_a_trapped_onion() {
     let d = m.drive_at(&inputs, 0.0);
     let y = [start.rotor_angle, 0.0, start.onion_angle, start.onion_tilt];
     let h = 1e-6;
-    assert!(m.decoupled_budget_drop(&y, &d, h, f64::INFINITY));
-    assert!(m.decoupled_budget_drop(&y, &d, h, h));
-    assert!(!m.decoupled_budget_drop(&y, &d, h, 0.5 * h));
+    assert!(m.decoupled_budget_drop(&y, &d, (h, f64::INFINITY), &Default::default()));
+    assert!(m.decoupled_budget_drop(&y, &d, (h, h), &Default::default()));
+    assert!(!m.decoupled_budget_drop(&y, &d, (h, 0.5 * h), &Default::default()));
     let (w, other, other_inputs) = case(&values(HEAVY_ROTOR)).unwrap();
     let e = w.drive_at(&other_inputs, 0.0);
     let z = [other.rotor_angle, 0.0, other.onion_angle, other.onion_tilt];
     assert!(w
         .onion_well(&w.landscape(z[0], e.direction, e.stress), z[2])
         .is_some());
-    assert!(!w.decoupled_budget_drop(&z, &e, h, f64::INFINITY));
+    assert!(!w.decoupled_budget_drop(&z, &e, (h, f64::INFINITY), &Default::default()));
     // Tilted out of the well: its energy above the lowest rim.
     let land = m.landscape(y[0], d.direction, d.stress);
     let well = m.onion_well(&land, y[2]).unwrap();
     let tilt = (2.0 * well.barrier / m.tilt_stiffness).sqrt() * 1.01;
-    assert!(!m.decoupled_budget_drop(&[y[0], y[1], y[2], tilt], &d, h, f64::INFINITY));
+    assert!(!m.decoupled_budget_drop(
+        &[y[0], y[1], y[2], tilt],
+        &d,
+        (h, f64::INFINITY),
+        &Default::default()
+    ));
 }
 
 /// A benchmark case: a load-driven rotor (inertial time 3e-13 s) at 1.2e7 rad/s whose ring's

@@ -36,7 +36,7 @@ impl Motor {
         d: &Drive,
         segment_end: f64,
     ) -> bool {
-        let settled = self.settle(&run.y, d);
+        let settled = self.settled_minimum(&run.settle_memo, &run.y, d).onion;
         if self.locked_ringing_ends(&run.y, d, settled, segment_end - run.t) {
             return true;
         }

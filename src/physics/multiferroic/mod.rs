@@ -34,18 +34,19 @@
 //! flow, `linear_ringing.rs`); a locked rotor's onion near or above its wells' rims is held to what
 //! its energy, which only falls, can reach (`rim_energy.rs`), a free rotor's to what the rotor's
 //! turn can feed it (`free_energy.rs`). A free rotor's onion is settled on its branch only where a
-//! minimum can lie within the check's slack (`branch_settle.rs`). A free rotor that turns too
-//! little between a schedule's switches for the ring's torque to change beyond the tolerance
-//! advances under that torque held, in closed form, with the quasi-static onion settled once per
-//! segment (`held_torque.rs`). On fast schedules whose ring barely couples the onion to the rotor,
-//! repeated periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an
-//! onion near its path advances by exact affine maps per switch (`onion_linear.rs`; a locked
-//! rotor's, the ring's torque folded into them, by `onion_linear_locked.rs`; a free rotor's that
-//! the ring turns the onion of but barely turns itself, by `onion_linear_free.rs`). The estimate
-//! sizes the next substep. A budget of attempted substeps per call bounds the cost of a long step
-//! (see [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion
-//! could not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot
-//! move is dropped into the well its ringing is trapped in (`decoupled_drop.rs`; at once where its
+//! minimum can lie within the check's slack (`branch_settle.rs`), and the checks of its branch in
+//! one pass share one settle of its state (`settle_memo.rs`). A free rotor that turns too little
+//! between a schedule's switches for the ring's torque to change beyond the tolerance advances
+//! under that torque held, in closed form, with the quasi-static onion settled once per segment
+//! (`held_torque.rs`). On fast schedules whose ring barely couples the onion to the rotor, repeated
+//! periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an onion near
+//! its path advances by exact affine maps per switch (`onion_linear.rs`; a locked rotor's, the
+//! ring's torque folded into them, by `onion_linear_locked.rs`; a free rotor's that the ring turns
+//! the onion of but barely turns itself, by `onion_linear_free.rs`). The estimate sizes the next
+//! substep. A budget of attempted substeps per call bounds the cost of a long step (see
+//! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
+//! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot move
+//! is dropped into the well its ringing is trapped in (`decoupled_drop.rs`; at once where its
 //! persisting ringing is forecast to spend the budget's fine half within its segment,
 //! `budget_forecast.rs`), and a locked rotor's ringing onion that neither a drop nor forced
 //! substeps can follow through the schedule's switches refuses the step (`locked_switches.rs`), as
@@ -174,6 +175,9 @@ mod ringing;
 #[cfg(test)]
 mod ringing_drop_tests;
 pub mod schedule;
+mod settle_memo;
+#[cfg(test)]
+mod settle_memo_tests;
 #[cfg(test)]
 mod slip_layer_tests;
 #[cfg(test)]

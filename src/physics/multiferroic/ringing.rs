@@ -3,6 +3,7 @@
 //! decays (see [`Motor::relaxed_onion`], [`Motor::averaged_ringing`]).
 
 use super::branch_settle::Relaxed;
+use super::settle_memo::SettleMemo;
 use super::{Drive, Motor, Vector};
 
 impl Motor {
@@ -49,6 +50,7 @@ impl Motor {
         rim_barrier: Option<&mut Rims>,
         remaining: f64,
         switches: (f64, f64),
+        memo: &SettleMemo,
     ) -> Option<Relaxed> {
         // Without the averaged ringing only the first test can pass, and its slack is at most
         // the tolerance plus MAX_FOLLOWED_LAG: a larger tilt fails it before the settle (a
@@ -72,11 +74,14 @@ impl Motor {
             if !self.onion_relaxes_fast() || y[3].abs() > slack() {
                 return None;
             }
-            // The same march as `self.settle`, from the angles and slope the bound evaluated.
+            // The same march as `self.settle`, from the angles and slope the bound evaluated
+            // (or the pass's, kept in `memo`).
             let start = self.settle_start_within(y, d, slack())?;
-            land.settle_from_slope(start.angles, start.gradient, start.curvature)
+            memo.get_or(y, d, || {
+                land.settle_from_slope(start.angles, start.gradient, start.curvature)
+            })
         } else {
-            land.settle_from(land.angles(y[2]))
+            self.settled_minimum(memo, y, d)
         };
         let settled = minimum.onion;
         let relaxed = |kick: f64, curvature: f64| Relaxed {
@@ -88,7 +93,7 @@ impl Motor {
         // speed, and so its lag, is 0). A free rotor's onion takes the cheap slack test first.
         // Made once at most, it gives the curvature at the minimum where it passes.
         let relaxed_in_fact = || {
-            let k = land.curvature(settled);
+            let (_, k) = self.settled_curvature(memo, y, d);
             self.ringing_ends_in(y, settled, k, switches, 0.1 * tol + lag)
                 .then_some(k)
         };

@@ -92,6 +92,9 @@ pub(super) struct StepRun {
     pub(super) amplification: super::amplification::Amplification,
     /// The present segment's spending (see [`Motor::budget_forecast_drops`]).
     pub(super) segment_spending: super::budget_forecast::SegmentSpending,
+    /// The minimum that the onion at the present state settles into, for the checks of its
+    /// branch that each need it ([`Motor::settled_minimum`]).
+    pub(super) settle_memo: super::settle_memo::SettleMemo,
 }
 
 impl StepRun {
@@ -144,6 +147,7 @@ impl StepRun {
             free_ledger: super::free_energy::FreeLedger::NONE,
             amplification: Default::default(),
             segment_spending: super::budget_forecast::SegmentSpending::NONE,
+            settle_memo: Default::default(),
         }
     }
 
@@ -423,10 +427,16 @@ impl Motor {
                     let to_switch = run
                         .schedule
                         .map_or(f64::INFINITY, |s| s.next_switch_after(run.t) - run.t);
-                    minimum = self.heads_for_settled(&run.y, d, run.t_end - run.start);
+                    let horizon = run.t_end - run.start;
+                    minimum = self.heads_for_settled(&run.y, d, horizon, &run.settle_memo);
                     minimum.is_some()
                         || run.limited
-                            && self.decoupled_budget_drop(&run.y, d, run.t_end - run.t, to_switch)
+                            && self.decoupled_budget_drop(
+                                &run.y,
+                                d,
+                                (run.t_end - run.t, to_switch),
+                                &run.settle_memo,
+                            )
                 });
         if run.unresolvable {
             return false;
@@ -466,7 +476,8 @@ impl Motor {
             let switches = run.schedule.map_or((f64::INFINITY, f64::INFINITY), |s| {
                 (s.next_switch_after(run.t) - run.t, s.step_period)
             });
-            let relaxed = self.relaxed_onion(&run.y, d, rims, segment_end - run.t, switches);
+            let memo = &run.settle_memo;
+            let relaxed = self.relaxed_onion(&run.y, d, rims, segment_end - run.t, switches, memo);
             // The decay check's orbits are charged on top of the check's own unit.
             let orbits = run.rim_barrier.1.decay_orbits.saturating_sub(orbits_before);
             let units = orbits.saturating_mul(ORBIT_WEIGHT);
