@@ -1,8 +1,8 @@
 //! A locked rotor's averaged advance back to its last lower turning point
 //! ([`Motor::advance_orbits`]): the secant stops once the phase misses that point by less than
 //! the averaged steps' own errors allow, and the step still ends within the tolerance of a
-//! converged RK4; where the quadratures' noise keeps the miss beyond that slack, the step is
-//! flagged.
+//! converged RK4; where the quadratures' noise keeps the miss beyond that slack, by enough to
+//! misplace the onion along its orbit by half the tolerance, the step is flagged.
 
 use super::locked_accuracy_tests::{onion_errors, step_against_rk4};
 use super::onion_periods_tests::{case, values};
@@ -48,8 +48,7 @@ fn locked_return_to_the_turning_point_stops_within_the_slack() {
 /// A locked onion whose return to its last turning point, one averaged step over 1,022 orbits,
 /// the quadratures' noise leaves 6.3e-3 cycles off after four tries, against a slack of 1.9e-5
 /// (the benchmark's draw 395829, printed to four digits, its second 1 us step).
-const NOISY_RETURN: &str =
-    "strain_direction=-2.996e2 stress=-1.780e3 load_torque=-5.691e-7 \
+const NOISY_RETURN: &str = "strain_direction=-2.996e2 stress=-1.780e3 load_torque=-5.691e-7 \
      ring_outer_diameter=1.021e-1 ring_inner_diameter=1.773e-3 bar_length=1.390e-3 \
      bar_width=2.839e-8 thickness=1.721e-9 saturation_magnetization=5.120e3 \
      magnetostriction=7.674e-3 wall_volume=3.221e-11 density=3.256e3 fluid_viscosity=2.185e-5 \
