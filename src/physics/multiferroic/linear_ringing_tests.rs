@@ -8,17 +8,19 @@ use super::orbit_phase_tests::DRAW_471993;
 
 /// Steps 1 to 3 (1 us each) of a locked-rotor bench draw with and without the propagator: per
 /// step the substeps reported, whether the propagator ended the step, and the onion's angle and
-/// tilt errors in tolerances against [`converged_rk4`] from the same start.
+/// tilt errors in tolerances against [`converged_rk4`] from the same start. With the propagator,
+/// steps 2 and 3 are not flagged (the first may be, by the averaged advance's return to its
+/// turning point).
 fn three_steps(text: &str, off: bool) -> Vec<(u32, bool, [f64; 2])> {
     let (m, mut st, inputs) = case(&values(text)).unwrap();
     assert!(inputs.rotor_locked);
     OFF.with(|c| c.set(off));
     let rows = (0..3)
-        .map(|_| {
+        .map(|k| {
             let start = st;
             let taken = TAKEN.with(|c| c.get());
             let report = m.step(&mut st, &inputs, 1e-6).unwrap();
-            assert!(!report.accuracy_limited, "{report:?}");
+            assert!(off || k == 0 || !report.accuracy_limited, "{report:?}");
             let errors = onion_errors(&m, &start, &st, &inputs, 2000.0);
             (report.substeps, TAKEN.with(|c| c.get()) > taken, errors)
         })

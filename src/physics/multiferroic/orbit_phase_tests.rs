@@ -2,7 +2,7 @@
 //! in eq. 3.4's pendulum well against a plain RK4 of the macrospin, both written here, and the
 //! bench draws that the bound lets the averaging take against a converged RK4 of the motor.
 
-use super::locked_accuracy_tests::step_against_rk4;
+use super::locked_accuracy_tests::{onion_errors, step_against_rk4};
 use super::onion_periods_tests::{case, values};
 use super::orbit_phase::{envelope, pendulum_anharmonicity};
 use crate::physics::numerics::rk4::rk4_step;
@@ -151,10 +151,19 @@ pub(super) const DRAW_471993: &str =
      strain=5.3382549327004175e-3 youngs_modulus=7.0448472765716165e6 strain_drive=1";
 
 /// Draw 471993: `k / T` = 2.4, damping 2.5e-3, tolerance 2.2e-9, the ringing 0.06 rad wide
-/// (4e-3 of the rim), 490 orbits in the step; averaged, 62 substeps, 0.5 tolerances off.
+/// (4e-3 of the rim), 490 orbits in the step; averaged, 12 substeps, 0.89 tolerances off. The
+/// step may be flagged: the return to the last turning point misses it by 3.6e-5 cycles, which
+/// may misplace the onion along its orbit by 2.1 tolerances.
 #[test]
 fn draw_471993_ringing_averaged_against_rk4() {
-    averaged_draw_against_rk4(DRAW_471993);
+    let (m, mut st, inputs) = case(&values(DRAW_471993)).unwrap();
+    let start = st;
+    let report = m.step(&mut st, &inputs, 1e-6).unwrap();
+    let errors = onion_errors(&m, &start, &st, &inputs, 2000.0);
+    println!("{report:?}, errors / tolerance {errors:?}");
+    assert_eq!(st.rotor_angle, start.rotor_angle);
+    assert!(errors.iter().all(|e| *e <= 1.0), "{errors:?}");
+    assert!(report.substeps <= 100, "{report:?}");
 }
 
 /// Draw 395829: `k / T` = 65, damping 1.4e-4, tolerance 1.2e-6, the ringing 0.42 rad wide (0.16
