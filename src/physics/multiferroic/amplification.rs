@@ -7,7 +7,9 @@
 //! onion's block of the Jacobian of the macrospin's equations (eq. 3.4 plus the tilt's shape
 //! anisotropy, [`Motor::onion_relaxation_time`]) at each substep's start. The step's end is then
 //! off by at most `sum_i e_i |G_i|` tolerances to first order ([`Amplification::bound`], `|G|`
-//! the largest row sum).
+//! the largest row sum). Where another path interrupts the resolved substeps, `G_i` still runs
+//! through every later resolved substep: the errors made before the interruption are amplified
+//! by the substeps after it as by those before.
 //!
 //! Where the onion passes close above a rim of its well (a saddle of the macrospin's energy),
 //! the time it takes to pass, and so its angle and tilt after it, depend on its energy there
@@ -26,7 +28,7 @@
 //! block is taken alone: the rotor's coupling to it and the paths that do not resolve the
 //! onion's substeps (averaged, settled, linear spans) carry the errors unchanged in the bound.
 
-use super::{Angles, Drive, Motor, Vector};
+use super::{Angles, Drive, Motor};
 use crate::physics::numerics::expm2::expm2;
 
 type Mat2 = [[f64; 2]; 2];
@@ -39,23 +41,13 @@ const AMPLIFIED_BEYOND: f64 = 1e6;
 #[derive(Clone, Debug, Default)]
 pub(super) struct Amplification {
     substeps: Vec<(Mat2, f64)>,
-    /// The state and time at the last recorded substep's end.
-    end: Option<(Vector, f64)>,
-    /// The bound carried from chains of substeps that another path interrupted.
-    carried: f64,
 }
 
 impl Amplification {
     /// `sum_i e_i |G_i|` (tolerances) over the substeps recorded, `|G_i|` the largest row sum of
-    /// the propagator from the end of substep `i` to the last recorded one's end; a path other
+    /// the product of the propagators of the substeps recorded after substep `i`; a path other
     /// than the resolved substeps between two of them is taken to carry the errors unchanged.
-    pub(super) fn bound(&mut self) -> f64 {
-        self.fold();
-        self.carried
-    }
-
-    /// Folds the chain recorded so far into `carried`.
-    fn fold(&mut self) {
+    pub(super) fn bound(&self) -> f64 {
         let mut p: Mat2 = [[1.0, 0.0], [0.0, 1.0]];
         let mut total = 0.0;
         for (phi, err) in self.substeps.iter().rev() {
@@ -77,27 +69,21 @@ impl Amplification {
                 ],
             ];
         }
-        self.carried += total;
-        self.substeps.clear();
+        total
     }
 }
 
 impl Motor {
-    /// Records a resolved Gilbert substep from `y` at `t` (angles `angles`) to `u` over `dt` (s)
-    /// under `d`, its error estimate `err` in tolerances (see [`Amplification`]).
+    /// Records a resolved Gilbert substep over `dt` (s) from a state at angles `angles` under
+    /// `d`, its error estimate `err` in tolerances (see [`Amplification`]).
     pub(super) fn record_amplification(
         &self,
         amp: &mut Amplification,
-        (y, u): (&Vector, &Vector),
-        (t, dt): (f64, f64),
+        dt: f64,
         d: &Drive,
         angles: &Angles,
         err: f64,
     ) {
-        if amp.end != Some((*y, t)) {
-            amp.fold();
-        }
-        amp.end = Some((*u, t + dt));
         // The onion's block of the Jacobian ([`Self::rhs_jacobian`]).
         let (_, k_bar) = self
             .ring_bar
@@ -121,7 +107,7 @@ impl Motor {
     /// Whether the resolved Gilbert substeps' errors recorded in `amp` are carried beyond
     /// [`AMPLIFIED_BEYOND`] tolerances by the step's end (see the module documentation): such a
     /// step is flagged.
-    pub(super) fn errors_amplified(&self, amp: &mut Amplification) -> bool {
+    pub(super) fn errors_amplified(&self, amp: &Amplification) -> bool {
         if self.quasi_static() {
             return false;
         }

@@ -463,14 +463,7 @@ impl Motor {
                 if err > 1.0 {
                     run.limited = true;
                 } else if !self.quasi_static() {
-                    self.record_amplification(
-                        &mut run.amplification,
-                        (&run.y, &y_new),
-                        (t, taken),
-                        d,
-                        &angles,
-                        err,
-                    );
+                    self.record_amplification(&mut run.amplification, taken, d, &angles, err);
                 }
                 run.y = y_new;
                 // The embedded pair's state is settled, with its angles; the others are not.

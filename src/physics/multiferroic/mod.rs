@@ -66,6 +66,8 @@
 //! cannot amplify. See [`Motor::step`].
 
 mod amplification;
+#[cfg(test)]
+mod amplification_tests;
 pub mod angles;
 pub mod branch;
 mod branch_settle;

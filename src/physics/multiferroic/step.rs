@@ -350,7 +350,7 @@ impl Motor {
         if run.t < run.t_end {
             return Err(too_many_switches());
         }
-        run.limited = run.limited || self.errors_amplified(&mut run.amplification);
+        run.limited = run.limited || self.errors_amplified(&run.amplification);
         let d = self.drive_at(inputs, run.t_end);
         if !run.is_settled(&d) {
             self.constrain(&mut run.y, &d, run.angles.as_ref());
