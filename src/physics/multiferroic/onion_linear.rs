@@ -233,9 +233,9 @@ impl Motor {
     /// [`Self::linear_ring_term`]): each interval is an exact affine map of `(delta, theta)` (see
     /// [`flow`]), chained over the span. The dropped term is bounded by `|R| <= (2 |E| + rho)
     /// delta^2 + tau_r` (Taylor's remainder: `|d^2/dx^2 sin 2x| <= 4`; `rho delta^2 + tau_r` the
-    /// ring term's remainder; under a free rotor the bar's turn `p` makes it `rho (|delta| + |p|)^2
-    /// + |k_0| |p|`, [`Self::free_ring_term`]), and enters the rates as `g (-a R, R)`. All bounds
-    /// on vectors are entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the
+    /// ring term's remainder; under a free rotor the bar's turn `p` makes it `rho (|delta| +
+    /// |p|)^2 + |k_0| |p|`, [`Self::free_ring_term`]), and enters the rates as `g (-a R, R)`. All
+    /// bounds on vectors are entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the
     /// entrywise bound on the interval's propagator `|exp(A s)|` ([`flow`]). Over interval `k` of
     /// length `h_k` the remainder's effect is at most `c_k = K_k (h_k g a, h_k g) R_k` (variation
     /// of constants), `R_k` a bound on `|R|` there from `r_k`, a bound on `|delta|`: the linear
