@@ -2,8 +2,7 @@
 //! half within its segment: dropped at once, into the minimum that the budget's drop would reach
 //! later in the same segment ([`Motor::budget_forecast_drops`]).
 
-use super::step::StepRun;
-use super::{Drive, Motor};
+use super::{Drive, Motor, StepRun};
 
 /// The spending of one segment, from its first pass: its start (s) and the budget spent then,
 /// the time and budget spent at the last forecast tried, and the budget spent at which it is
