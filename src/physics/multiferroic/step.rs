@@ -17,6 +17,9 @@ pub(super) struct StepRun {
     pub(super) attempts: u32,
     /// Budget spent beyond `attempts`: a Gilbert substep costs [`GILBERT_SUBSTEP_WEIGHT`].
     pub(super) extra_cost: u32,
+    /// The step is accuracy-limited and will be flagged (a substep forced beyond the tolerance,
+    /// ringing dropped, errors amplified, an averaged return that missed its turning point);
+    /// from then on the budget's drops may end the ringing at once ([`Motor::follows_branch`]).
     pub(super) limited: bool,
     /// Next substep size to try (s).
     pub(super) dt: f64,
