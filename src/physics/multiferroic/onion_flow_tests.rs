@@ -4,7 +4,7 @@
 //! closed forms).
 
 use super::etd_blocks::block_phi1;
-use super::onion_linear::{flow, M2};
+use super::onion_linear::{flow, Flow, M2};
 use crate::physics::numerics::expm::expm;
 
 /// `exp(A h)` and `J` by the augmented exponential.
@@ -20,6 +20,29 @@ fn reference(a: &M2, h: f64) -> (M2, M2) {
     let e = [[x[0][0], x[0][1]], [x[1][0], x[1][1]]];
     let j = [[x[0][2], x[0][3]], [x[1][2], x[1][3]]];
     (e, j)
+}
+
+/// Every entry of the flow's `exp(A h)` and `J` within `bound_e` and `bound_j` of the truth's.
+fn assert_flow_near(
+    f: &Flow,
+    (e, j): (&M2, &M2),
+    (bound_e, bound_j): (f64, f64),
+    (a, h): (&M2, f64),
+) {
+    for i in 0..2 {
+        for k in 0..2 {
+            assert!(
+                (f.e[i][k] - e[i][k]).abs() <= bound_e,
+                "{a:?} {h}: exp {:?} vs {e:?}",
+                f.e
+            );
+            assert!(
+                (f.j[i][k] - j[i][k]).abs() <= bound_j,
+                "{a:?} {h}: J {:?} vs {j:?}",
+                f.j
+            );
+        }
+    }
 }
 
 /// The onion block of eq. 3.4 linearized (rate `g` = 1): `[[-alpha d, -T], [d, -alpha T]]`.
@@ -72,20 +95,7 @@ fn flow_matches_the_augmented_exponential() {
         let scale_e = e.iter().flatten().fold(1.0f64, |s, x| s.max(x.abs()));
         // `h max |exp(A s)|` over the interval: sampled at the reference's end and start.
         let scale_j = h * scale_e;
-        for i in 0..2 {
-            for k in 0..2 {
-                assert!(
-                    (f.e[i][k] - e[i][k]).abs() <= 1e-13 * scale_e,
-                    "{a:?} {h}: exp {:?} vs {e:?}",
-                    f.e
-                );
-                assert!(
-                    (f.j[i][k] - j[i][k]).abs() <= 1e-13 * scale_j,
-                    "{a:?} {h}: J {:?} vs {j:?}",
-                    f.j
-                );
-            }
-        }
+        assert_flow_near(&f, (&e, &j), (1e-13 * scale_e, 1e-13 * scale_j), (&a, h));
         let ah = [[a[0][0] * h, a[0][1] * h], [a[1][0] * h, a[1][1] * h]];
         if block_phi1(&ah).is_some() {
             closed += 1;
@@ -134,19 +144,6 @@ fn a_long_overdamped_interval_is_taken() {
         let f = flow(&a, h).unwrap_or_else(|| panic!("{a:?} {h}: declined"));
         let scale_e = e.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
         let scale_j = j.iter().flatten().fold(0.0f64, |s, x| s.max(x.abs()));
-        for i in 0..2 {
-            for k in 0..2 {
-                assert!(
-                    (f.e[i][k] - e[i][k]).abs() <= 1e-12 * scale_e,
-                    "{a:?} {h}: exp {:?} vs {e:?}",
-                    f.e
-                );
-                assert!(
-                    (f.j[i][k] - j[i][k]).abs() <= 1e-12 * scale_j,
-                    "{a:?} {h}: J {:?} vs {j:?}",
-                    f.j
-                );
-            }
-        }
+        assert_flow_near(&f, (&e, &j), (1e-12 * scale_e, 1e-12 * scale_j), (&a, h));
     }
 }
