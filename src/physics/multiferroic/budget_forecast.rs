@@ -63,7 +63,7 @@ impl Motor {
     /// that follows a forced substep would take it: the forecast also holds on onions ringing
     /// 7e-4 and 1.4 rad wide at 232 and 481 ns periods whose substeps then grow and resolve the
     /// step within the budget, unflagged within 0.15 tolerances, which a drop on the forecast
-    /// alone leaves 9e5 tolerances off.
+    /// alone leaves 1e6 to 4e9 tolerances off.
     pub(super) fn budget_forecast_drops(
         &self,
         run: &mut StepRun,

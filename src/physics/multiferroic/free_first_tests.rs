@@ -25,7 +25,7 @@ const SPUN_UP: &str = "strain_direction=7.07320388957077e2 stress=-4.79883413123
 /// the onion by itself (where it does not head for its minimum within the step). Each step
 /// ends unflagged within the tolerance of the rotor's exact motion under load and drag (the
 /// ring cannot move it) and a converged RK4 of the onion it drives. A drop on the forecast
-/// alone flagged both and left their onions 9.7e5 and 8.8e5 tolerances off that RK4.
+/// alone flagged both and left their onions 9.7e5 and 3.7e9 tolerances off that RK4.
 #[test]
 fn forecast_alone_does_not_drop_ringing_resolved_within_budget() {
     let h = 1e-6;
