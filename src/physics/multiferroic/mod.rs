@@ -94,6 +94,8 @@ mod forced_crossing_tests;
 mod free_energy;
 #[cfg(test)]
 mod free_energy_tests;
+#[cfg(test)]
+mod free_first_tests;
 mod gilbert;
 mod held_torque;
 #[cfg(test)]
