@@ -149,6 +149,8 @@ mod orbit_free_tests;
 mod orbit_kept_well;
 #[cfg(test)]
 mod orbit_kept_well_tests;
+#[cfg(test)]
+mod orbit_loss_tests;
 mod orbit_phase;
 #[cfg(test)]
 mod orbit_phase_tests;
