@@ -42,7 +42,9 @@
 //! periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an onion near
 //! its path advances by exact affine maps per switch (`onion_linear.rs`; a locked rotor's, the
 //! ring's torque folded into them, by `onion_linear_locked.rs`; a free rotor's that the ring turns
-//! the onion of but barely turns itself, by `onion_linear_free.rs`). The estimate sizes the next
+//! the onion of but barely turns itself, by `onion_linear_free.rs`); a free rotor's onion that the
+//! ring neither moves nor is moved by takes each whole period of such a schedule in one substep of
+//! its own 2x2 system, the rotor on its exact drift (`decoupled_segment.rs`). The estimate sizes the next
 //! substep. A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot move
@@ -83,6 +85,9 @@ mod decoupled;
 mod decoupled_drop;
 #[cfg(test)]
 mod decoupled_drop_tests;
+mod decoupled_segment;
+#[cfg(test)]
+mod decoupled_segment_tests;
 #[cfg(test)]
 mod decoupled_tests;
 mod drift;

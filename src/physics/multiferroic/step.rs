@@ -98,6 +98,8 @@ pub(super) struct StepRun {
     /// The minimum that the onion at the present state settles into, for the checks of its
     /// branch that each need it ([`Motor::settled_minimum`]).
     pub(super) settle_memo: super::settle_memo::SettleMemo,
+    /// The decoupled onion's segments tried (see [`Motor::advance_decoupled_segment`]).
+    pub(super) decoupled_tries: super::decoupled_segment::DecoupledTries,
 }
 
 impl StepRun {
@@ -151,6 +153,7 @@ impl StepRun {
             amplification: Default::default(),
             segment_spending: super::budget_forecast::SegmentSpending::NONE,
             settle_memo: Default::default(),
+            decoupled_tries: Default::default(),
         }
     }
 
@@ -293,6 +296,11 @@ impl Motor {
                 Some(s) => s.next_switch_after(run.t).min(run.t_end),
                 None => run.t_end,
             };
+            if run.following != segment_end
+                && self.advance_decoupled_segment(&mut run, &d, segment_end, budget, true)
+            {
+                continue;
+            }
             let model = if !self.quasi_static() && self.follows_branch(&mut run, &d, segment_end) {
                 twin.get_or_init(|| self.quasi_static_twin())
             } else {
@@ -346,6 +354,9 @@ impl Motor {
                 }
             }
             if model.advance_held_torque(&mut run, &d, segment_end) {
+                continue;
+            }
+            if model.advance_decoupled_segment(&mut run, &d, segment_end, budget, false) {
                 continue;
             }
             model.substep(&mut run, &d, segment_end, budget);
