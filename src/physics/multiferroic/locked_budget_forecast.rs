@@ -78,6 +78,11 @@ impl Motor {
     ///   only lowers that energy (`dE/dt = -g alpha (U'^2 + T^2 theta^2)`), so the onion stays in
     ///   the well to the step's end, and the budget's drop marches it downhill to the same
     ///   minimum from wherever it then is.
+    /// - **Left to that drop**: the linearization loses more than [`MIN_LOSS_PER_ORBIT`] of its
+    ///   energy an orbit (the averaged advance and the averaged decay time refuse at every
+    ///   energy), the linear ringing's wait outlasts the horizon, the relaxed onion's check does
+    ///   not end the ringing now, and the substeps forced after the fine half are at least
+    ///   [`FORCED_RATIO`] times the one the error control proposes.
     pub(super) fn locked_budget_forecast_drops(&self, run: &mut StepRun, d: &Drive) -> bool {
         if !d.locked || self.quasi_static() {
             return false;
@@ -123,7 +128,8 @@ impl Motor {
             .min(f64::from(spent - last_spent) / (run.t - last_t));
         let horizon = FORECAST_MARGIN * f64::from(fine_end - spent) / rate;
         // (False for a NaN.)
-        if !(horizon <= run.t_end - run.t) {
+        let spends = horizon <= run.t_end - run.t;
+        if !spends {
             return false;
         }
         // Once the fine half is spent, the substeps' floor is the even spread of the budget left
@@ -132,7 +138,9 @@ impl Motor {
         // the tolerance (their error grows at least as the ratio's cube) and flag the step,
         // whose next pass drops the onion.
         let forced = (run.t_end - run.t - horizon / FORECAST_MARGIN) / f64::from(budget - fine_end);
-        if !(forced >= FORCED_RATIO * run.dt) {
+        // (False for a NaN.)
+        let beyond = forced >= FORCED_RATIO * run.dt;
+        if !beyond {
             return false;
         }
         let (settled, k) = self.settled_curvature(&run.settle_memo, &run.y, d);
