@@ -95,6 +95,8 @@ pub(super) struct StepRun {
     pub(super) amplification: super::amplification::Amplification,
     /// The present segment's spending (see [`Motor::budget_forecast_drops`]).
     pub(super) segment_spending: super::budget_forecast::SegmentSpending,
+    /// A locked rotor's step spending (see [`Motor::locked_budget_forecast_drops`]).
+    pub(super) locked_spending: super::locked_budget_forecast::LockedSpending,
     /// The minimum that the onion at the present state settles into, for the checks of its
     /// branch that each need it ([`Motor::settled_minimum`]).
     pub(super) settle_memo: super::settle_memo::SettleMemo,
@@ -152,6 +154,7 @@ impl StepRun {
             free_ledger: super::free_energy::FreeLedger::NONE,
             amplification: Default::default(),
             segment_spending: super::budget_forecast::SegmentSpending::NONE,
+            locked_spending: super::locked_budget_forecast::LockedSpending::NONE,
             settle_memo: Default::default(),
             decoupled_tries: Default::default(),
         }
@@ -402,17 +405,18 @@ impl Motor {
     /// It also does once the step is accuracy-limited (a substep was forced beyond the tolerance at
     /// the budget's minimum size), or is about to be (the budget left cannot pay for another
     /// Gilbert substep, or a free rotor's persisting ringing is forecast to spend the budget's fine
-    /// half within the segment, [`Self::budget_forecast_drops`]): the ringing that the budget
-    /// cannot resolve is dropped, the onion settled into the minimum it rings about. Forced
-    /// exponential substeps spanning several precession periods could otherwise carry a weakly
-    /// damped onion into the wrong minimum (at `gilbert_damping` 1e-4 the rotor then missed its
-    /// step); the rotor answers the ringing's alternating torque by at most `A tau_o / (tau_rotor
-    /// sqrt(1 + (omega_p tau_o)^2))` to first order, far less than the step it would lose. The step
-    /// stays flagged. (Only for an onion that relaxes at all within a tenth of the rotor's time, as
-    /// in [`Self::relaxed_onion`], and, under a free rotor, that heads for its minimum within the
-    /// step, [`Self::heads_for_minimum`], or, once forced beyond the tolerance, is trapped in its
-    /// well with the ring unable to move the rotor and no switch left in the step,
-    /// [`Self::decoupled_budget_drop`], unless it left its bounds; a locked rotor's as
+    /// half within the segment, [`Self::budget_forecast_drops`], or a locked rotor's trapped one
+    /// within a step without switches, [`Self::locked_budget_forecast_drops`]): the ringing that
+    /// the budget cannot resolve is dropped, the onion settled into the minimum it rings about.
+    /// Forced exponential substeps spanning several precession periods could otherwise carry a
+    /// weakly damped onion into the wrong minimum (at `gilbert_damping` 1e-4 the rotor then missed
+    /// its step); the rotor answers the ringing's alternating torque by at most `A tau_o /
+    /// (tau_rotor sqrt(1 + (omega_p tau_o)^2))` to first order, far less than the step it would
+    /// lose. The step stays flagged. (Only for an onion that relaxes at all within a tenth of the
+    /// rotor's time, as in [`Self::relaxed_onion`], and, under a free rotor, that heads for its
+    /// minimum within the step, [`Self::heads_for_minimum`], or, once forced beyond the tolerance,
+    /// is trapped in its well with the ring unable to move the rotor and no switch left in the
+    /// step, [`Self::decoupled_budget_drop`], unless it left its bounds; a locked rotor's as
     /// [`Self::locked_budget_drop`] says, which refuses the step where neither dropping nor forced
     /// substeps can follow the onion through the schedule's switches.) Otherwise it follows once
     /// relaxed ([`Self::relaxed_onion`]) and, under a free rotor, ends the rest of the step within
@@ -428,9 +432,11 @@ impl Motor {
         // ringing now instead, as once forced, and flag the step.
         let spent = run.attempts.saturating_add(run.extra_cost);
         let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
-        let out_of_budget =
-            (run.limited || broke || self.budget_forecast_drops(run, d, segment_end))
-                && self.onion_relaxes_fast();
+        let out_of_budget = (run.limited
+            || broke
+            || self.budget_forecast_drops(run, d, segment_end)
+            || self.locked_budget_forecast_drops(run, d))
+            && self.onion_relaxes_fast();
         // The minimum an onion heading for it settles into, where the branch then starts.
         let mut minimum = None;
         let dropped = out_of_budget
