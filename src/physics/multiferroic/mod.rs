@@ -178,6 +178,7 @@ mod rim_energy;
 #[cfg(test)]
 mod rim_energy_tests;
 mod ringing;
+mod ringing_outlasts;
 #[cfg(test)]
 mod ringing_drop_tests;
 pub mod schedule;
