@@ -178,9 +178,11 @@ mod rim_energy;
 #[cfg(test)]
 mod rim_energy_tests;
 mod ringing;
-mod ringing_outlasts;
 #[cfg(test)]
 mod ringing_drop_tests;
+mod ringing_outlasts;
+#[cfg(test)]
+mod ringing_outlasts_tests;
 pub mod schedule;
 mod settle_memo;
 #[cfg(test)]
