@@ -190,6 +190,9 @@ mod rim_energy_tests;
 mod ringing;
 #[cfg(test)]
 mod ringing_drop_tests;
+mod ringing_outlasts;
+#[cfg(test)]
+mod ringing_outlasts_tests;
 pub mod schedule;
 mod settle_memo;
 #[cfg(test)]

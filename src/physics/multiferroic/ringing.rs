@@ -70,6 +70,11 @@ impl Motor {
             tol + lag.max(ringing).min(MAX_FOLLOWED_LAG)
         };
         let land = self.landscape(y[0], d.direction, d.stress);
+        // A locked onion must pass the switch test first: its tilt alone may fail it, before
+        // the settle's march.
+        if d.locked && self.ringing_outlasts_switches(&land, y, switches, 0.1 * tol + lag) {
+            return None;
+        }
         let minimum = if !d.locked && rim_barrier.is_none() {
             if !self.onion_relaxes_fast() || y[3].abs() > slack() {
                 return None;
