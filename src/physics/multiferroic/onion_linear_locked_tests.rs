@@ -109,8 +109,9 @@ fn three_steps(text: &str, max_substeps: u32, max_spans: usize, per_ns: f64) -> 
             span_rk4(&m, &inputs, y, t, t_end, 2 * n),
         );
         let gap = |a: &Vector, b: &Vector| (a[2] - b[2]).abs().max((a[3] - b[3]).abs());
-        // (An RK4 too coarse for a stiff tilt diverges: not finite, not converged.)
-        while !(gap(&coarse, &fine) <= 0.01 * bound) && n < 4096 {
+        // An RK4 too coarse for a stiff tilt diverges: not finite, not converged.
+        let settled = |a: &Vector, b: &Vector| gap(a, b).is_finite() && gap(a, b) <= 0.01 * bound;
+        while !settled(&coarse, &fine) && n < 4096 {
             n *= 2;
             coarse = fine;
             fine = span_rk4(&m, &inputs, y, t, t_end, 2 * n);
