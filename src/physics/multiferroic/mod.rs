@@ -40,10 +40,9 @@
 //! under that torque held, in closed form, with the quasi-static onion settled once per segment
 //! (`held_torque.rs`). On fast schedules whose ring barely couples the onion to the rotor, repeated
 //! periods and cycles are taken at once (`onion_periods.rs`, `onion_cycles.rs`) and an onion near
-//! its path advances by exact affine maps per switch, each linearized about the maps' own path at
-//! its switch (`onion_linear.rs`; a locked rotor's, the ring's torque folded into them, by
-//! `onion_linear_locked.rs`; a free rotor's that the ring turns the onion of but barely turns
-//! itself, by `onion_linear_free.rs`). The estimate sizes the next
+//! its path advances by exact affine maps per switch (`onion_linear.rs`; a locked rotor's, the
+//! ring's torque folded into them, by `onion_linear_locked.rs`; a free rotor's that the ring turns
+//! the onion of but barely turns itself, by `onion_linear_free.rs`). The estimate sizes the next
 //! substep. A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot move
