@@ -216,9 +216,9 @@ impl Motor {
     /// Advances the rest of the step's switches, or some of them, at once where eq. 3.3's
     /// ring-bar torque is negligible ([`Self::ring_decoupled`], as for
     /// [`Self::skip_onion_periods`]), the rotor is locked ([`Self::linear_ring_term`]) or the
-    /// ring barely turns the free rotor ([`Self::free_ring_term`]), and the
-    /// Gilbert onion stays close enough to where a macro span
-    /// of switches begins for eq. 3.4 to be linear there. `true` if a span was taken.
+    /// ring barely turns the free rotor ([`Self::free_ring_term`]), and the Gilbert onion stays
+    /// close enough to where each switch of a macro span begins for eq. 3.4 to be linear over
+    /// that switch. `true` if a span was taken.
     ///
     /// A locked rotor stays; a free one follows load and drag alone ([`Self::drift_response`]),
     /// exactly where the ring is dropped, within [`Self::free_ring_term`]'s bound where the onion
@@ -227,22 +227,29 @@ impl Motor {
     /// ([`Self::snaps_forgotten`]): an onion the strain turns fast about is advanced here. The
     /// onion obeys the macrospin's rates ([`Self::onion_rate`]) with the energy's gradient `E sin
     /// 2(psi - gamma_k)` in the strain direction `gamma_k` of switch interval `k` (eq. 3.4) plus
-    /// the ring's torque (eq. 3.3). About the span's start `psi0`, with `delta = psi - psi0`, the
-    /// gradient is `G_k + d_k delta + R`, `G_k = E sin 2(psi0 - gamma_k) + tau_0`, `d_k = 2 E cos
-    /// 2(psi0 - gamma_k) + k_0` (`tau_0, k_0` the ring's linear term, zero where it is dropped,
-    /// [`Self::linear_ring_term`]): each interval is an exact affine map of `(delta, theta)` (see
-    /// [`flow`]), chained over the span. The dropped term is bounded by `|R| <= (2 |E| + rho)
-    /// delta^2 + tau_r` (Taylor's remainder: `|d^2/dx^2 sin 2x| <= 4`; `rho delta^2 + tau_r` the
-    /// ring term's remainder; under a free rotor the bar's turn `p` makes it `rho (|delta| +
-    /// |p|)^2 + |k_0| |p|`, [`Self::free_ring_term`]), and enters the rates as `g (-a R, R)`. All
-    /// bounds on vectors are entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the
+    /// the ring's torque (eq. 3.3). Each interval is linearized afresh about the chained maps'
+    /// path at its start, `psi_k` (an exponential Rosenbrock-Euler step a switch long): with
+    /// `delta = psi - psi_k` the gradient is `G_k + d_k delta + R`, `G_k = E sin 2(psi_k -
+    /// gamma_k) + tau_k`, `d_k = 2 E cos 2(psi_k - gamma_k) + k_k` (`tau_k, k_k` the ring's
+    /// linear term, zero where it is dropped, [`Self::linear_ring_term`]: under a held bar its
+    /// torque and slope at `psi_k`, under a drifting one its value and slope at the span's start
+    /// carried to `psi_k` along that slope): each interval is an exact affine map of `(delta,
+    /// theta)` (see [`flow`]), chained over the span. The dropped term is bounded by `|R| <= 2 |E|
+    /// delta^2 + rho (|delta| + l_k + |p|)^2 + |k_0| |p| + tau_r` (Taylor's remainder: `|d^2/dx^2
+    /// sin 2x| <= 4`; the rest the ring term's, `l_k = |psi_k - psi_0|` where its slope stays the
+    /// span's start's, `p` the bar's turn since then under a free rotor,
+    /// [`Self::free_ring_term`]), and enters the rates as `g (-a R, R)`. The error obeys the
+    /// same maps plus `R` along the path, so linearizing about the path, not the span's start,
+    /// leaves only each interval's own turn in eq. 3.4's `delta`. All bounds on
+    /// vectors are entry by entry (`|x|` the vector of the entries' magnitudes), with `K_k` the
     /// entrywise bound on the interval's propagator `|exp(A s)|` ([`flow`]). Over interval `k` of
     /// length `h_k` the remainder's effect is at most `c_k = K_k (h_k g a, h_k g) R_k` (variation
     /// of constants), `R_k` a bound on `|R|` there from `r_k`, a bound on `|delta|`: the linear
-    /// path's reach (`max(|delta_k|, |delta_k+1|) + h_k (K_k |A w_k + b|)_0 / 2`, or `(K_k (|w_k| +
-    /// h_k |b|))_0`) widened by the forward bound of the error so far (`eps_k+1 = |exp(A h_k)|
-    /// eps_k + c_k`, `K_k eps_k + c_k` within the interval). The bound at the span's end is the
-    /// larger entry of `sum_k |P_k| c_k`, `P_k` the exact product of the later intervals' maps.
+    /// path's reach within the interval (`|delta_k+1| + h_k (K_k |A u_k + b|)_0 / 2`, or `(K_k
+    /// (|u_k| + h_k |b|))_0`, `u_k = (0, theta_k)`) widened by the forward bound of the error so
+    /// far (`eps_k+1 = |exp(A h_k)| eps_k + c_k`, `K_k eps_k + c_k` within the interval). The
+    /// bound at the span's end is the larger entry of `sum_k |P_k| c_k`, `P_k` the exact product
+    /// of the later intervals' maps.
     /// Entry by entry, not in a norm: the tilt's stiffness `T` far exceeds the angle's `|d_k|`, so
     /// a switch's map carries the tilt into the angle many times over (a max norm of 5 to 32 on
     /// fast schedules) where its products over many switches stay near 1, and a norm's bound grows
@@ -370,8 +377,8 @@ impl Motor {
                 result: None,
             };
         };
-        let quadratic = 2.0 * e.abs() + ring.curvature;
         let psi0 = run.y[2];
+        // `w`: the onion's turn since the span's start and its tilt, on the chained maps.
         let mut w = [0.0, run.y[3]];
         let mut time = run.t;
         let mut eps = [0.0, 0.0];
@@ -381,45 +388,55 @@ impl Motor {
             let next = s.next_switch_after(time).min(run.t_end);
             let h = next - time;
             let gamma = self.drive_at(inputs, time).direction;
-            let (s2, c2) = turned_back(2.0 * (psi0 - gamma)).sin_cos();
-            let (grad, d) = (e * s2 + ring.value, 2.0 * e * c2 + ring.stiffness);
+            // Linearized about the maps' path at the switch, `centre`; the ring's torque there
+            // too under a held bar, else about the span's start with the onion's turn since then
+            // (`lead`) in its remainder.
+            let centre = psi0 + w[0];
+            let (value, stiffness, lead) = if ring.relinearized {
+                let (value, stiffness) = self.ring_bar.torque_stiffness(centre - run.y[0]);
+                (value, stiffness, 0.0)
+            } else {
+                (
+                    ring.value + ring.stiffness * w[0],
+                    ring.stiffness,
+                    w[0].abs(),
+                )
+            };
+            let (s2, c2) = turned_back(2.0 * (centre - gamma)).sin_cos();
+            let (grad, d) = (e * s2 + value, 2.0 * e * c2 + stiffness);
             let am: M2 = [[-g * a * d, -g * t], [g * d, -g * a * t]];
             let b = [-g * a * grad, g * grad];
             switches += 1;
             #[cfg(test)]
             CHAINED.with(|c| c.set(c.get() + 1));
-            let Some(f) = flow(&am, h) else {
+            let (Some(f), true) = (flow(&am, h), grad.is_finite() && d.is_finite()) else {
                 return Tried {
                     switches,
                     result: None,
                 };
             };
+            // The onion's turn within the switch and its tilt.
+            let u = [0.0, w[1]];
+            let eu = apply(&f.e, u);
             let jb = apply(&f.j, b);
-            let ew = apply(&f.e, w);
-            let w_next = [ew[0] + jb[0], ew[1] + jb[1]];
-            let aw = apply(&am, w);
-            let slope = apply(&f.k, [(aw[0] + b[0]).abs(), (aw[1] + b[1]).abs()])[0];
+            let u_next = [eu[0] + jb[0], eu[1] + jb[1]];
+            let au = apply(&am, u);
+            let slope = apply(&f.k, [(au[0] + b[0]).abs(), (au[1] + b[1]).abs()])[0];
             let spread = apply(
                 &f.k,
-                [w[0].abs() + h * b[0].abs(), w[1].abs() + h * b[1].abs()],
+                [u[0].abs() + h * b[0].abs(), u[1].abs() + h * b[1].abs()],
             )[0];
-            let reach = (w[0].abs().max(w_next[0].abs()) + 0.5 * h * slope).min(spread);
+            let reach = (u_next[0].abs() + 0.5 * h * slope).min(spread);
             // The dropped term's effect over the interval per unit of `|R|`: the rates
             // `g (-a R, R)` through `|exp(A s)|`.
             let unit = apply(&f.k, [h * g * a, h * g]);
             // The bar's turn since the span's start, at most, on a free rotor
             // ([`Motor::free_ring_term`]).
             let p = ring.drift_speed * (next - run.t);
+            let quadratic = 2.0 * e.abs();
             let remainder = |r: f64| {
-                if p == 0.0 {
-                    quadratic * r * r + ring.constant
-                } else {
-                    let q = r + p;
-                    2.0 * e.abs() * r * r
-                        + ring.curvature * q * q
-                        + ring.stiffness.abs() * p
-                        + ring.constant
-                }
+                let q = r + lead + p;
+                quadratic * r * r + ring.curvature * q * q + stiffness.abs() * p + ring.constant
             };
             // A bound `rb` on `|R|` that holds given itself (`remainder(reach + (K eps)_0 +
             // unit_0 rb) < rb`) holds: the true path cannot first leave the reach it implies.
@@ -441,7 +458,7 @@ impl Motor {
                 };
             }
             maps.push((f.e, c));
-            w = w_next;
+            w = [w[0] + u_next[0], u_next[1]];
             time = next;
         }
         // Carried to the end by the exact products of the later maps.

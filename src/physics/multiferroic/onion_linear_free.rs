@@ -39,6 +39,7 @@ impl Motor {
             drift_speed: run.y[1]
                 .abs()
                 .max((inputs.load_torque.abs() + tau_max) / self.drag),
+            relinearized: false,
         };
         [value, stiffness, term.curvature, term.drift_speed]
             .iter()

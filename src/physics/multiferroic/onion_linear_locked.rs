@@ -24,6 +24,10 @@ pub(super) struct RingTerm {
     /// the remainder and `|p|` to its `delta` (zero where the rotor stays or the ring is dropped
     /// whole).
     pub drift_speed: f64,
+    /// Whether the torque's value and slope are taken afresh at each switch, at the onion's place
+    /// on the maps' path there (the bar held); else they stay those at the span's start, the
+    /// onion's turn since then joining the remainder's `delta`.
+    pub relinearized: bool,
 }
 
 impl Motor {
@@ -34,9 +38,9 @@ impl Motor {
     /// dropped whole: nothing linear, the constant its bound `tau_max` ([`torque_bound`]). Where it
     /// is not but the rotor is locked, the bar's angle `phi` stays, so the torque is a fixed
     /// function of the onion angle alone, `tau(psi - phi)` (eq. 3.3): its value and slope (the
-    /// ring-bar stiffness) at the span's start join the affine maps, and Taylor's remainder,
-    /// `|tau''| / 2 delta^2`, joins the bound with `|tau''|` at most
-    /// [`stiffness_slope_bound`]. A free rotor the ring couples to the onion but not to the
+    /// ring-bar stiffness) at each switch's start on the maps' path join that switch's affine
+    /// map, and Taylor's remainder, `|tau''| / 2 delta^2`, joins the bound with `|tau''|` at
+    /// most [`stiffness_slope_bound`]. A free rotor the ring couples to the onion but not to the
     /// rotor itself, see [`Self::free_ring_term`].
     pub(super) fn linear_ring_term(&self, run: &StepRun, inputs: &MotorInputs) -> Option<RingTerm> {
         match run.onion_decoupled {
@@ -46,6 +50,7 @@ impl Motor {
                 curvature: 0.0,
                 constant: torque_bound(&self.ring_bar),
                 drift_speed: 0.0,
+                relinearized: false,
             }),
             Some(false) if inputs.rotor_locked => {
                 let (value, stiffness) = self.ring_bar.torque_stiffness(run.y[2] - run.y[0]);
@@ -55,6 +60,7 @@ impl Motor {
                     curvature: 0.5 * stiffness_slope_bound(&self.ring_bar),
                     constant: 0.0,
                     drift_speed: 0.0,
+                    relinearized: true,
                 };
                 (value.is_finite() && stiffness.is_finite() && term.curvature.is_finite())
                     .then_some(term)

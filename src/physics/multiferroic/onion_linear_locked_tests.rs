@@ -2,7 +2,7 @@
 //! linear macro spans ([`Motor::linear_ring_term`]), against RK4s of the macrospin.
 
 use super::locked_accuracy_tests::converged_rk4;
-use super::onion_linear::{SPANS, SPAN_LOG};
+use super::onion_linear::{MIN_SPAN, SPANS, SPAN_LOG};
 use super::onion_linear_locked::stiffness_slope_bound;
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
@@ -44,12 +44,28 @@ fn span_rk4(
     y
 }
 
+/// A benchmark draw (full precision): the rotor locked, a 3.9 ns schedule turning the strain by
+/// -5.4 rad a switch, damping 0.018, tolerance 2.0e-7: its onion turns through each switch far
+/// enough that eq. 3.4 linearized about a span's start ended each span within a few switches.
+const TURNING: &str = "strain_direction=-5.329894581414116e6 stress=2.688543931309062e9 \
+    load_torque=-3.896633403871854e-8 ring_outer_diameter=2.717014633722794e-2 \
+    ring_inner_diameter=7.408445409138786e-6 bar_length=6.841987101484022e-7 \
+    bar_width=6.387041762325759e-7 thickness=3.0062320544742366e-9 \
+    saturation_magnetization=9.616973530409085e6 magnetostriction=1.839703204150141e-3 \
+    wall_volume=5.2596852518610995e-11 density=5.857846417136614e4 \
+    fluid_viscosity=3.86944949402701e-1 gilbert_damping=1.806939913821002e-2 \
+    tolerance=2.0094487985789285e-7 step_angle=-5.357750812160171e0 \
+    step_period=3.87588338368737e-9 stress_amplitude=3.2471333981035194e1 \
+    schedule_initial_direction=-8.837653633677037e-9 onion_model=1e0 max_substeps=3.72e2 \
+    schedule=1e0 rotor_locked=1e0 initial_onion_offset=4.1034502131026436e1 \
+    strain=8.980118525953432e-2 youngs_modulus=1.8334259835074554e10 strain_drive=0e0";
+
 /// Three 1 us steps of a draw (as the benchmark takes them), each against a converged RK4 from
-/// its start within the tolerance (onion angle and tilt), in at most `max_substeps` and
-/// `max_spans` spans; every span's end within its bound (at most a hundredth of the tolerance)
-/// of an RK4 from the span's start. Returns the largest error in tolerances, the largest span
-/// error over its bound and the most switches a span took.
-fn three_steps(text: &str, max_substeps: u32, max_spans: usize) -> (f64, f64, f64) {
+/// its start (at `per_ns` steps a nanosecond) within the tolerance (onion angle and tilt), in at
+/// most `max_substeps` and `max_spans` spans; every span's end within its bound (at most a
+/// hundredth of the tolerance) of an RK4 from the span's start. Returns the largest error in
+/// tolerances, the largest span error over its bound and the most switches a span took.
+fn three_steps(text: &str, max_substeps: u32, max_spans: usize, per_ns: f64) -> (f64, f64, f64) {
     let (m, mut st, inputs) = case(&values(text)).unwrap();
     assert!(inputs.rotor_locked);
     let s = inputs.schedule.get().unwrap();
@@ -64,7 +80,7 @@ fn three_steps(text: &str, max_substeps: u32, max_spans: usize) -> (f64, f64, f6
         let report = m.step(&mut st, &inputs, 1e-6).unwrap();
         let spans = SPAN_LOG.with(|l| l.borrow().len()) - logged;
         assert!(spans <= max_spans, "{spans} spans");
-        let truth = converged_rk4(&m, &start, &inputs, st.time, 20.0);
+        let truth = converged_rk4(&m, &start, &inputs, st.time, per_ns);
         let errors = [
             (st.onion_angle - truth[2]).abs() / tol,
             (st.onion_tilt - truth[3]).abs() / tol,
@@ -93,7 +109,9 @@ fn three_steps(text: &str, max_substeps: u32, max_spans: usize) -> (f64, f64, f6
             span_rk4(&m, &inputs, y, t, t_end, 2 * n),
         );
         let gap = |a: &Vector, b: &Vector| (a[2] - b[2]).abs().max((a[3] - b[3]).abs());
-        while gap(&coarse, &fine) > 0.01 * bound && n < 512 {
+        // An RK4 too coarse for a stiff tilt diverges: not finite, not converged.
+        let settled = |a: &Vector, b: &Vector| gap(a, b).is_finite() && gap(a, b) <= 0.01 * bound;
+        while !settled(&coarse, &fine) && n < 4096 {
             n *= 2;
             coarse = fine;
             fine = span_rk4(&m, &inputs, y, t, t_end, 2 * n);
@@ -128,7 +146,7 @@ fn three_steps(text: &str, max_substeps: u32, max_spans: usize) -> (f64, f64, f6
 /// switches (76 spans a step).
 #[test]
 fn locked_creeping_onion_spans_against_rk4() {
-    let (_, _, longest) = three_steps(CREEPING, 20, 12);
+    let (_, _, longest) = three_steps(CREEPING, 20, 12, 20.0);
     assert!(longest >= 100.0, "{longest} switches");
 }
 
@@ -139,24 +157,29 @@ fn locked_creeping_onion_spans_against_rk4() {
 /// ended within 6 switches, 189 a step, their bounds at most 7e-6 of the tolerance.
 #[test]
 fn locked_onion_at_a_loose_tolerance_against_rk4() {
-    let (_, _, longest) = three_steps(LOOSE, 20, 12);
+    let (_, _, longest) = three_steps(LOOSE, 20, 12, 20.0);
     assert!(longest >= 200.0, "{longest} switches");
 }
 
-/// [`SHORT_SPANS`] over five 1 us steps, each step's end within a hundredth of the tolerance of
-/// [`converged_rk4`] from the start (2.7e-5 tolerances at the fifth): spans shorter than four
-/// switches are not taken. Taken, about 300 spans a step of two or three switches each, each
-/// within its bound, drifted the onion 0.36 tolerances off by the third step and 1.8 by the
-/// fifth.
+/// [`SHORT_SPANS`] over five 1 us steps against [`converged_rk4`] from the start: no span
+/// shorter than four switches is taken, and each step ends within 0.05 tolerances (the spans of
+/// four switches the fourth and fifth steps take, each within a hundredth of the tolerance, leave
+/// 3.8e-3 and 1.3e-2). Taken, about 300 spans a step of two or three switches each, each within
+/// its bound, drifted the onion 0.36 tolerances off by the third step and 1.8 by the fifth.
 #[test]
 fn short_locked_spans_are_not_taken() {
     let (m, mut st, inputs) = case(&values(SHORT_SPANS)).unwrap();
     let start = st;
     let tol = m.params.tolerance;
-    let spans_before = SPANS.with(|c| c.get());
+    let switch = inputs.schedule.get().unwrap().step_period;
     for _ in 0..5 {
+        SPAN_LOG.with(|l| l.borrow_mut().clear());
         let report = m.step(&mut st, &inputs, 1e-6).unwrap();
         assert!(!report.accuracy_limited, "{report:?}");
+        for (_, t0, t1, _, _) in SPAN_LOG.with(|l| l.borrow_mut().split_off(0)) {
+            let switches = ((t1 - t0) / switch).round() as usize;
+            assert!(switches >= MIN_SPAN || t1 >= st.time, "{switches} switches");
+        }
         let truth = converged_rk4(&m, &start, &inputs, st.time, 50.0);
         let error = (st.onion_angle - truth[2])
             .abs()
@@ -166,9 +189,8 @@ fn short_locked_spans_are_not_taken() {
             report.substeps,
             error / tol
         );
-        assert!(error <= 0.01 * tol, "{error:e} against {tol:e}");
+        assert!(error <= 0.05 * tol, "{error:e} against {tol:e}");
     }
-    assert_eq!(SPANS.with(|c| c.get()), spans_before);
 }
 
 /// [`stiffness_slope_bound`] bounds eq. 3.3's third derivative ([`RingBar::stiffness_slope`])
@@ -194,4 +216,12 @@ fn ring_stiffness_slope_bounded() {
         largest <= bound && largest >= 0.1 * bound,
         "{largest:e} against {bound:e}"
     );
+}
+
+/// [`TURNING`] in at most 40 substeps a step (25 to 28; 136 to 152 where each switch's map was
+/// linearized about its span's start), within the tolerance of the RK4 and its spans within
+/// their bounds.
+#[test]
+fn locked_onion_turning_through_its_spans_against_rk4() {
+    three_steps(TURNING, 40, 40, 200.0);
 }

@@ -158,8 +158,11 @@ fn three_steps(text: &str) -> Vec<u32> {
         assert!(
             (r.outputs.magnetostatic_energy - o.magnetostatic_energy).abs() <= tau * moved * 1.001
         );
+        // Plus the energy's own rounding, where the onion is within a few ulps of the truth.
+        let rounding = 8.0 * f64::EPSILON * o.magnetoelastic_energy.abs();
         assert!(
-            (r.outputs.magnetoelastic_energy - o.magnetoelastic_energy).abs() <= e * err[0] * 1.001
+            (r.outputs.magnetoelastic_energy - o.magnetoelastic_energy).abs()
+                <= e * err[0] * 1.001 + rounding
         );
         for (y, t0, t1, z, bound) in SPAN_LOG.with(|l| l.borrow_mut().split_off(0)) {
             let from = MotorState {
