@@ -1,5 +1,6 @@
-//! A free rotor's decoupled Gilbert onion over whole segments ([`Motor::advance_decoupled_segment`])
-//! against an onion-only RK4 with the rotor on its exact drift.
+//! A free rotor's decoupled Gilbert onion over whole segments
+//! ([`Motor::advance_decoupled_segment`]) against an onion-only RK4 with the rotor on its exact
+//! drift.
 
 use super::decoupled_segment::{LOG, TAKEN};
 use super::onion_linear_tests::{converged, drifted, SWINGING_FAST, SWINGING_SLOW_DECAY};

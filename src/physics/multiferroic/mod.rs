@@ -44,8 +44,8 @@
 //! ring's torque folded into them, by `onion_linear_locked.rs`; a free rotor's that the ring turns
 //! the onion of but barely turns itself, by `onion_linear_free.rs`); a free rotor's onion that the
 //! ring neither moves nor is moved by takes each whole period of such a schedule in one substep of
-//! its own 2x2 system, the rotor on its exact drift (`decoupled_segment.rs`). The estimate sizes the next
-//! substep. A budget of attempted substeps per call bounds the cost of a long step (see
+//! its own 2x2 system, the rotor on its exact drift (`decoupled_segment.rs`). The estimate sizes
+//! the next substep. A budget of attempted substeps per call bounds the cost of a long step (see
 //! [`MotorParams::max_substeps`]); where it runs out, forced substeps that the damped onion could
 //! not follow are not taken (`forced_crossing.rs`), a free rotor's onion that the ring cannot move
 //! is dropped into the well its ringing is trapped in (`decoupled_drop.rs`; at once where its
