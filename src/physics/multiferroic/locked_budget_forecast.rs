@@ -80,7 +80,8 @@ impl Motor {
     ///   minimum from wherever it then is.
     /// - **Left to that drop**: the linearization loses more than [`MIN_LOSS_PER_ORBIT`] of its
     ///   energy an orbit (the averaged advance and the averaged decay time refuse at every
-    ///   energy), the linear ringing's wait outlasts the horizon, the relaxed onion's check does
+    ///   energy), or both provably refuse the onion at every instant of the horizon
+    ///   ([`Motor::averaging_refused_over`]), the linear ringing's wait outlasts the horizon, the relaxed onion's check does
     ///   not end the ringing now, and the substeps forced after the fine half are at least
     ///   [`FORCED_RATIO`] times the one the error control proposes.
     pub(super) fn locked_budget_forecast_drops(&self, run: &mut StepRun, d: &Drive) -> bool {
@@ -146,22 +147,9 @@ impl Motor {
         let (settled, k) = self.settled_curvature(&run.settle_memo, &run.y, d);
         let t = self.tilt_stiffness;
         let trace = self.llg_rate * self.params.gilbert_damping * (k + t);
-        // The linearization's loss per orbit, `trace` times its period: beyond twice the
-        // averaging's small parameter neither the averaged advance nor the averaged decay time
-        // is tried, whatever the onion's energy.
-        let loss = 2.0 * PI * trace / (self.llg_rate * (k * t).sqrt());
         // (False for a NaN.)
-        if !(trace * horizon <= 1.0 && loss > MIN_LOSS_PER_ORBIT) {
-            return false;
-        }
-        // Nor does the linear ringing's propagator take the onion within the horizon: its wait,
-        // at the fastest decay the ringing can have, outlasts it.
-        match self.linear_ringing_end(&run.y, d, run.t_end - run.t) {
-            Err(wait) if wait >= horizon => {}
-            _ => return false,
-        }
-        // Not where the relaxed onion's check would end the ringing now, unflagged.
-        if self.locked_ringing_ends(&run.y, d, settled.onion, run.t_end - run.t) {
+        let persists = trace * horizon <= 1.0;
+        if !persists {
             return false;
         }
         let y = &run.y;
@@ -170,9 +158,32 @@ impl Motor {
             return false;
         };
         let energy = point(&land, y[2]).0 - well.floor + 0.5 * t * y[3] * y[3];
-        well.below < y[2]
+        let trapped = well.below < y[2]
             && y[2] < well.above
             && (well.minimum - settled.onion).abs() <= 1e-9 * (1.0 + settled.onion.abs())
-            && energy <= RIM_MARGIN * well.barrier
+            && energy <= RIM_MARGIN * well.barrier;
+        if !trapped {
+            return false;
+        }
+        // The linearization's loss per orbit, `trace` times its period: beyond twice the
+        // averaging's small parameter neither the averaged advance nor the averaged decay time
+        // is tried, whatever the onion's energy. Below it, both must refuse the onion
+        // throughout the horizon.
+        let loss = 2.0 * PI * trace / (self.llg_rate * (k * t).sqrt());
+        let remaining = run.t_end - run.t;
+        // (False for a NaN.)
+        if !(loss > MIN_LOSS_PER_ORBIT
+            || self.averaging_refused_over(&land, &well, k, energy, remaining, horizon))
+        {
+            return false;
+        }
+        // Nor does the linear ringing's propagator take the onion within the horizon: its wait,
+        // at the fastest decay the ringing can have, outlasts it.
+        match self.linear_ringing_end(&run.y, d, remaining) {
+            Err(wait) if wait >= horizon => {}
+            _ => return false,
+        }
+        // Not where the relaxed onion's check would end the ringing now, unflagged.
+        !self.locked_ringing_ends(&run.y, d, settled.onion, remaining)
     }
 }
