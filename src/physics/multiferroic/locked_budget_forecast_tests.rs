@@ -165,3 +165,40 @@ fn forecast_drops_ringing_the_averaging_refuses_throughout() {
         );
     }
 }
+
+/// A locked rotor without a schedule, gilbert_damping 8.9e-4, tolerance 2.1e-8, a budget of 988:
+/// the onion, released beside a maximum, rings down into the well of its minimum at 1.068 rad
+/// (a plain RK4 keeps it there), too slowly for the averaged paths and the budget.
+const SMALL_BUDGET: &str = "strain_direction=1.140440041606553e6 stress=6.073526936874994e8 \
+     load_torque=7.237854396073946e-7 ring_outer_diameter=1.5126138451699198e-2 \
+     ring_inner_diameter=1.5301020530239888e-3 bar_length=1.858786760452875e-5 \
+     bar_width=5.516579865728073e-9 thickness=2.701470326372294e-9 \
+     saturation_magnetization=4.328268722595498e3 magnetostriction=9.244867960322006e-4 \
+     wall_volume=9.790542485544858e-11 density=9.355553270409981e4 \
+     fluid_viscosity=6.838301938949665e4 gilbert_damping=8.875604957613958e-4 \
+     tolerance=2.0863084990919274e-8 step_angle=-2.432845804242345e0 \
+     step_period=4.206054628329679e-8 stress_amplitude=-2.105274321540755e10 \
+     schedule_initial_direction=1.9959782654982476e0 onion_model=1e0 max_substeps=9.88e2 \
+     schedule=0e0 rotor_locked=1e0 initial_onion_offset=-1.3183692763920512e-7 \
+     strain=2.093238324796673e-2 youngs_modulus=2.146425028383979e6 strain_drive=1e0";
+
+/// The forecast drops the ringing into the minimum of the well that a plain RK4's onion rings
+/// about at the step's end (its energy only falls below the well's rim); the budget's drop,
+/// after the forced substeps, put it into the opposite well, 3.1 rad away.
+#[test]
+fn forecast_drops_into_the_well_a_plain_rk4_keeps() {
+    let (m, start, inputs) = case(&values(SMALL_BUDGET)).unwrap();
+    let steps = three_steps(SMALL_BUDGET, true);
+    let (report, end) = steps[0];
+    assert!(report.accuracy_limited);
+    let y = super::resolved_tests::rk4(&m, &start, &inputs, 1e-6, 400.0);
+    let d = m.drive_at(&inputs, 1e-6);
+    let land = m.landscape(y[0], d.direction, d.stress);
+    let minimum = land.settle(y[2]);
+    assert!(
+        (end.onion_angle - minimum).abs() <= 1e-9,
+        "{} against {minimum} (RK4 onion {})",
+        end.onion_angle,
+        y[2]
+    );
+}
