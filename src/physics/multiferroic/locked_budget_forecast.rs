@@ -33,13 +33,15 @@ const RIM_MARGIN: f64 = 0.999;
 const MIN_LOSS_PER_ORBIT: f64 = 0.1;
 
 /// A locked rotor's step spending (see [`Motor::locked_budget_forecast_drops`]): its start (s)
-/// and the budget spent then, the time and budget spent at the last forecast tried, and the
-/// budget spent at which it is tried next.
+/// and the budget spent then, the time and budget spent at the last forecast tried, the
+/// budget spent at which it is tried next, and the budget spent below which the averaged paths'
+/// refusal over the horizon is not tried again (see [`Motor::averaging_refused_over`]).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct LockedSpending {
     start: (f64, u32),
     last: (f64, u32),
     next_check: u32,
+    refusal_retry: u32,
 }
 
 impl LockedSpending {
@@ -47,6 +49,7 @@ impl LockedSpending {
         start: (f64::NAN, 0),
         last: (f64::NAN, 0),
         next_check: 0,
+        refusal_retry: 0,
     };
 }
 
@@ -80,7 +83,8 @@ impl Motor {
     ///   minimum from wherever it then is.
     /// - **Left to that drop**: the linearization loses more than [`MIN_LOSS_PER_ORBIT`] of its
     ///   energy an orbit (the averaged advance and the averaged decay time refuse at every
-    ///   energy), the linear ringing's wait outlasts the horizon, the relaxed onion's check does
+    ///   energy), or both provably refuse the onion at every instant of the horizon
+    ///   ([`Motor::averaging_refused_over`]), the linear ringing's wait outlasts the horizon, the relaxed onion's check does
     ///   not end the ringing now, and the substeps forced after the fine half are at least
     ///   [`FORCED_RATIO`] times the one the error control proposes.
     pub(super) fn locked_budget_forecast_drops(&self, run: &mut StepRun, d: &Drive) -> bool {
@@ -105,6 +109,7 @@ impl Motor {
                 start: (run.t, spent),
                 last: (run.t, spent),
                 next_check: spent.saturating_add(budget / FIRST_FORECAST_SHARE),
+                refusal_retry: 0,
             };
             return false;
         }
@@ -146,33 +151,54 @@ impl Motor {
         let (settled, k) = self.settled_curvature(&run.settle_memo, &run.y, d);
         let t = self.tilt_stiffness;
         let trace = self.llg_rate * self.params.gilbert_damping * (k + t);
-        // The linearization's loss per orbit, `trace` times its period: beyond twice the
-        // averaging's small parameter neither the averaged advance nor the averaged decay time
-        // is tried, whatever the onion's energy.
-        let loss = 2.0 * PI * trace / (self.llg_rate * (k * t).sqrt());
         // (False for a NaN.)
-        if !(trace * horizon <= 1.0 && loss > MIN_LOSS_PER_ORBIT) {
+        let persists = trace * horizon <= 1.0;
+        if !persists {
             return false;
         }
-        // Nor does the linear ringing's propagator take the onion within the horizon: its wait,
-        // at the fastest decay the ringing can have, outlasts it.
-        match self.linear_ringing_end(&run.y, d, run.t_end - run.t) {
-            Err(wait) if wait >= horizon => {}
-            _ => return false,
-        }
-        // Not where the relaxed onion's check would end the ringing now, unflagged.
-        if self.locked_ringing_ends(&run.y, d, settled.onion, run.t_end - run.t) {
+        // The linearization's loss per orbit, `trace` times its period: beyond twice the
+        // averaging's small parameter neither the averaged advance nor the averaged decay time
+        // is tried, whatever the onion's energy. Below it, both must refuse the onion
+        // throughout the horizon: that check, with its search for the well's rims, is tried
+        // again only once the step's spending has doubled since it failed.
+        let loss = 2.0 * PI * trace / (self.llg_rate * (k * t).sqrt());
+        let lossy = loss > MIN_LOSS_PER_ORBIT;
+        if !lossy && spent < run.locked_spending.refusal_retry {
             return false;
         }
         let y = &run.y;
         let land = self.landscape(y[0], d.direction, d.stress);
-        let Some(well) = self.well_of_minimum(&land, settled.onion) else {
-            return false;
+        let remaining = run.t_end - run.t;
+        let well = self.well_of_minimum(&land, settled.onion);
+        let trapped = well.as_ref().and_then(|well| {
+            let energy = point(&land, y[2]).0 - well.floor + 0.5 * t * y[3] * y[3];
+            (well.below < y[2]
+                && y[2] < well.above
+                && (well.minimum - settled.onion).abs() <= 1e-9 * (1.0 + settled.onion.abs())
+                && energy <= RIM_MARGIN * well.barrier)
+                .then_some(energy)
+        });
+        let refused = |well: &super::orbit::Well, energy: f64| {
+            lossy || self.averaging_refused_over(&land, well, k, energy, remaining, horizon)
         };
-        let energy = point(&land, y[2]).0 - well.floor + 0.5 * t * y[3] * y[3];
-        well.below < y[2]
-            && y[2] < well.above
-            && (well.minimum - settled.onion).abs() <= 1e-9 * (1.0 + settled.onion.abs())
-            && energy <= RIM_MARGIN * well.barrier
+        // (False for a NaN.)
+        let left = match (well, trapped) {
+            (Some(well), Some(energy)) => refused(&well, energy),
+            _ => false,
+        };
+        if !left {
+            if !lossy {
+                run.locked_spending.refusal_retry = spent.saturating_mul(2);
+            }
+            return false;
+        }
+        // Nor does the linear ringing's propagator take the onion within the horizon: its wait,
+        // at the fastest decay the ringing can have, outlasts it.
+        match self.linear_ringing_end(&run.y, d, remaining) {
+            Err(wait) if wait >= horizon => {}
+            _ => return false,
+        }
+        // Not where the relaxed onion's check would end the ringing now, unflagged.
+        !self.locked_ringing_ends(&run.y, d, settled.onion, remaining)
     }
 }

@@ -51,7 +51,8 @@
 //! is dropped into the well its ringing is trapped in (`decoupled_drop.rs`; at once where its
 //! persisting ringing is forecast to spend the budget's fine half within its segment,
 //! `budget_forecast.rs`; a locked rotor's onion trapped in its well, in a step without switches,
-//! likewise where its ringing, too lossy for the averaged paths, is forecast to spend it,
+//! likewise where its ringing, too lossy for the averaged paths or provably refused by them over
+//! the forecast's horizon (`locked_averaging_refusal.rs`), is forecast to spend it,
 //! `locked_budget_forecast.rs`), and a locked rotor's ringing onion that neither a drop nor forced
 //! substeps can follow through the schedule's switches refuses the step (`locked_switches.rs`), as
 //! does a locked step whose switches outnumber its loop's passes once the linear spans fail or the
@@ -113,6 +114,9 @@ mod linear_ringing;
 mod linear_ringing_tests;
 #[cfg(test)]
 mod locked_accuracy_tests;
+mod locked_averaging_refusal;
+#[cfg(test)]
+mod locked_averaging_refusal_tests;
 mod locked_budget_forecast;
 #[cfg(test)]
 mod locked_budget_forecast_tests;

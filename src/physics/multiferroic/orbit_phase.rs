@@ -39,7 +39,7 @@ const PENDULUM: f64 = 1e-4;
 /// (the envelope's reach; beyond it the error grows faster than `mu^3`).
 const PENDULUM_REACH: f64 = 0.7;
 /// Twice the measured envelope.
-const SAFETY: f64 = 2.0;
+pub(super) const SAFETY: f64 = 2.0;
 /// The relative error of an orbit's period from its energy `E` rounded at the landscape's
 /// scale `|U(psi*)| + rim`: this many units of roundoff of that scale over `E`.
 const ROUNDING: f64 = 16.0 * f64::EPSILON;
