@@ -23,7 +23,8 @@ impl Motor {
     /// switch times the switches it remembers, within `slack`) fails whatever minimum of eq. 3.4
     /// in `land` it settles into: the energy-norm gap is at least the tilt's `|theta| sqrt(T /
     /// K)`, and it decays no faster, and the memory `1 + 1 / (lambda period)` is no shorter,
-    /// than at the rate for `K` (see the module documentation). The bound must exceed twice
+    /// than at the rate for `K` (see the module documentation), at most half the
+    /// linearization's trace there, `g alpha (K + T) / 2`. The bound must exceed twice
     /// `slack`, a margin far beyond rounding on either side. `(to_switch, period)` as for
     /// `ringing_ends_in` (both infinite without a schedule: never refused here).
     pub(super) fn ringing_outlasts_switches(
@@ -62,7 +63,13 @@ impl Motor {
     ) -> bool {
         let t = self.tilt_stiffness;
         let k = curvature_bound(land);
-        let rate = self.onion_decay_rate(k);
+        // On the tilt alone, half the linearization's trace at `K`, which bounds the rate at `K`
+        // too, spares its square root.
+        let rate = if angle > 0.0 {
+            self.onion_decay_rate(k)
+        } else {
+            0.5 * self.llg_rate * self.params.gilbert_damping * (k + t)
+        };
         if !(k > 0.0 && t > 0.0 && rate > 0.0 && k.is_finite() && rate.is_finite()) {
             return false;
         }
