@@ -36,7 +36,23 @@ impl Motor {
         d: &Drive,
         segment_end: f64,
     ) -> bool {
-        let settled = self.settled_minimum(&run.settle_memo, &run.y, d).onion;
+        // In the step's last segment, with a switch in the step, the check ends here unless the
+        // ringing ends: its bound refuses before the settle's march.
+        let last = segment_end >= run.t_end
+            && run
+                .schedule
+                .is_some_and(|s| s.step_index(run.t_end) > s.step_index(run.start));
+        let settled = if last {
+            let state = (&run.y, d);
+            let Some(minimum) =
+                self.settled_unless_ringing_on(&run.settle_memo, state, segment_end - run.t)
+            else {
+                return false;
+            };
+            minimum.onion
+        } else {
+            self.settled_minimum(&run.settle_memo, &run.y, d).onion
+        };
         if self.locked_ringing_ends(&run.y, d, settled, segment_end - run.t) {
             return true;
         }

@@ -70,9 +70,9 @@ impl Motor {
             tol + lag.max(ringing).min(MAX_FOLLOWED_LAG)
         };
         let land = self.landscape(y[0], d.direction, d.stress);
-        // A locked onion must pass the switch test first: its tilt alone may fail it, before
-        // the settle's march.
-        if d.locked && self.ringing_outlasts_switches(&land, y, switches, 0.1 * tol + lag) {
+        // Every onion placed here passes the switch test below: its tilt alone, or its slope
+        // (the settle's first evaluation), may fail it before the settle's march.
+        if self.ringing_outlasts_switches(&land, y, switches, 0.1 * tol + lag) {
             return None;
         }
         let minimum = if !d.locked && rim_barrier.is_none() {
@@ -82,11 +82,17 @@ impl Motor {
             // The same march as `self.settle`, from the angles and slope the bound evaluated
             // (or the pass's, kept in `memo`).
             let start = self.settle_start_within(y, d, slack())?;
+            let slope = (&start.angles, start.gradient, start.curvature);
+            if self.settle_outlasts_switches(&land, y, slope, switches, 0.1 * tol + lag) {
+                return None;
+            }
             memo.get_or(y, d, || {
                 land.settle_from_slope(start.angles, start.gradient, start.curvature)
             })
         } else {
-            self.settled_minimum(memo, y, d)
+            let test = (switches, 0.1 * tol + lag);
+            let ends = (d.locked && rim_barrier.is_none()).then_some(remaining);
+            self.settled_unless_outlasting(&land, memo, (y, d), test, ends)?
         };
         let settled = minimum.onion;
         let relaxed = |kick: f64, curvature: f64| Relaxed {

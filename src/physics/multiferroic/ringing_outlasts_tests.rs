@@ -3,6 +3,7 @@
 
 use super::onion::SETTLES;
 use super::onion_periods_tests::{case, values};
+use super::settle_memo::SettleMemo;
 use super::{Motor, MotorState};
 
 /// A benchmark case: a locked rotor on a 26.9 ns schedule, its onion (damping 2.6e-4, tolerance
@@ -93,6 +94,95 @@ fn tilt_refusal_never_refuses_a_passing_switch_test() {
 #[test]
 fn ringing_locked_check_skips_the_settle() {
     let (m, mut s, inputs) = case(&values(RINGING_LOCKED)).unwrap();
+    SETTLES.with(|c| c.set(0));
+    let report = m.step(&mut s, &inputs, 1e-6);
+    let settles = SETTLES.with(|c| c.get());
+    println!("{report:?}: {settles} settles");
+    assert!(settles < 100, "{settles} settles");
+}
+
+/// Wherever the bounds on the slope refuse, the checks they bound fail at the minimum that the
+/// settle's march returns from the onion and at its curvature there: the switch test, and the
+/// ringing's end within the segment's time left ([`Motor::locked_ringing_ends`]); where they do
+/// not refuse they return that minimum, bit for bit. Onions from 1e-12 to 1 rad either side of
+/// a minimum, tilts from none to 1e-4 rad; and they refuse often, or the check would be empty.
+#[test]
+fn slope_refusal_never_refuses_a_passing_switch_test() {
+    let (mut refused, mut checked, mut passing) = (0, 0, 0);
+    let (mut far, mut ends) = (0, 0);
+    for text in [RINGING_LOCKED, TRAILING_LOCKED] {
+        let (m, _, inputs): (Motor, MotorState, _) = case(&values(text)).unwrap();
+        let mut d = m.drive_at(&inputs, 0.0);
+        let period = inputs.schedule.get().unwrap().step_period;
+        let slack = 0.1 * m.params.tolerance;
+        for i in 0..4 {
+            let rotor = -3.0 + 1.7 * f64::from(i);
+            for j in 0..4 {
+                d.direction = 0.71 * f64::from(j);
+                let land = m.landscape(rotor, d.direction, d.stress);
+                let minimum = land.settle(rotor + 0.3 * f64::from(j));
+                for e in 0..25 {
+                    let side = if e % 2 == 0 { 1.0 } else { -1.0 };
+                    let onion = minimum + side * 10f64.powf(-0.5 * f64::from(e));
+                    let start = land.angles(onion);
+                    let (g0, c0) = land.gradient_curvature_of(&start);
+                    let settled = land.settle_from(start).onion;
+                    let curvature = land.curvature(settled);
+                    for tilt in [0.0, 1e-12, -1e-9, 1e-6, -1e-4] {
+                        let y = [rotor, 0.0, onion, tilt];
+                        for f in 0..5 {
+                            let to_switch = period * 0.25 * f64::from(f);
+                            let switches = (to_switch, period);
+                            checked += 1;
+                            let memory = 1.0 + 1.0 / (m.onion_decay_rate(curvature) * period);
+                            let gap = m.decayed_gap(&y, settled, curvature, to_switch) * memory;
+                            let passes = curvature > 0.0 && gap <= slack;
+                            passing += usize::from(passes);
+                            let slope = (&start, g0, c0);
+                            if m.settle_outlasts_switches(&land, &y, slope, switches, slack) {
+                                refused += 1;
+                                assert!(
+                                    !passes,
+                                    "rotor {rotor} strain {} onion {onion} tilt {tilt} \
+                                     to switch {to_switch}: gap {gap} within {slack}",
+                                    d.direction
+                                );
+                            }
+                            let ringing_ends = m.locked_ringing_ends(&y, &d, settled, to_switch);
+                            ends += usize::from(ringing_ends);
+                            let memo = SettleMemo::default();
+                            match m.settled_unless_ringing_on(&memo, (&y, &d), to_switch) {
+                                None => {
+                                    far += 1;
+                                    assert!(!ringing_ends, "onion {onion} tilt {tilt}");
+                                }
+                                Some(a) => assert_eq!(a.onion.to_bits(), settled.to_bits()),
+                            }
+                            let memo = SettleMemo::default();
+                            let test = (switches, slack);
+                            let left = Some(to_switch);
+                            match m.settled_unless_outlasting(&land, &memo, (&y, &d), test, left) {
+                                None => assert!(!passes || !ringing_ends, "onion {onion}"),
+                                Some(a) => assert_eq!(a.onion.to_bits(), settled.to_bits()),
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    println!("{refused} of {checked} refused, {passing} pass; {far} far, {ends} end");
+    assert!(2 * refused >= checked, "{refused} of {checked}");
+    assert!(2 * far >= checked, "{far} of {checked}");
+    assert!(passing > 0 && ends > 0);
+}
+
+/// The trailing locked onion's first step checks its branch at each pass, and every check
+/// fails on the onion's angle from its moving minimum while its tilt is small: the bound on
+/// the slope takes them before the settle's march.
+#[test]
+fn trailing_locked_check_skips_the_settle() {
+    let (m, mut s, inputs) = case(&values(TRAILING_LOCKED)).unwrap();
     SETTLES.with(|c| c.set(0));
     let report = m.step(&mut s, &inputs, 1e-6);
     let settles = SETTLES.with(|c| c.get());
