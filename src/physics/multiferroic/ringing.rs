@@ -81,7 +81,7 @@ impl Motor {
             }
             // The same march as `self.settle`, from the angles and slope the bound evaluated
             // (or the pass's, kept in `memo`).
-            let start = self.settle_start_within(y, d, slack())?;
+            let start = self.settle_start_within(y, d, slack(), memo)?;
             memo.get_or(y, d, || {
                 land.settle_from_slope(start.angles, start.gradient, start.curvature)
             })

@@ -319,7 +319,9 @@ impl Motor {
                 });
             }
             if !run.is_settled(&d) {
-                run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
+                // The branch checks may have computed these angles afresh already.
+                let hint = run.settle_memo.hint(run.angles, &run.y, &d);
+                run.angles = Some(model.constrain(&mut run.y, &d, hint.as_ref()));
                 run.settled = model.quasi_static();
             }
             run.enter_segment(segment_end, d.direction);
