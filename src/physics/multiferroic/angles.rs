@@ -48,8 +48,18 @@ pub struct Angles {
 impl Angles {
     /// Fresh from libm.
     pub fn exact(onion: f64, bar: f64, strain: f64) -> Self {
+        let double = turned_back(2.0 * (onion - strain)).sin_cos();
+        Self::exact_with_double(onion, bar, strain, double)
+    }
+
+    /// [`Self::exact`] with `turned_back(2 (onion - strain)).sin_cos()` computed already.
+    pub fn exact_with_double(
+        onion: f64,
+        bar: f64,
+        strain: f64,
+        (sin_double, cos_double): (f64, f64),
+    ) -> Self {
         let (sin_offset, cos_offset) = turned_back(onion - bar).sin_cos();
-        let (sin_double, cos_double) = turned_back(2.0 * (onion - strain)).sin_cos();
         Self {
             onion,
             bar,

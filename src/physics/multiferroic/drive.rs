@@ -118,7 +118,9 @@ mod tests {
         };
         let mut state = 0x9e37_79b9_7f4a_7c15_u64;
         let mut next = || {
-            state = state.wrapping_mul(6_364_136_223_846_793_005).wrapping_add(1);
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
             (state >> 11) as f64 / (1u64 << 53) as f64
         };
         for _ in 0..200_000 {
@@ -127,7 +129,11 @@ mod tests {
         for k in 0..=1_000_000u32 {
             let m = f64::from(k) * PI;
             let k2 = 10f64.powf(8.4 * next());
-            for x in [m, k2.round() * PI, -717.9 + f64::from(k) * 4.598_700_042_196_322] {
+            for x in [
+                m,
+                k2.round() * PI,
+                -717.9 + f64::from(k) * 4.598_700_042_196_322,
+            ] {
                 let mut y = x;
                 for _ in 0..3 {
                     check(y);
