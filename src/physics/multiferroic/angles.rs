@@ -76,7 +76,8 @@ impl Angles {
     /// else fresh.
     #[inline]
     pub fn moved(&self, onion: f64, bar: f64, strain: f64) -> Self {
-        let (d_offset, d_double) = self.increments(onion, bar, strain);
+        let d_offset = (onion - bar) - (self.onion - self.bar);
+        let d_double = 2.0 * ((onion - strain) - (self.onion - self.strain));
         if d_offset == 0.0 && d_double == 0.0 {
             return Self {
                 onion,
@@ -85,7 +86,10 @@ impl Angles {
                 ..*self
             };
         }
-        if !self.turns_by(d_offset, d_double) {
+        if !(d_offset.abs() <= MAX_TURN
+            && d_double.abs() <= MAX_TURN
+            && self.rotations < MAX_ROTATIONS)
+        {
             return Self::exact(onion, bar, strain);
         }
         let (s1, c1) = small_sin_cos(d_offset);
@@ -102,26 +106,16 @@ impl Angles {
         }
     }
 
-    /// Whether [`Self::moved`] to this point computes the angles afresh (as [`Self::exact`]).
-    #[inline]
+    /// Whether [`Self::moved`] to this point computes the angles afresh (as [`Self::exact`]):
+    /// its own tests, apart so that `moved` itself stays as the hot substeps inline it.
     pub fn moves_afresh(&self, onion: f64, bar: f64, strain: f64) -> bool {
-        let (d_offset, d_double) = self.increments(onion, bar, strain);
-        let still = d_offset == 0.0 && d_double == 0.0;
-        !(still || self.turns_by(d_offset, d_double))
-    }
-
-    /// How far the offset and the doubled angle move to this point.
-    #[inline(always)]
-    fn increments(&self, onion: f64, bar: f64, strain: f64) -> (f64, f64) {
         let d_offset = (onion - bar) - (self.onion - self.bar);
         let d_double = 2.0 * ((onion - strain) - (self.onion - self.strain));
-        (d_offset, d_double)
-    }
-
-    /// Whether a move by these increments is made by angle addition.
-    #[inline(always)]
-    fn turns_by(&self, d_offset: f64, d_double: f64) -> bool {
-        d_offset.abs() <= MAX_TURN && d_double.abs() <= MAX_TURN && self.rotations < MAX_ROTATIONS
+        let still = d_offset == 0.0 && d_double == 0.0;
+        let turned = d_offset.abs() <= MAX_TURN
+            && d_double.abs() <= MAX_TURN
+            && self.rotations < MAX_ROTATIONS;
+        !(still || turned)
     }
 
     /// The same angles at another onion angle (rotor and strain held).

@@ -79,15 +79,18 @@ impl SettleMemo {
         self.1.get().filter(same)
     }
 
-    /// The angles to turn from to `y` under `d` instead of `hint`: the kept fresh ones where
-    /// turning from `hint` would compute those very angles afresh (the move from them is then
-    /// nil, and gives them bit for bit), else `hint`.
-    pub(super) fn hint(&self, hint: Option<Angles>, y: &Vector, d: &Drive) -> Option<Angles> {
-        let afresh = hint.is_none_or(|h| h.moves_afresh(y[2], y[0], d.direction));
-        match afresh.then(|| self.fresh_at(y, d)).flatten() {
-            Some(a) => Some(a),
-            None => hint,
-        }
+    /// The kept fresh angles at `y` under `d` where turning from `hint` would compute those very
+    /// angles afresh (the move from them is then nil, and gives them bit for bit), else `None`.
+    pub(super) fn fresh_hint(
+        &self,
+        hint: Option<&Angles>,
+        y: &Vector,
+        d: &Drive,
+    ) -> Option<Angles> {
+        // The cheap bit test first: most passes keep nothing for this state.
+        let fresh = self.fresh_at(y, d)?;
+        hint.is_none_or(|h| h.moves_afresh(y[2], y[0], d.direction))
+            .then_some(fresh)
     }
 }
 

@@ -43,7 +43,7 @@ fn branch_checks_of_a_pass_settle_once() {
     assert!(m.heads_for_settled(&y, &d, h, &run.settle_memo).is_none());
 }
 
-/// The angles a constrain turns from ([`super::settle_memo::SettleMemo::hint`]): the kept fresh
+/// The angles a constrain turns from ([`super::settle_memo::SettleMemo::fresh_hint`]): the kept fresh
 /// ones only where turning from its own hint would compute them afresh (no hint, a far move, a
 /// hint turned too often), and then the same angles bit for bit as [`super::Angles::exact`];
 /// a near hint is kept (its turn differs from the fresh angles in the last bits).
@@ -63,7 +63,7 @@ fn constrain_turns_from_kept_fresh_angles_only_where_it_would_compute_them() {
     let y = [0.3, 0.0, 1.7, 0.0];
     let memo = SettleMemo::default();
     // Nothing kept yet: every hint stays.
-    assert_eq!(memo.hint(None, &y, &d), None);
+    assert_eq!(memo.fresh_hint(None, &y, &d), None);
     let fresh = memo.fresh_angles(&y, &d);
     assert_eq!(bits(&fresh), bits(&Angles::exact(y[2], y[0], d.direction)));
     let near = Angles::exact(y[2] - 0.01, y[0], d.direction);
@@ -77,7 +77,8 @@ fn constrain_turns_from_kept_fresh_angles_only_where_it_would_compute_them() {
     assert!(worn.moves_afresh(y[2], y[0], d.direction));
     let mut kept = 0;
     for hint in [None, Some(near), Some(far), Some(worn)] {
-        let chosen = memo.hint(hint, &y, &d);
+        let fresh_hint = memo.fresh_hint(hint.as_ref(), &y, &d);
+        let chosen = fresh_hint.or(hint);
         let plain = match hint {
             Some(h) => h.moved(y[2], y[0], d.direction),
             None => Angles::exact(y[2], y[0], d.direction),
@@ -93,5 +94,5 @@ fn constrain_turns_from_kept_fresh_angles_only_where_it_would_compute_them() {
     assert_ne!(bits(&near.moved(y[2], y[0], d.direction)), bits(&fresh));
     // Another state (one bit off) is not theirs.
     let other = [y[0], 0.0, y[2].next_up(), 0.0];
-    assert_eq!(memo.hint(None, &other, &d), None);
+    assert_eq!(memo.fresh_hint(None, &other, &d), None);
 }

@@ -320,8 +320,9 @@ impl Motor {
             }
             if !run.is_settled(&d) {
                 // The branch checks may have computed these angles afresh already.
-                let hint = run.settle_memo.hint(run.angles, &run.y, &d);
-                run.angles = Some(model.constrain(&mut run.y, &d, hint.as_ref()));
+                let fresh = run.settle_memo.fresh_hint(run.angles.as_ref(), &run.y, &d);
+                let hint = fresh.as_ref().or(run.angles.as_ref());
+                run.angles = Some(model.constrain(&mut run.y, &d, hint));
                 run.settled = model.quasi_static();
             }
             run.enter_segment(segment_end, d.direction);
