@@ -48,9 +48,10 @@ impl Motor {
         y: &Vector,
         d: &Drive,
         gap: f64,
+        memo: &SettleMemo,
     ) -> Option<SettleStart> {
         let land = self.landscape(y[0], d.direction, d.stress);
-        let angles = land.angles(y[2]);
+        let angles = memo.fresh_angles(y, d);
         let (g, c) = land.gradient_curvature_of(&angles);
         let start = SettleStart {
             angles,

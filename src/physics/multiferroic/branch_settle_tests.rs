@@ -109,7 +109,9 @@ fn settle_bound_never_misses_a_minimum_within_the_gap() {
                     for e in 0..13 {
                         let gap = 10f64.powi(-e);
                         checked += 1;
-                        if m.settle_start_within(&y, &d, gap).is_none() {
+                        if m.settle_start_within(&y, &d, gap, &Default::default())
+                            .is_none()
+                        {
                             farther += 1;
                             assert!(
                                 (settled - onion).abs() > gap,

@@ -2,7 +2,7 @@
 //! segment of constant drive at once: the onion's own 2x2 system by an exponential RK4, the rotor
 //! on its exact drift (see [`Motor::advance_decoupled_segment`]).
 
-use super::angles::turned_back;
+use super::angles::{turned_back, Angles};
 use super::etd_blocks::BlockPhi;
 use super::gilbert::fifth_order_error;
 use super::integrator::step_factor;
@@ -87,7 +87,9 @@ impl Motor {
         {
             return false;
         }
-        let Some((onion, err)) = self.decoupled_onion_step(run.y[2], run.y[3], h, d) else {
+        // The start's angles (below) share this sine and cosine.
+        let double = turned_back(2.0 * (run.y[2] - d.direction)).sin_cos();
+        let Some((onion, err)) = self.decoupled_onion_step(run.y[2], run.y[3], h, d, double) else {
             run.decoupled_tries = DecoupledTries {
                 declined_at: Some(segment_end),
                 declines: tries.declines + 1,
@@ -107,7 +109,12 @@ impl Motor {
             };
             return false;
         }
-        let angles = Self::angles_at(&start, d, run.angles.as_ref());
+        // `Self::angles_at`, with the doubled angle's sine and cosine where afresh.
+        let (psi, phi) = (start[2], start[0]);
+        let angles = match run.angles {
+            Some(a) if !a.moves_afresh(psi, phi, d.direction) => a.moved(psi, phi, d.direction),
+            _ => Angles::exact_with_double(psi, phi, d.direction, double),
+        };
         self.record_amplification(&mut run.amplification, h, d, &angles, err);
         run.decoupled_tries = DecoupledTries::default();
         // Tried before the segment is entered: its end is then a switch the next pass sees.
@@ -147,13 +154,14 @@ impl Motor {
     /// The onion's angle and tilt after `h` from `(psi, theta)` under eq. 3.4 alone (see
     /// [`Self::advance_decoupled_segment`]) and the error estimate in tolerances (as
     /// [`fifth_order_error`] gives it); `None` where the `phi` functions are not available or the
-    /// result is not finite.
+    /// result is not finite. `double` is `turned_back(2 (psi - gamma)).sin_cos()`.
     pub(super) fn decoupled_onion_step(
         &self,
         psi: f64,
         theta: f64,
         h: f64,
         d: &Drive,
+        double: (f64, f64),
     ) -> Option<([f64; 2], f64)> {
         let (g, a, t) = (
             self.llg_rate,
@@ -163,7 +171,7 @@ impl Motor {
         let e = self.magnetoelastic_per_stress * d.stress;
         // `sin 2(psi - gamma)` by the angle's turn from the start, `2 (psi - psi0)`, which stays
         // small and exact where `psi` and `gamma` are many turns.
-        let (s0, c0) = turned_back(2.0 * (psi - d.direction)).sin_cos();
+        let (s0, c0) = double;
         let rate = |z: [f64; 2]| {
             let (s, c) = (2.0 * (z[0] - psi)).sin_cos();
             self.onion_rate(e * (s0 * c + c0 * s), z[1])

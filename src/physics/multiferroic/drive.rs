@@ -49,10 +49,42 @@ pub(super) const REDUCED_DIRECTION_ABOVE: f64 = 1e3;
 /// The strain direction the physics uses for an applied one (see [`REDUCED_DIRECTION_ABOVE`]).
 pub(super) fn reduced_direction(applied: f64) -> f64 {
     if applied.abs() > REDUCED_DIRECTION_ABOVE {
-        applied.rem_euclid(PI)
+        // `applied.rem_euclid(PI)`, with its `%` by `rem_pi`.
+        let r = rem_pi(applied);
+        if r < 0.0 {
+            r + PI
+        } else {
+            r
+        }
     } else {
         applied
     }
+}
+
+/// `PI` with its low 27 significand bits cleared, and the rest: `q PI_HIGH` and `q PI_LOW` are
+/// exact for an integer `q < 2^26`.
+const PI_HIGH: f64 = f64::from_bits(PI.to_bits() & !((1 << 27) - 1));
+const PI_LOW: f64 = PI - PI_HIGH;
+/// Below this `|x|` the quotient `x / PI` is below 2^26 (and `x` below 2^28).
+const REM_PI_FAST_BELOW: f64 = 2e8;
+
+/// `x % PI`, bit for bit (the remainder is exact, so there is one right answer), without the
+/// software `fmod`'s bit-by-bit loop, a schedule's switch's largest single cost: with `q` the
+/// truncated quotient, `|x| - q PI_HIGH` is exact (both are multiples of `ulp(x)` below 2^28, with
+/// the difference no larger), and subtracting `q PI_LOW` rounds the exact remainder, which is
+/// representable, to itself. A quotient rounded up by one gives a negative difference, detected,
+/// and then (as beyond 2^28, or for NaN) `%` itself is taken.
+fn rem_pi(x: f64) -> f64 {
+    let ax = x.abs();
+    if ax < REM_PI_FAST_BELOW {
+        let q = (ax / PI) as i64 as f64;
+        let r = (ax - q * PI_HIGH) - q * PI_LOW;
+        if (0.0..PI).contains(&r) {
+            // `%` takes the sign of `x`, zero included.
+            return r.copysign(x);
+        }
+    }
+    x % PI
 }
 
 /// Strain, stress and load held over one substep.
@@ -71,6 +103,54 @@ pub(super) struct Drive {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// `rem_pi` against libm's `fmod` (Rust's `%`), bit for bit: random magnitudes across the
+    /// fast range and beyond, both signs, and the arguments next to multiples of pi (where the
+    /// rounded quotient is one too large), including the schedules' `initial + k step_angle`.
+    #[test]
+    fn rem_pi_is_fmod_bit_for_bit() {
+        let mut checked = 0u32;
+        let mut check = |x: f64| {
+            for x in [x, -x] {
+                assert_eq!(rem_pi(x).to_bits(), (x % PI).to_bits(), "{x:e}");
+                checked += 1;
+            }
+        };
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1);
+            (state >> 11) as f64 / (1u64 << 53) as f64
+        };
+        for _ in 0..200_000 {
+            check(10f64.powf(-3.0 + 13.0 * next()));
+        }
+        for k in 0..=1_000_000u32 {
+            let m = f64::from(k) * PI;
+            let k2 = 10f64.powf(8.4 * next());
+            for x in [
+                m,
+                k2.round() * PI,
+                -717.9 + f64::from(k) * 4.598_700_042_196_322,
+            ] {
+                let mut y = x;
+                for _ in 0..3 {
+                    check(y);
+                    y = y.next_up();
+                }
+                y = x;
+                for _ in 0..3 {
+                    y = y.next_down();
+                    check(y);
+                }
+            }
+        }
+        check(0.0);
+        check(REM_PI_FAST_BELOW);
+        assert!(rem_pi(f64::NAN).is_nan() && rem_pi(f64::INFINITY).is_nan());
+        assert!(checked > 10_000_000);
+    }
 
     #[test]
     fn two_hundred_micro_strain_in_nickel_is_forty_megapascal() {

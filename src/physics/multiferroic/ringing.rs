@@ -81,7 +81,7 @@ impl Motor {
             }
             // The same march as `self.settle`, from the angles and slope the bound evaluated
             // (or the pass's, kept in `memo`).
-            let start = self.settle_start_within(y, d, slack())?;
+            let start = self.settle_start_within(y, d, slack(), memo)?;
             let slope = (&start.angles, start.gradient, start.curvature);
             if self.settle_outlasts_switches(&land, y, slope, switches, 0.1 * tol + lag) {
                 return None;

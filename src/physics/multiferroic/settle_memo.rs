@@ -6,9 +6,10 @@ use super::angles::Angles;
 use super::{Drive, Motor, Vector};
 use std::cell::Cell;
 
-/// The last settled minimum ([`Kept`]).
+/// The last settled minimum ([`Kept`]), and the last angles computed afresh where a settle
+/// started ([`SettleMemo::fresh_angles`]).
 #[derive(Debug, Default)]
-pub(super) struct SettleMemo(Cell<Option<Kept>>);
+pub(super) struct SettleMemo(Cell<Option<Kept>>, Cell<Option<Angles>>);
 
 /// A settled minimum with the state and drive it was marched for (rotor and onion angle, strain
 /// direction and stress, bit for bit: the landscape and the march's start are theirs), and eq.
@@ -55,6 +56,44 @@ impl SettleMemo {
     }
 }
 
+impl SettleMemo {
+    /// [`Angles::exact`] at the onion at `y` under `d`, kept: right after a switch the
+    /// [`Motor::constrain`] that follows the branch checks computes the same fresh angles
+    /// ([`Self::hint`]).
+    pub(super) fn fresh_angles(&self, y: &Vector, d: &Drive) -> Angles {
+        if let Some(a) = self.fresh_at(y, d) {
+            return a;
+        }
+        let a = Angles::exact(y[2], y[0], d.direction);
+        self.1.set(Some(a));
+        a
+    }
+
+    /// The kept fresh angles if they are those at `y` under `d`, bit for bit.
+    fn fresh_at(&self, y: &Vector, d: &Drive) -> Option<Angles> {
+        let same = |a: &Angles| {
+            a.onion.to_bits() == y[2].to_bits()
+                && a.bar.to_bits() == y[0].to_bits()
+                && a.strain.to_bits() == d.direction.to_bits()
+        };
+        self.1.get().filter(same)
+    }
+
+    /// The kept fresh angles at `y` under `d` where turning from `hint` would compute those very
+    /// angles afresh (the move from them is then nil, and gives them bit for bit), else `None`.
+    pub(super) fn fresh_hint(
+        &self,
+        hint: Option<&Angles>,
+        y: &Vector,
+        d: &Drive,
+    ) -> Option<Angles> {
+        // The cheap bit test first: most passes keep nothing for this state.
+        let fresh = self.fresh_at(y, d)?;
+        hint.is_none_or(|h| h.moves_afresh(y[2], y[0], d.direction))
+            .then_some(fresh)
+    }
+}
+
 impl Motor {
     /// The angles at the minimum of eq. 3.4 that the onion at `y` settles into under `d`
     /// ([`super::onion::Landscape::settle`] from the angles at the onion), marched once per
@@ -62,7 +101,7 @@ impl Motor {
     pub(super) fn settled_minimum(&self, memo: &SettleMemo, y: &Vector, d: &Drive) -> Angles {
         memo.get_or(y, d, || {
             let land = self.landscape(y[0], d.direction, d.stress);
-            land.settle_from(land.angles(y[2]))
+            land.settle_from(memo.fresh_angles(y, d))
         })
     }
 

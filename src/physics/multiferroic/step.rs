@@ -319,7 +319,10 @@ impl Motor {
                 });
             }
             if !run.is_settled(&d) {
-                run.angles = Some(model.constrain(&mut run.y, &d, run.angles.as_ref()));
+                // The branch checks may have computed these angles afresh already.
+                let fresh = run.settle_memo.fresh_hint(run.angles.as_ref(), &run.y, &d);
+                let hint = fresh.as_ref().or(run.angles.as_ref());
+                run.angles = Some(model.constrain(&mut run.y, &d, hint));
                 run.settled = model.quasi_static();
             }
             run.enter_segment(segment_end, d.direction);
