@@ -48,30 +48,24 @@ pub struct Angles {
 impl Angles {
     /// Fresh from libm.
     pub fn exact(onion: f64, bar: f64, strain: f64) -> Self {
-        let (sin_offset, cos_offset) = turned_back(onion - bar).sin_cos();
-        let (sin_double, cos_double) = turned_back(2.0 * (onion - strain)).sin_cos();
-        Self {
-            onion,
-            bar,
-            strain,
-            sin_offset,
-            cos_offset,
-            sin_double,
-            cos_double,
-            rotations: 0,
-        }
+        let offset = turned_back(onion - bar).sin_cos();
+        let double = turned_back(2.0 * (onion - strain)).sin_cos();
+        Self::fresh(onion, bar, strain, offset, double)
     }
 
-    /// [`Self::exact`] with `turned_back(2 (onion - strain)).sin_cos()` computed already. (`exact`
-    /// keeps its own two calls in their order: the other order was measurably slower on some
-    /// steps at equal instruction counts.)
-    pub fn exact_with_double(
+    /// [`Self::exact`] with `turned_back(2 (onion - strain)).sin_cos()` computed already.
+    pub fn exact_with_double(onion: f64, bar: f64, strain: f64, double: (f64, f64)) -> Self {
+        let offset = turned_back(onion - bar).sin_cos();
+        Self::fresh(onion, bar, strain, offset, double)
+    }
+
+    fn fresh(
         onion: f64,
         bar: f64,
         strain: f64,
+        (sin_offset, cos_offset): (f64, f64),
         (sin_double, cos_double): (f64, f64),
     ) -> Self {
-        let (sin_offset, cos_offset) = turned_back(onion - bar).sin_cos();
         Self {
             onion,
             bar,
