@@ -4,35 +4,91 @@
 
 use super::{Drive, Motor, StepRun};
 
-/// The spending of one segment, from its first pass: its start (s) and the budget spent then,
-/// the time and budget spent at the last forecast tried, and the budget spent at which it is
-/// tried next.
+/// The spending of one segment, from its first pass (see [`Spending`]).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct SegmentSpending {
     segment_end: f64,
-    start: f64,
-    spent: u32,
-    last: (f64, u32),
-    next_check: u32,
+    spending: Spending,
 }
 
 impl SegmentSpending {
     pub(super) const NONE: Self = Self {
         segment_end: f64::NAN,
-        start: f64::NAN,
-        spent: 0,
-        last: (f64::NAN, 0),
-        next_check: 0,
+        spending: Spending::NONE,
     };
 }
 
-/// The forecast holds only where the segment's spending so far, kept up, reaches the budget's
-/// fine half within `1 / FORECAST_MARGIN` of the segment's time left: the rate may fall by a third
-/// over that time (the ringing decaying, its substeps growing) and the half is still reached.
-const FORECAST_MARGIN: f64 = 1.5;
+/// A forecast's record of spending, shared by a free rotor's segments and a locked rotor's
+/// steps: the time (s) and budget spent at its start and at the last forecast tried, and the
+/// budget spent at which it is tried next.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct Spending {
+    start: (f64, u32),
+    last: (f64, u32),
+    next_check: u32,
+}
 
-/// The forecast is first tried once the segment has spent this fraction of the budget, and then
-/// at spending spaced by an eighth of the segment's.
+impl Spending {
+    pub(super) const NONE: Self = Self {
+        start: (f64::NAN, 0),
+        last: (f64::NAN, 0),
+        next_check: 0,
+    };
+
+    /// Spending observed from time `t`, the budget spent then.
+    pub(super) fn starting(t: f64, spent: u32, budget: u32) -> Self {
+        Self {
+            start: (t, spent),
+            last: (t, spent),
+            next_check: spent.saturating_add(budget / FIRST_FORECAST_SHARE),
+        }
+    }
+
+    pub(super) fn started(&self) -> bool {
+        !self.start.0.is_nan()
+    }
+
+    /// At a pass at `t` with `spent` of `budget` spent: where a forecast is due, enough has been
+    /// observed and the budget's fine half is not yet spent, the time (s) in which the lesser of
+    /// the spending's rate since its start and since the last forecast spends that half, with
+    /// the forecast's margin ([`FORECAST_MARGIN`]), and the spending at which the half ends.
+    pub(super) fn fine_half_horizon(
+        &mut self,
+        t: f64,
+        spent: u32,
+        budget: u32,
+    ) -> Option<(f64, u32)> {
+        if spent < self.next_check {
+            return None;
+        }
+        let used = spent - self.start.1;
+        self.next_check = spent.saturating_add(1 + used / 8);
+        if used < MIN_OBSERVED {
+            return None;
+        }
+        let (last_t, last_spent) = std::mem::replace(&mut self.last, (t, spent));
+        // The fine floor holds while `2 left > budget + 1`: until this spending.
+        let fine_end = budget.saturating_sub(1).div_ceil(2);
+        if spent >= fine_end {
+            return None;
+        }
+        // The lesser of the two rates: ringing that decays spends less as it goes.
+        let rate = (f64::from(used) / (t - self.start.0))
+            .min(f64::from(spent - last_spent) / (t - last_t));
+        Some((
+            FORECAST_MARGIN * f64::from(fine_end - spent) / rate,
+            fine_end,
+        ))
+    }
+}
+
+/// The forecast holds only where the spending so far (a segment's, or a locked rotor's step's),
+/// kept up, reaches the budget's fine half within `1 / FORECAST_MARGIN` of the time left: the rate may fall by a third
+/// over that time (the ringing decaying, its substeps growing) and the half is still reached.
+pub(super) const FORECAST_MARGIN: f64 = 1.5;
+
+/// The forecast is first tried once the segment (or step) has spent this fraction of the budget,
+/// and then at spending spaced by an eighth of its spending.
 const FIRST_FORECAST_SHARE: u32 = 64;
 
 /// The least budget a segment has spent before its rate forecasts anything: 64 Gilbert substeps.
@@ -83,34 +139,16 @@ impl Motor {
         if s.segment_end != segment_end {
             *s = SegmentSpending {
                 segment_end,
-                start: run.t,
-                spent,
-                last: (run.t, spent),
-                next_check: spent.saturating_add(budget / FIRST_FORECAST_SHARE),
+                spending: Spending::starting(run.t, spent, budget),
             };
             return false;
         }
-        if spent < s.next_check {
+        let Some((horizon, _)) = s.spending.fine_half_horizon(run.t, spent, budget) else {
             return false;
-        }
-        let used = spent - s.spent;
-        s.next_check = spent.saturating_add(1 + used / 8);
-        if used < MIN_OBSERVED {
-            return false;
-        }
-        let (last_t, last_spent) = std::mem::replace(&mut s.last, (run.t, spent));
-        // The fine floor holds while `2 left > budget + 1`: until this spending.
-        let fine_end = budget.saturating_sub(1).div_ceil(2);
-        if spent >= fine_end {
-            return false;
-        }
+        };
         let left = segment_end - run.t;
-        // The lesser of the segment's rate and the rate since the last forecast: ringing that
-        // decays spends less as it goes.
-        let rate = (f64::from(used) / (run.t - s.start))
-            .min(f64::from(spent - last_spent) / (run.t - last_t));
         // (False for a NaN.)
-        let forecast = FORECAST_MARGIN * f64::from(fine_end - spent) / rate <= left;
+        let forecast = horizon <= left;
         if !forecast {
             return false;
         }

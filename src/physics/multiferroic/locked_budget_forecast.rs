@@ -3,21 +3,10 @@
 //! minimum that the budget's drop would reach later in the step
 //! ([`Motor::locked_budget_forecast_drops`]).
 
+use super::budget_forecast::{Spending, FORECAST_MARGIN};
 use super::orbit::point;
 use super::{Drive, Motor, StepRun};
 use std::f64::consts::PI;
-
-/// The forecast holds only where the step's spending so far, kept up, reaches the budget's fine
-/// half within `1 / FORECAST_MARGIN` of the step's time left (as for a free rotor,
-/// `budget_forecast.rs`).
-const FORECAST_MARGIN: f64 = 1.5;
-
-/// The forecast is first tried once the step has spent this fraction of the budget, and then at
-/// spending spaced by an eighth of the step's.
-const FIRST_FORECAST_SHARE: u32 = 64;
-
-/// The least budget spent before the step's rate forecasts anything: 64 Gilbert substeps.
-const MIN_OBSERVED: u32 = 64 * super::GILBERT_SUBSTEP_WEIGHT;
 
 /// The floor's substep after the fine half, over the substep the error control proposes, beyond
 /// which the forced substeps are taken to land beyond the tolerance.
@@ -32,23 +21,18 @@ const RIM_MARGIN: f64 = 0.999;
 /// and `locked_ringing.rs`'s).
 const MIN_LOSS_PER_ORBIT: f64 = 0.1;
 
-/// A locked rotor's step spending (see [`Motor::locked_budget_forecast_drops`]): its start (s)
-/// and the budget spent then, the time and budget spent at the last forecast tried, the
-/// budget spent at which it is tried next, and the budget spent below which the averaged paths'
-/// refusal over the horizon is not tried again (see [`Motor::averaging_refused_over`]).
+/// A locked rotor's step spending (see [`Motor::locked_budget_forecast_drops`]), and the budget
+/// spent below which the averaged paths' refusal over the horizon is not tried again (see
+/// [`Motor::averaging_refused_over`]).
 #[derive(Clone, Copy, Debug)]
 pub(super) struct LockedSpending {
-    start: (f64, u32),
-    last: (f64, u32),
-    next_check: u32,
+    spending: Spending,
     refusal_retry: u32,
 }
 
 impl LockedSpending {
     pub(super) const NONE: Self = Self {
-        start: (f64::NAN, 0),
-        last: (f64::NAN, 0),
-        next_check: 0,
+        spending: Spending::NONE,
         refusal_retry: 0,
     };
 }
@@ -104,34 +88,16 @@ impl Motor {
         let budget = self.params.max_substeps;
         let spent = run.attempts.saturating_add(run.extra_cost);
         let s = &mut run.locked_spending;
-        if s.start.0.is_nan() {
+        if !s.spending.started() {
             *s = LockedSpending {
-                start: (run.t, spent),
-                last: (run.t, spent),
-                next_check: spent.saturating_add(budget / FIRST_FORECAST_SHARE),
+                spending: Spending::starting(run.t, spent, budget),
                 refusal_retry: 0,
             };
             return false;
         }
-        if spent < s.next_check {
+        let Some((horizon, fine_end)) = s.spending.fine_half_horizon(run.t, spent, budget) else {
             return false;
-        }
-        let used = spent - s.start.1;
-        s.next_check = spent.saturating_add(1 + used / 8);
-        if used < MIN_OBSERVED {
-            return false;
-        }
-        let (last_t, last_spent) = std::mem::replace(&mut s.last, (run.t, spent));
-        // The fine floor holds while `2 left > budget + 1`: until this spending.
-        let fine_end = budget.saturating_sub(1).div_ceil(2);
-        if spent >= fine_end {
-            return false;
-        }
-        // The lesser of the step's rate and the rate since the last forecast: ringing that
-        // decays spends less as it goes.
-        let rate = (f64::from(used) / (run.t - s.start.0))
-            .min(f64::from(spent - last_spent) / (run.t - last_t));
-        let horizon = FORECAST_MARGIN * f64::from(fine_end - spent) / rate;
+        };
         // (False for a NaN.)
         let spends = horizon <= run.t_end - run.t;
         if !spends {
