@@ -83,8 +83,9 @@ impl Spending {
 }
 
 /// The forecast holds only where the spending so far (a segment's, or a locked rotor's step's),
-/// kept up, reaches the budget's fine half within `1 / FORECAST_MARGIN` of the time left: the rate may fall by a third
-/// over that time (the ringing decaying, its substeps growing) and the half is still reached.
+/// kept up, reaches the budget's fine half within `1 / FORECAST_MARGIN` of the time left: the rate
+/// may fall by a third over that time (the ringing decaying, its substeps growing) and the half is
+/// still reached.
 pub(super) const FORECAST_MARGIN: f64 = 1.5;
 
 /// The forecast is first tried once the segment (or step) has spent this fraction of the budget,

@@ -68,9 +68,9 @@ impl Motor {
     /// - **Left to that drop**: the linearization loses more than [`MIN_LOSS_PER_ORBIT`] of its
     ///   energy an orbit (the averaged advance and the averaged decay time refuse at every
     ///   energy), or both provably refuse the onion at every instant of the horizon
-    ///   ([`Motor::averaging_refused_over`]), the linear ringing's wait outlasts the horizon, the relaxed onion's check does
-    ///   not end the ringing now, and the substeps forced after the fine half are at least
-    ///   [`FORCED_RATIO`] times the one the error control proposes.
+    ///   ([`Motor::averaging_refused_over`]), the linear ringing's wait outlasts the horizon, the
+    ///   relaxed onion's check does not end the ringing now, and the substeps forced after the
+    ///   fine half are at least [`FORCED_RATIO`] times the one the error control proposes.
     pub(super) fn locked_budget_forecast_drops(&self, run: &mut StepRun, d: &Drive) -> bool {
         if !d.locked || self.quasi_static() {
             return false;
