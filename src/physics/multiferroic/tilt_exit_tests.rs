@@ -138,3 +138,42 @@ fn locked_onion_leaving_its_bounds_is_dropped_at_the_substep_that_carries_it_out
     assert_eq!(st.onion_tilt.to_bits(), st_crept.onion_tilt.to_bits());
     assert_eq!((st.rotor_angle, st.rotor_speed), (0.0, 0.0));
 }
+
+/// A locked rotor's onion ringing with a tilt of up to 8.6 rad (a plain RK4 of the ODE) at
+/// damping 4.2e-4 and a loose tolerance, 0.11 rad: substeps within that tolerance carry their
+/// onion past the 10 rad bound, and the step is flagged. Resolved as if within its bounds, the
+/// step ended unflagged with the onion 8.7 and its tilt 55 tolerances off the RK4.
+const LOCKED_LOOSE_RINGING: &str = "strain_direction=2.222e3 stress=-3.872e8 \
+     load_torque=3.458e-7 ring_outer_diameter=8.923e-1 ring_inner_diameter=1.596e-3 \
+     bar_length=4.268e-4 bar_width=1.041e-6 thickness=5.428e-7 saturation_magnetization=1.349e1 \
+     magnetostriction=6.793e-3 wall_volume=4.223e-11 density=1.226e4 fluid_viscosity=1.577e-4 \
+     gilbert_damping=4.240e-4 tolerance=1.129e-1 step_angle=-5.542e0 step_period=4.124e2 \
+     stress_amplitude=-2.784e0 schedule_initial_direction=-1.984e1 onion_model=1 \
+     max_substeps=5.451e3 schedule=1 rotor_locked=1 initial_onion_offset=3.162e-5 \
+     strain=3.806e-2 youngs_modulus=7.958e7";
+
+/// An unflagged step ends within the tolerance of a converged plain RK4 of the ODE.
+#[test]
+fn locked_loose_ringing_is_flagged_or_within_the_tolerance() {
+    let (m, start, inputs) = case(&values(LOCKED_LOOSE_RINGING)).unwrap();
+    let d = m.drive_at(&inputs, 0.0);
+    let span = 1e-6;
+    let tol = m.params.tolerance;
+    let y0 = [
+        start.rotor_angle,
+        start.rotor_speed,
+        start.onion_angle,
+        start.onion_tilt,
+    ];
+    let truth = |h: f64| rk4_span(&m, &d, y0, span, (span / h).round() as usize);
+    let (coarse, fine) = (truth(2e-12), truth(1e-12));
+    assert!((coarse[2] - fine[2]).abs() <= 0.01 * tol && (coarse[3] - fine[3]).abs() <= 0.01 * tol);
+    let mut st = start;
+    let report = m.step(&mut st, &inputs, span).unwrap();
+    let off = [
+        (st.onion_angle - fine[2]).abs() / tol,
+        (st.onion_tilt - fine[3]).abs() / tol,
+    ];
+    println!("{report:?} {st:?} against the RK4's {fine:?}: {off:?} tolerances off");
+    assert!(report.accuracy_limited || off.iter().all(|e| *e <= 1.0));
+}
