@@ -57,9 +57,9 @@
 //! substeps can follow through the schedule's switches refuses the step (`locked_switches.rs`), as
 //! does a locked step whose switches outnumber its loop's passes once the linear spans fail or the
 //! budget cannot pay for them (`switch_count.rs`; the spans count one unit per two switches they
-//! chain). A free rotor's onion whose tilt leaves its bounds escapes at the substep that carries it
-//! out, not at the budget's smallest (`tilt_exit.rs`). A Gilbert step whose onion's dynamics carry
-//! its resolved substeps' local errors far beyond the tolerance by its end is flagged
+//! chain). An onion whose tilt leaves its bounds escapes at the substep that carries it out, not
+//! at the budget's smallest (`tilt_exit.rs`). A Gilbert step whose onion's dynamics carry its
+//! resolved substeps' local errors far beyond the tolerance by its end is flagged
 //! (`amplification.rs`).
 //!
 //! Long steps: a substep far longer than the relaxation time is never integrated
