@@ -55,10 +55,20 @@ fn ringing_whose_budget_runs_out_in_the_last_segment_completes() {
 /// complete three 1 us steps: a budget of 352 over 102 switches of 9.8 ns that runs out only in
 /// each step's last segment (`gilbert_damping` 5.9e-4, not creeping), and an onion that may creep
 /// (`alpha^2 T` up to 3.2 times `4 |U''|`) whose forced substeps follow it once its budget of
-/// 1561 runs out at the 16th of 82 switches of 12 ns.
+/// 1561 runs out at the 16th of 82 switches of 12 ns; and, unflagged, ringing resolved through 25
+/// switches of 40 ns in 335 substeps a step of a budget of 4891 (`gilbert_damping` 0.78 on a weak
+/// landscape, `tolerance` 1.1e-2).
 #[test]
 fn kicks_that_outlast_a_period_complete_where_the_budget_allows() {
     for text in [
+        "stress=-6.400e5 load_torque=5.102e-7 ring_outer_diameter=1.419e-2 \
+         ring_inner_diameter=2.763e-5 bar_length=4.019e-6 bar_width=6.348e-8 \
+         thickness=3.830e-9 saturation_magnetization=1.057e2 magnetostriction=-2.932e-3 \
+         wall_volume=4.355e-11 density=1.345e3 fluid_viscosity=4.141e6 \
+         gilbert_damping=7.835e-1 tolerance=1.107e-2 step_angle=-8.531e0 step_period=3.995e-8 \
+         stress_amplitude=1.287e6 schedule_initial_direction=-3.720e-1 onion_model=1 \
+         max_substeps=4891 schedule=1 rotor_locked=1 initial_onion_offset=2.084e1 \
+         strain=6.591e-2 youngs_modulus=4.681e10",
         "stress=-9.586e8 load_torque=-4.828e-7 ring_outer_diameter=2.394e-4 \
          ring_inner_diameter=4.827e-5 bar_length=4.232e-6 bar_width=1.515e-8 \
          thickness=1.702e-9 saturation_magnetization=1.558e0 magnetostriction=-2.682e-3 \
@@ -139,5 +149,31 @@ fn locked_outcomes_from_log() {
     }
     if let Ok(file) = std::env::var("LOCKED_OUTCOMES") {
         std::fs::write(file, out).unwrap();
+    }
+}
+
+/// 970 switches of 1.03 ns against 60 passes (`max_substeps` 22) on a ring decoupled from the
+/// onion (`gilbert_damping` 0.51): once its periods repeat, the onion takes the rest of each step
+/// at once and the three 1 us steps complete. A refusal for the switches made before the loop
+/// runs out of passes would refuse them.
+#[test]
+fn switches_beyond_the_passes_complete_where_the_onion_periods_repeat() {
+    let (m, mut st, inputs) = case(&values(
+        "load_torque=-1.841e-8 ring_outer_diameter=3.275e-1 ring_inner_diameter=2.096e-1 \
+         bar_length=1.295e-2 bar_width=1.998e-8 thickness=1.017e-9 \
+         saturation_magnetization=1.408e5 magnetostriction=-6.267e-3 wall_volume=4.211e-11 \
+         density=1.439e3 fluid_viscosity=4.733e4 gilbert_damping=5.075e-1 \
+         tolerance=4.847e-7 step_angle=-6.110e0 step_period=1.030e-9 \
+         stress_amplitude=1.114e10 schedule_initial_direction=-3.920e-5 onion_model=1 \
+         max_substeps=22 schedule=1 rotor_locked=1 initial_onion_offset=1.452e-1 \
+         strain=5.779e-3 youngs_modulus=1.028e12 strain_drive=1",
+    ))
+    .unwrap();
+    let s = *inputs.schedule.get().unwrap();
+    let passes = 2.0 * f64::from(m.params.max_substeps) + 16.0;
+    assert!(s.step_index(1e-6) - s.step_index(0.0) > 10.0 * passes);
+    for k in 0..3 {
+        let report = m.step(&mut st, &inputs, 1e-6);
+        assert!(report.is_ok(), "step {k}: {report:?}");
     }
 }
