@@ -120,6 +120,8 @@ mod locked_averaging_refusal_tests;
 mod locked_budget_forecast;
 #[cfg(test)]
 mod locked_budget_forecast_tests;
+#[cfg(test)]
+mod locked_refusal_tests;
 mod locked_ringing;
 #[cfg(test)]
 mod locked_ringing_tests;
