@@ -22,9 +22,12 @@ const ABOVE_RIMS: &str = "strain_direction=-1.554e2 stress=-3.479e9 load_torque=
      max_substeps=1.313e4 schedule=1e0 initial_onion_offset=-7.309e-12 strain=-6.286e-2 \
      youngs_modulus=7.851e6";
 
+/// A step's state bits and report (`None` once refused).
+type Stepped = ([u64; 4], Option<StepReport>);
+
 /// Three 1 us steps of `text`'s motor, every free rotor's well searched (`full`) or not: each
-/// step's state bits and report (`None` once refused) and the refusals before the search.
-fn steps(text: &str, full: bool) -> (Vec<([u64; 4], Option<StepReport>)>, u32) {
+/// step's [`Stepped`] and the refusals before the search.
+fn steps(text: &str, full: bool) -> (Vec<Stepped>, u32) {
     let Ok((m, mut st, inputs)) = case(&values(text)) else {
         return (Vec::new(), 0);
     };
@@ -93,12 +96,19 @@ fn free_refusals_over_a_bench_log() {
         let Some(rest) = line.split("slow step: ").nth(1) else {
             continue;
         };
-        let text = rest.rsplit('[').next().unwrap_or_default().trim_end_matches(']');
+        let text = rest
+            .rsplit('[')
+            .next()
+            .unwrap_or_default()
+            .trim_end_matches(']');
         let label = rest.split(':').next().unwrap_or_default();
         let (full, _) = steps(text, true);
         let (quick, refused) = steps(text, false);
         assert_eq!(full, quick, "{label}");
         cases += 1;
+        if refused > 0 {
+            println!("{label}: {refused} refusals before the search");
+        }
         fired += u32::from(refused > 0);
         refusals += u64::from(refused);
     }

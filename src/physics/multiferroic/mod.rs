@@ -101,11 +101,11 @@ mod forced_crossing;
 mod forced_crossing_tests;
 mod free_energy;
 #[cfg(test)]
-mod free_rim_refusal_tests;
-#[cfg(test)]
 mod free_energy_tests;
 #[cfg(test)]
 mod free_first_tests;
+#[cfg(test)]
+mod free_rim_refusal_tests;
 mod gilbert;
 mod held_torque;
 #[cfg(test)]

@@ -110,7 +110,14 @@ impl Motor {
             let omega = self.rotor_speed(y, d, self.overdamped(period));
             // (The centre takes the well's minimum and curvature alone.)
             let (below, above, barrier) = (minimum, minimum, 0.0);
-            let well = Well { minimum, below, above, barrier, floor, curvature: k };
+            let well = Well {
+                minimum,
+                below,
+                above,
+                barrier,
+                floor,
+                curvature: k,
+            };
             let tilt = y[3] - self.tilt_centre(land, &well, omega);
             let e = point(land, y[2]).0 - floor + 0.5 * self.tilt_stiffness * tilt * tilt;
             let refused = e > RIM_MARGIN * energy_range(land);
