@@ -104,6 +104,8 @@ mod free_energy;
 mod free_energy_tests;
 #[cfg(test)]
 mod free_first_tests;
+#[cfg(test)]
+mod free_rim_refusal_tests;
 mod gilbert;
 mod held_torque;
 #[cfg(test)]

@@ -65,7 +65,7 @@ impl Motor {
     /// The tilt about which the onion rings while the rotor turns at `omega`: the minimum moves
     /// at `m' = omega k_bar / k` (the ring-bar stiffness over the well's curvature), and
     /// `psi' = -g T theta` follows it about `theta = -m' / (g T)`.
-    fn tilt_centre(&self, land: &Landscape, well: &Well, omega: f64) -> f64 {
+    pub(super) fn tilt_centre(&self, land: &Landscape, well: &Well, omega: f64) -> f64 {
         let k_bar = land.ring_bar.stiffness(well.minimum - land.bar_angle);
         -omega * k_bar / (well.curvature * self.llg_rate * self.tilt_stiffness)
     }
@@ -353,13 +353,13 @@ impl Motor {
     }
 
     /// Whether a free rotor is taken as overdamped over orbits of `period` (see [`OVERDAMPED`]).
-    fn overdamped(&self, period: f64) -> bool {
+    pub(super) fn overdamped(&self, period: f64) -> bool {
         self.inertia <= OVERDAMPED * self.drag * period
     }
 
     /// The rotor's speed at `y`: its own, or an overdamped rotor's `(tau + load) / c`, or 0
     /// locked.
-    fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
+    pub(super) fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
         if d.locked {
             0.0
         } else if overdamped {
@@ -417,7 +417,7 @@ impl Motor {
         if !(loss <= 2.0 * MAX_LOSS_PER_ORBIT && remaining >= 0.5 * MIN_ORBITS * period) || stiff {
             return None;
         }
-        let well = self.kept_onion_well(kept, &land, minimum)?;
+        let well = self.searched_well(kept, &land, y, d, (minimum, k), period)?;
         let omega = self.rotor_speed(y, d, self.overdamped(period));
         // The tilt about the orbit's centre.
         let tilt = y[3] - self.tilt_centre(&land, &well, omega);

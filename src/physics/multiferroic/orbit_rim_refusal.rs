@@ -11,9 +11,16 @@
 //! energy lies within [`ROUNDING`] of that level, where the minimum's and the rims' rounding
 //! could decide, or the onion left the well kept.
 //!
+//! A free rotor's landscape turns with it, and no well is kept from one check to the next; its
+//! onion is refused before the search ([`Motor::searched_well`]) where its energy above the
+//! minimum exceeds [`RIM_MARGIN`] of the landscape's whole range, which bounds every barrier.
+//!
 //! [`RIM_MARGIN`]: super::orbit_advance::RIM_MARGIN
 
+use super::onion::Landscape;
 use super::orbit::{point, Well};
+use super::orbit_advance::RIM_MARGIN;
+use super::orbit_kept_well::KeptWell;
 use super::{Drive, Motor, Vector};
 
 /// The energy is compared with the refusal's level to within this fraction of the barrier.
@@ -25,6 +32,10 @@ thread_local! {
     pub(super) static SKIPPED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
     /// Checks of the averaged advance made in full on this thread (for tests).
     pub(super) static FULL: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+    /// Free rotors' onions refused before the rims' search on this thread (for tests).
+    pub(super) static FREE_REFUSED: std::cell::Cell<u32> = const { std::cell::Cell::new(0) };
+    /// Searches every free rotor's well on this thread (for tests: the results must not change).
+    pub(super) static FREE_OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
     /// Makes every check in full on this thread (for tests: the results must not change).
     pub(super) static OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
 }
@@ -67,7 +78,68 @@ impl RimRefusal {
     }
 }
 
+/// A bound of the range of `U` in `land` (J): eq. 3.3's `K (1/B - 1/A)` is monotone in the
+/// offset's cosine, from `-2 |K| (1 / |r - a| - 1 / (r + a))` to minus that, and eq. 3.4's
+/// `E sin^2` spans `|E|`; widened by far more than the energies' rounding.
+pub(super) fn energy_range(land: &Landscape) -> f64 {
+    let r = land.ring_bar;
+    let (a, w) = (r.bar_charge_radius, r.wall_radius);
+    let ring = 2.0 * r.coupling.abs() * (1.0 / (w - a).abs() - 1.0 / (w + a));
+    (ring + land.magnetoelastic.abs()) * (1.0 + 1e-6)
+}
+
 impl Motor {
+    /// The well of `minimum` (curvature `k` there) in `land` for the averaged advance's check
+    /// of the onion at `y` under the drive `d`, orbits of about `period` (see
+    /// [`Motor::kept_onion_well`]); `None` without the rims' search for a free rotor's onion
+    /// whose energy above the minimum (as the check computes it: the well's floor is `U(psi*)`,
+    /// its curvature `k`) exceeds [`RIM_MARGIN`] of the range of `U` ([`energy_range`]): every
+    /// barrier is within that range, so the check refuses that onion in whatever well the
+    /// search finds, or none.
+    pub(super) fn searched_well(
+        &self,
+        kept: &mut KeptWell,
+        land: &Landscape,
+        y: &Vector,
+        d: &Drive,
+        (minimum, k): (f64, f64),
+        period: f64,
+    ) -> Option<Well> {
+        if !d.locked {
+            let floor = point(land, minimum).0;
+            let omega = self.rotor_speed(y, d, self.overdamped(period));
+            // (The centre takes the well's minimum and curvature alone.)
+            let (below, above, barrier) = (minimum, minimum, 0.0);
+            let well = Well {
+                minimum,
+                below,
+                above,
+                barrier,
+                floor,
+                curvature: k,
+            };
+            let tilt = y[3] - self.tilt_centre(land, &well, omega);
+            let e = point(land, y[2]).0 - floor + 0.5 * self.tilt_stiffness * tilt * tilt;
+            let refused = e > RIM_MARGIN * energy_range(land);
+            #[cfg(test)]
+            let refused = refused && !FREE_OFF.with(|c| c.get());
+            #[cfg(test)]
+            if refused {
+                FREE_REFUSED.with(|c| c.set(c.get() + 1));
+                // The full check's refusal, from the well the search finds.
+                if let Some(w) = self.well_of_minimum(land, minimum) {
+                    assert_eq!((w.floor, w.curvature), (floor, k));
+                    let inside = w.below < y[2] && y[2] < w.above;
+                    assert!(!(inside && e <= RIM_MARGIN * w.barrier), "{e} {w:?}");
+                }
+            }
+            if refused {
+                return None;
+            }
+        }
+        self.kept_onion_well(kept, land, minimum)
+    }
+
     /// Whether the averaged advance would refuse the locked rotor's onion at `y` under the drive
     /// `d` in the segment ending at `segment_end` for its energy, by the well of the last such
     /// refusal `r` (see the module documentation).
