@@ -79,8 +79,8 @@ impl RimRefusal {
 }
 
 /// A bound of the range of `U` in `land` (J): eq. 3.3's `K (1/B - 1/A)` is monotone in the
-/// offset's cosine, from `-2 |K| (1 / |r - a| - 1 / (r + a))` to minus that, and eq. 3.4's
-/// `E sin^2` spans `|E|`; widened by far more than the energies' rounding.
+/// offset's cosine, from `-|K| (1 / |r - a| - 1 / (r + a))` to minus that, a span of twice
+/// that, and eq. 3.4's `E sin^2` spans `|E|`; widened by far more than the energies' rounding.
 pub(super) fn energy_range(land: &Landscape) -> f64 {
     let r = land.ring_bar;
     let (a, w) = (r.bar_charge_radius, r.wall_radius);
