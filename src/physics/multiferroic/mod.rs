@@ -30,8 +30,9 @@
 //! `orbit_averager.rs`, its phase error bounded in `orbit_phase.rs`, the wells its checks find kept
 //! per landscape, `orbit_kept_well.rs`; a locked rotor's last orbit is resolved at once,
 //! `orbit_finish.rs`, its onion refused near the rim is refused again from the well kept,
-//! `orbit_rim_refusal.rs`, and its ringing small enough to be linear advances by its exact linear
-//! flow, `linear_ringing.rs`); a locked rotor's onion near or above its wells' rims is held to what
+//! `orbit_rim_refusal.rs` (a free rotor's, above every barrier, before the search for its rims),
+//! and its ringing small enough to be linear advances by its exact linear flow,
+//! `linear_ringing.rs`); a locked rotor's onion near or above its wells' rims is held to what
 //! its energy, which only falls, can reach (`rim_energy.rs`), a free rotor's to what the rotor's
 //! turn can feed it (`free_energy.rs`). A free rotor's onion is settled on its branch only where a
 //! minimum can lie within the check's slack (`branch_settle.rs`), and the checks of its branch in
