@@ -21,8 +21,8 @@ use super::Motor;
 use std::f64::consts::PI;
 
 /// The averaged advance's orbit count, energy margin to its rims, loss per orbit, refusal of a
-/// linearization and least orbits (`orbit_advance.rs`'s `MIN_ORBITS`, `RIM_MARGIN`,
-/// `MAX_LOSS_PER_ORBIT`), taken here as the bounds below use them.
+/// linearization and least orbits (`orbit_advance.rs`'s `MIN_ORBITS` and `MAX_LOSS_PER_ORBIT`,
+/// `orbit.rs`'s `RIM_MARGIN`), taken here as the bounds below use them.
 const ADVANCE_MIN_ORBITS: f64 = 8.0;
 const ADVANCE_RIM_MARGIN: f64 = 0.9;
 const ADVANCE_MAX_LOSS: f64 = 0.05;

@@ -40,6 +40,11 @@ use std::sync::OnceLock;
 use super::onion::Landscape;
 use super::{Angles, Motor};
 
+/// The orbit-averaged advance takes an orbit whose energy is at most this fraction of the lowest
+/// rim's height above the minimum: the quadrature stays converged and the averaged orbit's energy
+/// off by its oscillating part cannot leave the well.
+pub(super) const RIM_MARGIN: f64 = 0.9;
+
 /// Midpoint nodes on a half orbit.
 const NODES: usize = 32;
 /// Gauss-Legendre nodes on part of a half orbit.

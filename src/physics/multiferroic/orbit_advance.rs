@@ -3,7 +3,7 @@
 //! lower turning points of the orbits that `orbit.rs` evaluates (the method is described there).
 
 use super::onion::Landscape;
-use super::orbit::{point, Orbit, Well};
+use super::orbit::{point, Orbit, Well, RIM_MARGIN};
 use super::orbit_averager::{Averager, Slow};
 use super::orbit_finish::MAX_FINISH_STEPS;
 use super::orbit_kept_well::KeptWell;
@@ -14,10 +14,6 @@ use crate::physics::numerics::dormand_prince;
 use crate::physics::numerics::rk4::rk4_step;
 use std::f64::consts::PI;
 
-/// The orbit's energy at most this fraction of the lowest rim's height above the minimum: the
-/// quadrature stays converged and the averaged orbit's energy off by its oscillating part
-/// cannot leave the well.
-pub(super) const RIM_MARGIN: f64 = 0.9;
 /// At most this fraction of the energy lost per orbit (the averaging's small parameter).
 const MAX_LOSS_PER_ORBIT: f64 = 0.05;
 /// The averaged advance is tried when the segment has at least this many orbits left (fewer

@@ -15,11 +15,10 @@
 //! onion is refused before the search ([`Motor::searched_well`]) where its energy above the
 //! minimum exceeds [`RIM_MARGIN`] of the landscape's whole range, which bounds every barrier.
 //!
-//! [`RIM_MARGIN`]: super::orbit_advance::RIM_MARGIN
+//! [`RIM_MARGIN`]: super::orbit::RIM_MARGIN
 
 use super::onion::Landscape;
-use super::orbit::{point, Well};
-use super::orbit_advance::RIM_MARGIN;
+use super::orbit::{point, Well, RIM_MARGIN};
 use super::orbit_kept_well::KeptWell;
 use super::{Drive, Motor, Vector};
 
