@@ -1,7 +1,7 @@
 //! A free rotor's onion refused by the averaged advance's check before the rims' search, for
-//! its energy against the landscape's range ([`Motor::searched_well`]). Each refusal is also
-//! checked against the full check's, from the well the search finds, inside
-//! `searched_well` itself under `cfg(test)`.
+//! its energy against the landscape's range ([`Motor::above_every_barrier`]). Each refusal is
+//! also checked against the full check's, from the well the search finds, inside
+//! `above_every_barrier` itself under `cfg(test)`.
 
 use super::onion_periods_tests::{case, values};
 use super::orbit_rim_refusal::{energy_range, FREE_OFF, FREE_REFUSED};

@@ -61,9 +61,14 @@ impl Motor {
     /// The tilt about which the onion rings while the rotor turns at `omega`: the minimum moves
     /// at `m' = omega k_bar / k` (the ring-bar stiffness over the well's curvature), and
     /// `psi' = -g T theta` follows it about `theta = -m' / (g T)`.
-    pub(super) fn tilt_centre(&self, land: &Landscape, well: &Well, omega: f64) -> f64 {
-        let k_bar = land.ring_bar.stiffness(well.minimum - land.bar_angle);
-        -omega * k_bar / (well.curvature * self.llg_rate * self.tilt_stiffness)
+    fn tilt_centre(&self, land: &Landscape, well: &Well, omega: f64) -> f64 {
+        self.tilt_centre_at(land, well.minimum, well.curvature, omega)
+    }
+
+    /// [`Self::tilt_centre`] of a well with its `minimum` and its `curvature` there.
+    fn tilt_centre_at(&self, land: &Landscape, minimum: f64, curvature: f64, omega: f64) -> f64 {
+        let k_bar = land.ring_bar.stiffness(minimum - land.bar_angle);
+        -omega * k_bar / (curvature * self.llg_rate * self.tilt_stiffness)
     }
 
     /// Advances the Gilbert onion's ringing and the rotor by the orbit-averaged equations (see
@@ -349,13 +354,13 @@ impl Motor {
     }
 
     /// Whether a free rotor is taken as overdamped over orbits of `period` (see [`OVERDAMPED`]).
-    pub(super) fn overdamped(&self, period: f64) -> bool {
+    fn overdamped(&self, period: f64) -> bool {
         self.inertia <= OVERDAMPED * self.drag * period
     }
 
     /// The rotor's speed at `y`: its own, or an overdamped rotor's `(tau + load) / c`, or 0
     /// locked.
-    pub(super) fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
+    fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
         if d.locked {
             0.0
         } else if overdamped {
@@ -413,11 +418,15 @@ impl Motor {
         if !(loss <= 2.0 * MAX_LOSS_PER_ORBIT && remaining >= 0.5 * MIN_ORBITS * period) || stiff {
             return None;
         }
-        let well = self.searched_well(kept, &land, y, d, (minimum, k), period)?;
+        // The energy above the minimum, the tilt taken about the orbit's centre (both set by
+        // the well's minimum and its curvature there alone).
         let omega = self.rotor_speed(y, d, self.overdamped(period));
-        // The tilt about the orbit's centre.
-        let tilt = y[3] - self.tilt_centre(&land, &well, omega);
-        let e = point(&land, y[2]).0 - well.floor + 0.5 * t * tilt * tilt;
+        let tilt = y[3] - self.tilt_centre_at(&land, minimum, k, omega);
+        let e = point(&land, y[2]).0 - point(&land, minimum).0 + 0.5 * t * tilt * tilt;
+        if self.above_every_barrier(&land, d, (y[2], minimum), e) {
+            return None;
+        }
+        let well = self.kept_onion_well(kept, &land, minimum)?;
         let inside = well.below < y[2] && y[2] < well.above;
         if !(inside && e <= RIM_MARGIN * well.barrier) {
             if d.locked && inside {

@@ -19,7 +19,6 @@
 
 use super::onion::Landscape;
 use super::orbit::{point, Well, RIM_MARGIN};
-use super::orbit_kept_well::KeptWell;
 use super::{Drive, Motor, Vector};
 
 /// The energy is compared with the refusal's level to within this fraction of the barrier.
@@ -88,55 +87,33 @@ pub(super) fn energy_range(land: &Landscape) -> f64 {
 }
 
 impl Motor {
-    /// The well of `minimum` (curvature `k` there) in `land` for the averaged advance's check
-    /// of the onion at `y` under the drive `d`, orbits of about `period` (see
-    /// [`Motor::kept_onion_well`]); `None` without the rims' search for a free rotor's onion
-    /// whose energy above the minimum (as the check computes it: the well's floor is `U(psi*)`,
-    /// its curvature `k`) exceeds [`RIM_MARGIN`] of the range of `U` ([`energy_range`]): every
-    /// barrier is within that range, so the check refuses that onion in whatever well the
-    /// search finds, or none.
-    pub(super) fn searched_well(
+    /// Whether the averaged advance's check refuses a free rotor's onion at `psi` without the
+    /// search for the rims of the well of `minimum` in `land`: its energy `e` above the minimum
+    /// (J, as the check computes it) exceeds [`RIM_MARGIN`] of the range of `U`
+    /// ([`energy_range`]), which bounds every barrier, so the check refuses that onion in
+    /// whatever well the search finds, or none.
+    pub(super) fn above_every_barrier(
         &self,
-        kept: &mut KeptWell,
         land: &Landscape,
-        y: &Vector,
         d: &Drive,
-        (minimum, k): (f64, f64),
-        period: f64,
-    ) -> Option<Well> {
-        if !d.locked {
-            let floor = point(land, minimum).0;
-            let omega = self.rotor_speed(y, d, self.overdamped(period));
-            // (The centre takes the well's minimum and curvature alone.)
-            let (below, above, barrier) = (minimum, minimum, 0.0);
-            let well = Well {
-                minimum,
-                below,
-                above,
-                barrier,
-                floor,
-                curvature: k,
-            };
-            let tilt = y[3] - self.tilt_centre(land, &well, omega);
-            let e = point(land, y[2]).0 - floor + 0.5 * self.tilt_stiffness * tilt * tilt;
-            let refused = e > RIM_MARGIN * energy_range(land);
-            #[cfg(test)]
-            let refused = refused && !FREE_OFF.with(|c| c.get());
-            #[cfg(test)]
-            if refused {
-                FREE_REFUSED.with(|c| c.set(c.get() + 1));
-                // The full check's refusal, from the well the search finds.
-                if let Some(w) = self.well_of_minimum(land, minimum) {
-                    assert_eq!((w.floor, w.curvature), (floor, k));
-                    let inside = w.below < y[2] && y[2] < w.above;
-                    assert!(!(inside && e <= RIM_MARGIN * w.barrier), "{e} {w:?}");
-                }
-            }
-            if refused {
-                return None;
+        (psi, minimum): (f64, f64),
+        e: f64,
+    ) -> bool {
+        let refused = !d.locked && e > RIM_MARGIN * energy_range(land);
+        #[cfg(test)]
+        let refused = refused && !FREE_OFF.with(|c| c.get());
+        #[cfg(test)]
+        if refused {
+            FREE_REFUSED.with(|c| c.set(c.get() + 1));
+            // The full check's refusal, from the well the search finds.
+            if let Some(w) = self.well_of_minimum(land, minimum) {
+                let inside = w.below < psi && psi < w.above;
+                assert!(!(inside && e <= RIM_MARGIN * w.barrier), "{e} {w:?}");
             }
         }
-        self.kept_onion_well(kept, land, minimum)
+        #[cfg(not(test))]
+        let _ = (psi, minimum);
+        refused
     }
 
     /// Whether the averaged advance would refuse the locked rotor's onion at `y` under the drive
