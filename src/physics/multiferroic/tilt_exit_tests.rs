@@ -3,6 +3,21 @@
 
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
+use super::{Drive, Motor, MotorInputs, MotorState, Vector};
+
+/// The motor, its state, inputs and drive at the start of the case `text`, and its state as the
+/// RK4's vector.
+fn start_of(text: &str) -> (Motor, MotorState, MotorInputs, Drive, Vector) {
+    let (m, start, inputs) = case(&values(text)).unwrap();
+    let d = m.drive_at(&inputs, 0.0);
+    let y0 = [
+        start.rotor_angle,
+        start.rotor_speed,
+        start.onion_angle,
+        start.onion_tilt,
+    ];
+    (m, start, inputs, d, y0)
+}
 
 /// A benchmark draw (the FMU's variables, full precision): the onion released 3.5e-4 rad from
 /// the rim of its well at damping 1.5e-3, its tilt stiffness 4.5e-7 of the well's curvature, so
@@ -28,16 +43,9 @@ const SOFT_TILT: &str = "strain_direction=-6.483190734194401e10 stress=9.1488855
 /// shrinking the substeps towards the bound until the budget's smallest is forced takes 77.
 #[test]
 fn onion_leaving_its_bounds_is_dropped_at_the_substep_that_carries_it_out() {
-    let (m, start, inputs) = case(&values(SOFT_TILT)).unwrap();
-    let d = m.drive_at(&inputs, 0.0);
+    let (m, start, inputs, d, y0) = start_of(SOFT_TILT);
     let span = 1e-6;
     let tol = m.params.tolerance;
-    let y0 = [
-        start.rotor_angle,
-        start.rotor_speed,
-        start.onion_angle,
-        start.onion_tilt,
-    ];
     // The onion's angle where its tilt first passes 10 rad, and the rotor at the step's end.
     let truth = |h: f64| {
         let steps = (span / h).round() as usize;
@@ -92,17 +100,10 @@ const LOCKED_SOFT_TILT: &str = "strain_direction=1.998e-2 stress=2.826e-1 load_t
 /// bit, as where the budget's smallest substep lets it escape, with 6 substeps instead of 79.
 #[test]
 fn locked_onion_leaving_its_bounds_is_dropped_at_the_substep_that_carries_it_out() {
-    let (m, start, inputs) = case(&values(LOCKED_SOFT_TILT)).unwrap();
+    let (m, start, inputs, d, y0) = start_of(LOCKED_SOFT_TILT);
     assert!(inputs.rotor_locked);
-    let d = m.drive_at(&inputs, 0.0);
     let span = 1e-6;
     let tol = m.params.tolerance;
-    let y0 = [
-        start.rotor_angle,
-        start.rotor_speed,
-        start.onion_angle,
-        start.onion_tilt,
-    ];
     let truth = |h: f64| {
         let mut y = y0;
         let mut crossed = false;
@@ -155,16 +156,9 @@ const LOCKED_LOOSE_RINGING: &str = "strain_direction=2.222e3 stress=-3.872e8 \
 /// An unflagged step ends within the tolerance of a converged plain RK4 of the ODE.
 #[test]
 fn locked_loose_ringing_is_flagged_or_within_the_tolerance() {
-    let (m, start, inputs) = case(&values(LOCKED_LOOSE_RINGING)).unwrap();
-    let d = m.drive_at(&inputs, 0.0);
+    let (m, start, inputs, d, y0) = start_of(LOCKED_LOOSE_RINGING);
     let span = 1e-6;
     let tol = m.params.tolerance;
-    let y0 = [
-        start.rotor_angle,
-        start.rotor_speed,
-        start.onion_angle,
-        start.onion_tilt,
-    ];
     let truth = |h: f64| rk4_span(&m, &d, y0, span, (span / h).round() as usize);
     let (coarse, fine) = (truth(2e-12), truth(1e-12));
     assert!((coarse[2] - fine[2]).abs() <= 0.01 * tol && (coarse[3] - fine[3]).abs() <= 0.01 * tol);
