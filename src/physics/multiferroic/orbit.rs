@@ -38,12 +38,15 @@ use std::f64::consts::{FRAC_PI_2, PI};
 use std::sync::OnceLock;
 
 use super::onion::Landscape;
-use super::{Angles, Motor};
+use super::{Angles, Drive, Motor, Vector};
 
 /// The orbit-averaged advance takes an orbit whose energy is at most this fraction of the lowest
 /// rim's height above the minimum: the quadrature stays converged and the averaged orbit's energy
 /// off by its oscillating part cannot leave the well.
 pub(super) const RIM_MARGIN: f64 = 0.9;
+/// A free rotor whose speed relaxes within this fraction of an orbit (`I / c`) is taken as
+/// overdamped over the averaged advance: it turns at `(<tau> + load) / c`.
+pub(super) const OVERDAMPED: f64 = 0.01;
 
 /// Midpoint nodes on a half orbit.
 const NODES: usize = 32;
@@ -234,6 +237,38 @@ struct Partial {
 }
 
 impl Motor {
+    /// The tilt about which the onion rings in the well of `minimum` (its `curvature` `k` there)
+    /// while the rotor turns at `omega`: the minimum moves at `m' = omega k_bar / k` (`k_bar`
+    /// the ring-bar stiffness), and `psi' = -g T theta` follows it about `theta = -m' / (g T)`.
+    pub(super) fn tilt_centre(
+        &self,
+        land: &Landscape,
+        minimum: f64,
+        curvature: f64,
+        omega: f64,
+    ) -> f64 {
+        let k_bar = land.ring_bar.stiffness(minimum - land.bar_angle);
+        -omega * k_bar / (curvature * self.llg_rate * self.tilt_stiffness)
+    }
+
+    /// Whether a free rotor is taken as overdamped over orbits of `period` (see [`OVERDAMPED`]).
+    pub(super) fn overdamped(&self, period: f64) -> bool {
+        self.inertia <= OVERDAMPED * self.drag * period
+    }
+
+    /// The rotor's speed at `y`: its own, or an overdamped rotor's `(tau + load) / c`, or 0
+    /// locked.
+    pub(super) fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
+        if d.locked {
+            0.0
+        } else if overdamped {
+            let land = self.landscape(y[0], d.direction, d.stress);
+            (point(&land, y[2]).2 + d.load) / self.drag
+        } else {
+            y[1]
+        }
+    }
+
     /// The well of eq. 3.4 at rotor angle `phi` whose minimum the onion at `near` settles into,
     /// with its rims; `None` where it has none (a flat or degenerate landscape).
     pub(super) fn onion_well(&self, land: &Landscape, near: f64) -> Option<Well> {

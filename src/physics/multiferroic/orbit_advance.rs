@@ -3,7 +3,7 @@
 //! lower turning points of the orbits that `orbit.rs` evaluates (the method is described there).
 
 use super::onion::Landscape;
-use super::orbit::{point, Orbit, Well, RIM_MARGIN};
+use super::orbit::{point, Orbit, Well, OVERDAMPED, RIM_MARGIN};
 use super::orbit_averager::{Averager, Slow};
 use super::orbit_finish::MAX_FINISH_STEPS;
 use super::orbit_kept_well::KeptWell;
@@ -25,9 +25,6 @@ const MIN_ORBITS: f64 = 8.0;
 const ORBIT_EVALUATION_WEIGHT: u32 = 6;
 /// A Dormand-Prince step of the averaged equations (six evaluations) in the budget's units.
 const AVERAGED_STEP_WEIGHT: u32 = 6 * ORBIT_EVALUATION_WEIGHT;
-/// A free rotor whose speed relaxes within this fraction of an orbit (`I / c`) is taken as
-/// overdamped over the averaged advance: it turns at `(<tau> + load) / c`.
-const OVERDAMPED: f64 = 0.01;
 /// The relative error allowed to an orbit's quadrature against [`Motor::period_floor`] (the
 /// midpoint rule converges spectrally, within 1e-10 up to 0.99 of the rim; see `orbit.rs`).
 const PERIOD_FLOOR_MARGIN: f64 = 1e-3;
@@ -58,19 +55,6 @@ impl OrbitAdvance {
 }
 
 impl Motor {
-    /// The tilt about which the onion rings while the rotor turns at `omega`: the minimum moves
-    /// at `m' = omega k_bar / k` (the ring-bar stiffness over the well's curvature), and
-    /// `psi' = -g T theta` follows it about `theta = -m' / (g T)`.
-    fn tilt_centre(&self, land: &Landscape, well: &Well, omega: f64) -> f64 {
-        self.tilt_centre_at(land, well.minimum, well.curvature, omega)
-    }
-
-    /// [`Self::tilt_centre`] of a well with its `minimum` and its `curvature` there.
-    fn tilt_centre_at(&self, land: &Landscape, minimum: f64, curvature: f64, omega: f64) -> f64 {
-        let k_bar = land.ring_bar.stiffness(minimum - land.bar_angle);
-        -omega * k_bar / (curvature * self.llg_rate * self.tilt_stiffness)
-    }
-
     /// Advances the Gilbert onion's ringing and the rotor by the orbit-averaged equations (see
     /// the module documentation) from `run`'s state towards `segment_end`, when the onion is
     /// trapped in its well (at most [`RIM_MARGIN`] of the lowest rim's height above the
@@ -121,7 +105,7 @@ impl Motor {
         let land = self.landscape(y[0], d.direction, d.stress);
         let overdamped = !d.locked && self.overdamped(o.period);
         let omega = self.rotor_speed(&y, d, overdamped);
-        let tilt = y[3] - self.tilt_centre(&land, &well, omega);
+        let tilt = y[3] - self.tilt_centre(&land, well.minimum, well.curvature, omega);
         let (phase, impulse, damped) = self.phase_on_orbit(&land, &well, &o, y[2], tilt);
         // Within a rounding of the turning point: the phase within [-1/2, 1/2).
         let phase = phase - phase.round();
@@ -278,7 +262,12 @@ impl Motor {
             s[1]
         };
         run.limited |= missed;
-        run.y = [s[0], omega, o.below, self.tilt_centre(&land, &well, omega)];
+        run.y = [
+            s[0],
+            omega,
+            o.below,
+            self.tilt_centre(&land, well.minimum, well.curvature, omega),
+        ];
         run.t = time;
         run.angles = None;
         run.settled = false;
@@ -353,24 +342,6 @@ impl Motor {
         (-r * left).exp()
     }
 
-    /// Whether a free rotor is taken as overdamped over orbits of `period` (see [`OVERDAMPED`]).
-    fn overdamped(&self, period: f64) -> bool {
-        self.inertia <= OVERDAMPED * self.drag * period
-    }
-
-    /// The rotor's speed at `y`: its own, or an overdamped rotor's `(tau + load) / c`, or 0
-    /// locked.
-    fn rotor_speed(&self, y: &Vector, d: &Drive, overdamped: bool) -> f64 {
-        if d.locked {
-            0.0
-        } else if overdamped {
-            let land = self.landscape(y[0], d.direction, d.stress);
-            (point(&land, y[2]).2 + d.load) / self.drag
-        } else {
-            y[1]
-        }
-    }
-
     /// Ringing narrower than this (rad) is within the relaxed onion's slack (see
     /// [`Self::relaxed_onion`]): the averaged advance stops there and the branch takes over.
     /// Half the tolerance under a `locked` rotor, whose onion's angle the ringing moves (there
@@ -421,7 +392,7 @@ impl Motor {
         // The energy above the minimum, the tilt taken about the orbit's centre (both set by
         // the well's minimum and its curvature there alone).
         let omega = self.rotor_speed(y, d, self.overdamped(period));
-        let tilt = y[3] - self.tilt_centre_at(&land, minimum, k, omega);
+        let tilt = y[3] - self.tilt_centre(&land, minimum, k, omega);
         let e = point(&land, y[2]).0 - point(&land, minimum).0 + 0.5 * t * tilt * tilt;
         if self.above_every_barrier(&land, d, (y[2], minimum), e) {
             return None;

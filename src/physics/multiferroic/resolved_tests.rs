@@ -157,13 +157,10 @@ const LOCKED_CREEP_BUDGET: &str = "strain_direction=6.025e-3 load_torque=-4.567e
     max_substeps=9.820e2 schedule=1 rotor_locked=1 initial_onion_offset=8.787e-12 \
     strain=-6.229e-2 youngs_modulus=1.856e6 strain_drive=1";
 
-/// `steps` 1 us steps of a locked rotor's creeping onion (`case`) against an RK4 of the
-/// macrospin (its step a fiftieth of the onion's fastest rate, within 1/100 of the tolerance of
-/// the same RK4 at twice the step): not accuracy-limited, onion and tilt within the tolerance at
-/// every step's end, in at most `most` substeps a step.
-fn locked_creep_against_rk4(case_text: &str, steps: usize, most: u32) {
-    let (m, start, inputs) = case(&values(case_text)).unwrap();
-    let tol = m.params.tolerance;
+/// The motor, its state, inputs and drive at the start of the case `text`, and its state as the
+/// RK4's vector.
+pub(super) fn start_of(text: &str) -> (Motor, MotorState, MotorInputs, Drive, Vector) {
+    let (m, start, inputs) = case(&values(text)).unwrap();
     let d = m.drive_at(&inputs, 0.0);
     let y0 = [
         start.rotor_angle,
@@ -171,6 +168,16 @@ fn locked_creep_against_rk4(case_text: &str, steps: usize, most: u32) {
         start.onion_angle,
         start.onion_tilt,
     ];
+    (m, start, inputs, d, y0)
+}
+
+/// `steps` 1 us steps of a locked rotor's creeping onion (`case`) against an RK4 of the
+/// macrospin (its step a fiftieth of the onion's fastest rate, within 1/100 of the tolerance of
+/// the same RK4 at twice the step): not accuracy-limited, onion and tilt within the tolerance at
+/// every step's end, in at most `most` substeps a step.
+fn locked_creep_against_rk4(case_text: &str, steps: usize, most: u32) {
+    let (m, start, inputs, d, y0) = start_of(case_text);
+    let tol = m.params.tolerance;
     let (_, j) = m.rhs_jacobian(&y0, &d, 1e-12);
     let fastest = j[2][2].abs() + j[3][3].abs() + (j[2][3] * j[3][2]).abs().sqrt();
     let per_ns = 1e-9 * fastest / 0.02;

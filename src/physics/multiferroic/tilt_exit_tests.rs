@@ -1,23 +1,7 @@
 //! A Gilbert onion whose soft tilt carries it out of the small-tilt model's bounds
 //! ([`Motor::onion_leaves_bounds`]) against a plain RK4 of the motor's ODE.
 
-use super::onion_periods_tests::{case, values};
-use super::resolved_tests::rk4_span;
-use super::{Drive, Motor, MotorInputs, MotorState, Vector};
-
-/// The motor, its state, inputs and drive at the start of the case `text`, and its state as the
-/// RK4's vector.
-fn start_of(text: &str) -> (Motor, MotorState, MotorInputs, Drive, Vector) {
-    let (m, start, inputs) = case(&values(text)).unwrap();
-    let d = m.drive_at(&inputs, 0.0);
-    let y0 = [
-        start.rotor_angle,
-        start.rotor_speed,
-        start.onion_angle,
-        start.onion_tilt,
-    ];
-    (m, start, inputs, d, y0)
-}
+use super::resolved_tests::{rk4_span, start_of};
 
 /// A benchmark draw (the FMU's variables, full precision): the onion released 3.5e-4 rad from
 /// the rim of its well at damping 1.5e-3, its tilt stiffness 4.5e-7 of the well's curvature, so
