@@ -33,7 +33,8 @@ pub(super) struct Averager<'a> {
 
 impl Averager<'_> {
     /// The well at rotor angle `phi`: the last one's rims moved with its minimum (they bracket
-    /// the turning points; [`turning_point`] checks that they still do).
+    /// the turning points; [`turning_point`](super::orbit::turning_point) checks that they
+    /// still do).
     pub(super) fn well_at(&self, land: &Landscape) -> Option<Well> {
         let minimum = land.settle(self.well.minimum);
         let shift = minimum - self.well.minimum;

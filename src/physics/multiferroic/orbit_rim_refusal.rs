@@ -12,7 +12,7 @@
 //! could decide, or the onion left the well kept.
 //!
 //! A free rotor's landscape turns with it, and no well is kept from one check to the next; its
-//! onion is refused before the search ([`Motor::searched_well`]) where its energy above the
+//! onion is refused before the search ([`Motor::above_every_barrier`]) where its energy above the
 //! minimum exceeds [`RIM_MARGIN`] of the landscape's whole range, which bounds every barrier.
 //!
 //! [`RIM_MARGIN`]: super::orbit::RIM_MARGIN

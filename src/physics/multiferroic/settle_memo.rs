@@ -59,7 +59,7 @@ impl SettleMemo {
 impl SettleMemo {
     /// [`Angles::exact`] at the onion at `y` under `d`, kept: right after a switch the
     /// [`Motor::constrain`] that follows the branch checks computes the same fresh angles
-    /// ([`Self::hint`]).
+    /// ([`Self::fresh_hint`]).
     pub(super) fn fresh_angles(&self, y: &Vector, d: &Drive) -> Angles {
         if let Some(a) = self.fresh_at(y, d) {
             return a;

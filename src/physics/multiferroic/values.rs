@@ -84,7 +84,7 @@ pub struct MotorOutputs {
     pub applied_stress: f64,
 }
 
-/// What one call of [`Motor::step`] did.
+/// What one call of [`Motor::step`](super::Motor::step) did.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StepReport {
     pub outputs: MotorOutputs,
