@@ -1,7 +1,6 @@
 //! A locked rotor's heavily damped onion whose tilt is far softer than its curvature: after each
 //! switch it falls into its minimum within picoseconds and its tilt then creeps back over tens of
-//! nanoseconds. The tilt is an output: the averaged ringing may not drop it while it lasts, and
-//! the substeps that fail at the switch retry at the explicit pair's reach.
+//! nanoseconds. The tilt is an output: the averaged ringing may not drop it while it lasts.
 
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
