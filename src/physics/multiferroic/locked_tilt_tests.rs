@@ -5,7 +5,6 @@
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
 use super::ringing::Rims;
-use super::*;
 
 /// Damping 0.78, tolerance 0.011 rad, a 40 ns schedule: the tilt stiffness `T` is 1e-6 of the
 /// curvature at the minimum, the tilt's creep ~33 ns (`alpha / (g (1 + alpha^2) T)`).
