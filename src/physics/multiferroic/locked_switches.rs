@@ -1,7 +1,7 @@
 //! A locked rotor's Gilbert onion on a schedule faster than its ringing, once the step's budget
 //! is spent (see [`Motor::locked_budget_drop`]).
 
-use super::{reduced_direction, Drive, Motor, MotorInputs, StepRun};
+use super::{reduced_direction, Drive, Motor, MotorInputs, StepRun, GILBERT_SUBSTEP_WEIGHT};
 use std::f64::consts::PI;
 
 #[cfg(test)]
@@ -71,7 +71,13 @@ impl Motor {
             return false;
         }
         let ends = self.switch_ringing_ends(run, d, &s, settled, k, segment_end);
-        run.unresolvable = !ends;
+        // Where the onion's periods may still repeat (a ring decoupled from the onion, see
+        // `Self::skip_onion_periods`), refused only once the budget is spent: before that, a
+        // substep forced beyond the tolerance has flagged the step, and the forced substeps
+        // that follow the onion may still reach that repeat.
+        let spent = run.attempts.saturating_add(run.extra_cost);
+        let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
+        run.unresolvable = !ends && (broke || run.onion_decoupled != Some(true));
         ends
     }
 
