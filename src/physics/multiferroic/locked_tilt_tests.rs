@@ -43,3 +43,32 @@ fn soft_tilt_is_not_dropped_while_it_lasts() {
     let kept = m.averaged_ringing(&y, &d, minimum, &mut rims, remaining);
     assert!(kept.is_none(), "dropped: {kept:?}");
 }
+
+/// The same onion, in its minimum with that tilt, over a 20 ns step inside one segment of the
+/// schedule: the step's tilt is the RK4's (0.1 ps steps, checked against 0.05 ps) within the
+/// tolerance, unflagged, where dropping the ringing would report no tilt at all, over 20
+/// tolerances off.
+#[test]
+fn soft_tilt_step_ends_at_the_rk4_tilt() {
+    let (m, mut st, inputs) = case(&values(SOFT_TILT)).unwrap();
+    let d = m.drive_at(&inputs, 0.0);
+    let minimum = m.landscape(0.0, d.direction, d.stress).settle(20.9);
+    let y = [0.0, 0.0, minimum, -1.14];
+    let h = 2e-8;
+    let end = rk4_span(&m, &d, y, h, 200_000);
+    let finer = rk4_span(&m, &d, y, h, 400_000);
+    let tol = m.params.tolerance;
+    assert!((end[3] - finer[3]).abs() <= 1e-2 * tol, "{end:?} {finer:?}");
+    assert!(finer[3].abs() >= 20.0 * tol, "{finer:?}");
+    (st.onion_angle, st.onion_tilt) = (minimum, -1.14);
+    let report = m.step(&mut st, &inputs, h).unwrap();
+    let off = [st.onion_angle - finer[2], st.onion_tilt - finer[3]].map(|e| e.abs() / tol);
+    println!(
+        "{report:?}: off the RK4 by {off:?} tolerances (tilt {})",
+        finer[3]
+    );
+    assert!(
+        !report.accuracy_limited && off[0] <= 1.0 && off[1] <= 1.0,
+        "{off:?}"
+    );
+}
