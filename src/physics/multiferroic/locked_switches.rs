@@ -4,6 +4,11 @@
 use super::{reduced_direction, Drive, Motor, MotorInputs, StepRun, GILBERT_SUBSTEP_WEIGHT};
 use std::f64::consts::PI;
 
+/// The segments over which a locked step's refusal for its ringing is put off where the onion's
+/// periods may still repeat (see [`Motor::locked_budget_drop`]): the onion-periods skip needs two
+/// or three period ends alike.
+const REFUSAL_PUT_OFF: u32 = 3;
+
 #[cfg(test)]
 thread_local! {
     /// Passes of [`Motor::step`]'s loop on this thread (tests count them).
@@ -72,12 +77,22 @@ impl Motor {
         }
         let ends = self.switch_ringing_ends(run, d, &s, settled, k, segment_end);
         // Where the onion's periods may still repeat (a ring decoupled from the onion, see
-        // `Self::skip_onion_periods`), refused only once the budget is spent: before that, a
-        // substep forced beyond the tolerance has flagged the step, and the forced substeps
-        // that follow the onion may still reach that repeat.
+        // `Self::skip_onion_periods`, which compares their ends), the refusal is put off over
+        // [`REFUSAL_PUT_OFF`] segments while the budget lasts: the substeps go on (flagged where
+        // one was forced) and may reach that repeat at the next switches (a kept tilt, no
+        // longer dropped with the ringing, can leave the first periods' ends apart).
         let spent = run.attempts.saturating_add(run.extra_cost);
         let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
-        run.unresolvable = !ends && (broke || run.onion_decoupled != Some(true));
+        if !ends && !broke && run.onion_decoupled == Some(true) {
+            let (at, count) = &mut run.refusal_put_off;
+            if *at != segment_end {
+                (*at, *count) = (segment_end, *count + 1);
+            }
+            if *count <= REFUSAL_PUT_OFF {
+                return false;
+            }
+        }
+        run.unresolvable = !ends;
         ends
     }
 
