@@ -1,8 +1,13 @@
 //! A locked rotor's Gilbert onion on a schedule faster than its ringing, once the step's budget
 //! is spent (see [`Motor::locked_budget_drop`]).
 
-use super::{reduced_direction, Drive, Motor, MotorInputs, StepRun};
+use super::{reduced_direction, Drive, Motor, MotorInputs, StepRun, GILBERT_SUBSTEP_WEIGHT};
 use std::f64::consts::PI;
+
+/// The segments over which a locked step's refusal for its ringing is put off where the onion's
+/// periods may still repeat (see [`Motor::locked_budget_drop`]): the onion-periods skip needs two
+/// or three period ends alike.
+const REFUSAL_PUT_OFF: u32 = 3;
 
 #[cfg(test)]
 thread_local! {
@@ -25,8 +30,9 @@ impl Motor {
     /// - A ringing one is kept in the step's last segment, where its ringing is the output; before
     ///   it, it is dropped where every switch's ringing ends within the tolerance within its
     ///   period and the present ringing by the step's end ([`Self::switch_ringing_ends`]), and
-    ///   otherwise the step is refused (`run.unresolvable`). A drop into the minimum at every
-    ///   switch turns the onion with the strain where the resolved onion, its period of
+    ///   otherwise the step is refused (`run.unresolvable`; put off over [`REFUSAL_PUT_OFF`]
+    ///   segments while the budget lasts where the onion's periods may still repeat). A drop
+    ///   into the minimum at every switch turns the onion with the strain where the resolved onion, its period of
     ///   precession or of decay longer than the schedule's, barely follows it (1 us steps ended
     ///   up to 900 rad off an RK4), and forced substeps spanning several precession periods do
     ///   not follow it either.
@@ -71,6 +77,22 @@ impl Motor {
             return false;
         }
         let ends = self.switch_ringing_ends(run, d, &s, settled, k, segment_end);
+        // Where the onion's periods may still repeat (a ring decoupled from the onion, see
+        // `Self::skip_onion_periods`, which compares their ends), the refusal is put off over
+        // [`REFUSAL_PUT_OFF`] segments while the budget lasts: the substeps go on (flagged where
+        // one was forced) and may reach that repeat at the next switches (a kept tilt, no
+        // longer dropped with the ringing, can leave the first periods' ends apart).
+        let spent = run.attempts.saturating_add(run.extra_cost);
+        let broke = spent.saturating_add(GILBERT_SUBSTEP_WEIGHT) > self.params.max_substeps;
+        if !ends && !broke && run.onion_decoupled == Some(true) {
+            let (at, count) = &mut run.refusal_put_off;
+            if *at != segment_end {
+                (*at, *count) = (segment_end, *count + 1);
+            }
+            if *count <= REFUSAL_PUT_OFF {
+                return false;
+            }
+        }
         run.unresolvable = !ends;
         ends
     }

@@ -134,6 +134,8 @@ mod locked_stiff_tests;
 mod locked_switches;
 #[cfg(test)]
 mod locked_switches_tests;
+#[cfg(test)]
+mod locked_tilt_tests;
 mod long_steps;
 pub mod magnetics;
 pub mod model_exchange;

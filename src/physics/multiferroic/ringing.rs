@@ -193,15 +193,23 @@ impl Motor {
         if (settled - y[2]).abs() * (-rate * remaining).exp() > tol {
             return false;
         }
-        // The tilt, put to zero with the ringing, is an output as well: its reach
-        // `sqrt(2 E / T)` decays with the energy as the angle's does.
-        let excess =
-            land.energy(y[2]) - land.energy(settled) + 0.5 * self.tilt_stiffness * y[3] * y[3];
-        let tilt_reach = (2.0 * excess.max(0.0) / self.tilt_stiffness).sqrt();
+        let tilt_reach = self.tilt_reach(y, d, settled);
         self.trapped_ringing(y, d, settled, None)
             .is_some_and(|trap| {
                 trap.amplitude.max(tilt_reach) * (-trap.rate * remaining).exp() <= tol
             })
+    }
+
+    /// The reach `sqrt(2 E / T)` of a locked rotor's Gilbert onion's tilt (rad), `E` its energy
+    /// above the minimum `settled` of eq. 3.4, tilt included: the tilt, put to zero with the
+    /// ringing, is an output as well, and its reach decays with the energy as the angle's does.
+    /// Where the tilt stiffness `T` is far below the curvature (an onion that creeps back after
+    /// a switch on its slow, tilt-led mode) it is the tilt itself, far beyond the angle's reach.
+    fn tilt_reach(&self, y: &Vector, d: &Drive, settled: f64) -> f64 {
+        let land = self.landscape(y[0], d.direction, d.stress);
+        let excess =
+            land.energy(y[2]) - land.energy(settled) + 0.5 * self.tilt_stiffness * y[3] * y[3];
+        (2.0 * excess.max(0.0) / self.tilt_stiffness).sqrt()
     }
 
     /// The rotor's speed kick (rad/s) that replaces the Gilbert onion's ringing about the minimum
@@ -276,9 +284,14 @@ impl Motor {
             // no impulse, so only that counts), or its whole torque moves the rotor too little.
             // (A NaN fails every bound.)
             let tol = self.params.tolerance;
+            let tilt_reach = if d.locked {
+                self.tilt_reach(y, d, settled)
+            } else {
+                0.0
+            };
             let passes = |amplitude: f64, rate: f64| {
                 if d.locked {
-                    amplitude * (-rate * remaining).exp() <= tol
+                    amplitude.max(tilt_reach) * (-rate * remaining).exp() <= tol
                 } else {
                     speed * self.drag <= limit * rate
                         && amplitude * (k_bar.abs() + self.ring_bar_slope_bound * amplitude)
@@ -315,7 +328,8 @@ impl Motor {
         // A locked rotor takes no impulse, so the bounds below on it decide nothing: its onion's
         // ringing is dropped only once it has decayed by the segment's end.
         if d.locked {
-            return (amplitude * (-rate * remaining).exp() <= self.params.tolerance).then_some(0.0);
+            let reach = amplitude.max(self.tilt_reach(y, d, settled));
+            return (reach * (-rate * remaining).exp() <= self.params.tolerance).then_some(0.0);
         }
         // (A NaN fails every bound below.)
         if speed * self.drag > limit * rate {

@@ -86,6 +86,9 @@ pub(super) struct StepRun {
     /// A locked rotor's ringing onion outlasts what the budget left can resolve (see
     /// [`Motor::locked_budget_drop`]): the step is refused.
     pub(super) unresolvable: bool,
+    /// The segments (their ends) over which that refusal was put off for a repeat of the
+    /// onion's periods (see [`Motor::locked_budget_drop`]).
+    pub(super) refusal_put_off: (f64, u32),
     /// The energy bound of a locked rotor's Gilbert onion (see [`Motor::energy_checked_error`]).
     pub(super) rim_ledger: super::rim_energy::RimLedger,
     /// The energy bound of a free rotor's Gilbert onion (see
@@ -150,6 +153,7 @@ impl StepRun {
             bounds_exit_at: f64::NAN,
             schedule: None,
             unresolvable: false,
+            refusal_put_off: (f64::NAN, 0),
             rim_ledger: super::rim_energy::RimLedger::NONE,
             free_ledger: super::free_energy::FreeLedger::NONE,
             amplification: Default::default(),
