@@ -32,10 +32,10 @@ impl Motor {
     ///   period and the present ringing by the step's end ([`Self::switch_ringing_ends`]), and
     ///   otherwise the step is refused (`run.unresolvable`; put off over [`REFUSAL_PUT_OFF`]
     ///   segments while the budget lasts where the onion's periods may still repeat). A drop
-    ///   into the minimum at every switch turns the onion with the strain where the resolved onion, its period of
-    ///   precession or of decay longer than the schedule's, barely follows it (1 us steps ended
-    ///   up to 900 rad off an RK4), and forced substeps spanning several precession periods do
-    ///   not follow it either.
+    ///   into the minimum at every switch turns the onion with the strain where the resolved
+    ///   onion, its period of precession or of decay longer than the schedule's, barely follows
+    ///   it (1 us steps ended up to 900 rad off an RK4), and forced substeps spanning several
+    ///   precession periods do not follow it either.
     pub(super) fn locked_budget_drop(
         &self,
         run: &mut StepRun,
