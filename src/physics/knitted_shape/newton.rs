@@ -30,11 +30,23 @@ const SADDLE_STEPS: usize = 2;
 /// Step halvings when a step leaves a segment unable to close.
 const MAX_BACKTRACKS: usize = 30;
 
+/// What the fast path's steps after a release from a profile at its bounds depend on, beside
+/// the multiplier the release sets.
+struct Exchange {
+    radii: Vec<f64>,
+    releases: Vec<u8>,
+    /// Backtracks, edge holds and idle steps so far.
+    counters: (usize, usize, usize),
+    /// The last inertia-correcting shift and the solver's hint, as bits.
+    shifts: (u64, u64),
+}
+
 impl Solver {
     /// Maximizes `V` at `L = target` from the current rings and multiplier (the predictor).
     /// Converged to the robust solve's residual (`1e-10 S_row^2` per ring) with the length exact
     /// to `1e-13 L_max`; leaves `dr/dL` in `y` as [`Solver::sensitivity`] does. `None` if the
-    /// start does not close or Newton does not reach a maximum.
+    /// start does not close or Newton does not reach a maximum. Leaves in
+    /// [`Solver::shift_mattered`] whether `shift` changed (or, unset, would have changed) a step.
     pub(super) fn solve_newton(
         &mut self,
         geom: &ShapeGeometry,
@@ -62,7 +74,15 @@ impl Solver {
         let mut last_shift = self.shift_hint;
         let mut edge_holds = 0;
         let mut saddle_run = 0;
-        for iteration in 0..max_iterations + MAX_BACKTRACKS {
+        self.shift_mattered = false;
+        // The last release from a profile with every ring at a bound: the ring, the iteration,
+        // and what the steps after it depend on.
+        let mut exchange: Option<(usize, usize, Exchange)> = None;
+        let budget = max_iterations + MAX_BACKTRACKS;
+        let mut next_iteration = 0;
+        while next_iteration < budget {
+            let mut iteration = next_iteration;
+            next_iteration += 1;
             #[cfg(test)]
             super::solver::ITERATIONS.with(|c| c.set(c.get() + 1));
             let Some((length, volume)) = self.assemble(geom) else {
@@ -135,6 +155,32 @@ impl Solver {
                 if !(target < length) {
                     return None;
                 }
+                let state = Exchange {
+                    radii: self.radii.clone(),
+                    releases: self.releases.clone(),
+                    counters: (backtracks, edge_holds, idle),
+                    shifts: (last_shift.to_bits(), self.shift_hint.to_bits()),
+                };
+                if let Some((ring, at, before)) = exchange.take() {
+                    // The last release came back to the same profile with the same counts (its
+                    // ring on the floor again): releasing that ring again would repeat the same
+                    // iterations, up to its last release. They are counted, not taken.
+                    let mut expected = before.releases.clone();
+                    expected[ring] = self.releases[ring];
+                    if state.radii == before.radii
+                        && state.releases == expected
+                        && state.counters == before.counters
+                        && state.shifts == before.shifts
+                    {
+                        let repeats = usize::from(MAX_RELEASES - self.releases[ring]);
+                        iteration += repeats * (iteration - at);
+                        next_iteration = iteration + 1;
+                        self.releases[ring] = MAX_RELEASES;
+                        if iteration >= budget {
+                            return None;
+                        }
+                    }
+                }
                 let ratio = |j: usize| self.gv[j] / self.gl[j];
                 let j = (1..rings - 1)
                     .filter(|&j| {
@@ -143,6 +189,9 @@ impl Solver {
                     .min_by(|&a, &b| ratio(a).total_cmp(&ratio(b)))?;
                 lambda = ratio(j);
                 self.held[j] = false;
+                let mut state = state;
+                state.releases.clone_from(&self.releases);
+                exchange = Some((j, iteration, state));
                 self.releases[j] += 1;
                 set_changed = true;
             }
@@ -224,12 +273,17 @@ impl Solver {
             // radius and the slant's concavity (eq. 1.17) small, would be sent back below the
             // floor. The Hessian is then shifted until the reduced one is negative definite
             // (bordered inertia one), as in the robust solve, so the step ascends.
-            if shift
+            // Without the shift the same test is made (until it first holds) so that the caller
+            // knows whether the other setting would take any other step.
+            if (shift || !self.shift_mattered)
                 && pos + usize::from(gy < 0.0) != 1
                 && !(self.is_mirror_symmetric(r_ceiling)
                     && self.symmetric_ascents(lambda) == Some(1))
             {
-                (gx, gy) = self.shifted_products(lambda, s_row, &mut last_shift)?;
+                self.shift_mattered = true;
+                if shift {
+                    (gx, gy) = self.shifted_products(lambda, s_row, &mut last_shift)?;
+                }
             }
             // Newton step on (r, lambda): H dr - g dlambda = -R, g . dr = target - L.
             let dlambda = (target - length + gx) / gy;
