@@ -155,8 +155,13 @@ impl Solver {
         // at it), in that order; the end rings have one segment each.
         let (mut gv, mut gl, mut dv, mut dl) = (0.0, 0.0, 0.0, 0.0);
         let r_min = geom.min_radius;
+        // Slices of one length: the loop indexes them without bounds checks.
+        let radii = &self.radii[..rings];
+        let (sgv, sgl) = (&mut self.gv[..rings], &mut self.gl[..rings]);
+        let (sdv, sdl) = (&mut self.dv[..rings], &mut self.dl[..rings]);
+        let (sov, sol) = (&mut self.ov[..rings], &mut self.ol[..rings]);
         for i in 1..rings {
-            let (ra, rb) = (self.radii[i - 1], self.radii[i]);
+            let (ra, rb) = (radii[i - 1], radii[i]);
             let seg = match (self.floor_segment, self.segment_cache.get_mut(i - 1)) {
                 (Some(floor), _) if ra == r_min && rb == r_min => floor,
                 (_, Some(&mut (a, b, seg))) if a == ra && b == rb => seg,
@@ -171,12 +176,12 @@ impl Solver {
             l += seg.l;
             v += seg.v;
             let a = i - 1;
-            self.gv[a] = gv + seg.va;
-            self.gl[a] = gl + seg.la;
-            self.dv[a] = dv + seg.vaa;
-            self.dl[a] = dl + seg.laa;
-            self.ov[a] = seg.vab;
-            self.ol[a] = seg.lab;
+            sgv[a] = gv + seg.va;
+            sgl[a] = gl + seg.la;
+            sdv[a] = dv + seg.vaa;
+            sdl[a] = dl + seg.laa;
+            sov[a] = seg.vab;
+            sol[a] = seg.lab;
             (gv, gl, dv, dl) = (seg.vb, seg.lb, seg.vbb, seg.lbb);
         }
         let last = rings - 1;
@@ -211,8 +216,10 @@ impl Solver {
     /// The largest `|Hess V - lambda Hess L|` on the diagonal, the scale of a vanishing pivot.
     pub(super) fn pivot_scale(&self, lambda: f64) -> f64 {
         let mut scale = 0.0f64;
-        for j in 0..self.radii.len() {
-            scale = scale.max((self.dv[j] - lambda * self.dl[j]).abs());
+        let rings = self.radii.len();
+        let (dv, dl) = (&self.dv[..rings], &self.dl[..rings]);
+        for j in 0..rings {
+            scale = scale.max((dv[j] - lambda * dl[j]).abs());
         }
         scale
     }
