@@ -30,11 +30,23 @@ const SADDLE_STEPS: usize = 2;
 /// Step halvings when a step leaves a segment unable to close.
 const MAX_BACKTRACKS: usize = 30;
 
+/// What the fast path's steps after a release from a profile at its bounds depend on, beside
+/// the multiplier the release sets.
+struct Exchange {
+    radii: Vec<f64>,
+    releases: Vec<u8>,
+    /// Backtracks, edge holds and idle steps so far.
+    counters: (usize, usize, usize),
+    /// The last inertia-correcting shift and the solver's hint, as bits.
+    shifts: (u64, u64),
+}
+
 impl Solver {
     /// Maximizes `V` at `L = target` from the current rings and multiplier (the predictor).
     /// Converged to the robust solve's residual (`1e-10 S_row^2` per ring) with the length exact
     /// to `1e-13 L_max`; leaves `dr/dL` in `y` as [`Solver::sensitivity`] does. `None` if the
-    /// start does not close or Newton does not reach a maximum.
+    /// start does not close or Newton does not reach a maximum. Leaves in
+    /// [`Solver::shift_mattered`] whether `shift` changed (or, unset, would have changed) a step.
     pub(super) fn solve_newton(
         &mut self,
         geom: &ShapeGeometry,
@@ -62,7 +74,15 @@ impl Solver {
         let mut last_shift = self.shift_hint;
         let mut edge_holds = 0;
         let mut saddle_run = 0;
-        for iteration in 0..max_iterations + MAX_BACKTRACKS {
+        self.shift_mattered = false;
+        // The last release from a profile with every ring at a bound: the ring, the iteration,
+        // and what the steps after it depend on.
+        let mut exchange: Option<(usize, usize, Exchange)> = None;
+        let budget = max_iterations + MAX_BACKTRACKS;
+        let mut next_iteration = 0;
+        while next_iteration < budget {
+            let mut iteration = next_iteration;
+            next_iteration += 1;
             #[cfg(test)]
             super::solver::ITERATIONS.with(|c| c.set(c.get() + 1));
             let Some((length, volume)) = self.assemble(geom) else {
@@ -85,42 +105,47 @@ impl Solver {
             let mut projected = false;
             let mut residual = 0.0f64;
             let mut largest_term = 0.0f64;
+            // Slices of one length: the loop indexes them without bounds checks.
+            let (gv, gl) = (&self.gv[..rings], &self.gl[..rings]);
+            let (dv, dl) = (&self.dv[..rings], &self.dl[..rings]);
+            let (radii, held) = (&mut self.radii[..rings], &mut self.held[..rings]);
+            let releases = &mut self.releases[..rings];
             for j in 1..rings - 1 {
-                let z = self.gv[j] - lambda * self.gl[j];
-                let curvature = (self.dv[j] - lambda * self.dl[j]).abs();
+                let z = gv[j] - lambda * gl[j];
+                let curvature = (dv[j] - lambda * dl[j]).abs();
                 // The bound a ring is held at: the floor, or the ceiling where a bead's ring on a
                 // thin strand would take more than the row's strand as circumference.
-                let stuck = self.held[j] && self.releases[j] >= MAX_RELEASES;
+                let stuck = held[j] && releases[j] >= MAX_RELEASES;
                 let bound = if first {
-                    self.held[j].then_some(self.radii[j])
-                } else if self.radii[j] <= r_min {
+                    held[j].then_some(radii[j])
+                } else if radii[j] <= r_min {
                     // A ring that keeps falling back to the floor (its pull is at roundoff) is
                     // left there, as in the robust solve.
                     (z <= grad_tol || stuck).then_some(r_min)
-                } else if self.radii[j] >= r_ceiling {
+                } else if radii[j] >= r_ceiling {
                     (z >= -grad_tol || stuck).then_some(r_ceiling)
-                } else if (self.radii[j] - r_min) * curvature + z < 0.0 {
+                } else if (radii[j] - r_min) * curvature + z < 0.0 {
                     Some(r_min)
                 } else {
                     None
                 };
                 let hold = bound.is_some();
-                if hold != self.held[j] {
+                if hold != held[j] {
                     set_changed = true;
-                    self.held[j] = hold;
+                    held[j] = hold;
                     if !hold {
-                        self.releases[j] = self.releases[j].saturating_add(1);
+                        releases[j] = releases[j].saturating_add(1);
                     }
                 }
                 if let Some(r) = bound {
-                    if self.radii[j] != r {
-                        self.radii[j] = r;
+                    if radii[j] != r {
+                        radii[j] = r;
                         projected = true;
                     }
                 }
                 if !hold {
                     residual = residual.max(z.abs());
-                    largest_term = largest_term.max(self.gv[j].abs());
+                    largest_term = largest_term.max(gv[j].abs());
                 }
             }
             step = None;
@@ -135,6 +160,32 @@ impl Solver {
                 if !(target < length) {
                     return None;
                 }
+                let state = Exchange {
+                    radii: self.radii.clone(),
+                    releases: self.releases.clone(),
+                    counters: (backtracks, edge_holds, idle),
+                    shifts: (last_shift.to_bits(), self.shift_hint.to_bits()),
+                };
+                if let Some((ring, at, before)) = exchange.take() {
+                    // The last release came back to the same profile with the same counts (its
+                    // ring on the floor again): releasing that ring again would repeat the same
+                    // iterations, up to its last release. They are counted, not taken.
+                    let mut expected = before.releases.clone();
+                    expected[ring] = self.releases[ring];
+                    if state.radii == before.radii
+                        && state.releases == expected
+                        && state.counters == before.counters
+                        && state.shifts == before.shifts
+                    {
+                        let repeats = usize::from(MAX_RELEASES - self.releases[ring]);
+                        iteration += repeats * (iteration - at);
+                        next_iteration = iteration + 1;
+                        self.releases[ring] = MAX_RELEASES;
+                        if iteration >= budget {
+                            return None;
+                        }
+                    }
+                }
                 let ratio = |j: usize| self.gv[j] / self.gl[j];
                 let j = (1..rings - 1)
                     .filter(|&j| {
@@ -143,6 +194,9 @@ impl Solver {
                     .min_by(|&a, &b| ratio(a).total_cmp(&ratio(b)))?;
                 lambda = ratio(j);
                 self.held[j] = false;
+                let mut state = state;
+                state.releases.clone_from(&self.releases);
+                exchange = Some((j, iteration, state));
                 self.releases[j] += 1;
                 set_changed = true;
             }
@@ -224,20 +278,26 @@ impl Solver {
             // radius and the slant's concavity (eq. 1.17) small, would be sent back below the
             // floor. The Hessian is then shifted until the reduced one is negative definite
             // (bordered inertia one), as in the robust solve, so the step ascends.
-            if shift
+            // Without the shift the same test is made (until it first holds) so that the caller
+            // knows whether the other setting would take any other step.
+            if (shift || !self.shift_mattered)
                 && pos + usize::from(gy < 0.0) != 1
                 && !(self.is_mirror_symmetric(r_ceiling)
                     && self.symmetric_ascents(lambda) == Some(1))
             {
-                (gx, gy) = self.shifted_products(lambda, s_row, &mut last_shift)?;
+                self.shift_mattered = true;
+                if shift {
+                    (gx, gy) = self.shifted_products(lambda, s_row, &mut last_shift)?;
+                }
             }
             // Newton step on (r, lambda): H dr - g dlambda = -R, g . dr = target - L.
             let dlambda = (target - length + gx) / gy;
             let mut largest = 0.0f64;
+            let (held, x, y) = (&self.held[..rings], &mut self.x[..rings], &self.y[..rings]);
             for j in 0..rings {
-                if !self.held[j] {
-                    self.x[j] = -self.x[j] + dlambda * self.y[j];
-                    largest = largest.max(self.x[j].abs());
+                if !held[j] {
+                    x[j] = -x[j] + dlambda * y[j];
+                    largest = largest.max(x[j].abs());
                 }
             }
             if !largest.is_finite() || !dlambda.is_finite() {
@@ -254,8 +314,11 @@ impl Solver {
             // it) leaves the state where it was: after a few such steps the fast path gives up
             // instead of spending its remaining iterations there. The robust solve restarts from
             // the same prediction either way, so the table does not change.
-            let moved = (0..rings)
-                .map(|j| (self.radii[j] - self.base[j]).abs())
+            let moved = self
+                .radii
+                .iter()
+                .zip(&self.base)
+                .map(|(r, b)| (r - b).abs())
                 .fold(0.0, f64::max);
             idle = if moved <= 1e-13 * r_ceiling {
                 idle + 1
@@ -309,10 +372,13 @@ impl Solver {
     /// `g_L . x` and `g_L . y` over the free rings.
     fn border_products(&self) -> (f64, f64) {
         let (mut gx, mut gy) = (0.0, 0.0);
-        for j in 0..self.radii.len() {
-            if !self.held[j] {
-                gx += self.gl[j] * self.x[j];
-                gy += self.gl[j] * self.y[j];
+        let rings = self.radii.len();
+        let (held, gl) = (&self.held[..rings], &self.gl[..rings]);
+        let (x, y) = (&self.x[..rings], &self.y[..rings]);
+        for j in 0..rings {
+            if !held[j] {
+                gx += gl[j] * x[j];
+                gy += gl[j] * y[j];
             }
         }
         (gx, gy)
@@ -320,10 +386,12 @@ impl Solver {
 
     /// Free rings at `base + alpha x`, kept within `[r_min, r_ceiling]`.
     fn take_step(&mut self, alpha: f64, r_min: f64, r_ceiling: f64) {
-        for j in 0..self.radii.len() {
-            if !self.held[j] {
-                let r = self.base[j] + alpha * self.x[j];
-                self.radii[j] = crate::physics::numerics::bounds::limit(r, r_min, r_ceiling);
+        let rings = self.radii.len();
+        let (held, base, x) = (&self.held[..rings], &self.base[..rings], &self.x[..rings]);
+        for (j, radius) in self.radii.iter_mut().enumerate() {
+            if !held[j] {
+                let r = base[j] + alpha * x[j];
+                *radius = crate::physics::numerics::bounds::limit(r, r_min, r_ceiling);
             }
         }
     }

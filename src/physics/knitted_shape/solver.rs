@@ -49,9 +49,16 @@ pub(super) struct Solver {
     /// The last inertia-correcting shift the fast path used: the next solve's search for one
     /// starts a little below it (it changes slowly along the path).
     pub(super) shift_hint: f64,
+    /// Whether the last fast solve met an iterate where the inertia-correcting shift applies:
+    /// if not, the same solve with the other setting takes the same steps.
+    pub(super) shift_mattered: bool,
     /// The segment between two rings on the floor (`None` if it cannot close): the same for
     /// every such pair, and most segments of a pocket's early stroke.
     floor_segment: Option<Segment>,
+    /// Per segment, the end radii it was last evaluated at and the result: between rings held
+    /// at their bounds (beads at the ceiling beside rings on the floor, late on thin strands)
+    /// a segment stays the same over many iterations.
+    segment_cache: Vec<(f64, f64, Segment)>,
 }
 
 /// Converged point on the path.
@@ -89,7 +96,13 @@ impl Solver {
             releases: vec![0; rings],
             prefer_shift: false,
             shift_hint: 0.0,
+            shift_mattered: false,
             floor_segment: geom.segment(geom.min_radius, geom.min_radius),
+            // No radius equals NaN: every entry misses until it is first evaluated.
+            segment_cache: geom
+                .segment(geom.min_radius, geom.min_radius)
+                .map(|seg| vec![(f64::NAN, f64::NAN, seg); rings - 1])
+                .unwrap_or_default(),
         }
     }
 
@@ -142,21 +155,33 @@ impl Solver {
         // at it), in that order; the end rings have one segment each.
         let (mut gv, mut gl, mut dv, mut dl) = (0.0, 0.0, 0.0, 0.0);
         let r_min = geom.min_radius;
+        // Slices of one length: the loop indexes them without bounds checks.
+        let radii = &self.radii[..rings];
+        let (sgv, sgl) = (&mut self.gv[..rings], &mut self.gl[..rings]);
+        let (sdv, sdl) = (&mut self.dv[..rings], &mut self.dl[..rings]);
+        let (sov, sol) = (&mut self.ov[..rings], &mut self.ol[..rings]);
         for i in 1..rings {
-            let (ra, rb) = (self.radii[i - 1], self.radii[i]);
-            let seg = match self.floor_segment {
-                Some(floor) if ra == r_min && rb == r_min => floor,
-                _ => k.segment(ra, rb)?,
+            let (ra, rb) = (radii[i - 1], radii[i]);
+            let seg = match (self.floor_segment, self.segment_cache.get_mut(i - 1)) {
+                (Some(floor), _) if ra == r_min && rb == r_min => floor,
+                (_, Some(&mut (a, b, seg))) if a == ra && b == rb => seg,
+                (_, cached) => {
+                    let seg = k.segment(ra, rb)?;
+                    if let Some(entry) = cached {
+                        *entry = (ra, rb, seg);
+                    }
+                    seg
+                }
             };
             l += seg.l;
             v += seg.v;
             let a = i - 1;
-            self.gv[a] = gv + seg.va;
-            self.gl[a] = gl + seg.la;
-            self.dv[a] = dv + seg.vaa;
-            self.dl[a] = dl + seg.laa;
-            self.ov[a] = seg.vab;
-            self.ol[a] = seg.lab;
+            sgv[a] = gv + seg.va;
+            sgl[a] = gl + seg.la;
+            sdv[a] = dv + seg.vaa;
+            sdl[a] = dl + seg.laa;
+            sov[a] = seg.vab;
+            sol[a] = seg.lab;
             (gv, gl, dv, dl) = (seg.vb, seg.lb, seg.vbb, seg.lbb);
         }
         let last = rings - 1;
@@ -191,8 +216,10 @@ impl Solver {
     /// The largest `|Hess V - lambda Hess L|` on the diagonal, the scale of a vanishing pivot.
     pub(super) fn pivot_scale(&self, lambda: f64) -> f64 {
         let mut scale = 0.0f64;
-        for j in 0..self.radii.len() {
-            scale = scale.max((self.dv[j] - lambda * self.dl[j]).abs());
+        let rings = self.radii.len();
+        let (dv, dl) = (&self.dv[..rings], &self.dl[..rings]);
+        for j in 0..rings {
+            scale = scale.max((dv[j] - lambda * dl[j]).abs());
         }
         scale
     }
@@ -209,45 +236,55 @@ impl Solver {
         let tiny = 1e-14 * scale.max(f64::MIN_POSITIVE) + mu * 1e-14;
         let mut positive = 0;
         let mut prev_off = 0.0;
+        let (mut cp, mut xp, mut yp) = (0.0, 0.0, 0.0);
+        // Slices of one length: the loops index them without bounds checks.
+        let held = &self.held[..rings];
+        let (gv, gl) = (&self.gv[..rings], &self.gl[..rings]);
+        let (dv, dl) = (&self.dv[..rings], &self.dl[..rings]);
+        let (ov, ol) = (&self.ov[..rings], &self.ol[..rings]);
+        let (c, x, y) = (
+            &mut self.c[..rings],
+            &mut self.x[..rings],
+            &mut self.y[..rings],
+        );
         for j in 0..rings {
-            let held = self.held[j];
-            let diag = if held {
+            let free = !held[j];
+            let diag = if free {
+                dv[j] - lambda * dl[j] - mu
+            } else {
                 1.0
-            } else {
-                self.dv[j] - lambda * self.dl[j] - mu
             };
-            let off_here = if held || j + 1 >= rings || self.held[j + 1] {
+            let off_here = if free && j + 1 < rings && !held[j + 1] {
+                ov[j] - lambda * ol[j]
+            } else {
                 0.0
-            } else {
-                self.ov[j] - lambda * self.ol[j]
             };
-            let (rx, ry) = if held {
+            let (rx, ry) = if free {
+                (gv[j] - lambda * gl[j], gl[j])
+            } else {
                 (0.0, 0.0)
-            } else {
-                (self.gv[j] - lambda * self.gl[j], self.gl[j])
-            };
-            let (cp, xp, yp) = if j > 0 {
-                (self.c[j - 1], self.x[j - 1], self.y[j - 1])
-            } else {
-                (0.0, 0.0, 0.0)
             };
             let denom = diag - prev_off * cp;
             if !(denom.abs() > tiny) || !denom.is_finite() {
                 return None;
             }
-            if !held && denom > 0.0 {
+            if free && denom > 0.0 {
                 positive += 1;
             }
             // A held ring's row is the identity (no coupling reaches it): its pivot is exactly 1.
-            let inv = if held { 1.0 } else { 1.0 / denom };
-            self.c[j] = off_here * inv;
-            self.x[j] = (rx - prev_off * xp) * inv;
-            self.y[j] = (ry - prev_off * yp) * inv;
+            let inv = if free { 1.0 / denom } else { 1.0 };
+            (cp, xp, yp) = (
+                off_here * inv,
+                (rx - prev_off * xp) * inv,
+                (ry - prev_off * yp) * inv,
+            );
+            (c[j], x[j], y[j]) = (cp, xp, yp);
             prev_off = off_here;
         }
         for j in (0..rings - 1).rev() {
-            self.x[j] -= self.c[j] * self.x[j + 1];
-            self.y[j] -= self.c[j] * self.y[j + 1];
+            xp = x[j] - c[j] * xp;
+            yp = y[j] - c[j] * yp;
+            (x[j], y[j]) = (xp, yp);
         }
         Some(positive)
     }

@@ -361,7 +361,9 @@ fn predict(
 }
 
 /// The fast Newton path from `start` (a copy of `solver`): plain Newton and Newton with the
-/// inertia-correcting shift, the one the last solve succeeded with first.
+/// inertia-correcting shift, the one the last solve succeeded with first. The second is skipped
+/// where the shift applied at no iterate of the first: it would repeat the first step for step
+/// (often a full budget of iterations, late on thin strands).
 fn fast_solve(
     geom: &ShapeGeometry,
     solver: &mut Solver,
@@ -375,6 +377,9 @@ fn fast_solve(
         if let Some(p) = solver.solve_newton(geom, aim, max_iterations, shift) {
             solver.prefer_shift = shift;
             return Some(p);
+        }
+        if !solver.shift_mattered {
+            return None;
         }
     }
     None
