@@ -227,6 +227,8 @@ fn follow_path(
     let mut backup = solver.clone();
     let mut predicted = solver.clone();
     let mut spare = solver.clone();
+    // The state at the first node, from which full extension's curvature is taken.
+    let mut first_node: Option<(Solver, f64)> = None;
     'nodes: for &target in &targets {
         let mut sub = target - current;
         let mut halvings = 0;
@@ -269,6 +271,9 @@ fn follow_path(
                     edges = [Some((aim, solver.first_free())), edges[0]];
                     if current <= target {
                         pts.push(p);
+                        if pts.len() == 2 {
+                            first_node = Some((solver.clone(), p.length));
+                        }
                         // Past the free contraction (dV/dL >= 0: no tension left) the volume
                         // maximum soon stops being a maximum and the solves fail; a table that
                         // reaches zero force has all the stroke, so it ends at the first node
@@ -297,11 +302,29 @@ fn follow_path(
                 .to_string(),
         );
     }
-    // Full extension's curvature: the right-hand limit, from a solve just below it (falls back
-    // to the secant through the first node).
+    // Full extension's curvature: the right-hand limit of the maximum the path follows, from
+    // its first node solved back up to just below full extension (a new nucleation there can
+    // land on another pocket). Taken where that maximum meets the cylinder's slope there, so
+    // that the curvature is the slope's rate; where the slope jumps at full extension (a
+    // pocket nucleating at finite depth) no curvature is, and a nucleation there is kept, else
+    // the secant through the first node.
     let probe_length = l_max - 1e-3 * step;
+    let slope_at_full = pts[0].slope;
+    let climbed = first_node
+        .and_then(|(mut state, length)| {
+            climb_towards_full(geom, &mut state, length, pts[1].curvature, step)
+        })
+        .filter(|p| {
+            let below = l_max - p.length;
+            let rate = (slope_at_full - p.slope) / below;
+            let roundoff = 64.0 * f64::EPSILON * slope_at_full.abs() / below;
+            (rate - p.curvature).abs() <= 0.02 * p.curvature.abs() + roundoff
+        });
     let mut probe = Solver::new(geom);
-    pts[0].curvature = match nucleate(geom, &mut probe, probe_length) {
+    pts[0].curvature = match climbed
+        .ok_or(())
+        .or_else(|_| nucleate(geom, &mut probe, probe_length).map_err(|_| ()))
+    {
         Ok(p) if p.curvature.is_finite() => p.curvature,
         _ => {
             let p1 = pts[1];
@@ -314,6 +337,45 @@ fn follow_path(
         }
     };
     Ok(pts)
+}
+
+/// From the first node's converged `state` at `length`, follows the same maximum back up to
+/// `step / 1000` below full extension, halving the distance each solve: the tangent predictor
+/// stays on the branch where one jump of a whole step may not. `None` if a solve fails.
+fn climb_towards_full(
+    geom: &ShapeGeometry,
+    state: &mut Solver,
+    length: f64,
+    curvature: f64,
+    step: f64,
+) -> Option<PathPoint> {
+    let l_max = geom.max_length();
+    let (mut current, mut curvature) = (length, curvature);
+    let mut last = state.clone();
+    let mut start = state.clone();
+    let iterations = MAX_PATH_ITERATIONS + state.radii.len() / 16;
+    let mut found = None;
+    for k in 1..=10 {
+        let below = if k < 10 {
+            step / f64::powi(2.0, k)
+        } else {
+            1e-3 * step
+        };
+        let aim = l_max - below;
+        last.copy_from(state);
+        predict(geom, state, &last, aim - current, curvature, &[None, None]);
+        start.copy_from(state);
+        let p = match fast_solve(geom, state, &start, aim, iterations) {
+            Some(p) => p,
+            None => {
+                state.copy_from(&start);
+                state.solve(geom, aim).ok()?
+            }
+        };
+        (current, curvature) = (aim, p.curvature);
+        found = Some(p);
+    }
+    found
 }
 
 /// Sets the start of the next solve, `dl` (negative) from the last: every free ring moves along
@@ -503,3 +565,6 @@ fn nucleate(
         _ => Ok(found),
     }
 }
+
+#[cfg(test)]
+mod first_curvature_tests;
