@@ -136,6 +136,8 @@ mod locked_switches;
 mod locked_switches_tests;
 #[cfg(test)]
 mod locked_tilt_tests;
+#[cfg(test)]
+mod locked_unflagged_tests;
 mod long_steps;
 pub mod magnetics;
 pub mod model_exchange;
@@ -188,6 +190,8 @@ mod pair_midpoint;
 #[cfg(test)]
 mod pair_midpoint_tests;
 mod params;
+#[cfg(test)]
+mod pass_trace;
 mod periods;
 pub mod phi;
 #[cfg(test)]
