@@ -60,7 +60,7 @@ pub(super) fn trace_against_rk4(text: &str, steps: usize) {
             if plain {
                 let d = m.drive_at(&inputs, *t0);
                 println!(
-                    "  {i} [{label}] {t0:.6e}..{t1:.6e} psi {:.6} theta {:.4e} -> psi {:.6} theta {:.4e} rate {:.2e}/ns flag {limited}",
+                    "  {i} [{label}] {t0:.6e}..{t1:.6e} psi {:.6} theta {:.4e} -> psi {:?} theta {:?} rate {:.2e}/ns flag {limited}",
                     y0[2], y0[3], y1[2], y1[3], rk4_rate(&m, y0, &d).max(rk4_rate(&m, y1, &d))
                 );
                 continue;
@@ -173,4 +173,50 @@ fn linear_flow_at_the_minimum() {
         x[0] / tol,
         x[1] / tol
     );
+}
+
+/// A locked rotor's onion on a landscape 5.8e11 times stiffer than its tilt (`gilbert_damping`
+/// 0.12, tolerance 1.04e-9 rad, no schedule): within 1e-15 s the onion settles beside its
+/// minimum with a tilt of -1.117 rad, which then decays on the slow mode of the onion's
+/// linearization, `theta(t) = theta(t1) exp(-lambda (t - t1))` (`lambda` its slow eigenvalue,
+/// 8.0e6 /s; the equations are linear in the tilt and the angle stays within 1e-11 rad of the
+/// minimum). Against it the first 1 us step ends 3.55e5 tolerances off in tilt (the averaged
+/// ringing drops the tilt), 266 with the tilt kept (the exponential substeps of a block this
+/// stiff lose about 1e-6 of the tilt a substep, beyond their estimates of 0). Ignored: it fails.
+#[test]
+#[ignore]
+fn stiff_locked_tilt_decays_on_its_slow_mode() {
+    let (m, mut st, inputs, d, y0) = super::resolved_tests::start_of(
+        "strain_direction=-3.1002191807592154e8 stress=-3.948789659539256e4 \
+         load_torque=-2.915188660354659e-7 ring_outer_diameter=7.837451461560799e-1 \
+         ring_inner_diameter=1.035370771336858e-2 bar_length=3.4210622097133195e-4 \
+         bar_width=6.39162716150182e-5 thickness=1.0607461343112492e-7 \
+         saturation_magnetization=4.355039291841464e0 magnetostriction=-2.8791103888862945e-3 \
+         wall_volume=7.77674560293228e-11 density=3.1722774403025265e4 \
+         fluid_viscosity=1.6959714680699903e-2 gilbert_damping=1.2029041133580391e-1 \
+         tolerance=1.0440132657313633e-9 step_angle=-5.976616289125117e0 \
+         step_period=1.782970712804833e3 stress_amplitude=-3.1497651246790237e9 \
+         schedule_initial_direction=-7.61318701039412e-1 onion_model=1 max_substeps=11968 \
+         schedule=0 rotor_locked=1 initial_onion_offset=-1.132617672120048e-6 \
+         strain=8.060435449644146e-2 youngs_modulus=1.9847058949682484e10 strain_drive=1",
+    );
+    let tol = m.params.tolerance;
+    let t1 = 1e-15;
+    let mut early = st;
+    m.step(&mut early, &inputs, t1).unwrap();
+    let report = m.step(&mut st, &inputs, 1e-6).unwrap();
+    // The slow eigenvalue of `g [[-a k, -T], [k, -a T]]` at the step's end (its minimum).
+    let (_, j) = m.rhs_jacobian(&[y0[0], 0.0, st.onion_angle, 0.0], &d, 1e-12);
+    let trace = -(j[2][2] + j[3][3]);
+    let det = j[2][2] * j[3][3] - j[2][3] * j[3][2];
+    let slow = 2.0 * det / (trace + (trace * trace - 4.0 * det).sqrt());
+    let tilt = early.onion_tilt * (-slow * (1e-6 - t1)).exp();
+    println!(
+        "tilt at {t1:e} s {:e}; end tilt {:e} against {tilt:e}: {:.3e} tolerances, flagged {}",
+        early.onion_tilt,
+        st.onion_tilt,
+        (st.onion_tilt - tilt) / tol,
+        report.accuracy_limited
+    );
+    assert!(report.accuracy_limited || (st.onion_tilt - tilt).abs() <= tol);
 }
