@@ -128,7 +128,17 @@ fn locked_outcomes_from_log() {
                     row += &format!(
                         " ok({} {} {:e} {:e});",
                         r.substeps, r.accuracy_limited, st.onion_angle, st.onion_tilt
-                    )
+                    );
+                    if std::env::var("LOCKED_BOUNDS").is_ok() {
+                        let bound = super::amplification::AMPLIFICATION.with(|c| c.replace(0.0));
+                        let land = m.landscape(0.0, inputs.strain_direction, inputs.stress);
+                        let stiffest =
+                            land.ring_bar.stiffness_bound() + 2.0 * land.magnetoelastic.abs();
+                        row += &format!(
+                            " [bound {bound:.2e} aspect {:.2e}]",
+                            (m.tilt_stiffness / stiffest).sqrt()
+                        );
+                    }
                 }
                 Err(e) => {
                     let kind = if e.contains("ringing on the locked rotor") {

@@ -48,11 +48,15 @@ pub(super) fn trace_against_rk4(text: &str, steps: usize) {
             start.onion_tilt,
         ];
         let per_ns = rk4_rate(&m, &y0, &d);
+        let land = m.landscape(y0[0], d.direction, d.stress);
+        let stiffest = land.ring_bar.stiffness_bound() + 2.0 * land.magnetoelastic.abs();
         println!(
-            "step {k}: {} substeps, flagged {}, {} passes, rk4 {per_ns:.0}/ns",
+            "step {k}: {} substeps, flagged {}, {} passes, rk4 {per_ns:.0}/ns, amplification bound {:.3e}, sqrt(T/K) {:.3e}",
             report.substeps,
             report.accuracy_limited,
-            trace.len()
+            trace.len(),
+            super::amplification::AMPLIFICATION.with(|c| c.get()),
+            (m.tilt_stiffness / stiffest).sqrt()
         );
         let mut truth = start;
         let plain = std::env::var("TRACE_NO_RK4").is_ok();
@@ -219,4 +223,66 @@ fn stiff_locked_tilt_decays_on_its_slow_mode() {
         report.accuracy_limited
     );
     assert!(report.accuracy_limited || (st.onion_tilt - tilt).abs() <= tol);
+}
+
+/// Each locked Gilbert case of a benchmark log (`MOTOR_CASES`) whose label is listed in
+/// `LOCKED_LABELS` (comma-separated, e.g. `random 189369`): each of three 1 us steps' flag, its
+/// amplification bound and its end's onion and tilt against an RK4 of the macrospin from the
+/// step's start (at 1/50 of the onion's fastest period, skipped beyond `RK4_MOST` steps).
+#[test]
+#[ignore]
+fn locked_step_ends_against_rk4() {
+    let (Ok(path), Ok(labels)) = (std::env::var("MOTOR_CASES"), std::env::var("LOCKED_LABELS"))
+    else {
+        return;
+    };
+    let most: f64 = std::env::var("RK4_MOST").map_or(2e7, |s| s.parse().unwrap());
+    let labels: Vec<&str> = labels.split(',').collect();
+    for line in std::fs::read_to_string(path).unwrap().lines() {
+        let Some(rest) = line.split("slow step: ").nth(1) else {
+            continue;
+        };
+        let label = rest.split(':').next().unwrap_or_default();
+        if !labels.contains(&label) {
+            continue;
+        }
+        let text = line.rsplit('[').next().unwrap_or_default();
+        let (m, mut st, inputs) = super::onion_periods_tests::case(
+            &super::onion_periods_tests::values(text.trim_end_matches(']')),
+        )
+        .unwrap();
+        let tol = m.params.tolerance;
+        for k in 0..3 {
+            let start = st;
+            let Ok(report) = m.step(&mut st, &inputs, 1e-6) else {
+                println!("{label} step {k}: refused");
+                break;
+            };
+            let bound = super::amplification::AMPLIFICATION.with(|c| c.get());
+            let y0 = [
+                start.rotor_angle,
+                start.rotor_speed,
+                start.onion_angle,
+                start.onion_tilt,
+            ];
+            let d = m.drive_at(&inputs, start.time);
+            let per_ns = rk4_rate(&m, &y0, &d);
+            if per_ns * 1e3 > most {
+                println!(
+                    "{label} step {k}: flagged {} bound {bound:.2e}: RK4 skipped ({per_ns:.1e}/ns)",
+                    report.accuracy_limited
+                );
+                continue;
+            }
+            let a = rk4(&m, &start, &inputs, st.time, per_ns);
+            let b = rk4(&m, &start, &inputs, st.time, 2.0 * per_ns);
+            println!(
+                "{label} step {k}: flagged {} bound {bound:.2e}: onion {:.3e} tilt {:.3e} tolerances off (RK4 halved {:.1e})",
+                report.accuracy_limited,
+                (st.onion_angle - b[2]) / tol,
+                (st.onion_tilt - b[3]) / tol,
+                (a[2] - b[2]).abs().max((a[3] - b[3]).abs()) / tol
+            );
+        }
+    }
 }
