@@ -206,13 +206,19 @@ impl Motor {
             #[cfg(test)]
             PAIR_AFTER_RK4.with(|c| c.set(c.get() + 1));
             match self.gilbert_embedded_step(y, dt, d, &start) {
-                Some((u, err)) if err <= 1.0 || rk4.is_none() => return Some((u, err, dt, None)),
+                Some((u, err)) if err <= 1.0 || rk4.is_none() => {
+                    #[cfg(test)]
+                    super::pass_trace::trace_label("pair");
+                    return Some((u, err, dt, None));
+                }
                 _ => {}
             }
             if let Some((u, err, _)) = rk4 {
                 return Some((u, err, dt, None));
             }
         }
+        #[cfg(test)]
+        super::pass_trace::trace_label("doubled");
         self.doubled_step(y, dt, d)
             .map(|(u, err)| (u, err, dt, None))
     }
