@@ -124,6 +124,8 @@ mod locked_budget_forecast;
 #[cfg(test)]
 mod locked_budget_forecast_tests;
 #[cfg(test)]
+mod locked_onion_increments_tests;
+#[cfg(test)]
 mod locked_refusal_tests;
 mod locked_ringing;
 #[cfg(test)]
