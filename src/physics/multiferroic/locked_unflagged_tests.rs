@@ -116,6 +116,8 @@ fn trace_locked_case() {
         return;
     };
     let steps = std::env::var("LOCKED_STEPS").map_or(3, |s| s.parse().unwrap());
+    let off = std::env::var("CLOSED_FORM_OFF").is_ok();
+    super::etd_blocks::CLOSED_FORM_OFF.with(|c| c.set(off));
     trace_against_rk4(&text, steps);
 }
 
@@ -283,6 +285,69 @@ fn locked_step_ends_against_rk4() {
                 (st.onion_angle - b[2]) / tol,
                 (st.onion_tilt - b[3]) / tol,
                 (a[2] - b[2]).abs().max((a[3] - b[3]).abs()) / tol
+            );
+        }
+    }
+}
+
+/// Each locked Gilbert case of a benchmark log (`MOTOR_CASES`) listed in `LOCKED_LABELS`, for
+/// onions too stiff for an RK4: each step's end tilt against its exact decay on the slow mode of
+/// the onion's linearization from a point `SETTLED_AFTER` s into the step (default 1e-9 s, its
+/// fast mode long over; the slow eigenvalue at that point's angle and at the end's, which differ
+/// where a switch changes the landscape). `CLOSED_FORM_OFF` takes the general exponential.
+#[test]
+#[ignore]
+fn locked_tilts_against_their_slow_decay() {
+    let (Ok(path), Ok(labels)) = (std::env::var("MOTOR_CASES"), std::env::var("LOCKED_LABELS"))
+    else {
+        return;
+    };
+    let off = std::env::var("CLOSED_FORM_OFF").is_ok();
+    super::etd_blocks::CLOSED_FORM_OFF.with(|c| c.set(off));
+    let settled: f64 = std::env::var("SETTLED_AFTER").map_or(1e-9, |s| s.parse().unwrap());
+    let labels: Vec<&str> = labels.split(',').collect();
+    for line in std::fs::read_to_string(path).unwrap().lines() {
+        let Some(rest) = line.split("slow step: ").nth(1) else {
+            continue;
+        };
+        let label = rest.split(':').next().unwrap_or_default();
+        if !labels.contains(&label) {
+            continue;
+        }
+        let text = line.rsplit('[').next().unwrap_or_default();
+        let (m, mut st, inputs) = super::onion_periods_tests::case(
+            &super::onion_periods_tests::values(text.trim_end_matches(']')),
+        )
+        .unwrap();
+        let tol = m.params.tolerance;
+        let slow = |s: &super::MotorState| {
+            let d = m.drive_at(&inputs, s.time);
+            let (_, j) = m.rhs_jacobian(&[s.rotor_angle, 0.0, s.onion_angle, 0.0], &d, 1e-12);
+            let trace = -(j[2][2] + j[3][3]);
+            let det = j[2][2] * j[3][3] - j[2][3] * j[3][2];
+            2.0 * det / (trace + (trace * trace - 4.0 * det).sqrt())
+        };
+        for k in 0..3 {
+            let mut early = st;
+            let Ok(_) = m.step(&mut early, &inputs, settled) else {
+                println!("{label} step {k}: refused");
+                break;
+            };
+            let Ok(report) = m.step(&mut st, &inputs, 1e-6) else {
+                println!("{label} step {k}: refused");
+                break;
+            };
+            let left = 1e-6 - settled;
+            let (a, b) = (slow(&early), slow(&st));
+            let exact = |lambda: f64| early.onion_tilt * (-lambda * left).exp();
+            println!(
+                "{label} step {k}: flagged {} {} substeps: tilt {:e}, {:.3e} / {:.3e} tolerances off (slow {a:.4e} / {b:.4e} /s, tilt at {settled:e} s {:.3e})",
+                report.accuracy_limited,
+                report.substeps,
+                st.onion_tilt,
+                (st.onion_tilt - exact(a)) / tol,
+                (st.onion_tilt - exact(b)) / tol,
+                early.onion_tilt
             );
         }
     }
