@@ -36,7 +36,9 @@ impl Motor {
     /// its `phi_1` column, as [`Self::exponential_step`]), then with the linearization's defect
     /// `D = F(u1) - F(y) - J (u1 - y)` the correction `2 h phi_3(hJ) D`, which is the error
     /// estimate of `u1` and, within the tolerance, is added to it (as in the quasi-static
-    /// rotor's [`Self::embedded_step`]).
+    /// rotor's [`Self::embedded_step`]). A locked rotor's stiff onion block takes `u1` in closed
+    /// form from its eigenvalues instead ([`locked_onion_increments`]), which keeps its slow
+    /// mode's decay where the 4x4 exponential's rounding would not.
     ///
     /// `phi_3(hJ)` is taken as its (0,1) Padé approximant `(6 I - 1.5 hJ)^-1`, one 4x4 solve
     /// instead of a second (7x7) exponential: it matches `phi_3` to second order at 0, and over
