@@ -231,8 +231,9 @@ pub(super) fn locked_onion_increments(
     let block = |h: f64| [[h * j[2][2], h * j[2][3]], [h * j[3][2], h * j[3][3]]];
     let z = block(dt);
     let norm = (z[0][0].abs() + z[0][1].abs()).max(z[1][0].abs() + z[1][1].abs());
-    // (False for a NaN norm too.)
-    if !(norm > CLOSED_FORM_ABOVE) {
+    // (Within for a NaN norm too.)
+    let beyond = norm > CLOSED_FORM_ABOVE;
+    if !beyond {
         return (None, 0.0);
     }
     let increments = |h: f64| {

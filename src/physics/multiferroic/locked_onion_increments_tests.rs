@@ -75,7 +75,7 @@ fn keeps_the_slow_mode_of_a_stiff_block() {
                 [length * j[3][2], length * j[3][3]],
             ];
             let (_, general) = expm_affine(&block, &[length * f[2], length * f[3]]).unwrap();
-            let exact = (-length as f64).exp_m1();
+            let exact = (-length).exp_m1();
             let err = (2..4)
                 .map(|i| (ours[i] - exact).abs() / exact.abs())
                 .fold(0.0, f64::max);
@@ -86,4 +86,21 @@ fn keeps_the_slow_mode_of_a_stiff_block() {
             assert!(err <= 1e-13, "{length}: {ours:?} {exact:e}");
         }
     }
+}
+
+/// A stiff block with repeated eigenvalues has no closed form: the general exponential takes it
+/// and its rounding is returned for the pair's estimate; a block of norm within the general
+/// exponential's accuracy takes it with none.
+#[test]
+fn a_repeated_stiff_block_returns_its_rounding() {
+    let f = [0.0, 0.0, 1.0, -2.0];
+    let mut j = [[0.0; 4]; 4];
+    j[2][2] = -1e8;
+    j[3][3] = -1e8;
+    let (increments, rounding) = locked_onion_increments(&f, &j, 1e-2);
+    assert!(increments.is_none());
+    assert!(rounding > 1e-10 && rounding < 1e-8, "{rounding:e}");
+    let (increments, rounding) = locked_onion_increments(&f, &j, 1e-6);
+    assert!(increments.is_none());
+    assert_eq!(rounding, 0.0);
 }
