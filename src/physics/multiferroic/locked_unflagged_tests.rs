@@ -186,9 +186,9 @@ fn linear_flow_at_the_minimum() {
 /// minimum with a tilt of -1.117 rad, which then decays on the slow mode of the onion's
 /// linearization, `theta(t) = theta(t1) exp(-lambda (t - t1))` (`lambda` its slow eigenvalue,
 /// 8.0e6 /s; the equations are linear in the tilt and the angle stays within 1e-11 rad of the
-/// minimum). Against it the first 1 us step ends 3.55e5 tolerances off in tilt (the averaged
-/// ringing drops the tilt), 266 with the tilt kept (the exponential substeps of a block this
-/// stiff lose about 1e-6 of the tilt a substep, beyond their estimates of 0). Ignored: it fails.
+/// minimum). The first 1 us step must end on it: a dropped tilt ends 3.55e5 tolerances off, and
+/// exponential substeps whose onion block (norm up to 4e10) is taken by scaling and squaring lose
+/// 5e-6 to 7e-4 of the slow mode's decay each, beyond their estimates of 0 (266 tolerances off).
 #[test]
 fn stiff_locked_tilt_decays_on_its_slow_mode() {
     let (m, mut st, inputs, d, y0) = super::resolved_tests::start_of(
