@@ -2,6 +2,7 @@
 //! Dormand-Prince pair while the onion rings, and an exponential RK4 on a stiff rotor or a locked
 //! rotor's overdamped onion.
 
+use super::etd_blocks::locked_onion_increments;
 use super::phi::Phi2x2;
 use super::{Angles, Drive, Motor, Vector};
 use crate::physics::numerics::dormand_prince;
@@ -35,7 +36,9 @@ impl Motor {
     /// its `phi_1` column, as [`Self::exponential_step`]), then with the linearization's defect
     /// `D = F(u1) - F(y) - J (u1 - y)` the correction `2 h phi_3(hJ) D`, which is the error
     /// estimate of `u1` and, within the tolerance, is added to it (as in the quasi-static
-    /// rotor's [`Self::embedded_step`]).
+    /// rotor's [`Self::embedded_step`]). A locked rotor's stiff onion block takes `u1` in closed
+    /// form from its eigenvalues instead ([`locked_onion_increments`]), which keeps its slow
+    /// mode's decay where the 4x4 exponential's rounding would not.
     ///
     /// `phi_3(hJ)` is taken as its (0,1) Padé approximant `(6 I - 1.5 hJ)^-1`, one 4x4 solve
     /// instead of a second (7x7) exponential: it matches `phi_3` to second order at 0, and over
@@ -54,8 +57,23 @@ impl Motor {
     ) -> Option<(Vector, f64)> {
         let (f0, j) = (start.f, start.j);
         let unit = self.speed_unit();
-        let (half, increments) = self.increments_of::<4>(&f0, &j, dt, true, unit)?;
+        let (closed_form, rounding) = match d.locked {
+            true => locked_onion_increments(&f0, &j, dt),
+            false => (None, 0.0),
+        };
+        let (half, increments) = match closed_form {
+            Some(increments) => increments,
+            None => self.increments_of::<4>(&f0, &j, dt, true, unit)?,
+        };
         let u1 = self.finish_exponential_step(y, &increments, d)?;
+        // A locked onion's stiff block without the closed form: the exponential's rounding.
+        let exponential_rounding = |i: usize| match i {
+            0 | 1 => 0.0,
+            _ => {
+                let scale = |k: usize| increments[k].abs().max(dt * f0[k].abs());
+                rounding * scale(2).max(scale(3))
+            }
+        };
         let f1 = self.gilbert_rate(&u1, d, &start.angles.moved(u1[2], u1[0], d.direction));
         let step: Vector = std::array::from_fn(|i| u1[i] - y[i]);
         let rhs: Vector = std::array::from_fn(|i| {
@@ -71,6 +89,10 @@ impl Motor {
         let err = self
             .error_norm(|i| correction[i], y, &u3)
             .max(self.pair_midpoint_error(y, dt, d, start, &half?)?);
+        let err = match rounding > 0.0 {
+            true => err + self.error_norm(exponential_rounding, y, &u3),
+            false => err,
+        };
         // Beyond the tolerance the correction is no longer small and the substep, if taken at
         // all (forced at the budget's minimum size), is the exponential Euler step, which is
         // exact for the linear part and cannot amplify (see [`Self::rhs_jacobian`]).

@@ -163,6 +163,8 @@ impl Motor {
                 .then(|| self.locked_stiff_step(y, dt, d, &start))
                 .flatten()
             {
+                #[cfg(test)]
+                super::pass_trace::trace_label("stiff");
                 return Some((u, err, dt, None));
             }
             let explicit = (!forced)
@@ -176,6 +178,8 @@ impl Motor {
                 // a period, is followed exactly (one substep a switch instead of 3.5). Under a
                 // free rotor only: it gains nothing for a locked rotor's onion.
                 if err <= 1.0 || d.locked {
+                    #[cfg(test)]
+                    super::pass_trace::trace_label("dp5");
                     return Some((u, err, dt, None));
                 }
                 return match self.gilbert_embedded_step(y, dt, d, &start) {
@@ -190,6 +194,8 @@ impl Motor {
                 .then(|| self.gilbert_exponential_rk4_step(y, dt, d, &start))
                 .flatten();
             if let Some((u, err, _)) = rk4.filter(|(_, err, _)| *err <= 1.0) {
+                #[cfg(test)]
+                super::pass_trace::trace_label("exprk4");
                 return Some((u, err, dt, None));
             }
             // A rejection by little is the step-size rule's overshoot, which the exponential pair
@@ -200,13 +206,19 @@ impl Motor {
             #[cfg(test)]
             PAIR_AFTER_RK4.with(|c| c.set(c.get() + 1));
             match self.gilbert_embedded_step(y, dt, d, &start) {
-                Some((u, err)) if err <= 1.0 || rk4.is_none() => return Some((u, err, dt, None)),
+                Some((u, err)) if err <= 1.0 || rk4.is_none() => {
+                    #[cfg(test)]
+                    super::pass_trace::trace_label("pair");
+                    return Some((u, err, dt, None));
+                }
                 _ => {}
             }
             if let Some((u, err, _)) = rk4 {
                 return Some((u, err, dt, None));
             }
         }
+        #[cfg(test)]
+        super::pass_trace::trace_label("doubled");
         self.doubled_step(y, dt, d)
             .map(|(u, err)| (u, err, dt, None))
     }
@@ -445,6 +457,8 @@ impl Motor {
                         err,
                     )
                 };
+                #[cfg(test)]
+                super::pass_trace::trace_label(&format!("err {err:.3}"));
                 (u, err, taken, a)
             });
         run.extra_cost = run.extra_cost.saturating_add(bisections);

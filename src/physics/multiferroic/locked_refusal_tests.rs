@@ -104,6 +104,8 @@ fn locked_outcomes_from_log() {
         return;
     };
     let mut out = String::new();
+    let off = std::env::var("CLOSED_FORM_OFF").is_ok();
+    super::etd_blocks::CLOSED_FORM_OFF.with(|c| c.set(off));
     for line in std::fs::read_to_string(path).unwrap().lines() {
         let Some(rest) = line.split("slow step: ").nth(1) else {
             continue;
@@ -128,7 +130,17 @@ fn locked_outcomes_from_log() {
                     row += &format!(
                         " ok({} {} {:e} {:e});",
                         r.substeps, r.accuracy_limited, st.onion_angle, st.onion_tilt
-                    )
+                    );
+                    if std::env::var("LOCKED_BOUNDS").is_ok() {
+                        let bound = super::amplification::AMPLIFICATION.with(|c| c.replace(0.0));
+                        let land = m.landscape(0.0, inputs.strain_direction, inputs.stress);
+                        let stiffest =
+                            land.ring_bar.stiffness_bound() + 2.0 * land.magnetoelastic.abs();
+                        row += &format!(
+                            " [bound {bound:.2e} aspect {:.2e}]",
+                            (m.tilt_stiffness / stiffest).sqrt()
+                        );
+                    }
                 }
                 Err(e) => {
                     let kind = if e.contains("ringing on the locked rotor") {

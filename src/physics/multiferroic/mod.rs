@@ -124,6 +124,8 @@ mod locked_budget_forecast;
 #[cfg(test)]
 mod locked_budget_forecast_tests;
 #[cfg(test)]
+mod locked_onion_increments_tests;
+#[cfg(test)]
 mod locked_refusal_tests;
 mod locked_ringing;
 #[cfg(test)]
@@ -136,6 +138,8 @@ mod locked_switches;
 mod locked_switches_tests;
 #[cfg(test)]
 mod locked_tilt_tests;
+#[cfg(test)]
+mod locked_unflagged_tests;
 mod long_steps;
 pub mod magnetics;
 pub mod model_exchange;
@@ -188,6 +192,8 @@ mod pair_midpoint;
 #[cfg(test)]
 mod pair_midpoint_tests;
 mod params;
+#[cfg(test)]
+mod pass_trace;
 mod periods;
 pub mod phi;
 #[cfg(test)]

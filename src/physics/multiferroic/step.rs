@@ -290,11 +290,15 @@ impl Motor {
             }
             #[cfg(test)]
             super::locked_switches::PASSES.with(|c| c.set(c.get() + 1));
+            #[cfg(test)]
+            super::pass_trace::trace_pass(&run, "");
             if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
                 if self.skip_repeated_periods(&mut run, s)
                     || self.skip_onion_periods(&mut run, s, inputs)
                     || self.advance_onion_linear(&mut run, s, inputs)
                 {
+                    #[cfg(test)]
+                    super::pass_trace::trace_label("periods/linear");
                     continue;
                 }
             }
@@ -306,13 +310,21 @@ impl Motor {
             if run.following != segment_end
                 && self.advance_decoupled_segment(&mut run, &d, segment_end, budget, true)
             {
+                #[cfg(test)]
+                super::pass_trace::trace_label("decoupled");
                 continue;
             }
+            #[cfg(test)]
+            let was_following = run.following == segment_end;
             let model = if !self.quasi_static() && self.follows_branch(&mut run, &d, segment_end) {
                 twin.get_or_init(|| self.quasi_static_twin())
             } else {
                 self
             };
+            #[cfg(test)]
+            if !was_following && run.following == segment_end {
+                super::pass_trace::trace_label(if run.limited { "drop" } else { "relaxed" });
+            }
             if run.unresolvable {
                 // A step whose switches outnumber its passes is refused for them, whichever
                 // refusal comes first.
@@ -331,9 +343,13 @@ impl Motor {
             }
             run.enter_segment(segment_end, d.direction);
             if self.skip_strain_held_periods(&mut run, &d, segment_end) {
+                #[cfg(test)]
+                super::pass_trace::trace_label("strain_held");
                 continue;
             }
             if model.advance_spinning(&mut run, &d, segment_end) {
+                #[cfg(test)]
+                super::pass_trace::trace_label("spinning");
                 continue;
             }
             if model.quasi_static()
@@ -342,11 +358,15 @@ impl Motor {
             {
                 run.settle_tried_for = segment_end;
                 if model.advance_overdamped(&mut run, &d, segment_end) {
+                    #[cfg(test)]
+                    super::pass_trace::trace_label("overdamped");
                     continue;
                 }
             }
             if !model.quasi_static() && run.attempts >= run.orbit_check_at {
                 if self.advance_linear_ringing(&mut run, &d, segment_end) {
+                    #[cfg(test)]
+                    super::pass_trace::trace_label("linear_ringing");
                     continue;
                 }
                 // Tried at attempts spaced by an eighth of those made, as the averaged ringing.
@@ -360,17 +380,31 @@ impl Motor {
                 if let Some(a) = advance {
                     run.attempts = run.attempts.saturating_add(a.steps);
                     run.extra_cost = run.extra_cost.saturating_add(a.extra_cost());
+                    #[cfg(test)]
+                    super::pass_trace::trace_label("orbits");
                     continue;
                 }
             }
             if model.advance_held_torque(&mut run, &d, segment_end) {
+                #[cfg(test)]
+                super::pass_trace::trace_label("held_torque");
                 continue;
             }
             if model.advance_decoupled_segment(&mut run, &d, segment_end, budget, false) {
+                #[cfg(test)]
+                super::pass_trace::trace_label("decoupled2");
                 continue;
             }
+            #[cfg(test)]
+            super::pass_trace::trace_label(if model.quasi_static() {
+                "branch"
+            } else {
+                "substep"
+            });
             model.substep(&mut run, &d, segment_end, budget);
         }
+        #[cfg(test)]
+        super::pass_trace::trace_pass(&run, "");
         if run.t < run.t_end {
             return Err(too_many_switches());
         }
