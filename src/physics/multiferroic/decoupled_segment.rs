@@ -3,7 +3,7 @@
 //! on its exact drift (see [`Motor::advance_decoupled_segment`]).
 
 use super::angles::{turned_back, Angles};
-use super::etd_blocks::BlockPhi;
+use super::block_phi::BlockPhi;
 use super::gilbert::fifth_order_error;
 use super::integrator::step_factor;
 use super::{Drive, Motor, StepRun, GILBERT_SUBSTEP_WEIGHT};

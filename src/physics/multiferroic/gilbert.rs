@@ -2,7 +2,7 @@
 //! Dormand-Prince pair while the onion rings, and an exponential RK4 on a stiff rotor or a locked
 //! rotor's overdamped onion.
 
-use super::etd_blocks::locked_onion_increments;
+use super::block_phi::locked_onion_increments;
 use super::phi::Phi2x2;
 use super::{Angles, Drive, Motor, Vector};
 use crate::physics::numerics::dormand_prince;

@@ -2,7 +2,7 @@
 //! the general scaling-and-squaring exponential where that is accurate, and against the exact
 //! decay of a diagonal block's modes where it is not.
 
-use super::etd_blocks::locked_onion_increments;
+use super::block_phi::locked_onion_increments;
 use crate::physics::numerics::expm::expm_affine;
 
 /// A locked Jacobian with the onion block `g [[-a k, -T], [k, -a T]]` (its linearization at a

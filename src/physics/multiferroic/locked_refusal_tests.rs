@@ -105,7 +105,7 @@ fn locked_outcomes_from_log() {
     };
     let mut out = String::new();
     let off = std::env::var("CLOSED_FORM_OFF").is_ok();
-    super::etd_blocks::CLOSED_FORM_OFF.with(|c| c.set(off));
+    super::block_phi::CLOSED_FORM_OFF.with(|c| c.set(off));
     for line in std::fs::read_to_string(path).unwrap().lines() {
         let Some(rest) = line.split("slow step: ").nth(1) else {
             continue;

@@ -117,7 +117,7 @@ fn trace_locked_case() {
     };
     let steps = std::env::var("LOCKED_STEPS").map_or(3, |s| s.parse().unwrap());
     let off = std::env::var("CLOSED_FORM_OFF").is_ok();
-    super::etd_blocks::CLOSED_FORM_OFF.with(|c| c.set(off));
+    super::block_phi::CLOSED_FORM_OFF.with(|c| c.set(off));
     trace_against_rk4(&text, steps);
 }
 
@@ -238,7 +238,7 @@ fn locked_step_ends_against_rk4() {
         return;
     };
     let off = std::env::var("CLOSED_FORM_OFF").is_ok();
-    super::etd_blocks::CLOSED_FORM_OFF.with(|c| c.set(off));
+    super::block_phi::CLOSED_FORM_OFF.with(|c| c.set(off));
     let most: f64 = std::env::var("RK4_MOST").map_or(2e7, |s| s.parse().unwrap());
     let labels: Vec<&str> = labels.split(',').collect();
     for line in std::fs::read_to_string(path).unwrap().lines() {
@@ -303,7 +303,7 @@ fn locked_tilts_against_their_slow_decay() {
         return;
     };
     let off = std::env::var("CLOSED_FORM_OFF").is_ok();
-    super::etd_blocks::CLOSED_FORM_OFF.with(|c| c.set(off));
+    super::block_phi::CLOSED_FORM_OFF.with(|c| c.set(off));
     let settled: f64 = std::env::var("SETTLED_AFTER").map_or(1e-9, |s| s.parse().unwrap());
     let labels: Vec<&str> = labels.split(',').collect();
     for line in std::fs::read_to_string(path).unwrap().lines() {

@@ -75,6 +75,7 @@ mod amplification;
 #[cfg(test)]
 mod amplification_tests;
 pub mod angles;
+mod block_phi;
 pub mod branch;
 mod branch_settle;
 #[cfg(test)]

@@ -3,7 +3,7 @@
 //! s) ds` (scaling and squaring of a Taylor series, `numerics::expm`, independent of the 2x2
 //! closed forms).
 
-use super::etd_blocks::block_phi1;
+use super::block_phi::block_phi1;
 use super::onion_linear::{flow, Flow, M2};
 use crate::physics::numerics::expm::expm;
 

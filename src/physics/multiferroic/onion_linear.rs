@@ -3,7 +3,7 @@
 //! affine maps (see [`Motor::advance_onion_linear`]).
 
 use super::angles::turned_back;
-use super::etd_blocks::block_phi1;
+use super::block_phi::block_phi1;
 use super::{Motor, MotorInputs, StepRun, SteppingSchedule};
 use crate::physics::numerics::expm2::expm2;
 

@@ -1,7 +1,6 @@
 //! A trace of [`Motor::step`](super::Motor::step)'s passes, for tests that compare each path's
 //! piece of a step with an RK4.
 
-use super::step::StepRun;
 use super::Vector;
 
 /// A pass's record: its path's labels, start time and state, end time and state, and whether
@@ -25,18 +24,20 @@ pub(super) fn trace_label(label: &str) {
     });
 }
 
-pub(super) fn trace_pass(run: &StepRun, _: &str) {
-    if PASS_TRACE.with(|t| t.borrow().is_none()) {
+/// Closes the pending pass at time `t` and state `y` (`limited`: the step flagged so far) and,
+/// before the step's end `t_end`, opens the next.
+pub(super) fn trace_pass(t: f64, y: Vector, limited: bool, t_end: f64) {
+    if PASS_TRACE.with(|trace| trace.borrow().is_none()) {
         return;
     }
     if let Some((label, t0, y0)) = PENDING.with(|p| p.borrow_mut().take()) {
-        PASS_TRACE.with(|t| {
-            if let Some(v) = t.borrow_mut().as_mut() {
-                v.push((label, t0, y0, run.t, run.y, run.limited));
+        PASS_TRACE.with(|trace| {
+            if let Some(v) = trace.borrow_mut().as_mut() {
+                v.push((label, t0, y0, t, y, limited));
             }
         });
     }
-    if run.t < run.t_end {
-        PENDING.with(|p| *p.borrow_mut() = Some((String::new(), run.t, run.y)));
+    if t < t_end {
+        PENDING.with(|p| *p.borrow_mut() = Some((String::new(), t, y)));
     }
 }

@@ -291,7 +291,7 @@ impl Motor {
             #[cfg(test)]
             super::locked_switches::PASSES.with(|c| c.set(c.get() + 1));
             #[cfg(test)]
-            super::pass_trace::trace_pass(&run, "");
+            super::pass_trace::trace_pass(run.t, run.y, run.limited, run.t_end);
             if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
                 if self.skip_repeated_periods(&mut run, s)
                     || self.skip_onion_periods(&mut run, s, inputs)
@@ -404,7 +404,7 @@ impl Motor {
             model.substep(&mut run, &d, segment_end, budget);
         }
         #[cfg(test)]
-        super::pass_trace::trace_pass(&run, "");
+        super::pass_trace::trace_pass(run.t, run.y, run.limited, run.t_end);
         if run.t < run.t_end {
             return Err(too_many_switches());
         }

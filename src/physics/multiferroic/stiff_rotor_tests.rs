@@ -1,7 +1,7 @@
 //! A ringing onion on a stiff free rotor against a plain RK4 of the motor's ODE, and the `phi`
 //! functions of a 2x2 block against their integral.
 
-use super::etd_blocks::BlockPhi;
+use super::block_phi::BlockPhi;
 use super::onion_periods_tests::{case, values};
 use super::resolved_tests::rk4_span;
 
