@@ -226,6 +226,32 @@ fn stiff_locked_tilt_decays_on_its_slow_mode() {
     assert!(report.accuracy_limited || (st.onion_tilt - tilt).abs() <= tol);
 }
 
+/// The cases of a benchmark log (`MOTOR_CASES`, its "slow step" lines) whose labels are listed in
+/// `LOCKED_LABELS` (comma-separated, e.g. `random 189369`), each with its motor, start and inputs;
+/// `None` without both. `CLOSED_FORM_OFF` takes the general exponential.
+fn listed_cases() -> Option<Vec<(String, Motor, MotorState, MotorInputs)>> {
+    let path = std::env::var("MOTOR_CASES").ok()?;
+    let labels = std::env::var("LOCKED_LABELS").ok()?;
+    let off = std::env::var("CLOSED_FORM_OFF").is_ok();
+    super::block_phi::CLOSED_FORM_OFF.with(|c| c.set(off));
+    let labels: Vec<&str> = labels.split(',').collect();
+    let text = std::fs::read_to_string(path).unwrap();
+    let listed = text.lines().filter_map(|line| {
+        let rest = line.split("slow step: ").nth(1)?;
+        let label = rest.split(':').next().unwrap_or_default();
+        if !labels.contains(&label) {
+            return None;
+        }
+        let values = line.rsplit('[').next().unwrap_or_default();
+        let (m, st, inputs) = super::onion_periods_tests::case(
+            &super::onion_periods_tests::values(values.trim_end_matches(']')),
+        )
+        .unwrap();
+        Some((label.to_string(), m, st, inputs))
+    });
+    Some(listed.collect())
+}
+
 /// Each locked Gilbert case of a benchmark log (`MOTOR_CASES`) whose label is listed in
 /// `LOCKED_LABELS` (comma-separated, e.g. `random 189369`): each of three 1 us steps' flag, its
 /// amplification bound and its end's onion and tilt against an RK4 of the macrospin from the
@@ -233,27 +259,11 @@ fn stiff_locked_tilt_decays_on_its_slow_mode() {
 #[test]
 #[ignore]
 fn locked_step_ends_against_rk4() {
-    let (Ok(path), Ok(labels)) = (std::env::var("MOTOR_CASES"), std::env::var("LOCKED_LABELS"))
-    else {
+    let Some(cases) = listed_cases() else {
         return;
     };
-    let off = std::env::var("CLOSED_FORM_OFF").is_ok();
-    super::block_phi::CLOSED_FORM_OFF.with(|c| c.set(off));
     let most: f64 = std::env::var("RK4_MOST").map_or(2e7, |s| s.parse().unwrap());
-    let labels: Vec<&str> = labels.split(',').collect();
-    for line in std::fs::read_to_string(path).unwrap().lines() {
-        let Some(rest) = line.split("slow step: ").nth(1) else {
-            continue;
-        };
-        let label = rest.split(':').next().unwrap_or_default();
-        if !labels.contains(&label) {
-            continue;
-        }
-        let text = line.rsplit('[').next().unwrap_or_default();
-        let (m, mut st, inputs) = super::onion_periods_tests::case(
-            &super::onion_periods_tests::values(text.trim_end_matches(']')),
-        )
-        .unwrap();
+    for (label, m, mut st, inputs) in cases {
         let tol = m.params.tolerance;
         for k in 0..3 {
             let start = st;
@@ -298,27 +308,11 @@ fn locked_step_ends_against_rk4() {
 #[test]
 #[ignore]
 fn locked_tilts_against_their_slow_decay() {
-    let (Ok(path), Ok(labels)) = (std::env::var("MOTOR_CASES"), std::env::var("LOCKED_LABELS"))
-    else {
+    let Some(cases) = listed_cases() else {
         return;
     };
-    let off = std::env::var("CLOSED_FORM_OFF").is_ok();
-    super::block_phi::CLOSED_FORM_OFF.with(|c| c.set(off));
     let settled: f64 = std::env::var("SETTLED_AFTER").map_or(1e-9, |s| s.parse().unwrap());
-    let labels: Vec<&str> = labels.split(',').collect();
-    for line in std::fs::read_to_string(path).unwrap().lines() {
-        let Some(rest) = line.split("slow step: ").nth(1) else {
-            continue;
-        };
-        let label = rest.split(':').next().unwrap_or_default();
-        if !labels.contains(&label) {
-            continue;
-        }
-        let text = line.rsplit('[').next().unwrap_or_default();
-        let (m, mut st, inputs) = super::onion_periods_tests::case(
-            &super::onion_periods_tests::values(text.trim_end_matches(']')),
-        )
-        .unwrap();
+    for (label, m, mut st, inputs) in cases {
         let tol = m.params.tolerance;
         let slow = |s: &super::MotorState| {
             let d = m.drive_at(&inputs, s.time);
