@@ -57,9 +57,10 @@ impl Motor {
     ) -> Option<(Vector, f64)> {
         let (f0, j) = (start.f, start.j);
         let unit = self.speed_unit();
-        let (closed_form, rounding) = match d.locked {
-            true => locked_onion_increments(&f0, &j, dt),
-            false => (None, 0.0),
+        let (closed_form, rounding) = if d.locked {
+            locked_onion_increments(&f0, &j, dt)
+        } else {
+            (None, 0.0)
         };
         let (half, increments) = match closed_form {
             Some(increments) => increments,
@@ -89,9 +90,10 @@ impl Motor {
         let err = self
             .error_norm(|i| correction[i], y, &u3)
             .max(self.pair_midpoint_error(y, dt, d, start, &half?)?);
-        let err = match rounding > 0.0 {
-            true => err + self.error_norm(exponential_rounding, y, &u3),
-            false => err,
+        let err = if rounding > 0.0 {
+            err + self.error_norm(exponential_rounding, y, &u3)
+        } else {
+            err
         };
         // Beyond the tolerance the correction is no longer small and the substep, if taken at
         // all (forced at the budget's minimum size), is the exponential Euler step, which is
