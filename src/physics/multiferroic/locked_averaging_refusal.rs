@@ -14,23 +14,17 @@
 //! loss per orbit over the period. Every orbit's turning points lie at least `sqrt(2 E / K)` from
 //! the minimum (`U - U(psi*) <= K s^2 / 2`).
 
+use super::locked_ringing::TIME_MARGIN;
 use super::onion::Landscape;
-use super::orbit::Well;
+use super::orbit::{Well, RIM_MARGIN};
+use super::orbit_advance::{MAX_LOSS_PER_ORBIT, MIN_ORBITS};
 use super::orbit_phase::{envelope, pendulum_anharmonicity, SAFETY};
 use super::Motor;
 use std::f64::consts::PI;
 
-/// The averaged advance's orbit count, energy margin to its rims, loss per orbit, refusal of a
-/// linearization and least orbits (`orbit_advance.rs`'s `MIN_ORBITS` and `MAX_LOSS_PER_ORBIT`,
-/// `orbit.rs`'s `RIM_MARGIN`), taken here as the bounds below use them.
-const ADVANCE_MIN_ORBITS: f64 = 8.0;
-const ADVANCE_RIM_MARGIN: f64 = 0.9;
-const ADVANCE_MAX_LOSS: f64 = 0.05;
 /// The energy held beyond the advance's rim margin, as a fraction of the barrier (the well's
 /// rims found afresh by each check).
 const RIM_ROUNDING: f64 = 1e-3;
-/// The averaged decay time's share of the time left (`locked_ringing.rs`'s `TIME_MARGIN`).
-const DECAY_TIME_MARGIN: f64 = 0.75;
 /// The slack kept against the checks' own rounding (the well's curvature, the quadrature's
 /// period and width, found afresh by each check): each bound is held this factor beyond its
 /// check's threshold.
@@ -83,9 +77,8 @@ impl Motor {
         // The averaged decay time's cheap refusal at both ends of the horizon.
         let linear_rate = g * alpha * (k + t);
         let e1 = tol * tol * (5.0 * k / 12.0).min(0.5 * t);
-        let refuses = |e: f64, left: f64| {
-            (e / e1).ln() > SLACK * 2.0 * DECAY_TIME_MARGIN * left * linear_rate
-        };
+        let refuses =
+            |e: f64, left: f64| (e / e1).ln() > SLACK * 2.0 * TIME_MARGIN * left * linear_rate;
         let linear_loss = 2.0 * PI * alpha * (k + t) / (k * t).sqrt();
         let decay_refused =
             linear_loss > 0.1 || (refuses(energy, remaining) && refuses(low, remaining - horizon));
@@ -93,10 +86,10 @@ impl Motor {
             return false;
         }
         // The averaged advance: refused at its rims, ...
-        if low > (ADVANCE_RIM_MARGIN + RIM_ROUNDING) * well.barrier {
+        if low > (RIM_MARGIN + RIM_ROUNDING) * well.barrier {
             return true;
         }
-        if linear_loss > 2.0 * ADVANCE_MAX_LOSS {
+        if linear_loss > 2.0 * MAX_LOSS_PER_ORBIT {
             return true;
         }
         // ... or neither dropping the ringing ...
@@ -112,7 +105,7 @@ impl Motor {
             return false;
         }
         // ... nor bounding its phase's drift within the tolerance.
-        let orbits = ADVANCE_MIN_ORBITS.min(2.0 * (width / slack).ln() / ADVANCE_MAX_LOSS);
+        let orbits = MIN_ORBITS.min(2.0 * (width / slack).ln() / MAX_LOSS_PER_ORBIT);
         let end_width = width * (-0.5 * fastest * remaining).exp();
         let shift = alpha * alpha * (t - k) * (t - k) / (8.0 * k * t);
         let mu = pendulum_anharmonicity(low / well.barrier);

@@ -25,7 +25,7 @@ const MAX_LOSS_PER_ORBIT: f64 = 0.1;
 /// The averaged decay time is held within this fraction of the time left in the segment: the
 /// actual energy, staircase-like over each orbit, lags the averaged one by at most an orbit's
 /// loss, and the averaging errs by the loss per orbit to second order.
-const TIME_MARGIN: f64 = 0.75;
+pub(super) const TIME_MARGIN: f64 = 0.75;
 /// An orbit's quadrature in [`Motor::locked_ringing_decays`] (about 1.4 us) in the budget's
 /// units, substeps of the quasi-static onion (0.32 us, see [`super::GILBERT_SUBSTEP_WEIGHT`]),
 /// so that the budget bounds the check's cost as it bounds the substeps'.

@@ -15,10 +15,10 @@ use crate::physics::numerics::rk4::rk4_step;
 use std::f64::consts::PI;
 
 /// At most this fraction of the energy lost per orbit (the averaging's small parameter).
-const MAX_LOSS_PER_ORBIT: f64 = 0.05;
+pub(super) const MAX_LOSS_PER_ORBIT: f64 = 0.05;
 /// The averaged advance is tried when the segment has at least this many orbits left (fewer
 /// are resolved at about the cost of the averaged advance's entry and exit).
-const MIN_ORBITS: f64 = 8.0;
+pub(super) const MIN_ORBITS: f64 = 8.0;
 /// An evaluation of the averaged equations' right-hand side (an orbit's quadrature and the
 /// well's minimum, about 2 us) in the budget's units, substeps of the quasi-static onion
 /// (0.32 us, see [`super::GILBERT_SUBSTEP_WEIGHT`]).
