@@ -1,6 +1,7 @@
 //! Exponential Rosenbrock substeps with an embedded error estimate (each onion model its own pair;
 //! step doubling where neither applies); see [`Motor::step`].
 
+use super::pass_trace::{trace_error, trace_label};
 use super::{phi, Angles, Drive, Motor, StepRun, Vector, MAX_ANGLE};
 use crate::physics::numerics::expm;
 
@@ -163,8 +164,7 @@ impl Motor {
                 .then(|| self.locked_stiff_step(y, dt, d, &start))
                 .flatten()
             {
-                #[cfg(test)]
-                super::pass_trace::trace_label("stiff");
+                trace_label("stiff");
                 return Some((u, err, dt, None));
             }
             let explicit = (!forced)
@@ -178,8 +178,7 @@ impl Motor {
                 // a period, is followed exactly (one substep a switch instead of 3.5). Under a
                 // free rotor only: it gains nothing for a locked rotor's onion.
                 if err <= 1.0 || d.locked {
-                    #[cfg(test)]
-                    super::pass_trace::trace_label("dp5");
+                    trace_label("dp5");
                     return Some((u, err, dt, None));
                 }
                 return match self.gilbert_embedded_step(y, dt, d, &start) {
@@ -194,8 +193,7 @@ impl Motor {
                 .then(|| self.gilbert_exponential_rk4_step(y, dt, d, &start))
                 .flatten();
             if let Some((u, err, _)) = rk4.filter(|(_, err, _)| *err <= 1.0) {
-                #[cfg(test)]
-                super::pass_trace::trace_label("exprk4");
+                trace_label("exprk4");
                 return Some((u, err, dt, None));
             }
             // A rejection by little is the step-size rule's overshoot, which the exponential pair
@@ -207,8 +205,7 @@ impl Motor {
             PAIR_AFTER_RK4.with(|c| c.set(c.get() + 1));
             match self.gilbert_embedded_step(y, dt, d, &start) {
                 Some((u, err)) if err <= 1.0 || rk4.is_none() => {
-                    #[cfg(test)]
-                    super::pass_trace::trace_label("pair");
+                    trace_label("pair");
                     return Some((u, err, dt, None));
                 }
                 _ => {}
@@ -217,8 +214,7 @@ impl Motor {
                 return Some((u, err, dt, None));
             }
         }
-        #[cfg(test)]
-        super::pass_trace::trace_label("doubled");
+        trace_label("doubled");
         self.doubled_step(y, dt, d)
             .map(|(u, err)| (u, err, dt, None))
     }
@@ -457,8 +453,7 @@ impl Motor {
                         err,
                     )
                 };
-                #[cfg(test)]
-                super::pass_trace::trace_label(&format!("err {err:.3}"));
+                trace_error(err);
                 (u, err, taken, a)
             });
         run.extra_cost = run.extra_cost.saturating_add(bisections);

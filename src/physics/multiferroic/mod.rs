@@ -193,7 +193,6 @@ mod pair_midpoint;
 #[cfg(test)]
 mod pair_midpoint_tests;
 mod params;
-#[cfg(test)]
 mod pass_trace;
 mod periods;
 pub mod phi;

@@ -3,6 +3,7 @@
 
 use super::branch_settle::Relaxed;
 use super::locked_ringing::ORBIT_WEIGHT;
+use super::pass_trace::{trace_label, trace_pass};
 use super::ringing::Rims;
 use super::{Angles, Drive, Motor, MotorInputs, MotorState, StepReport, Vector, MAX_STEP};
 
@@ -290,15 +291,13 @@ impl Motor {
             }
             #[cfg(test)]
             super::locked_switches::PASSES.with(|c| c.set(c.get() + 1));
-            #[cfg(test)]
-            super::pass_trace::trace_pass(run.t, run.y, run.limited, run.t_end);
+            trace_pass(run.t, run.y, run.limited, run.t_end);
             if let (Some(s), true) = (inputs.schedule.get(), run.t == run.segment_end) {
                 if self.skip_repeated_periods(&mut run, s)
                     || self.skip_onion_periods(&mut run, s, inputs)
                     || self.advance_onion_linear(&mut run, s, inputs)
                 {
-                    #[cfg(test)]
-                    super::pass_trace::trace_label("periods/linear");
+                    trace_label("periods/linear");
                     continue;
                 }
             }
@@ -310,8 +309,7 @@ impl Motor {
             if run.following != segment_end
                 && self.advance_decoupled_segment(&mut run, &d, segment_end, budget, true)
             {
-                #[cfg(test)]
-                super::pass_trace::trace_label("decoupled");
+                trace_label("decoupled");
                 continue;
             }
             #[cfg(test)]
@@ -323,7 +321,7 @@ impl Motor {
             };
             #[cfg(test)]
             if !was_following && run.following == segment_end {
-                super::pass_trace::trace_label(if run.limited { "drop" } else { "relaxed" });
+                trace_label(if run.limited { "drop" } else { "relaxed" });
             }
             if run.unresolvable {
                 // A step whose switches outnumber its passes is refused for them, whichever
@@ -343,13 +341,11 @@ impl Motor {
             }
             run.enter_segment(segment_end, d.direction);
             if self.skip_strain_held_periods(&mut run, &d, segment_end) {
-                #[cfg(test)]
-                super::pass_trace::trace_label("strain_held");
+                trace_label("strain_held");
                 continue;
             }
             if model.advance_spinning(&mut run, &d, segment_end) {
-                #[cfg(test)]
-                super::pass_trace::trace_label("spinning");
+                trace_label("spinning");
                 continue;
             }
             if model.quasi_static()
@@ -358,15 +354,13 @@ impl Motor {
             {
                 run.settle_tried_for = segment_end;
                 if model.advance_overdamped(&mut run, &d, segment_end) {
-                    #[cfg(test)]
-                    super::pass_trace::trace_label("overdamped");
+                    trace_label("overdamped");
                     continue;
                 }
             }
             if !model.quasi_static() && run.attempts >= run.orbit_check_at {
                 if self.advance_linear_ringing(&mut run, &d, segment_end) {
-                    #[cfg(test)]
-                    super::pass_trace::trace_label("linear_ringing");
+                    trace_label("linear_ringing");
                     continue;
                 }
                 // Tried at attempts spaced by an eighth of those made, as the averaged ringing.
@@ -380,31 +374,26 @@ impl Motor {
                 if let Some(a) = advance {
                     run.attempts = run.attempts.saturating_add(a.steps);
                     run.extra_cost = run.extra_cost.saturating_add(a.extra_cost());
-                    #[cfg(test)]
-                    super::pass_trace::trace_label("orbits");
+                    trace_label("orbits");
                     continue;
                 }
             }
             if model.advance_held_torque(&mut run, &d, segment_end) {
-                #[cfg(test)]
-                super::pass_trace::trace_label("held_torque");
+                trace_label("held_torque");
                 continue;
             }
             if model.advance_decoupled_segment(&mut run, &d, segment_end, budget, false) {
-                #[cfg(test)]
-                super::pass_trace::trace_label("decoupled2");
+                trace_label("decoupled2");
                 continue;
             }
-            #[cfg(test)]
-            super::pass_trace::trace_label(if model.quasi_static() {
+            trace_label(if model.quasi_static() {
                 "branch"
             } else {
                 "substep"
             });
             model.substep(&mut run, &d, segment_end, budget);
         }
-        #[cfg(test)]
-        super::pass_trace::trace_pass(run.t, run.y, run.limited, run.t_end);
+        trace_pass(run.t, run.y, run.limited, run.t_end);
         if run.t < run.t_end {
             return Err(too_many_switches());
         }
