@@ -207,7 +207,8 @@ const EXPONENTIAL_ROUNDING: f64 = 2e-15;
 #[cfg(test)]
 thread_local! {
     /// Test-only: the general exponential everywhere, to compare the two.
-    pub(super) static CLOSED_FORM_OFF: std::cell::Cell<bool> = const { std::cell::Cell::new(false) };
+    pub(super) static CLOSED_FORM_OFF: std::cell::Cell<bool> =
+        const { std::cell::Cell::new(false) };
 }
 
 /// For a locked rotor (its rows of `J` and `f` vanish, so only the onion's block acts), the

@@ -210,8 +210,8 @@ impl Motor {
     /// piece of constant drive (a "segment") is advanced by one of:
     /// - the overdamped settle ([`Self::settle_rotor`]) when the segment is longer than 10 rotor
     ///   relaxation times and the rotor ends it within `long_steps.rs`'s `MAX_SETTLE_RESIDUAL`
-    ///   of its equilibrium, on the exponential tail (agrees with resolved integration within 3e-7 rad
-    ///   for the default schedule), at the cost of one substep;
+    ///   of its equilibrium, on the exponential tail (agrees with resolved integration within
+    ///   3e-7 rad for the default schedule), at the cost of one substep;
     /// - otherwise exponential substeps sized by the embedded (or step-doubling) error estimate
     ///   (growth and shrink at most 5x per substep). The minimum substep is `remaining time / remaining
     ///   budget`, 2^30 times less while more than half the budget is left (so that a short stiff
